@@ -1,0 +1,3 @@
+from robomax_py.cli import main
+
+main()

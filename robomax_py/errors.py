@@ -1,0 +1,40 @@
+"""The only exceptions the package raises.
+
+A user's mistake becomes one of these, carrying a message that names the file, the key path and the
+problem; the CLI prints that message and exits 2. Anything else escaping is a bug in robomax_py.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+class RobomaxError(Exception):
+    """Base of every error robomax_py raises on purpose."""
+
+
+class _LocatedError(RobomaxError):
+    """An error in a file the user wrote, located by file and key path."""
+
+    def __init__(self, file: str | Path | None, key: str | None, problem: str) -> None:
+        self.file = None if file is None else str(file)
+        self.key = key
+        self.problem = problem
+        parts = [p for p in (self.file, key) if p]
+        super().__init__(": ".join([*parts, problem]))
+
+
+class CellFileError(_LocatedError):
+    """A cell file (or a file it names) is malformed."""
+
+
+class RobotModelError(_LocatedError):
+    """A robot.yaml, tool.yaml, URDF or mesh cannot be used."""
+
+
+class ProgramError(_LocatedError):
+    """A robot program file cannot be parsed; `key` holds 'line L, column C'."""
+
+
+class ExportError(RobomaxError):
+    """A plan cannot be written in the requested format."""

@@ -1,0 +1,92 @@
+"""Shapes and meshes -> coal collision geometry.
+
+Convex hulls are built with `coal.Convex.convexHull` from trimesh's hull vertices: coal 3.0.3's
+`BVHModel.buildConvexRepresentation` has reported clearance between meshes that overlap. A mesh is
+replaced by convex pieces only when each piece *is* convex (hull volume equals piece volume);
+otherwise it stays an exact BVH, so a shortcut never changes a collision answer.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import coal
+import numpy as np
+import trimesh
+
+from robomax_py.spec import Box, Capsule, Cylinder, MeshShape, Shape, Sphere
+
+# Relative volume difference below which a closed piece counts as convex (mesh tessellation noise).
+CONVEX_VOLUME_RTOL = 1e-6
+
+
+def load_mesh(path: Path, scale: np.ndarray | None = None) -> trimesh.Trimesh:
+    """Any format trimesh reads, flattened into one triangle mesh (scene graphs concatenated)."""
+    loaded = trimesh.load(str(path), force="mesh", process=True)
+    if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
+        raise ValueError("no triangles in file")
+    if scale is not None and not np.allclose(scale, 1.0):
+        loaded.apply_scale(np.asarray(scale, dtype=float))
+    return loaded
+
+
+def convex_hull_shape(vertices: np.ndarray) -> coal.ConvexBase:
+    """coal convex polytope of the hull of a point set (m)."""
+    hull = trimesh.convex.convex_hull(np.asarray(vertices, dtype=float))
+    points = coal.StdVec_Vec3s()
+    for p in np.asarray(hull.vertices, dtype=float):
+        points.append(p)
+    return coal.Convex.convexHull(points, False, None)
+
+
+def bvh_shape(mesh: trimesh.Trimesh) -> coal.BVHModelOBBRSS:
+    """Exact triangle-soup collision model of a mesh."""
+    bvh = coal.BVHModelOBBRSS()
+    bvh.beginModel(len(mesh.faces), len(mesh.vertices))
+    bvh.addVertices(np.ascontiguousarray(mesh.vertices, dtype=float))
+    bvh.addTriangles(np.ascontiguousarray(mesh.faces, dtype=np.int64))
+    bvh.endModel()
+    return bvh
+
+
+def is_convex_piece(piece: trimesh.Trimesh) -> bool:
+    if not piece.is_watertight or piece.volume <= 0:
+        return False
+    hull_volume = piece.convex_hull.volume
+    return abs(hull_volume - piece.volume) <= CONVEX_VOLUME_RTOL * hull_volume + 1e-12
+
+
+def mesh_collision_shapes(mesh: trimesh.Trimesh) -> list[coal.CollisionGeometry]:
+    """Convex pieces when the mesh is a set of closed convex shells, else one exact BVH."""
+    pieces = mesh.split(only_watertight=False)
+    if len(pieces) > 0 and all(is_convex_piece(p) for p in pieces):
+        return [convex_hull_shape(p.vertices) for p in pieces]
+    return [bvh_shape(mesh)]
+
+
+def primitive_shape(shape: Shape) -> coal.CollisionGeometry:
+    """coal geometry of a SPEC §3 primitive, centred on its local frame, axis z."""
+    if isinstance(shape, Box):
+        return coal.Box(*shape.extents)
+    if isinstance(shape, Cylinder):
+        return coal.Cylinder(shape.radius, shape.length)
+    if isinstance(shape, Sphere):
+        return coal.Sphere(shape.radius)
+    if isinstance(shape, Capsule):
+        return coal.Capsule(shape.radius, shape.length)
+    raise TypeError(f"not a primitive: {shape!r}")
+
+
+def shape_trimesh(shape: Shape) -> trimesh.Trimesh:
+    """A triangle mesh of any shape in its local frame (for previews and exact-answer tests)."""
+    if isinstance(shape, Box):
+        return trimesh.creation.box(extents=shape.extents)
+    if isinstance(shape, Cylinder):
+        return trimesh.creation.cylinder(radius=shape.radius, height=shape.length, sections=48)
+    if isinstance(shape, Sphere):
+        return trimesh.creation.icosphere(subdivisions=3, radius=shape.radius)
+    if isinstance(shape, Capsule):
+        return trimesh.creation.capsule(height=shape.length, radius=shape.radius, count=[48, 24])
+    if isinstance(shape, MeshShape):
+        return load_mesh(shape.path)
+    raise TypeError(f"unknown shape: {shape!r}")

@@ -1,0 +1,137 @@
+"""Frozen, checked descriptions of robots, tools and cells, in SI units (m, rad, s).
+
+`cell_io` builds these from files and is the only module that knows file keys or file units; every
+other module reads these values. Arrays held here are read-only copies.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+
+
+def frozen_array(values: Any) -> FloatArray:
+    """A float64 copy that cannot be written to, so frozen specs stay frozen."""
+    arr = np.array(values, dtype=float)
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RobotSpec:
+    """A robot.yaml, checked. Velocity and position limits live in the URDF."""
+
+    name: str
+    source: Path                      # the robot.yaml
+    urdf: Path
+    flange: str                       # URDF frame the tool mounts on
+    ik_solver: str                    # "opw" | "ur" | "numeric"
+    ik_params: Any                    # typed params from robomax_py.ik.params_from_mapping
+    acceleration: FloatArray | None   # (n,) rad/s^2, None: derived from velocity limits
+    jerk: FloatArray | None           # (n,) rad/s^3, None: derived from acceleration limits
+    payload_kg: float | None = None   # rated payload, for listings only
+    description: str = ""
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ToolSpec:
+    """A tool.yaml, checked: meshes in the flange frame, TCP pose in the flange frame."""
+
+    name: str
+    source: Path
+    body: Path
+    tips: Path
+    T_flange_tcp: FloatArray          # (4, 4)
+
+
+@dataclass(frozen=True, slots=True)
+class Box:
+    extents: tuple[float, float, float]       # full side lengths, m
+
+
+@dataclass(frozen=True, slots=True)
+class Cylinder:
+    radius: float
+    length: float                             # along local z, m
+
+
+@dataclass(frozen=True, slots=True)
+class Sphere:
+    radius: float
+
+
+@dataclass(frozen=True, slots=True)
+class Capsule:
+    radius: float
+    length: float                             # cylindrical part along local z; caps add radius each end
+
+
+@dataclass(frozen=True, slots=True)
+class MeshShape:
+    path: Path
+
+
+Shape = Box | Cylinder | Sphere | Capsule | MeshShape
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ObjectSpec:
+    """A static obstacle, or a dynamic one when `present` is not None."""
+
+    name: str
+    shape: Shape
+    T_world_object: FloatArray                # (4, 4)
+    workpiece: bool = False
+    # Time windows (s from program start) in which a dynamic obstacle exists; None: always.
+    present: tuple[tuple[float, float], ...] | None = None
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SpotSpec:
+    name: str
+    xyz: FloatArray                           # (3,) world, m
+    normal: FloatArray                        # (3,) unit, outward: the moving electrode's side
+    direction: FloatArray                     # (3,) unit, orthogonal to normal
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SeamSpec:
+    name: str
+    ordered: bool
+    alpha_max: float                          # rad, |alpha| <= alpha_max
+    beta_max: float                           # rad
+    gamma_range: tuple[float, float]          # rad, min <= max
+    grid: int                                 # samples per angle, ends included
+    spots: tuple[SpotSpec, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class ProcessSpec:
+    weld_time: float = 0.5                    # s
+    approach: float = 0.03                    # m, along the electrode axis
+    clearance: float = 0.0                    # m, safety margin to obstacles
+
+
+@dataclass(frozen=True, slots=True)
+class PlannerSpec:
+    seed: int = 0
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class CellSpec:
+    name: str
+    source: Path
+    robot: RobotSpec
+    T_world_base: FloatArray                  # (4, 4)
+    home: FloatArray                          # (n,) rad (m for prismatic joints)
+    tool: ToolSpec
+    objects: tuple[ObjectSpec, ...]
+    seams: tuple[SeamSpec, ...]
+    process: ProcessSpec = field(default_factory=ProcessSpec)
+    planner: PlannerSpec = field(default_factory=PlannerSpec)
+    dynamic: tuple[ObjectSpec, ...] = ()
