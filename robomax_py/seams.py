@@ -1,0 +1,103 @@
+"""Seams x orientation grid -> candidate TCP poses (SPEC §3 "Spot frame and tolerance angles").
+
+For a spot with outward normal n and seam direction d the nominal TCP frame has z = -n (the electrode
+closes into the sheet), x = d orthogonal to n, y = z x x. A candidate orientation is
+R = R_nominal · Rx(alpha) · Ry(beta) · Rz(gamma).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.spec import SeamSpec, SpotSpec
+from robomax_py.transforms import rot_x, rot_y, rot_z
+
+# Two grid orientations closer than this (rad) are the same (gamma = -180 and +180 deg, say).
+SAME_ORIENTATION_RAD = 1e-9
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class OrientationGrid:
+    """The distinct orientations of a seam's tolerance grid, in grid order.
+
+    angles : (m, 3) float, rad — (alpha, beta, gamma) of each distinct orientation
+    R_offset : (m, 3, 3) float — Rx(alpha) Ry(beta) Rz(gamma)
+    """
+
+    angles: FloatArray
+    R_offset: FloatArray
+
+    def __len__(self) -> int:
+        return len(self.angles)
+
+
+def axis_samples(lo: float, hi: float, grid: int) -> FloatArray:
+    """`grid` evenly spaced values from lo to hi, ends included; one value for an empty range."""
+    if hi - lo <= SAME_ORIENTATION_RAD or grid == 1:
+        return np.array([(lo + hi) / 2.0]) if grid == 1 else np.array([lo])
+    return np.linspace(lo, hi, grid)
+
+
+def orientation_grid(seam: SeamSpec) -> OrientationGrid:
+    """grid^3 samples of (alpha, beta, gamma), duplicate rotations removed (first kept).
+
+    The nominal orientation (0, 0, 0) is first when the grid contains it, so stable tie-breaking
+    prefers it.
+    """
+    alphas = axis_samples(-seam.alpha_max, seam.alpha_max, seam.grid)
+    betas = axis_samples(-seam.beta_max, seam.beta_max, seam.grid)
+    gammas = axis_samples(seam.gamma_range[0], seam.gamma_range[1], seam.grid)
+    combos = np.array([(a, b, g) for a in alphas for b in betas for g in gammas])
+    # Order by distance from nominal so that ties between equally good orientations resolve
+    # towards the nominal one (the published baseline's choice); stable for equal distances.
+    order = np.argsort(np.abs(combos).sum(axis=1), kind="stable")
+    combos = combos[order]
+    kept_angles: list[FloatArray] = []
+    kept_R: list[FloatArray] = []
+    for a, b, g in combos:
+        R = rot_x(a) @ rot_y(b) @ rot_z(g)
+        if any(np.abs(R - other).max() < SAME_ORIENTATION_RAD for other in kept_R):
+            continue
+        kept_angles.append(np.array([a, b, g]))
+        kept_R.append(R)
+    return OrientationGrid(angles=np.array(kept_angles), R_offset=np.array(kept_R))
+
+
+def nominal_rotation(spot: SpotSpec) -> FloatArray:
+    """(3, 3) nominal TCP orientation at a spot, world frame."""
+    z = -np.asarray(spot.normal, dtype=float)
+    x = np.asarray(spot.direction, dtype=float)
+    x = x - np.dot(x, z) * z
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    return np.column_stack([x, y, z])
+
+
+def spot_poses(spots: tuple[SpotSpec, ...], grid: OrientationGrid) -> FloatArray:
+    """Candidate TCP poses in the world frame.
+
+    Returns
+    -------
+    (n_spot, m, 4, 4) float
+        T_world_tcp for every spot and every distinct grid orientation, metres.
+    """
+    out = np.zeros((len(spots), len(grid), 4, 4))
+    for i, spot in enumerate(spots):
+        out[i, :, :3, :3] = nominal_rotation(spot) @ grid.R_offset
+        out[i, :, :3, 3] = spot.xyz
+        out[i, :, 3, 3] = 1.0
+    return out
+
+
+def approach_poses(T_world_tcp: FloatArray, approach: float) -> FloatArray:
+    """Poses `approach` metres along +TCP z from each spot pose, (..., 4, 4).
+
+    The gun arrives from (and leaves to) the fixed electrode's side: with the moving electrode open,
+    a C-gun moved along -z towards the sheet never passes an electrode through the sheet.
+    """
+    out = np.array(T_world_tcp, dtype=float, copy=True)
+    out[..., :3, 3] += approach * out[..., :3, 2]
+    return out

@@ -1,0 +1,342 @@
+"""Choosing the spot order and one candidate per spot so that the total cycle time is least.
+
+This is a generalised travelling-salesman problem over a layered graph: spots are layers, candidate
+configurations are nodes, and an edge costs the motion time between two nodes. For a fixed spot
+order the best candidates follow exactly by dynamic programming (min-plus products along the
+layers); the order itself is improved by local search (Or-opt, 2-opt and seam moves) whose moves
+are screened with a spot-level lower bound before the exact DP judges them. `exact_tour` enumerates
+every admissible order, for checking the search on small instances.
+
+Nothing here knows geometry: costs come from an `EdgeCosts` callable, so the planner can make
+blocked edges expensive, add detours, and ask again.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+
+HOME = -1  # the start/end configuration, a layer of one node
+# Consecutive perturbations that found no unseen order before the search gives up.
+MAX_STALE_KICKS = 50
+
+# cost(i, j) -> (N_i, N_j) float: motion time from every candidate of spot i to every candidate of
+# spot j (HOME has one candidate). Must be deterministic; the optimiser caches what it asks for.
+EdgeCosts = Callable[[int, int], FloatArray]
+
+
+@dataclass(frozen=True, slots=True)
+class SeamBlock:
+    """A seam's spots (global spot ids) in their given order; `ordered` fixes that order."""
+
+    spots: tuple[int, ...]
+    ordered: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Tour:
+    """A visiting order (global spot ids) and the chosen candidate index at each visited spot."""
+
+    order: tuple[int, ...]
+    choice: tuple[int, ...]
+    cost: float                # s: sum of edge costs (home -> ... -> home) plus node costs
+
+
+@dataclass(frozen=True, slots=True)
+class SearchStats:
+    dp_evaluations: int
+    moves_screened: int
+    improvements: int
+
+
+class _Costs:
+    """Caches edge-cost matrices (float64) and spot-level lower bounds."""
+
+    def __init__(self, edge: EdgeCosts, node: Sequence[FloatArray]) -> None:
+        self._edge = edge
+        self.node = [np.asarray(c, dtype=float) for c in node]
+        self._cache: dict[tuple[int, int], FloatArray] = {}
+        self._bounds: dict[tuple[int, int], float] = {}
+        self.node_min = [float(np.min(c)) for c in self.node]
+
+    def __call__(self, i: int, j: int) -> FloatArray:
+        key = (i, j)
+        got = self._cache.get(key)
+        if got is None:
+            got = np.asarray(self._edge(i, j), dtype=float)
+            self._cache[key] = got
+        return got
+
+    def lower_bound(self, i: int, j: int) -> float:
+        got = self._bounds.get((i, j))
+        if got is None:
+            got = self._bounds[(i, j)] = float(np.min(self(i, j)))
+        return got
+
+    def bound_matrix(self, spots: Sequence[int]) -> FloatArray:
+        """(S+1, S+1) min edge cost between spots, index S standing for HOME; spots are 0..S-1."""
+        ids = [*spots, HOME]
+        out = np.zeros((len(ids), len(ids)))
+        for a, i in enumerate(ids):
+            for b, j in enumerate(ids):
+                if i != j or i == HOME:
+                    out[a, b] = self.lower_bound(i, j)
+        return out
+
+
+def best_choice(order: Sequence[int], costs: _Costs) -> tuple[tuple[int, ...], float]:
+    """Exact best candidate per spot for a fixed order, by DP over the layers.
+
+    Ties are broken towards the lowest candidate index, so results are deterministic.
+    """
+    if not order:
+        return (), float(costs(HOME, HOME)[0, 0])
+    value = costs(HOME, order[0])[0] + costs.node[order[0]]
+    back: list[np.ndarray] = []
+    for prev, nxt in zip(order[:-1], order[1:]):
+        total = value[:, None] + costs(prev, nxt)           # (N_prev, N_next)
+        arg = np.argmin(total, axis=0)
+        value = total[arg, np.arange(total.shape[1])] + costs.node[nxt]
+        back.append(arg)
+    final = value + costs(order[-1], HOME)[:, 0]
+    last = int(np.argmin(final))
+    best = float(final[last])
+    choice = [last]
+    for arg in reversed(back):
+        choice.append(int(arg[choice[-1]]))
+    return tuple(reversed(choice)), best
+
+
+# A tour under construction: seams in visiting order, each (seam id, its spots in visiting order).
+Blocks = list[tuple[int, tuple[int, ...]]]
+
+
+def _flatten(blocks: Blocks) -> tuple[int, ...]:
+    return tuple(s for _, block in blocks for s in block)
+
+
+def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> list[Blocks]:
+    """Every order one move away: within free seams Or-opt (1-3 spots) and 2-opt; seam swaps."""
+    out: list[Blocks] = []
+    for b, (seam, block) in enumerate(blocks):
+        if ordered[seam] or len(block) < 2:
+            continue
+        n = len(block)
+        for i in range(n):                                   # 2-opt: reverse block[i:j]
+            for j in range(i + 2, n + 1):
+                new = block[:i] + block[i:j][::-1] + block[j:]
+                if new != block:
+                    out.append(blocks[:b] + [(seam, new)] + blocks[b + 1:])
+        for length in (1, 2, 3):                             # Or-opt: move a run elsewhere
+            for i in range(n - length + 1):
+                run = block[i:i + length]
+                rest = block[:i] + block[i + length:]
+                for k in range(len(rest) + 1):
+                    if k == i:
+                        continue
+                    for piece in (run, run[::-1]) if length > 1 else (run,):
+                        new = rest[:k] + piece + rest[k:]
+                        if new != block:
+                            out.append(blocks[:b] + [(seam, new)] + blocks[b + 1:])
+    for a, b in itertools.combinations(range(len(blocks)), 2):  # seam order
+        swapped = list(blocks)
+        swapped[a], swapped[b] = swapped[b], swapped[a]
+        out.append(swapped)
+    return out
+
+
+def _bound(order: tuple[int, ...], costs: _Costs) -> float:
+    """Spot-level lower bound of an order's cost (min edge per pair, min node per spot)."""
+    stops = (HOME, *order, HOME)
+    edges = sum(costs.lower_bound(a, b) for a, b in zip(stops[:-1], stops[1:]))
+    return edges + sum(costs.node_min[s] for s in order)
+
+
+def _bounds(orders: Sequence[tuple[int, ...]], bound: FloatArray, home: int) -> FloatArray:
+    """`_bound` of many same-length orders at once; `bound` from `_Costs.bound_matrix`.
+
+    Node minima are the same for every permutation of the same spots, so they are left out: the
+    result ranks orders correctly but is a bound only after adding them back.
+    """
+    arr = np.asarray(orders, dtype=np.int64)
+    padded = np.concatenate([np.full((len(arr), 1), home), arr, np.full((len(arr), 1), home)], axis=1)
+    return bound[padded[:, :-1], padded[:, 1:]].sum(axis=1)
+
+
+def optimise(
+    blocks: Sequence[SeamBlock],
+    edge: EdgeCosts,
+    node: Sequence[FloatArray],
+    rng: np.random.Generator | None = None,
+    max_evaluations: int = 600,
+    screen: int = 12,
+    exact_limit: int = 720,
+) -> tuple[Tour, SearchStats]:
+    """Best tour: exact when few orders are admissible, else construction + iterated local search.
+
+    With at most `exact_limit` admissible orders every one is evaluated by DP (exact). Otherwise the
+    search starts from the given order, the given order with free seams reversed, and a
+    candidate-aware cheapest-insertion construction; each start is improved by local search
+    (neighbours tried in order of their spot-level lower bound, the first improvement taken; after
+    the `screen` most promising, only those whose bound beats the current cost),
+    then the best tour is perturbed (a random segment of a free seam reversed and moved) and
+    improved again until `max_evaluations` DP evaluations are spent. Deterministic for a given rng.
+    """
+    rng = rng if rng is not None else np.random.default_rng(0)
+    costs = _Costs(edge, node)
+    if _count_orders(blocks) <= exact_limit:
+        tour = _exact(blocks, costs)
+        n = _count_orders(blocks)
+        return tour, SearchStats(dp_evaluations=n, moves_screened=n, improvements=0)
+
+    ordered = [b.ordered for b in blocks]   # by seam id (= index in `blocks`)
+    all_spots = sorted(s for b in blocks for s in b.spots)
+    if all_spots != list(range(len(all_spots))):
+        raise ValueError("spot ids must be 0..S-1")  # an internal contract, not user input
+    bound = costs.bound_matrix(all_spots)
+    home_index = len(all_spots)
+    node_total = sum(costs.node_min)
+    counter = {"evaluations": 0, "screened": 0, "improvements": 0}
+    seen: dict[tuple[int, ...], float] = {}
+
+    def evaluate(candidate: Blocks) -> float:
+        flat = _flatten(candidate)
+        if flat not in seen:
+            counter["evaluations"] += 1
+            seen[flat] = best_choice(flat, costs)[1]
+        return seen[flat]
+
+    def descend(start: Blocks) -> tuple[Blocks, float]:
+        current, current_cost = start, evaluate(start)
+        while counter["evaluations"] < max_evaluations:
+            options = _neighbours(current, ordered)
+            if not options:
+                break
+            counter["screened"] += len(options)
+            bounds = _bounds([_flatten(c) for c in options], bound, home_index) + node_total
+            ranked = np.argsort(bounds, kind="stable").tolist()
+            improved = False
+            for rank, idx in enumerate(ranked):
+                # Past the `screen` most promising moves, a neighbour whose lower bound does not
+                # beat the current cost cannot improve it (and nor can any later one).
+                if counter["evaluations"] >= max_evaluations or (
+                    rank >= screen and bounds[idx] >= current_cost - 1e-9
+                ):
+                    break
+                value = evaluate(options[idx])
+                if value < current_cost - 1e-9:
+                    current, current_cost, improved = options[idx], value, True
+                    counter["improvements"] += 1
+                    break
+            if not improved:
+                break
+        return current, current_cost
+
+    starts: list[Blocks] = [
+        [(i, b.spots) for i, b in enumerate(blocks)],
+        [(i, b.spots if b.ordered else b.spots[::-1]) for i, b in enumerate(blocks)],
+        _insertion_start(blocks, costs),
+    ]
+    best, best_cost = min((descend(s) for s in starts), key=lambda pair: pair[1])
+    can_kick = len(blocks) > 1 or any(not b.ordered and len(b.spots) >= 3 for b in blocks)
+    # Kicks that only revisit known orders spend no budget; they grow stronger, and are capped so
+    # the search always ends.
+    stale = kicks = 0
+    while (counter["evaluations"] < max_evaluations and can_kick and stale < MAX_STALE_KICKS
+           and kicks < 3 * max_evaluations):
+        kicks += 1
+        before = counter["evaluations"]
+        kicked = best
+        for _ in range(1 + stale // 5):
+            kicked = _perturb(kicked, ordered, rng)
+        cand, cand_cost = descend(kicked)
+        stale = stale + 1 if counter["evaluations"] == before else 0
+        if cand_cost < best_cost - 1e-9:
+            best, best_cost = cand, cand_cost
+    flat = _flatten(best)
+    choice, cost = best_choice(flat, costs)
+    stats = SearchStats(counter["evaluations"], counter["screened"], counter["improvements"])
+    return Tour(flat, choice, cost), stats
+
+
+def _insertion_start(blocks: Sequence[SeamBlock], costs: _Costs) -> Blocks:
+    """Cheapest insertion, spot by spot, judged by the spot-level bound (no DP: it is a start)."""
+    out: Blocks = []
+    for seam, block in enumerate(blocks):
+        if block.ordered or len(block.spots) <= 2:
+            out.append((seam, block.spots))
+            continue
+        tour: list[int] = [block.spots[0]]
+        for spot in block.spots[1:]:
+            options = [tuple(tour[:k] + [spot] + tour[k:]) for k in range(len(tour) + 1)]
+            best = min(options, key=lambda o: _bound(_flatten([*out, (seam, o)]), costs))
+            tour = list(best)
+        out.append((seam, tuple(tour)))
+    return out
+
+
+def _perturb(blocks: Blocks, ordered: Sequence[bool], rng: np.random.Generator) -> Blocks:
+    """A random kick: move a random run of a free seam elsewhere, reversed; or swap two seams."""
+    out = list(blocks)
+    free = [b for b, (seam, spots) in enumerate(out) if not ordered[seam] and len(spots) >= 3]
+    if free and (len(out) < 2 or rng.random() < 0.8):
+        b = free[int(rng.integers(len(free)))]
+        seam, block = out[b]
+        n = len(block)
+        i = int(rng.integers(n))
+        j = int(rng.integers(i + 1, n + 1))
+        run, rest = block[i:j][::-1], block[:i] + block[j:]
+        k = int(rng.integers(len(rest) + 1))
+        out[b] = (seam, rest[:k] + run + rest[k:])
+    elif len(out) >= 2:
+        a, c = rng.choice(len(out), size=2, replace=False)
+        out[a], out[c] = out[c], out[a]
+    return out
+
+
+def _count_orders(blocks: Sequence[SeamBlock]) -> int:
+    count = 1
+    for i, b in enumerate(blocks, start=1):
+        count *= i * (1 if b.ordered else _factorial(len(b.spots)))
+    return count
+
+
+def _factorial(n: int) -> int:
+    out = 1
+    for k in range(2, n + 1):
+        out *= k
+        if out > 10**9:
+            return out
+    return out
+
+
+def admissible_orders(blocks: Sequence[SeamBlock]) -> list[tuple[int, ...]]:
+    """Every order the constraints allow: seams contiguous, ordered seams in their given order."""
+    per_block = [
+        [b.spots] if b.ordered else list(itertools.permutations(b.spots)) for b in blocks
+    ]
+    orders: list[tuple[int, ...]] = []
+    for seam_order in itertools.permutations(range(len(blocks))):
+        for inner in itertools.product(*(per_block[b] for b in seam_order)):
+            orders.append(tuple(s for part in inner for s in part))
+    return orders
+
+
+def exact_tour(blocks: Sequence[SeamBlock], edge: EdgeCosts, node: Sequence[FloatArray]) -> Tour:
+    """The optimum by enumerating admissible orders (each with exact DP). Small instances only."""
+    return _exact(blocks, _Costs(edge, node))
+
+
+def _exact(blocks: Sequence[SeamBlock], costs: _Costs) -> Tour:
+    best: Tour | None = None
+    for order in admissible_orders(blocks):
+        choice, cost = best_choice(order, costs)
+        if best is None or cost < best.cost - 1e-12:
+            best = Tour(order, choice, cost)
+    assert best is not None  # admissible_orders always yields at least one order
+    return best
