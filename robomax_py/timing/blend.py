@@ -1,0 +1,219 @@
+"""Fly-by corners made of quintic Bézier curves, G2 with the straight legs they join.
+
+A corner p_prev -> c -> p_next is replaced, within distance r of c, by the quintic Bézier with
+control points
+
+    P0 = c - r d_in,  P1 = c - r/2 d_in,  P2 = P3 = c,  P4 = c + r/2 d_out,  P5 = c + r d_out
+
+(d_in, d_out the unit leg directions) on a parameter interval of length h = 5 r / 2. Then
+B'(0) = d_in and B'(h) = d_out (unit speed, as on the arc-length lines) and B''(0) = B''(h) = 0
+(P0, P1, P2 and P3, P4, P5 are equally spaced on the legs). The lines therefore join the curve
+with continuous first and second derivatives: the path is C2 in s and G2 (curvature continuous,
+zero at the joins), so toppra can time it without stopping and with bounded joint acceleration.
+All control points lie within r of c, so by the convex-hull property the whole curve does too; it
+lies in the plane of the two legs, inside the joint limits whenever the legs are.
+
+`blend_join` matches value, first and second derivative of two arbitrary paths the same way (a
+quintic Hermite join), for fly-by between consecutive motions that are not straight lines (e.g.
+the end of a Cartesian retract into the next joint move).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.spec import frozen_array
+from robomax_py.timing._common import ZERO_MOVE, TimingError
+from robomax_py.timing.paths import PATH_JOIN_TOL, GeometricPath, concatenate_paths, distinct_waypoints, elevate
+
+# Turning angles above this (rad) are not blended: near a reversal the corner curve would have to
+# turn on the spot; the move stops at the waypoint instead.
+MAX_BLEND_TURN_RAD = np.deg2rad(175.0)
+# Corners smaller than this (rad) stay sharp: their curve would be shorter than round-off allows.
+MIN_BLEND_RADIUS = 1e-6
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class BlendCorner:
+    """A fly-by corner: a quintic Bézier from c - r d_in to c + r d_out (see the module docstring).
+
+    control_points : (6, n) float, rad
+    radius : float
+        The r used (the requested radius, clipped to the legs), rad; the curve lies within it of c.
+    param_length : float
+        h = 5 r / 2: the curve's parameter interval, on which its speed is 1 at both ends.
+    turn : float
+        Angle between the legs' directions, rad (0 = straight on).
+    """
+
+    control_points: FloatArray
+    radius: float
+    param_length: float
+    turn: float
+
+    @property
+    def path(self) -> GeometricPath:
+        """The corner as a one-piece path over [0, param_length]."""
+        return GeometricPath(breaks=np.array([0.0, self.param_length]), control_points=self.control_points[None])
+
+    def sample(self, count: int) -> FloatArray:
+        """(count, n) points at equal steps of the curve parameter, ends included."""
+        return self.path(np.linspace(0.0, self.param_length, max(2, count)))
+
+
+def blend_corner(p_prev: FloatArray, p_corner: FloatArray, p_next: FloatArray, radius: float) -> BlendCorner:
+    """The quintic G2 corner replacing p_prev -> p_corner -> p_next within `radius` of p_corner.
+
+    Parameters
+    ----------
+    p_prev, p_corner, p_next : (n,) float
+        Polyline points, rad (any n >= 1; works as well for Cartesian points in m).
+    radius : float
+        Largest distance from p_corner at which the curve leaves the legs, >= MIN_BLEND_RADIUS;
+        clipped to the length of either leg.
+
+    Returns
+    -------
+    BlendCorner
+        Joins the legs with matching position, unit tangent and zero curvature at both ends.
+
+    Raises
+    ------
+    TimingError
+        For a zero-length leg or a reversal (turn > MAX_BLEND_TURN_RAD), which cannot be blended.
+    """
+    a, c, b = (np.asarray(p, dtype=float).reshape(-1) for p in (p_prev, p_corner, p_next))
+    len_in, len_out = float(np.linalg.norm(c - a)), float(np.linalg.norm(b - c))
+    if len_in <= ZERO_MOVE or len_out <= ZERO_MOVE:
+        raise TimingError("cannot blend a corner with a zero-length leg")
+    d_in, d_out = (c - a) / len_in, (b - c) / len_out
+    turn = float(np.arccos(np.clip(d_in @ d_out, -1.0, 1.0)))
+    if turn > MAX_BLEND_TURN_RAD:
+        raise TimingError(f"cannot blend a corner turning by {np.rad2deg(turn):.1f} deg (a reversal)")
+    r = float(min(radius, len_in, len_out))
+    if not r >= MIN_BLEND_RADIUS:
+        raise TimingError(f"blend radius must be >= {MIN_BLEND_RADIUS} (and the legs as long), got {radius}")
+    P = np.stack([c - r * d_in, c - 0.5 * r * d_in, c, c, c + 0.5 * r * d_out, c + r * d_out])
+    return BlendCorner(control_points=frozen_array(P), radius=r, param_length=2.5 * r, turn=turn)
+
+
+def blended_polyline_path(waypoints: FloatArray, radius: float | FloatArray) -> tuple[GeometricPath, FloatArray]:
+    """Polyline with G2 quintic corners at the interior waypoints.
+
+    Parameters
+    ----------
+    waypoints : (m, n) float
+        rad; consecutive duplicates are dropped.
+    radius : float or (m,) float
+        Largest corner size per (distinct) waypoint, rad; entries for the two ends are ignored.
+        Each corner uses min(radius, half of either adjacent leg), so neighbouring corners never
+        overlap; corners below MIN_BLEND_RADIUS or turning above MAX_BLEND_TURN_RAD stay sharp (the path has
+        a kink there, where a timed move stops).
+
+    Returns
+    -------
+    path : GeometricPath
+        s is arc length on the straight parts and the Bézier parameter (h = 5 r / 2) in corners.
+    radii : (m,) float
+        Corner radius used at each distinct waypoint (0 at the ends and at sharp corners), rad.
+    """
+    w = distinct_waypoints(waypoints)
+    m = len(w)
+    r_req = np.full(m, float(radius)) if np.ndim(radius) == 0 else np.asarray(radius, dtype=float)
+    if r_req.shape != (m,):
+        raise TimingError(f"radius must be a number or one per distinct waypoint ({m}), got shape {r_req.shape}")
+    legs = np.linalg.norm(np.diff(w, axis=0), axis=1)
+    radii = np.zeros(m)
+    corners: dict[int, BlendCorner] = {}
+    for i in range(1, m - 1):
+        r = min(float(r_req[i]), 0.5 * legs[i - 1], 0.5 * legs[i])
+        d_in, d_out = (w[i] - w[i - 1]) / legs[i - 1], (w[i + 1] - w[i]) / legs[i]
+        if r < MIN_BLEND_RADIUS or np.arccos(np.clip(d_in @ d_out, -1.0, 1.0)) > MAX_BLEND_TURN_RAD:
+            continue
+        corners[i] = blend_corner(w[i - 1], w[i], w[i + 1], r)
+        radii[i] = corners[i].radius
+    pieces: list[FloatArray] = []
+    lengths: list[float] = []
+    point = w[0]
+    for i in range(1, m):
+        end = corners[i].control_points[0] if i in corners else w[i]
+        if np.linalg.norm(end - point) > ZERO_MOVE:
+            pieces.append(elevate(np.stack([point, end]), 5))
+            lengths.append(float(np.linalg.norm(end - point)))
+        if i in corners:
+            pieces.append(np.asarray(corners[i].control_points))
+            lengths.append(corners[i].param_length)
+            point = corners[i].control_points[-1]
+        else:
+            point = w[i]
+    path = GeometricPath(breaks=np.concatenate([[0.0], np.cumsum(lengths)]), control_points=np.stack(pieces))
+    return path, radii
+
+
+def blend_join(first: GeometricPath, second: GeometricPath, radius: float) -> GeometricPath:
+    """Fly-by from `first` into `second` (which starts where `first` ends), C2 in the parameter.
+
+    The last part of `first` and the first part of `second` within joint-space distance `radius`
+    of their meeting point (at most half of either path's parameter range) are replaced by a
+    quintic matching position, first and second derivative of both paths at the cut points. For
+    two straight paths this is exactly `blend_corner`. The join's control points lie within
+    `radius` of the meeting point up to the paths' second derivatives at the cuts times h^2 / 20,
+    so near-straight paths keep the curve within about `radius` of the meeting point.
+
+    Returns
+    -------
+    GeometricPath
+        first[0, s_a] + join + second[s_b, end], s continuing across the pieces; time it with
+        `time_path` (rest at both ends, no stop at the join).
+    """
+    if float(np.max(np.abs(second.start - first.end))) > PATH_JOIN_TOL:
+        raise TimingError("blend_join: the second path must start where the first ends")
+    if not radius >= MIN_BLEND_RADIUS:
+        raise TimingError(f"blend radius must be >= {MIN_BLEND_RADIUS}, got {radius}")
+    corner = first.end
+    s_a = _cut_at_distance(first, corner, radius, from_end=True)
+    s_b = _cut_at_distance(second, corner, radius, from_end=False)
+    p0, d0, dd0 = first(s_a), first(s_a, 1), first(s_a, 2)
+    p5, d5, dd5 = second(s_b), second(s_b, 1), second(s_b, 2)
+    r_used = max(float(np.linalg.norm(p0 - corner)), float(np.linalg.norm(p5 - corner)))
+    speed = max(float(np.linalg.norm(d0)), float(np.linalg.norm(d5)), 1e-12)
+    h = 2.5 * r_used / speed
+    P = np.stack([
+        p0,
+        p0 + h / 5 * d0,
+        p0 + 2 * h / 5 * d0 + h * h / 20 * dd0,
+        p5 - 2 * h / 5 * d5 + h * h / 20 * dd5,
+        p5 - h / 5 * d5,
+        p5,
+    ])
+    parts = [first.restrict(0.0, s_a)] if s_a > 0 else []
+    parts.append(GeometricPath(breaks=np.array([0.0, h]), control_points=P[None]))
+    if s_b < second.length:
+        parts.append(second.restrict(s_b, second.length))
+    return concatenate_paths(parts)
+
+
+def _cut_at_distance(path: GeometricPath, point: FloatArray, radius: float, *, from_end: bool) -> float:
+    """s where the path, walked from its end (or start), first gets `radius` away from `point`.
+
+    Limited to the half of the parameter range next to that end.
+    """
+    half = 0.5 * path.length
+    s = path.grid(radius / 16.0)
+    s = s[s >= half][::-1] if from_end else s[s <= half]
+    dist = np.linalg.norm(path(s) - point, axis=1)
+    beyond = np.nonzero(dist >= radius)[0]
+    if len(beyond) == 0:
+        return half
+    k = int(beyond[0])
+    lo, hi = float(s[k - 1]), float(s[k])        # dist(lo) < radius <= dist(hi)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if np.linalg.norm(path(mid) - point) < radius:
+            lo = mid
+        else:
+            hi = mid
+    return hi

@@ -1,0 +1,132 @@
+"""Closed-form minimum times of rest-to-rest joint moves, vectorised for ranking many candidate pairs.
+
+Both estimates come in two flavours:
+
+* ``straight=True`` (default): the time of the straight joint-space line from q0 to q1 with every
+  joint within its limits, which is exactly what `ptp_move` (rest to rest) executes. Along the line
+  q = q0 + s (q1 - q0) the joint limits become scalar limits on s: V = min_j v_j / |dq_j| and alike
+  for acceleration and jerk, so the time is the 1-D profile time with those limits.
+* ``straight=False``: the largest of the joints' independent minimum times. This is a lower bound,
+  and the duration a time-synchronised controller achieves (joints then follow differently shaped
+  profiles, so the joint-space path is not the straight line). It differs from the straight-line
+  time only when one joint limits the velocity and another the acceleration (or jerk).
+
+Formulas are written in the ratios r_v = d / v, r_a = d / a, r_j = d / j (d = |q1 - q0| per joint)
+so that joints that do not move (all ratios zero) need no special case.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.robot import JointLimits
+from robomax_py.timing._common import ZERO_MOVE, scaled_limits
+
+
+def ptp_time_estimate(
+    q0: FloatArray,
+    q1: FloatArray,
+    limits: JointLimits,
+    speed: float = 1.0,
+    *,
+    accel: float = 1.0,
+    straight: bool = True,
+) -> FloatArray:
+    """Minimum rest-to-rest time under velocity and acceleration limits (trapezoidal profiles).
+
+    Parameters
+    ----------
+    q0, q1 : (..., n) float
+        Start and goal configurations, rad (m for prismatic joints); broadcast against each other.
+    limits : JointLimits
+        velocity (n,) rad/s and acceleration (n,) rad/s^2 are used.
+    speed, accel : float
+        Overrides in (0, 1] scaling the velocity and the acceleration limits.
+    straight : bool
+        True: time of the straight joint-space line (what `ptp_move` and toppra on a line achieve);
+        False: max over joints of the independent times (a lower bound).
+
+    Returns
+    -------
+    (...) float
+        Seconds; 0 where q0 == q1.
+    """
+    lim = scaled_limits(limits, speed, accel)
+    d = _distance(q0, q1)
+    r_v = d / lim.velocity
+    r_a = d / lim.acceleration
+    if straight:
+        return _trapezoid_time(np.max(r_v, axis=-1), np.max(r_a, axis=-1))
+    return np.asarray(np.max(_trapezoid_time(r_v, r_a), axis=-1), dtype=float)
+
+
+def jerk_limited_time_estimate(
+    q0: FloatArray,
+    q1: FloatArray,
+    limits: JointLimits,
+    speed: float = 1.0,
+    *,
+    accel: float = 1.0,
+    straight: bool = True,
+) -> FloatArray:
+    """Minimum rest-to-rest time under velocity, acceleration and jerk limits (double-S profiles).
+
+    Parameters and return value as `ptp_time_estimate`; jerk (n,) rad/s^3 is used as well, scaled
+    by `accel`. With ``straight=True`` this equals the duration of `ptp_move(q0, q1, ...)` to
+    round-off (ruckig's 1-D profile is the time-optimal double-S).
+    """
+    lim = scaled_limits(limits, speed, accel)
+    d = _distance(q0, q1)
+    r_v = d / lim.velocity
+    r_a = d / lim.acceleration
+    r_j = d / lim.jerk
+    if straight:
+        return _double_s_time(np.max(r_v, axis=-1), np.max(r_a, axis=-1), np.max(r_j, axis=-1))
+    return np.asarray(np.max(_double_s_time(r_v, r_a, r_j), axis=-1), dtype=float)
+
+
+def _distance(q0: FloatArray, q1: FloatArray) -> FloatArray:
+    """(..., n) |q1 - q0| per joint, with differences of at most ZERO_MOVE counted as none (as the moves do)."""
+    d = np.abs(np.asarray(q1, dtype=float) - np.asarray(q0, dtype=float))
+    return np.where(d > ZERO_MOVE, d, 0.0)
+
+
+def _trapezoid_time(r_v: FloatArray, r_a: FloatArray) -> FloatArray:
+    """Rest-to-rest time over unit distance with V = 1/r_v, A = 1/r_a (s).
+
+    Cruise phase exists iff V^2 / A <= 1, i.e. r_a <= r_v^2: T = 1/V + V/A = r_v + r_a / r_v;
+    otherwise the triangle T = 2 sqrt(1/A) = 2 sqrt(r_a).
+    """
+    r_v = np.asarray(r_v, dtype=float)
+    r_a = np.asarray(r_a, dtype=float)
+    cruise = r_a < r_v * r_v
+    safe_rv = np.where(cruise, r_v, 1.0)
+    return np.where(cruise, r_v + r_a / safe_rv, 2.0 * np.sqrt(r_a))
+
+
+def _double_s_time(r_v: FloatArray, r_a: FloatArray, r_j: FloatArray) -> FloatArray:
+    """Rest-to-rest jerk-limited time over unit distance with V = 1/r_v, A = 1/r_a, J = 1/r_j (s).
+
+    Cases (Biagiotti & Melchiorri, "Trajectory Planning for Automatic Machines and Robots", §3.4):
+    time to reach V from rest Tv = V/A + A/J if V J >= A^2 else 2 sqrt(V/J); if the distance allows
+    (V Tv <= 1) T = Tv + 1/V. Otherwise the peak velocity vp < V: with a constant-acceleration phase
+    (1 >= 2 A^3 / J^2) vp solves vp^2/A + vp A/J = 1 and T = 2 (vp/A + A/J); without it
+    T = 4 (1 / (2 J))^(1/3).
+    """
+    r_v, r_a, r_j = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (r_v, r_a, r_j)))
+    moving = r_v > 0
+    rv = np.where(moving, r_v, 1.0)
+    ra = np.where(moving, r_a, 1.0)
+    rj = np.where(moving, r_j, 1.0)
+    reaches_a = ra * ra >= rv * rj                               # V J >= A^2
+    t_v = np.where(reaches_a, ra / rv + rj / ra, 2.0 * np.sqrt(rj / rv))
+    cruise = t_v <= rv                                           # V Tv <= 1
+    # vp in units of 1/time: vp = (A/2) (-A/J + sqrt(A^2/J^2 + 4/A)), A = 1/ra, J = 1/rj.
+    a_over_j = rj / ra
+    vp = 2.0 / (np.sqrt(a_over_j * a_over_j + 4.0 * ra) + a_over_j)     # the root above, cancellation-free
+    t_acc_phase = 2.0 * (vp * ra + a_over_j)
+    t_no_acc_phase = 4.0 * np.cbrt(rj / 2.0)
+    with_acc_phase = ra**3 >= 2.0 * rj * rj                      # 1 >= 2 A^3 / J^2
+    t = np.where(cruise, t_v + rv, np.where(with_acc_phase, t_acc_phase, t_no_acc_phase))
+    return np.where(moving, t, 0.0)
