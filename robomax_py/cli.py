@@ -79,6 +79,54 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")]) -> Non
     _guarded(run)
 
 
+@app.command()
+def plan(
+    cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
+    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder")] = Path("programs"),
+    baseline: Annotated[bool, typer.Option("--baseline", help="the published method: given order, nominal orientation, first branch")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable report instead of tables")] = False,
+) -> None:
+    """Plan a cell and write its program files (only when the plan is complete and verified)."""
+
+    def run() -> int:
+        import json as _json
+        import time
+
+        from robomax_py.cell_io import load_cell, load_cell_robot
+        from robomax_py.export import EXPORTERS, render
+        from robomax_py.files import write_atomic
+        from robomax_py.plan import PlanOptions, plan_cell
+        from robomax_py.report import plan_report, report_tables
+
+        t0 = time.perf_counter()
+        spec = load_cell(cell)
+        robot = load_cell_robot(spec)
+        result = plan_cell(spec, robot, PlanOptions(baseline=baseline))
+        seconds = time.perf_counter() - t0
+        written: list[Path] = []
+        if result.status == "planned":
+            texts = {fmt: render(result, fmt) for fmt in EXPORTERS}   # all rendered before any write
+            for fmt, text in texts.items():
+                path = out_dir / f"{spec.name}{EXPORTERS[fmt][0]}"
+                write_atomic(path, text)
+                written.append(path)
+        report = plan_report(result, seconds, written)
+        if as_json:
+            out.print_json(_json.dumps(report))
+        else:
+            for renderable in report_tables(report):
+                out.print(renderable)
+        if result.status != "planned":
+            err.print(f"[bold red]infeasible:[/] {result.message}", soft_wrap=True)
+            for f in result.failures:
+                err.print(f"  {f.seam}/{f.name}: {f.reason} ({f.detail})", soft_wrap=True)
+            return EXIT_INFEASIBLE
+        return EXIT_OK
+
+    code = _guarded(run)
+    raise typer.Exit(code)
+
+
 def main() -> None:
     """Console entry point."""
     try:

@@ -176,6 +176,7 @@ def optimise(
     max_evaluations: int = 600,
     screen: int = 12,
     exact_limit: int = 720,
+    starts: Sequence[tuple[int, ...]] = (),
 ) -> tuple[Tour, SearchStats]:
     """Best tour: exact when few orders are admissible, else construction + iterated local search.
 
@@ -186,6 +187,7 @@ def optimise(
     the `screen` most promising, only those whose bound beats the current cost),
     then the best tour is perturbed (a random segment of a free seam reversed and moved) and
     improved again until `max_evaluations` DP evaluations are spent. Deterministic for a given rng.
+    `starts` adds admissible orders to start from (e.g. the previous best, when costs changed).
     """
     rng = rng if rng is not None else np.random.default_rng(0)
     costs = _Costs(edge, node)
@@ -237,12 +239,13 @@ def optimise(
                 break
         return current, current_cost
 
-    starts: list[Blocks] = [
+    initial: list[Blocks] = [
+        *(_as_blocks(order, blocks) for order in starts),
         [(i, b.spots) for i, b in enumerate(blocks)],
         [(i, b.spots if b.ordered else b.spots[::-1]) for i, b in enumerate(blocks)],
         _insertion_start(blocks, costs),
     ]
-    best, best_cost = min((descend(s) for s in starts), key=lambda pair: pair[1])
+    best, best_cost = min((descend(s) for s in initial), key=lambda pair: pair[1])
     can_kick = len(blocks) > 1 or any(not b.ordered and len(b.spots) >= 3 for b in blocks)
     # Kicks that only revisit known orders spend no budget; they grow stronger, and are capped so
     # the search always ends.
@@ -262,6 +265,17 @@ def optimise(
     choice, cost = best_choice(flat, costs)
     stats = SearchStats(counter["evaluations"], counter["screened"], counter["improvements"])
     return Tour(flat, choice, cost), stats
+
+
+def _as_blocks(order: tuple[int, ...], blocks: Sequence[SeamBlock]) -> Blocks:
+    """A flat admissible order back into seam blocks (seams in order of first appearance)."""
+    seam_of = {spot: b for b, block in enumerate(blocks) for spot in block.spots}
+    out: Blocks = []
+    for spot in order:
+        if not out or out[-1][0] != seam_of[spot]:
+            out.append((seam_of[spot], ()))
+        out[-1] = (out[-1][0], (*out[-1][1], spot))
+    return out
 
 
 def _insertion_start(blocks: Sequence[SeamBlock], costs: _Costs) -> Blocks:

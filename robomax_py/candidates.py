@@ -1,0 +1,175 @@
+"""Candidate robot configurations for every spot: orientation grid x IK branch, pruned with reasons.
+
+A candidate survives when it is within joint limits, collision-free at the spot, and its approach
+line (a straight TCP line of `process.approach` metres along the electrode axis) stays in the same
+IK branch and is collision-free along its whole length. Every rejection is counted by reason.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from robomax_py._typing import BoolArray, FloatArray, IntArray
+from robomax_py.collision import CollisionWorld
+from robomax_py.ik import solve_all
+from robomax_py.robot import RobotModel, prismatic_mask
+from robomax_py.seams import OrientationGrid, approach_poses, orientation_grid, spot_poses
+from robomax_py.spec import CellSpec, SeamSpec
+from robomax_py.transforms import invert
+
+# The approach line is solved by IK at this TCP spacing; the sweep between samples is then checked
+# by `segment_free` with the collision world's own motion bound.
+APPROACH_SAMPLE_M = 0.005
+# Largest joint change between neighbouring approach samples before we call it a branch switch:
+# 5 mm of TCP motion moves a well-conditioned wrist by well under 0.2 rad.
+BRANCH_JUMP_RAD = 0.2
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SpotCandidates:
+    """The surviving configurations of one spot.
+
+    orient : (c,) int — index into the seam's OrientationGrid
+    angles : (c, 3) float, rad — alpha, beta, gamma of each candidate
+    column : (c,) int — IK table column (branch and turn variant)
+    q_spot : (c, n) float, rad — configuration with the TCP at the spot
+    q_app : (c, n) float, rad — configuration at the approach point (TCP `approach` m along +z)
+    app_path : (c, s, n) float, rad — the approach line, from q_app to q_spot
+    status, turn : (c,) int — configuration indicator bits
+    rejected : reason -> number of (orientation, branch) pairs rejected for it
+    """
+
+    seam_index: int
+    spot_index: int
+    name: str
+    orient: IntArray
+    angles: FloatArray
+    column: IntArray
+    q_spot: FloatArray
+    q_app: FloatArray
+    app_path: FloatArray
+    status: IntArray
+    turn: IntArray
+    rejected: Counter[str] = field(default_factory=Counter)
+
+    def __len__(self) -> int:
+        return len(self.orient)
+
+
+@dataclass(frozen=True, slots=True)
+class CandidateStats:
+    ik_poses: int
+    collision_checks: int
+
+
+def seam_candidates(
+    cell: CellSpec, robot: RobotModel, world: CollisionWorld, seam_index: int
+) -> tuple[list[SpotCandidates], CandidateStats]:
+    """Candidates for every spot of one seam."""
+    seam = cell.seams[seam_index]
+    grid = orientation_grid(seam)
+    T_base_world = invert(np.asarray(cell.T_world_base))
+    T_spot = T_base_world @ spot_poses(seam.spots, grid)                    # (S, m, 4, 4)
+    n_line = max(2, int(np.ceil(cell.process.approach / APPROACH_SAMPLE_M)) + 1)
+    fractions = np.linspace(1.0, 0.0, n_line)                               # approach point -> spot
+    T_line = np.stack([approach_poses(T_spot, cell.process.approach * f) for f in fractions], axis=2)
+    table = solve_all(robot, T_line)                                        # (S, m, L, B, n)
+    reach = _reachable(table)
+    checks = 0
+    out: list[SpotCandidates] = []
+    for s, spot in enumerate(seam.spots):
+        result, used = _spot_candidates(cell, robot, world, seam, grid, s, table, reach, seam_index)
+        checks += used
+        out.append(result)
+        del spot
+    return out, CandidateStats(ik_poses=int(np.prod(T_line.shape[:-2])), collision_checks=checks)
+
+
+def _reachable(table: object) -> BoolArray:
+    """Where the IK found a solution before limit filtering, if the table says; else its validity."""
+    reachable = getattr(table, "reachable", None)
+    return np.asarray(reachable if reachable is not None else table.valid)  # type: ignore[attr-defined]
+
+
+def _spot_candidates(
+    cell: CellSpec, robot: RobotModel, world: CollisionWorld, seam: SeamSpec, grid: OrientationGrid,
+    s: int, table: object, reach: BoolArray, seam_index: int,
+) -> tuple[SpotCandidates, int]:
+    q = np.asarray(table.q)[s]                 # type: ignore[attr-defined]  (m, L, B, n)
+    valid = np.asarray(table.valid)[s]         # type: ignore[attr-defined]  (m, L, B)
+    status = np.asarray(table.status)[s]       # type: ignore[attr-defined]
+    turn = np.asarray(table.turn)[s]           # type: ignore[attr-defined]
+    reachable = reach[s]
+    limits = robot.limits
+    revolute = ~prismatic_mask(robot.model)
+    rejected: Counter[str] = Counter()
+    keep: list[tuple[int, int]] = []
+    lines: dict[tuple[int, int], FloatArray] = {}
+    checks = 0
+    verdicts: dict[tuple[int, ...], str] = {}   # wrapped spot q -> "" (free) or rejection reason
+    m, n_line, n_col = valid.shape
+    for o in range(m):
+        for k in range(n_col):
+            if not reachable[o, -1, k]:
+                continue  # not a solution at the spot; counted per orientation below
+            if not valid[o, -1, k]:
+                rejected["joint_limit"] += 1
+                continue
+            # IK columns are fixed 2 pi shifts of wrapped values, so a joint crossing +-180 deg along
+            # the line jumps within its column: unwrap revolute joints towards the spot value.
+            line = q[o, :, k].copy()                                        # (L, n)
+            spot_q = line[-1]
+            line[:, revolute] = spot_q[revolute] + _wrap(line[:, revolute] - spot_q[revolute])
+            if not reachable[o, :, k].all() or np.abs(np.diff(line, axis=0)).max() > BRANCH_JUMP_RAD:
+                rejected["approach_branch"] += 1
+                continue
+            if not limits.contains(line).all():
+                rejected["approach_joint_limit"] += 1
+                continue
+            # Turn variants (q +- 2 pi) share their geometry: check each wrapped line once.
+            key = tuple(np.round(np.where(revolute, _wrap(line[-1]), line[-1]), 9))
+            verdict = verdicts.get(key)
+            if verdict is None:
+                verdict, used = _line_verdict(world, line)
+                checks += used
+                verdicts[key] = verdict
+            if verdict:
+                rejected[verdict] += 1
+                continue
+            keep.append((o, k))
+            lines[(o, k)] = line
+        if not reachable[o, -1].any():
+            rejected["unreachable"] += n_col
+    idx_o = np.array([o for o, _ in keep], dtype=np.int64)
+    idx_k = np.array([k for _, k in keep], dtype=np.int64)
+    n = robot.dof
+    paths = np.array([lines[(o, k)] for o, k in keep]) if keep else np.zeros((0, n_line, n))
+    spot = seam.spots[s]
+    return SpotCandidates(
+        seam_index=seam_index, spot_index=s, name=spot.name,
+        orient=idx_o, angles=grid.angles[idx_o] if keep else np.zeros((0, 3)), column=idx_k,
+        q_spot=paths[:, -1] if keep else np.zeros((0, n)), q_app=paths[:, 0] if keep else np.zeros((0, n)),
+        app_path=paths, status=status[idx_o, -1, idx_k] if keep else np.zeros(0, dtype=np.int64),
+        turn=turn[idx_o, -1, idx_k] if keep else np.zeros(0, dtype=np.int64), rejected=rejected,
+    ), checks
+
+
+def _line_verdict(world: CollisionWorld, line: FloatArray) -> tuple[str, int]:
+    """'' when the spot configuration and its approach line are free, else the rejection reason."""
+    contact = world.first_contact(line[-1])
+    checks = 1
+    if contact is not None:
+        return f"collision:{contact.describe()}", checks
+    for a, b in zip(line[:-1], line[1:]):
+        res = world.check_segment(a, b)
+        checks += res.checks
+        if not res.free:
+            return "approach_blocked", checks
+    return "", checks
+
+
+def _wrap(q: FloatArray) -> FloatArray:
+    return (q + np.pi) % (2 * np.pi) - np.pi

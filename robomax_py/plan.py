@@ -1,0 +1,608 @@
+"""A cell -> a collision-free, cycle-time-optimised spot-welding trajectory (no file I/O, no printing).
+
+Stages: candidates per spot (orientation grid x IK branch, pruned) -> sequencing (spot order and
+candidates by DP and local search on estimated motion times, straight moves verified lazily, detours
+through a roadmap where they are blocked) -> timing (jerk-limited PTP moves, detours, LIN
+approach/retract, dwells) -> a dense re-check of the timed trajectory, which is only returned when
+every sample pair is collision-free and within limits.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.candidates import SpotCandidates, seam_candidates
+from robomax_py.collision import CollisionWorld
+from robomax_py.ik import ConfigIndicator, solve_all
+from robomax_py.robot import RobotModel, fk_tcp
+from robomax_py.roadmap import Detour, Roadmap
+from robomax_py.scene import build_scene
+from robomax_py.seams import approach_poses, orientation_grid, spot_poses
+from robomax_py.sequence import HOME, SeamBlock, Tour, best_choice, optimise, _Costs
+from robomax_py.spec import CellSpec
+from robomax_py.timing import (
+    Segment,
+    Trajectory,
+    TimingError,
+    concatenate,
+    dwell,
+    lin_move,
+    path_move,
+    ptp_move,
+    ptp_time_estimate,
+    resample,
+)
+from robomax_py.transforms import invert
+
+# Heights (m, world z) tried for up-across-down detours over clamps, lowest first.
+LIFT_HEIGHTS_M = (0.08, 0.15, 0.25, 0.4)
+# Cost of a detour not yet found, as a multiple of the straight move's estimate.
+DETOUR_PRIOR = 1.6
+# Placeholder keeping detour indices stable for pairs a detour cannot serve.
+_UNUSABLE = Detour(np.zeros((0, 0)), float("inf"), 0)
+# Limits are checked on the final samples with this relative slack (toppra's output is within ~1e-5).
+LIMIT_RTOL = 1e-3
+
+
+@dataclass(frozen=True, slots=True)
+class PlanOptions:
+    """How to plan; every field has a production default."""
+
+    baseline: bool = False           # the published method: given order, nominal orientation, first branch
+    speed: float = 1.0               # global velocity override in (0, 1]
+    tcp_speed: float = 0.5           # m/s on approach and retract lines
+    roadmap_nodes: int = 600
+    roadmap_k: int = 12
+    straight_tries: int = 12         # blocked straight moves between two spots before detours only
+    max_rounds: int = 80             # sequencing rounds (optimise, verify, repair)
+    max_evaluations: int = 400       # DP evaluations per sequencing round
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SpotPlan:
+    """One welded spot: where and how."""
+
+    seam: str
+    name: str
+    angles: FloatArray               # (3,) alpha, beta, gamma, rad
+    config: str                      # KUKA-style Status/Turn string
+    q_spot: FloatArray
+    q_app: FloatArray
+    t_arrive: float
+    t_leave: float
+
+
+@dataclass(frozen=True, slots=True)
+class SpotFailure:
+    seam: str
+    name: str
+    reason: str                      # unreachable | joint_limit | collision | approach_blocked
+    detail: str
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Transition:
+    """The joint path between two stops (home or an approach point); kind 'move' or 'detour'."""
+
+    kind: str
+    waypoints: FloatArray            # (m, n), both ends included
+    label: str
+
+
+@dataclass(frozen=True, slots=True)
+class PlanStats:
+    candidates: int
+    candidate_checks: int
+    sequencing_checks: int
+    roadmap_checks: int
+    verify_checks: int
+    detours: int
+    rounds: int
+    dp_evaluations: int
+    seconds: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PlanResult:
+    cell: str
+    robot: str
+    status: str                      # "planned" | "infeasible"
+    message: str
+    spots: tuple[SpotPlan, ...] = ()
+    failures: tuple[SpotFailure, ...] = ()
+    transitions: tuple[Transition, ...] = ()
+    trajectory: Trajectory | None = None
+    stats: PlanStats | None = None
+    baseline: bool = False
+    joint_names: tuple[str, ...] = ()
+
+    @property
+    def cycle_time(self) -> float:
+        return float("nan") if self.trajectory is None else self.trajectory.duration
+
+
+def plan_cell(cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOptions()) -> PlanResult:
+    """Plan a cell whose robot (with its tool mounted) is given."""
+    clock: dict[str, float] = {}
+    t0 = time.perf_counter()
+    world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+    clock["world"] = time.perf_counter() - t0
+
+    home_contact = world.first_contact(cell.home)
+    if home_contact is not None:
+        return PlanResult(cell.name, robot.name, "infeasible", f"home is in collision: {home_contact.describe()}")
+
+    t0 = time.perf_counter()
+    spots: list[SpotCandidates] = []
+    candidate_checks = 0
+    for s in range(len(cell.seams)):
+        found, stats = seam_candidates(cell, robot, world, s)
+        spots.extend(found)
+        candidate_checks += stats.collision_checks
+    clock["candidates"] = time.perf_counter() - t0
+    failures = tuple(_failure(cell, c) for c in spots if len(c) == 0)
+    if failures:
+        names = ", ".join(f"{f.seam}/{f.name} ({f.reason})" for f in failures)
+        return PlanResult(cell.name, robot.name, "infeasible", f"{len(failures)} spot(s) cannot be welded: {names}",
+                          failures=failures)
+    if options.baseline:
+        spots = [_baseline_candidate(c) for c in spots]
+
+    t0 = time.perf_counter()
+    rng = np.random.default_rng(cell.planner.seed)
+    anchors = np.vstack([cell.home[None, :], *[c.q_app for c in spots]])
+    roadmap = Roadmap(world, robot.limits, anchors, rng, options.roadmap_nodes, options.roadmap_k, seeds=anchors)
+    clock["roadmap"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    sequencer = _Sequencer(cell, robot, world, roadmap, spots, options, rng)
+    outcome = sequencer.run()
+    clock["sequencing"] = time.perf_counter() - t0
+    if isinstance(outcome, str):
+        return PlanResult(cell.name, robot.name, "infeasible", outcome)
+    tour, transitions = outcome
+
+    t0 = time.perf_counter()
+    try:
+        trajectory, plans = _time_tour(cell, robot, spots, tour, transitions, options)
+    except TimingError as exc:
+        return PlanResult(cell.name, robot.name, "infeasible", f"timing failed: {exc}")
+    clock["timing"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    problem, verify_checks = verify_trajectory(world, robot, trajectory)
+    clock["verify"] = time.perf_counter() - t0
+    if problem:
+        return PlanResult(cell.name, robot.name, "infeasible", f"the timed program failed its own check: {problem}")
+
+    stats = PlanStats(
+        candidates=sum(len(c) for c in spots), candidate_checks=candidate_checks,
+        sequencing_checks=sequencer.checks, roadmap_checks=roadmap.sampling_checks + roadmap.edge_checks,
+        verify_checks=verify_checks, detours=sum(1 for t in transitions if t.kind == "detour"),
+        rounds=sequencer.rounds, dp_evaluations=sequencer.dp_evaluations, seconds=clock,
+    )
+    return PlanResult(cell.name, robot.name, "planned", "planned", spots=tuple(plans), transitions=tuple(transitions),
+                      trajectory=trajectory, stats=stats, baseline=options.baseline, joint_names=robot.joint_names)
+
+
+def verify_trajectory(world: CollisionWorld, robot: RobotModel, traj: Trajectory) -> tuple[str, int]:
+    """'' if every sample is within limits and every straight step between samples is free, else why.
+
+    Between samples the motion is taken as linear in joint space (SPEC §5), which is exactly what
+    `check_segment` sweeps; dynamic obstacles are evaluated at the samples' times.
+    """
+    lim = robot.limits
+    tol = 1e-9
+    if not lim.contains(traj.q, tol).all():
+        i = int(np.flatnonzero(~lim.contains(traj.q, tol))[0])
+        return f"joint position limit at t = {traj.t[i]:.3f} s", 0
+    speed = np.abs(np.diff(traj.q, axis=0)) / np.diff(traj.t)[:, None]
+    over = speed > lim.velocity * (1 + LIMIT_RTOL)
+    if over.any():
+        i, j = np.argwhere(over)[0]
+        return f"{robot.joint_names[j]} velocity {speed[i, j]:.3f} rad/s over its limit at t = {traj.t[i]:.3f} s", 0
+    checks = 0
+    for i in range(len(traj.t) - 1):
+        res = world.check_segment(traj.q[i], traj.q[i + 1], float(traj.t[i]), float(traj.t[i + 1]))
+        checks += res.checks
+        if not res.free:
+            contact = world.first_contact(
+                traj.q[i] + (res.s_contact or 0.0) * (traj.q[i + 1] - traj.q[i]), float(traj.t[i])
+            )
+            what = contact.describe() if contact else "collision"
+            return f"{what} at t = {traj.t[i]:.3f} s", checks
+    return "", checks
+
+
+def _failure(cell: CellSpec, c: SpotCandidates) -> SpotFailure:
+    """The dominant reason a spot has no candidate."""
+    seam = cell.seams[c.seam_index].name
+    if not c.rejected:
+        return SpotFailure(seam, c.name, "unreachable", "no IK solution at any orientation")
+    groups: Counter[str] = Counter()
+    for reason, n in c.rejected.items():
+        groups[reason.split(":")[0]] += n
+    order = ("approach_blocked", "collision", "approach_branch", "approach_joint_limit", "joint_limit", "unreachable")
+    for reason in order:
+        if groups.get(reason):
+            detail = ", ".join(f"{k} x{v}" for k, v in c.rejected.most_common(4))
+            label = {"approach_branch": "approach_blocked", "approach_joint_limit": "joint_limit"}.get(reason, reason)
+            return SpotFailure(seam, c.name, label, detail)
+    return SpotFailure(seam, c.name, "unreachable", "no IK solution at any orientation")
+
+
+def _baseline_candidate(c: SpotCandidates) -> SpotCandidates:
+    """The published method's choice: nearest-to-nominal orientation, then the first branch."""
+    from dataclasses import replace
+
+    # Grid orientations are ordered by distance from nominal, so the lowest index is the nearest.
+    best = int(np.lexsort((c.column, c.orient))[0])
+    sel = np.array([best])
+    return replace(
+        c, orient=c.orient[sel], angles=c.angles[sel], column=c.column[sel], q_spot=c.q_spot[sel],
+        q_app=c.q_app[sel], app_path=c.app_path[sel], status=c.status[sel], turn=c.turn[sel],
+    )
+
+
+class _Sequencer:
+    """Spot order and candidates with lazily verified straight moves and roadmap detours.
+
+    Knowledge grows round by round: straight moves found blocked, detours found between two spots
+    (offered to every candidate pair of those spots as enter-leg + detour + leave-leg), and detour
+    legs found blocked. Cost matrices are cached per spot pair and recomputed only when what is
+    known about that pair changes. When a straight move between two spots is blocked, the cheapest
+    few other straight moves between them are checked at once; if all are blocked the spot pair is
+    treated as detour-only (this may miss a rare free straight move, never admits a blocked one).
+    """
+
+    def __init__(
+        self, cell: CellSpec, robot: RobotModel, world: CollisionWorld, roadmap: Roadmap,
+        spots: list[SpotCandidates], options: PlanOptions, rng: np.random.Generator,
+    ) -> None:
+        self.cell, self.robot, self.world, self.roadmap = cell, robot, world, roadmap
+        self.spots, self.options, self.rng = spots, options, rng
+        self.limits = robot.limits
+        self.home = np.asarray(cell.home)[None, :]
+        self.checks = 0
+        self.rounds = 0
+        self.dp_evaluations = 0
+        # Per spot: time of approach + weld + retract (joint-time estimate of the short LIN moves).
+        weld = cell.process.weld_time
+        self.node = [2 * ptp_time_estimate(c.q_app, c.q_spot, self.limits, options.speed) + weld for c in spots]
+        self.straight: dict[tuple[int, int], dict[tuple[int, int], bool]] = {}   # (i, j) -> (a, b) -> free
+        self.detour_only: set[tuple[int, int]] = set()                           # unordered spot pairs
+        self.no_way: dict[tuple[int, int], set[tuple[int, int]]] = {}            # (i, j) -> {(a, b)} unconnectable
+        self.detours: list[tuple[int, int, Detour]] = []                          # (from spot, to spot, path)
+        self.legs_bad: dict[tuple[int, int], set[tuple[int, int, int]]] = {}      # (i, j) -> {(a, b, v)}
+        self.legs_ok: dict[tuple[int, int], set[tuple[int, int, int]]] = {}
+        self._matrices: dict[tuple[int, int], FloatArray] = {}
+        self._estimates: dict[tuple[int, int], FloatArray] = {}
+
+    # ------------------------------------------------------------------ knowledge and costs
+
+    def q(self, i: int) -> FloatArray:
+        return self.home if i == HOME else self.spots[i].q_app
+
+    def _forget(self, i: int, j: int) -> None:
+        self._matrices.pop((i, j), None)
+        self._matrices.pop((j, i), None)
+
+    def estimate(self, i: int, j: int) -> FloatArray:
+        key = (i, j)
+        if key not in self._estimates:
+            qa, qb = self.q(i), self.q(j)
+            self._estimates[key] = ptp_time_estimate(qa[:, None, :], qb[None, :, :], self.limits, self.options.speed)
+        return self._estimates[key]
+
+    def vias_for(self, i: int, j: int) -> list[Detour]:
+        """Known detours usable from spot i to spot j, oriented i -> j: those found between i and j,
+        and those leaving i or reaching j (another leg then joins their far end to the other spot).
+        Indices are stable: new detours are only appended."""
+        out: list[Detour] = []
+        for di, dj, det in self.detours:
+            if di == i or dj == j:
+                out.append(det)
+            elif dj == i or di == j:
+                out.append(Detour(det.waypoints[::-1].copy(), det.time_estimate, det.checks))
+            else:
+                out.append(_UNUSABLE)
+        return out
+
+    def _via_costs(self, i: int, j: int, v: int) -> FloatArray:
+        det = self.vias_for(i, j)[v]
+        if det is _UNUSABLE:
+            return np.full((len(self.q(i)), len(self.q(j))), np.inf)
+        wp, sp = det.waypoints, self.options.speed
+        enter = ptp_time_estimate(self.q(i), wp[0][None, :], self.limits, sp)
+        leave = ptp_time_estimate(wp[-1][None, :], self.q(j), self.limits, sp)
+        inner = float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits, sp)))
+        via = enter[:, None] + inner + leave[None, :]
+        for a, b, vv in self.legs_bad.get((i, j), ()):
+            if vv == v:
+                via[a, b] = np.inf
+        return via
+
+    def cost(self, i: int, j: int) -> FloatArray:
+        """Estimated move time between every candidate pair, using what is known about blockages."""
+        key = (i, j)
+        if key in self._matrices:
+            return self._matrices[key]
+        est = self.estimate(i, j).copy()
+        if (min(i, j), max(i, j)) in self.detour_only:
+            # Until a detour is known, price one at a multiple of the straight move: optimistic
+            # enough to be explored, costly enough not to be preferred.
+            usable = any(d is not _UNUSABLE for d in self.vias_for(i, j))
+            est = np.full_like(est, np.inf) if usable else est * DETOUR_PRIOR
+        else:
+            for (a, b), free in self.straight.get(key, {}).items():
+                if not free:
+                    est[a, b] = np.inf
+        for v in range(len(self.vias_for(i, j))):
+            est = np.minimum(est, self._via_costs(i, j, v))
+        for a, b in self.no_way.get(key, ()):
+            est[a, b] = np.inf
+        self._matrices[key] = est
+        return est
+
+    def _record_straight(self, i: int, a: int, j: int, b: int, free: bool) -> None:
+        self.straight.setdefault((i, j), {})[(a, b)] = free
+        self.straight.setdefault((j, i), {})[(b, a)] = free
+        self._forget(i, j)
+
+    def _record_leg(self, i: int, a: int, j: int, b: int, v: int, ok: bool) -> None:
+        table = self.legs_ok if ok else self.legs_bad
+        table.setdefault((i, j), set()).add((a, b, v))
+        table.setdefault((j, i), set()).add((b, a, v))
+        self._forget(i, j)
+
+    # ------------------------------------------------------------------ the loop
+
+    def _blocks(self) -> list[SeamBlock]:
+        blocks = []
+        start = 0
+        for seam in self.cell.seams:
+            ids = tuple(range(start, start + len(seam.spots)))
+            start += len(seam.spots)
+            blocks.append(SeamBlock(ids, seam.ordered or self.options.baseline))
+        return blocks
+
+    def _probe_pairs(self) -> None:
+        """One straight check per spot pair (its cheapest candidate pair): blocked pairs start detour-only."""
+        ids = [HOME, *range(len(self.spots))]
+        for x, i in enumerate(ids):
+            for j in ids[x + 1:]:
+                est = self.estimate(i, j)
+                a, b = np.unravel_index(int(np.argmin(est)), est.shape)
+                res = self.world.check_segment(self.q(i)[a], self.q(j)[b])
+                self.checks += res.checks
+                self._record_straight(i, int(a), j, int(b), res.free)
+                if not res.free:
+                    self.detour_only.add((min(i, j), max(i, j)))
+
+    def run(self) -> tuple[Tour, list[Transition]] | str:
+        blocks = self._blocks()
+        self._probe_pairs()
+        previous: tuple[tuple[int, ...], ...] = ()
+        for _ in range(self.options.max_rounds):
+            self.rounds += 1
+            if self.options.baseline:
+                order = tuple(s for b in blocks for s in b.spots)
+                choice, cost = best_choice(order, _Costs(self.cost, self.node))
+                tour = Tour(order, choice, cost)
+            else:
+                budget = self.options.max_evaluations if self.rounds == 1 else max(50, self.options.max_evaluations // 4)
+                tour, stats = optimise(blocks, self.cost, self.node, rng=self.rng, max_evaluations=budget,
+                                       starts=previous)
+                self.dp_evaluations += stats.dp_evaluations
+                previous = (tour.order,)
+            if not np.isfinite(tour.cost):
+                return "no collision-free connection found between some spots (roadmap exhausted)"
+            transitions = self._verify(tour)
+            if transitions is not None:
+                return tour, transitions
+        return f"sequencing did not converge in {self.options.max_rounds} rounds"
+
+    def _verify(self, tour: Tour) -> list[Transition] | None:
+        """Transitions of the tour if every leg is known free; else learn from every leg, return None."""
+        stops = [(HOME, 0), *zip(tour.order, tour.choice), (HOME, 0)]
+        out: list[Transition] = []
+        complete = True
+        for (i, a), (j, b) in zip(stops[:-1], stops[1:]):
+            qa, qb = self.q(i)[a], self.q(j)[b]
+            label = f"{self._name(i)} -> {self._name(j)}"
+            straight_ok = (min(i, j), max(i, j)) not in self.detour_only and \
+                self.straight.get((i, j), {}).get((a, b), True)
+            straight_cost = float(self.estimate(i, j)[a, b]) if straight_ok else np.inf
+            via_costs = [float(self._via_costs(i, j, v)[a, b]) for v in range(len(self.vias_for(i, j)))]
+            best_v = int(np.argmin(via_costs)) if via_costs else -1
+            if straight_ok and (best_v < 0 or straight_cost <= via_costs[best_v]):
+                if self._check_straight(i, a, j, b):
+                    out.append(Transition("move", np.array([qa, qb]), label))
+                else:
+                    complete = False
+                continue
+            if best_v < 0 or not np.isfinite(via_costs[best_v]):
+                self._new_detour(i, a, j, b)
+                complete = False
+                continue
+            path = self._check_via(i, a, j, b, best_v)
+            if path is None:
+                complete = False
+                continue
+            out.append(Transition("detour", path, label))
+        return out if complete else None
+
+    def _check_straight(self, i: int, a: int, j: int, b: int) -> bool:
+        known = self.straight.get((i, j), {}).get((a, b))
+        if known is not None:
+            return known
+        res = self.world.check_segment(self.q(i)[a], self.q(j)[b])
+        self.checks += res.checks
+        self._record_straight(i, a, j, b, res.free)
+        if res.free:
+            return True
+        # Blocked: try the cheapest other straight moves between these two spots right away.
+        est = self.estimate(i, j)
+        known_pairs = self.straight.get((i, j), {})
+        tried = sum(1 for free in known_pairs.values() if not free)
+        for flat in np.argsort(est, axis=None, kind="stable"):
+            if tried >= self.options.straight_tries:
+                break
+            aa, bb = np.unravel_index(int(flat), est.shape)
+            if (int(aa), int(bb)) in known_pairs:
+                continue
+            r = self.world.check_segment(self.q(i)[aa], self.q(j)[bb])
+            self.checks += r.checks
+            self._record_straight(i, int(aa), j, int(bb), r.free)
+            if r.free:
+                return False          # a free alternative exists; let the optimiser weigh it
+            tried += 1
+        self.detour_only.add((min(i, j), max(i, j)))
+        self._forget(i, j)
+        self._new_detour(i, a, j, b)
+        return False
+
+    def _lift_detour(self, i: int, a: int, j: int, b: int) -> Detour | None:
+        """Up, across, down: the TCP raised by h at both ends in the same IK branch, for clamps.
+
+        The cheapest kind of detour an operator would teach; tried for rising h before the roadmap.
+        """
+        qa, qb = self.q(i)[a], self.q(j)[b]
+        up = invert(np.asarray(self.cell.T_world_base))[:3, :3] @ np.array([0.0, 0.0, 1.0])
+        checks = 0
+        for h in LIFT_HEIGHTS_M:
+            ends = []
+            for q, idx, col in ((qa, i, a), (qb, j, b)):
+                if idx == HOME:
+                    ends.append(q)
+                    continue
+                T = fk_tcp(self.robot, q)
+                T[:3, 3] += h * up
+                table = solve_all(self.robot, T[None], q_hint=q)
+                column = int(self.spots[idx].column[col])
+                if not table.valid[0, column]:
+                    break
+                lifted = table.q[0, column].copy()
+                ends.append(q + _wrap(lifted - q))
+            if len(ends) < 2 or not self.limits.contains(np.array(ends)).all():
+                continue
+            path = np.array([qa, ends[0], ends[1], qb])
+            ok = True
+            for p0, p1 in zip(path[:-1], path[1:]):
+                if np.allclose(p0, p1):
+                    continue
+                res = self.world.check_segment(p0, p1)
+                checks += res.checks
+                if not res.free:
+                    ok = False
+                    break
+            self.checks += checks
+            checks = 0
+            if ok:
+                keep = [0] + [k for k in range(1, 4) if not np.allclose(path[k], path[k - 1])]
+                wp = path[keep]
+                return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits))), 0)
+        self.checks += checks
+        return None
+
+    def _new_detour(self, i: int, a: int, j: int, b: int) -> None:
+        det = self._lift_detour(i, a, j, b) or self.roadmap.query(self.q(i)[a], self.q(j)[b])
+        if det is None:
+            # No way found for this exact pair: make sure the optimiser stops choosing it.
+            self.no_way.setdefault((i, j), set()).add((a, b))
+            self.no_way.setdefault((j, i), set()).add((b, a))
+            self._forget(i, j)
+            return
+        self.checks += det.checks
+        self.detours.append((i, j, det))
+        # Every pair sharing an end spot with this detour may now use it.
+        self._matrices.clear()
+        self._record_leg(i, a, j, b, len(self.detours) - 1, True)   # its ends are this pair's configurations
+
+    def _check_via(self, i: int, a: int, j: int, b: int, v: int) -> FloatArray | None:
+        wp = self.vias_for(i, j)[v].waypoints
+        qa, qb = self.q(i)[a], self.q(j)[b]
+        if (a, b, v) not in self.legs_ok.get((i, j), set()):
+            for p, r in ((qa, wp[0]), (wp[-1], qb)):
+                if np.allclose(p, r):
+                    continue
+                res = self.world.check_segment(p, r)
+                self.checks += res.checks
+                if not res.free:
+                    self._record_leg(i, a, j, b, v, False)
+                    self._new_detour(i, a, j, b)
+                    return None
+            self._record_leg(i, a, j, b, v, True)
+        path = np.vstack([qa[None, :], wp, qb[None, :]])
+        keep = [0] + [k for k in range(1, len(path)) if not np.allclose(path[k], path[k - 1])]
+        return path[keep]
+
+    def _name(self, i: int) -> str:
+        return "home" if i == HOME else self.spots[i].name
+
+
+def _time_tour(
+    cell: CellSpec, robot: RobotModel, spots: list[SpotCandidates], tour: Tour,
+    transitions: list[Transition], options: PlanOptions,
+) -> tuple[Trajectory, list[SpotPlan]]:
+    """Jerk-limited moves, stop-at-waypoint detours, LIN approach/retract and dwells, end to end."""
+    lim = robot.limits
+    segments: list[Segment] = []
+    T_base_world = invert(np.asarray(cell.T_world_base))
+    grids = [orientation_grid(seam) for seam in cell.seams]
+    q_now = np.asarray(cell.home, dtype=float)
+    welded: list[tuple[int, int]] = []
+    for step, trans in enumerate(transitions):
+        wp = np.array(trans.waypoints, dtype=float)
+        wp[0] = q_now
+        segments.append(_move_segment(wp, lim, options, trans.kind, trans.label))
+        q_now = segments[-1].q[-1]
+        if step == len(tour.order):
+            break
+        i, a = tour.order[step], tour.choice[step]
+        c = spots[i]
+        seam = cell.seams[c.seam_index]
+        T_spot = T_base_world @ spot_poses((seam.spots[c.spot_index],), grids[c.seam_index])[0, c.orient[a]]
+        T_app = approach_poses(T_spot, cell.process.approach)
+        column = int(c.column[a])
+        label = f"{seam.name}/{c.name}"
+        app = lin_move(robot, T_app, T_spot, column, lim, options.tcp_speed, speed=options.speed,
+                       q_start=q_now, kind="approach", label=label)
+        segments.append(app)
+        segments.append(dwell(app.q[-1], cell.process.weld_time, kind="weld", label=label))
+        ret = lin_move(robot, T_spot, T_app, column, lim, options.tcp_speed, speed=options.speed,
+                       q_start=app.q[-1], kind="retract", label=label)
+        segments.append(ret)
+        q_now = ret.q[-1]
+        welded.append((i, a))
+    traj = resample(concatenate(segments))
+    plans = []
+    for i, a in welded:
+        c = spots[i]
+        seam = cell.seams[c.seam_index]
+        label = f"{seam.name}/{c.name}"
+        phase = traj.phases_of("weld", label)[0]
+        config = ConfigIndicator(int(c.status[a]), int(c.turn[a]))
+        plans.append(SpotPlan(seam.name, c.name, c.angles[a], str(config), c.q_spot[a], c.q_app[a],
+                              float(phase.t_start), float(phase.t_end)))
+    return traj, plans
+
+
+def _move_segment(waypoints: FloatArray, lim: object, options: PlanOptions, kind: str, label: str) -> Segment:
+    """A straight jerk-limited PTP move, or a detour that stops at each waypoint (the checked polyline)."""
+    if len(waypoints) == 2 or kind == "move":
+        return ptp_move(waypoints[0], waypoints[-1], lim, options.speed, kind=kind, label=label)  # type: ignore[arg-type]
+    return path_move(waypoints, lim, options.speed, mode="stop", kind=kind, label=label).segment  # type: ignore[arg-type]
+
+
+def _wrap(q: FloatArray) -> FloatArray:
+    return (q + np.pi) % (2 * np.pi) - np.pi
+
+
+Progress = Callable[[str, float], None]

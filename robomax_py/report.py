@@ -1,0 +1,68 @@
+"""What a plan chose and why, as plain data (for --json) and as rich tables."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+from rich.table import Table
+
+from robomax_py.plan import PlanResult
+
+KINDS = ("move", "detour", "approach", "weld", "retract", "wait")
+
+
+def plan_report(result: PlanResult, seconds: float, written: list[Path]) -> dict[str, Any]:
+    """A JSON-ready summary: status, cycle time and its split, spots, detours, planning time."""
+    report: dict[str, Any] = {
+        "cell": result.cell, "robot": result.robot, "status": result.status, "message": result.message,
+        "method": "baseline" if result.baseline else "optimised", "planning_seconds": round(seconds, 3),
+        "failures": [{"seam": f.seam, "spot": f.name, "reason": f.reason, "detail": f.detail} for f in result.failures],
+        "files": [str(p) for p in written],
+    }
+    if result.trajectory is None:
+        return report
+    split = {k: 0.0 for k in KINDS}
+    for phase in result.trajectory.phases:
+        split[phase.kind] = split.get(phase.kind, 0.0) + float(phase.t_end - phase.t_start)
+    report["cycle_time"] = round(result.cycle_time, 4)
+    report["split"] = {k: round(v, 4) for k, v in split.items()}
+    report["spots"] = [
+        {"seam": s.seam, "spot": s.name, "t_arrive": round(s.t_arrive, 4),
+         "alpha": round(math.degrees(s.angles[0]), 3), "beta": round(math.degrees(s.angles[1]), 3),
+         "gamma": round(math.degrees(s.angles[2]), 3), "config": s.config}
+        for s in result.spots
+    ]
+    report["detours"] = [t.label for t in result.transitions if t.kind == "detour"]
+    if result.stats is not None:
+        st = result.stats
+        report["stats"] = {
+            "candidates": st.candidates, "collision_checks": st.candidate_checks + st.sequencing_checks + st.verify_checks,
+            "roadmap_checks": st.roadmap_checks, "sequencing_rounds": st.rounds, "dp_evaluations": st.dp_evaluations,
+            "stage_seconds": {k: round(v, 3) for k, v in st.seconds.items()},
+        }
+    return report
+
+
+def report_tables(report: dict[str, Any]) -> list[Any]:
+    head = Table.grid(padding=(0, 2))
+    head.add_row("cell", f"{report['cell']} ({report['robot']}), {report['method']}")
+    head.add_row("status", report["status"] if report["status"] == "planned" else f"{report['status']}: {report['message']}")
+    if "cycle_time" in report:
+        split = ", ".join(f"{k} {v:.2f}" for k, v in report["split"].items() if v > 0)
+        head.add_row("cycle time", f"{report['cycle_time']:.2f} s  ({split})")
+        head.add_row("detours", ", ".join(report["detours"]) or "none")
+    head.add_row("planning", f"{report['planning_seconds']:.2f} s")
+    for f in report["files"]:
+        head.add_row("wrote", f)
+    out: list[Any] = [head]
+    if report.get("spots"):
+        spots = Table(title="spots in weld order", title_justify="left")
+        for col in ("seam", "spot", "arrive (s)", "alpha", "beta", "gamma (deg)", "config"):
+            spots.add_column(col)
+        for s in report["spots"]:
+            spots.add_row(s["seam"], s["spot"], f"{s['t_arrive']:.2f}", f"{s['alpha']:g}", f"{s['beta']:g}",
+                          f"{s['gamma']:g}", s["config"])
+        out.append(spots)
+    return out
