@@ -73,7 +73,8 @@ def _collision_files(name: str, link: str) -> list[Path]:
 @pytest.mark.parametrize("name", ARMS)
 def test_robot_yaml_has_exactly_the_spec_keys(name: str) -> None:
     data = _robot_yaml(name)
-    assert set(data) == {"name", "urdf", "flange", "ik", "limits"}
+    # SPEC §1 keys plus our optional, informational extensions.
+    assert set(data) == {"name", "urdf", "flange", "ik", "limits", "payload", "description"}
     assert data["name"] == name
     assert data["urdf"] == f"{name}.urdf"
     assert data["flange"] == "tool0"

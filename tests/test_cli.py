@@ -1,0 +1,109 @@
+"""End-to-end tests of the `robomax` command on real cells: exit codes, messages, files."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from robomax_py.cli import EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_OK, app
+
+REPO = Path(__file__).resolve().parents[1]
+SHIPPED_CELL = REPO / "cells" / "cabin_flange.yaml"
+MAX_DT_S = 0.010
+TIME_TOL_S = 1e-6        # the file writes times with 1 µs resolution
+JOINT_TOL_RAD = 2e-9     # the file writes joints with 1e-9 rad resolution
+runner = CliRunner()
+
+
+def small_cell(tmp_path: Path, extra_spots: list[dict] | None = None) -> Path:
+    """Two reachable spots of the shipped cell (between the clamps) plus any extra spots."""
+    data = yaml.safe_load(SHIPPED_CELL.read_text())
+    shutil.copytree(SHIPPED_CELL.parent / "parts", tmp_path / "parts")
+    spots = [s for s in data["seams"][0]["spots"] if s["name"] in ("s7", "s8")]
+    data["name"] = "small"
+    data["seams"][0]["spots"] = spots + (extra_spots or [])
+    data["seams"][0]["grid"] = 3
+    data["seams"][0]["tolerance"]["gamma"] = [0, 0]
+    path = tmp_path / "small.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def test_robots_lists_the_library() -> None:
+    result = runner.invoke(app, ["robots"])
+    assert result.exit_code == EXIT_OK, result.output
+    for name in ("kr125", "kr16", "ur10", "spot_gun_c"):
+        assert name in result.output
+
+
+def test_unreachable_spot_exits_3_names_it_and_writes_nothing(tmp_path: Path) -> None:
+    far = {"name": "far", "xyz": [4.0, 0.0, 1.0], "normal": [-1, 0, 0], "direction": [0, 1, 0]}
+    cell = small_cell(tmp_path, [far])
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
+    assert result.exit_code == EXIT_INFEASIBLE, result.output
+    text = " ".join(result.output.split())
+    assert "flange/far: unreachable" in text
+    assert "flange/s7:" not in text and "flange/s8:" not in text
+    assert not out.exists()
+
+
+def test_bad_cell_exits_2_and_writes_nothing(tmp_path: Path) -> None:
+    cell = small_cell(tmp_path)
+    text = cell.read_text().replace("weld_time: 0.5", "weld_time: -1")
+    cell.write_text(text)
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
+    assert result.exit_code == EXIT_BAD_INPUT, result.output
+    assert "process.weld_time" in " ".join(result.output.split())
+    assert "Traceback" not in result.output
+    assert not out.exists()
+
+
+def check_trajectory_file(path: Path, n_spots: int, home_deg: list[float], weld_time: float) -> dict:
+    """SPEC §5: keys, strictly increasing t at most 10 ms apart, home at both ends, spots."""
+    data = json.loads(path.read_text())
+    assert data["format"] == "robomax.trajectory/1"
+    t = np.array(data["t"])
+    q = np.array(data["q"])
+    assert q.shape == (len(t), len(data["joints"]))
+    assert np.all(np.diff(t) > 0) and np.all(np.diff(t) <= MAX_DT_S + TIME_TOL_S)
+    assert data["cycle_time"] == pytest.approx(t[-1] - t[0], abs=TIME_TOL_S)
+    home = np.radians(home_deg)
+    np.testing.assert_allclose(q[0], home, atol=JOINT_TOL_RAD)
+    np.testing.assert_allclose(q[-1], home, atol=JOINT_TOL_RAD)
+    assert len(data["spots"]) == n_spots
+    for spot in data["spots"]:
+        assert spot["t_leave"] - spot["t_arrive"] == pytest.approx(weld_time, abs=2 * TIME_TOL_S)
+        inside = (t >= spot["t_arrive"] - TIME_TOL_S) & (t <= spot["t_leave"] + TIME_TOL_S)
+        assert np.ptp(q[inside], axis=0).max() <= JOINT_TOL_RAD   # at rest while welding
+    return data
+
+
+def test_plan_small_cell_writes_the_trajectory(tmp_path: Path) -> None:
+    cell = small_cell(tmp_path)
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
+    assert result.exit_code == EXIT_OK, result.output
+    check_trajectory_file(out / "small.json", 2, [0, -90, 90, 0, 0, 0], 0.5)
+    assert sorted(p.name for p in out.iterdir()) == ["small.json"]   # no temporary files left
+
+
+@pytest.mark.slow
+def test_plan_reference_cell_twice_is_byte_identical(tmp_path: Path, reference_cell_path: Path) -> None:
+    outputs = []
+    for k in range(2):
+        out = tmp_path / f"run{k}"
+        result = runner.invoke(app, ["plan", str(reference_cell_path), "-o", str(out), "--json"])
+        assert result.exit_code == EXIT_OK, result.output
+        report = json.loads(result.output)
+        assert report["status"] == "planned" and len(report["spots"]) == 15
+        outputs.append((out / "cabin_flange.json").read_bytes())
+    assert outputs[0] == outputs[1]
+    check_trajectory_file(tmp_path / "run0" / "cabin_flange.json", 15, [0, -90, 90, 0, 0, 0], 0.5)
