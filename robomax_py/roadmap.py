@@ -24,7 +24,7 @@ from robomax_py.timing import ptp_time_estimate
 # Sampling box margin around the work's joint-space spread, rad (or m), per joint.
 BOX_MARGIN = 0.6
 # Lazy search gives up after this many blocked edges in one query.
-MAX_BLOCKED_PER_QUERY = 400
+MAX_BLOCKED_PER_QUERY = 60
 
 
 @dataclass(frozen=True, slots=True)
@@ -81,6 +81,12 @@ class Roadmap:
                 for v in row[1:]:
                     self._adjacent[u].add(int(v))
                     self._adjacent[int(v)].add(u)
+        # Edge weights (s, estimated) computed once, vectorised.
+        self._weight: dict[tuple[int, int], float] = {}
+        pairs = np.array([(u, v) for u, adj in enumerate(self._adjacent) for v in adj if u < v], dtype=np.int64)
+        if len(pairs):
+            w = ptp_time_estimate(self.nodes[pairs[:, 0]], self.nodes[pairs[:, 1]], limits)
+            self._weight = {(int(u), int(v)): float(x) for (u, v), x in zip(pairs, w)}
         self._edge_free: dict[tuple[int, int], bool] = {}
         self.edge_checks = 0
 
@@ -160,7 +166,9 @@ class Roadmap:
                 table = extra_free if u < 0 or v < 0 else self._edge_free
                 if table.get(key) is False:
                     continue
-                w = float(ptp_time_estimate(pu, point(v), self._limits))
+                w = self._weight.get(key)
+                if w is None:
+                    w = float(ptp_time_estimate(pu, point(v), self._limits))
                 nd = d + w
                 if nd < dist.get(v, np.inf):
                     dist[v] = nd
