@@ -22,9 +22,9 @@ from robomax_py.transforms import invert
 
 # The approach line is solved by IK at this TCP spacing; the sweep between samples is then checked
 # by `segment_free` with the collision world's own motion bound.
-APPROACH_SAMPLE_M = 0.005
+APPROACH_SAMPLE_M = 0.01
 # Largest joint change between neighbouring approach samples before we call it a branch switch:
-# 5 mm of TCP motion moves a well-conditioned wrist by well under 0.2 rad.
+# 10 mm of TCP motion moves a well-conditioned wrist by well under 0.2 rad.
 BRANCH_JUMP_RAD = 0.2
 
 

@@ -120,18 +120,27 @@ def _flatten(blocks: Blocks) -> tuple[int, ...]:
     return tuple(s for _, block in blocks for s in block)
 
 
-def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> list[Blocks]:
-    """Every order one move away: within free seams Or-opt (1-3 spots) and 2-opt; seam swaps."""
-    out: list[Blocks] = []
+def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> list[tuple[Blocks, tuple[int, ...]]]:
+    """Every order one move away, with its flat form: within free seams Or-opt (1-3 spots) and
+    2-opt; seam swaps. Flat orders are built by joining the unchanged prefix and suffix."""
+    out: list[tuple[Blocks, tuple[int, ...]]] = []
+    flats = [block for _, block in blocks]
     for b, (seam, block) in enumerate(blocks):
         if ordered[seam] or len(block) < 2:
             continue
+        prefix = tuple(s for f in flats[:b] for s in f)
+        suffix = tuple(s for f in flats[b + 1:] for s in f)
         n = len(block)
+        seen: set[tuple[int, ...]] = {block}
+
+        def add(new: tuple[int, ...]) -> None:
+            if new not in seen:
+                seen.add(new)
+                out.append((blocks[:b] + [(seam, new)] + blocks[b + 1:], prefix + new + suffix))
+
         for i in range(n):                                   # 2-opt: reverse block[i:j]
             for j in range(i + 2, n + 1):
-                new = block[:i] + block[i:j][::-1] + block[j:]
-                if new != block:
-                    out.append(blocks[:b] + [(seam, new)] + blocks[b + 1:])
+                add(block[:i] + block[i:j][::-1] + block[j:])
         for length in (1, 2, 3):                             # Or-opt: move a run elsewhere
             for i in range(n - length + 1):
                 run = block[i:i + length]
@@ -140,13 +149,11 @@ def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> list[Blocks]:
                     if k == i:
                         continue
                     for piece in (run, run[::-1]) if length > 1 else (run,):
-                        new = rest[:k] + piece + rest[k:]
-                        if new != block:
-                            out.append(blocks[:b] + [(seam, new)] + blocks[b + 1:])
-    for a, b in itertools.combinations(range(len(blocks)), 2):  # seam order
+                        add(rest[:k] + piece + rest[k:])
+    for a, c in itertools.combinations(range(len(blocks)), 2):  # seam order
         swapped = list(blocks)
-        swapped[a], swapped[b] = swapped[b], swapped[a]
-        out.append(swapped)
+        swapped[a], swapped[c] = swapped[c], swapped[a]
+        out.append((swapped, _flatten(swapped)))
     return out
 
 
@@ -206,8 +213,8 @@ def optimise(
     counter = {"evaluations": 0, "screened": 0, "improvements": 0}
     seen: dict[tuple[int, ...], float] = {}
 
-    def evaluate(candidate: Blocks) -> float:
-        flat = _flatten(candidate)
+    def evaluate(candidate: Blocks, flat: tuple[int, ...] | None = None) -> float:
+        flat = _flatten(candidate) if flat is None else flat
         if flat not in seen:
             counter["evaluations"] += 1
             seen[flat] = best_choice(flat, costs)[1]
@@ -220,7 +227,7 @@ def optimise(
             if not options:
                 break
             counter["screened"] += len(options)
-            bounds = _bounds([_flatten(c) for c in options], bound, home_index) + node_total
+            bounds = _bounds([flat for _, flat in options], bound, home_index) + node_total
             ranked = np.argsort(bounds, kind="stable").tolist()
             improved = False
             for rank, idx in enumerate(ranked):
@@ -230,9 +237,9 @@ def optimise(
                     rank >= screen and bounds[idx] >= current_cost - 1e-9
                 ):
                     break
-                value = evaluate(options[idx])
+                value = evaluate(*options[idx])
                 if value < current_cost - 1e-9:
-                    current, current_cost, improved = options[idx], value, True
+                    current, current_cost, improved = options[idx][0], value, True
                     counter["improvements"] += 1
                     break
             if not improved:
