@@ -93,6 +93,7 @@ class Transition:
     kind: str
     waypoints: FloatArray            # (m, n), both ends included
     label: str
+    checks: int = 0                  # collision checks spent finding this detour (0 for a straight move)
 
 
 @dataclass(frozen=True, slots=True)
@@ -435,7 +436,7 @@ class _Sequencer:
             if path is None:
                 complete = False
                 continue
-            out.append(Transition("detour", path, label))
+            out.append(Transition("detour", path, label, self.vias_for(i, j)[best_v].checks))
         return out if complete else None
 
     def _check_straight(self, i: int, a: int, j: int, b: int) -> bool:
@@ -502,12 +503,10 @@ class _Sequencer:
                 if not res.free:
                     ok = False
                     break
-            self.checks += checks
-            checks = 0
             if ok:
                 keep = [0] + [k for k in range(1, 4) if not np.allclose(path[k], path[k - 1])]
                 wp = path[keep]
-                return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits))), 0)
+                return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits))), checks)
         self.checks += checks
         return None
 

@@ -34,7 +34,10 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path]) -> dict
          "gamma": round(math.degrees(s.angles[2]), 3), "config": s.config}
         for s in result.spots
     ]
-    report["detours"] = [t.label for t in result.transitions if t.kind == "detour"]
+    report["detours"] = [
+        {"between": t.label, "waypoints": len(t.waypoints), "checks_to_find": t.checks}
+        for t in result.transitions if t.kind == "detour"
+    ]
     if result.stats is not None:
         st = result.stats
         report["stats"] = {
@@ -52,7 +55,8 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
     if "cycle_time" in report:
         split = ", ".join(f"{k} {v:.2f}" for k, v in report["split"].items() if v > 0)
         head.add_row("cycle time", f"{report['cycle_time']:.2f} s  ({split})")
-        head.add_row("detours", ", ".join(report["detours"]) or "none")
+        detours = ", ".join(f"{d['between']} ({d['checks_to_find']} checks)" for d in report["detours"])
+        head.add_row("detours", detours or "none")
     head.add_row("planning", f"{report['planning_seconds']:.2f} s")
     for f in report["files"]:
         head.add_row("wrote", f)
