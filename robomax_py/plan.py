@@ -511,6 +511,7 @@ class _Sequencer:
         return None
 
     def _new_detour(self, i: int, a: int, j: int, b: int) -> None:
+        # Lift first: on clamp cells it is found in ~1,000 checks; the roadmap is the general fallback.
         det = self._lift_detour(i, a, j, b) or self.roadmap.query(self.q(i)[a], self.q(j)[b])
         if det is None:
             # No way found for this exact pair: make sure the optimiser stops choosing it.

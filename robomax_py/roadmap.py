@@ -23,6 +23,10 @@ from robomax_py.timing import ptp_time_estimate
 
 # Sampling box margin around the work's joint-space spread, rad (or m), per joint.
 BOX_MARGIN = 0.6
+# Share of samples drawn near the anchors (Gaussian, this sigma per joint) rather than uniformly:
+# detours leave and rejoin the work, where uniform samples in a 6-D box are sparse.
+NEAR_FRACTION = 0.5
+NEAR_SIGMA = 0.25
 # Lazy search gives up after this many blocked edges in one query.
 MAX_BLOCKED_PER_QUERY = 60
 
@@ -63,8 +67,11 @@ class Roadmap:
         hi = np.minimum(np.max(anchors, axis=0) + BOX_MARGIN, limits.upper)
         self.sampling_checks = 0
         nodes: list[FloatArray] = []
+        anchors = np.asarray(anchors, dtype=float)
         while len(nodes) < n_nodes and self.sampling_checks < max_samples:
-            batch = rng.uniform(lo, hi, size=(256, len(lo)))
+            uniform = rng.uniform(lo, hi, size=(256, len(lo)))
+            near = anchors[rng.integers(len(anchors), size=256)] + rng.normal(0.0, NEAR_SIGMA, size=(256, len(lo)))
+            batch = np.where((rng.random(256) < NEAR_FRACTION)[:, None], np.clip(near, lo, hi), uniform)
             free = world.are_free(batch)
             self.sampling_checks += len(batch)
             nodes.extend(batch[free])

@@ -156,7 +156,7 @@ def main() -> None:
     a6 = int(np.argmin(np.abs(spots[i6].q_app - q6).sum(axis=1)))
     t0 = cpu()
     lift = seq._lift_detour(i5, a5, i6, a6)
-    print(f"{'lift (up, across, down), ours':34s} {seq.checks:>10,} {cpu() - t0:>9.3f}  "
+    print(f"{'lift (up, across, down), ours':34s} {(lift.checks if lift else seq.checks):>10,} {cpu() - t0:>9.3f}  "
           f"{'found, ' + str(len(lift.waypoints)) + ' waypoints' if lift else 'none'}")
     t0 = cpu()
     anchors = np.vstack([cell.home[None, :], *[c.q_app for c in spots]])
