@@ -54,7 +54,9 @@ def test_dp_is_exact_for_a_fixed_order(seed: int) -> None:
     assert abs(recomputed - cost) < COST_TOL_S
 
 
-@pytest.mark.parametrize("seed", [*range(6), 24])
+@pytest.mark.parametrize(
+    "seed", [0, 24, *(pytest.param(k, marks=pytest.mark.slow) for k in range(1, 6))]
+)
 def test_local_search_matches_exact_optimum_on_small_instances(seed: int) -> None:
     rng = np.random.default_rng(seed)
     edge, node = make_instance(rng, n_spots=6, n_cand=5)
