@@ -22,6 +22,9 @@ import numpy as np
 from robomax_py._typing import FloatArray
 
 HOME = -1  # the start/end configuration, a layer of one node
+# Or-opt moves a run at most this many positions: spots of a seam lie along a line, far moves are
+# rarely good and are still reachable through 2-opt and perturbations; keeps neighbourhoods O(n^2).
+OR_OPT_WINDOW = 6
 # Consecutive perturbations that found no unseen order before the search gives up.
 MAX_STALE_KICKS = 50
 
@@ -121,8 +124,8 @@ def _flatten(blocks: Blocks) -> tuple[int, ...]:
 
 
 def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> list[tuple[Blocks, tuple[int, ...]]]:
-    """Every order one move away, with its flat form: within free seams Or-opt (1-3 spots) and
-    2-opt; seam swaps. Flat orders are built by joining the unchanged prefix and suffix."""
+    """Every order one move away, with its flat form: within free seams Or-opt (1-3 spots, moved at
+    most OR_OPT_WINDOW places) and 2-opt; seam swaps. Flat orders join the unchanged prefix and suffix."""
     out: list[tuple[Blocks, tuple[int, ...]]] = []
     flats = [block for _, block in blocks]
     for b, (seam, block) in enumerate(blocks):
@@ -145,7 +148,7 @@ def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> list[tuple[Blocks, t
             for i in range(n - length + 1):
                 run = block[i:i + length]
                 rest = block[:i] + block[i + length:]
-                for k in range(len(rest) + 1):
+                for k in range(max(0, i - OR_OPT_WINDOW), min(len(rest), i + OR_OPT_WINDOW) + 1):
                     if k == i:
                         continue
                     for piece in (run, run[::-1]) if length > 1 else (run,):
