@@ -12,9 +12,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from robomax_py._typing import BoolArray, FloatArray, IntArray
+from robomax_py._typing import FloatArray, IntArray
 from robomax_py.collision import CollisionWorld
-from robomax_py.ik import solve_all
+from robomax_py.ik import IkTable, solve_all
+from robomax_py.ik.turns import wrap_to_pi
 from robomax_py.robot import RobotModel, prismatic_mask
 from robomax_py.seams import OrientationGrid, approach_poses, orientation_grid, spot_poses
 from robomax_py.spec import CellSpec, SeamSpec
@@ -77,32 +78,24 @@ def seam_candidates(
     fractions = np.linspace(1.0, 0.0, n_line)                               # approach point -> spot
     T_line = np.stack([approach_poses(T_spot, cell.process.approach * f) for f in fractions], axis=2)
     table = solve_all(robot, T_line)                                        # (S, m, L, B, n)
-    reach = _reachable(table)
     checks = 0
     out: list[SpotCandidates] = []
-    for s, spot in enumerate(seam.spots):
-        result, used = _spot_candidates(cell, robot, world, seam, grid, s, table, reach, seam_index)
+    for s in range(len(seam.spots)):
+        result, used = _spot_candidates(robot, world, seam, grid, s, table, seam_index)
         checks += used
         out.append(result)
-        del spot
     return out, CandidateStats(ik_poses=int(np.prod(T_line.shape[:-2])), collision_checks=checks)
 
 
-def _reachable(table: object) -> BoolArray:
-    """Where the IK found a solution before limit filtering, if the table says; else its validity."""
-    reachable = getattr(table, "reachable", None)
-    return np.asarray(reachable if reachable is not None else table.valid)  # type: ignore[attr-defined]
-
-
 def _spot_candidates(
-    cell: CellSpec, robot: RobotModel, world: CollisionWorld, seam: SeamSpec, grid: OrientationGrid,
-    s: int, table: object, reach: BoolArray, seam_index: int,
+    robot: RobotModel, world: CollisionWorld, seam: SeamSpec, grid: OrientationGrid,
+    s: int, table: IkTable, seam_index: int,
 ) -> tuple[SpotCandidates, int]:
-    q = np.asarray(table.q)[s]                 # type: ignore[attr-defined]  (m, L, B, n)
-    valid = np.asarray(table.valid)[s]         # type: ignore[attr-defined]  (m, L, B)
-    status = np.asarray(table.status)[s]       # type: ignore[attr-defined]
-    turn = np.asarray(table.turn)[s]           # type: ignore[attr-defined]
-    reachable = reach[s]
+    q = table.q[s]                             # (m, L, B, n)
+    valid = table.valid[s]                     # (m, L, B)
+    status = table.status[s]
+    turn = table.turn[s]
+    reachable = table.reachable[s]             # a branch exists before limit filtering
     limits = robot.limits
     revolute = ~prismatic_mask(robot.model)
     rejected: Counter[str] = Counter()
@@ -122,7 +115,7 @@ def _spot_candidates(
             # the line jumps within its column: unwrap revolute joints towards the spot value.
             line = q[o, :, k].copy()                                        # (L, n)
             spot_q = line[-1]
-            line[:, revolute] = spot_q[revolute] + _wrap(line[:, revolute] - spot_q[revolute])
+            line[:, revolute] = spot_q[revolute] + wrap_to_pi(line[:, revolute] - spot_q[revolute])
             if not reachable[o, :, k].all() or np.abs(np.diff(line, axis=0)).max() > BRANCH_JUMP_RAD:
                 rejected["approach_branch"] += 1
                 continue
@@ -130,7 +123,7 @@ def _spot_candidates(
                 rejected["approach_joint_limit"] += 1
                 continue
             # Turn variants (q +- 2 pi) share their geometry: check each wrapped line once.
-            key = tuple(np.round(np.where(revolute, _wrap(line[-1]), line[-1]), 9))
+            key = tuple(np.round(np.where(revolute, wrap_to_pi(line[-1]), line[-1]), 9))
             verdict = verdicts.get(key)
             if verdict is None:
                 verdict, used = _line_verdict(world, line)
@@ -169,7 +162,3 @@ def _line_verdict(world: CollisionWorld, line: FloatArray) -> tuple[str, int]:
         if not res.free:
             return "approach_blocked", checks
     return "", checks
-
-
-def _wrap(q: FloatArray) -> FloatArray:
-    return (q + np.pi) % (2 * np.pi) - np.pi

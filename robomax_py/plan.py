@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import time
 from collections import Counter
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -20,11 +19,12 @@ from robomax_py._typing import FloatArray
 from robomax_py.candidates import SpotCandidates, seam_candidates
 from robomax_py.collision import CollisionWorld
 from robomax_py.ik import ConfigIndicator, solve_all
-from robomax_py.robot import RobotModel, fk_tcp
+from robomax_py.ik.turns import wrap_to_pi
+from robomax_py.robot import JointLimits, RobotModel, fk_tcp
 from robomax_py.roadmap import Detour, Roadmap
 from robomax_py.scene import build_scene
 from robomax_py.seams import approach_poses, orientation_grid, spot_poses
-from robomax_py.sequence import HOME, SeamBlock, Tour, best_choice, optimise, _Costs
+from robomax_py.sequence import HOME, SeamBlock, Tour, choice_for_order, optimise
 from robomax_py.spec import CellSpec
 from robomax_py.timing import (
     Segment,
@@ -394,7 +394,7 @@ class _Sequencer:
             self.rounds += 1
             if self.options.baseline:
                 order = tuple(s for b in blocks for s in b.spots)
-                choice, cost = best_choice(order, _Costs(self.cost, self.node))
+                choice, cost = choice_for_order(order, self.cost, self.node)
                 tour = Tour(order, choice, cost)
             else:
                 budget = self.options.max_evaluations if self.rounds == 1 else max(50, self.options.max_evaluations // 4)
@@ -490,7 +490,7 @@ class _Sequencer:
                 if not table.valid[0, column]:
                     break
                 lifted = table.q[0, column].copy()
-                ends.append(q + _wrap(lifted - q))
+                ends.append(q + wrap_to_pi(lifted - q))
             if len(ends) < 2 or not self.limits.contains(np.array(ends)).all():
                 continue
             path = np.array([qa, ends[0], ends[1], qb])
@@ -594,15 +594,11 @@ def _time_tour(
     return traj, plans
 
 
-def _move_segment(waypoints: FloatArray, lim: object, options: PlanOptions, kind: str, label: str) -> Segment:
+def _move_segment(waypoints: FloatArray, lim: JointLimits, options: PlanOptions, kind: str, label: str) -> Segment:
     """A straight jerk-limited PTP move, or a detour that stops at each waypoint (the checked polyline)."""
     if len(waypoints) == 2 or kind == "move":
-        return ptp_move(waypoints[0], waypoints[-1], lim, options.speed, kind=kind, label=label)  # type: ignore[arg-type]
-    return path_move(waypoints, lim, options.speed, mode="stop", kind=kind, label=label).segment  # type: ignore[arg-type]
+        return ptp_move(waypoints[0], waypoints[-1], lim, options.speed, kind=kind, label=label)
+    return path_move(waypoints, lim, options.speed, mode="stop", kind=kind, label=label).segment
 
 
-def _wrap(q: FloatArray) -> FloatArray:
-    return (q + np.pi) % (2 * np.pi) - np.pi
 
-
-Progress = Callable[[str, float], None]

@@ -119,6 +119,11 @@ def best_choice(order: Sequence[int], costs: _Costs) -> tuple[tuple[int, ...], f
 Blocks = list[tuple[int, tuple[int, ...]]]
 
 
+def choice_for_order(order: Sequence[int], edge: EdgeCosts, node: Sequence[FloatArray]) -> tuple[tuple[int, ...], float]:
+    """The exact best candidates for a fixed spot order (public form of `best_choice`)."""
+    return best_choice(order, _Costs(edge, node))
+
+
 def _flatten(blocks: Blocks) -> tuple[int, ...]:
     return tuple(s for _, block in blocks for s in block)
 
