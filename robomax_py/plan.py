@@ -76,6 +76,8 @@ class SpotPlan:
     q_app: FloatArray
     t_arrive: float
     t_leave: float
+    T_spot: FloatArray               # (4, 4) TCP at the spot, robot base frame
+    T_app: FloatArray                # (4, 4) TCP at the approach point, robot base frame
 
 
 @dataclass(frozen=True, slots=True)
@@ -122,6 +124,12 @@ class PlanResult:
     stats: PlanStats | None = None
     baseline: bool = False
     joint_names: tuple[str, ...] = ()
+    tool: str = ""
+    T_flange_tcp: FloatArray | None = None   # (4, 4)
+    T_world_base: FloatArray | None = None   # (4, 4)
+    home: FloatArray | None = None
+    options: PlanOptions = PlanOptions()
+    weld_time: float = 0.0
 
     @property
     def cycle_time(self) -> float:
@@ -189,7 +197,10 @@ def plan_cell(cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOpti
         rounds=sequencer.rounds, dp_evaluations=sequencer.dp_evaluations, seconds=clock,
     )
     return PlanResult(cell.name, robot.name, "planned", "planned", spots=tuple(plans), transitions=tuple(transitions),
-                      trajectory=trajectory, stats=stats, baseline=options.baseline, joint_names=robot.joint_names)
+                      trajectory=trajectory, stats=stats, baseline=options.baseline, joint_names=robot.joint_names,
+                      tool=cell.tool.name, T_flange_tcp=np.asarray(robot.T_flange_tcp),
+                      T_world_base=np.asarray(cell.T_world_base), home=np.asarray(cell.home), options=options,
+                      weld_time=cell.process.weld_time)
 
 
 def verify_trajectory(world: CollisionWorld, robot: RobotModel, traj: Trajectory) -> tuple[str, int]:
@@ -557,7 +568,7 @@ def _time_tour(
     T_base_world = invert(np.asarray(cell.T_world_base))
     grids = [orientation_grid(seam) for seam in cell.seams]
     q_now = np.asarray(cell.home, dtype=float)
-    welded: list[tuple[int, int]] = []
+    welded: list[tuple[int, int, FloatArray, FloatArray]] = []
     for step, trans in enumerate(transitions):
         wp = np.array(trans.waypoints, dtype=float)
         wp[0] = q_now
@@ -580,17 +591,17 @@ def _time_tour(
                        q_start=app.q[-1], kind="retract", label=label)
         segments.append(ret)
         q_now = ret.q[-1]
-        welded.append((i, a))
+        welded.append((i, a, T_spot, T_app))
     traj = resample(concatenate(segments))
     plans = []
-    for i, a in welded:
+    for i, a, T_spot, T_app in welded:
         c = spots[i]
         seam = cell.seams[c.seam_index]
         label = f"{seam.name}/{c.name}"
         phase = traj.phases_of("weld", label)[0]
         config = ConfigIndicator(int(c.status[a]), int(c.turn[a]))
         plans.append(SpotPlan(seam.name, c.name, c.angles[a], str(config), c.q_spot[a], c.q_app[a],
-                              float(phase.t_start), float(phase.t_end)))
+                              float(phase.t_start), float(phase.t_end), T_spot, T_app))
     return traj, plans
 
 

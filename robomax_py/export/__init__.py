@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from robomax_py.errors import ExportError
-from robomax_py.export import trajectory_json
+from robomax_py.export import plan_program, trajectory_json
 from robomax_py.plan import PlanResult
 
 Exporter = Callable[[PlanResult], str]
@@ -13,6 +13,7 @@ Exporter = Callable[[PlanResult], str]
 # format name -> (file extension, exporter)
 EXPORTERS: dict[str, tuple[str, Exporter]] = {
     "json": (".json", trajectory_json.render),
+    "srcl": (".srcl", plan_program.render),
 }
 
 

@@ -1,0 +1,88 @@
+"""A planned result -> the dialect-independent robot program (`robomax_py.program`).
+
+PTP moves to every stop (each detour waypoint is a stop: the polyline is what was checked), LIN
+approach and retract along the electrode axis with the chosen configuration indicator, a SPOT
+statement per spot, and comments carrying the planned times and orientation angles. Cartesian
+targets are TCP poses in the robot base frame (mm, ZYX degrees); the tool and base frames are
+declared. Names are made into identifiers where a cell uses other characters.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+
+from robomax_py.errors import ExportError
+from robomax_py.plan import PlanResult
+from robomax_py.program import Comment, FrameDef, Header, Instruction, LinMove, Program, PtpMove, Spot
+from robomax_py.transforms import rpy_from_matrix
+
+_NOT_IDENT = re.compile(r"[^A-Za-z0-9_]")
+
+
+def identifier(name: str) -> str:
+    """'door-L 2' -> 'door_L_2'; a leading digit gets an underscore; keywords are avoided."""
+    from robomax_py.export.srcl import RESERVED
+
+    ident = _NOT_IDENT.sub("_", name) or "_"
+    if ident[0].isdigit():
+        ident = "_" + ident
+    if ident.upper() in RESERVED or ident in RESERVED:
+        ident += "_"
+    return ident
+
+
+def pose_mm_zyx(T: np.ndarray) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(4, 4) pose -> position (mm) and ZYX angles (deg): R = Rz(a) Ry(b) Rx(c)."""
+    roll, pitch, yaw = rpy_from_matrix(np.asarray(T)[:3, :3])
+    xyz = tuple(float(v) * 1000.0 for v in np.asarray(T)[:3, 3])
+    return xyz, (math.degrees(yaw), math.degrees(pitch), math.degrees(roll))
+
+
+def program_from_plan(result: PlanResult) -> Program:
+    traj = result.trajectory
+    if traj is None or result.T_flange_tcp is None or result.T_world_base is None or result.home is None:
+        raise ExportError(f"cell {result.cell} has no complete plan to export")
+    opts = result.options
+    tool_xyz, tool_zyx = pose_mm_zyx(result.T_flange_tcp)
+    base_xyz, base_zyx = pose_mm_zyx(result.T_world_base)
+    frames = (
+        FrameDef(identifier(result.tool) + "_tcp", "tool", tool_xyz, tool_zyx),
+        FrameDef("robot_base", "base", base_xyz, base_zyx),
+    )
+    t0 = float(traj.t[0])
+    moves = [p for p in traj.phases if p.kind in ("move", "detour")]
+    out: list[Instruction] = [
+        Comment(f"start at home; {len(result.spots)} spots, planned cycle {traj.duration:.3f} s"),
+        PtpMove(tuple(np.degrees(result.home)), opts.speed, 1.0, comment="home"),
+    ]
+    for k, trans in enumerate(result.transitions):
+        start = f"t {moves[k].t_start - t0:.3f} s" if k < len(moves) else ""
+        for w, q in enumerate(trans.waypoints[1:], start=1):
+            last = w == len(trans.waypoints) - 1
+            note = f"{trans.label}, {start}" if w == 1 else ""
+            note = note if last or trans.kind == "move" else (note + ", " if note else "") + f"detour point {w}"
+            out.append(PtpMove(tuple(np.degrees(q)), opts.speed, 1.0, comment=note.strip(", ")))
+        if k >= len(result.spots):
+            break
+        spot = result.spots[k]
+        alpha, beta, gamma = (math.degrees(v) for v in spot.angles)
+        out.append(Comment(f"{spot.seam}/{spot.name}: arrive {spot.t_arrive - t0:.3f} s, leave "
+                           f"{spot.t_leave - t0:.3f} s, alpha {alpha:.1f} beta {beta:.1f} gamma {gamma:.1f} deg"))
+        for T in (spot.T_spot,):
+            xyz, zyx = pose_mm_zyx(T)
+            out.append(LinMove(xyz, zyx, spot.config, opts.tcp_speed * 1000.0, comment="approach"))
+        out.append(Spot(identifier(spot.name), identifier(spot.seam), result.weld_time))
+        xyz, zyx = pose_mm_zyx(spot.T_app)
+        out.append(LinMove(xyz, zyx, spot.config, opts.tcp_speed * 1000.0, comment="retract"))
+    header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
+                    tuple(identifier(j) for j in result.joint_names))
+    return Program(identifier(result.cell), header, frames, tuple(out))
+
+
+def render(result: PlanResult) -> str:
+    from robomax_py.export.srcl import write_program
+
+    return write_program(program_from_plan(result))

@@ -1,0 +1,311 @@
+"""A robot program as values, independent of any controller dialect.
+
+An exporter turns a `Program` into text (`export/srcl.py`) and a parser turns text back into one
+(`export/srcl_parser.py`). Every float is rounded *when the value is built* to the fixed number of
+decimals the program files carry, so ``parse(write(p)) == p`` holds exactly:
+
+=================================  =========  ========
+quantity                           unit       decimals
+=================================  =========  ========
+joint values (`PtpMove.target_deg`)  deg        4
+positions, frame offsets           mm         3
+ZYX orientation angles             deg        4
+PTP speed / acceleration           fraction   3
+LIN speed                          mm/s       3
+weld, wait and cycle times         s          3
+=================================  =========  ========
+
+Rounding is Python's correctly rounded `round` (half-even on the exact binary value), which agrees
+digit for digit with ``f"{x:.{n}f}"``; ``-0.0`` is stored as ``0.0``. Non-finite values are kept as
+they are (the writer rejects them), and nothing is range-checked here: `find_problem` says what is
+wrong with a value, and the writer (`ExportError`) and parser (`ProgramError`) report it.
+
+Orientations are ZYX angles ``(a, b, c)`` in degrees, R = Rz(a)·Ry(b)·Rx(c), as KUKA's A, B, C.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Literal, TypeAlias
+
+__all__ = [
+    "ANGLE_DECIMALS",
+    "JOINT_DECIMALS",
+    "MM_DECIMALS",
+    "SPEED_DECIMALS",
+    "TIME_DECIMALS",
+    "Comment",
+    "FrameDef",
+    "Header",
+    "Instruction",
+    "LinMove",
+    "Program",
+    "PtpMove",
+    "Spot",
+    "Wait",
+    "WaitFor",
+    "find_problem",
+]
+
+JOINT_DECIMALS = 4   # deg
+MM_DECIMALS = 3      # mm
+ANGLE_DECIMALS = 4   # deg (ZYX orientation angles)
+SPEED_DECIMALS = 3   # PTP fractions and LIN mm/s
+TIME_DECIMALS = 3    # s
+
+FrameKind: TypeAlias = Literal["tool", "base"]
+
+
+def _fixed(value: float, decimals: int) -> float:
+    """`value` rounded to `decimals` places; -0.0 becomes 0.0, NaN and inf pass through."""
+    x = float(value)
+    if not math.isfinite(x):
+        return x
+    return round(x, decimals) + 0.0
+
+
+def _fixed_all(values: Iterable[float], decimals: int) -> tuple[float, ...]:
+    return tuple(_fixed(v, decimals) for v in values)
+
+
+def _set(obj: object, name: str, value: object) -> None:
+    object.__setattr__(obj, name, value)
+
+
+@dataclass(frozen=True, slots=True)
+class Header:
+    """What the program is for.
+
+    Attributes
+    ----------
+    cell, robot, tool : str
+        Names of the cell, robot model and tool.
+    cycle_time_s : float
+        Planned cycle time, s (3 decimals).
+    joints : tuple[str, ...]
+        Joint names in controller order; every `PtpMove` gives one value per joint.
+    """
+
+    cell: str
+    robot: str
+    tool: str
+    cycle_time_s: float
+    joints: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        _set(self, "cycle_time_s", _fixed(self.cycle_time_s, TIME_DECIMALS))
+        _set(self, "joints", tuple(str(j) for j in self.joints))
+
+
+@dataclass(frozen=True, slots=True)
+class FrameDef:
+    """A named tool or base frame.
+
+    Attributes
+    ----------
+    name : str
+    kind : {"tool", "base"}
+        "tool": TCP in the flange frame; "base": robot base in the world frame.
+    xyz_mm : (3,) tuple of float
+        Origin, mm (3 decimals).
+    zyx_deg : (3,) tuple of float
+        Orientation as ZYX angles (A, B, C), deg (4 decimals).
+    """
+
+    name: str
+    kind: FrameKind
+    xyz_mm: tuple[float, ...]
+    zyx_deg: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        _set(self, "xyz_mm", _fixed_all(self.xyz_mm, MM_DECIMALS))
+        _set(self, "zyx_deg", _fixed_all(self.zyx_deg, ANGLE_DECIMALS))
+
+
+@dataclass(frozen=True, slots=True)
+class PtpMove:
+    """Joint-interpolated move.
+
+    Attributes
+    ----------
+    target_deg : (n_joints,) tuple of float
+        Joint values, deg (4 decimals).
+    speed, accel : float
+        Fractions of the maximum joint speed / acceleration, in (0, 1] (3 decimals).
+    flyby : bool
+        Blend into the next move instead of stopping exactly.
+    comment : str
+        Note carried with the move; surrounding whitespace is stripped; "" for none.
+    """
+
+    target_deg: tuple[float, ...]
+    speed: float = 1.0
+    accel: float = 1.0
+    flyby: bool = False
+    comment: str = ""
+
+    def __post_init__(self) -> None:
+        _set(self, "target_deg", _fixed_all(self.target_deg, JOINT_DECIMALS))
+        _set(self, "speed", _fixed(self.speed, SPEED_DECIMALS))
+        _set(self, "accel", _fixed(self.accel, SPEED_DECIMALS))
+        _set(self, "flyby", bool(self.flyby))
+        _set(self, "comment", str(self.comment).strip())
+
+
+@dataclass(frozen=True, slots=True)
+class LinMove:
+    """Straight-line TCP move.
+
+    Attributes
+    ----------
+    position_mm : (3,) tuple of float
+        TCP position in the base frame, mm (3 decimals).
+    zyx_deg : (3,) tuple of float
+        TCP orientation as ZYX angles (A, B, C), deg (4 decimals).
+    config : str
+        Arm configuration (status and turn), e.g. "S010 T101010"; "" for none.
+    speed_mm_s : float
+        TCP path speed, mm/s, > 0 (3 decimals).
+    flyby : bool
+    comment : str
+    """
+
+    position_mm: tuple[float, ...]
+    zyx_deg: tuple[float, ...]
+    config: str = ""
+    speed_mm_s: float = 250.0
+    flyby: bool = False
+    comment: str = ""
+
+    def __post_init__(self) -> None:
+        _set(self, "position_mm", _fixed_all(self.position_mm, MM_DECIMALS))
+        _set(self, "zyx_deg", _fixed_all(self.zyx_deg, ANGLE_DECIMALS))
+        _set(self, "config", str(self.config))
+        _set(self, "speed_mm_s", _fixed(self.speed_mm_s, SPEED_DECIMALS))
+        _set(self, "flyby", bool(self.flyby))
+        _set(self, "comment", str(self.comment).strip())
+
+
+@dataclass(frozen=True, slots=True)
+class Spot:
+    """Weld spot `name` of seam `seam` at the current point, holding for `time_s` s (3 decimals)."""
+
+    name: str
+    seam: str
+    time_s: float
+
+    def __post_init__(self) -> None:
+        _set(self, "time_s", _fixed(self.time_s, TIME_DECIMALS))
+
+
+@dataclass(frozen=True, slots=True)
+class Wait:
+    """Dwell for `seconds` s (3 decimals), >= 0."""
+
+    seconds: float
+
+    def __post_init__(self) -> None:
+        _set(self, "seconds", _fixed(self.seconds, TIME_DECIMALS))
+
+
+@dataclass(frozen=True, slots=True)
+class WaitFor:
+    """Block until the named input signal is set."""
+
+    signal: str
+
+
+@dataclass(frozen=True, slots=True)
+class Comment:
+    """A line of text for the reader; surrounding whitespace is stripped."""
+
+    text: str
+
+    def __post_init__(self) -> None:
+        _set(self, "text", str(self.text).strip())
+
+
+Instruction: TypeAlias = PtpMove | LinMove | Spot | Wait | WaitFor | Comment
+
+
+@dataclass(frozen=True, slots=True)
+class Program:
+    """A complete program: header, frame definitions and the instruction list, in order."""
+
+    name: str
+    header: Header
+    frames: tuple[FrameDef, ...] = ()
+    instructions: tuple[Instruction, ...] = ()
+
+    def __post_init__(self) -> None:
+        _set(self, "frames", tuple(self.frames))
+        _set(self, "instructions", tuple(self.instructions))
+
+
+def _finite(label: str, values: tuple[float, ...]) -> str | None:
+    for v in values:
+        if not math.isfinite(v):
+            return f"{label} must be finite, got {v}"
+    return None
+
+
+def _triple(label: str, values: tuple[float, ...]) -> str | None:
+    if len(values) != 3:
+        return f"{label} needs 3 values, got {len(values)}"
+    return _finite(label, values)
+
+
+def find_problem(item: Header | FrameDef | Instruction, n_joints: int) -> str | None:
+    """What is wrong with one value of a program, independent of the dialect; None if nothing.
+
+    Parameters
+    ----------
+    item : Header | FrameDef | Instruction
+    n_joints : int
+        Joint count from the header; a `PtpMove` must give exactly this many values.
+
+    Returns
+    -------
+    str | None
+        A short message such as "speed 0.000 is outside (0, 1]".
+    """
+    if isinstance(item, Header):
+        if not item.joints:
+            return "the robot needs at least one joint"
+        if len(set(item.joints)) != len(item.joints):
+            return "joint names must be unique"
+        return _finite("cycle time", (item.cycle_time_s,)) or (
+            f"cycle time {item.cycle_time_s:.3f} s is negative" if item.cycle_time_s < 0 else None
+        )
+    if isinstance(item, FrameDef):
+        if item.kind not in ("tool", "base"):
+            return f"frame kind must be 'tool' or 'base', got {item.kind!r}"
+        return _triple("frame position", item.xyz_mm) or _triple("frame orientation", item.zyx_deg)
+    if isinstance(item, PtpMove):
+        if len(item.target_deg) != n_joints:
+            return f"PTP target has {len(item.target_deg)} axis values, but the robot has {n_joints} joints"
+        problem = _finite("PTP axis value", item.target_deg) or _finite("PTP speed/accel", (item.speed, item.accel))
+        if problem:
+            return problem
+        for label, v in (("speed", item.speed), ("accel", item.accel)):
+            if not 0.0 < v <= 1.0:
+                return f"PTP {label} {v:.3f} is outside (0, 1] (a fraction of the maximum)"
+        return None
+    if isinstance(item, LinMove):
+        problem = (
+            _triple("LIN position", item.position_mm)
+            or _triple("LIN orientation", item.zyx_deg)
+            or _finite("LIN speed", (item.speed_mm_s,))
+        )
+        if problem:
+            return problem
+        return f"LIN speed {item.speed_mm_s:.3f} mm/s must be > 0" if item.speed_mm_s <= 0 else None
+    if isinstance(item, Spot):
+        problem = _finite("weld time", (item.time_s,))
+        return problem or (f"weld time {item.time_s:.3f} s is negative" if item.time_s < 0 else None)
+    if isinstance(item, Wait):
+        problem = _finite("wait time", (item.seconds,))
+        return problem or (f"wait time {item.seconds:.3f} s is negative" if item.seconds < 0 else None)
+    return None
