@@ -92,7 +92,7 @@ def test_plan_small_cell_writes_the_trajectory(tmp_path: Path) -> None:
     result = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
     assert result.exit_code == EXIT_OK, result.output
     check_trajectory_file(out / "small.json", 2, [0, -90, 90, 0, 0, 0], 0.5)
-    assert sorted(p.name for p in out.iterdir()) == ["small.json"]   # no temporary files left
+    assert sorted(p.name for p in out.iterdir()) == ["small.json", "small.srcl"]   # no temporary files left
 
 
 @pytest.mark.slow
