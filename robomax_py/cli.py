@@ -127,6 +127,39 @@ def plan(
     raise typer.Exit(code)
 
 
+@app.command()
+def verify(
+    cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
+    program: Annotated[Path, typer.Argument(help="trajectory file written by plan (.json)")],
+) -> None:
+    """Re-simulate a program against the cell; report collisions, limit and tolerance violations."""
+
+    def run() -> int:
+        from robomax_py.cell_io import load_cell, load_cell_robot
+        from robomax_py.errors import ProgramError
+        from robomax_py.verify import verify_trajectory_file
+
+        spec = load_cell(cell)
+        robot = load_cell_robot(spec)
+        if program.suffix.lower() != ".json":
+            raise ProgramError(program, None, "only trajectory files (.json) can be verified so far; "
+                                              "verify the .json that plan wrote beside this program")
+        report = verify_trajectory_file(spec, robot, program)
+        out.print(f"{program}: {report.samples} samples, cycle {report.cycle_time:.3f} s, "
+                  f"{report.collision_checks} collision checks")
+        for v in report.violations:
+            when = "" if v.t is None else f"t = {v.t:.3f} s: "
+            out.print(f"  [red]{v.kind}[/]: {when}{v.detail}", soft_wrap=True)
+        if report.clean:
+            out.print("[green]clean[/]: no collisions, limits kept, every spot welded within tolerance")
+            return EXIT_OK
+        out.print(f"[red]{len(report.violations)} violation(s)[/]")
+        return EXIT_VIOLATIONS
+
+    code = _guarded(run)
+    raise typer.Exit(code)
+
+
 def main() -> None:
     """Console entry point."""
     try:

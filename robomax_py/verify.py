@@ -1,0 +1,207 @@
+"""Re-simulate a written program against its cell and report every violation (no printing).
+
+A trajectory file (SPEC §5) is checked on its own samples, the motion between samples taken as
+linear in joint space: joint position, velocity and acceleration limits; collisions with static
+objects, dynamic objects inside their windows and the robot itself, swept between samples with the
+collision world's 2 mm bound; start and end at home; every spot of the cell welded once, at rest
+for at least the weld time with the TCP within 0.1 mm of the spot and its orientation within the
+seam's tolerance; the configuration indicator as written; ordered seams in their order.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.collision import CollisionWorld
+from robomax_py.errors import ProgramError
+from robomax_py.ik import config_of
+from robomax_py.robot import RobotModel, fk_tcp
+from robomax_py.scene import build_scene
+from robomax_py.seams import nominal_rotation
+from robomax_py.spec import CellSpec
+from robomax_py.tolerances import DEFAULT as TOL
+
+# Finite differences of 10 ms samples: velocity is exact for the linear interpolation the SPEC
+# prescribes; acceleration from second differences of a jerk-limited profile overshoots the
+# sampled peak slightly, hence the larger slack.
+VELOCITY_RTOL = 0.01
+ACCELERATION_RTOL = 0.05
+HOME_TOL_RAD = 1e-6
+REST_TOL_RAD = 1e-9          # joint change allowed while welding (file precision 1e-9 rad)
+ANGLE_TOL_RAD = 1e-6         # tolerance-window slack for the orientation angles
+TIME_TOL_S = 2e-6            # file times are written with 1 us resolution
+MAX_REPORTED_COLLISIONS = 20
+
+
+@dataclass(frozen=True, slots=True)
+class Violation:
+    t: float | None
+    kind: str                # collision | joint_limit | velocity | acceleration | spot | dwell | order | home | format
+    detail: str
+
+
+@dataclass(frozen=True, slots=True)
+class VerifyReport:
+    program: str
+    samples: int
+    cycle_time: float
+    collision_checks: int
+    violations: tuple[Violation, ...]
+
+    @property
+    def clean(self) -> bool:
+        return not self.violations
+
+
+def load_trajectory_file(path: Path, robot: RobotModel) -> dict[str, Any]:
+    """Read and check the structure of a SPEC §5 file; ProgramError names what is wrong."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ProgramError(path, None, "program file not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ProgramError(path, None, f"cannot read program: {exc}") from None
+    except json.JSONDecodeError as exc:
+        raise ProgramError(path, f"line {exc.lineno}, column {exc.colno}", f"not valid JSON: {exc.msg}") from None
+    if not isinstance(data, dict):
+        raise ProgramError(path, None, "expected a JSON object at the top level")
+    if data.get("format") != "robomax.trajectory/1":
+        raise ProgramError(path, "format", f"expected 'robomax.trajectory/1', got {data.get('format')!r}")
+    for key in ("joints", "t", "q", "spots"):
+        if key not in data:
+            raise ProgramError(path, key, "required key is missing")
+    if list(data["joints"]) != list(robot.joint_names):
+        raise ProgramError(path, "joints", f"expected {list(robot.joint_names)} for {robot.name}, got {data['joints']}")
+    try:
+        t = np.asarray(data["t"], dtype=float)
+        q = np.asarray(data["q"], dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ProgramError(path, "t/q", f"not numeric arrays: {exc}") from None
+    if t.ndim != 1 or len(t) < 2 or q.shape != (len(t), robot.dof) or not (np.isfinite(t).all() and np.isfinite(q).all()):
+        raise ProgramError(path, "q", f"expected {len(t)} rows of {robot.dof} finite joint values and as many times")
+    if not np.all(np.diff(t) > 0):
+        raise ProgramError(path, "t", "times must be strictly increasing")
+    for k, spot in enumerate(data["spots"]):
+        missing = [key for key in ("seam", "name", "t_arrive", "t_leave", "alpha", "beta", "gamma") if key not in spot]
+        if missing:
+            raise ProgramError(path, f"spots[{k}]", f"missing {', '.join(missing)}")
+    data["t"], data["q"] = t, q
+    return data
+
+
+def verify_trajectory_file(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
+    data = load_trajectory_file(path, robot)
+    t, q = data["t"], data["q"]
+    out: list[Violation] = []
+    lim = robot.limits
+    if abs(float(data.get("cycle_time", t[-1] - t[0])) - (t[-1] - t[0])) > TIME_TOL_S:
+        out.append(Violation(None, "format", f"cycle_time {data['cycle_time']} is not last t - first t"))
+    if np.diff(t).max() > 0.010 + TIME_TOL_S:
+        i = int(np.argmax(np.diff(t)))
+        out.append(Violation(float(t[i]), "format", f"samples {np.diff(t)[i] * 1000:.1f} ms apart (at most 10 ms)"))
+    for end, idx in (("start", 0), ("end", -1)):
+        if np.abs(q[idx] - cell.home).max() > HOME_TOL_RAD:
+            out.append(Violation(float(t[idx]), "home", f"program does not {end} at robot.home"))
+
+    outside = ~lim.contains(q, 1e-9)
+    for i in np.flatnonzero(outside)[:5]:
+        j = int(np.flatnonzero((q[i] < lim.lower - 1e-9) | (q[i] > lim.upper + 1e-9))[0])
+        out.append(Violation(float(t[i]), "joint_limit", f"{robot.joint_names[j]} = {math.degrees(q[i, j]):.3f} deg"))
+    dt = np.diff(t)
+    v = np.diff(q, axis=0) / dt[:, None]
+    over_v = np.abs(v) > lim.velocity * (1 + VELOCITY_RTOL)
+    for i, j in np.argwhere(over_v)[:5]:
+        out.append(Violation(float(t[i]), "velocity", f"{robot.joint_names[j]} {abs(v[i, j]):.3f} rad/s > "
+                                                      f"{lim.velocity[j]:.3f}"))
+    a = np.diff(v, axis=0) / ((dt[:-1] + dt[1:]) / 2)[:, None]
+    over_a = np.abs(a) > lim.acceleration * (1 + ACCELERATION_RTOL)
+    for i, j in np.argwhere(over_a)[:5]:
+        out.append(Violation(float(t[i + 1]), "acceleration", f"{robot.joint_names[j]} {abs(a[i, j]):.3f} rad/s^2 > "
+                                                              f"{lim.acceleration[j]:.3f}"))
+
+    world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+    checks = 0
+    collisions = 0
+    for i in range(len(t) - 1):
+        res = world.check_segment(q[i], q[i + 1], float(t[i]), float(t[i + 1]))
+        checks += res.checks
+        if not res.free:
+            qc = q[i] + (res.s_contact or 0.0) * (q[i + 1] - q[i])
+            tc = float(t[i] + (res.s_contact or 0.0) * (t[i + 1] - t[i]))
+            contact = world.first_contact(qc, tc)
+            out.append(Violation(tc, "collision", contact.describe() if contact else "collision"))
+            collisions += 1
+            if collisions >= MAX_REPORTED_COLLISIONS:
+                break
+
+    out.extend(_check_spots(cell, robot, data))
+    return VerifyReport(str(path), len(t), float(t[-1] - t[0]), checks, tuple(out))
+
+
+def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> list[Violation]:
+    t, q = data["t"], data["q"]
+    out: list[Violation] = []
+    wanted = {(seam.name, spot.name): (seam, spot) for seam in cell.seams for spot in seam.spots}
+    seen: dict[tuple[str, str], float] = {}
+    for entry in data["spots"]:
+        key = (str(entry["seam"]), str(entry["name"]))
+        label = f"{key[0]}/{key[1]}"
+        if key not in wanted:
+            out.append(Violation(None, "spot", f"{label} is not a spot of the cell"))
+            continue
+        if key in seen:
+            out.append(Violation(None, "spot", f"{label} welded twice"))
+            continue
+        seam, spot = wanted[key]
+        t0, t1 = float(entry["t_arrive"]), float(entry["t_leave"])
+        seen[key] = t0
+        if t1 - t0 < cell.process.weld_time - TIME_TOL_S:
+            out.append(Violation(t0, "dwell", f"{label}: dwell {t1 - t0:.3f} s < weld time {cell.process.weld_time:.3f} s"))
+        inside = (t >= t0 - TIME_TOL_S) & (t <= t1 + TIME_TOL_S)
+        if inside.sum() < 2:
+            out.append(Violation(t0, "dwell", f"{label}: no samples between arrive and leave"))
+            continue
+        qs = q[inside]
+        if np.ptp(qs, axis=0).max() > REST_TOL_RAD:
+            out.append(Violation(t0, "dwell", f"{label}: the robot moves while welding"))
+        T_world = np.asarray(cell.T_world_base) @ fk_tcp(robot, qs)
+        err = np.linalg.norm(T_world[:, :3, 3] - spot.xyz, axis=1).max()
+        if err > TOL.spot_pos_m:
+            out.append(Violation(t0, "spot", f"{label}: TCP {err * 1000:.3f} mm from the spot (at most 0.1 mm)"))
+        alpha, beta, gamma = _tolerance_angles(nominal_rotation(spot), T_world[0, :3, :3])
+        g0, g1 = seam.gamma_range
+        gamma_ok = g1 - g0 >= 2 * math.pi - ANGLE_TOL_RAD or any(
+            g0 - ANGLE_TOL_RAD <= gamma + k * 2 * math.pi <= g1 + ANGLE_TOL_RAD for k in (-1, 0, 1))
+        if abs(alpha) > seam.alpha_max + ANGLE_TOL_RAD or abs(beta) > seam.beta_max + ANGLE_TOL_RAD or not gamma_ok:
+            out.append(Violation(t0, "spot", f"{label}: orientation alpha {math.degrees(alpha):.2f} beta "
+                                             f"{math.degrees(beta):.2f} gamma {math.degrees(gamma):.2f} deg outside the tolerance"))
+        written = entry.get("config")
+        if written is not None:
+            actual = str(config_of(robot, qs[0]))
+            if str(written) != actual:
+                out.append(Violation(t0, "spot", f"{label}: configuration written as {written}, robot is in {actual}"))
+    for key in wanted:
+        if key not in seen:
+            out.append(Violation(None, "spot", f"{key[0]}/{key[1]} is never welded"))
+    for seam in cell.seams:
+        if seam.ordered:
+            times = [seen[(seam.name, s.name)] for s in seam.spots if (seam.name, s.name) in seen]
+            if any(b < a for a, b in zip(times[:-1], times[1:])):
+                out.append(Violation(None, "order", f"seam {seam.name} is ordered but welded out of order"))
+    return out
+
+
+def _tolerance_angles(R_nominal: FloatArray, R: FloatArray) -> tuple[float, float, float]:
+    """(alpha, beta, gamma) with R = R_nominal Rx(alpha) Ry(beta) Rz(gamma), rad."""
+    M = R_nominal.T @ R
+    beta = math.atan2(M[0, 2], math.hypot(M[1, 2], M[2, 2]))
+    alpha = math.atan2(-M[1, 2], M[2, 2])
+    gamma = math.atan2(-M[0, 1], M[0, 0])
+    return alpha, beta, gamma
