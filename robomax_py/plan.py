@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import time
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -40,6 +40,8 @@ from robomax_py.timing import (
 )
 from robomax_py.transforms import invert
 
+# Corner radii (rad, joint space) tried for blended detours, largest first.
+BLEND_RADII_RAD = (0.2, 0.1, 0.05)
 # Heights (m, world z) tried for up-across-down detours over clamps, lowest first.
 LIFT_HEIGHTS_M = (0.08, 0.15, 0.25, 0.4)
 # Cost of a detour not yet found, as a multiple of the straight move's estimate.
@@ -96,6 +98,7 @@ class Transition:
     waypoints: FloatArray            # (m, n), both ends included
     label: str
     checks: int = 0                  # collision checks spent finding this detour (0 for a straight move)
+    blend_radius: float = 0.0        # rad: corners passed on G2 blends of this radius; 0: stops at each
 
 
 @dataclass(frozen=True, slots=True)
@@ -179,7 +182,7 @@ def plan_cell(cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOpti
 
     t0 = time.perf_counter()
     try:
-        trajectory, plans = _time_tour(cell, robot, spots, tour, transitions, options)
+        trajectory, plans, transitions = _time_tour(cell, robot, world, spots, tour, transitions, options)
     except TimingError as exc:
         return PlanResult(cell.name, robot.name, "infeasible", f"timing failed: {exc}")
     clock["timing"] = time.perf_counter() - t0
@@ -251,8 +254,6 @@ def _failure(cell: CellSpec, c: SpotCandidates) -> SpotFailure:
 
 def _baseline_candidate(c: SpotCandidates) -> SpotCandidates:
     """The published method's choice: nearest-to-nominal orientation, then the first branch."""
-    from dataclasses import replace
-
     # Grid orientations are ordered by distance from nominal, so the lowest index is the nearest.
     best = int(np.lexsort((c.column, c.orient))[0])
     sel = np.array([best])
@@ -559,20 +560,23 @@ class _Sequencer:
 
 
 def _time_tour(
-    cell: CellSpec, robot: RobotModel, spots: list[SpotCandidates], tour: Tour,
+    cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots: list[SpotCandidates], tour: Tour,
     transitions: list[Transition], options: PlanOptions,
-) -> tuple[Trajectory, list[SpotPlan]]:
-    """Jerk-limited moves, stop-at-waypoint detours, LIN approach/retract and dwells, end to end."""
+) -> tuple[Trajectory, list[SpotPlan], list[Transition]]:
+    """Jerk-limited moves, blended (or stop-at-waypoint) detours, LIN approach/retract and dwells."""
     lim = robot.limits
     segments: list[Segment] = []
     T_base_world = invert(np.asarray(cell.T_world_base))
     grids = [orientation_grid(seam) for seam in cell.seams]
     q_now = np.asarray(cell.home, dtype=float)
     welded: list[tuple[int, int, FloatArray, FloatArray]] = []
+    timed: list[Transition] = []
     for step, trans in enumerate(transitions):
         wp = np.array(trans.waypoints, dtype=float)
         wp[0] = q_now
-        segments.append(_move_segment(wp, lim, options, trans.kind, trans.label))
+        segment, radius = _move_segment(wp, lim, options, trans.kind, trans.label, world)
+        segments.append(segment)
+        timed.append(replace(trans, blend_radius=radius))
         q_now = segments[-1].q[-1]
         if step == len(tour.order):
             break
@@ -602,14 +606,32 @@ def _time_tour(
         config = ConfigIndicator(int(c.status[a]), int(c.turn[a]))
         plans.append(SpotPlan(seam.name, c.name, c.angles[a], str(config), c.q_spot[a], c.q_app[a],
                               float(phase.t_start), float(phase.t_end), T_spot, T_app))
-    return traj, plans
+    return traj, plans, timed
 
 
-def _move_segment(waypoints: FloatArray, lim: JointLimits, options: PlanOptions, kind: str, label: str) -> Segment:
-    """A straight jerk-limited PTP move, or a detour that stops at each waypoint (the checked polyline)."""
+def _move_segment(
+    waypoints: FloatArray, lim: JointLimits, options: PlanOptions, kind: str, label: str, world: CollisionWorld
+) -> tuple[Segment, float]:
+    """A straight jerk-limited PTP move, or a detour.
+
+    A detour passes its corners on G2 quintic blends when the blended path is collision-free (the
+    largest radius of BLEND_RADII_RAD that checks free); otherwise it stops at each waypoint, on
+    the polyline that was checked when the detour was found.
+    """
     if len(waypoints) == 2 or kind == "move":
-        return ptp_move(waypoints[0], waypoints[-1], lim, options.speed, kind=kind, label=label)
-    return path_move(waypoints, lim, options.speed, mode="stop", kind=kind, label=label).segment
+        return ptp_move(waypoints[0], waypoints[-1], lim, options.speed, kind=kind, label=label), 0.0
+    stop = path_move(waypoints, lim, options.speed, mode="stop", kind=kind, label=label).segment
+    for radius in BLEND_RADII_RAD:
+        try:
+            moved = path_move(waypoints, lim, options.speed, mode="blend", blend_radius=radius, kind=kind, label=label)
+        except TimingError:
+            continue
+        if moved.segment.t[-1] - moved.segment.t[0] >= stop.t[-1] - stop.t[0]:
+            continue
+        path = moved.path
+        if all(world.segment_free(a, b) for a, b in zip(path[:-1], path[1:])):
+            return moved.segment, radius
+    return stop, 0.0
 
 
 

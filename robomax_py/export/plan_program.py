@@ -1,6 +1,7 @@
 """A planned result -> the dialect-independent robot program (`robomax_py.program`).
 
-PTP moves to every stop (each detour waypoint is a stop: the polyline is what was checked), LIN
+PTP moves to every stop (detour waypoints are FLYBY where the planner blended them, after checking
+the blended path), LIN
 approach and retract along the electrode axis with the chosen configuration indicator, a SPOT
 statement per spot, and comments carrying the planned times and orientation angles. Cartesian
 targets are TCP poses in the robot base frame (mm, ZYX degrees); the tool and base frames are
@@ -64,7 +65,11 @@ def program_from_plan(result: PlanResult) -> Program:
             last = w == len(trans.waypoints) - 1
             note = f"{trans.label}, {start}" if w == 1 else ""
             note = note if last or trans.kind == "move" else (note + ", " if note else "") + f"detour point {w}"
-            out.append(PtpMove(tuple(np.degrees(q)), opts.speed, 1.0, comment=note.strip(", ")))
+            # Blended detour corners are passed without stopping: FLYBY (radius in the comment).
+            flyby = trans.blend_radius > 0 and not last
+            if flyby:
+                note = (note + ", " if note else "") + f"fly-by radius {trans.blend_radius:.3f} rad"
+            out.append(PtpMove(tuple(np.degrees(q)), opts.speed, 1.0, flyby=flyby, comment=note.strip(", ")))
         if k >= len(result.spots):
             break
         spot = result.spots[k]
