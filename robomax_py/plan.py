@@ -33,10 +33,13 @@ from robomax_py.timing import (
     concatenate,
     dwell,
     lin_move,
+    line_path,
     path_move,
+    polyline_path,
     ptp_move,
     ptp_time_estimate,
     resample,
+    time_path,
 )
 from robomax_py.transforms import invert
 
@@ -64,6 +67,8 @@ class PlanOptions:
     straight_tries: int = 12         # blocked straight moves between two spots before detours only
     max_rounds: int = 80             # sequencing rounds (optimise, verify, repair)
     max_evaluations: int = 400       # DP evaluations per sequencing round
+    jerk_limited: bool = True        # PTP moves and detour legs with ruckig; False: toppra (vel/acc only)
+    blend: bool = True               # pass detour corners on checked G2 blends where that is faster
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -618,10 +623,14 @@ def _move_segment(
     largest radius of BLEND_RADII_RAD that checks free); otherwise it stops at each waypoint, on
     the polyline that was checked when the detour was found.
     """
+    if not options.jerk_limited:
+        # toppra on the polyline: it stops wherever the tangent jumps, i.e. at every waypoint.
+        path = line_path(waypoints[0], waypoints[-1]) if len(waypoints) == 2 else polyline_path(waypoints)
+        return time_path(path, lim, options.speed, kind=kind, label=label), 0.0
     if len(waypoints) == 2 or kind == "move":
         return ptp_move(waypoints[0], waypoints[-1], lim, options.speed, kind=kind, label=label), 0.0
     stop = path_move(waypoints, lim, options.speed, mode="stop", kind=kind, label=label).segment
-    for radius in BLEND_RADII_RAD:
+    for radius in BLEND_RADII_RAD if options.blend else ():
         try:
             moved = path_move(waypoints, lim, options.speed, mode="blend", blend_radius=radius, kind=kind, label=label)
         except TimingError:

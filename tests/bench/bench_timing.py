@@ -1,0 +1,76 @@
+"""Timing benchmark on the reference cell (a script, not a test).
+
+    python tests/bench/bench_timing.py [CELL] [--runs 3]
+
+The same planned tour timed three ways: (a) toppra, velocity and acceleration limits only, stopping
+at every waypoint; (b) jerk-limited (ruckig) moves, stopping at detour waypoints; (c) (b) with detour
+corners blended where the blended path checks free. Reports medians of the cycle time, the time
+spent timing, and the ratio of the cycle time to a straight-move lower bound: the weld times plus,
+for every move between two stops (moves, detour legs, approach and retract), the slowest joint's
+time-optimal trapezoid time (velocity and acceleration limits) between the configurations.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+from robomax_py.cell_io import load_cell, load_cell_robot  # noqa: E402
+from robomax_py.plan import PlanOptions, PlanResult, plan_cell  # noqa: E402
+from robomax_py.robot import JointLimits  # noqa: E402
+from robomax_py.timing import ptp_time_estimate  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[2]
+VARIANTS = {
+    "(a) toppra vel/acc": PlanOptions(jerk_limited=False, blend=False),
+    "(b) jerk-limited": PlanOptions(jerk_limited=True, blend=False),
+    "(c) jerk-limited + blending": PlanOptions(jerk_limited=True, blend=True),
+}
+
+
+def lower_bound(result: PlanResult, limits: JointLimits) -> float:
+    """Weld times + per stop-to-stop move the slowest joint's trapezoid time (velocity, acceleration)."""
+    assert result.trajectory is not None and result.stats is not None
+    stops: list[np.ndarray] = []
+    for k, trans in enumerate(result.transitions):
+        stops.extend(trans.waypoints if k == 0 else trans.waypoints[1:])
+        if k < len(result.spots):
+            spot = result.spots[k]
+            stops.extend([spot.q_spot, spot.q_app])
+    qs = np.array(stops)
+    moves = float(np.sum(ptp_time_estimate(qs[:-1], qs[1:], limits, straight=False)))
+    return moves + result.weld_time * len(result.spots)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("cell", nargs="?", default=str(REPO / "cells" / "cabin_flange.yaml"))
+    parser.add_argument("--runs", type=int, default=3)
+    args = parser.parse_args()
+    cell = load_cell(args.cell)
+    robot = load_cell_robot(cell)
+    print(f"cell {cell.name}: {args.runs} runs, medians (timing stage: CPU seconds)")
+    print(f"{'variant':32s} {'cycle s':>9s} {'timing s':>9s} {'/ bound':>8s}")
+    bound = None
+    for name, options in VARIANTS.items():
+        cycles, seconds = [], []
+        for _ in range(args.runs):
+            result = plan_cell(cell, robot, options)
+            assert result.status == "planned", result.message
+            assert result.stats is not None
+            cycles.append(result.cycle_time)
+            seconds.append(result.stats.seconds["timing"])
+            bound = bound or lower_bound(result, robot.limits)
+        c = statistics.median(cycles)
+        print(f"{name:32s} {c:9.3f} {statistics.median(seconds):9.3f} {c / bound:8.3f}")
+    print(f"{'straight-move lower bound':32s} {bound:9.3f}")
+
+
+if __name__ == "__main__":
+    main()
