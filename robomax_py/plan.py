@@ -49,10 +49,10 @@ BLEND_RADII_RAD = (0.2, 0.1, 0.05)
 LIFT_HEIGHTS_M = (0.08, 0.15, 0.25, 0.4)
 # Cost of a detour not yet found, as a multiple of the straight move's estimate.
 DETOUR_PRIOR = 1.6
+# The planner's own check allows this relative velocity slack (toppra's output is within ~1e-5).
+PLAN_VELOCITY_RTOL = 1e-3
 # Placeholder keeping detour indices stable for pairs a detour cannot serve.
 _UNUSABLE = Detour(np.zeros((0, 0)), float("inf"), 0)
-# Limits are checked on the final samples with this relative slack (toppra's output is within ~1e-5).
-LIMIT_RTOL = 1e-3
 
 
 @dataclass(frozen=True, slots=True)
@@ -214,30 +214,15 @@ def plan_cell(cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOpti
 def verify_trajectory(world: CollisionWorld, robot: RobotModel, traj: Trajectory) -> tuple[str, int]:
     """'' if every sample is within limits and every straight step between samples is free, else why.
 
-    Between samples the motion is taken as linear in joint space (SPEC §5), which is exactly what
-    `check_segment` sweeps; dynamic obstacles are evaluated at the samples' times.
+    The same check `robomax verify` runs (`verify.check_motion`), stopping at the first problem.
     """
-    lim = robot.limits
-    tol = 1e-9
-    if not lim.contains(traj.q, tol).all():
-        i = int(np.flatnonzero(~lim.contains(traj.q, tol))[0])
-        return f"joint position limit at t = {traj.t[i]:.3f} s", 0
-    speed = np.abs(np.diff(traj.q, axis=0)) / np.diff(traj.t)[:, None]
-    over = speed > lim.velocity * (1 + LIMIT_RTOL)
-    if over.any():
-        i, j = np.argwhere(over)[0]
-        return f"{robot.joint_names[j]} velocity {speed[i, j]:.3f} rad/s over its limit at t = {traj.t[i]:.3f} s", 0
-    checks = 0
-    for i in range(len(traj.t) - 1):
-        res = world.check_segment(traj.q[i], traj.q[i + 1], float(traj.t[i]), float(traj.t[i + 1]))
-        checks += res.checks
-        if not res.free:
-            contact = world.first_contact(
-                traj.q[i] + (res.s_contact or 0.0) * (traj.q[i + 1] - traj.q[i]), float(traj.t[i])
-            )
-            what = contact.describe() if contact else "collision"
-            return f"{what} at t = {traj.t[i]:.3f} s", checks
-    return "", checks
+    from robomax_py.verify import check_motion
+
+    found, checks = check_motion(world, robot, traj.t, traj.q, stop_at_first=True, velocity_rtol=PLAN_VELOCITY_RTOL)
+    if not found:
+        return "", checks
+    v = found[0]
+    return f"{v.kind}: {v.detail} at t = {v.t:.3f} s", checks
 
 
 def _failure(cell: CellSpec, c: SpotCandidates) -> SpotFailure:

@@ -110,39 +110,63 @@ def verify_trajectory_file(cell: CellSpec, robot: RobotModel, path: Path) -> Ver
         if np.abs(q[idx] - cell.home).max() > HOME_TOL_RAD:
             out.append(Violation(float(t[idx]), "home", f"program does not {end} at robot.home"))
 
+    world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+    motion, checks = check_motion(world, robot, t, q)
+    out.extend(motion)
+    out.extend(_check_spots(cell, robot, data))
+    return VerifyReport(str(path), len(t), float(t[-1] - t[0]), checks, tuple(out))
+
+
+def check_motion(
+    world: CollisionWorld, robot: RobotModel, t: FloatArray, q: FloatArray,
+    max_collisions: int = MAX_REPORTED_COLLISIONS, stop_at_first: bool = False,
+    velocity_rtol: float = VELOCITY_RTOL,
+) -> tuple[list[Violation], int]:
+    """Limits and swept collisions of sampled motion, linear in joint space between samples.
+
+    Parameters
+    ----------
+    t : (k,) float, s, strictly increasing
+    q : (k, n) float, rad
+
+    velocity_rtol : relative slack on the velocity limits (the planner's own check is tighter).
+
+    Returns the violations (collisions in time order, at most `max_collisions`; with
+    `stop_at_first`, at most one violation and no collision check once a limit is broken) and
+    the number of collision checks spent.
+    """
+    lim = robot.limits
+    out: list[Violation] = []
     outside = ~lim.contains(q, 1e-9)
     for i in np.flatnonzero(outside)[:5]:
         j = int(np.flatnonzero((q[i] < lim.lower - 1e-9) | (q[i] > lim.upper + 1e-9))[0])
         out.append(Violation(float(t[i]), "joint_limit", f"{robot.joint_names[j]} = {math.degrees(q[i, j]):.3f} deg"))
     dt = np.diff(t)
     v = np.diff(q, axis=0) / dt[:, None]
-    over_v = np.abs(v) > lim.velocity * (1 + VELOCITY_RTOL)
-    for i, j in np.argwhere(over_v)[:5]:
+    for i, j in np.argwhere(np.abs(v) > lim.velocity * (1 + velocity_rtol))[:5]:
         out.append(Violation(float(t[i]), "velocity", f"{robot.joint_names[j]} {abs(v[i, j]):.3f} rad/s > "
                                                       f"{lim.velocity[j]:.3f}"))
     a = np.diff(v, axis=0) / ((dt[:-1] + dt[1:]) / 2)[:, None]
-    over_a = np.abs(a) > lim.acceleration * (1 + ACCELERATION_RTOL)
-    for i, j in np.argwhere(over_a)[:5]:
+    for i, j in np.argwhere(np.abs(a) > lim.acceleration * (1 + ACCELERATION_RTOL))[:5]:
         out.append(Violation(float(t[i + 1]), "acceleration", f"{robot.joint_names[j]} {abs(a[i, j]):.3f} rad/s^2 > "
                                                               f"{lim.acceleration[j]:.3f}"))
-
-    world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+    if stop_at_first and out:
+        return out[:1], 0
     checks = 0
     collisions = 0
+    limit = 1 if stop_at_first else max_collisions
     for i in range(len(t) - 1):
         res = world.check_segment(q[i], q[i + 1], float(t[i]), float(t[i + 1]))
         checks += res.checks
         if not res.free:
-            qc = q[i] + (res.s_contact or 0.0) * (q[i + 1] - q[i])
-            tc = float(t[i] + (res.s_contact or 0.0) * (t[i + 1] - t[i]))
-            contact = world.first_contact(qc, tc)
+            s_hit = res.s_contact or 0.0
+            tc = float(t[i] + s_hit * (t[i + 1] - t[i]))
+            contact = world.first_contact(q[i] + s_hit * (q[i + 1] - q[i]), tc)
             out.append(Violation(tc, "collision", contact.describe() if contact else "collision"))
             collisions += 1
-            if collisions >= MAX_REPORTED_COLLISIONS:
+            if collisions >= limit:
                 break
-
-    out.extend(_check_spots(cell, robot, data))
-    return VerifyReport(str(path), len(t), float(t[-1] - t[0]), checks, tuple(out))
+    return out, checks
 
 
 def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> list[Violation]:
