@@ -3,36 +3,20 @@
 from __future__ import annotations
 
 import json
-import shutil
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 from typer.testing import CliRunner
 
 from robomax_py.cli import EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_OK, app
 
-REPO = Path(__file__).resolve().parents[1]
-SHIPPED_CELL = REPO / "cells" / "cabin_flange.yaml"
+SmallCell = Callable[..., Path]   # conftest.write_small_cell
 MAX_DT_S = 0.010
 TIME_TOL_S = 1e-6        # the file writes times with 1 µs resolution
 JOINT_TOL_RAD = 2e-9     # the file writes joints with 1e-9 rad resolution
 runner = CliRunner()
-
-
-def small_cell(tmp_path: Path, extra_spots: list[dict] | None = None) -> Path:
-    """Two reachable spots of the shipped cell (between the clamps) plus any extra spots."""
-    data = yaml.safe_load(SHIPPED_CELL.read_text())
-    shutil.copytree(SHIPPED_CELL.parent / "parts", tmp_path / "parts")
-    spots = [s for s in data["seams"][0]["spots"] if s["name"] in ("s7", "s8")]
-    data["name"] = "small"
-    data["seams"][0]["spots"] = spots + (extra_spots or [])
-    data["seams"][0]["grid"] = 3
-    data["seams"][0]["tolerance"]["gamma"] = [0, 0]
-    path = tmp_path / "small.yaml"
-    path.write_text(yaml.safe_dump(data, sort_keys=False))
-    return path
 
 
 def test_robots_lists_the_library() -> None:
@@ -42,9 +26,9 @@ def test_robots_lists_the_library() -> None:
         assert name in result.output
 
 
-def test_unreachable_spot_exits_3_names_it_and_writes_nothing(tmp_path: Path) -> None:
+def test_unreachable_spot_exits_3_names_it_and_writes_nothing(tmp_path: Path, write_small_cell: SmallCell) -> None:
     far = {"name": "far", "xyz": [4.0, 0.0, 1.0], "normal": [-1, 0, 0], "direction": [0, 1, 0]}
-    cell = small_cell(tmp_path, [far])
+    cell = write_small_cell(tmp_path, "small", [far])
     out = tmp_path / "out"
     result = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
     assert result.exit_code == EXIT_INFEASIBLE, result.output
@@ -54,8 +38,8 @@ def test_unreachable_spot_exits_3_names_it_and_writes_nothing(tmp_path: Path) ->
     assert not out.exists()
 
 
-def test_bad_cell_exits_2_and_writes_nothing(tmp_path: Path) -> None:
-    cell = small_cell(tmp_path)
+def test_bad_cell_exits_2_and_writes_nothing(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    cell = write_small_cell(tmp_path, "small")
     text = cell.read_text().replace("weld_time: 0.5", "weld_time: -1")
     cell.write_text(text)
     out = tmp_path / "out"
@@ -86,8 +70,8 @@ def check_trajectory_file(path: Path, n_spots: int, home_deg: list[float], weld_
     return data
 
 
-def test_plan_small_cell_writes_the_trajectory(tmp_path: Path) -> None:
-    cell = small_cell(tmp_path)
+def test_plan_small_cell_writes_the_trajectory(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    cell = write_small_cell(tmp_path, "small")
     out = tmp_path / "out"
     result = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
     assert result.exit_code == EXIT_OK, result.output

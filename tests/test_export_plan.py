@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import pytest
-import yaml
 
 from robomax_py.cell_io import load_cell, load_cell_robot
 from robomax_py.export import EXPORTERS, render
@@ -20,19 +18,9 @@ GOLDEN = REPO / "tests" / "golden"
 
 
 @pytest.fixture(scope="module")
-def small_plan(tmp_path_factory: pytest.TempPathFactory):  # type: ignore[no-untyped-def]
-    """s7 and s8 of the shipped cell (no clamp between them), grid 3, gamma fixed."""
-    tmp = tmp_path_factory.mktemp("small")
-    data = yaml.safe_load((REPO / "cells" / "cabin_flange.yaml").read_text())
-    shutil.copytree(REPO / "cells" / "parts", tmp / "parts")
-    data["name"] = "small_cell"
-    seam = data["seams"][0]
-    seam["spots"] = [s for s in seam["spots"] if s["name"] in ("s7", "s8")]
-    seam["grid"] = 3
-    seam["tolerance"]["gamma"] = [0, 0]
-    path = tmp / "small_cell.yaml"
-    path.write_text(yaml.safe_dump(data, sort_keys=False))
-    cell = load_cell(path)
+def small_plan(tmp_path_factory: pytest.TempPathFactory, write_small_cell):  # type: ignore[no-untyped-def]
+    """The plan of the small test cell (conftest.write_small_cell)."""
+    cell = load_cell(write_small_cell(tmp_path_factory.mktemp("small")))
     result = plan_cell(cell, load_cell_robot(cell))
     assert result.status == "planned", result.message
     return result

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import copy
 import json
-import shutil
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -18,23 +18,15 @@ from robomax_py.cli import EXIT_BAD_INPUT, EXIT_OK, EXIT_VIOLATIONS, app
 from robomax_py.robot import fk_tcp
 from robomax_py.verify import verify_trajectory_file
 
-REPO = Path(__file__).resolve().parents[1]
+SmallCell = Callable[..., Path]   # conftest.write_small_cell
 runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
-def planned(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any], Path]:
-    """A small cell (s7, s8 of the shipped cell), its plan's trajectory file, and the folder."""
+def planned(tmp_path_factory: pytest.TempPathFactory, write_small_cell: SmallCell) -> tuple[Path, dict[str, Any], Path]:
+    """The small test cell (conftest.write_small_cell), its plan's trajectory file, and the folder."""
     tmp = tmp_path_factory.mktemp("verify")
-    data = yaml.safe_load((REPO / "cells" / "cabin_flange.yaml").read_text())
-    shutil.copytree(REPO / "cells" / "parts", tmp / "parts")
-    data["name"] = "small_cell"
-    seam = data["seams"][0]
-    seam["spots"] = [s for s in seam["spots"] if s["name"] in ("s7", "s8")]
-    seam["grid"] = 3
-    seam["tolerance"]["gamma"] = [0, 0]
-    cell = tmp / "small_cell.yaml"
-    cell.write_text(yaml.safe_dump(data, sort_keys=False))
+    cell = write_small_cell(tmp)
     result = runner.invoke(app, ["plan", str(cell), "-o", str(tmp / "out")])
     assert result.exit_code == EXIT_OK, result.output
     return cell, json.loads((tmp / "out" / "small_cell.json").read_text()), tmp
