@@ -26,25 +26,10 @@ from robomax_py.scene import build_scene
 from robomax_py.seams import approach_poses, orientation_grid, spot_poses
 from robomax_py.sequence import HOME, SeamBlock, Tour, choice_for_order, optimise
 from robomax_py.spec import CellSpec
-from robomax_py.timing import (
-    Segment,
-    Trajectory,
-    TimingError,
-    concatenate,
-    dwell,
-    lin_move,
-    line_path,
-    path_move,
-    polyline_path,
-    ptp_move,
-    ptp_time_estimate,
-    resample,
-    time_path,
-)
+from robomax_py.junction import WeldEnd, time_junction
+from robomax_py.timing import Segment, TimingError, Trajectory, concatenate, dwell, ptp_time_estimate, resample
 from robomax_py.transforms import invert
 
-# Corner radii (rad, joint space) tried for blended detours, largest first.
-BLEND_RADII_RAD = (0.2, 0.1, 0.05)
 # Heights (m, world z) tried for up-across-down detours over clamps, lowest first.
 LIFT_HEIGHTS_M = (0.08, 0.15, 0.25, 0.4)
 # Cost of a detour not yet found, as a multiple of the straight move's estimate.
@@ -68,7 +53,7 @@ class PlanOptions:
     max_rounds: int = 80             # sequencing rounds (optimise, verify, repair)
     max_evaluations: int = 400       # DP evaluations per sequencing round
     jerk_limited: bool = True        # PTP moves and detour legs with ruckig; False: toppra (vel/acc only)
-    blend: bool = True               # pass detour corners on checked G2 blends where that is faster
+    blend: bool = True               # fly by detour corners and approach points on checked G2 blends where faster
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -103,7 +88,8 @@ class Transition:
     waypoints: FloatArray            # (m, n), both ends included
     label: str
     checks: int = 0                  # collision checks spent finding this detour (0 for a straight move)
-    blend_radius: float = 0.0        # rad: corners passed on G2 blends of this radius; 0: stops at each
+    blend_radius: float = 0.0        # rad: detour corners passed on G2 blends of this radius; 0: stops at each
+    flyby_radius: float = 0.0        # rad: the retract -> move and move -> approach joins flown by; 0: stops
 
 
 @dataclass(frozen=True, slots=True)
@@ -553,39 +539,33 @@ def _time_tour(
     cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots: list[SpotCandidates], tour: Tour,
     transitions: list[Transition], options: PlanOptions,
 ) -> tuple[Trajectory, list[SpotPlan], list[Transition]]:
-    """Jerk-limited moves, blended (or stop-at-waypoint) detours, LIN approach/retract and dwells."""
-    lim = robot.limits
-    segments: list[Segment] = []
+    """Junction by junction (retract, move or detour, approach; `junction.time_junction`) and dwells."""
     T_base_world = invert(np.asarray(cell.T_world_base))
     grids = [orientation_grid(seam) for seam in cell.seams]
-    q_now = np.asarray(cell.home, dtype=float)
+    ends: list[WeldEnd] = []
     welded: list[tuple[int, int, FloatArray, FloatArray]] = []
-    timed: list[Transition] = []
-    for step, trans in enumerate(transitions):
-        wp = np.array(trans.waypoints, dtype=float)
-        wp[0] = q_now
-        segment, radius = _move_segment(wp, lim, options, trans.kind, trans.label, world)
-        segments.append(segment)
-        timed.append(replace(trans, blend_radius=radius))
-        q_now = segments[-1].q[-1]
-        if step == len(tour.order):
-            break
-        i, a = tour.order[step], tour.choice[step]
+    for i, a in zip(tour.order, tour.choice):
         c = spots[i]
         seam = cell.seams[c.seam_index]
         T_spot = T_base_world @ spot_poses((seam.spots[c.spot_index],), grids[c.seam_index])[0, c.orient[a]]
         T_app = approach_poses(T_spot, cell.process.approach)
-        column = int(c.column[a])
-        label = f"{seam.name}/{c.name}"
-        app = lin_move(robot, T_app, T_spot, column, lim, options.tcp_speed, speed=options.speed,
-                       q_start=q_now, kind="approach", label=label)
-        segments.append(app)
-        segments.append(dwell(app.q[-1], cell.process.weld_time, kind="weld", label=label))
-        ret = lin_move(robot, T_spot, T_app, column, lim, options.tcp_speed, speed=options.speed,
-                       q_start=app.q[-1], kind="retract", label=label)
-        segments.append(ret)
-        q_now = ret.q[-1]
+        ends.append(WeldEnd(T_spot, T_app, int(c.column[a]), f"{seam.name}/{c.name}"))
         welded.append((i, a, T_spot, T_app))
+    segments: list[Segment] = []
+    timed: list[Transition] = []
+    q_now = np.asarray(cell.home, dtype=float)
+    for k, trans in enumerate(transitions):
+        before = ends[k - 1] if k > 0 else None
+        after = ends[k] if k < len(ends) else None
+        junction = time_junction(
+            robot, world, robot.limits, q_now, trans.waypoints, trans.kind, trans.label, before, after,
+            tcp_speed=options.tcp_speed, speed=options.speed, jerk_limited=options.jerk_limited, flyby=options.blend,
+        )
+        segments.extend(junction.segments)
+        timed.append(replace(trans, blend_radius=junction.corner_radius, flyby_radius=junction.junction_radius))
+        q_now = segments[-1].q[-1]
+        if after is not None:
+            segments.append(dwell(q_now, cell.process.weld_time, kind="weld", label=after.label))
     traj = resample(concatenate(segments))
     plans = []
     for i, a, T_spot, T_app in welded:
@@ -597,35 +577,3 @@ def _time_tour(
         plans.append(SpotPlan(seam.name, c.name, c.angles[a], str(config), c.q_spot[a], c.q_app[a],
                               float(phase.t_start), float(phase.t_end), T_spot, T_app))
     return traj, plans, timed
-
-
-def _move_segment(
-    waypoints: FloatArray, lim: JointLimits, options: PlanOptions, kind: str, label: str, world: CollisionWorld
-) -> tuple[Segment, float]:
-    """A straight jerk-limited PTP move, or a detour.
-
-    A detour passes its corners on G2 quintic blends when the blended path is collision-free (the
-    largest radius of BLEND_RADII_RAD that checks free); otherwise it stops at each waypoint, on
-    the polyline that was checked when the detour was found.
-    """
-    if not options.jerk_limited:
-        # toppra on the polyline: it stops wherever the tangent jumps, i.e. at every waypoint.
-        path = line_path(waypoints[0], waypoints[-1]) if len(waypoints) == 2 else polyline_path(waypoints)
-        return time_path(path, lim, options.speed, kind=kind, label=label), 0.0
-    if len(waypoints) == 2 or kind == "move":
-        return ptp_move(waypoints[0], waypoints[-1], lim, options.speed, kind=kind, label=label), 0.0
-    stop = path_move(waypoints, lim, options.speed, mode="stop", kind=kind, label=label).segment
-    for radius in BLEND_RADII_RAD if options.blend else ():
-        try:
-            moved = path_move(waypoints, lim, options.speed, mode="blend", blend_radius=radius, kind=kind, label=label)
-        except TimingError:
-            continue
-        if moved.segment.t[-1] - moved.segment.t[0] >= stop.t[-1] - stop.t[0]:
-            continue
-        path = moved.path
-        if all(world.segment_free(a, b) for a, b in zip(path[:-1], path[1:])):
-            return moved.segment, radius
-    return stop, 0.0
-
-
-

@@ -8,6 +8,7 @@ decimals the program files carry, so ``parse(write(p)) == p`` holds exactly:
 quantity                           unit       decimals
 =================================  =========  ========
 joint values (`PtpMove.target_deg`)  deg        4
+fly-by radii (joint space)         deg        4
 positions, frame offsets           mm         3
 ZYX orientation angles             deg        4
 PTP speed / acceleration           fraction   3
@@ -134,8 +135,10 @@ class PtpMove:
         Joint values, deg (4 decimals).
     speed, accel : float
         Fractions of the maximum joint speed / acceleration, in (0, 1] (3 decimals).
-    flyby : bool
-        Blend into the next move instead of stopping exactly.
+    flyby : float
+        Fly-by radius, deg (4 decimals): pass the target without stopping, leaving the programmed
+        path within this joint-space distance (Euclidean over the joint values) of the target and
+        joining the next move; 0 stops exactly.
     comment : str
         Note carried with the move; surrounding whitespace is stripped; "" for none.
     """
@@ -143,14 +146,14 @@ class PtpMove:
     target_deg: tuple[float, ...]
     speed: float = 1.0
     accel: float = 1.0
-    flyby: bool = False
+    flyby: float = 0.0
     comment: str = ""
 
     def __post_init__(self) -> None:
         _set(self, "target_deg", _fixed_all(self.target_deg, JOINT_DECIMALS))
         _set(self, "speed", _fixed(self.speed, SPEED_DECIMALS))
         _set(self, "accel", _fixed(self.accel, SPEED_DECIMALS))
-        _set(self, "flyby", bool(self.flyby))
+        _set(self, "flyby", _fixed(self.flyby, ANGLE_DECIMALS))
         _set(self, "comment", str(self.comment).strip())
 
 
@@ -168,7 +171,8 @@ class LinMove:
         Arm configuration (status and turn), e.g. "S010 T101010"; "" for none.
     speed_mm_s : float
         TCP path speed, mm/s, > 0 (3 decimals).
-    flyby : bool
+    flyby : float
+        As for `PtpMove` (deg, joint space; 0 stops exactly).
     comment : str
     """
 
@@ -176,7 +180,7 @@ class LinMove:
     zyx_deg: tuple[float, ...]
     config: str = ""
     speed_mm_s: float = 250.0
-    flyby: bool = False
+    flyby: float = 0.0
     comment: str = ""
 
     def __post_init__(self) -> None:
@@ -184,7 +188,7 @@ class LinMove:
         _set(self, "zyx_deg", _fixed_all(self.zyx_deg, ANGLE_DECIMALS))
         _set(self, "config", str(self.config))
         _set(self, "speed_mm_s", _fixed(self.speed_mm_s, SPEED_DECIMALS))
-        _set(self, "flyby", bool(self.flyby))
+        _set(self, "flyby", _fixed(self.flyby, ANGLE_DECIMALS))
         _set(self, "comment", str(self.comment).strip())
 
 
@@ -257,6 +261,11 @@ def _triple(label: str, values: tuple[float, ...]) -> str | None:
     return _finite(label, values)
 
 
+def _flyby_problem(radius: float) -> str | None:
+    problem = _finite("fly-by radius", (radius,))
+    return problem or (f"fly-by radius {radius:.4f} deg is negative" if radius < 0 else None)
+
+
 def find_problem(item: Header | FrameDef | Instruction, n_joints: int) -> str | None:
     """What is wrong with one value of a program, independent of the dialect; None if nothing.
 
@@ -292,7 +301,7 @@ def find_problem(item: Header | FrameDef | Instruction, n_joints: int) -> str | 
         for label, v in (("speed", item.speed), ("accel", item.accel)):
             if not 0.0 < v <= 1.0:
                 return f"PTP {label} {v:.3f} is outside (0, 1] (a fraction of the maximum)"
-        return None
+        return _flyby_problem(item.flyby)
     if isinstance(item, LinMove):
         problem = (
             _triple("LIN position", item.position_mm)
@@ -301,7 +310,9 @@ def find_problem(item: Header | FrameDef | Instruction, n_joints: int) -> str | 
         )
         if problem:
             return problem
-        return f"LIN speed {item.speed_mm_s:.3f} mm/s must be > 0" if item.speed_mm_s <= 0 else None
+        if item.speed_mm_s <= 0:
+            return f"LIN speed {item.speed_mm_s:.3f} mm/s must be > 0"
+        return _flyby_problem(item.flyby)
     if isinstance(item, Spot):
         problem = _finite("weld time", (item.time_s,))
         return problem or (f"weld time {item.time_s:.3f} s is negative" if item.time_s < 0 else None)

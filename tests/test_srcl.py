@@ -42,12 +42,12 @@ def example_program() -> Program:
         instructions=(
             Comment("start at home"),
             PtpMove((0.0, -90.0, 90.0, 0.0, 0.0, 0.0), speed=1.0, accel=1.0, comment="home"),
-            PtpMove((-29.53125, -71.2, 101.33333333, -0.000001, 55.5, 179.99999), speed=0.8, accel=0.5, flyby=True),
-            LinMove((1224.88, -693.91, 893.2), (90.0, 0.0, 180.0), "S010 T101010", 500.0, flyby=True,
+            PtpMove((-29.53125, -71.2, 101.33333333, -0.000001, 55.5, 179.99999), speed=0.8, accel=0.5, flyby=11.999999),
+            LinMove((1224.88, -693.91, 893.2), (90.0, 0.0, 180.0), "S010 T101010", 500.0, flyby=1.2,
                     comment="approach s1"),
             LinMove((1224.88, -693.91, 843.2), (90.0, 0.0, 180.0), "S010 T101010", 150.0),
             Spot("s1", "flange", 0.5),
-            LinMove((1224.88, -693.91, 893.2), (90.0, 0.0, 180.0), "S010 T101010", 500.0, flyby=True),
+            LinMove((1224.88, -693.91, 893.2), (90.0, 0.0, 180.0), "S010 T101010", 500.0, flyby=0.6),
             WaitFor("door_clear"),
             Wait(2.0),
             Comment("back home"),
@@ -87,13 +87,13 @@ def test_parser_is_lenient_about_layout_but_not_meaning() -> None:
     text = (
         "PROGRAM p;  CELL c; { ignored } ROBOT r AXES(a1,a2); TOOL t; CYCLE 3 SEC;\n"
         "VAR f: BASE FRAME := (POS(1, 2, 3), ORI(4, 5, 6)); { ignored too }\n"
-        "BEGIN MOVE PTP AXIS(1.5, -2) SPEED 1 ACCEL 0.25 FLYBY;   WAIT 1.25 SEC; ENDPROGRAM;"
+        "BEGIN MOVE PTP AXIS(1.5, -2) SPEED 1 ACCEL 0.25 FLYBY 3;   WAIT 1.25 SEC; ENDPROGRAM;"
     )
     program = parse_program(text)
     assert program == Program(
         "p", Header("c", "r", "t", 3.0, ("a1", "a2")),
         (FrameDef("f", "base", (1, 2, 3), (4, 5, 6)),),
-        (PtpMove((1.5, -2.0), 1.0, 0.25, True), Wait(1.25)),
+        (PtpMove((1.5, -2.0), 1.0, 0.25, 3.0), Wait(1.25)),
     )
 
 
@@ -124,6 +124,7 @@ MM = _floats(-5000.0, 5000.0)
 ANGLE = _floats(-360.0, 360.0)
 FRACTION = _floats(0.001, 1.0)
 SECONDS = _floats(0.0, 1000.0)
+RADIUS = st.one_of(st.just(0.0), _floats(0.0001, 90.0))   # fly-by radius, deg; 0: exact stop
 
 
 @st.composite
@@ -138,9 +139,9 @@ def programs(draw: st.DrawFn) -> Program:
         for name in frame_names
     )
     instruction: st.SearchStrategy[Instruction] = st.one_of(
-        st.builds(PtpMove, st.tuples(*[_floats(-720.0, 720.0)] * n), FRACTION, FRACTION, st.booleans(), TEXT),
+        st.builds(PtpMove, st.tuples(*[_floats(-720.0, 720.0)] * n), FRACTION, FRACTION, RADIUS, TEXT),
         st.builds(LinMove, st.tuples(MM, MM, MM), st.tuples(ANGLE, ANGLE, ANGLE), CONFIG, _floats(0.001, 10000.0),
-                  st.booleans(), TEXT),
+                  RADIUS, TEXT),
         st.builds(Spot, NAMES, NAMES, SECONDS),
         st.builds(Wait, SECONDS),
         st.builds(WaitFor, NAMES),

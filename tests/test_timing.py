@@ -571,3 +571,19 @@ def test_lin_path_reports_unreachable(ur10: RobotModel) -> None:
     result = lin_path(ur10, T0, T1, _branch_of(ur10, Q_UR))
     assert not result.ok and result.reason == "unreachable"
     assert 0.0 < result.fraction < 1.0
+
+
+def test_time_path_phases_cuts_the_same_motion(limits: JointLimits) -> None:
+    from robomax_py.timing.topp import time_path_phases
+
+    w = np.array([[0.0] * N, [0.5] * N, [0.5, 1.0] + [0.3] * (N - 2)])
+    path, _ = blended_polyline_path(w, 0.2)
+    whole = time_path(path, limits)
+    cuts = np.array([0.0, 0.3 * path.length, 0.3 * path.length, 0.8 * path.length, path.length])
+    parts = time_path_phases(path, limits, cuts, [("move", "a"), ("move", "empty"), ("detour", "b"), ("move", "c")])
+    assert [p.kind for p in parts] == ["move", "move", "detour", "move"]
+    assert parts[1].duration == 0.0
+    joined = concatenate(parts)                      # raises if any join is off in position or speed
+    assert_allclose(joined.duration, whole.duration, rtol=1e-12)
+    assert_allclose(joined.q[-1], w[-1], atol=1e-12)
+    assert [p.label for p in joined.phases] == ["a", "empty", "b", "c"]

@@ -1,8 +1,7 @@
 """A planned result -> the dialect-independent robot program (`robomax_py.program`).
 
-PTP moves to every stop (detour waypoints are FLYBY where the planner blended them, after checking
-the blended path), LIN
-approach and retract along the electrode axis with the chosen configuration indicator, a SPOT
+PTP moves to every stop, FLYBY with the radius the planner chose and checked (detour corners, the
+joins retract -> move -> approach), LIN approach and retract along the electrode axis with the chosen configuration indicator, a SPOT
 statement per spot, and comments carrying the planned times and orientation angles. Cartesian
 targets are TCP poses in the robot base frame (mm, ZYX degrees); the tool and base frames are
 declared. Names are made into identifiers where a cell uses other characters.
@@ -54,34 +53,36 @@ def program_from_plan(result: PlanResult) -> Program:
         FrameDef("robot_base", "base", base_xyz, base_zyx),
     )
     t0 = float(traj.t[0])
-    moves = [p for p in traj.phases if p.kind in ("move", "detour")]
     out: list[Instruction] = [
         Comment(f"start at home; {len(result.spots)} spots, planned cycle {traj.duration:.3f} s"),
         PtpMove(tuple(np.degrees(result.home)), opts.speed, 1.0, comment="home"),
     ]
-    for k, trans in enumerate(result.transitions):
-        start = f"t {moves[k].t_start - t0:.3f} s" if k < len(moves) else ""
+    transitions = result.transitions
+    for k, trans in enumerate(transitions):
+        phases = traj.phases_of(trans.kind, trans.label)
+        start = f"t {phases[0].t_start - t0:.3f} s" if phases else ""
+        approach_follows = k < len(result.spots)
         for w, q in enumerate(trans.waypoints[1:], start=1):
             last = w == len(trans.waypoints) - 1
             note = f"{trans.label}, {start}" if w == 1 else ""
             note = note if last or trans.kind == "move" else (note + ", " if note else "") + f"detour point {w}"
-            # Blended detour corners are passed without stopping: FLYBY (radius in the comment).
-            flyby = trans.blend_radius > 0 and not last
-            if flyby:
-                note = (note + ", " if note else "") + f"fly-by radius {trans.blend_radius:.3f} rad"
-            out.append(PtpMove(tuple(np.degrees(q)), opts.speed, 1.0, flyby=flyby, comment=note.strip(", ")))
-        if k >= len(result.spots):
+            # Radii as planned: detour corners and the join into the approach (joint space, deg).
+            radius = (trans.flyby_radius if approach_follows else 0.0) if last else trans.blend_radius
+            out.append(PtpMove(tuple(np.degrees(q)), opts.speed, 1.0, flyby=math.degrees(radius),
+                               comment=note.strip(", ")))
+        if not approach_follows:
             break
         spot = result.spots[k]
         alpha, beta, gamma = (math.degrees(v) for v in spot.angles)
         out.append(Comment(f"{spot.seam}/{spot.name}: arrive {spot.t_arrive - t0:.3f} s, leave "
                            f"{spot.t_leave - t0:.3f} s, alpha {alpha:.1f} beta {beta:.1f} gamma {gamma:.1f} deg"))
-        for T in (spot.T_spot,):
-            xyz, zyx = pose_mm_zyx(T)
-            out.append(LinMove(xyz, zyx, spot.config, opts.tcp_speed * 1000.0, comment="approach"))
+        xyz, zyx = pose_mm_zyx(spot.T_spot)
+        out.append(LinMove(xyz, zyx, spot.config, opts.tcp_speed * 1000.0, comment="approach"))
         out.append(Spot(identifier(spot.name), identifier(spot.seam), result.weld_time))
         xyz, zyx = pose_mm_zyx(spot.T_app)
-        out.append(LinMove(xyz, zyx, spot.config, opts.tcp_speed * 1000.0, comment="retract"))
+        retract_radius = transitions[k + 1].flyby_radius if k + 1 < len(transitions) else 0.0
+        out.append(LinMove(xyz, zyx, spot.config, opts.tcp_speed * 1000.0, flyby=math.degrees(retract_radius),
+                           comment="retract"))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
                     tuple(identifier(j) for j in result.joint_names))
     return Program(identifier(result.cell), header, frames, tuple(out))

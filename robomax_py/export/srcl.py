@@ -101,8 +101,9 @@ def _frame(f: FrameDef) -> str:
     return f"{f.name}: {f.kind.upper()} FRAME := ({pos}, {ori});"
 
 
-def _tail(flyby: bool, comment: str) -> str:
-    return (" FLYBY" if flyby else "") + (f" {{ {comment} }}" if comment else "") + ";"
+def _tail(flyby: float, comment: str) -> str:
+    fly = f" FLYBY {_num(flyby, ANGLE_DECIMALS)}" if flyby > 0 else ""
+    return fly + (f" {{ {comment} }}" if comment else "") + ";"
 
 
 def _statement(ins: Instruction) -> str:

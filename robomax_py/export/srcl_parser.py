@@ -50,8 +50,9 @@ pos: "POS" "(" NUMBER "," NUMBER "," NUMBER ")"
 ori: "ORI" "(" NUMBER "," NUMBER "," NUMBER ")"
 
 _stmt: ptp | lin | spot | wait | wait_for | note
-ptp: "MOVE" "PTP" "AXIS" "(" NUMBER ("," NUMBER)* ")" "SPEED" NUMBER "ACCEL" NUMBER FLYBY? COMMENT? ";"
-lin: "MOVE" "LIN" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S FLYBY? COMMENT? ";"
+ptp: "MOVE" "PTP" "AXIS" "(" NUMBER ("," NUMBER)* ")" "SPEED" NUMBER "ACCEL" NUMBER flyby? COMMENT? ";"
+lin: "MOVE" "LIN" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S flyby? COMMENT? ";"
+flyby: FLYBY NUMBER
 spot: "SPOT" IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ";"
 wait: "WAIT" NUMBER "SEC" ";"
 wait_for: "WAIT" "FOR" IDENT ";"
@@ -282,7 +283,8 @@ class _Builder:
         return str(comments[0])[1:-1].strip() if comments else ""
 
     def statement(self, tree: Tree[Token]) -> Instruction:
-        flyby = bool(self.tokens(tree, "FLYBY"))
+        fly = [c for c in tree.children if isinstance(c, Tree) and c.data == "flyby"]
+        flyby = self.number(self.tokens(fly[0], "NUMBER")[0]) if fly else 0.0
         if tree.data == "ptp":
             values = [self.number(t) for t in self.tokens(tree, "NUMBER")]
             return PtpMove(tuple(values[:-2]), values[-2], values[-1], flyby, self.note(tree))

@@ -20,6 +20,7 @@ the end of a Cartesian retract into the next joint move).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -169,16 +170,87 @@ def blend_join(first: GeometricPath, second: GeometricPath, radius: float) -> Ge
         first[0, s_a] + join + second[s_b, end], s continuing across the pieces; time it with
         `time_path` (rest at both ends, no stop at the join).
     """
-    if float(np.max(np.abs(second.start - first.end))) > PATH_JOIN_TOL:
-        raise TimingError("blend_join: the second path must start where the first ends")
     if not radius >= MIN_BLEND_RADIUS:
         raise TimingError(f"blend radius must be >= {MIN_BLEND_RADIUS}, got {radius}")
-    corner = first.end
-    s_a = _cut_at_distance(first, corner, radius, from_end=True)
-    s_b = _cut_at_distance(second, corner, radius, from_end=False)
+    return blend_chain([first, second], [radius]).path
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class BlendedChain:
+    """Consecutive paths joined by `blend_join`-style quintics at every junction.
+
+    path : GeometricPath
+    piece_ranges : (m, 2) float
+        s range of what is left of each input path in `path` (the joins lie between them).
+    radii : (m - 1,) float
+        Radius used at each junction, rad; 0 where the junction stays sharp (a kink: a timed
+        move stops there).
+    """
+
+    path: GeometricPath
+    piece_ranges: FloatArray
+    radii: FloatArray
+
+
+def blend_chain(paths: Sequence[GeometricPath], radii: Sequence[float]) -> BlendedChain:
+    """Join paths end to start, flying by each junction within its radius (0: keep it sharp).
+
+    Each junction consumes at most half of the parameter range of either adjacent path, so joins
+    never overlap; a junction whose radius is below MIN_BLEND_RADIUS, or where a path ends with a
+    reversal of direction (turn above MAX_BLEND_TURN_RAD), stays sharp.
+    """
+    if len(paths) == 0 or len(radii) != len(paths) - 1:
+        raise TimingError(f"blend_chain needs m paths and m - 1 radii, got {len(paths)} and {len(radii)}")
+    for a, b in zip(paths[:-1], paths[1:]):
+        if float(np.max(np.abs(b.start - a.end))) > PATH_JOIN_TOL:
+            raise TimingError("blend_chain: each path must start where the previous one ends")
+    m = len(paths)
+    lo = np.zeros(m)
+    hi = np.array([p.length for p in paths])
+    used = np.zeros(m - 1)
+    joins: list[GeometricPath | None] = [None] * (m - 1)
+    for k in range(m - 1):
+        first, second, r = paths[k], paths[k + 1], float(radii[k])
+        if r < MIN_BLEND_RADIUS or _turn(first, second) > MAX_BLEND_TURN_RAD:
+            continue
+        corner = first.end
+        s_a = _cut_at_distance(first, corner, r, from_end=True)
+        s_b = _cut_at_distance(second, corner, r, from_end=False)
+        p0, p5 = first(s_a), second(s_b)
+        r_used = max(float(np.linalg.norm(p0 - corner)), float(np.linalg.norm(p5 - corner)))
+        if r_used < MIN_BLEND_RADIUS:
+            continue
+        joins[k] = _join(first, s_a, second, s_b, r_used)
+        hi[k], lo[k + 1], used[k] = s_a, s_b, r_used
+    parts: list[GeometricPath] = []
+    ranges = np.zeros((m, 2))
+    s = 0.0
+    for k, p in enumerate(paths):
+        start = s
+        if hi[k] - lo[k] > 1e-12 * max(p.length, 1.0):
+            piece = p if (lo[k] == 0.0 and hi[k] == p.length) else p.restrict(lo[k], hi[k])
+            parts.append(piece)
+            s += piece.length
+        ranges[k] = (start, s)
+        if k < m - 1 and joins[k] is not None:
+            parts.append(joins[k])
+            s += joins[k].length
+    return BlendedChain(concatenate_paths(parts), frozen_array(ranges), frozen_array(used))
+
+
+def _turn(first: GeometricPath, second: GeometricPath) -> float:
+    """Angle between the end tangent of `first` and the start tangent of `second`, rad."""
+    d0, d1 = first(first.length, 1), second(0.0, 1)
+    n0, n1 = float(np.linalg.norm(d0)), float(np.linalg.norm(d1))
+    if n0 <= ZERO_MOVE or n1 <= ZERO_MOVE:
+        return float(np.pi)
+    return float(np.arccos(np.clip(d0 @ d1 / (n0 * n1), -1.0, 1.0)))
+
+
+def _join(first: GeometricPath, s_a: float, second: GeometricPath, s_b: float, r_used: float) -> GeometricPath:
+    """The quintic from first(s_a) to second(s_b) matching value, first and second derivatives."""
     p0, d0, dd0 = first(s_a), first(s_a, 1), first(s_a, 2)
     p5, d5, dd5 = second(s_b), second(s_b, 1), second(s_b, 2)
-    r_used = max(float(np.linalg.norm(p0 - corner)), float(np.linalg.norm(p5 - corner)))
     speed = max(float(np.linalg.norm(d0)), float(np.linalg.norm(d5)), 1e-12)
     h = 2.5 * r_used / speed
     P = np.stack([
@@ -189,11 +261,7 @@ def blend_join(first: GeometricPath, second: GeometricPath, radius: float) -> Ge
         p5 - h / 5 * d5,
         p5,
     ])
-    parts = [first.restrict(0.0, s_a)] if s_a > 0 else []
-    parts.append(GeometricPath(breaks=np.array([0.0, h]), control_points=P[None]))
-    if s_b < second.length:
-        parts.append(second.restrict(s_b, second.length))
-    return concatenate_paths(parts)
+    return GeometricPath(breaks=np.array([0.0, h]), control_points=P[None])
 
 
 def _cut_at_distance(path: GeometricPath, point: FloatArray, radius: float, *, from_end: bool) -> float:

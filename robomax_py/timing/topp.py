@@ -18,7 +18,8 @@ Paths must be C1 for a move to pass through without stopping; `time_path` stops 
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -114,28 +115,115 @@ def _time_piece(
     path: GeometricPath, lim: KinematicLimits, speed_limit: PathSpeedLimit | None, dt: float, kind: str, label: str
 ) -> Segment:
     """Rest-to-rest toppra timing of a C1 path, sampled every <= dt."""
-    s_grid = gridpoints(path)
-    x = _toppra_sd_squared(path, s_grid, lim, speed_limit)
-    ds = np.diff(s_grid)
-    sd = np.sqrt(x)
-    mean = 0.5 * (sd[:-1] + sd[1:])
-    if np.any(mean <= 0):
-        raise TimingError("toppra returned a standstill inside the path")
-    t_grid = np.concatenate([[0.0], np.cumsum(ds / mean)])
-    u = (x[1:] - x[:-1]) / (2.0 * ds)                        # path acceleration per interval
-    t = time_grid(float(t_grid[-1]), dt)
-    i = np.clip(np.searchsorted(t_grid, t, side="right") - 1, 0, len(ds) - 1)
-    tau = t - t_grid[i]
-    s = np.minimum(s_grid[i] + sd[i] * tau + 0.5 * u[i] * tau * tau, s_grid[i + 1])
-    s_dot = np.maximum(sd[i] + u[i] * tau, 0.0)
-    s[0], s_dot[0], s[-1], s_dot[-1] = 0.0, 0.0, path.length, 0.0
-    d1 = path(s, 1)
-    q = path(s)
-    qd = d1 * s_dot[:, None]
-    qdd = path(s, 2) * (s_dot * s_dot)[:, None] + d1 * u[i][:, None]
-    q[0], q[-1] = path.start, path.end
-    qd[0], qd[-1] = 0.0, 0.0
-    return Segment(t=t, q=q, qd=qd, qdd=qdd, kind=kind, label=label)
+    law = _TimingLaw.of(path, lim, speed_limit)
+    return law.segment(path, law.times(0.0, law.duration, dt), kind, label)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _TimingLaw:
+    """s(t) from toppra's grid: constant path acceleration between grid points."""
+
+    s_grid: FloatArray
+    sd: FloatArray
+    u: FloatArray
+    t_grid: FloatArray
+
+    @staticmethod
+    def of(path: GeometricPath, lim: KinematicLimits, speed_limit: PathSpeedLimit | None) -> _TimingLaw:
+        s_grid = gridpoints(path)
+        x = _toppra_sd_squared(path, s_grid, lim, speed_limit)
+        ds = np.diff(s_grid)
+        sd = np.sqrt(x)
+        mean = 0.5 * (sd[:-1] + sd[1:])
+        if np.any(mean <= 0):
+            raise TimingError("toppra returned a standstill inside the path")
+        t_grid = np.concatenate([[0.0], np.cumsum(ds / mean)])
+        u = (x[1:] - x[:-1]) / (2.0 * ds)                        # path acceleration per interval
+        return _TimingLaw(s_grid, sd, u, t_grid)
+
+    @property
+    def duration(self) -> float:
+        return float(self.t_grid[-1])
+
+    def time_at(self, s: float) -> float:
+        """The time the motion passes path parameter s."""
+        i = int(np.clip(np.searchsorted(self.s_grid, s, side="right") - 1, 0, len(self.u) - 1))
+        rest = float(s - self.s_grid[i])
+        v, a = float(self.sd[i]), float(self.u[i])
+        if abs(a) < 1e-12:
+            tau = rest / v if v > 0 else 0.0
+        else:
+            tau = (-v + np.sqrt(max(v * v + 2.0 * a * rest, 0.0))) / a
+        return float(np.clip(self.t_grid[i] + tau, self.t_grid[i], self.t_grid[i + 1]))
+
+    def times(self, t0: float, t1: float, dt: float) -> FloatArray:
+        """Sample times from t0 to t1 (both included), at most dt apart."""
+        return t0 + time_grid(max(t1 - t0, 0.0), dt)
+
+    def segment(self, path: GeometricPath, t: FloatArray, kind: str, label: str) -> Segment:
+        """The motion sampled at times t (absolute on this law's clock), as a segment starting at 0."""
+        i = np.clip(np.searchsorted(self.t_grid, t, side="right") - 1, 0, len(self.u) - 1)
+        tau = t - self.t_grid[i]
+        s = np.minimum(self.s_grid[i] + self.sd[i] * tau + 0.5 * self.u[i] * tau * tau, self.s_grid[i + 1])
+        s_dot = np.maximum(self.sd[i] + self.u[i] * tau, 0.0)
+        at_start, at_end = t <= 0.0, t >= self.duration
+        s[at_start], s_dot[at_start] = 0.0, 0.0
+        s[at_end], s_dot[at_end] = path.length, 0.0
+        d1 = path(s, 1)
+        q = path(s)
+        qd = d1 * s_dot[:, None]
+        qdd = path(s, 2) * (s_dot * s_dot)[:, None] + d1 * self.u[i][:, None]
+        q[at_start], q[at_end] = path.start, path.end
+        qd[at_start | at_end] = 0.0
+        return Segment(t=t - t[0], q=q, qd=qd, qdd=qdd, kind=kind, label=label)
+
+
+def time_path_phases(
+    path: GeometricPath,
+    limits: JointLimits,
+    cuts: FloatArray,
+    names: Sequence[tuple[str, str]],
+    speed: float = 1.0,
+    *,
+    accel: float = 1.0,
+    path_speed_limit: PathSpeedLimit | None = None,
+    dt: float = DEFAULT_DT_S,
+) -> list[Segment]:
+    """`time_path`, with the motion cut into consecutive segments where s passes `cuts`.
+
+    cuts : (m + 1,) float
+        Non-decreasing s values from 0 to path.length; segment k covers [cuts[k], cuts[k + 1]].
+    names : m (kind, label) pairs, one per segment.
+
+    The segments join exactly (the cut sample belongs to both), so `concatenate` accepts them;
+    their total duration equals `time_path`'s. Empty ranges give zero-duration segments.
+    """
+    cuts = np.asarray(cuts, dtype=float)
+    if len(cuts) != len(names) + 1 or cuts[0] != 0.0 or abs(cuts[-1] - path.length) > 1e-9 * max(path.length, 1.0) \
+            or np.any(np.diff(cuts) < 0):
+        raise TimingError("cuts must run from 0 to the path length, one more than the names")
+    lim = scaled_limits(limits, speed, accel)
+    stops = [0.0, *kinks(path).tolist(), path.length]
+    laws = []
+    for a, b in zip(stops[:-1], stops[1:]):
+        piece = path if (a == 0.0 and b == path.length) else path.restrict(a, b)
+        shifted = None if path_speed_limit is None else _shifted(path_speed_limit, a)
+        laws.append((a, b, piece, _TimingLaw.of(piece, lim, shifted)))
+    out: list[Segment] = []
+    for k, (kind, label) in enumerate(names):
+        s0, s1 = float(cuts[k]), min(float(cuts[k + 1]), path.length)
+        parts: list[Segment] = []
+        for a, b, piece, law in laws:
+            lo, hi = max(s0, a), min(s1, b)
+            if hi < lo or (hi == lo and parts):
+                continue
+            t0 = law.time_at(lo - a) if lo > a else 0.0
+            t1 = law.time_at(hi - a) if hi < b else law.duration
+            parts.append(law.segment(piece, law.times(t0, max(t1, t0), dt), kind, label))
+        seg = parts[0] if len(parts) == 1 else as_segment(concatenate(parts), kind, label)
+        check_within_limits(seg.q, limits, "path")
+        out.append(seg)
+    return out
 
 
 def _toppra_sd_squared(

@@ -1,0 +1,138 @@
+"""Junctions fly by only where the flown path checks free and is faster; the electrodes keep the axis."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from robomax_py.cell_io import load_cell, load_cell_robot
+from robomax_py.junction import time_junction
+from robomax_py.plan import PlanOptions, PlanResult, plan_cell
+from robomax_py.robot import JointLimits, fk_tcp
+from robomax_py.spec import CellSpec, frozen_array
+from robomax_py.timing import concatenate
+
+# Distance (rad) from the polyline beyond which the strict world reports a collision.
+OFF_POLYLINE_RAD = 1e-6
+# TCP distance from the electrode axis allowed on the exact half of an approach, m (the LIN path
+# tolerance is 1e-5 m between samples; the dense samples here lie on the refined joint path).
+ON_AXIS_TOL_M = 2e-5
+# Relative slack on the TCP speed measured by finite differences of 4 ms samples.
+TCP_SPEED_RTOL = 0.01
+
+LIMITS = JointLimits(
+    lower=frozen_array([-3.0] * 3), upper=frozen_array([3.0] * 3), velocity=frozen_array([1.0] * 3),
+    acceleration=frozen_array([3.0] * 3), jerk=frozen_array([30.0] * 3),
+)
+WAYPOINTS = np.array([[0.0, 0.0, 0.0], [0.6, 0.0, 0.0], [0.6, 0.6, 0.0], [1.2, 0.6, 0.2]])
+
+
+def _distance_to_polyline(p: np.ndarray) -> float:
+    best = np.inf
+    for a, b in zip(WAYPOINTS[:-1], WAYPOINTS[1:]):
+        d = b - a
+        s = np.clip(np.dot(p - a, d) / np.dot(d, d), 0.0, 1.0)
+        best = min(best, float(np.linalg.norm(p - (a + s * d))))
+    return best
+
+
+class StrictWorld:
+    """Free only on the waypoint polyline: any corner cut 'collides'."""
+
+    def segment_free(self, q0: np.ndarray, q1: np.ndarray) -> bool:
+        return all(_distance_to_polyline(q0 + s * (q1 - q0)) <= OFF_POLYLINE_RAD for s in np.linspace(0, 1, 5))
+
+
+class OpenWorld:
+    def segment_free(self, q0: np.ndarray, q1: np.ndarray) -> bool:
+        return True
+
+
+def _detour(world: Any) -> Any:
+    # No LIN moves in this junction, so no robot model is needed.
+    return time_junction(None, world, LIMITS, WAYPOINTS[0], WAYPOINTS, "detour", "d", None, None,  # type: ignore[arg-type]
+                         tcp_speed=0.5)
+
+
+def _duration(junction: Any) -> float:
+    return sum(s.duration for s in junction.segments)
+
+
+def test_blocked_corners_fall_back_to_stopping_on_the_polyline() -> None:
+    junction = _detour(StrictWorld())
+    assert junction.corner_radius == 0.0 and junction.junction_radius == 0.0
+    for seg in junction.segments:
+        assert max(_distance_to_polyline(q) for q in seg.q) <= OFF_POLYLINE_RAD
+    assert len(junction.segments) == len(WAYPOINTS) - 1          # a rest-to-rest move per leg
+
+
+def test_free_corners_are_flown_and_faster() -> None:
+    stop = _detour(StrictWorld())
+    flown = _detour(OpenWorld())
+    assert flown.corner_radius > 0.0
+    assert _duration(flown) < _duration(stop)
+    traj = concatenate(flown.segments)
+    assert_allclose(traj.q[0], WAYPOINTS[0], atol=1e-9)
+    assert_allclose(traj.q[-1], WAYPOINTS[-1], atol=1e-9)
+    # Only where the corners are cut does the path leave the polyline, by less than the radius.
+    assert max(_distance_to_polyline(q) for q in traj.q) <= flown.corner_radius
+
+
+@pytest.fixture(scope="module")
+def small_plan(tmp_path_factory: pytest.TempPathFactory, write_small_cell: Any) -> tuple[CellSpec, Any, PlanResult]:
+    path: Path = write_small_cell(tmp_path_factory.mktemp("junction"))
+    cell = load_cell(path)
+    robot = load_cell_robot(cell)
+    return cell, robot, plan_cell(cell, robot, PlanOptions())
+
+
+def test_approach_points_are_flown_by_and_the_electrodes_keep_the_axis(small_plan: Any) -> None:
+    cell, robot, result = small_plan
+    assert result.status == "planned", result.message
+    traj = result.trajectory
+    assert all(t.flyby_radius > 0 for t in result.transitions), [t.flyby_radius for t in result.transitions]
+    approach = cell.process.approach
+    for spot in result.spots:
+        axis = spot.T_spot[:3, 2]                 # the electrode axis: TCP z
+        # Passing the approach point: the robot does not stop there.
+        for kind in ("approach", "retract"):
+            (phase,) = traj.phases_of(kind, f"{spot.seam}/{spot.name}")
+            inside = (traj.t > phase.t_start) & (traj.t < phase.t_end)
+            assert np.all(np.linalg.norm(traj.qd[inside], axis=1) > 0)
+        # The half of the approach nearest the sheet is exactly on the axis.
+        p = fk_tcp(robot, traj.q)[:, :3, 3]
+        rel = p - spot.T_spot[:3, 3]
+        along = -(rel @ axis)                    # distance back up the axis from the spot
+        off = np.linalg.norm(rel + along[:, None] * axis, axis=1)
+        near = (along >= -1e-9) & (along <= 0.5 * approach - 1e-4) & (np.linalg.norm(rel, axis=1) < approach)
+        assert np.any(near)
+        assert float(np.max(off[near])) <= ON_AXIS_TOL_M
+        # At rest on the spot for the weld.
+        weld = (traj.t >= spot.t_arrive) & (traj.t <= spot.t_leave)
+        assert float(np.max(np.linalg.norm(rel[weld], axis=1))) <= 1e-4
+        assert float(np.max(np.abs(traj.qd[weld]))) == 0.0
+
+
+def test_tcp_speed_holds_on_lines_and_their_joins(small_plan: Any) -> None:
+    cell, robot, result = small_plan
+    traj = result.trajectory
+    p = fk_tcp(robot, traj.q)[:, :3, 3]
+    v = np.linalg.norm(np.diff(p, axis=0), axis=1) / np.diff(traj.t)
+    limit = result.options.tcp_speed * (1 + TCP_SPEED_RTOL)
+    for kind in ("approach", "retract"):
+        for phase in traj.phases_of(kind):
+            k = np.arange(phase.i_start, phase.i_end)
+            assert float(np.max(v[k])) <= limit, f"{kind} {phase.label}: TCP at {np.max(v[k]):.3f} m/s"
+
+
+def test_without_flyby_every_junction_stops() -> None:
+    from robomax_py.junction import split_chains
+    from robomax_py.timing.chain import LinStep, PtpStep
+
+    steps = [LinStep(np.eye(4), 0.5, flyby=0.02), PtpStep(np.zeros(3), flyby=0.0), PtpStep(np.ones(3), flyby=0.1),
+             LinStep(np.eye(4), 0.5)]
+    assert [len(c) for c in split_chains(steps)] == [2, 2]
