@@ -130,21 +130,17 @@ def plan(
 @app.command()
 def verify(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
-    program: Annotated[Path, typer.Argument(help="trajectory file written by plan (.json)")],
+    program: Annotated[Path, typer.Argument(help="program written by plan: .srcl (motion rebuilt from its statements) or .json")],
 ) -> None:
     """Re-simulate a program against the cell; report collisions, limit and tolerance violations."""
 
     def run() -> int:
         from robomax_py.cell_io import load_cell, load_cell_robot
-        from robomax_py.errors import ProgramError
-        from robomax_py.verify import verify_trajectory_file
+        from robomax_py.verify import verify_program
 
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
-        if program.suffix.lower() != ".json":
-            raise ProgramError(program, None, "only trajectory files (.json) can be verified so far; "
-                                              "verify the .json that plan wrote beside this program")
-        report = verify_trajectory_file(spec, robot, program)
+        report = verify_program(spec, robot, program)
         out.print(f"{program}: {report.samples} samples, cycle {report.cycle_time:.3f} s, "
                   f"{report.collision_checks} collision checks")
         for v in report.violations:

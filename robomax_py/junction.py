@@ -40,7 +40,7 @@ class WeldEnd:
 
     T_spot: FloatArray
     T_app: FloatArray
-    column: int
+    column: int | None          # None: the column of the configuration the line starts from
     label: str
 
 
@@ -72,16 +72,19 @@ def time_junction(
 ) -> Junction:
     """The fastest collision-free way through a junction.
 
+    tcp_speed : the LIN lines' TCP speed, m/s (any override applied).
+    speed : the PTP moves' speed fraction.
     q_start : the configuration at the start (at the spot when `before` is given, else home).
-    waypoints : (m, n) the transition's joint path, first row its start (replaced by where the
-        retract ends), last row the approach point of `after` (or home).
+    waypoints : (m, n) the transition's joint path: first row where it starts (not used: the
+        motion starts where the retract ends, or at q_start), then the PTP targets, the last the
+        approach point of `after` (or home).
     """
     lin_cache: dict[bytes, LinPath] = {}
 
     def timed(rj: float, rd: float) -> tuple[float, list[ChainPath], list[Segment]] | None:
-        steps = _steps(waypoints, kind, label, before, after, tcp_speed, rj, rd)
+        steps = _steps(waypoints, kind, label, before, after, tcp_speed, speed, rj, rd)
         try:
-            return _time_steps(robot, limits, q_start, steps, speed, jerk_limited, lin_cache)
+            return _time_steps(robot, limits, q_start, steps, jerk_limited, lin_cache)
         except TimingError:
             return None
 
@@ -112,7 +115,7 @@ def time_junction(
 
 def _steps(
     waypoints: FloatArray, kind: str, label: str, before: WeldEnd | None, after: WeldEnd | None,
-    tcp_speed: float, rj: float, rd: float,
+    tcp_speed: float, speed: float, rj: float, rd: float,
 ) -> list[Step]:
     steps: list[Step] = []
     if before is not None:
@@ -121,7 +124,7 @@ def _steps(
     for w, q in enumerate(targets):
         last = w == len(targets) - 1
         fly = (rj if after is not None else 0.0) if last else rd
-        steps.append(PtpStep(q, flyby=fly, kind=kind, label=label))
+        steps.append(PtpStep(q, speed=speed, flyby=fly, kind=kind, label=label))
     if after is not None:
         steps.append(LinStep(after.T_spot, tcp_speed, after.column, kind="approach", label=after.label))
     return steps
@@ -138,7 +141,7 @@ def split_chains(steps: list[Step]) -> list[list[Step]]:
 
 
 def _time_steps(
-    robot: RobotModel, limits: JointLimits, q_start: FloatArray, steps: list[Step], speed: float,
+    robot: RobotModel, limits: JointLimits, q_start: FloatArray, steps: list[Step],
     jerk_limited: bool, lin_cache: dict[bytes, LinPath],
 ) -> tuple[float, list[ChainPath], list[Segment]]:
     q = np.asarray(q_start, dtype=float)
@@ -147,7 +150,7 @@ def _time_steps(
     for chain in split_chains(steps):
         path = chain_path(robot, q, chain, lin_cache=lin_cache)
         paths.append(path)
-        segments.extend(time_chain(path, chain, limits, speed=speed, jerk_limited=jerk_limited))
+        segments.extend(time_chain(path, chain, limits, jerk_limited=jerk_limited))
         q = np.asarray(path.targets[-1], dtype=float)
     return sum(s.duration for s in segments), paths, segments
 

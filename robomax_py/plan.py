@@ -27,6 +27,7 @@ from robomax_py.seams import approach_poses, orientation_grid, spot_poses
 from robomax_py.sequence import HOME, SeamBlock, Tour, choice_for_order, optimise
 from robomax_py.spec import CellSpec
 from robomax_py.junction import WeldEnd, time_junction
+from robomax_py.program import as_written_joints, as_written_pose, written_speed, written_tcp_speed
 from robomax_py.timing import Segment, TimingError, Trajectory, concatenate, dwell, ptp_time_estimate, resample
 from robomax_py.transforms import invert
 
@@ -548,18 +549,24 @@ def _time_tour(
         c = spots[i]
         seam = cell.seams[c.seam_index]
         T_spot = T_base_world @ spot_poses((seam.spots[c.spot_index],), grids[c.seam_index])[0, c.orient[a]]
-        T_app = approach_poses(T_spot, cell.process.approach)
-        ends.append(WeldEnd(T_spot, T_app, int(c.column[a]), f"{seam.name}/{c.name}"))
+        # Timed and checked as the program states them (rounded to its decimals), so the written
+        # program is exactly the motion checked here (`rebuild` gives it back).
+        T_spot = as_written_pose(T_spot)
+        T_app = as_written_pose(approach_poses(T_spot, cell.process.approach))
+        ends.append(WeldEnd(T_spot, T_app, None, f"{seam.name}/{c.name}"))
         welded.append((i, a, T_spot, T_app))
     segments: list[Segment] = []
     timed: list[Transition] = []
-    q_now = np.asarray(cell.home, dtype=float)
+    q_now = as_written_joints(cell.home)
     for k, trans in enumerate(transitions):
         before = ends[k - 1] if k > 0 else None
         after = ends[k] if k < len(ends) else None
+        waypoints = as_written_joints(trans.waypoints)      # the first row: where the retract ends
+        trans = replace(trans, waypoints=waypoints)
         junction = time_junction(
-            robot, world, robot.limits, q_now, trans.waypoints, trans.kind, trans.label, before, after,
-            tcp_speed=options.tcp_speed, speed=options.speed, jerk_limited=options.jerk_limited, flyby=options.blend,
+            robot, world, robot.limits, q_now, waypoints, trans.kind, trans.label, before, after,
+            tcp_speed=written_tcp_speed(options.tcp_speed * options.speed),
+            speed=written_speed(options.speed), jerk_limited=options.jerk_limited, flyby=options.blend,
         )
         segments.extend(junction.segments)
         timed.append(replace(trans, blend_radius=junction.corner_radius, flyby_radius=junction.junction_radius))
@@ -574,6 +581,7 @@ def _time_tour(
         label = f"{seam.name}/{c.name}"
         phase = traj.phases_of("weld", label)[0]
         config = ConfigIndicator(int(c.status[a]), int(c.turn[a]))
-        plans.append(SpotPlan(seam.name, c.name, c.angles[a], str(config), c.q_spot[a], c.q_app[a],
+        q_spot = np.asarray(traj.q[phase.i_start], dtype=float)
+        plans.append(SpotPlan(seam.name, c.name, c.angles[a], str(config), q_spot, as_written_joints(c.q_app[a]),
                               float(phase.t_start), float(phase.t_end), T_spot, T_app))
     return traj, plans, timed

@@ -31,7 +31,19 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Literal, TypeAlias
 
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.transforms import pose_matrix, rpy_from_matrix
+
 __all__ = [
+    "as_written_joints",
+    "as_written_pose",
+    "lin_pose",
+    "pose_mm_zyx",
+    "ptp_target",
+    "written_speed",
+    "written_tcp_speed",
     "ANGLE_DECIMALS",
     "JOINT_DECIMALS",
     "MM_DECIMALS",
@@ -320,3 +332,51 @@ def find_problem(item: Header | FrameDef | Instruction, n_joints: int) -> str | 
         problem = _finite("wait time", (item.seconds,))
         return problem or (f"wait time {item.seconds:.3f} s is negative" if item.seconds < 0 else None)
     return None
+
+
+# ------------------------------------------------------------------ values as a program states them
+
+
+def pose_mm_zyx(T: FloatArray) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(4, 4) pose -> position (mm) and ZYX angles (deg): R = Rz(a) Ry(b) Rx(c)."""
+    roll, pitch, yaw = rpy_from_matrix(np.asarray(T)[:3, :3])
+    xyz = tuple(float(v) * 1000.0 for v in np.asarray(T)[:3, 3])
+    return xyz, (math.degrees(yaw), math.degrees(pitch), math.degrees(roll))
+
+
+def ptp_target(move: PtpMove) -> FloatArray:
+    """The joint target a PTP move states, rad."""
+    return np.deg2rad(np.asarray(move.target_deg, dtype=float))
+
+
+def lin_pose(move: LinMove) -> FloatArray:
+    """The TCP pose a LIN move states, (4, 4) in m."""
+    a, b, c = np.deg2rad(np.asarray(move.zyx_deg, dtype=float))
+    return pose_matrix(np.asarray(move.position_mm, dtype=float) / 1000.0, [c, b, a])
+
+
+def as_written_joints(q: FloatArray) -> FloatArray:
+    """q (n,) or (m, n) rad as PTP statements give it back: rounded to the program's decimals.
+
+    The planner times and checks these values, so the program is exactly what was checked.
+    """
+    q = np.asarray(q, dtype=float)
+    if q.ndim == 2:
+        return np.array([as_written_joints(row) for row in q]).reshape(q.shape)
+    return ptp_target(PtpMove(tuple(float(v) for v in np.degrees(q))))
+
+
+def as_written_pose(T: FloatArray) -> FloatArray:
+    """A TCP pose as a LIN statement gives it back."""
+    xyz, zyx = pose_mm_zyx(T)
+    return lin_pose(LinMove(xyz, zyx))
+
+
+def written_speed(fraction: float) -> float:
+    """A PTP speed or acceleration fraction as a program states it."""
+    return _fixed(fraction, SPEED_DECIMALS)
+
+
+def written_tcp_speed(m_s: float) -> float:
+    """A LIN speed (m/s) as a program states it (in mm/s)."""
+    return _fixed(m_s * 1000.0, SPEED_DECIMALS) / 1000.0

@@ -44,6 +44,7 @@ MAX_REPORTED_COLLISIONS = 20
 class Violation:
     t: float | None
     kind: str                # collision | joint_limit | velocity | acceleration | spot | dwell | order | home | format
+    #                          (.srcl also: lin | config | flyby | frame | signal | timing)
     detail: str
 
 
@@ -96,25 +97,58 @@ def load_trajectory_file(path: Path, robot: RobotModel) -> dict[str, Any]:
     return data
 
 
+def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
+    """Verify a `.json` trajectory file or a `.srcl` program (its motion rebuilt from its statements)."""
+    if path.suffix.lower() == ".srcl":
+        return verify_srcl_file(cell, robot, path)
+    if path.suffix.lower() == ".json":
+        return verify_trajectory_file(cell, robot, path)
+    raise ProgramError(path, None, "expected a trajectory file (.json) or an SRCL program (.srcl)")
+
+
 def verify_trajectory_file(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
     data = load_trajectory_file(path, robot)
-    t, q = data["t"], data["q"]
+    t = data["t"]
     out: list[Violation] = []
-    lim = robot.limits
     if abs(float(data.get("cycle_time", t[-1] - t[0])) - (t[-1] - t[0])) > TIME_TOL_S:
         out.append(Violation(None, "format", f"cycle_time {data['cycle_time']} is not last t - first t"))
     if np.diff(t).max() > 0.010 + TIME_TOL_S:
         i = int(np.argmax(np.diff(t)))
         out.append(Violation(float(t[i]), "format", f"samples {np.diff(t)[i] * 1000:.1f} ms apart (at most 10 ms)"))
+    return _verify_motion(cell, robot, str(path), data, out)
+
+
+def verify_srcl_file(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
+    """Parse an SRCL program, rebuild its motion (`rebuild.rebuild`) and check it like a trajectory."""
+    from robomax_py.export.srcl_parser import parse_program
+    from robomax_py.rebuild import rebuild
+
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ProgramError(path, None, "program file not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ProgramError(path, None, f"cannot read program: {exc}") from None
+    rebuilt = rebuild(parse_program(text, path), cell, robot, path)
+    out = [Violation(p.t, p.kind, p.detail) for p in rebuilt.problems]
+    if rebuilt.trajectory is None:
+        return VerifyReport(str(path), 0, float("nan"), 0, tuple(out))
+    traj = rebuilt.trajectory
+    data = {"t": np.asarray(traj.t), "q": np.asarray(traj.q), "spots": rebuilt.spots}
+    return _verify_motion(cell, robot, str(path), data, out)
+
+
+def _verify_motion(cell: CellSpec, robot: RobotModel, name: str, data: dict[str, Any], out: list[Violation]) -> VerifyReport:
+    """Home at both ends, limits and swept collisions, spots: appended to `out`."""
+    t, q = data["t"], data["q"]
     for end, idx in (("start", 0), ("end", -1)):
         if np.abs(q[idx] - cell.home).max() > HOME_TOL_RAD:
             out.append(Violation(float(t[idx]), "home", f"program does not {end} at robot.home"))
-
     world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
     motion, checks = check_motion(world, robot, t, q)
     out.extend(motion)
     out.extend(_check_spots(cell, robot, data))
-    return VerifyReport(str(path), len(t), float(t[-1] - t[0]), checks, tuple(out))
+    return VerifyReport(name, len(t), float(t[-1] - t[0]), checks, tuple(out))
 
 
 def check_motion(

@@ -16,8 +16,7 @@ import numpy as np
 
 from robomax_py.errors import ExportError
 from robomax_py.plan import PlanResult
-from robomax_py.program import Comment, FrameDef, Header, Instruction, LinMove, Program, PtpMove, Spot
-from robomax_py.transforms import rpy_from_matrix
+from robomax_py.program import Comment, FrameDef, Header, Instruction, LinMove, Program, PtpMove, Spot, pose_mm_zyx
 
 _NOT_IDENT = re.compile(r"[^A-Za-z0-9_]")
 
@@ -32,13 +31,6 @@ def identifier(name: str) -> str:
     if ident.upper() in RESERVED or ident in RESERVED:
         ident += "_"
     return ident
-
-
-def pose_mm_zyx(T: np.ndarray) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """(4, 4) pose -> position (mm) and ZYX angles (deg): R = Rz(a) Ry(b) Rx(c)."""
-    roll, pitch, yaw = rpy_from_matrix(np.asarray(T)[:3, :3])
-    xyz = tuple(float(v) * 1000.0 for v in np.asarray(T)[:3, 3])
-    return xyz, (math.degrees(yaw), math.degrees(pitch), math.degrees(roll))
 
 
 def program_from_plan(result: PlanResult) -> Program:
@@ -58,6 +50,7 @@ def program_from_plan(result: PlanResult) -> Program:
         PtpMove(tuple(np.degrees(result.home)), opts.speed, 1.0, comment="home"),
     ]
     transitions = result.transitions
+    lin_mm_s = opts.tcp_speed * opts.speed * 1000.0     # the override scales LIN speeds too
     for k, trans in enumerate(transitions):
         phases = traj.phases_of(trans.kind, trans.label)
         start = f"t {phases[0].t_start - t0:.3f} s" if phases else ""
@@ -77,11 +70,11 @@ def program_from_plan(result: PlanResult) -> Program:
         out.append(Comment(f"{spot.seam}/{spot.name}: arrive {spot.t_arrive - t0:.3f} s, leave "
                            f"{spot.t_leave - t0:.3f} s, alpha {alpha:.1f} beta {beta:.1f} gamma {gamma:.1f} deg"))
         xyz, zyx = pose_mm_zyx(spot.T_spot)
-        out.append(LinMove(xyz, zyx, spot.config, opts.tcp_speed * 1000.0, comment="approach"))
+        out.append(LinMove(xyz, zyx, spot.config, lin_mm_s, comment="approach"))
         out.append(Spot(identifier(spot.name), identifier(spot.seam), result.weld_time))
         xyz, zyx = pose_mm_zyx(spot.T_app)
         retract_radius = transitions[k + 1].flyby_radius if k + 1 < len(transitions) else 0.0
-        out.append(LinMove(xyz, zyx, spot.config, opts.tcp_speed * 1000.0, flyby=math.degrees(retract_radius),
+        out.append(LinMove(xyz, zyx, spot.config, lin_mm_s, flyby=math.degrees(retract_radius),
                            comment="retract"))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
                     tuple(identifier(j) for j in result.joint_names))
