@@ -146,6 +146,10 @@ class ProcessFile(_Strict):
 
 class PlannerFile(_Strict):
     seed: Annotated[int, Field(ge=0)] = 0
+    # Extensions of SPEC §3 (README, "Cell file extensions"): speeds the program states per move.
+    speed: Annotated[float, Field(gt=0, le=1)] = 1.0
+    tcp_speed: Annotated[float, Field(gt=0, le=2)] = 0.5
+    detour_speed: Annotated[float, Field(gt=0, le=1)] = 1.0
 
 
 class CellFile(_Strict):
@@ -203,7 +207,8 @@ def load_cell(path: str | Path) -> CellSpec:
             approach=parsed.process.approach,
             clearance=parsed.process.clearance,
         ),
-        planner=PlannerSpec(seed=parsed.planner.seed),
+        planner=PlannerSpec(seed=parsed.planner.seed, speed=parsed.planner.speed, tcp_speed=parsed.planner.tcp_speed,
+                            detour_speed=parsed.planner.detour_speed),
         dynamic=tuple(_object(o, path, f"dynamic[{i}]") for i, o in enumerate(parsed.dynamic)),
     )
 

@@ -85,6 +85,7 @@ def plan(
     out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder")] = Path("programs"),
     baseline: Annotated[bool, typer.Option("--baseline", help="the published method: given order, nominal orientation, first branch")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable report instead of tables")] = False,
+    speed: Annotated[float | None, typer.Option("--speed", min=0.01, max=1.0, help="override of every programmed speed, fraction in (0, 1] (default: the cell's planner.speed, else 1)")] = None,
 ) -> None:
     """Plan a cell and write its program files (only when the plan is complete and verified)."""
 
@@ -101,7 +102,7 @@ def plan(
         t0 = time.perf_counter()
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
-        result = plan_cell(spec, robot, PlanOptions(baseline=baseline))
+        result = plan_cell(spec, robot, PlanOptions(baseline=baseline, speed=speed))
         seconds = time.perf_counter() - t0
         written: list[Path] = []
         if result.status == "planned":

@@ -46,8 +46,10 @@ class PlanOptions:
     """How to plan; every field has a production default."""
 
     baseline: bool = False           # the published method: given order, nominal orientation, first branch
-    speed: float = 1.0               # global velocity override in (0, 1]
-    tcp_speed: float = 0.5           # m/s on approach and retract lines
+    # Speeds; None takes the cell's `planner` values (defaults 1.0, 0.5 m/s, 1.0).
+    speed: float | None = None       # global override in (0, 1] of every programmed speed
+    tcp_speed: float | None = None   # m/s on approach and retract lines (before the override)
+    detour_speed: float | None = None  # speed fraction of detour moves (before the override)
     roadmap_nodes: int = 600
     roadmap_k: int = 12
     straight_tries: int = 12         # blocked straight moves between two spots before detours only
@@ -131,8 +133,20 @@ class PlanResult:
         return float("nan") if self.trajectory is None else self.trajectory.duration
 
 
+def resolved_options(cell: CellSpec, options: PlanOptions) -> PlanOptions:
+    """The options with every speed left None taken from the cell's `planner` section."""
+    p = cell.planner
+    return replace(
+        options,
+        speed=p.speed if options.speed is None else options.speed,
+        tcp_speed=p.tcp_speed if options.tcp_speed is None else options.tcp_speed,
+        detour_speed=p.detour_speed if options.detour_speed is None else options.detour_speed,
+    )
+
+
 def plan_cell(cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOptions()) -> PlanResult:
     """Plan a cell whose robot (with its tool mounted) is given."""
+    options = resolved_options(cell, options)
     clock: dict[str, float] = {}
     t0 = time.perf_counter()
     world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
@@ -308,7 +322,7 @@ class _Sequencer:
         det = self.vias_for(i, j)[v]
         if det is _UNUSABLE:
             return np.full((len(self.q(i)), len(self.q(j))), np.inf)
-        wp, sp = det.waypoints, self.options.speed
+        wp, sp = det.waypoints, self.options.speed * self.options.detour_speed
         enter = ptp_time_estimate(self.q(i), wp[0][None, :], self.limits, sp)
         leave = ptp_time_estimate(wp[-1][None, :], self.q(j), self.limits, sp)
         inner = float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits, sp)))
@@ -566,7 +580,8 @@ def _time_tour(
         junction = time_junction(
             robot, world, robot.limits, q_now, waypoints, trans.kind, trans.label, before, after,
             tcp_speed=written_tcp_speed(options.tcp_speed * options.speed),
-            speed=written_speed(options.speed), jerk_limited=options.jerk_limited, flyby=options.blend,
+            speed=written_speed(options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)),
+            jerk_limited=options.jerk_limited, flyby=options.blend,
         )
         segments.extend(junction.segments)
         timed.append(replace(trans, blend_radius=junction.corner_radius, flyby_radius=junction.junction_radius))

@@ -120,6 +120,9 @@ class ProcessSpec:
 @dataclass(frozen=True, slots=True)
 class PlannerSpec:
     seed: int = 0
+    speed: float = 1.0            # override of every programmed speed, fraction in (0, 1]
+    tcp_speed: float = 0.5        # m/s on the LIN approach and retract lines
+    detour_speed: float = 1.0     # speed fraction of PTP moves through detours (near clamps)
 
 
 @dataclass(frozen=True, slots=True, eq=False)

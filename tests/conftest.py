@@ -14,7 +14,8 @@ import yaml
 REPO = Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared"
 REFERENCE_CELL = SHARED / "cells" / "reference" / "cabin_flange.yaml"
-SHIPPED_CELL = REPO / "cells" / "cabin_flange.yaml"
+# The small test cell's source: a frozen copy of the reference cell (shipped cells may change).
+SHIPPED_CELL = REPO / "tests" / "data" / "flange_cell" / "cabin_flange.yaml"
 
 SmallCell = Callable[..., Path]
 

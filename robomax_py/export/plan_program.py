@@ -61,7 +61,8 @@ def program_from_plan(result: PlanResult) -> Program:
             note = note if last or trans.kind == "move" else (note + ", " if note else "") + f"detour point {w}"
             # Radii as planned: detour corners and the join into the approach (joint space, deg).
             radius = (trans.flyby_radius if approach_follows else 0.0) if last else trans.blend_radius
-            out.append(PtpMove(tuple(np.degrees(q)), opts.speed, 1.0, flyby=math.degrees(radius),
+            speed = opts.speed * (opts.detour_speed if trans.kind == "detour" else 1.0)
+            out.append(PtpMove(tuple(np.degrees(q)), speed, 1.0, flyby=math.degrees(radius),
                                comment=note.strip(", ")))
         if not approach_follows:
             break
