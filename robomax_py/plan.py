@@ -27,9 +27,10 @@ from robomax_py.seams import approach_poses, orientation_grid, spot_poses
 from robomax_py.sequence import HOME, SeamBlock, Tour, choice_for_order, optimise
 from robomax_py.spec import CellSpec
 from robomax_py.junction import WeldEnd, time_junction
-from robomax_py.program import as_written_joints, as_written_pose, written_speed, written_tcp_speed
+from robomax_py.program import as_written_joints, as_written_pose, written_seconds, written_speed, written_tcp_speed
 from robomax_py.timing import Segment, TimingError, Trajectory, concatenate, dwell, ptp_time_estimate, resample
 from robomax_py.transforms import invert
+from robomax_py.waiting import WaitingError, WaitPlan, schedule_waits
 
 # Heights (m, world z) tried for up-across-down detours over clamps, lowest first.
 LIFT_HEIGHTS_M = (0.08, 0.15, 0.25, 0.4)
@@ -93,6 +94,7 @@ class Transition:
     checks: int = 0                  # collision checks spent finding this detour (0 for a straight move)
     blend_radius: float = 0.0        # rad: detour corners passed on G2 blends of this radius; 0: stops at each
     flyby_radius: float = 0.0        # rad: the retract -> move and move -> approach joins flown by; 0: stops
+    wait: WaitPlan | None = None     # a wait at rest before it, for a dynamic obstacle to clear
 
 
 @dataclass(frozen=True, slots=True)
@@ -149,7 +151,11 @@ def plan_cell(cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOpti
     options = resolved_options(cell, options)
     clock: dict[str, float] = {}
     t0 = time.perf_counter()
-    world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+    full_world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+    # Planned as if the dynamic obstacles were absent; `waiting` then holds the robot where one is
+    # in the way. The final check is against everything, at its time.
+    world = CollisionWorld(robot, build_scene(replace(cell, dynamic=()), robot), cell.process.clearance) \
+        if cell.dynamic else full_world
     clock["world"] = time.perf_counter() - t0
 
     home_contact = world.first_contact(cell.home)
@@ -191,10 +197,12 @@ def plan_cell(cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOpti
         trajectory, plans, transitions = _time_tour(cell, robot, world, spots, tour, transitions, options)
     except TimingError as exc:
         return PlanResult(cell.name, robot.name, "infeasible", f"timing failed: {exc}")
+    except WaitingError as exc:
+        return PlanResult(cell.name, robot.name, "infeasible", f"dynamic obstacles: {exc}")
     clock["timing"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    problem, verify_checks = verify_trajectory(world, robot, trajectory)
+    problem, verify_checks = verify_trajectory(full_world, robot, trajectory)
     clock["verify"] = time.perf_counter() - t0
     if problem:
         return PlanResult(cell.name, robot.name, "infeasible", f"the timed program failed its own check: {problem}")
@@ -569,9 +577,10 @@ def _time_tour(
         T_app = as_written_pose(approach_poses(T_spot, cell.process.approach))
         ends.append(WeldEnd(T_spot, T_app, None, f"{seam.name}/{c.name}"))
         welded.append((i, a, T_spot, T_app))
-    segments: list[Segment] = []
+    blocks: list[list[Segment]] = []
     timed: list[Transition] = []
     q_now = as_written_joints(cell.home)
+    weld_time = written_seconds(cell.process.weld_time)
     for k, trans in enumerate(transitions):
         before = ends[k - 1] if k > 0 else None
         after = ends[k] if k < len(ends) else None
@@ -583,11 +592,20 @@ def _time_tour(
             speed=written_speed(options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)),
             jerk_limited=options.jerk_limited, flyby=options.blend,
         )
-        segments.extend(junction.segments)
+        block = list(junction.segments)
         timed.append(replace(trans, blend_radius=junction.corner_radius, flyby_radius=junction.junction_radius))
-        q_now = segments[-1].q[-1]
+        q_now = block[-1].q[-1]
         if after is not None:
-            segments.append(dwell(q_now, cell.process.weld_time, kind="weld", label=after.label))
+            block.append(dwell(q_now, weld_time, kind="weld", label=after.label))
+        blocks.append(block)
+    segments: list[Segment] = []
+    waits = {w.index: w for w in _waits(cell, robot, blocks)}
+    for k, block in enumerate(blocks):
+        if k in waits:
+            w = waits[k]
+            segments.append(dwell(block[0].q[0], w.seconds, kind="wait", label=f"wait for {w.obstacle}"))
+            timed[k] = replace(timed[k], wait=w)
+        segments.extend(block)
     traj = resample(concatenate(segments))
     plans = []
     for i, a, T_spot, T_app in welded:
@@ -600,3 +618,12 @@ def _time_tour(
         plans.append(SpotPlan(seam.name, c.name, c.angles[a], str(config), q_spot, as_written_joints(c.q_app[a]),
                               float(phase.t_start), float(phase.t_end), T_spot, T_app))
     return traj, plans, timed
+
+
+def _waits(cell: CellSpec, robot: RobotModel, blocks: list[list[Segment]]) -> list[WaitPlan]:
+    """Where the robot waits for dynamic obstacles (`waiting`), checked against them alone."""
+    if not cell.dynamic:
+        return []
+    world = CollisionWorld(robot, build_scene(replace(cell, objects=()), robot), cell.process.clearance)
+    windows = {d.name: d.present if d.present is not None else ((0.0, float("inf")),) for d in cell.dynamic}
+    return schedule_waits(world, blocks, windows)

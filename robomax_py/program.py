@@ -42,6 +42,7 @@ __all__ = [
     "lin_pose",
     "pose_mm_zyx",
     "ptp_target",
+    "written_seconds",
     "written_speed",
     "written_tcp_speed",
     "ANGLE_DECIMALS",
@@ -380,3 +381,8 @@ def written_speed(fraction: float) -> float:
 def written_tcp_speed(m_s: float) -> float:
     """A LIN speed (m/s) as a program states it (in mm/s)."""
     return _fixed(m_s * 1000.0, SPEED_DECIMALS) / 1000.0
+
+
+def written_seconds(seconds: float) -> float:
+    """A time (weld, wait) as a program states it."""
+    return _fixed(seconds, TIME_DECIMALS)

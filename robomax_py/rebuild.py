@@ -26,13 +26,12 @@ from robomax_py.program import Comment, FrameDef, LinMove, Program, PtpMove, Spo
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.timing import LinMoveError, Segment, TimingError, Trajectory, concatenate, dwell, resample
+from robomax_py.waiting import CLEAR_SUFFIX, clear_wait
 from robomax_py.timing.chain import LinStep, PtpStep, Step, chain_path, time_chain
 
 # Frame definitions must match the cell's tool and base within the program's decimals.
 FRAME_TOL_MM = 1.5e-3
 FRAME_TOL_DEG = 1.5e-4
-# Suffix of the signal that reports a dynamic object absent: `WAIT FOR door_clear;`.
-CLEAR_SUFFIX = "_clear"
 
 
 @dataclass(frozen=True, slots=True)
@@ -167,16 +166,14 @@ class _Builder:
             self.t += seconds
 
     def _wait_for(self, signal: str) -> None:
-        name = signal[: -len(CLEAR_SUFFIX)] if signal.endswith(CLEAR_SUFFIX) else None
-        obstacle = next((d for d in self.cell.dynamic if d.name == name), None)
+        from robomax_py.export.plan_program import identifier
+
+        obstacle = next((d for d in self.cell.dynamic if identifier(d.name) + CLEAR_SUFFIX == signal), None)
         if obstacle is None:
-            known = ", ".join(d.name + CLEAR_SUFFIX for d in self.cell.dynamic) or "none in this cell"
+            known = ", ".join(identifier(d.name) + CLEAR_SUFFIX for d in self.cell.dynamic) or "none in this cell"
             self.problems.append(Problem(self.t, "signal", f"WAIT FOR {signal}: unknown signal (known: {known})"))
             return
-        for a, b in obstacle.present or ():
-            if a <= self.t < b:
-                self._hold(b - self.t, f"WAIT FOR {signal}")
-                return
+        self._hold(clear_wait(self.t, obstacle.present or ()), f"WAIT FOR {signal}")
 
 
 def _frame_problems(frames: tuple[FrameDef, ...], cell: CellSpec, robot: RobotModel) -> list[Problem]:

@@ -16,7 +16,10 @@ import numpy as np
 
 from robomax_py.errors import ExportError
 from robomax_py.plan import PlanResult
-from robomax_py.program import Comment, FrameDef, Header, Instruction, LinMove, Program, PtpMove, Spot, pose_mm_zyx
+from robomax_py.program import (
+    Comment, FrameDef, Header, Instruction, LinMove, Program, PtpMove, Spot, Wait, WaitFor, pose_mm_zyx,
+)
+from robomax_py.waiting import CLEAR_SUFFIX, WaitPlan
 
 _NOT_IDENT = re.compile(r"[^A-Za-z0-9_]")
 
@@ -50,6 +53,8 @@ def program_from_plan(result: PlanResult) -> Program:
         PtpMove(tuple(np.degrees(result.home)), opts.speed, 1.0, comment="home"),
     ]
     transitions = result.transitions
+    if transitions and transitions[0].wait is not None:
+        out.extend(_wait(transitions[0].wait))
     lin_mm_s = opts.tcp_speed * opts.speed * 1000.0     # the override scales LIN speeds too
     for k, trans in enumerate(transitions):
         phases = traj.phases_of(trans.kind, trans.label)
@@ -74,12 +79,22 @@ def program_from_plan(result: PlanResult) -> Program:
         out.append(LinMove(xyz, zyx, spot.config, lin_mm_s, comment="approach"))
         out.append(Spot(identifier(spot.name), identifier(spot.seam), result.weld_time))
         xyz, zyx = pose_mm_zyx(spot.T_app)
+        if k + 1 < len(transitions) and transitions[k + 1].wait is not None:
+            out.extend(_wait(transitions[k + 1].wait))
         retract_radius = transitions[k + 1].flyby_radius if k + 1 < len(transitions) else 0.0
         out.append(LinMove(xyz, zyx, spot.config, lin_mm_s, flyby=math.degrees(retract_radius),
                            comment="retract"))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
                     tuple(identifier(j) for j in result.joint_names))
     return Program(identifier(result.cell), header, frames, tuple(out))
+
+
+def _wait(w: WaitPlan) -> list[Instruction]:
+    """A wait for a dynamic obstacle: for its clear signal when it is there as the wait begins."""
+    note = Comment(f"wait {w.seconds:.3f} s for {w.obstacle} to clear")
+    if w.for_signal:
+        return [note, WaitFor(identifier(w.obstacle) + CLEAR_SUFFIX)]
+    return [note, Wait(w.seconds)]
 
 
 def render(result: PlanResult) -> str:
