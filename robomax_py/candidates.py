@@ -8,6 +8,7 @@ IK branch and is collision-free along its whole length. Every rejection is count
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -67,9 +68,10 @@ class CandidateStats:
 
 
 def seam_candidates(
-    cell: CellSpec, robot: RobotModel, world: CollisionWorld, seam_index: int
+    cell: CellSpec, robot: RobotModel, world: CollisionWorld, seam_index: int,
+    on_spot: Callable[[], None] | None = None,
 ) -> tuple[list[SpotCandidates], CandidateStats]:
-    """Candidates for every spot of one seam."""
+    """Candidates for every spot of one seam; `on_spot()` is called as each spot is done."""
     seam = cell.seams[seam_index]
     grid = orientation_grid(seam)
     T_base_world = invert(np.asarray(cell.T_world_base))
@@ -84,6 +86,8 @@ def seam_candidates(
         result, used = _spot_candidates(robot, world, seam, grid, s, table, seam_index)
         checks += used
         out.append(result)
+        if on_spot is not None:
+            on_spot()
     return out, CandidateStats(ik_poses=int(np.prod(T_line.shape[:-2])), collision_checks=checks)
 
 

@@ -86,6 +86,7 @@ def plan(
     baseline: Annotated[bool, typer.Option("--baseline", help="the published method: given order, nominal orientation, first branch")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable report instead of tables")] = False,
     speed: Annotated[float | None, typer.Option("--speed", min=0.01, max=1.0, help="override of every programmed speed, fraction in (0, 1] (default: the cell's planner.speed, else 1)")] = None,
+    verbose: Annotated[bool, typer.Option("-v", "--verbose", help="debug logging: stage sizes, counts and times")] = False,
 ) -> None:
     """Plan a cell and write its program files (only when the plan is complete and verified)."""
 
@@ -97,12 +98,15 @@ def plan(
         from robomax_py.export import EXPORTERS, render
         from robomax_py.files import write_atomic
         from robomax_py.plan import PlanOptions, plan_cell
+        from robomax_py.progress_bars import configure_logging, stage_bars
         from robomax_py.report import plan_report, report_tables
 
+        configure_logging(err, verbose)
         t0 = time.perf_counter()
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
-        result = plan_cell(spec, robot, PlanOptions(baseline=baseline, speed=speed))
+        with stage_bars(err, enabled=not verbose) as progress:
+            result = plan_cell(spec, robot, PlanOptions(baseline=baseline, speed=speed), progress)
         seconds = time.perf_counter() - t0
         written: list[Path] = []
         if result.status == "planned":
@@ -155,6 +159,35 @@ def verify(
 
     code = _guarded(run)
     raise typer.Exit(code)
+
+
+@app.command()
+def bench(
+    cell: Annotated[Path, typer.Argument(help="cell to plan (default: the shipped cabin_flange cell)")] = Path("cells/cabin_flange.yaml"),
+    runs: Annotated[int, typer.Option("--runs", min=1, help="planning runs (median)")] = 3,
+    quick: Annotated[bool, typer.Option("--quick", help="smaller IK and collision batches")] = False,
+) -> None:
+    """Measure this machine: IK/s, collision checks/s, planning time, cycle vs baseline vs lower bound."""
+
+    def run() -> None:
+        from rich.status import Status
+
+        from robomax_py.bench import run_bench
+        from robomax_py.cell_io import load_cell, load_cell_robot
+
+        spec = load_cell(cell)
+        robot = load_cell_robot(spec)
+        with Status("", console=err) as status:
+            rows = run_bench(spec, robot, runs=runs, quick=quick, on_step=lambda s: status.update(f"measuring {s}"))
+        table = Table(title=f"robomax bench: {spec.name} ({robot.name}), one process", title_justify="left")
+        for col, justify in (("figure", "left"), ("value", "right"), ("unit", "left"), ("note", "left")):
+            table.add_column(col, justify=justify)  # type: ignore[arg-type]
+        for r in rows:
+            value = f"{r.value:,.0f}" if r.value >= 1000 else f"{r.value:.3f}"
+            table.add_row(r.name, value, r.unit, r.note)
+        out.print(table)
+
+    _guarded(run)
 
 
 def main() -> None:

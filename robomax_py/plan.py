@@ -9,8 +9,10 @@ every sample pair is collision-free and within limits.
 
 from __future__ import annotations
 
+import logging
 import time
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -31,6 +33,17 @@ from robomax_py.program import as_written_joints, as_written_pose, written_secon
 from robomax_py.timing import Segment, TimingError, Trajectory, concatenate, dwell, ptp_time_estimate, resample
 from robomax_py.transforms import invert
 from robomax_py.waiting import WaitingError, WaitPlan, schedule_waits
+
+log = logging.getLogger(__name__)
+
+Progress = Callable[[str, int, int], None]
+"""progress(stage, done, total): called as a long stage advances ("candidates", "sequencing",
+"timing", "verify"); the CLI draws progress bars from it. total may grow (sequencing rounds)."""
+
+
+def _no_progress(stage: str, done: int, total: int) -> None:
+    pass
+
 
 # Heights (m, world z) tried for up-across-down detours over clamps, lowest first.
 LIFT_HEIGHTS_M = (0.08, 0.15, 0.25, 0.4)
@@ -146,8 +159,10 @@ def resolved_options(cell: CellSpec, options: PlanOptions) -> PlanOptions:
     )
 
 
-def plan_cell(cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOptions()) -> PlanResult:
-    """Plan a cell whose robot (with its tool mounted) is given."""
+def plan_cell(
+    cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOptions(), progress: Progress = _no_progress,
+) -> PlanResult:
+    """Plan a cell whose robot (with its tool mounted) is given; `progress` hears of each stage's advance."""
     options = resolved_options(cell, options)
     clock: dict[str, float] = {}
     t0 = time.perf_counter()
@@ -157,6 +172,8 @@ def plan_cell(cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOpti
     world = CollisionWorld(robot, build_scene(replace(cell, dynamic=()), robot), cell.process.clearance) \
         if cell.dynamic else full_world
     clock["world"] = time.perf_counter() - t0
+    log.debug("%s: collision world of %d pieces, %d pairs in %.2f s", cell.name, world.geometry_model.ngeoms,
+              world.n_pairs, clock["world"])
 
     home_contact = world.first_contact(cell.home)
     if home_contact is not None:
@@ -165,11 +182,18 @@ def plan_cell(cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOpti
     t0 = time.perf_counter()
     spots: list[SpotCandidates] = []
     candidate_checks = 0
+    n_spots = sum(len(seam.spots) for seam in cell.seams)
+    done = iter(range(1, n_spots + 1))
+    progress("candidates", 0, n_spots)
     for s in range(len(cell.seams)):
-        found, stats = seam_candidates(cell, robot, world, s)
+        found, stats = seam_candidates(cell, robot, world, s,
+                                       on_spot=lambda: progress("candidates", next(done), n_spots))
         spots.extend(found)
         candidate_checks += stats.collision_checks
     clock["candidates"] = time.perf_counter() - t0
+    for c in spots:
+        log.debug("spot %s/%s: %d candidates; rejected %s", cell.seams[c.seam_index].name, c.name, len(c),
+                  dict(c.rejected.most_common()) or "none")
     failures = tuple(_failure(cell, c) for c in spots if len(c) == 0)
     if failures:
         names = ", ".join(f"{f.seam}/{f.name} ({f.reason})" for f in failures)
@@ -183,27 +207,34 @@ def plan_cell(cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOpti
     anchors = np.vstack([cell.home[None, :], *[c.q_app for c in spots]])
     roadmap = Roadmap(world, robot.limits, anchors, rng, options.roadmap_nodes, options.roadmap_k, seeds=anchors)
     clock["roadmap"] = time.perf_counter() - t0
+    log.debug("roadmap: %d nodes in %.2f s", len(roadmap.nodes), clock["roadmap"])
 
     t0 = time.perf_counter()
-    sequencer = _Sequencer(cell, robot, world, roadmap, spots, options, rng)
+    sequencer = _Sequencer(cell, robot, world, roadmap, spots, options, rng, progress)
     outcome = sequencer.run()
     clock["sequencing"] = time.perf_counter() - t0
+    log.debug("sequencing: %d rounds, %d DP evaluations, %d collision checks in %.2f s", sequencer.rounds,
+              sequencer.dp_evaluations, sequencer.checks, clock["sequencing"])
     if isinstance(outcome, str):
         return PlanResult(cell.name, robot.name, "infeasible", outcome)
     tour, transitions = outcome
 
     t0 = time.perf_counter()
     try:
-        trajectory, plans, transitions = _time_tour(cell, robot, world, spots, tour, transitions, options)
+        trajectory, plans, transitions = _time_tour(cell, robot, world, spots, tour, transitions, options, progress)
     except TimingError as exc:
         return PlanResult(cell.name, robot.name, "infeasible", f"timing failed: {exc}")
     except WaitingError as exc:
         return PlanResult(cell.name, robot.name, "infeasible", f"dynamic obstacles: {exc}")
     clock["timing"] = time.perf_counter() - t0
+    log.debug("timing: cycle %.3f s, %d samples in %.2f s", trajectory.duration, len(trajectory.t), clock["timing"])
 
     t0 = time.perf_counter()
+    progress("verify", 0, 1)
     problem, verify_checks = verify_trajectory(full_world, robot, trajectory)
+    progress("verify", 1, 1)
     clock["verify"] = time.perf_counter() - t0
+    log.debug("verify: %d collision checks in %.2f s: %s", verify_checks, clock["verify"], problem or "clean")
     if problem:
         return PlanResult(cell.name, robot.name, "infeasible", f"the timed program failed its own check: {problem}")
 
@@ -276,8 +307,10 @@ class _Sequencer:
     def __init__(
         self, cell: CellSpec, robot: RobotModel, world: CollisionWorld, roadmap: Roadmap,
         spots: list[SpotCandidates], options: PlanOptions, rng: np.random.Generator,
+        progress: Progress = _no_progress,
     ) -> None:
         self.cell, self.robot, self.world, self.roadmap = cell, robot, world, roadmap
+        self.progress = progress
         self.spots, self.options, self.rng = spots, options, rng
         self.limits = robot.limits
         self.home = np.asarray(cell.home)[None, :]
@@ -403,6 +436,8 @@ class _Sequencer:
         previous: tuple[tuple[int, ...], ...] = ()
         for _ in range(self.options.max_rounds):
             self.rounds += 1
+            # Rounds end when a tour's legs are all known free; the bar shows rounds so far.
+            self.progress("sequencing", self.rounds - 1, self.rounds)
             if self.options.baseline:
                 order = tuple(s for b in blocks for s in b.spots)
                 choice, cost = choice_for_order(order, self.cost, self.node)
@@ -417,6 +452,7 @@ class _Sequencer:
                 return "no collision-free connection found between some spots (roadmap exhausted)"
             transitions = self._verify(tour)
             if transitions is not None:
+                self.progress("sequencing", self.rounds, self.rounds)
                 return tour, transitions
         return f"sequencing did not converge in {self.options.max_rounds} rounds"
 
@@ -560,7 +596,7 @@ class _Sequencer:
 
 def _time_tour(
     cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots: list[SpotCandidates], tour: Tour,
-    transitions: list[Transition], options: PlanOptions,
+    transitions: list[Transition], options: PlanOptions, progress: Progress = _no_progress,
 ) -> tuple[Trajectory, list[SpotPlan], list[Transition]]:
     """Junction by junction (retract, move or detour, approach; `junction.time_junction`) and dwells."""
     T_base_world = invert(np.asarray(cell.T_world_base))
@@ -582,6 +618,7 @@ def _time_tour(
     q_now = as_written_joints(cell.home)
     weld_time = written_seconds(cell.process.weld_time)
     for k, trans in enumerate(transitions):
+        progress("timing", k, len(transitions))
         before = ends[k - 1] if k > 0 else None
         after = ends[k] if k < len(ends) else None
         waypoints = as_written_joints(trans.waypoints)      # the first row: where the retract ends
@@ -606,6 +643,7 @@ def _time_tour(
             segments.append(dwell(block[0].q[0], w.seconds, kind="wait", label=f"wait for {w.obstacle}"))
             timed[k] = replace(timed[k], wait=w)
         segments.extend(block)
+    progress("timing", len(transitions), len(transitions))
     traj = resample(concatenate(segments))
     plans = []
     for i, a, T_spot, T_app in welded:

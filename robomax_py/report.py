@@ -57,7 +57,13 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
         head.add_row("cycle time", f"{report['cycle_time']:.2f} s  ({split})")
         detours = ", ".join(f"{d['between']} ({d['checks_to_find']} checks)" for d in report["detours"])
         head.add_row("detours", detours or "none")
-    head.add_row("planning", f"{report['planning_seconds']:.2f} s")
+    stages = report.get("stats", {}).get("stage_seconds", {})
+    split = ", ".join(f"{k} {v:.2f}" for k, v in stages.items())
+    head.add_row("planning", f"{report['planning_seconds']:.2f} s" + (f"  ({split})" if split else ""))
+    if "stats" in report:
+        st = report["stats"]
+        head.add_row("work", f"{st['candidates']} candidates, {st['collision_checks']:,} collision checks, "
+                             f"{st['sequencing_rounds']} sequencing rounds")
     for f in report["files"]:
         head.add_row("wrote", f)
     out: list[Any] = [head]

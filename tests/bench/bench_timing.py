@@ -5,9 +5,9 @@
 The same planned tour timed three ways: (a) toppra, velocity and acceleration limits only, stopping
 at every waypoint; (b) jerk-limited (ruckig) moves, stopping at detour waypoints; (c) (b) with detour
 corners blended where the blended path checks free. Reports medians of the cycle time, the time
-spent timing, and the ratio of the cycle time to a straight-move lower bound: the weld times plus,
-for every move between two stops (moves, detour legs, approach and retract), the slowest joint's
-time-optimal trapezoid time (velocity and acceleration limits) between the configurations.
+spent timing, and the ratio of the cycle time to a straight-move lower bound (`robomax_py.bench.
+lower_bound`): the weld times plus, for every rest-to-rest move (home -> spot -> spot ... -> home),
+the slowest joint's time-optimal trapezoid time (velocity and acceleration limits).
 """
 
 from __future__ import annotations
@@ -19,14 +19,12 @@ from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
-
 from robomax_py.cell_io import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.plan import PlanOptions, PlanResult, plan_cell  # noqa: E402
-from robomax_py.robot import JointLimits  # noqa: E402
-from robomax_py.timing import ptp_time_estimate  # noqa: E402
+from robomax_py.bench import lower_bound  # noqa: E402
+from robomax_py.plan import PlanOptions, plan_cell  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
+REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
 VARIANTS = {
     "(a) toppra vel/acc": PlanOptions(jerk_limited=False, blend=False),
     "(b) jerk-limited": PlanOptions(jerk_limited=True, blend=False),
@@ -34,23 +32,9 @@ VARIANTS = {
 }
 
 
-def lower_bound(result: PlanResult, limits: JointLimits) -> float:
-    """Weld times + per stop-to-stop move the slowest joint's trapezoid time (velocity, acceleration)."""
-    assert result.trajectory is not None and result.stats is not None
-    stops: list[np.ndarray] = []
-    for k, trans in enumerate(result.transitions):
-        stops.extend(trans.waypoints if k == 0 else trans.waypoints[1:])
-        if k < len(result.spots):
-            spot = result.spots[k]
-            stops.extend([spot.q_spot, spot.q_app])
-    qs = np.array(stops)
-    moves = float(np.sum(ptp_time_estimate(qs[:-1], qs[1:], limits, straight=False)))
-    return moves + result.weld_time * len(result.spots)
-
-
 def main() -> None:
     parser = argparse.ArgumentParser()
-    parser.add_argument("cell", nargs="?", default=str(REPO / "cells" / "cabin_flange.yaml"))
+    parser.add_argument("cell", nargs="?", default=str(REFERENCE_CELL))
     parser.add_argument("--runs", type=int, default=3)
     args = parser.parse_args()
     cell = load_cell(args.cell)
