@@ -94,8 +94,8 @@ def plan(
         import time
 
         from robomax_py.cell_io import load_cell, load_cell_robot
-        from robomax_py.export import EXPORTERS, render
-        from robomax_py.files import write_atomic
+        from robomax_py.export import render_programs
+        from robomax_py.files import write_programs
         from robomax_py.plan import PlanOptions, plan_cell
         from robomax_py.report import plan_report, report_tables
 
@@ -106,11 +106,7 @@ def plan(
         seconds = time.perf_counter() - t0
         written: list[Path] = []
         if result.status == "planned":
-            texts = {fmt: render(result, fmt) for fmt in EXPORTERS}   # all rendered before any write
-            for fmt, text in texts.items():
-                path = out_dir / f"{spec.name}{EXPORTERS[fmt][0]}"
-                write_atomic(path, text)
-                written.append(path)
+            written = write_programs(out_dir, render_programs(result))   # all rendered before any write
         report = plan_report(result, seconds, written)
         if as_json:
             out.print_json(_json.dumps(report))
