@@ -14,6 +14,7 @@ import io
 import multiprocessing
 import multiprocessing.connection
 import signal
+import sys
 import time
 import traceback
 from collections import deque
@@ -31,11 +32,14 @@ TIMEOUT = "timeout"
 CRASHED = "crashed"
 STATUSES = (PLANNED, INFEASIBLE, BAD_INPUT, TIMEOUT, CRASHED)
 
-SUMMARY_COLUMNS = ("cell", "file", "status", "cycle_time_s", "planning_s", "spots", "detours", "reasons")
+SUMMARY_COLUMNS = ("cell", "file", "status", "cycle_time_s", "planning_s", "spots", "detours", "reasons",
+                   "peak_rss_mb")
 # After a worker sent its result it exits at once; one that does not within this is killed.
 EXIT_GRACE_S = 10.0
-# Modules the fork server imports once, so each cell's process starts warm.
-PRELOAD = ("robomax_py.batch", "robomax_py.cell_io", "robomax_py.plan", "robomax_py.export")
+# Modules the fork server imports once, so each cell's process starts warm (the planner imports the
+# timing libraries lazily: ~2 s per cell otherwise). A name that does not import is skipped.
+PRELOAD = ("robomax_py.batch", "robomax_py.cell_io", "robomax_py.plan", "robomax_py.export", "robomax_py.export.srcl",
+           "robomax_py.verify", "ruckig", "toppra", "toppra.algorithm", "toppra.constraint", "toppra.interpolator")
 
 
 @dataclass(frozen=True, slots=True)
@@ -61,6 +65,7 @@ class CellOutcome:
     reasons: str = ""                # why it is not planned: failing spots, the file error, the crash
     programs: tuple[tuple[str, str], ...] = ()   # (file name, text) rendered by the worker
     written: tuple[str, ...] = ()    # program files written by the caller
+    peak_rss_mb: float | None = None  # peak resident memory of the worker's process so far, MiB (Unix)
 
 
 Worker = Callable[[str, bool], CellOutcome]
@@ -98,11 +103,22 @@ def run_worker(worker: Worker, file: str, baseline: bool) -> CellOutcome:
     """Run a worker; an exception escaping it (a bug, not a user's mistake) becomes a `crashed` outcome."""
     t0 = time.perf_counter()
     try:
-        return worker(file, baseline)
+        outcome = worker(file, baseline)
     except Exception as exc:  # noqa: BLE001 - reported per cell; the batch goes on
         where = traceback.extract_tb(exc.__traceback__)[-1]
         detail = f"{type(exc).__name__}: {exc} (at {Path(where.filename).name}:{where.lineno})"
-        return CellOutcome(file, Path(file).stem, CRASHED, time.perf_counter() - t0, reasons=detail)
+        outcome = CellOutcome(file, Path(file).stem, CRASHED, time.perf_counter() - t0, reasons=detail)
+    return replace(outcome, peak_rss_mb=_peak_rss_mb())
+
+
+def _peak_rss_mb() -> float | None:
+    """Peak resident set size of this process, MiB; None where the platform does not say."""
+    try:
+        import resource
+    except ImportError:
+        return None
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / 1024 / 1024 if sys.platform == "darwin" else peak / 1024   # bytes on macOS, KiB on Linux
 
 
 def _child_main(conn: multiprocessing.connection.Connection, worker: Worker, file: str, baseline: bool) -> None:
@@ -318,7 +334,7 @@ def summary_rows(outcomes: Sequence[CellOutcome]) -> list[dict[str, str]]:
     return [
         {"cell": o.cell, "file": o.file, "status": o.status, "cycle_time_s": num(o.cycle_time, ".3f"),
          "planning_s": num(o.seconds, ".3f"), "spots": num(o.spots, "d"), "detours": num(o.detours, "d"),
-         "reasons": o.reasons}
+         "reasons": o.reasons, "peak_rss_mb": num(o.peak_rss_mb, ".0f")}
         for o in outcomes
     ]
 
