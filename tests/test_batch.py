@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import os
 import signal
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,6 +22,7 @@ from robomax_py.batch import (
     BatchOptions,
     CellOutcome,
     run_local,
+    run_ray,
 )
 from robomax_py.cli import EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_OK, _bare_ray_flag, app
 
@@ -114,6 +116,8 @@ def fake_worker(file: str, baseline: bool) -> CellOutcome:
         os.kill(os.getpid(), signal.SIGKILL)
     if stem == "raises":
         raise ValueError("a bug")
+    if stem == "sleeps":
+        time.sleep(120)
     return CellOutcome(file, stem, PLANNED, 0.0, cycle_time=1.0, spots=1, detours=0)
 
 
@@ -151,3 +155,18 @@ def test_ray_batch_gives_the_same_bytes_as_the_local_pool(batch_run: Batch, tmp_
     assert [r["status"] for r in read_summary(out)] == [PLANNED, INFEASIBLE, BAD_INPUT, PLANNED]
     for name in ("cell_a.json", "cell_a.srcl", "cell_b.json", "cell_b.srcl"):
         assert (out / name).read_bytes() == (batch_run.out / name).read_bytes()
+
+
+@pytest.mark.slow
+def test_ray_reports_crashed_and_timed_out_tasks_and_finishes_the_others() -> None:
+    pytest.importorskip("ray")
+    import sys
+
+    files = ["ok1.yaml", "exits.yaml", "sleeps.yaml", "ok2.yaml"]
+    path = os.pathsep.join([str(Path(__file__).parent), *sys.path])   # Ray workers import this module
+    t0 = time.monotonic()
+    outcomes = run_ray(files, BatchOptions(jobs=2, timeout=20.0), worker=fake_worker,
+                       init_kwargs={"runtime_env": {"env_vars": {"PYTHONPATH": path}}})
+    assert [o.status for o in outcomes] == [PLANNED, CRASHED, TIMEOUT, PLANNED]
+    assert "WorkerCrashedError" in outcomes[1].reasons
+    assert time.monotonic() - t0 < 100     # the sleeping task was cancelled, not waited for
