@@ -5,6 +5,10 @@ render) in a process of its own, so a cell that fails, hangs or crashes its proc
 others: a worker past its deadline is killed and reported as `timeout`, a process that dies (signal,
 `os._exit`, out of memory) is reported as `crashed`. Programs are rendered in the worker and written
 by the caller's process with the same functions as `robomax plan`, so the bytes are the same.
+
+A cell file that is unreadable or invalid is one cell's outcome (`bad input`, the message naming the
+file, key and problem), like an infeasible one: the other cells still plan and the summary lists it
+(`robomax batch` then exits 2). Paths that do not exist are refused by the CLI before anything runs.
 """
 
 from __future__ import annotations
@@ -153,7 +157,9 @@ def run_local(
 
     `on_done(index, outcome)` is called in this process as each cell finishes (in finishing order) and
     returns the outcome to keep.
-    `worker` must be importable by name in a fresh interpreter (a module-level function).
+    `worker` must be importable by name in a fresh interpreter (a module-level function). As always
+    with spawn / forkserver, each process imports the caller's main module: a script calling this
+    needs the `if __name__ == "__main__":` guard.
     """
     ctx = context or default_context()
     pending = deque(enumerate(files))
@@ -277,7 +283,10 @@ def run_ray(
                 for ref in ready:
                     i, t_submit = running.pop(ref)
                     try:
-                        outcome = replace(ray.get(ref), file=files[i])
+                        got: CellOutcome = ray.get(ref)
+                        # The task had the absolute path; report the file as given, as run_local does.
+                        outcome = replace(got, file=files[i],
+                                          reasons=got.reasons.replace(str(Path(files[i]).resolve()), files[i]))
                     except (ray.exceptions.WorkerCrashedError, ray.exceptions.RayTaskError,
                             ray.exceptions.TaskCancelledError, ray.exceptions.RayError) as exc:
                         outcome = CellOutcome(files[i], Path(files[i]).stem, CRASHED, time.monotonic() - t_submit,

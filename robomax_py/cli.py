@@ -163,7 +163,11 @@ def batch(
                                                     help="plan on Ray: a local Ray without ADDRESS (or with `local`), else the cluster at ADDRESS")] = None,
     baseline: Annotated[bool, typer.Option("--baseline", help="the published method: given order, nominal orientation, first branch")] = False,
 ) -> None:
-    """Plan many cells in parallel (one process per cell); write their programs and a summary table."""
+    """Plan many cells in parallel (one process per cell); write their programs and a summary table.
+
+    Exit 0 all planned; 3 some infeasible, timed out or crashed; 2 a cell file is bad (reported in its
+    row, the others still plan) or does not exist (nothing is planned).
+    """
 
     def run() -> int:
         import os

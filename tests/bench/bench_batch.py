@@ -7,8 +7,8 @@ cell) and plans them as a batch with 1 and 2 local worker processes and on a loc
 Reports per setting, as medians over `--runs`: wall time, throughput (cells/min), parallel
 efficiency (throughput with 2 workers / (2 x throughput with 1)), the largest and median peak RSS of
 a worker process (each worker measures its own, getrusage), and the statuses. Ray's start-up
-(ray.init) is timed separately; it and one untimed warm-up batch per setting (the fork server's
-imports, Ray's worker processes) are not counted in the throughput.
+(ray.init) is timed separately; it and one untimed warm-up batch of the small cell per setting (the fork
+server's imports, Ray's worker processes) are not counted in the throughput.
 """
 
 from __future__ import annotations
@@ -77,8 +77,10 @@ def main() -> None:
     rss: dict[str, list[float]] = {name: [] for name, _, _ in settings}
     statuses: dict[str, Counter[str]] = {name: Counter() for name, _, _ in settings}
     reference: dict[str, bytes] = {}
-    for name, jobs, use_ray in settings:   # untimed warm-up: the fork server's imports, Ray's worker processes
-        one_batch(files[:jobs], tmp / "warmup", jobs, use_ray)
+    # Untimed warm-up on the small cell: the fork server's imports, Ray's worker processes.
+    warm = [str(_write_small_cell(tmp / "warm", f"warm{k}")) for k in range(2)]
+    for name, jobs, use_ray in settings:
+        one_batch(warm[:jobs], tmp / "warmup", jobs, use_ray)
     for run in range(args.runs):
         for name, jobs, use_ray in settings:
             out = tmp / f"out_{run}_{jobs}_{int(use_ray)}"
