@@ -336,3 +336,29 @@ def _unit(v: list[float], path: Path, key: str) -> np.ndarray:
     if norm < 1e-9:
         raise CellFileError(path, key, f"zero-length vector {v}")
     return arr / norm
+
+
+def read_cell_file(path: str | Path) -> CellFile:
+    """A cell file as its checked schema (file units, keys as written), for tools that rewrite cells.
+
+    Only the file itself is checked here; `load_cell` checks what it names (robot, tool, meshes).
+    """
+    path = Path(path)
+    data = read_yaml_mapping(path, CellFileError, "cell file")
+    try:
+        return CellFile.model_validate(data)
+    except ValidationError as exc:
+        raise validation_error(exc, CellFile, path, CellFileError) from None
+
+
+def dump_cell_file(cell: CellFile, header: str = "") -> str:
+    """Cell-file text of a schema object: the keys that were set, in schema order; `header` as comments.
+
+    Deterministic: the same object gives the same bytes. Lists of numbers are written inline.
+    """
+    import yaml
+
+    data = cell.model_dump(mode="json", exclude_unset=True)
+    comment = "".join(f"# {line}\n" if line else "#\n" for line in header.splitlines())
+    text: str = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, allow_unicode=True, width=120)
+    return comment + text

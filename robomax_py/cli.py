@@ -95,8 +95,8 @@ def plan(
         import time
 
         from robomax_py.cell_io import load_cell, load_cell_robot
-        from robomax_py.export import EXPORTERS, render
-        from robomax_py.files import write_atomic
+        from robomax_py.export import render_programs
+        from robomax_py.files import write_programs
         from robomax_py.plan import PlanOptions, plan_cell
         from robomax_py.progress_bars import configure_logging, stage_bars
         from robomax_py.report import plan_report, report_tables
@@ -110,11 +110,7 @@ def plan(
         seconds = time.perf_counter() - t0
         written: list[Path] = []
         if result.status == "planned":
-            texts = {fmt: render(result, fmt) for fmt in EXPORTERS}   # all rendered before any write
-            for fmt, text in texts.items():
-                path = out_dir / f"{spec.name}{EXPORTERS[fmt][0]}"
-                write_atomic(path, text)
-                written.append(path)
+            written = write_programs(out_dir, render_programs(result))   # all rendered before any write
         report = plan_report(result, seconds, written)
         if as_json:
             out.print_json(_json.dumps(report))
@@ -190,10 +186,115 @@ def bench(
     _guarded(run)
 
 
+@app.command()
+def batch(
+    cells: Annotated[list[Path], typer.Argument(help="cell files (YAML)")],
+    jobs: Annotated[int | None, typer.Option("-j", "--jobs", min=1, help="cells planned at once (default: the number of CPUs)")] = None,
+    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder for programs and summary.csv / summary.md")] = Path("programs"),
+    timeout: Annotated[float | None, typer.Option("--timeout", min=0.0, help="seconds per cell before its worker is killed")] = None,
+    ray_address: Annotated[str | None, typer.Option("--ray", metavar="[ADDRESS]",
+                                                    help="plan on Ray: a local Ray without ADDRESS (or with `local`), else the cluster at ADDRESS")] = None,
+    baseline: Annotated[bool, typer.Option("--baseline", help="the published method: given order, nominal orientation, first branch")] = False,
+) -> None:
+    """Plan many cells in parallel (one process per cell); write their programs and a summary table.
+
+    Exit 0 all planned; 3 some infeasible, timed out or crashed; 2 a cell file is bad (reported in its
+    row, the others still plan) or does not exist (nothing is planned).
+    """
+
+    def run() -> int:
+        import os
+
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+        from robomax_py.batch import BAD_INPUT, PLANNED, BatchOptions, CellOutcome, run_batch
+
+        files = [str(c) for c in cells]
+        use_ray = ray_address is not None
+        address = None if ray_address in (None, "", RAY_LOCAL) else ray_address
+        missing = [f for f in files if not Path(f).is_file()]
+        if missing:
+            for f in missing:
+                err.print(f"[bold red]error:[/] {f}: cell file not found", soft_wrap=True)
+            return EXIT_BAD_INPUT
+        if use_ray:
+            try:
+                import ray  # noqa: F401
+            except ImportError:
+                err.print("[bold red]error:[/] --ray needs Ray: pip install 'robomax-py[ray]'", soft_wrap=True)
+                return EXIT_BAD_INPUT
+        options = BatchOptions(jobs=jobs or os.cpu_count() or 1, timeout=timeout, baseline=baseline)
+        where = f"Ray ({address or 'local'})" if use_ray else f"{options.jobs} process(es)"
+        with Progress(TextColumn("planning"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                      console=err, transient=False) as progress:
+            task = progress.add_task("cells", total=len(files))
+            progress.console.print(f"{len(files)} cell(s) on {where}")
+
+            def done(i: int, o: CellOutcome) -> CellOutcome:
+                style = "green" if o.status == PLANNED else "red"
+                detail = f"cycle {o.cycle_time:.2f} s" if o.cycle_time is not None else o.reasons
+                progress.console.print(f"[{style}]{o.status}[/]: {o.file} ({o.seconds:.1f} s) {detail}",
+                                       soft_wrap=True, markup=True, highlight=False)
+                progress.advance(task)
+                return o
+
+            outcomes = run_batch(files, out_dir, options, use_ray=use_ray, ray_address=address, on_done=done)
+        table = Table(title=f"batch: {out_dir / 'summary.md'}", title_justify="left")
+        for col in ("cell", "status", "cycle (s)", "planning (s)", "spots", "detours"):
+            table.add_column(col)
+        for o in outcomes:
+            table.add_row(o.cell, o.status, "" if o.cycle_time is None else f"{o.cycle_time:.2f}",
+                          f"{o.seconds:.1f}", "" if o.spots is None else str(o.spots),
+                          "" if o.detours is None else str(o.detours))
+        out.print(table)
+        if all(o.status == PLANNED for o in outcomes):
+            return EXIT_OK
+        return EXIT_BAD_INPUT if any(o.status == BAD_INPUT for o in outcomes) else EXIT_INFEASIBLE
+
+    code = _guarded(run)
+    raise typer.Exit(code)
+
+
+@app.command()
+def variants(
+    cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
+    n: Annotated[int, typer.Option("--n", "-n", min=1, help="number of variants")] = 20,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="seed: the same seed writes the same files")] = 0,
+    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder")] = Path("variants"),
+) -> None:
+    """Write seeded perturbed copies of a cell (clamps ±15 mm, part ±5 mm / ±1°, spot order of free seams)."""
+
+    def run() -> None:
+        from robomax_py.variants import write_variants
+
+        made = write_variants(cell, n, seed, out_dir)
+        out.print(f"wrote {len(made)} variant(s) of {cell}: {made[0].path} ... {made[-1].path}")
+
+    _guarded(run)
+
+
+RAY_LOCAL = "local"
+
+
+def _bare_ray_flag(argv: list[str]) -> list[str]:
+    """`batch ... --ray` without an address (last, or before an option or a cell file) -> `--ray=local`.
+
+    typer has no options with an optional value, so the console entry point spells the default out.
+    """
+    if "batch" not in argv:
+        return argv
+    args = list(argv)
+    for k, arg in enumerate(args):
+        nxt = args[k + 1] if k + 1 < len(args) else None
+        if arg == "--ray" and (nxt is None or nxt.startswith("-") or nxt.endswith((".yaml", ".yml"))):
+            args[k] = f"--ray={RAY_LOCAL}"
+    return args
+
+
 def main() -> None:
     """Console entry point."""
     try:
-        app()
+        app(args=_bare_ray_flag(sys.argv[1:]))
     except KeyboardInterrupt:
         err.print("interrupted")
         sys.exit(130)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
 
 
@@ -22,3 +23,13 @@ def write_atomic(path: Path, text: str) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def write_programs(out_dir: Path, texts: Mapping[str, str]) -> list[Path]:
+    """Write rendered program files (file name -> text) into `out_dir`, each atomically; the paths written."""
+    written: list[Path] = []
+    for name, text in texts.items():
+        path = out_dir / name
+        write_atomic(path, text)
+        written.append(path)
+    return written

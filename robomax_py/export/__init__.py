@@ -24,3 +24,14 @@ def render(result: PlanResult, fmt: str) -> str:
     if result.status != "planned" or result.trajectory is None:
         raise ExportError(f"cell {result.cell} is not planned: {result.message}")
     return EXPORTERS[fmt][1](result)
+
+
+def render_programs(result: PlanResult) -> dict[str, str]:
+    """Every program file of a planned result, all rendered before anything is written.
+
+    Returns
+    -------
+    dict[str, str]
+        File name (``<cell><ext>``, one per exporter, in registry order) -> text.
+    """
+    return {f"{result.cell}{ext}": render(result, fmt) for fmt, (ext, _) in EXPORTERS.items()}

@@ -1,0 +1,172 @@
+"""`robomax batch`: statuses per cell, exit codes, summary files, timeouts, crashed workers, determinism."""
+
+from __future__ import annotations
+
+import csv
+import os
+import signal
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from robomax_py.batch import (
+    BAD_INPUT,
+    CRASHED,
+    INFEASIBLE,
+    PLANNED,
+    TIMEOUT,
+    BatchOptions,
+    CellOutcome,
+    run_local,
+    run_ray,
+)
+from robomax_py.cli import EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_OK, _bare_ray_flag, app
+
+SmallCell = Callable[..., Path]   # conftest.write_small_cell
+FAR_SPOT = {"name": "far", "xyz": [4.0, 0.0, 1.0], "normal": [-1, 0, 0], "direction": [0, 1, 0]}
+runner = CliRunner()
+
+
+@dataclass(frozen=True)
+class Batch:
+    cells: Path
+    files: list[str]
+    out: Path
+    exit_code: int
+    output: str
+
+
+@pytest.fixture(scope="module")
+def batch_run(tmp_path_factory: pytest.TempPathFactory, write_small_cell: SmallCell) -> Batch:
+    """Two small cells, one infeasible, one bad file: planned by `robomax batch -j 2` once for the module."""
+    cells = tmp_path_factory.mktemp("cells")
+    a = write_small_cell(cells, "cell_a")
+    b = write_small_cell(cells, "cell_b")
+    far = write_small_cell(cells, "cell_far", [FAR_SPOT])
+    bad = write_small_cell(cells, "cell_bad")
+    bad.write_text(bad.read_text().replace("weld_time: 0.5", "weld_time: -1"))
+    files = [str(p) for p in (a, far, bad, b)]
+    out = cells / "out"
+    result = runner.invoke(app, ["batch", *files, "-j", "2", "-o", str(out)])
+    return Batch(cells, files, out, result.exit_code, result.output)
+
+
+def read_summary(out: Path) -> list[dict[str, str]]:
+    with (out / "summary.csv").open(newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def test_batch_statuses_in_argument_order_and_exit_2_for_a_bad_file(batch_run: Batch) -> None:
+    assert batch_run.exit_code == EXIT_BAD_INPUT, batch_run.output
+    rows = read_summary(batch_run.out)
+    assert [r["file"] for r in rows] == batch_run.files
+    assert [r["status"] for r in rows] == [PLANNED, INFEASIBLE, BAD_INPUT, PLANNED]
+    a, far, bad, b = rows
+    assert float(a["cycle_time_s"]) > 0 and a["spots"] == "2" and a["detours"] != ""
+    assert "flange/far: unreachable" in far["reasons"] and far["cycle_time_s"] == ""
+    assert "cell_bad.yaml" in bad["reasons"] and "process.weld_time" in bad["reasons"]
+    assert "Traceback" not in batch_run.output
+
+
+def test_batch_writes_programs_of_planned_cells_only_and_a_markdown_table(batch_run: Batch) -> None:
+    names = sorted(p.name for p in batch_run.out.iterdir())
+    assert names == ["cell_a.json", "cell_a.srcl", "cell_b.json", "cell_b.srcl", "summary.csv", "summary.md"]
+    md = (batch_run.out / "summary.md").read_text().splitlines()
+    table = [line for line in md if line.startswith("|")]
+    assert table[0].split("|")[1:4] == [" cell ", " file ", " status "]
+    assert len(table) == 2 + len(batch_run.files)
+    assert "| cell_far |" in table[3] and f"| {INFEASIBLE} |" in table[3]
+
+
+def test_batch_programs_equal_plan_programs_byte_for_byte(batch_run: Batch, tmp_path: Path) -> None:
+    result = runner.invoke(app, ["plan", batch_run.files[0], "-o", str(tmp_path)])
+    assert result.exit_code == EXIT_OK, result.output
+    for ext in (".json", ".srcl"):
+        assert (tmp_path / f"cell_a{ext}").read_bytes() == (batch_run.out / f"cell_a{ext}").read_bytes()
+
+
+def test_missing_cell_file_exits_2_up_front_and_plans_nothing(batch_run: Batch, tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    missing = str(tmp_path / "nope.yaml")
+    result = runner.invoke(app, ["batch", batch_run.files[0], missing, "-o", str(out)])
+    assert result.exit_code == EXIT_BAD_INPUT
+    assert "nope.yaml" in result.output and "not found" in result.output
+    assert not out.exists()
+
+
+def test_timeout_is_reported_the_worker_killed_and_exit_3(batch_run: Batch, tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["batch", batch_run.files[0], "-o", str(out), "--timeout", "0.2"])
+    assert result.exit_code == EXIT_INFEASIBLE, result.output
+    (row,) = read_summary(out)
+    assert row["status"] == TIMEOUT and "0.2 s" in row["reasons"]
+    assert sorted(p.name for p in out.iterdir()) == ["summary.csv", "summary.md"]
+
+
+def fake_worker(file: str, baseline: bool) -> CellOutcome:
+    """Test worker (imported by name in each cell's process): dies as the file's stem says, else 'plans'."""
+    stem = Path(file).stem
+    if stem == "exits":
+        os._exit(7)
+    if stem == "killed":
+        os.kill(os.getpid(), signal.SIGKILL)
+    if stem == "raises":
+        raise ValueError("a bug")
+    if stem == "sleeps":
+        time.sleep(120)
+    return CellOutcome(file, stem, PLANNED, 0.0, cycle_time=1.0, spots=1, detours=0)
+
+
+def test_crashed_workers_are_reported_and_the_others_finish() -> None:
+    files = ["ok1.yaml", "exits.yaml", "killed.yaml", "raises.yaml", "ok2.yaml"]
+    seen: list[int] = []
+
+    def done(i: int, o: CellOutcome) -> CellOutcome:
+        seen.append(i)
+        return o
+
+    outcomes = run_local(files, BatchOptions(jobs=2), done, worker=fake_worker)
+    assert [o.file for o in outcomes] == files
+    assert [o.status for o in outcomes] == [PLANNED, CRASHED, CRASHED, CRASHED, PLANNED]
+    assert "exited with code 7" in outcomes[1].reasons
+    assert "SIGKILL" in outcomes[2].reasons
+    assert "ValueError: a bug" in outcomes[3].reasons
+    assert sorted(seen) == list(range(len(files)))
+
+
+def test_bare_ray_flag_means_a_local_ray() -> None:
+    assert _bare_ray_flag(["batch", "a.yaml", "--ray"]) == ["batch", "a.yaml", "--ray=local"]
+    assert _bare_ray_flag(["batch", "--ray", "a.yaml"]) == ["batch", "--ray=local", "a.yaml"]
+    assert _bare_ray_flag(["batch", "--ray", "-j", "2", "a.yaml"]) == ["batch", "--ray=local", "-j", "2", "a.yaml"]
+    assert _bare_ray_flag(["batch", "a.yaml", "--ray", "ray://head:10001"]) == \
+        ["batch", "a.yaml", "--ray", "ray://head:10001"]
+
+
+@pytest.mark.slow
+def test_ray_batch_gives_the_same_bytes_as_the_local_pool(batch_run: Batch, tmp_path: Path) -> None:
+    pytest.importorskip("ray")
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["batch", *batch_run.files, "-j", "2", "-o", str(out), "--ray=local"])
+    assert result.exit_code == EXIT_BAD_INPUT, result.output
+    assert [r["status"] for r in read_summary(out)] == [PLANNED, INFEASIBLE, BAD_INPUT, PLANNED]
+    for name in ("cell_a.json", "cell_a.srcl", "cell_b.json", "cell_b.srcl"):
+        assert (out / name).read_bytes() == (batch_run.out / name).read_bytes()
+
+
+@pytest.mark.slow
+def test_ray_reports_crashed_and_timed_out_tasks_and_finishes_the_others() -> None:
+    pytest.importorskip("ray")
+    import sys
+
+    files = ["ok1.yaml", "exits.yaml", "sleeps.yaml", "ok2.yaml"]
+    path = os.pathsep.join([str(Path(__file__).parent), *sys.path])   # Ray workers import this module
+    t0 = time.monotonic()
+    outcomes = run_ray(files, BatchOptions(jobs=2, timeout=20.0), worker=fake_worker,
+                       init_kwargs={"runtime_env": {"env_vars": {"PYTHONPATH": path}}})
+    assert [o.status for o in outcomes] == [PLANNED, CRASHED, TIMEOUT, PLANNED]
+    assert "WorkerCrashedError" in outcomes[1].reasons
+    assert time.monotonic() - t0 < 100     # the sleeping task was cancelled, not waited for
