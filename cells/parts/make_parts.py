@@ -282,11 +282,13 @@ def tray() -> Part:
         slab([(x0, y), (x1, y), (x1, y + r), (x0, y + r)], zr - t, zr + t),
     ]
     mid = 0.5 * r
-    front = [Spot(f"f{n}", _vec((x0 - mid, yy, zr)), (0.0, 0.0, 1.0), (0.0, 1.0, 0.0))
+    # Directions chosen so that gamma = 0 puts the gun's C back outwards, round the rim's outer edge
+    # (TCP y = -normal x direction).
+    front = [Spot(f"f{n}", _vec((x0 - mid, yy, zr)), (0.0, 0.0, 1.0), (0.0, -1.0, 0.0))
              for n, yy in enumerate((-0.18, -0.06, 0.06, 0.18), start=1)]
     left = [Spot(f"l{n}", _vec((xx, -y - mid, zr)), (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
             for n, xx in enumerate((0.62, 0.75, 0.88), start=1)]
-    right = [Spot(f"r{n}", _vec((xx, y + mid, zr)), (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+    right = [Spot(f"r{n}", _vec((xx, y + mid, zr)), (0.0, 0.0, 1.0), (-1.0, 0.0, 0.0))
              for n, xx in enumerate((0.62, 0.75, 0.88), start=1)]
     seams = (Seam("rim_front", False, tuple(front)), Seam("rim_left", False, tuple(left)),
              Seam("rim_right", False, tuple(right)))
