@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -28,6 +28,11 @@ APPROACH_SAMPLE_M = 0.01
 # Largest joint change between neighbouring approach samples before we call it a branch switch:
 # 10 mm of TCP motion moves a well-conditioned wrist by well under 0.2 rad.
 BRANCH_JUMP_RAD = 0.2
+# Turn variants kept per (orientation, IK branch): those nearest home in joint time. An arm whose six
+# joints all turn +-360 deg (UR10) has up to 64 variants of every solution, which multiplied the
+# candidates of a spot by ~16 and the sequencing time with them; 4 keeps every variant of a KUKA-class
+# arm (A4 and A6 beyond +-180 deg: at most 2 x 2).
+MAX_TURN_VARIANTS = 4
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -69,9 +74,11 @@ class CandidateStats:
 
 def seam_candidates(
     cell: CellSpec, robot: RobotModel, world: CollisionWorld, seam_index: int,
-    on_spot: Callable[[], None] | None = None,
+    max_variants: int = MAX_TURN_VARIANTS, on_spot: Callable[[], None] | None = None,
 ) -> tuple[list[SpotCandidates], CandidateStats]:
-    """Candidates for every spot of one seam; `on_spot()` is called as each spot is done."""
+    """Candidates for every spot of one seam; at most `max_variants` turn variants per orientation
+    and IK branch (those nearest home), the others counted as rejected `turn_variant`;
+    `on_spot()` is called as each spot is done."""
     seam = cell.seams[seam_index]
     grid = orientation_grid(seam)
     T_base_world = invert(np.asarray(cell.T_world_base))
@@ -85,7 +92,7 @@ def seam_candidates(
     for s in range(len(seam.spots)):
         result, used = _spot_candidates(robot, world, seam, grid, s, table, seam_index)
         checks += used
-        out.append(result)
+        out.append(_nearest_variants(result, table.branch, np.asarray(cell.home), robot, max_variants))
         if on_spot is not None:
             on_spot()
     return out, CandidateStats(ik_poses=int(np.prod(T_line.shape[:-2])), collision_checks=checks)
@@ -152,6 +159,35 @@ def _spot_candidates(
         app_path=paths, status=status[idx_o, -1, idx_k] if keep else np.zeros(0, dtype=np.int64),
         turn=turn[idx_o, -1, idx_k] if keep else np.zeros(0, dtype=np.int64), rejected=rejected,
     ), checks
+
+
+def _nearest_variants(
+    c: SpotCandidates, branch_of_column: IntArray, home: FloatArray, robot: RobotModel, max_variants: int
+) -> SpotCandidates:
+    """At most `max_variants` candidates per (orientation, IK branch): the nearest to home in joint
+    time (max over joints of |q_spot - home| / velocity limit); ties by column, so deterministic."""
+    if len(c) == 0:
+        return c
+    branch = np.asarray(branch_of_column)[c.column]
+    dist = np.max(np.abs(c.q_spot - home[None, :]) / robot.limits.velocity[None, :], axis=1)
+    order = np.lexsort((c.column, dist, branch, c.orient))
+    rank = np.zeros(len(c), dtype=np.int64)
+    prev: tuple[int, int] | None = None
+    n = 0
+    for idx in order:
+        key = (int(c.orient[idx]), int(branch[idx]))
+        n = n + 1 if key == prev else 0
+        prev = key
+        rank[idx] = n
+    sel = np.flatnonzero(rank < max_variants)
+    if len(sel) == len(c):
+        return c
+    rejected = Counter(c.rejected)
+    rejected["turn_variant"] += len(c) - len(sel)
+    return replace(
+        c, orient=c.orient[sel], angles=c.angles[sel], column=c.column[sel], q_spot=c.q_spot[sel],
+        q_app=c.q_app[sel], app_path=c.app_path[sel], status=c.status[sel], turn=c.turn[sel], rejected=rejected,
+    )
 
 
 def _line_verdict(world: CollisionWorld, line: FloatArray) -> tuple[str, int]:

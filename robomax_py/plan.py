@@ -49,6 +49,10 @@ def _no_progress(stage: str, done: int, total: int) -> None:
 LIFT_HEIGHTS_M = (0.08, 0.15, 0.25, 0.4)
 # Cost of a detour not yet found, as a multiple of the straight move's estimate.
 DETOUR_PRIOR = 1.6
+# Blocked detour legs between two spots after which only verified legs are offered for that pair:
+# each blocked leg bans one (candidate, candidate, detour) triple, and two spots with hundreds of
+# candidates each would otherwise let the optimiser try a fresh unverified triple every round.
+MAX_BLOCKED_LEGS = 4
 # The planner's own check allows this relative velocity slack (toppra's output is within ~1e-5).
 PLAN_VELOCITY_RTOL = 1e-3
 # Placeholder keeping detour indices stable for pairs a detour cannot serve.
@@ -302,6 +306,9 @@ class _Sequencer:
     known about that pair changes. When a straight move between two spots is blocked, the cheapest
     few other straight moves between them are checked at once; if all are blocked the spot pair is
     treated as detour-only (this may miss a rare free straight move, never admits a blocked one).
+    A detour-only pair for which no detour is found gets a bounded number of further straight checks
+    (`_retry_straight`); a free one lifts the detour-only mark, so one unlucky probe cannot leave the
+    optimiser banning candidate pairs one round at a time.
     """
 
     def __init__(
@@ -328,6 +335,7 @@ class _Sequencer:
         self.legs_ok: dict[tuple[int, int], set[tuple[int, int, int]]] = {}
         self._matrices: dict[tuple[int, int], FloatArray] = {}
         self._estimates: dict[tuple[int, int], FloatArray] = {}
+        self.unresolved: Counter[str] = Counter()                                 # move label -> rounds left open
 
     # ------------------------------------------------------------------ knowledge and costs
 
@@ -368,7 +376,14 @@ class _Sequencer:
         leave = ptp_time_estimate(wp[-1][None, :], self.q(j), self.limits, sp)
         inner = float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits, sp)))
         via = enter[:, None] + inner + leave[None, :]
-        for a, b, vv in self.legs_bad.get((i, j), ()):
+        bad = self.legs_bad.get((i, j), set())
+        if len(bad) >= MAX_BLOCKED_LEGS:
+            verified = np.full_like(via, np.inf)
+            for a, b, vv in self.legs_ok.get((i, j), ()):
+                if vv == v:
+                    verified[a, b] = via[a, b]
+            return verified
+        for a, b, vv in bad:
             if vv == v:
                 via[a, b] = np.inf
         return via
@@ -454,7 +469,9 @@ class _Sequencer:
             if transitions is not None:
                 self.progress("sequencing", self.rounds, self.rounds)
                 return tour, transitions
-        return f"sequencing did not converge in {self.options.max_rounds} rounds"
+        worst = ", ".join(f"{label} ({n} rounds)" for label, n in self.unresolved.most_common(5))
+        return (f"sequencing did not converge in {self.options.max_rounds} rounds; moves left without a "
+                f"verified connection most often: {worst}")
 
     def _verify(self, tour: Tour) -> list[Transition] | None:
         """Transitions of the tour if every leg is known free; else learn from every leg, return None."""
@@ -474,14 +491,17 @@ class _Sequencer:
                     out.append(Transition("move", np.array([qa, qb]), label))
                 else:
                     complete = False
+                    self.unresolved[label] += 1
                 continue
             if best_v < 0 or not np.isfinite(via_costs[best_v]):
                 self._new_detour(i, a, j, b)
                 complete = False
+                self.unresolved[label] += 1
                 continue
             path = self._check_via(i, a, j, b, best_v)
             if path is None:
                 complete = False
+                self.unresolved[label] += 1
                 continue
             out.append(Transition("detour", path, label, self.vias_for(i, j)[best_v].checks))
         return out if complete else None
@@ -565,12 +585,41 @@ class _Sequencer:
             self.no_way.setdefault((i, j), set()).add((a, b))
             self.no_way.setdefault((j, i), set()).add((b, a))
             self._forget(i, j)
+            if (min(i, j), max(i, j)) in self.detour_only:
+                self._retry_straight(i, j)
             return
         self.checks += det.checks
         self.detours.append((i, j, det))
         # Every pair sharing an end spot with this detour may now use it.
         self._matrices.clear()
         self._record_leg(i, a, j, b, len(self.detours) - 1, True)   # its ends are this pair's configurations
+
+    def _retry_straight(self, i: int, j: int) -> bool:
+        """A detour-only spot pair without a detour: check up to `straight_tries` straight moves between
+        candidate pairs not yet checked, cheapest first; a free one lifts the detour-only mark.
+
+        The pair may have been marked detour-only after a single blocked probe (`_probe_pairs`) while
+        other candidate pairs of the same two spots move freely (a clamp beside one orientation only).
+        """
+        est = self.estimate(i, j)
+        known = self.straight.get((i, j), {})
+        banned = self.no_way.get((i, j), set())
+        tried = 0
+        for flat in np.argsort(est, axis=None, kind="stable"):
+            if tried >= self.options.straight_tries:
+                break
+            a, b = (int(x) for x in np.unravel_index(int(flat), est.shape))
+            if (a, b) in known or (a, b) in banned or not np.isfinite(est[a, b]):
+                continue
+            res = self.world.check_segment(self.q(i)[a], self.q(j)[b])
+            self.checks += res.checks
+            self._record_straight(i, a, j, b, res.free)
+            tried += 1
+            if res.free:
+                self.detour_only.discard((min(i, j), max(i, j)))
+                self._forget(i, j)
+                return True
+        return False
 
     def _check_via(self, i: int, a: int, j: int, b: int, v: int) -> FloatArray | None:
         wp = self.vias_for(i, j)[v].waypoints

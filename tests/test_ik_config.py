@@ -101,6 +101,16 @@ def test_turn_bits() -> None:
     assert turn_bits(np.array([-1.0, 2.0])) == 0b01
 
 
+def test_turn_bit_of_negative_zero_survives_fixed_decimals() -> None:
+    """Regression (cabin_flange cell): A4 = -1e-12 rad at a spot was stated T..1..., written to the
+    trajectory file as -0.000000000, read back as -0.0 and judged T..0... by `robomax verify`."""
+    planned = np.array([0.5, -1.5, 2.1, -1e-12, 1.0, -2.4])
+    read_back = np.array([float(f"{v:.9f}") for v in planned])
+    assert read_back[3] == 0.0                      # -0.0
+    assert turn_bits(read_back) == turn_bits(planned) == 0b101010
+    assert turn_bits(np.array([0.0, 0, 0, 0, 0, 0])) == 0
+
+
 def test_abb_confdata() -> None:
     ind = ConfigIndicator(status=0b010, turn=0)
     q = np.array([100, -30, 40, -45, 20, 190]) * DEG

@@ -28,8 +28,9 @@ from robomax_py.timing import ptp_time_estimate
 from robomax_py.transforms import invert
 
 REPO = Path(__file__).resolve().parents[1]
-REFERENCE_CELL = REPO / "cells" / "cabin_flange.yaml"
-PANEL_STL = REPO / "cells" / "parts" / "cabin_panel.stl"
+# Frozen copy of the reference cell (cells/cabin_flange.yaml is now our own cabin-panel cell).
+REFERENCE_CELL = REPO / "tests" / "data" / "flange_cell" / "cabin_flange.yaml"
+PANEL_STL = REPO / "tests" / "data" / "flange_cell" / "parts" / "cabin_panel.stl"
 
 SAMPLE_STEP_S = 0.010          # SPEC §5: samples at most 10 ms apart
 TIME_TOL_S = 1e-9
@@ -39,7 +40,7 @@ ZERO_SPEED_TOL_RAD_S = 1e-9    # "at zero speed" while welding
 VELOCITY_SLACK = 0.01          # finite-difference joint speeds may exceed the limit by 1 %
 COST_TOL_S = 1e-9
 
-# Reference-cell geometry (cells/cabin_flange.yaml), copied so that editing the reference cell does not
+# Reference-cell geometry (tests/data/flange_cell/cabin_flange.yaml), copied so that editing the reference cell does not
 # silently change these tests.
 OBJECTS: dict[str, dict[str, Any]] = {
     "table": {"name": "table", "box": [0.8, 2, 0.62], "pose": {"xyz": [1.85, 0, 0.31]}},

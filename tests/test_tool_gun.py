@@ -21,10 +21,10 @@ import yaml
 
 REPO = Path(__file__).resolve().parents[1]
 GUN_DIR = REPO / "robots" / "tools" / "spot_gun_c"
-# The reference cell lives in the contract's shared/ folder, beside the clone (as in CI); a copy in
-# the repo's cells/ is used first if one is ever added.
+# The reference cell: its frozen copy in tests/data (cells/cabin_flange.yaml is now our own cell), else
+# the contract's shared/ folder beside the clone (as in CI).
 CELL_CANDIDATES = (
-    REPO / "cells" / "cabin_flange.yaml",
+    REPO / "tests" / "data" / "flange_cell" / "cabin_flange.yaml",
     REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml",
 )
 CONVEX_REL_TOL = 1e-6

@@ -114,10 +114,14 @@ class ConfigIndicator:
 
 
 def turn_bits(q: FloatArray) -> IntArray:
-    """(..., n) joint values -> (...) int: bit i set when joint i+1 < 0 (first six joints); -1 for NaN rows."""
+    """(..., n) joint values -> (...) int: bit i set when joint i+1 < 0 (first six joints); -1 for NaN rows.
+
+    -0.0 counts as negative (its sign bit): a joint at -1e-12 rad written with fixed decimals reads
+    back as -0.0, and must keep the indicator the planner stated for it.
+    """
     q = np.asarray(q, dtype=float)
     k = min(q.shape[-1], 6)
-    bits = np.sum((q[..., :k] < 0) * (1 << np.arange(k)), axis=-1).astype(np.int64)
+    bits = np.sum(np.signbit(q[..., :k]) * (1 << np.arange(k)), axis=-1).astype(np.int64)
     return np.where(np.isnan(q).any(axis=-1), -1, bits)
 
 

@@ -1,0 +1,153 @@
+#!/usr/bin/env python
+"""Generate the light C-type spot gun ``robots/tools/spot_gun_light`` (tool.yaml, body.stl, tips.stl).
+
+Run from anywhere:  ``python robots/generate_light_gun.py [--out DIR]``  (DIR defaults to this file's
+folder). Deterministic, like ``robots/generate.py``, whose mesh primitives and STL writer it reuses.
+
+A compact pneumatic C-gun for light-gauge sheet (about 8 kg with bracket, estimated), the class
+carried by 10 kg collaborative arms such as the UR10: 40 mm open gap, 100 mm throat, 13 mm electrodes.
+It hangs from the flange like ``spot_gun_c`` (electrode axis perpendicular to the flange axis, the C
+back towards -flange z), so cells written for one gun read the same with the other.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+
+import numpy as np
+import trimesh
+
+HERE = Path(__file__).resolve().parent
+NAME = "spot_gun_light"
+
+
+def _generate_module() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("robots_generate", HERE / "generate.py")
+    if spec is None or spec.loader is None:
+        raise RuntimeError("robots/generate.py not found")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module          # dataclasses look their module up while it executes
+    spec.loader.exec_module(module)
+    return module
+
+
+G = _generate_module()
+
+
+@dataclass(frozen=True, slots=True)
+class LightGun:
+    """Key dimensions, m (gun frame G: z = closing axis, the C back along +y)."""
+
+    tcp_z: float = 0.22           # fixed-electrode tip face = TCP
+    gap: float = 0.04             # open stroke between the tips
+    throat: float = 0.10          # electrode axis to the inside of the C back, along +y
+    back_thickness: float = 0.03
+    c_width: float = 0.035
+    electrode_radius: float = 0.0065
+    mount_y: float = 0.16         # flange face above the electrode axis
+    mount_z: float = 0.12         # flange centre along the electrode axis
+
+
+GUN = LightGun()
+
+
+def gun_mount(g: LightGun) -> np.ndarray:
+    """T_gun_flange, as `generate.gun_mount`: flange z = -G y, flange x = G z."""
+    T = np.eye(4)
+    T[:3, 0] = (0.0, 0.0, 1.0)
+    T[:3, 1] = (-1.0, 0.0, 0.0)
+    T[:3, 2] = (0.0, -1.0, 0.0)
+    T[:3, 3] = (0.0, g.mount_y, g.mount_z)
+    return T
+
+
+def shells(g: LightGun) -> tuple[list[trimesh.Trimesh], list[trimesh.Trimesh]]:
+    """Convex shells of the body and of the tips, in the flange frame."""
+    cyl, box = G.cylinder, G.box
+    z_tcp, re = g.tcp_z, g.electrode_radius
+    z_mov = z_tcp - g.gap
+    hw = 0.5 * g.c_width
+    y0, y1 = g.throat, g.throat + g.back_thickness
+    body = [
+        # Adapter plate (ISO 9409-1-50 size) 2 mm off the flange face, and the bracket to the C back.
+        cyl((0, g.mount_y - 0.002, g.mount_z), (0, g.mount_y - 0.015, g.mount_z), 0.04),
+        box((-0.03, y1 - 0.004, g.mount_z - 0.045), (0.03, g.mount_y - 0.014, g.mount_z + 0.045)),
+        # Pneumatic cylinder and guided piston rod on the electrode axis.
+        cyl((0, 0, 0.0), (0, 0, 0.085), 0.04),
+        cyl((0, 0, 0.084), (0, 0, z_mov - 0.045), 0.016),
+        cyl((0, 0, z_mov - 0.046), (0, 0, z_mov - 0.022), 0.011),
+        # C frame: lower arm from the cylinder to the back, the back, the upper jaw, the holder block.
+        box((-hw, 0.035, 0.02), (hw, y1, 0.07)),
+        box((-hw, y0, 0.065), (hw, y1, z_tcp + 0.05)),
+        box((-0.5 * hw, 0.05, z_tcp + 0.025), (0.5 * hw, y0 + 0.004, z_tcp + 0.05)),
+        box((-0.012, 0.024, z_tcp + 0.022), (0.012, 0.052, z_tcp + 0.045)),
+    ]
+    crank0 = np.array([0.0, 0.0, z_tcp + 0.012])
+    crank1 = np.array([0.0, 0.03, z_tcp + 0.034])
+    tips = [
+        cyl((0, 0, z_mov - 0.005), (0, 0, z_mov), re, 0.004),           # moving cap, face at z_mov
+        cyl((0, 0, z_mov - 0.023), (0, 0, z_mov - 0.0045), re),          # moving shank
+        cyl((0, 0, z_tcp + 0.005), (0, 0, z_tcp), re, 0.004),           # fixed cap, face at the TCP
+        cyl((0, 0, z_tcp + 0.0045), crank0 + np.array([0, 0, 0.003]), re),
+        cyl(crank0 - 0.0025 * G._unit(crank1 - crank0), crank1, re),   # cranked into the holder
+    ]
+    T_flange_gun = np.linalg.inv(gun_mount(g))
+    return [m.apply_transform(T_flange_gun) for m in body], [m.apply_transform(T_flange_gun) for m in tips]
+
+
+def tool_yaml(g: LightGun) -> str:
+    T_gun_tcp = np.eye(4)
+    T_gun_tcp[2, 3] = g.tcp_z
+    T = np.linalg.inv(gun_mount(g)) @ T_gun_tcp
+    expected = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+    if not np.allclose(T[:3, :3], expected, atol=1e-12):
+        raise RuntimeError("gun mount no longer matches the TCP rpy written to tool.yaml")
+    xyz = T[:3, 3]
+    return (
+        "# Light pneumatic C-type spot gun for 10 kg-class arms (UR10): generic, generated look-alike,\n"
+        "# about 8 kg with bracket (estimated). Generated by robots/generate_light_gun.py -- do not edit.\n"
+        f"# Throat depth {g.throat:g} m, open gap {g.gap:g} m, electrodes 13 mm diameter.\n"
+        "# Hung from the flange like spot_gun_c: electrode axis perpendicular to the flange axis.\n"
+        "# body.stl and tips.stl are unions of separate convex shells (split() recovers them).\n"
+        f"name: {NAME}\n"
+        "body: body.stl\n"
+        "tips: tips.stl\n"
+        f"tcp: {{xyz: [{G._g(xyz[0])}, {G._g(xyz[1])}, {G._g(xyz[2])}], rpy: [-90, 0, -90]}}"
+        "   # fixed-tip face; z = closing axis = flange x\n"
+    )
+
+
+def generate(out: Path) -> list[Path]:
+    """Write the gun's files under ``out`` (the ``robots/`` folder layout); returns them in order."""
+    root = out / "tools" / NAME
+    root.mkdir(parents=True, exist_ok=True)
+    body, tips = shells(GUN)
+    files = {
+        "body.stl": G._stl_bytes(G._shells_mesh(body)),
+        "tips.stl": G._stl_bytes(G._shells_mesh(tips)),
+        "tool.yaml": tool_yaml(GUN).encode(),
+    }
+    written = []
+    for name, data in files.items():
+        (root / name).write_bytes(data)
+        written.append(root / name)
+    return written
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0] if __doc__ else None)
+    parser.add_argument("--out", type=Path, default=HERE, help="output folder (default: robots/)")
+    args = parser.parse_args(argv)
+    for path in generate(args.out):
+        print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,114 @@
+"""Regression: a spot pair marked detour-only after one blocked straight probe, with no detour to be found.
+
+Found while building cells/frame.yaml: `_Sequencer._probe_pairs` checks one straight move per spot pair
+(the cheapest candidate pair) and marks the pair detour-only when it is blocked; when `_new_detour` then
+found nothing, only that exact candidate pair was banned, the optimiser picked the next candidate pair
+of the same spots, and the loop ended with "sequencing did not converge in N rounds" without naming a
+spot. Here the small two-spot cell gets a "clamp" that blocks exactly the first probed move s7 -> s8
+(a collision world that reports that one segment blocked) and a roadmap that finds nothing, while every
+other straight move between s7 and s8 is free.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from conftest import SmallCell
+from robomax_py.candidates import SpotCandidates, seam_candidates
+from robomax_py.cell_io import load_cell, load_cell_robot
+from robomax_py.collision import CollisionWorld, SegmentCheck
+from robomax_py.plan import PlanOptions, _Sequencer, resolved_options
+from robomax_py.roadmap import Detour
+from robomax_py.scene import build_scene
+from robomax_py.spec import CellSpec
+
+JOINT_TOL_RAD = 1e-12
+
+
+class _ClampedWorld:
+    """The real collision world, except that one joint-space segment (either way) is blocked."""
+
+    def __init__(self, world: CollisionWorld, q0: np.ndarray, q1: np.ndarray) -> None:
+        self._world, self._q0, self._q1 = world, q0, q1
+        self.blocked_asks = 0
+
+    def _is_blocked(self, a: np.ndarray, b: np.ndarray) -> bool:
+        def same(x: np.ndarray, y: np.ndarray) -> bool:
+            return bool(np.allclose(x, y, atol=JOINT_TOL_RAD))
+
+        return (same(a, self._q0) and same(b, self._q1)) or (same(a, self._q1) and same(b, self._q0))
+
+    def check_segment(self, q0: np.ndarray, q1: np.ndarray, *args: Any, **kwargs: Any) -> SegmentCheck:
+        if self._is_blocked(q0, q1):
+            self.blocked_asks += 1
+            return SegmentCheck(free=False, checks=1, states=2, narrow_phase_tests=1, s_contact=0.5)
+        return self._world.check_segment(q0, q1, *args, **kwargs)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._world, name)
+
+
+class _NoRoadmap:
+    def query(self, q0: np.ndarray, q1: np.ndarray) -> Detour | None:
+        return None
+
+
+def _setup(tmp_path: Path, write_small_cell: SmallCell) -> tuple[CellSpec, Any, CollisionWorld, list[SpotCandidates]]:
+    cell = load_cell(write_small_cell(tmp_path, "detour_only"))
+    robot = load_cell_robot(cell)
+    world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+    spots, _ = seam_candidates(cell, robot, world, 0)
+    assert [c.name for c in spots] == ["s7", "s8"] and min(len(c) for c in spots) > 1
+    return cell, robot, world, spots
+
+
+def _sequencer(cell: CellSpec, robot: Any, world: Any, spots: list[SpotCandidates], rounds: int) -> _Sequencer:
+    seq = _Sequencer(cell, robot, world, _NoRoadmap(), spots, resolved_options(cell, PlanOptions(max_rounds=rounds)),  # type: ignore[arg-type]
+                     np.random.default_rng(0))
+    seq._lift_detour = lambda i, a, j, b: None  # type: ignore[method-assign]   # no way over the "clamp"
+    return seq
+
+
+def test_blocked_first_probe_with_free_alternative_plans_straight(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    cell, robot, world, spots = _setup(tmp_path, write_small_cell)
+    probe = _sequencer(cell, robot, world, spots, 1)
+    est = probe.estimate(0, 1)
+    a, b = np.unravel_index(int(np.argmin(est)), est.shape)          # what `_probe_pairs` checks first
+    clamped = _ClampedWorld(world, spots[0].q_app[a], spots[1].q_app[b])
+    seq = _sequencer(cell, robot, clamped, spots, 80)
+    outcome = seq.run()
+    assert not isinstance(outcome, str), outcome
+    tour, transitions = outcome
+    assert clamped.blocked_asks >= 1                                 # the probe did hit the "clamp"
+    between = [t for t in transitions if t.label in ("s7 -> s8", "s8 -> s7")]
+    assert len(between) == 1 and between[0].kind == "move"
+    assert (0, 1) not in seq.detour_only                              # the mark was lifted
+    # The move the tour takes is not the blocked one.
+    q_from, q_to = between[0].waypoints[0], between[0].waypoints[-1]
+    assert not clamped._is_blocked(q_from, q_to)
+    assert seq.rounds < 10
+
+
+def test_non_convergence_names_the_moves(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    """If the loop still runs out of rounds, the message names the moves left open."""
+    cell, robot, world, spots = _setup(tmp_path, write_small_cell)
+    seq = _sequencer(cell, robot, _BlockEverything(world), spots, 2)
+    outcome = seq.run()
+    assert isinstance(outcome, str)
+    assert "did not converge in 2 rounds" in outcome
+    assert "home -> s7" in outcome or "home -> s8" in outcome, outcome
+
+
+class _BlockEverything:
+    """Every straight move between different configurations is blocked."""
+
+    def __init__(self, world: CollisionWorld) -> None:
+        self._world = world
+
+    def check_segment(self, q0: np.ndarray, q1: np.ndarray, *args: Any, **kwargs: Any) -> SegmentCheck:
+        return SegmentCheck(free=False, checks=1, states=2, narrow_phase_tests=1, s_contact=0.5)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._world, name)

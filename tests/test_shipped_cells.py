@@ -1,0 +1,55 @@
+"""End to end on every shipped example cell (cells/*.yaml): `robomax plan` writes both program files
+and `robomax verify` passes on both; the frame's seams are all welded and its ordered pillar seam
+keeps its order. Slow: each cell plans in 10-40 s."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from robomax_py.cli import EXIT_OK, app
+
+REPO = Path(__file__).resolve().parents[1]
+CELLS = sorted((REPO / "cells").glob("*.yaml"))
+runner = CliRunner()
+
+
+def test_at_least_three_shipped_cells() -> None:
+    assert {p.stem for p in CELLS} >= {"cabin_flange", "frame", "ur10_tray"}
+
+
+def _plan(cell: Path, out: Path) -> dict[str, object]:
+    result = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
+    assert result.exit_code == EXIT_OK, result.output
+    name = yaml.safe_load(cell.read_text()).get("name", cell.stem)
+    for ext in (".json", ".srcl"):
+        program = out / f"{name}{ext}"
+        assert program.is_file(), f"{program} not written"
+        check = runner.invoke(app, ["verify", str(cell), str(program)])
+        assert check.exit_code == EXIT_OK, check.output
+    data: dict[str, object] = json.loads((out / f"{name}.json").read_text())
+    return data
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("cell", CELLS, ids=[p.stem for p in CELLS])
+def test_shipped_cell_plans_and_verifies(cell: Path, tmp_path: Path) -> None:
+    data = _plan(cell, tmp_path)
+    spec = yaml.safe_load(cell.read_text())
+    wanted = {(s["name"], p["name"]) for s in spec["seams"] for p in s["spots"]}
+    welded = [(s["seam"], s["name"]) for s in data["spots"]]  # type: ignore[union-attr]
+    assert sorted(welded) == sorted(wanted)                      # every spot of every seam, once
+    for seam in spec["seams"]:
+        if seam.get("ordered"):
+            got = [name for s, name in welded if s == seam["name"]]
+            assert got == [p["name"] for p in seam["spots"]], f"{seam['name']} welded out of order"
+
+
+def test_frame_has_an_ordered_seam_and_several_seams() -> None:
+    spec = yaml.safe_load((REPO / "cells" / "frame.yaml").read_text())
+    assert 3 <= len(spec["seams"]) <= 4
+    assert [s["name"] for s in spec["seams"] if s.get("ordered")] == ["pillar"]
