@@ -157,6 +157,31 @@ def verify(
     raise typer.Exit(code)
 
 
+@app.command()
+def preview(
+    cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
+    program: Annotated[Path | None, typer.Argument(help="program written by plan (.json or .srcl); without it the robot stands at home")] = None,
+    html: Annotated[Path | None, typer.Option("--html", help="write one self-contained HTML page instead of serving")] = None,
+) -> None:
+    """Show the cell in meshcat, animated along a program (serves until Ctrl-C, or writes --html)."""
+
+    def run() -> None:
+        from robomax_py.cell_io import load_cell, load_cell_robot
+        from robomax_py.preview import serve, write_html
+        from robomax_py.preview_program import home_program, load_program
+
+        spec = load_cell(cell)
+        robot = load_cell_robot(spec)
+        shown = home_program(spec) if program is None else load_program(program, spec, robot)
+        if html is not None:
+            content = write_html(html, spec, robot, shown)
+            out.print(f"wrote {html} ({content.frames} animation frames, cycle {content.duration:.3f} s)")
+            return
+        serve(spec, robot, shown, lambda url: out.print(f"meshcat preview at {url}  (Ctrl-C to stop)"))
+
+    _guarded(run)
+
+
 def main() -> None:
     """Console entry point."""
     try:
