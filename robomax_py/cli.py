@@ -86,6 +86,7 @@ def plan(
     baseline: Annotated[bool, typer.Option("--baseline", help="the published method: given order, nominal orientation, first branch")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable report instead of tables")] = False,
     speed: Annotated[float | None, typer.Option("--speed", min=0.01, max=1.0, help="override of every programmed speed, fraction in (0, 1] (default: the cell's planner.speed, else 1)")] = None,
+    plot: Annotated[bool, typer.Option("--plot", help="also write DIR/<name>.png: a cycle-time Gantt chart, one row per spot")] = False,
 ) -> None:
     """Plan a cell and write its program files (only when the plan is complete and verified)."""
 
@@ -107,9 +108,20 @@ def plan(
         written: list[Path] = []
         if result.status == "planned":
             texts = {fmt: render(result, fmt) for fmt in EXPORTERS}   # all rendered before any write
+            png = None
+            if plot:
+                from robomax_py.cycle_chart import cycle_chart, render_png
+
+                png = render_png(cycle_chart(result))
             for fmt, text in texts.items():
                 path = out_dir / f"{spec.name}{EXPORTERS[fmt][0]}"
                 write_atomic(path, text)
+                written.append(path)
+            if png is not None:
+                from robomax_py.files import write_atomic_bytes
+
+                path = out_dir / f"{spec.name}.png"
+                write_atomic_bytes(path, png)
                 written.append(path)
         report = plan_report(result, seconds, written)
         if as_json:
