@@ -21,6 +21,9 @@ ROLE_COLOURS: dict[str, int] = {
 }
 DYNAMIC_OPACITY = 0.45
 
+# The floor plate under the cell.
+FLOOR = 0xD9DCE1
+
 # Spot markers.
 SPOT = 0xFFD400
 
@@ -63,6 +66,7 @@ def hex_colour(colour: int) -> str:
 
 __all__ = [
     "DYNAMIC_OPACITY",
+    "FLOOR",
     "PHASE_COLOURS",
     "ROBOT",
     "ROLE_COLOURS",

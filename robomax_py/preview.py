@@ -12,6 +12,10 @@ What is drawn, in the cell (world) frame, under the meshcat path `robomax/`:
 - an animation of the links and the tool on the program's own clock (frame k at k / fps seconds,
   the last at exactly the cycle time), played once when the page opens.
 
+Poses under `robomax/` are in the cell frame; `robomax/` itself is shifted so that the point the
+camera looks at (between the robot base and the spots) is the viewer's origin, which meshcat's orbit
+controls always look at; the floor grid is shifted with it.
+
 `write_html` writes one self-contained page (meshcat's `static_html`, which inlines the viewer's
 three.js bundle and the scene); `serve` keeps a meshcat server running until interrupted.
 """
@@ -43,9 +47,11 @@ ROOT = "robomax"
 SPOT_MARKER_RADIUS_M = 0.006
 TRIAD_SCALE_M = 0.06
 # Camera: looks at the centre of the cell objects from this direction (world frame, unit-free).
-CAMERA_DIRECTION = (-0.9, -1.5, 1.1)
-CAMERA_DISTANCE_FACTOR = 1.5
-CAMERA_MIN_DISTANCE_M = 3.5
+CAMERA_DIRECTION = (-0.75, -1.0, 0.8)
+CAMERA_DISTANCE_FACTOR = 1.05
+CAMERA_MIN_DISTANCE_M = 2.5
+FLOOR_MARGIN_M = 1.0
+FLOOR_THICKNESS_M = 0.01
 # A light background (meshcat's default is a dark blue gradient), RGB in [0, 1].
 BACKGROUND_TOP = [0.98, 0.98, 0.99]
 BACKGROUND_BOTTOM = [0.78, 0.81, 0.86]
@@ -350,19 +356,33 @@ def _draw_path(root: Any, robot: RobotModel, program: ShownProgram, T_world_base
 
 
 def _place_camera(vis: Any, cell: CellSpec, robot: RobotModel) -> None:
-    """Look at the centre of the cell objects (and the robot base) from CAMERA_DIRECTION; light background."""
-    points = [np.asarray(cell.T_world_base, dtype=float)[:3, 3]]
-    points.extend(np.asarray(o.T_world_object, dtype=float)[:3, 3] for o in cell.objects)
-    points.extend(np.asarray(s.xyz, dtype=float) for seam in cell.seams for s in seam.spots)
-    pts = np.array(points)
-    target = (pts.min(axis=0) + pts.max(axis=0)) / 2.0
-    target[2] = max(float(target[2]), 0.5)
+    """Look between the robot base and the spots from CAMERA_DIRECTION, far enough to see both; a floor
+    plate under the cell; light background."""
+    import meshcat.geometry as g
+
+    base = np.asarray(cell.T_world_base, dtype=float)[:3, 3]
+    spots = [np.asarray(s.xyz, dtype=float) for seam in cell.seams for s in seam.spots]
+    pts = np.array([base, *spots, *(np.asarray(o.T_world_object, dtype=float)[:3, 3] for o in cell.objects)])
+    work = np.mean(spots, axis=0) if spots else (pts.min(axis=0) + pts.max(axis=0)) / 2.0
+    target = (base + work) / 2.0
+    target[2] = float(work[2])
     size = float(np.max(pts.max(axis=0) - pts.min(axis=0)))
     direction = np.array(CAMERA_DIRECTION, dtype=float)
     offset = direction / np.linalg.norm(direction) * max(CAMERA_MIN_DISTANCE_M, CAMERA_DISTANCE_FACTOR * size + 1.0)
-    T = np.eye(4)
-    T[:3, 3] = target
-    vis["/Cameras/default"].set_transform(T)
+    # meshcat's orbit controls always look at the viewer's origin: shift the cell so the target is
+    # there. Paths under robomax/ keep their cell-frame poses relative to that shift. meshcat's grid
+    # stays at the viewer's z = 0, so it is hidden and a floor plate is drawn at the cell's z = 0.
+    shift = np.eye(4)
+    shift[:3, 3] = -target
+    vis[ROOT].set_transform(shift)
+    vis["/Grid"].set_property("visible", False)
+    lo = pts.min(axis=0) - FLOOR_MARGIN_M
+    hi = pts.max(axis=0) + FLOOR_MARGIN_M
+    floor = np.eye(4)
+    floor[:3, 3] = [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0, -FLOOR_THICKNESS_M / 2.0]
+    vis[f"{ROOT}/floor"].set_object(g.Box([float(hi[0] - lo[0]), float(hi[1] - lo[1]), FLOOR_THICKNESS_M]),
+                                    g.MeshLambertMaterial(color=palette.FLOOR))
+    vis[f"{ROOT}/floor"].set_transform(floor)
     # The camera sits in a frame rotated +90 deg about x (three.js is y-up): world (x, y, z) = local (x, -z, y).
     vis["/Cameras/default/rotated/<object>"].set_property("position", [float(offset[0]), float(offset[2]), float(-offset[1])])
     vis["/Background"].set_property("top_color", BACKGROUND_TOP)
