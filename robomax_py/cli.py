@@ -190,6 +190,7 @@ def preview(
             out.print(f"wrote {html} ({content.frames} animation frames, cycle {content.duration:.3f} s)")
             return
         serve(spec, robot, shown, lambda url: out.print(f"meshcat preview at {url}  (Ctrl-C to stop)"))
+        out.print("preview stopped")
 
     _guarded(run)
 

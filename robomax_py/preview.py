@@ -176,7 +176,7 @@ def write_html(path: Path, cell: CellSpec, robot: RobotModel, program: ShownProg
 
 
 def serve(cell: CellSpec, robot: RobotModel, program: ShownProgram, announce: Callable[[str], None], fps: int = DEFAULT_FPS) -> None:
-    """Start a meshcat server with the preview, announce its URL, and serve until interrupted."""
+    """Start a meshcat server with the preview, announce its URL, and serve until Ctrl-C (then return)."""
     import time
 
     vis = _visualizer()
@@ -185,6 +185,8 @@ def serve(cell: CellSpec, robot: RobotModel, program: ShownProgram, announce: Ca
         announce(vis.url())
         while True:
             time.sleep(3600)
+    except KeyboardInterrupt:
+        return                               # Ctrl-C is how a preview ends (SPEC §4: exit 0)
     finally:
         _close(vis)
 

@@ -203,3 +203,29 @@ def test_json_phases_match_the_rebuilt_programs(planned: tuple[Path, Path]) -> N
         assert abs(a - b) <= 0.0101 * 2, (kind, a, b)
     covered = sum(p.duration for p in from_json.phases)
     assert abs(covered - from_json.duration) < TIME_TOL_S
+
+
+def test_serve_announces_its_url_and_ends_cleanly_on_ctrl_c(planned: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch) -> None:
+    import time
+
+    from robomax_py import preview
+
+    cell_path, _ = planned
+    cell = load_cell(cell_path)
+    urls: list[str] = []
+    servers: list[Any] = []
+    make = preview._visualizer
+
+    def visualizer() -> Any:
+        vis = make()
+        servers.append(vis.window.server_proc)
+        return vis
+
+    def ctrl_c(seconds: float) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(preview, "_visualizer", visualizer)
+    monkeypatch.setattr(time, "sleep", ctrl_c)
+    preview.serve(cell, load_cell_robot(cell), home_program(cell), urls.append)
+    assert len(urls) == 1 and urls[0].startswith("http://127.0.0.1:")
+    assert servers and servers[0].poll() is not None          # the meshcat server was stopped
