@@ -10,7 +10,8 @@ What is drawn, in the cell (world) frame, under the meshcat path `robomax/`:
   with (the nominal spot frame when there is no program);
 - `path/<k>_<kind>`: the TCP path, one line per phase, coloured by phase kind;
 - an animation of the links and the tool on the program's own clock (frame k at k / fps seconds,
-  the last at exactly the cycle time), played once when the page opens.
+  the last at exactly the cycle time), played once when the page opens; dynamic objects are
+  visible only inside their presence windows.
 
 Poses under `robomax/` are in the cell frame; `robomax/` itself is shifted so that the point the
 camera looks at (between the robot base and the spots) is the viewer's origin, which meshcat's orbit
@@ -140,10 +141,13 @@ def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram,
     if len(frames):
         anim = mc_anim.Animation(default_framerate=fps)
         qs = program.q_at(program.t[0] + frames / fps)
+        dynamic = [(p, obj) for (p, role, _), obj in zip(objects, (*cell.objects, *cell.dynamic)) if role == "dynamic"]
         for frame, q in zip(frames, qs):
             at = anim.at_frame(root, float(frame))
             for path, T in _node_poses(robot, links, T_world_base, q).items():
                 at[path].set_transform(T)
+            for path, obj in dynamic:
+                at[path].set_property("visible", "boolean", _present(obj.present, float(frame) / fps))
         vis.set_animation(anim, play=True, repetitions=1)
     _place_camera(vis, cell, robot)
     return PreviewContent(
@@ -200,6 +204,11 @@ def _visualizer() -> Any:
 
     with contextlib.redirect_stdout(io.StringIO()):
         return meshcat.Visualizer()
+
+
+def _present(windows: tuple[tuple[float, float], ...] | None, t: float) -> bool:
+    """Whether a dynamic object exists at program time t, s (no windows: always)."""
+    return windows is None or any(a <= t <= b for a, b in windows)
 
 
 def _close(vis: Any) -> None:

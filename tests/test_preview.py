@@ -229,3 +229,28 @@ def test_serve_announces_its_url_and_ends_cleanly_on_ctrl_c(planned: tuple[Path,
     preview.serve(cell, load_cell_robot(cell), home_program(cell), urls.append)
     assert len(urls) == 1 and urls[0].startswith("http://127.0.0.1:")
     assert servers and servers[0].poll() is not None          # the meshcat server was stopped
+
+
+def test_dynamic_objects_are_visible_only_in_their_windows(planned: tuple[Path, Path]) -> None:
+    import dataclasses
+
+    from robomax_py.spec import Box, ObjectSpec
+
+    cell_path, _ = planned
+    cell = load_cell(cell_path)
+    door = ObjectSpec("door", Box((0.8, 0.05, 0.6)), np.eye(4), present=((0.0, 0.5), (1.5, 2.0)))
+    cell = dataclasses.replace(cell, dynamic=(door,))
+    robot = load_cell_robot(cell)
+    t = np.linspace(0.0, 2.0, 201)
+    q = np.repeat(np.asarray(cell.home)[None, :], len(t), axis=0)
+    shown = ShownProgram("still", t, q, (), ())
+    rec = Recorder()
+    content = populate(meshcat.Visualizer(window=rec), cell, robot, shown, fps=10)
+    assert ("robomax/cell/dynamic/door", "dynamic", palette.ROLE_COLOURS["dynamic"]) in content.objects
+    (anim,) = [c for c in rec.commands if c["type"] == "set_animation"]
+    (clip,) = [a["clip"] for a in anim["animations"] if a["path"] == "/meshcat/robomax/cell/dynamic/door"]
+    (track,) = clip["tracks"]
+    assert track["name"] == ".visible" and track["type"] == "boolean"
+    shown_at = {round(k["time"] / 10, 6): k["value"] for k in track["keys"]}
+    assert len(shown_at) == content.frames == 21
+    assert [s for s, v in sorted(shown_at.items()) if v] == [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 1.5, 1.6, 1.7, 1.8, 1.9, 2.0]
