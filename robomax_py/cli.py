@@ -87,6 +87,7 @@ def plan(
     as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable report instead of tables")] = False,
     speed: Annotated[float | None, typer.Option("--speed", min=0.01, max=1.0, help="override of every programmed speed, fraction in (0, 1] (default: the cell's planner.speed, else 1)")] = None,
     verbose: Annotated[bool, typer.Option("-v", "--verbose", help="debug logging: stage sizes, counts and times")] = False,
+    plot: Annotated[bool, typer.Option("--plot", help="also write DIR/<name>.png: a cycle-time Gantt chart, one row per spot")] = False,
 ) -> None:
     """Plan a cell and write its program files (only when the plan is complete and verified)."""
 
@@ -110,7 +111,16 @@ def plan(
         seconds = time.perf_counter() - t0
         written: list[Path] = []
         if result.status == "planned":
-            written = write_programs(out_dir, render_programs(result))   # all rendered before any write
+            from robomax_py.cycle_chart import cycle_chart, render_png
+            from robomax_py.files import write_atomic_bytes
+
+            texts = render_programs(result)   # everything rendered before any write
+            png = render_png(cycle_chart(result)) if plot else None
+            written = write_programs(out_dir, texts)
+            if png is not None:
+                path = out_dir / f"{spec.name}.png"
+                write_atomic_bytes(path, png)
+                written.append(path)
         report = plan_report(result, seconds, written)
         if as_json:
             out.print_json(_json.dumps(report))
@@ -182,6 +192,32 @@ def bench(
             value = f"{r.value:,.0f}" if r.value >= 1000 else f"{r.value:.3f}"
             table.add_row(r.name, value, r.unit, r.note)
         out.print(table)
+
+    _guarded(run)
+
+
+@app.command()
+def preview(
+    cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
+    program: Annotated[Path | None, typer.Argument(help="program written by plan (.json or .srcl); without it the robot stands at home")] = None,
+    html: Annotated[Path | None, typer.Option("--html", help="write one self-contained HTML page instead of serving")] = None,
+) -> None:
+    """Show the cell in meshcat, animated along a program (serves until Ctrl-C, or writes --html)."""
+
+    def run() -> None:
+        from robomax_py.cell_io import load_cell, load_cell_robot
+        from robomax_py.preview import serve, write_html
+        from robomax_py.preview_program import home_program, load_program
+
+        spec = load_cell(cell)
+        robot = load_cell_robot(spec)
+        shown = home_program(spec) if program is None else load_program(program, spec, robot)
+        if html is not None:
+            content = write_html(html, spec, robot, shown)
+            out.print(f"wrote {html} ({content.frames} animation frames, cycle {content.duration:.3f} s)")
+            return
+        serve(spec, robot, shown, lambda url: out.print(f"meshcat preview at {url}  (Ctrl-C to stop)"))
+        out.print("preview stopped")
 
     _guarded(run)
 

@@ -33,3 +33,19 @@ def write_programs(out_dir: Path, texts: Mapping[str, str]) -> list[Path]:
         write_atomic(path, text)
         written.append(path)
     return written
+
+
+def write_atomic_bytes(path: Path, data: bytes) -> None:
+    """`write_atomic` for binary content (images): the file appears whole or not at all."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

@@ -1,0 +1,108 @@
+"""The `--html` preview page in a real browser: headless Debian chromium driven by Playwright.
+
+The page is opened from disk with the network features of the browser off; the test asserts the
+scene really drew (pixels in the robot's colour inside the canvas), that nothing but the page itself
+and its inline data was requested, and that the console shows no errors.
+
+Skips when /usr/bin/chromium (or the playwright package) is missing, unless ROBOMAX_REQUIRE_BROWSER
+is set (CI sets it): then it fails. Playwright never downloads a browser here.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from robomax_py import palette
+from robomax_py.cli import EXIT_OK, app
+
+pytestmark = pytest.mark.slow
+
+SmallCell = Callable[..., Path]   # conftest.write_small_cell
+CHROMIUM = Path("/usr/bin/chromium")
+CHROMIUM_ARGS = [
+    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+]
+VIEWPORT = {"width": 1000, "height": 700}
+SETTLE_MS = 2500                 # the viewer draws the scene and starts the animation
+MIN_ROBOT_FRACTION = 0.01        # of the canvas' pixels in the robot's colour
+runner = CliRunner()
+
+
+def _browser_or_skip() -> Any:
+    """playwright.sync_api, or skip (fail when ROBOMAX_REQUIRE_BROWSER is set) if it cannot run."""
+    problem = None
+    if not CHROMIUM.is_file():
+        problem = f"{CHROMIUM} not found (apt-get install chromium)"
+    try:
+        import playwright.sync_api as sync_api
+    except ImportError:
+        problem = problem or "the playwright package is not installed (pip install -e '.[test]')"
+        sync_api = None
+    if problem is not None:
+        if os.environ.get("ROBOMAX_REQUIRE_BROWSER"):
+            pytest.fail(f"ROBOMAX_REQUIRE_BROWSER is set but {problem}")
+        pytest.skip(problem)
+    return sync_api
+
+
+def robot_coloured(rgb: np.ndarray) -> np.ndarray:
+    """(h, w, 3) uint8 -> (h, w) bool: pixels of palette.ROBOT's hue under any shading.
+
+    Lambert shading scales the channels together, so the ratios of the orange stay: red bright,
+    green between 35 % and 80 % of red, blue below 35 % of red.
+    """
+    want = np.array([(palette.ROBOT >> 16) & 0xFF, (palette.ROBOT >> 8) & 0xFF, palette.ROBOT & 0xFF], dtype=float)
+    assert want[0] > 200 and 0.35 < want[1] / want[0] < 0.8 and want[2] / want[0] < 0.35   # the rule fits the palette
+    r, gr, b = (rgb[..., i].astype(float) for i in range(3))
+    return (r > 120) & (gr > 0.35 * r) & (gr < 0.8 * r) & (b < 0.35 * r)
+
+
+def test_html_preview_draws_the_robot_offline_without_console_errors(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    sync_api = _browser_or_skip()
+    from PIL import Image
+
+    cell = write_small_cell(tmp_path, "small_cell")
+    out = tmp_path / "programs"
+    result = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
+    assert result.exit_code == EXIT_OK, result.output
+    page_file = tmp_path / "small_cell.html"
+    result = runner.invoke(app, ["preview", str(cell), str(out / "small_cell.json"), "--html", str(page_file)])
+    assert result.exit_code == EXIT_OK, result.output
+
+    errors: list[str] = []
+    requests: list[str] = []
+    with sync_api.sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=str(CHROMIUM), headless=True, args=CHROMIUM_ARGS)
+        try:
+            page = browser.new_page(viewport=VIEWPORT)
+            page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+            page.on("pageerror", lambda e: errors.append(str(e)))
+            page.on("request", lambda r: requests.append(r.url))
+            page.goto(page_file.resolve().as_uri())
+            page.wait_for_selector("canvas")
+            page.wait_for_timeout(SETTLE_MS)
+            box = page.locator("canvas").first.bounding_box()
+            shot = page.screenshot()
+        finally:
+            browser.close()
+
+    assert errors == [], errors
+    assert all(u.startswith(("file:", "data:")) for u in requests), [u for u in requests if not u.startswith(("file:", "data:"))]
+    assert box is not None and box["width"] > 100 and box["height"] > 100
+    image = np.asarray(Image.open(io.BytesIO(shot)).convert("RGB"))
+    x0, y0 = int(box["x"]), int(box["y"])
+    canvas = image[y0:y0 + int(box["height"]), x0:x0 + int(box["width"])]
+    (tmp_path / "screenshot.png").write_bytes(shot)
+    fraction = float(np.mean(robot_coloured(canvas)))
+    assert fraction > MIN_ROBOT_FRACTION, f"{fraction:.4f} of the canvas in the robot's colour: the scene did not draw"
+    # Not a blank canvas: many distinct colours (shaded meshes, grid, path).
+    assert len(np.unique(canvas.reshape(-1, 3)[::7], axis=0)) > 200
