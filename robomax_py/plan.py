@@ -349,8 +349,13 @@ class _Sequencer:
     def estimate(self, i: int, j: int) -> FloatArray:
         key = (i, j)
         if key not in self._estimates:
-            qa, qb = self.q(i), self.q(j)
-            self._estimates[key] = ptp_time_estimate(qa[:, None, :], qb[None, :, :], self.limits, self.options.speed)
+            back = self._estimates.get((j, i))
+            if back is not None:        # |qb - qa| = |qa - qb| bit for bit: the estimate is symmetric
+                self._estimates[key] = back.T
+            else:
+                qa, qb = self.q(i), self.q(j)
+                self._estimates[key] = ptp_time_estimate(qa[:, None, :], qb[None, :, :], self.limits,
+                                                         self.options.speed)
         return self._estimates[key]
 
     def vias_for(self, i: int, j: int) -> list[Detour]:
