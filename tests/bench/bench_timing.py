@@ -39,7 +39,7 @@ def main() -> None:
     args = parser.parse_args()
     cell = load_cell(args.cell)
     robot = load_cell_robot(cell)
-    print(f"cell {cell.name}: {args.runs} runs, medians (timing stage: CPU seconds)")
+    print(f"cell {cell.name}: {args.runs} runs, medians (timing stage: wall seconds)")
     print(f"{'variant':32s} {'cycle s':>9s} {'timing s':>9s} {'/ bound':>8s}")
     bound = None
     for name, options in VARIANTS.items():
