@@ -228,15 +228,26 @@ def optimise(
             seen[flat] = best_choice(flat, costs)[1]
         return seen[flat]
 
+    # Descents from different starts and kicks pass through the same orders again and again.
+    screened: dict[tuple[tuple[int, tuple[int, ...]], ...], tuple[list[tuple[Blocks, tuple[int, ...]]], FloatArray, list[int]]] = {}
+
+    def neighbours(current: Blocks) -> tuple[list[tuple[Blocks, tuple[int, ...]]], FloatArray, list[int]]:
+        """The moves from `current`, their bounds and their ranking (cached per order)."""
+        key = tuple(current)
+        got = screened.get(key)
+        if got is None:
+            options = _neighbours(current, ordered)
+            bounds = _bounds([flat for _, flat in options], bound, home_index) + node_total if options else np.zeros(0)
+            got = screened[key] = (options, bounds, np.argsort(bounds, kind="stable").tolist())
+        return got
+
     def descend(start: Blocks) -> tuple[Blocks, float]:
         current, current_cost = start, evaluate(start)
         while counter["evaluations"] < max_evaluations:
-            options = _neighbours(current, ordered)
+            options, bounds, ranked = neighbours(current)
             if not options:
                 break
             counter["screened"] += len(options)
-            bounds = _bounds([flat for _, flat in options], bound, home_index) + node_total
-            ranked = np.argsort(bounds, kind="stable").tolist()
             improved = False
             for rank, idx in enumerate(ranked):
                 # Past the `screen` most promising moves, a neighbour whose lower bound does not
