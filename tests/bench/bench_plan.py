@@ -32,6 +32,7 @@ from robomax_py.roadmap import Roadmap  # noqa: E402
 from robomax_py.scene import build_scene  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
+REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
 PUBLISHED = {20: (8_000, 0.3), 50: (25_000, 22.3), 100: (1_000_000, 122.2)}
 
 
@@ -96,7 +97,7 @@ def grid_detour(world: CollisionWorld, q_start: np.ndarray, q_goal: np.ndarray, 
 
 def main() -> None:
     parser = argparse.ArgumentParser()
-    parser.add_argument("cell", nargs="?", default=str(REPO / "cells" / "cabin_flange.yaml"))
+    parser.add_argument("cell", nargs="?", default=str(REFERENCE_CELL))
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--resolutions", default="20,50,100")
     args = parser.parse_args()
