@@ -16,10 +16,8 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
-import statistics  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
-from collections.abc import Callable  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -27,6 +25,7 @@ import numpy as np  # noqa: E402
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))
 
+from robomax_py.bench import median_cpu_seconds  # noqa: E402
 from robomax_py.cell_io import load_cell, load_cell_robot  # noqa: E402
 from robomax_py.collision import CollisionWorld  # noqa: E402
 from robomax_py.scene import build_scene  # noqa: E402
@@ -34,17 +33,6 @@ from robomax_py.scene import build_scene  # noqa: E402
 RUNS = 5
 REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
 SEGMENT_MAX_DEG = 10.0          # random short segments: each joint moves by at most this
-
-
-def median_seconds(fn: Callable[[], object]) -> float:
-    """Median CPU seconds of RUNS calls of fn, after one warm-up call."""
-    fn()
-    times = []
-    for _ in range(RUNS):
-        t0 = time.process_time()
-        fn()
-        times.append(time.process_time() - t0)
-    return max(statistics.median(times), 1e-9)
 
 
 def main() -> None:
@@ -90,10 +78,10 @@ def main() -> None:
     rows = []
     for label, world, n in (("broad phase", broad, n_configs), ("exhaustive", exhaustive, max(n_configs // 10, 500))):
         sub = qs[:n]
-        single = n / median_seconds(lambda: [world.is_free(q) for q in sub])
-        batch = n / median_seconds(lambda: world.are_free(sub))
+        single = n / median_cpu_seconds(lambda: [world.is_free(q) for q in sub], RUNS)
+        batch = n / median_cpu_seconds(lambda: world.are_free(sub), RUNS)
         m = n_segments if world is broad else max(n_segments // 10, 10)
-        seg_time = median_seconds(lambda: [world.segment_free(a, b) for a, b in zip(seg_a[:m], seg_b[:m])])
+        seg_time = median_cpu_seconds(lambda: [world.segment_free(a, b) for a, b in zip(seg_a[:m], seg_b[:m])], RUNS)
         rows.append((label, single, batch, m / seg_time, seg_done * m / seg_time))
 
     print(f"cell {cell.name}: robot {robot.name}, tool {cell.tool.name}, clearance {cell.process.clearance} m")

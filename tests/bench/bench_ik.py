@@ -13,9 +13,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
-import statistics  # noqa: E402
 import sys  # noqa: E402
-import time  # noqa: E402
 from collections.abc import Callable  # noqa: E402
 from importlib import metadata  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -25,6 +23,7 @@ import pinocchio as pin  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
+from robomax_py.bench import median_cpu_seconds  # noqa: E402
 from robomax_py.ik._chain import chain_to_frame, frame_pose  # noqa: E402
 from robomax_py.ik.numeric import numeric_ik  # noqa: E402
 from robomax_py.ik.opw import OpwParams, opw_fk, opw_ik  # noqa: E402
@@ -40,13 +39,7 @@ KR16 = OpwParams(
 
 def median_rate(fn: Callable[[], object], items: int) -> float:
     """items per CPU second, median over RUNS calls of fn (after one warm-up call)."""
-    fn()
-    times = []
-    for _ in range(RUNS):
-        t0 = time.process_time()
-        fn()
-        times.append(time.process_time() - t0)
-    return items / max(statistics.median(times), 1e-9)
+    return items / median_cpu_seconds(fn, RUNS)
 
 
 def ur10_urdf() -> str:
