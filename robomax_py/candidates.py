@@ -23,7 +23,7 @@ from robomax_py.spec import CellSpec, SeamSpec
 from robomax_py.transforms import invert
 
 # The approach line is solved by IK at this TCP spacing; the sweep between samples is then checked
-# by `segment_free` with the collision world's own motion bound.
+# by `check_path` with the collision world's own motion bound.
 APPROACH_SAMPLE_M = 0.01
 # Largest joint change between neighbouring approach samples before we call it a branch switch:
 # 10 mm of TCP motion moves a well-conditioned wrist by well under 0.2 rad.
@@ -196,9 +196,6 @@ def _line_verdict(world: CollisionWorld, line: FloatArray) -> tuple[str, int]:
     checks = 1
     if contact is not None:
         return f"collision:{contact.describe()}", checks
-    for a, b in zip(line[:-1], line[1:]):
-        res = world.check_segment(a, b)
-        checks += res.checks
-        if not res.free:
-            return "approach_blocked", checks
-    return "", checks
+    res = world.check_path(line)
+    checks += res.checks
+    return ("" if res.free else "approach_blocked"), checks

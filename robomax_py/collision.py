@@ -487,6 +487,43 @@ class CollisionWorld:
                 return SegmentCheck(False, checks, m + 1, tests, float(fractions[k]))
         return SegmentCheck(True, checks, m + 1, tests, None)
 
+    def check_path(self, points: FloatArray, max_step: float = TOL.sweep_step_m) -> SegmentCheck:
+        """Check the joint-space polyline through `points` (k, n), every dynamic obstacle present.
+
+        Exactly the states `check_segment` checks on each segment, a state shared by two segments
+        once, in coarse-to-fine order over the whole polyline (a blocked path is found early); the
+        polyline is free iff every `check_segment` of its segments is. s_contact is the colliding
+        state's fraction of the states, start to end.
+        """
+        if not max_step > 0:
+            raise ValueError(f"max_step must be > 0 m, got {max_step}")
+        pts = np.asarray(points, dtype=np.float64)
+        if pts.ndim != 2 or len(pts) == 0:
+            raise ValueError("points must be a non-empty (k, n) array")
+        pieces = [pts[:1]]
+        for q0, q1 in zip(pts[:-1], pts[1:]):
+            m = int(math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12))
+            if m == 0:
+                continue                  # check_segment checks q0 alone: already in
+            states = q0 + (np.arange(1, m + 1) / m)[:, None] * (q1 - q0)
+            states[-1] = q1               # the end exactly, as check_segment
+            pieces.append(states)
+        states = np.concatenate(pieces)
+        self._set_presence(None, None)
+        last = len(states) - 1
+        order = bisection_order(last)
+        tests = 0
+        for k, idx in enumerate(order):
+            hit = self._collides(states[idx])
+            tests += self._tests(self._hit_pair() if hit else -1)
+            if hit:
+                return SegmentCheck(False, k + 1, len(states), int(tests), float(idx) / last if last else 0.0)
+        return SegmentCheck(True, len(order), len(states), int(tests), None)
+
+    def path_free(self, points: FloatArray, max_step: float = TOL.sweep_step_m) -> bool:
+        """Whether the joint-space polyline through `points` is collision-free (see `check_path`)."""
+        return self.check_path(points, max_step).free
+
     # ------------------------------------------------------------------------------- internals
 
     def _collides(self, q: FloatArray) -> bool:

@@ -156,12 +156,20 @@ def _time_steps(
 
 
 def _path_free(world: FreeSegments, paths: list[ChainPath]) -> tuple[bool, int]:
-    """Whether every chain's geometric path is free (checked between samples CHECK_STEP_RAD apart)."""
+    """Whether every chain's geometric path is free (checked between samples CHECK_STEP_RAD apart);
+    the collision checks it took."""
     checks = 0
     for chain in paths:
         if not np.any(chain.radii > 0):
             continue                       # an exact-stop chain is the checked polyline / line itself
         pts = chain.path.sample(CHECK_STEP_RAD)
+        check_path = getattr(world, "check_path", None)
+        if check_path is not None:         # a CollisionWorld: the same states, in one sweep
+            res = check_path(pts)
+            checks += res.checks
+            if not res.free:
+                return False, checks
+            continue
         for a, b in zip(pts[:-1], pts[1:]):
             checks += 1
             if not world.segment_free(a, b):

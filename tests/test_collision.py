@@ -384,6 +384,48 @@ def _step_bound_holds(world: CollisionWorld, robot: RobotModel, rng: np.random.G
     return worst
 
 
+def test_path_check_catches_the_thin_plate_on_its_segment(ur10: RobotModel, gun: ToolSpec) -> None:
+    q_a = UR10_Q0 + [-0.8, 0, 0, 0, 0, 0]
+    q_b = UR10_Q0 + [0.8, 0, 0, 0, 0, 0]
+    theta = -0.8 + 0.3 * 1.6
+    T = np.eye(4)
+    T[:3, :3] = rot_z(theta)
+    T_plate = T @ in_flange(ur10, UR10_Q0, [0.0, 0.0, 0.05])
+    tangent = rot_z(theta) @ np.cross([0, 0, 1], fk_flange(ur10, UR10_Q0)[:3, 3])
+    T_plate[:3, :3] = rot_z(math.atan2(tangent[1], tangent[0]))
+    w = world_for(ur10, gun, (at(T_plate, "plate", Box((0.002, 0.3, 0.3))),))
+    q_c = q_b + [0, 0.2, 0, 0, 0, 0]
+    free_part = w.check_path(np.array([q_b, q_c]))
+    assert free_part.free and free_part.s_contact is None
+    blocked = w.check_path(np.array([q_a, q_b, q_c]))            # the plate is on the first segment
+    assert not blocked.free and not w.path_free(np.array([q_a, q_b, q_c]))
+    states_ab = w.check_segment(q_a, q_b).states
+    assert blocked.states == states_ab + free_part.states - 1    # the shared state once
+    assert blocked.s_contact is not None and blocked.s_contact < (states_ab - 1) / (blocked.states - 1)
+    single = w.check_path(q_a[None, :])
+    assert single.free and single.states == 1
+
+
+def test_path_check_equals_its_segments_checked_one_by_one(
+    reference: tuple[CellSpec, RobotModel, CollisionWorld], rng: np.random.Generator
+) -> None:
+    # Polylines near the flange of the reference cell, free and blocked: the path check must give
+    # exactly the verdict of checking every segment with check_segment, on the same states.
+    _, robot, world = reference
+    q_near = np.radians([0.0, -60.0, 110.0, 0.0, 40.0, 0.0])
+    verdicts = set()
+    for _ in range(40):
+        centre = q_near + rng.uniform(-0.5, 0.5, robot.dof)
+        pts = centre + rng.uniform(-0.15, 0.15, size=(4, robot.dof))
+        pts[1] = pts[0]                                          # a zero-length segment too
+        segs = [world.check_segment(a, b) for a, b in zip(pts[:-1], pts[1:])]
+        res = world.check_path(pts)
+        assert res.free == all(seg.free for seg in segs)
+        assert res.states == 1 + sum(seg.states - 1 for seg in segs if seg.states > 1)
+        verdicts.add(res.free)
+    assert verdicts == {True, False}                             # both cases were exercised
+
+
 def test_step_bound_no_point_moves_more_than_max_step(ur10: RobotModel, gun: ToolSpec, rng: np.random.Generator) -> None:
     w = world_for(ur10, gun, options=CollisionOptions())
     ratio = _step_bound_holds(w, ur10, rng, segments=6, max_step=0.05, max_dq=0.5)
