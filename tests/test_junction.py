@@ -10,6 +10,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from robomax_py.cell_io import load_cell, load_cell_robot
+from robomax_py import junction as junction_module
 from robomax_py.junction import time_junction
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell
 from robomax_py.robot import JointLimits, fk_tcp
@@ -83,6 +84,43 @@ def test_free_corners_are_flown_and_faster() -> None:
     assert_allclose(traj.q[-1], WAYPOINTS[-1], atol=1e-9)
     # Only where the corners are cut does the path leave the polyline, by less than the radius.
     assert max(_distance_to_polyline(q) for q in traj.q) <= flown.corner_radius
+
+
+def test_exact_stop_bound_is_below_its_time_and_changes_no_choice(monkeypatch: pytest.MonkeyPatch) -> None:
+    stop = _detour(StrictWorld())                                # the exact-stop motion itself
+    bounds: list[float] = []
+    real_bound = junction_module._exact_lower_bound
+
+    def spy(*args: Any) -> float:
+        bounds.append(real_bound(*args))
+        return bounds[-1]
+
+    exact_timings = []
+    real_time_steps = junction_module._time_steps
+
+    def count(robot: Any, limits: Any, q: Any, steps: Any, *rest: Any) -> Any:
+        exact_timings.extend([1] if all(step.flyby == 0.0 for step in steps) else [])
+        return real_time_steps(robot, limits, q, steps, *rest)
+
+    monkeypatch.setattr(junction_module, "_exact_lower_bound", spy)
+    monkeypatch.setattr(junction_module, "_time_steps", count)
+    flown = _detour(OpenWorld())
+    assert bounds and max(bounds) <= _duration(stop)
+    assert not exact_timings                                     # the bound spared timing it
+    # Without the bound the exact-stop motion is always timed: the same variant is chosen.
+    monkeypatch.setattr(junction_module, "_exact_lower_bound", lambda *args: 0.0)
+    forced = _detour(OpenWorld())
+    assert (forced.corner_radius, forced.junction_radius) == (flown.corner_radius, flown.junction_radius)
+    assert _duration(forced) == _duration(flown)
+
+
+def test_exact_stop_bound_changes_no_plan(monkeypatch: pytest.MonkeyPatch, small_plan: Any) -> None:
+    cell, robot, result = small_plan
+    monkeypatch.setattr(junction_module, "_exact_lower_bound", lambda *args: 0.0)
+    forced = plan_cell(cell, robot, PlanOptions())
+    assert forced.trajectory is not None and result.trajectory is not None
+    assert np.array_equal(forced.trajectory.t, result.trajectory.t)
+    assert np.array_equal(forced.trajectory.q, result.trajectory.q)
 
 
 @pytest.fixture(scope="module")
