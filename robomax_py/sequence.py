@@ -119,6 +119,45 @@ def best_choice(order: Sequence[int], costs: _Costs) -> tuple[tuple[int, ...], f
 Blocks = list[tuple[int, tuple[int, ...]]]
 
 
+class _PrefixCost:
+    """The DP cost of orders near an anchor order (a descent's current one): the anchor's layer
+    values are kept, so an order that first differs from it at position p is costed from layer p
+    on. The arithmetic is `best_choice`'s (a column's min is the value at its argmin), so costs
+    are the same bit for bit."""
+
+    def __init__(self, costs: _Costs) -> None:
+        self.costs = costs
+        self.anchor: tuple[int, ...] = ()
+        self.values: list[FloatArray] = []      # values[k]: best cost ending at each node of layer k
+
+    def set_anchor(self, order: tuple[int, ...]) -> None:
+        if order != self.anchor:
+            self.anchor, self.values = order, []
+
+    def _layer(self, order: tuple[int, ...], k: int, value: FloatArray | None) -> FloatArray:
+        node = self.costs.node[order[k]]
+        if k == 0:
+            return self.costs(HOME, order[0])[0] + node
+        assert value is not None
+        return np.min(value[:, None] + self.costs(order[k - 1], order[k]), axis=0) + node
+
+    def __call__(self, order: tuple[int, ...]) -> float:
+        if not order:
+            return float(self.costs(HOME, HOME)[0, 0])
+        anchor = self.anchor
+        p, n = 0, min(len(order), len(anchor))
+        while p < n and order[p] == anchor[p]:
+            p += 1
+        while len(self.values) < p:
+            k = len(self.values)
+            self.values.append(self._layer(anchor, k, self.values[-1] if k else None))
+        value = self.values[p - 1] if p else None
+        for k in range(p, len(order)):
+            value = self._layer(order, k, value)
+        assert value is not None
+        return float(np.min(value + self.costs(order[-1], HOME)[:, 0]))
+
+
 def choice_for_order(order: Sequence[int], edge: EdgeCosts, node: Sequence[FloatArray]) -> tuple[tuple[int, ...], float]:
     """The exact best candidates for a fixed spot order (public form of `best_choice`)."""
     return best_choice(order, _Costs(edge, node))
@@ -221,11 +260,13 @@ def optimise(
     counter = {"evaluations": 0, "screened": 0, "improvements": 0}
     seen: dict[tuple[int, ...], float] = {}
 
+    prefix = _PrefixCost(costs)
+
     def evaluate(candidate: Blocks, flat: tuple[int, ...] | None = None) -> float:
         flat = _flatten(candidate) if flat is None else flat
         if flat not in seen:
             counter["evaluations"] += 1
-            seen[flat] = best_choice(flat, costs)[1]
+            seen[flat] = prefix(flat)
         return seen[flat]
 
     # Descents from different starts and kicks pass through the same orders again and again.
@@ -247,6 +288,7 @@ def optimise(
             options, bounds, ranked = neighbours(current)
             if not options:
                 break
+            prefix.set_anchor(_flatten(current))      # its neighbours share prefixes with it
             counter["screened"] += len(options)
             improved = False
             for rank, idx in enumerate(ranked):

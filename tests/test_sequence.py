@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robomax_py.sequence import HOME, SeamBlock, admissible_orders, best_choice, exact_tour, optimise, _Costs
+from robomax_py.sequence import HOME, SeamBlock, admissible_orders, best_choice, exact_tour, optimise, _Costs, _PrefixCost
 
 COST_TOL_S = 1e-9
 
@@ -52,6 +52,31 @@ def test_dp_is_exact_for_a_fixed_order(seed: int) -> None:
     recomputed = sum(edge(a, b)[ca, cb] for (a, ca), (b, cb) in zip(stops[:-1], stops[1:]))
     recomputed += sum(node[s][c] for s, c in zip(order, choice))
     assert abs(recomputed - cost) < COST_TOL_S
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1))
+def test_prefix_reuse_gives_the_dp_cost_bit_for_bit(seed: int) -> None:
+    # Orders near changing anchors (2-opt reversals, swaps), with blocked (infinite) edges too.
+    rng = np.random.default_rng(seed)
+    edge, node = make_instance(rng, n_spots=7, n_cand=5)
+    blocked = {key: rng.random(size=edge(*key).shape) < 0.3 for key in itertools.permutations([HOME, *range(7)], 2)}
+
+    def masked(i: int, j: int) -> np.ndarray:
+        out = edge(i, j).copy()
+        out[blocked[(i, j)]] = np.inf
+        return out
+
+    costs = _Costs(masked, node)
+    prefix = _PrefixCost(costs)
+    order = tuple(rng.permutation(7).tolist())
+    for _ in range(12):
+        prefix.set_anchor(order)
+        for _ in range(4):
+            i, j = sorted(rng.choice(8, size=2, replace=False).tolist())
+            near = order[:i] + order[i:j][::-1] + order[j:]
+            assert prefix(near) == best_choice(near, costs)[1]
+        order = near
 
 
 @pytest.mark.parametrize(
