@@ -167,10 +167,30 @@ def _flatten(blocks: Blocks) -> tuple[int, ...]:
     return tuple(s for _, block in blocks for s in block)
 
 
-def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> list[tuple[Blocks, tuple[int, ...]]]:
-    """Every order one move away, with its flat form: within free seams Or-opt (1-3 spots, moved at
-    most OR_OPT_WINDOW places) and 2-opt; seam swaps. Flat orders join the unchanged prefix and suffix."""
-    out: list[tuple[Blocks, tuple[int, ...]]] = []
+class _Moves:
+    """The orders one move away from `origin`: their flat forms, and their seam blocks on demand
+    (only the few a descent moves to are ever needed as blocks)."""
+
+    def __init__(self, origin: Blocks) -> None:
+        self.origin = origin
+        self.flats: list[tuple[int, ...]] = []
+        self._how: list[tuple[int, tuple[int, ...]] | Blocks] = []   # (block index, its new spots) or whole
+
+    def __len__(self) -> int:
+        return len(self.flats)
+
+    def blocks(self, k: int) -> Blocks:
+        how = self._how[k]
+        if isinstance(how, list):
+            return how
+        b, spots = how
+        return self.origin[:b] + [(self.origin[b][0], spots)] + self.origin[b + 1:]
+
+
+def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> _Moves:
+    """Every order one move away: within free seams Or-opt (1-3 spots, moved at most
+    OR_OPT_WINDOW places) and 2-opt; seam swaps. Flat orders join the unchanged prefix and suffix."""
+    out = _Moves(blocks)
     flats = [block for _, block in blocks]
     for b, (seam, block) in enumerate(blocks):
         if ordered[seam] or len(block) < 2:
@@ -178,16 +198,10 @@ def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> list[tuple[Blocks, t
         prefix = tuple(s for f in flats[:b] for s in f)
         suffix = tuple(s for f in flats[b + 1:] for s in f)
         n = len(block)
-        seen: set[tuple[int, ...]] = {block}
-
-        def add(new: tuple[int, ...]) -> None:
-            if new not in seen:
-                seen.add(new)
-                out.append((blocks[:b] + [(seam, new)] + blocks[b + 1:], prefix + new + suffix))
-
+        made: list[tuple[int, ...]] = []
         for i in range(n):                                   # 2-opt: reverse block[i:j]
             for j in range(i + 2, n + 1):
-                add(block[:i] + block[i:j][::-1] + block[j:])
+                made.append(block[:i] + block[i:j][::-1] + block[j:])
         for length in (1, 2, 3):                             # Or-opt: move a run elsewhere
             for i in range(n - length + 1):
                 run = block[i:i + length]
@@ -196,11 +210,16 @@ def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> list[tuple[Blocks, t
                     if k == i:
                         continue
                     for piece in (run, run[::-1]) if length > 1 else (run,):
-                        add(rest[:k] + piece + rest[k:])
+                        made.append(rest[:k] + piece + rest[k:])
+        # Each new order once, first occurrence first; the unchanged block is no move.
+        fresh = [new for new in dict.fromkeys(made) if new != block]
+        out.flats.extend([prefix + new + suffix for new in fresh] if prefix or suffix else fresh)
+        out._how.extend((b, new) for new in fresh)
     for a, c in itertools.combinations(range(len(blocks)), 2):  # seam order
         swapped = list(blocks)
         swapped[a], swapped[c] = swapped[c], swapped[a]
-        out.append((swapped, _flatten(swapped)))
+        out.flats.append(_flatten(swapped))
+        out._how.append(swapped)
     return out
 
 
@@ -270,15 +289,15 @@ def optimise(
         return seen[flat]
 
     # Descents from different starts and kicks pass through the same orders again and again.
-    screened: dict[tuple[tuple[int, tuple[int, ...]], ...], tuple[list[tuple[Blocks, tuple[int, ...]]], FloatArray, list[int]]] = {}
+    screened: dict[tuple[tuple[int, tuple[int, ...]], ...], tuple[_Moves, FloatArray, list[int]]] = {}
 
-    def neighbours(current: Blocks) -> tuple[list[tuple[Blocks, tuple[int, ...]]], FloatArray, list[int]]:
+    def neighbours(current: Blocks) -> tuple[_Moves, FloatArray, list[int]]:
         """The moves from `current`, their bounds and their ranking (cached per order)."""
         key = tuple(current)
         got = screened.get(key)
         if got is None:
             options = _neighbours(current, ordered)
-            bounds = _bounds([flat for _, flat in options], bound, home_index) + node_total if options else np.zeros(0)
+            bounds = _bounds(options.flats, bound, home_index) + node_total if len(options) else np.zeros(0)
             got = screened[key] = (options, bounds, np.argsort(bounds, kind="stable").tolist())
         return got
 
@@ -298,9 +317,9 @@ def optimise(
                     rank >= screen and bounds[idx] >= current_cost - 1e-9
                 ):
                     break
-                value = evaluate(*options[idx])
+                value = evaluate(options.origin, options.flats[idx])
                 if value < current_cost - 1e-9:
-                    current, current_cost, improved = options[idx][0], value, True
+                    current, current_cost, improved = options.blocks(idx), value, True
                     counter["improvements"] += 1
                     break
             if not improved:
