@@ -154,6 +154,32 @@ def test_estimates_are_vectorised(limits: JointLimits, rng: np.random.Generator)
         assert_allclose(fn(q0, q1, limits, 0.5), fn(q0, q1, dataclasses.replace(limits, velocity=limits.velocity * 0.5)))
 
 
+def test_estimates_equal_the_whole_array_formula_bit_for_bit(limits: JointLimits, rng: np.random.Generator) -> None:
+    # The estimates reduce joint by joint; the formula over the (..., n) array must give the same
+    # floats (rankings and tie-breaks of the sequencer depend on them). Equal and near-equal
+    # configurations included (differences at and below ZERO_MOVE count as none).
+    from robomax_py.timing._common import ZERO_MOVE, scaled_limits
+    from robomax_py.timing.estimate import _double_s_time, _trapezoid_time
+
+    q0 = rng.uniform(-2, 2, size=(7, 1, N))
+    q1 = rng.uniform(-2, 2, size=(1, 5, N))
+    q1[0, 0] = q0[0, 0]
+    q1[0, 1] = q0[1, 0] + ZERO_MOVE / 2
+    for speed in (1.0, 0.3):
+        lim = scaled_limits(limits, speed, 1.0)
+        d = np.abs(q1 - q0)
+        d = np.where(d > ZERO_MOVE, d, 0.0)
+        r_v, r_a, r_j = d / lim.velocity, d / lim.acceleration, d / lim.jerk
+        assert np.array_equal(ptp_time_estimate(q0, q1, limits, speed),
+                              _trapezoid_time(r_v.max(axis=-1), r_a.max(axis=-1)))
+        assert np.array_equal(ptp_time_estimate(q0, q1, limits, speed, straight=False),
+                              _trapezoid_time(r_v, r_a).max(axis=-1))
+        assert np.array_equal(jerk_limited_time_estimate(q0, q1, limits, speed),
+                              _double_s_time(r_v.max(axis=-1), r_a.max(axis=-1), r_j.max(axis=-1)))
+        assert np.array_equal(jerk_limited_time_estimate(q0, q1, limits, speed, straight=False),
+                              _double_s_time(r_v, r_a, r_j).max(axis=-1))
+
+
 # --- ruckig PTP ----------------------------------------------------------------------------------
 
 

@@ -17,6 +17,8 @@ so that joints that do not move (all ratios zero) need no special case.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
 
 from robomax_py._typing import FloatArray
@@ -53,12 +55,11 @@ def ptp_time_estimate(
         Seconds; 0 where q0 == q1.
     """
     lim = scaled_limits(limits, speed, accel)
-    d = _distance(q0, q1)
-    r_v = d / lim.velocity
-    r_a = d / lim.acceleration
+    per_joint = _joint_ratios(q0, q1, lim.velocity, lim.acceleration)
     if straight:
-        return _trapezoid_time(np.max(r_v, axis=-1), np.max(r_a, axis=-1))
-    return np.asarray(np.max(_trapezoid_time(r_v, r_a), axis=-1), dtype=float)
+        r_v, r_a = _largest(per_joint)
+        return _trapezoid_time(r_v, r_a)
+    return _largest_time(_trapezoid_time(r_v, r_a) for r_v, r_a in per_joint)
 
 
 def jerk_limited_time_estimate(
@@ -77,19 +78,44 @@ def jerk_limited_time_estimate(
     round-off (ruckig's 1-D profile is the time-optimal double-S).
     """
     lim = scaled_limits(limits, speed, accel)
-    d = _distance(q0, q1)
-    r_v = d / lim.velocity
-    r_a = d / lim.acceleration
-    r_j = d / lim.jerk
+    per_joint = _joint_ratios(q0, q1, lim.velocity, lim.acceleration, lim.jerk)
     if straight:
-        return _double_s_time(np.max(r_v, axis=-1), np.max(r_a, axis=-1), np.max(r_j, axis=-1))
-    return np.asarray(np.max(_double_s_time(r_v, r_a, r_j), axis=-1), dtype=float)
+        r_v, r_a, r_j = _largest(per_joint)
+        return _double_s_time(r_v, r_a, r_j)
+    return _largest_time(_double_s_time(r_v, r_a, r_j) for r_v, r_a, r_j in per_joint)
 
 
-def _distance(q0: FloatArray, q1: FloatArray) -> FloatArray:
-    """(..., n) |q1 - q0| per joint, with differences of at most ZERO_MOVE counted as none (as the moves do)."""
-    d = np.abs(np.asarray(q1, dtype=float) - np.asarray(q0, dtype=float))
-    return np.where(d > ZERO_MOVE, d, 0.0)
+def _joint_ratios(q0: FloatArray, q1: FloatArray, *limits: FloatArray) -> list[tuple[FloatArray, ...]]:
+    """Per joint k: (d_k / limit_k for each limit), d_k = |q1 - q0| of joint k broadcast over the
+    leading axes, differences of at most ZERO_MOVE counted as none (as the moves do).
+
+    Joint by joint rather than as one (..., n) array: the candidate-pair matrices this ranks are
+    (N, M, 6), and reductions over a last axis of 6 cost numpy several times the arithmetic.
+    """
+    q0 = np.asarray(q0, dtype=float)
+    q1 = np.asarray(q1, dtype=float)
+    out = []
+    for k in range(max(q0.shape[-1], q1.shape[-1])):
+        d = np.abs(q1[..., k] - q0[..., k])
+        d = np.where(d > ZERO_MOVE, d, 0.0)
+        out.append(tuple(d / np.asarray(lim, dtype=float)[k] for lim in limits))
+    return out
+
+
+def _largest(per_joint: list[tuple[FloatArray, ...]]) -> tuple[FloatArray, ...]:
+    """Element-wise largest of each ratio over the joints (exact, like np.max over the joint axis)."""
+    best = list(per_joint[0])
+    for ratios in per_joint[1:]:
+        best = [np.maximum(b, r) for b, r in zip(best, ratios)]
+    return tuple(np.asarray(b, dtype=float) for b in best)
+
+
+def _largest_time(times: Iterable[FloatArray]) -> FloatArray:
+    out: FloatArray | None = None
+    for t in times:
+        out = t if out is None else np.maximum(out, t)
+    assert out is not None
+    return np.asarray(out, dtype=float)
 
 
 def _trapezoid_time(r_v: FloatArray, r_a: FloatArray) -> FloatArray:
