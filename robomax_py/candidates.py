@@ -115,38 +115,64 @@ def _spot_candidates(
     checks = 0
     verdicts: dict[tuple[int, ...], str] = {}   # wrapped spot q -> "" (free) or rejection reason
     m, n_line, n_col = valid.shape
-    for o in range(m):
-        for k in range(n_col):
-            if not reachable[o, -1, k]:
-                continue  # not a solution at the spot; counted per orientation below
-            if not valid[o, -1, k]:
-                rejected["joint_limit"] += 1
-                continue
-            # IK columns are fixed 2 pi shifts of wrapped values, so a joint crossing +-180 deg along
-            # the line jumps within its column: unwrap revolute joints towards the spot value.
-            line = q[o, :, k].copy()                                        # (L, n)
-            spot_q = line[-1]
-            line[:, revolute] = spot_q[revolute] + wrap_to_pi(line[:, revolute] - spot_q[revolute])
-            if not reachable[o, :, k].all() or np.abs(np.diff(line, axis=0)).max() > BRANCH_JUMP_RAD:
-                rejected["approach_branch"] += 1
-                continue
-            if not limits.contains(line).all():
-                rejected["approach_joint_limit"] += 1
-                continue
-            # Turn variants (q +- 2 pi) share their geometry: check each wrapped line once.
-            key = tuple(np.round(np.where(revolute, wrap_to_pi(line[-1]), line[-1]), 9))
-            verdict = verdicts.get(key)
-            if verdict is None:
-                verdict, used = _line_verdict(world, line)
-                checks += used
-                verdicts[key] = verdict
-            if verdict:
-                rejected[verdict] += 1
-                continue
-            keep.append((o, k))
-            lines[(o, k)] = line
-        if not reachable[o, -1].any():
-            rejected["unreachable"] += n_col
+    # The cheap tests for every (orientation, column) at once; collision checks only for survivors.
+    # IK columns are fixed 2 pi shifts of wrapped values, so a joint crossing +-180 deg along the
+    # line jumps within its column: unwrap revolute joints towards the spot value.
+    at_spot = reachable[:, -1, :]
+    within = at_spot & valid[:, -1, :]                               # (m, B)
+    oo, kk = np.nonzero(within)
+    sub = q[oo, :, kk]                                               # (c, L, n) lines of those
+    along_sub = reachable[oo, :, kk].all(axis=1)
+    spot_q = sub[:, -1:, :]
+    # Samples without a solution within the limits are NaN, and stay NaN (the line then fails the
+    # limit test below); they are wrapped as zeros, since np.mod of NaN is very slow.
+    missing = np.isnan(sub)
+    filled = np.where(missing, spot_q, sub)
+    filled[..., revolute] = spot_q[..., revolute] + wrap_to_pi(filled[..., revolute] - spot_q[..., revolute])
+    sub = np.where(missing, np.nan, filled)
+    jump = np.zeros(within.shape)
+    with np.errstate(invalid="ignore"):
+        jump[oo, kk] = np.abs(np.diff(sub, axis=1)).max(axis=(1, 2)) if len(sub) else 0.0
+    inside = np.zeros(within.shape, dtype=bool)
+    inside[oo, kk] = limits.contains(sub).all(axis=1)
+    along = np.zeros(within.shape, dtype=bool)
+    along[oo, kk] = along_sub
+    row = np.full(within.shape, -1, dtype=np.int64)                 # (o, k) -> its row of sub
+    row[oo, kk] = np.arange(len(oo))
+    branch_ok = along & ~(jump > BRANCH_JUMP_RAD)
+    # Reasons are counted in the order an (orientation, column) scan first meets them, so reports
+    # list equal counts in that order: reason -> (first position in the scan, count).
+    found: dict[str, tuple[float, int]] = {}
+
+    def count(reason: str, mask: np.ndarray) -> None:
+        n = int(np.sum(mask))
+        if n:
+            found[reason] = (float(np.argmax(mask.reshape(-1))), n)
+
+    count("joint_limit", at_spot & ~within)
+    count("approach_branch", within & ~branch_ok)
+    count("approach_joint_limit", within & branch_ok & ~inside)
+    no_branch = ~at_spot.any(axis=1)
+    if no_branch.any():            # counted after its orientation's columns
+        found["unreachable"] = (int(np.argmax(no_branch)) * n_col + n_col - 0.5, n_col * int(np.sum(no_branch)))
+    for o, k in zip(*np.nonzero(within & branch_ok & inside)):
+        o, k = int(o), int(k)
+        line = sub[row[o, k]]
+        # Turn variants (q +- 2 pi) share their geometry: check each wrapped line once.
+        key = tuple(np.round(np.where(revolute, wrap_to_pi(line[-1]), line[-1]), 9))
+        verdict = verdicts.get(key)
+        if verdict is None:
+            verdict, used = _line_verdict(world, line)
+            checks += used
+            verdicts[key] = verdict
+        if verdict:
+            first, n = found.get(verdict, (float(o * n_col + k), 0))
+            found[verdict] = (first, n + 1)
+            continue
+        keep.append((o, k))
+        lines[(o, k)] = line
+    for reason, (_, n) in sorted(found.items(), key=lambda item: item[1][0]):
+        rejected[reason] = n
     idx_o = np.array([o for o, _ in keep], dtype=np.int64)
     idx_k = np.array([k for _, k in keep], dtype=np.int64)
     n = robot.dof
