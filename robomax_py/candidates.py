@@ -114,15 +114,14 @@ def _spot_candidates(
     lines: dict[tuple[int, int], FloatArray] = {}
     checks = 0
     verdicts: dict[tuple[int, ...], str] = {}   # wrapped spot q -> "" (free) or rejection reason
-    m, n_line, n_col = valid.shape
+    _, n_line, n_col = valid.shape
     # The cheap tests for every (orientation, column) at once; collision checks only for survivors.
     # IK columns are fixed 2 pi shifts of wrapped values, so a joint crossing +-180 deg along the
     # line jumps within its column: unwrap revolute joints towards the spot value.
     at_spot = reachable[:, -1, :]
     within = at_spot & valid[:, -1, :]                               # (m, B)
-    oo, kk = np.nonzero(within)
-    sub = q[oo, :, kk]                                               # (c, L, n) lines of those
-    along_sub = reachable[oo, :, kk].all(axis=1)
+    oo, kk = np.nonzero(within)                                      # in scan order
+    sub = q[oo, :, kk]                                               # (c, L, n) their lines
     spot_q = sub[:, -1:, :]
     # Samples without a solution within the limits are NaN, and stay NaN (the line then fails the
     # limit test below); they are wrapped as zeros, since np.mod of NaN is very slow.
@@ -130,34 +129,29 @@ def _spot_candidates(
     filled = np.where(missing, spot_q, sub)
     filled[..., revolute] = spot_q[..., revolute] + wrap_to_pi(filled[..., revolute] - spot_q[..., revolute])
     sub = np.where(missing, np.nan, filled)
-    jump = np.zeros(within.shape)
     with np.errstate(invalid="ignore"):
-        jump[oo, kk] = np.abs(np.diff(sub, axis=1)).max(axis=(1, 2)) if len(sub) else 0.0
-    inside = np.zeros(within.shape, dtype=bool)
-    inside[oo, kk] = limits.contains(sub).all(axis=1)
-    along = np.zeros(within.shape, dtype=bool)
-    along[oo, kk] = along_sub
-    row = np.full(within.shape, -1, dtype=np.int64)                 # (o, k) -> its row of sub
-    row[oo, kk] = np.arange(len(oo))
-    branch_ok = along & ~(jump > BRANCH_JUMP_RAD)
+        jump = np.abs(np.diff(sub, axis=1)).max(axis=(1, 2)) if len(sub) else np.zeros(0)
+    branch_ok = reachable[oo, :, kk].all(axis=1) & ~(jump > BRANCH_JUMP_RAD)
+    inside = limits.contains(sub).all(axis=1)
+    position = oo * n_col + kk                                       # of each line in the scan
     # Reasons are counted in the order an (orientation, column) scan first meets them, so reports
     # list equal counts in that order: reason -> (first position in the scan, count).
     found: dict[str, tuple[float, int]] = {}
 
-    def count(reason: str, mask: np.ndarray) -> None:
+    def count(reason: str, mask: np.ndarray, where: np.ndarray) -> None:
         n = int(np.sum(mask))
         if n:
-            found[reason] = (float(np.argmax(mask.reshape(-1))), n)
+            found[reason] = (float(where[np.argmax(mask)]), n)
 
-    count("joint_limit", at_spot & ~within)
-    count("approach_branch", within & ~branch_ok)
-    count("approach_joint_limit", within & branch_ok & ~inside)
+    count("joint_limit", (at_spot & ~within).reshape(-1), np.arange(at_spot.size))
+    count("approach_branch", ~branch_ok, position)
+    count("approach_joint_limit", branch_ok & ~inside, position)
     no_branch = ~at_spot.any(axis=1)
     if no_branch.any():            # counted after its orientation's columns
         found["unreachable"] = (int(np.argmax(no_branch)) * n_col + n_col - 0.5, n_col * int(np.sum(no_branch)))
-    for o, k in zip(*np.nonzero(within & branch_ok & inside)):
-        o, k = int(o), int(k)
-        line = sub[row[o, k]]
+    for r in np.flatnonzero(branch_ok & inside):
+        o, k = int(oo[r]), int(kk[r])
+        line = sub[r]
         # Turn variants (q +- 2 pi) share their geometry: check each wrapped line once.
         key = tuple(np.round(np.where(revolute, wrap_to_pi(line[-1]), line[-1]), 9))
         verdict = verdicts.get(key)

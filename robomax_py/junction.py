@@ -15,6 +15,7 @@ from typing import Protocol
 import numpy as np
 
 from robomax_py._typing import FloatArray
+from robomax_py.collision import SegmentCheck
 from robomax_py.robot import JointLimits, RobotModel
 from robomax_py.timing import Segment, TimingError, ptp_time_estimate
 from robomax_py.timing.chain import ChainPath, LinStep, PtpStep, Step, chain_path, time_chain
@@ -32,8 +33,10 @@ EXACT_BOUND_SLACK = 1e-3
 CHECK_STEP_RAD = 0.005
 
 
-class FreeSegments(Protocol):
-    def segment_free(self, q0: FloatArray, q1: FloatArray) -> bool: ...
+class PathChecks(Protocol):
+    """What a junction needs of a collision world: `CollisionWorld.check_path`."""
+
+    def check_path(self, points: FloatArray) -> SegmentCheck: ...
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -58,7 +61,7 @@ class Junction:
 
 def time_junction(
     robot: RobotModel,
-    world: FreeSegments,
+    world: PathChecks,
     limits: JointLimits,
     q_start: FloatArray,
     waypoints: FloatArray,
@@ -110,7 +113,8 @@ def time_junction(
     def faster(trial: tuple[float, list[ChainPath], list[Segment]]) -> bool:
         if best is not None:
             return trial[0] < best[0]
-        bound = _exact_lower_bound(q_start, waypoints, kind, label, before, after, tcp_speed, speed, trial[1], limits)
+        stops = _steps(waypoints, kind, label, before, after, tcp_speed, speed, 0.0, 0.0)
+        bound = _exact_lower_bound(q_start, stops, trial[1], limits)
         return trial[0] < bound or trial[0] < exact_motion()[0]
 
     corner_options = [np.deg2rad(r) for r in DETOUR_RADII_DEG] if len(waypoints) > 2 else []
@@ -134,15 +138,11 @@ def time_junction(
     return Junction(best[2], best_rj, best_rd, checks)
 
 
-def _exact_lower_bound(
-    q_start: FloatArray, waypoints: FloatArray, kind: str, label: str, before: WeldEnd | None,
-    after: WeldEnd | None, tcp_speed: float, speed: float, paths: list[ChainPath], limits: JointLimits,
-) -> float:
-    """A lower bound (s) of the exact-stop motion's time: every move stops at its target, so each
-    takes at least its slowest joint's rest-to-rest time under the velocity and acceleration
-    limits it may use. The targets are those of a fly-by variant's paths (the same moves: the
-    same LIN ends, the same PTP targets); shrunk by EXACT_BOUND_SLACK for solver round-off."""
-    steps = _steps(waypoints, kind, label, before, after, tcp_speed, speed, 0.0, 0.0)
+def _exact_lower_bound(q_start: FloatArray, steps: list[Step], paths: list[ChainPath], limits: JointLimits) -> float:
+    """A lower bound (s) of the time of `steps` stopping at every target: each move takes at least
+    its slowest joint's rest-to-rest time under the velocity and acceleration limits it may use.
+    The targets are those of a fly-by variant's paths of the same moves (the same LIN ends, the
+    same PTP targets); shrunk by EXACT_BOUND_SLACK for solver round-off."""
     targets = np.vstack([p.targets for p in paths])
     if len(targets) != len(steps):
         return 0.0
@@ -196,23 +196,15 @@ def _time_steps(
     return sum(s.duration for s in segments), paths, segments
 
 
-def _path_free(world: FreeSegments, paths: list[ChainPath]) -> tuple[bool, int]:
+def _path_free(world: PathChecks, paths: list[ChainPath]) -> tuple[bool, int]:
     """Whether every chain's geometric path is free (checked between samples CHECK_STEP_RAD apart);
     the collision checks it took."""
     checks = 0
     for chain in paths:
         if not np.any(chain.radii > 0):
             continue                       # an exact-stop chain is the checked polyline / line itself
-        pts = chain.path.sample(CHECK_STEP_RAD)
-        check_path = getattr(world, "check_path", None)
-        if check_path is not None:         # a CollisionWorld: the same states, in one sweep
-            res = check_path(pts)
-            checks += res.checks
-            if not res.free:
-                return False, checks
-            continue
-        for a, b in zip(pts[:-1], pts[1:]):
-            checks += 1
-            if not world.segment_free(a, b):
-                return False, checks
+        res = world.check_path(chain.path.sample(CHECK_STEP_RAD))
+        checks += res.checks
+        if not res.free:
+            return False, checks
     return True, checks

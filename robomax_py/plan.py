@@ -25,7 +25,7 @@ from robomax_py.ik.turns import wrap_to_pi
 from robomax_py.robot import JointLimits, RobotModel, fk_tcp
 from robomax_py.roadmap import Detour, Roadmap
 from robomax_py.scene import build_scene
-from robomax_py.seams import approach_poses, orientation_grid, spot_poses
+from robomax_py.seams import OrientationGrid, approach_poses, orientation_grid, spot_poses
 from robomax_py.sequence import HOME, SeamBlock, Tour, choice_for_order, optimise
 from robomax_py.spec import CellSpec
 from robomax_py.junction import WeldEnd, time_junction
@@ -653,20 +653,13 @@ def _time_tour(
     transitions: list[Transition], options: PlanOptions, progress: Progress = _no_progress,
 ) -> tuple[Trajectory, list[SpotPlan], list[Transition]]:
     """Junction by junction (retract, move or detour, approach; `junction.time_junction`) and dwells."""
-    T_base_world = invert(np.asarray(cell.T_world_base))
     grids = [orientation_grid(seam) for seam in cell.seams]
     ends: list[WeldEnd] = []
     welded: list[tuple[int, int, FloatArray, FloatArray]] = []
     for i, a in zip(tour.order, tour.choice):
-        c = spots[i]
-        seam = cell.seams[c.seam_index]
-        T_spot = T_base_world @ spot_poses((seam.spots[c.spot_index],), grids[c.seam_index])[0, c.orient[a]]
-        # Timed and checked as the program states them (rounded to its decimals), so the written
-        # program is exactly the motion checked here (`rebuild` gives it back).
-        T_spot = as_written_pose(T_spot)
-        T_app = as_written_pose(approach_poses(T_spot, cell.process.approach))
-        ends.append(WeldEnd(T_spot, T_app, None, f"{seam.name}/{c.name}"))
-        welded.append((i, a, T_spot, T_app))
+        end = weld_end(cell, spots[i], a, grids)
+        ends.append(end)
+        welded.append((i, a, end.T_spot, end.T_app))
     blocks: list[list[Segment]] = []
     timed: list[Transition] = []
     q_now = as_written_joints(cell.home)
@@ -710,6 +703,18 @@ def _time_tour(
         plans.append(SpotPlan(seam.name, c.name, c.angles[a], str(config), q_spot, as_written_joints(c.q_app[a]),
                               float(phase.t_start), float(phase.t_end), T_spot, T_app))
     return traj, plans, timed
+
+
+def weld_end(cell: CellSpec, c: SpotCandidates, a: int, grids: list[OrientationGrid]) -> WeldEnd:
+    """Candidate a of spot c as a junction end: its TCP poses at the spot and the approach point
+    (robot base frame) as the program states them. Timed and checked rounded to the program's
+    decimals, so the written program is exactly the motion checked (`rebuild` gives it back).
+    grids: `orientation_grid` of every seam of the cell."""
+    seam = cell.seams[c.seam_index]
+    T_world = spot_poses((seam.spots[c.spot_index],), grids[c.seam_index])[0, c.orient[a]]
+    T_spot = as_written_pose(invert(np.asarray(cell.T_world_base)) @ T_world)
+    T_app = as_written_pose(approach_poses(T_spot, cell.process.approach))
+    return WeldEnd(T_spot, T_app, None, f"{seam.name}/{c.name}")
 
 
 def _waits(cell: CellSpec, robot: RobotModel, blocks: list[list[Segment]]) -> list[WaitPlan]:

@@ -281,8 +281,7 @@ def optimise(
 
     prefix = _PrefixCost(costs)
 
-    def evaluate(candidate: Blocks, flat: tuple[int, ...] | None = None) -> float:
-        flat = _flatten(candidate) if flat is None else flat
+    def evaluate(flat: tuple[int, ...]) -> float:
         if flat not in seen:
             counter["evaluations"] += 1
             seen[flat] = prefix(flat)
@@ -302,7 +301,7 @@ def optimise(
         return got
 
     def descend(start: Blocks) -> tuple[Blocks, float]:
-        current, current_cost = start, evaluate(start)
+        current, current_cost = start, evaluate(_flatten(start))
         while counter["evaluations"] < max_evaluations:
             options, bounds, ranked = neighbours(current)
             if not options:
@@ -317,7 +316,7 @@ def optimise(
                     rank >= screen and bounds[idx] >= current_cost - 1e-9
                 ):
                     break
-                value = evaluate(options.origin, options.flats[idx])
+                value = evaluate(options.flats[idx])
                 if value < current_cost - 1e-9:
                     current, current_cost, improved = options.blocks(idx), value, True
                     counter["improvements"] += 1

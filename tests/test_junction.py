@@ -10,6 +10,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from robomax_py.cell_io import load_cell, load_cell_robot
+from robomax_py.collision import SegmentCheck
 from robomax_py import junction as junction_module
 from robomax_py.junction import time_junction
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell
@@ -44,14 +45,27 @@ def _distance_to_polyline(p: np.ndarray) -> float:
     return best
 
 
-class StrictWorld:
+class _SegmentWorld:
+    """A stand-in collision world judging a path segment by segment."""
+
+    def segment_free(self, q0: np.ndarray, q1: np.ndarray) -> bool:
+        raise NotImplementedError
+
+    def check_path(self, points: np.ndarray) -> SegmentCheck:
+        for k, (a, b) in enumerate(zip(points[:-1], points[1:]), start=1):
+            if not self.segment_free(a, b):
+                return SegmentCheck(False, k, len(points), 0, None)
+        return SegmentCheck(True, max(len(points) - 1, 1), len(points), 0, None)
+
+
+class StrictWorld(_SegmentWorld):
     """Free only on the waypoint polyline: any corner cut 'collides'."""
 
     def segment_free(self, q0: np.ndarray, q1: np.ndarray) -> bool:
         return all(_distance_to_polyline(q0 + s * (q1 - q0)) <= OFF_POLYLINE_RAD for s in np.linspace(0, 1, 5))
 
 
-class OpenWorld:
+class OpenWorld(_SegmentWorld):
     def segment_free(self, q0: np.ndarray, q1: np.ndarray) -> bool:
         return True
 

@@ -57,9 +57,8 @@ def ptp_time_estimate(
     lim = scaled_limits(limits, speed, accel)
     per_joint = _joint_ratios(q0, q1, lim.velocity, lim.acceleration)
     if straight:
-        r_v, r_a = _largest(per_joint)
-        return _trapezoid_time(r_v, r_a)
-    return _largest_time(_trapezoid_time(r_v, r_a) for r_v, r_a in per_joint)
+        return _trapezoid_time(*(_largest(ratio) for ratio in zip(*per_joint)))
+    return _largest(_trapezoid_time(r_v, r_a) for r_v, r_a in per_joint)
 
 
 def jerk_limited_time_estimate(
@@ -80,9 +79,8 @@ def jerk_limited_time_estimate(
     lim = scaled_limits(limits, speed, accel)
     per_joint = _joint_ratios(q0, q1, lim.velocity, lim.acceleration, lim.jerk)
     if straight:
-        r_v, r_a, r_j = _largest(per_joint)
-        return _double_s_time(r_v, r_a, r_j)
-    return _largest_time(_double_s_time(r_v, r_a, r_j) for r_v, r_a, r_j in per_joint)
+        return _double_s_time(*(_largest(ratio) for ratio in zip(*per_joint)))
+    return _largest(_double_s_time(r_v, r_a, r_j) for r_v, r_a, r_j in per_joint)
 
 
 def _joint_ratios(q0: FloatArray, q1: FloatArray, *limits: FloatArray) -> list[tuple[FloatArray, ...]]:
@@ -102,18 +100,11 @@ def _joint_ratios(q0: FloatArray, q1: FloatArray, *limits: FloatArray) -> list[t
     return out
 
 
-def _largest(per_joint: list[tuple[FloatArray, ...]]) -> tuple[FloatArray, ...]:
-    """Element-wise largest of each ratio over the joints (exact, like np.max over the joint axis)."""
-    best = list(per_joint[0])
-    for ratios in per_joint[1:]:
-        best = [np.maximum(b, r) for b, r in zip(best, ratios)]
-    return tuple(np.asarray(b, dtype=float) for b in best)
-
-
-def _largest_time(times: Iterable[FloatArray]) -> FloatArray:
+def _largest(per_joint: Iterable[FloatArray]) -> FloatArray:
+    """Element-wise largest over the joints' arrays (exact, like np.max over a joint axis)."""
     out: FloatArray | None = None
-    for t in times:
-        out = t if out is None else np.maximum(out, t)
+    for value in per_joint:
+        out = value if out is None else np.maximum(out, value)
     assert out is not None
     return np.asarray(out, dtype=float)
 

@@ -36,13 +36,12 @@ from robomax_py.candidates import SpotCandidates, seam_candidates  # noqa: E402
 from robomax_py.cell_io import load_cell, load_cell_robot  # noqa: E402
 from robomax_py.collision import CollisionWorld  # noqa: E402
 from robomax_py.junction import WeldEnd, time_junction  # noqa: E402
-from robomax_py.plan import PlanOptions, PlanResult, plan_cell, resolved_options  # noqa: E402
-from robomax_py.program import as_written_joints, as_written_pose, written_speed, written_tcp_speed  # noqa: E402
+from robomax_py.plan import PlanOptions, PlanResult, plan_cell, resolved_options, weld_end  # noqa: E402
+from robomax_py.program import as_written_joints, written_speed, written_tcp_speed  # noqa: E402
 from robomax_py.scene import build_scene  # noqa: E402
-from robomax_py.seams import approach_poses, orientation_grid, spot_poses  # noqa: E402
+from robomax_py.seams import orientation_grid  # noqa: E402
 from robomax_py.spec import CellSpec  # noqa: E402
 from robomax_py.timing import ptp_time_estimate  # noqa: E402
-from robomax_py.transforms import invert  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
@@ -89,15 +88,10 @@ class LegTimer:
     def __init__(self, cell: CellSpec, robot, world: CollisionWorld, spots: list[SpotCandidates]) -> None:  # type: ignore[no-untyped-def]
         self.cell, self.robot, self.world, self.spots = cell, robot, world, spots
         self.options = resolved_options(cell, PlanOptions())
-        self.T_base_world = invert(np.asarray(cell.T_world_base))
         self.grids = [orientation_grid(seam) for seam in cell.seams]
 
     def end(self, i: int, a: int) -> WeldEnd:
-        c = self.spots[i]
-        seam = self.cell.seams[c.seam_index]
-        T = self.T_base_world @ spot_poses((seam.spots[c.spot_index],), self.grids[c.seam_index])[0, c.orient[a]]
-        T_spot = as_written_pose(T)
-        return WeldEnd(T_spot, as_written_pose(approach_poses(T_spot, self.cell.process.approach)), None, c.name)
+        return weld_end(self.cell, self.spots[i], a, self.grids)
 
     def best_straight(self, i: int, j: int, pairs: int) -> tuple[float, int]:
         """Fastest timed straight leg i -> j over the `pairs` best-estimated free candidate pairs;
