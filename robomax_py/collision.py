@@ -15,6 +15,8 @@ Allowed-collision matrix (pairs never checked), deterministic for a given `Colli
 - "rigid": two pieces on the same joint (a link's own pieces, the tool on the flange link, body vs
   tips): they never move relative to each other.
 - "adjacent": robot link pieces on a joint and on its parent joint (they meet at the joint).
+- "disabled in robot.yaml": link pairs named in robot.yaml `collision.disable` or its SRDF's
+  `disable_collisions` (parts that touch by design, such as an ABB arm's link_4 and link_6).
 - "tips on workpiece": tool tips vs objects marked `workpiece: true`. The tool *body* vs a workpiece
   stays checked.
 - "fixed base": robot pieces on the fixed base (joint 0) vs obstacles: they never move, so their
@@ -181,7 +183,7 @@ class SegmentCheck:
 class DisabledPair:
     piece_a: str
     piece_b: str
-    reason: str      # "rigid" | "adjacent" | "tips on workpiece" | "fixed base" | "tool touches flange link" | "never close"
+    reason: str      # "rigid" | "adjacent" | "disabled in robot.yaml" | "tips on workpiece" | "fixed base" | "tool touches flange link" | "never close"
 
 
 @dataclass(frozen=True, slots=True)
@@ -660,6 +662,9 @@ def _build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Co
                 int(model.parents[pa.joint]) == pb.joint or int(model.parents[pb.joint]) == pa.joint
             ):
                 disabled.append(DisabledPair(pa.name, pb.name, "adjacent"))
+                continue
+            if not tool_a and not tool_b and frozenset((pa.body, pb.body)) in robot.disabled_links:
+                disabled.append(DisabledPair(pa.name, pb.name, "disabled in robot.yaml"))
                 continue
             if (tool_a and pb.joint == mount_parent) or (tool_b and pa.joint == mount_parent):
                 flange_candidates.add((a, b))

@@ -20,7 +20,7 @@ import numpy as np
 from robomax_py._typing import FloatArray
 from robomax_py.candidates import SpotCandidates, seam_candidates
 from robomax_py.collision import CollisionWorld
-from robomax_py.ik import ConfigIndicator, solve_all
+from robomax_py.ik import config_text, solve_all
 from robomax_py.ik.turns import wrap_to_pi
 from robomax_py.robot import JointLimits, RobotModel, fk_tcp
 from robomax_py.roadmap import Detour, Roadmap
@@ -84,13 +84,14 @@ class SpotPlan:
     seam: str
     name: str
     angles: FloatArray               # (3,) alpha, beta, gamma, rad
-    config: str                      # KUKA-style Status/Turn string
+    config: str                      # the controller brand's configuration data at the spot
     q_spot: FloatArray
     q_app: FloatArray
     t_arrive: float
     t_leave: float
     T_spot: FloatArray               # (4, 4) TCP at the spot, robot base frame
     T_app: FloatArray                # (4, 4) TCP at the approach point, robot base frame
+    config_app: str = ""             # configuration data at the approach point (where the retract ends)
 
 
 @dataclass(frozen=True, slots=True)
@@ -698,10 +699,12 @@ def _time_tour(
         seam = cell.seams[c.seam_index]
         label = f"{seam.name}/{c.name}"
         phase = traj.phases_of("weld", label)[0]
-        config = ConfigIndicator(int(c.status[a]), int(c.turn[a]))
         q_spot = np.asarray(traj.q[phase.i_start], dtype=float)
-        plans.append(SpotPlan(seam.name, c.name, c.angles[a], str(config), q_spot, as_written_joints(c.q_app[a]),
-                              float(phase.t_start), float(phase.t_end), T_spot, T_app))
+        # Each target states its own configuration: on ABB and FANUC arms J2 is often near 0 at
+        # the spot and changes sign over the approach line (issue 14).
+        plans.append(SpotPlan(seam.name, c.name, c.angles[a], config_text(robot, c.q_spot[a]), q_spot,
+                              as_written_joints(c.q_app[a]), float(phase.t_start), float(phase.t_end), T_spot, T_app,
+                              config_text(robot, c.q_app[a])))
     return traj, plans, timed
 
 

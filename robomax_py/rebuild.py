@@ -21,7 +21,7 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
-from robomax_py.ik import config_of
+from robomax_py.ik import config_text, same_config
 from robomax_py.program import Comment, FrameDef, LinMove, Program, PtpMove, Spot, Wait, WaitFor, lin_pose, ptp_target, pose_mm_zyx
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
@@ -112,7 +112,7 @@ class _Builder:
         if isinstance(ins, Spot):
             label = f"{ins.seam}/{ins.name}"
             self.segments.append(dwell(self.q, ins.time_s, kind="weld", label=label))
-            config = self.last_config or str(config_of(self.robot, self.q))
+            config = self.last_config or config_text(self.robot, self.q)
             self.spots.append({"seam": ins.seam, "name": ins.name, "t_arrive": self.t,
                                "t_leave": self.t + ins.time_s, "config": config})
             self.t += ins.time_s
@@ -151,9 +151,9 @@ class _Builder:
             t_end += seg.duration
             for idx, written in configs:
                 if idx == k:
-                    actual = str(config_of(self.robot, path.targets[k]))
+                    actual = config_text(self.robot, path.targets[k])
                     self.last_config = actual
-                    if written and written != actual:
+                    if written and not same_config(written, actual):
                         self.problems.append(Problem(t_end, "config", f"LIN ends in {actual}, the program says {written}"))
         self.segments.extend(segments)
         self.t = t_end

@@ -16,8 +16,9 @@ import pinocchio as pin
 from robomax_py._typing import FloatArray
 from robomax_py.errors import RobotModelError
 from robomax_py.geometry import convex_hull_shape, load_mesh
-from robomax_py.robot_io import package_share_dirs
-from robomax_py.spec import RobotSpec, frozen_array
+from robomax_py.tolerances import DEFAULT as TOL
+from robomax_py.robot_io import package_dirs_for, urdf_package_names
+from robomax_py.spec import ControllerSpec, RobotSpec, frozen_array
 
 # When robot.yaml gives no acceleration or jerk limits (SPEC §1 makes them optional) we derive them
 # from the URDF velocity: full speed in 0.4 s, full acceleration in 0.1 s. Conservative for
@@ -57,6 +58,10 @@ class RobotModel:
     ik_solver: str
     ik_params: Any
     T_flange_tcp: FloatArray  # (4, 4); identity until a tool is mounted
+    controller: ControllerSpec = dataclasses.field(default_factory=ControllerSpec)
+    disabled_links: frozenset[frozenset[str]] = frozenset()   # link pairs robot.yaml / SRDF exempt
+    defaulted_limits: tuple[str, ...] = ()   # "acceleration", "jerk": derived, not given in robot.yaml
+    warnings: tuple[str, ...] = ()           # what the user should know (fallbacks taken at load)
 
     @property
     def dof(self) -> int:
@@ -89,8 +94,14 @@ def prismatic_mask(model: pin.Model) -> np.ndarray:
 
 
 def load_robot(spec: RobotSpec) -> RobotModel:
-    """Build the Pinocchio model and convex link geometry named by a checked robot.yaml."""
+    """Build the Pinocchio model and convex link geometry named by a checked robot.yaml.
+
+    The IK parameters (given, or fitted from the URDF when robot.yaml has none) must reproduce the
+    URDF's forward kinematics within TOL.ik_fit_m on random configurations, else RobotModelError.
+    """
     model = kinematic_model(spec)
+    ik_params = checked_ik_params(spec, model)
+    disabled = _disabled_links(spec, model)
     n = model.nq
     lower = np.array(model.lowerPositionLimit, dtype=float)
     upper = np.array(model.upperPositionLimit, dtype=float)
@@ -99,10 +110,22 @@ def load_robot(spec: RobotSpec) -> RobotModel:
     acceleration = _limit_vector(spec, "acceleration", spec.acceleration, velocity / DEFAULT_TIME_TO_FULL_SPEED_S, n)
     jerk = _limit_vector(spec, "jerk", spec.jerk, acceleration / DEFAULT_TIME_TO_FULL_ACCEL_S, n)
 
-    package_dirs = [str(spec.urdf.parent), *[str(d) for d in package_share_dirs()]]
+    package_dirs = [str(spec.urdf.parent), *[str(d) for d in urdf_package_dirs(spec)]]
+    warnings: list[str] = []
     collision = _build_geometry(model, spec, pin.GeometryType.COLLISION, package_dirs)
     _make_meshes_convex(collision, spec)
-    visual = _build_geometry(model, spec, pin.GeometryType.VISUAL, package_dirs)
+    try:
+        visual = _build_geometry(model, spec, pin.GeometryType.VISUAL, package_dirs)
+    except RobotModelError as exc:
+        # Visual meshes only serve the preview: plan with the collision meshes shown instead.
+        warnings.append(f"{spec.urdf}: visual meshes not loaded ({exc.problem}); the preview shows the collision meshes")
+        visual = collision.copy()
+    defaulted = tuple(k for k, v in (("acceleration", spec.acceleration), ("jerk", spec.jerk)) if v is None)
+    if defaulted:
+        warnings.append(
+            f"{spec.source}: limits.{' and limits.'.join(defaulted)} not given; derived from the URDF velocities "
+            f"(full speed in {DEFAULT_TIME_TO_FULL_SPEED_S} s, full acceleration in {DEFAULT_TIME_TO_FULL_ACCEL_S} s)"
+        )
 
     return RobotModel(
         name=spec.name,
@@ -120,9 +143,66 @@ def load_robot(spec: RobotSpec) -> RobotModel:
             jerk=frozen_array(jerk),
         ),
         ik_solver=spec.ik_solver,
-        ik_params=spec.ik_params,
+        ik_params=ik_params,
         T_flange_tcp=frozen_array(np.eye(4)),
+        controller=spec.controller,
+        disabled_links=disabled,
+        defaulted_limits=defaulted,
+        warnings=tuple(warnings),
     )
+
+
+def urdf_package_dirs(spec: RobotSpec) -> list[Path]:
+    """Package folders for the `package://NAME/...` meshes the robot's URDF names."""
+    try:
+        text = spec.urdf.read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise RobotModelError(spec.urdf, None, f"cannot read URDF: {exc}") from None
+    dirs: list[Path] = []
+    for name in urdf_package_names(text):
+        for d in package_dirs_for(name, spec.urdf.parent):
+            if d not in dirs:
+                dirs.append(d)
+    return dirs
+
+
+def checked_ik_params(spec: RobotSpec, model: pin.Model) -> Any:
+    """The robot's closed-form IK parameters, fitted when not given, and checked against the URDF."""
+    from robomax_py.ik.fit import FitError, fit_opw, fit_ur, fk_agreement
+
+    if spec.ik_solver not in ("opw", "ur"):
+        return spec.ik_params
+    frame_id = int(model.getFrameId(spec.flange))
+    params = spec.ik_params
+    origin = "ik.params"
+    if params is None:
+        origin = "ik.params (fitted from the URDF)"
+        try:
+            params = fit_opw(model, frame_id) if spec.ik_solver == "opw" else fit_ur(model, frame_id)
+        except FitError as exc:
+            raise RobotModelError(spec.source, "ik.solver", f"the URDF {spec.urdf.name} is not a "
+                                  f"{spec.ik_solver.upper()}-class arm up to '{spec.flange}': {exc.problem}") from None
+    agreement = fk_agreement(model, frame_id, params)
+    if not agreement.ok:
+        raise RobotModelError(
+            spec.source, origin,
+            f"the {spec.ik_solver} solver's forward kinematics disagrees with the URDF {spec.urdf.name}: "
+            f"up to {agreement.position_m * 1000:.3f} mm and {np.degrees(agreement.rotation_rad):.4f} deg over "
+            f"{agreement.samples} random configurations (allowed {TOL.ik_fit_m:g} m); parameters {params}",
+        )
+    return params
+
+
+def _disabled_links(spec: RobotSpec, model: pin.Model) -> frozenset[frozenset[str]]:
+    links = {f.name for f in model.frames if f.type == pin.FrameType.BODY}
+    for key, pairs in (("collision.disable", spec.disabled_links), ("srdf", spec.srdf_disabled_links)):
+        for i, pair in enumerate(pairs):
+            for name in pair:
+                if name not in links:
+                    where = f"{key}[{i}]" if key == "collision.disable" else key
+                    raise RobotModelError(spec.source, where, f"link '{name}' is not in the URDF {spec.urdf.name} "
+                                          f"(links: {', '.join(sorted(links))})")
+    return frozenset(frozenset(p) for p in (*spec.disabled_links, *spec.srdf_disabled_links))
 
 
 def mount_tool(robot: RobotModel, T_flange_tcp: FloatArray) -> RobotModel:

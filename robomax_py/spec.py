@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -22,6 +22,22 @@ def frozen_array(values: Any) -> FloatArray:
     return arr
 
 
+Brand = Literal["kuka", "abb", "fanuc", "ur"]
+
+
+def _identity() -> FloatArray:
+    return frozen_array(np.eye(4))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ControllerSpec:
+    """The robot's controller (SPEC §6): whose configuration data programs carry, and its frames."""
+
+    brand: Brand = "kuka"
+    j23_coupling: bool = False        # FANUC: J3 as the controller counts it = J3 + J2 of the URDF
+    T_root_base: FloatArray = field(default_factory=_identity)   # (4, 4) controller base in the URDF root
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class RobotSpec:
     """A robot.yaml, checked. Velocity and position limits live in the URDF."""
@@ -31,11 +47,14 @@ class RobotSpec:
     urdf: Path
     flange: str                       # URDF frame the tool mounts on
     ik_solver: str                    # "opw" | "ur" | "numeric"
-    ik_params: Any                    # typed params from robomax_py.ik.params_from_mapping
+    ik_params: Any                    # typed params (robomax_py.ik); None: fitted from the URDF
     acceleration: FloatArray | None   # (n,) rad/s^2, None: derived from velocity limits
     jerk: FloatArray | None           # (n,) rad/s^3, None: derived from acceleration limits
     payload_kg: float | None = None   # rated payload, for listings only
     description: str = ""
+    controller: ControllerSpec = field(default_factory=ControllerSpec)
+    disabled_links: tuple[tuple[str, str], ...] = ()        # robot.yaml collision.disable: never checked
+    srdf_disabled_links: tuple[tuple[str, str], ...] = ()   # the SRDF's disable_collisions
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -21,7 +21,7 @@ import numpy as np
 from robomax_py._typing import FloatArray
 from robomax_py.collision import CollisionWorld
 from robomax_py.errors import ProgramError
-from robomax_py.ik import config_of
+from robomax_py.ik import config_text, same_config
 from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.scene import build_scene
 from robomax_py.seams import nominal_rotation
@@ -242,8 +242,8 @@ def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> lis
                                              f"{math.degrees(beta):.2f} gamma {math.degrees(gamma):.2f} deg outside the tolerance"))
         written = entry.get("config")
         if written is not None:
-            actual = str(config_of(robot, qs[0]))
-            if str(written) != actual:
+            actual = config_text(robot, qs[0])
+            if not same_config(str(written), actual):
                 out.append(Violation(t0, "spot", f"{label}: configuration written as {written}, robot is in {actual}"))
     for key in wanted:
         if key not in seen:

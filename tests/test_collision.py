@@ -151,7 +151,7 @@ def ur10_cell_world(ur10: RobotModel, gun: ToolSpec) -> CollisionWorld:
 
 @pytest.fixture(scope="module")
 def reference() -> tuple[CellSpec, RobotModel, CollisionWorld]:
-    if not REFERENCE_CELL.is_file() or not (REPO / "robots" / "kr125" / "robot.yaml").is_file():
+    if not REFERENCE_CELL.is_file() or not (REPO / "robomax_py" / "robots" / "kr125" / "robot.yaml").is_file():
         pytest.skip("reference cell or robots/kr125 not available")
     from robomax_py.cell_io import load_cell, load_cell_robot
 
@@ -161,7 +161,7 @@ def reference() -> tuple[CellSpec, RobotModel, CollisionWorld]:
 
 
 def library_robot(name: str) -> RobotModel:
-    path = REPO / "robots" / name / "robot.yaml"
+    path = REPO / "robomax_py" / "robots" / name / "robot.yaml"
     if not path.is_file():
         pytest.skip(f"robots/{name} not available")
     return load_robot(load_robot_spec(path))

@@ -158,7 +158,7 @@ def test_status_distinct_over_branches_in_solve_all(rng: np.random.Generator) ->
 
 def test_against_robot_urdf_if_present(rng: np.random.Generator) -> None:
     yaml = pytest.importorskip("yaml")
-    folder = REPO / "robots" / "kr16"
+    folder = REPO / "robomax_py" / "robots" / "kr16"
     if not (folder / "kr16.urdf").is_file() or not (folder / "robot.yaml").is_file():
         pytest.skip("robots/kr16 not written yet")
     spec = yaml.safe_load((folder / "robot.yaml").read_text())

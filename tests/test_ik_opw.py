@@ -216,7 +216,7 @@ def test_full_stretch_round_off_is_reachable() -> None:
 @pytest.mark.parametrize("robot", ["kr16", "kr125"])
 def test_against_robot_urdf(robot: str, rng: np.random.Generator) -> None:
     yaml = pytest.importorskip("yaml")
-    folder = REPO / "robots" / robot
+    folder = REPO / "robomax_py" / "robots" / robot
     urdf, robot_yaml = folder / f"{robot}.urdf", folder / "robot.yaml"
     if not (urdf.is_file() and robot_yaml.is_file()):
         pytest.skip(f"{urdf} or {robot_yaml} not written yet")

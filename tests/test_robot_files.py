@@ -25,7 +25,7 @@ import yaml
 from robomax_py.ik.opw import OpwParams, opw_fk
 
 REPO = Path(__file__).resolve().parents[1]
-ROBOTS = REPO / "robots"
+ROBOTS = REPO / "robomax_py" / "robots"
 ARMS = ("kr125", "kr16")
 LINKS = ("base_link", "link_1", "link_2", "link_3", "link_4", "link_5", "link_6")
 HOME_DEG = (0.0, -90.0, 90.0, 0.0, 0.0, 0.0)

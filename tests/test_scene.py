@@ -167,7 +167,7 @@ def test_meshes_convex_shells_become_pieces_open_sheets_stay_exact(
 
 
 def test_reference_panel_stays_exact_and_gun_is_convex_pieces() -> None:
-    if not REFERENCE_CELL.is_file() or not (REPO / "robots" / "kr125" / "robot.yaml").is_file():
+    if not REFERENCE_CELL.is_file() or not (REPO / "robomax_py" / "robots" / "kr125" / "robot.yaml").is_file():
         pytest.skip("reference cell or robots/kr125 not available")
     from robomax_py.cell_io import load_cell, load_cell_robot
 

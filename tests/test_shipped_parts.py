@@ -39,10 +39,10 @@ def test_make_parts_reproduces_committed_stls(tmp_path: Path) -> None:
 
 
 def test_light_gun_generator_reproduces_committed_files(tmp_path: Path) -> None:
-    gen = _module(REPO / "robots" / "generate_light_gun.py", "robots_generate_light_gun")
+    gen = _module(REPO / "robomax_py" / "robots" / "generate_light_gun.py", "robots_generate_light_gun")
     for path in gen.generate(tmp_path):
         rel = path.relative_to(tmp_path)
-        assert (REPO / "robots" / rel).read_bytes() == path.read_bytes(), f"{rel} differs: rerun the generator"
+        assert (REPO / "robomax_py" / "robots" / rel).read_bytes() == path.read_bytes(), f"{rel} differs: rerun the generator"
 
 
 @pytest.mark.parametrize("cell", CELLS, ids=[p.stem for p in CELLS])

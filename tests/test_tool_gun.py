@@ -20,7 +20,7 @@ import trimesh
 import yaml
 
 REPO = Path(__file__).resolve().parents[1]
-GUN_DIR = REPO / "robots" / "tools" / "spot_gun_c"
+GUN_DIR = REPO / "robomax_py" / "robots" / "tools" / "spot_gun_c"
 # The reference cell: its frozen copy in tests/data (cells/cabin_flange.yaml is now our own cell), else
 # the contract's shared/ folder beside the clone (as in CI).
 CELL_CANDIDATES = (
@@ -215,7 +215,7 @@ def test_gun_clear_of_the_wrist(robot: str, a5_deg: float) -> None:
     import coal
     import pinocchio as pin
 
-    root = REPO / "robots" / robot
+    root = REPO / "robomax_py" / "robots" / robot
     model = pin.buildModelFromUrdf(str(root / f"{robot}.urdf"))
     data = model.createData()
     q = np.radians([0.0, -90.0, 90.0, 30.0, a5_deg, 45.0])

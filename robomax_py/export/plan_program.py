@@ -1,7 +1,8 @@
 """A planned result -> the dialect-independent robot program (`robomax_py.program`).
 
 PTP moves to every stop, FLYBY with the radius the planner chose and checked (detour corners, the
-joins retract -> move -> approach), LIN approach and retract along the electrode axis with the chosen configuration indicator, a SPOT
+joins retract -> move -> approach), LIN approach and retract along the electrode axis, each with the configuration data of its own
+target (the controller brand's), a SPOT
 statement per spot, and comments carrying the planned times and orientation angles. Cartesian
 targets are TCP poses in the robot base frame (mm, ZYX degrees); the tool and base frames are
 declared. Names are made into identifiers where a cell uses other characters.
@@ -82,7 +83,7 @@ def program_from_plan(result: PlanResult) -> Program:
         if k + 1 < len(transitions) and transitions[k + 1].wait is not None:
             out.extend(_wait(transitions[k + 1].wait))
         retract_radius = transitions[k + 1].flyby_radius if k + 1 < len(transitions) else 0.0
-        out.append(LinMove(xyz, zyx, spot.config, lin_mm_s, flyby=math.degrees(retract_radius),
+        out.append(LinMove(xyz, zyx, spot.config_app, lin_mm_s, flyby=math.degrees(retract_radius),
                            comment="retract"))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
                     tuple(identifier(j) for j in result.joint_names))

@@ -36,7 +36,7 @@ import numpy as np
 from robomax_py._typing import BoolArray, FloatArray, IntArray
 from robomax_py.errors import RobotModelError
 from robomax_py.ik._chain import chain_to_frame, revolute_mask
-from robomax_py.ik.config import ConfigIndicator, status_generic, status_opw, turn_bits
+from robomax_py.ik.config import ConfigIndicator, brand_text, same_config, status_generic, status_opw, turn_bits
 from robomax_py.ik.numeric import NumericIkParams, numeric_ik
 from robomax_py.ik.opw import OpwParams, opw_fk, opw_ik
 from robomax_py.ik.turns import expand, turn_shifts, wrap_to_pi
@@ -53,6 +53,8 @@ __all__ = [
     "OpwParams",
     "UrParams",
     "config_of",
+    "config_text",
+    "same_config",
     "numeric_ik",
     "opw_fk",
     "opw_ik",
@@ -299,3 +301,9 @@ def config_of(robot: RobotModel, q: FloatArray) -> ConfigIndicator:
     else:
         status = status_generic(robot.model, robot.flange_frame_id, q)
     return ConfigIndicator(status=int(status), turn=int(turn_bits(q)))
+
+
+def config_text(robot: RobotModel, q: FloatArray) -> str:
+    """The configuration data the robot's controller brand writes for q (n,), rad (`config.brand_text`)."""
+    ind = config_of(robot, q)
+    return brand_text(robot.controller.brand, ind.status, ind.turn, np.asarray(q, dtype=float))

@@ -142,8 +142,10 @@ def status_opw(params: OpwParams, q: FloatArray) -> IntArray:
     -------
     (...) int
         0..7 as defined in the module docstring; -1 for rows containing NaN. The A1 frame is the
-        paper's frame turned by theta1 (the base frame turned with axis 1 when offsets[0] = 0), and
-        phi = (offsets[2] - atan2(a2, c3)) * sign_corrections[2].
+        link-1 frame: the paper's frame turned by theta1, x towards the arm's front (the a1 offset),
+        which splits the shoulder branches exactly also when b != 0. The elbow
+        bit is geometric (SPEC §6): the wrist point in front of the line through the A2 and A3
+        axes, whichever way the URDF's axis 3 turns (ROS-Industrial FANUC arms turn it about -y).
     """
     q = np.asarray(q, dtype=float)
     th = to_paper_angles(params, q)
@@ -151,7 +153,7 @@ def status_opw(params: OpwParams, q: FloatArray) -> IntArray:
     k = np.hypot(params.a2, params.c3)
     beta = th[..., 2] + psi3                                            # 0 = stretched arm
     x_wrist = params.c2 * np.sin(th[..., 1]) + k * np.sin(th[..., 1] + beta) + params.a1
-    elbow_angle = np.mod(params.sign_corrections[2] * beta, TWO_PI)    # A3 - phi, in [0, 2 pi)
+    elbow_angle = np.mod(beta, TWO_PI)                                  # forearm from the upper arm, about y
     status = (x_wrist < 0) * 1 + (elbow_angle < np.pi) * 2 + _wrist_bit(q[..., 4]) * 4
     return np.where(np.isnan(q).any(axis=-1), -1, status).astype(np.int64)
 
@@ -194,7 +196,11 @@ def status_generic(model: pin.Model, frame_id: int, q: FloatArray) -> IntArray:
     x1 = F[:, 0, :3, 0]
     bit0 = np.einsum("mi,mi->m", wrist_56 - origin[0], x1) < 0
 
-    a3 = axis[2]
+    # The arm plane's normal from the A1 frame (up x front), not from axis 3 as the URDF turns it:
+    # the elbow bit is geometric (SPEC §6), the same on arms whose axis 3 points the other way.
+    up = np.where((axis[0][:, 2] >= 0)[:, None], axis[0], -axis[0])
+    a3 = np.cross(up, x1)
+    a3 = a3 / np.maximum(np.linalg.norm(a3, axis=1, keepdims=True), 1e-300)
     upper = origin[2] - origin[1]
     fore = wrist - origin[2]
     upper = upper - np.einsum("mi,mi->m", upper, a3)[:, None] * a3
@@ -217,3 +223,39 @@ def _closest_on_line(p: FloatArray, a: FloatArray, p_ref: FloatArray, a_ref: Flo
     denom = 1.0 - b * b
     t = np.where(denom > 1e-12, (b * e - d) / np.where(denom > 1e-12, denom, 1.0), 0.0)
     return p + t[:, None] * a
+
+
+# ------------------------------------------------------------------ the controllers' own words
+
+def brand_text(brand: str, status: int, turn: int, q: FloatArray) -> str:
+    """The configuration data a `brand`'s controller writes for joint values q (6,), rad (SPEC §6).
+
+    kuka: Status and Turn, `S110 T010011` (KUKA System Software 8.x manual, "Status" and "Turn").
+    abb: robtarget confdata `[cf1,cf4,cf6,cfx]`: quadrants floor(q / 90 deg) of axes 1, 4, 6 and
+    cfx = 4 (wrist centre behind axis 1) + 2 (behind the lower arm) + (axis 5 negative), the
+    configuration table of the RAPID reference manual (data type confdata, 6-axis robots).
+    fanuc: `F|N U|D T|B, t4, t5, t6`: flip when J5 < 0, up when the elbow is above the
+    shoulder-wrist line (the same turn from upper arm to forearm as KUKA's elbow bit), T when the
+    wrist point is in front of J1, and the
+    turn numbers of J4, J5, J6 (0 for -180 < q <= 180 deg), as in the FANUC R-30iB operator's
+    manual ("Configuration"). ur: no configuration data ("").
+    """
+    ind = ConfigIndicator(status, turn)
+    if brand == "kuka":
+        return str(ind)
+    if brand == "abb":
+        cf1, cf4, cf6, cfx = ind.to_abb(q)
+        return f"[{cf1},{cf4},{cf6},{cfx}]"
+    if brand == "fanuc":
+        qq = np.asarray(q, dtype=float)
+        letters = ("F" if ind.wrist else "N", "U" if ind.elbow else "D", "B" if ind.overhead else "T")
+        turns = [int(np.ceil((qq[i] - np.pi) / TWO_PI)) for i in (3, 4, 5)]
+        return f"{' '.join(letters)}, {turns[0]}, {turns[1]}, {turns[2]}"
+    if brand == "ur":
+        return ""
+    raise ValueError(f"unknown controller brand {brand!r}")
+
+
+def same_config(written: str, actual: str) -> bool:
+    """Whether two configuration texts say the same (spaces do not count)."""
+    return "".join(written.split()).upper() == "".join(actual.split()).upper()
