@@ -29,6 +29,34 @@ err = Console(stderr=True, highlight=False)
 T = TypeVar("T")
 
 
+@app.callback()
+def _library(
+    robots_dirs: Annotated[list[Path] | None, typer.Option(
+        "--robots", metavar="DIR",
+        help="a robot library folder searched before ROBOMAX_ROBOTS and the shipped library (repeatable; "
+             "any command takes it, before or after the command name)")] = None,
+) -> None:
+    """Offline programming for spot-welding robot cells."""
+    if robots_dirs:
+        _prepend_library([str(d) for d in robots_dirs])
+
+
+def _prepend_library(dirs: list[str]) -> None:
+    """Put folders in front of ROBOMAX_ROBOTS; batch workers and local Ray inherit the environment."""
+    import os
+
+    from robomax_py.robot_io import ROBOTS_ENV
+
+    current = [p for p in os.environ.get(ROBOTS_ENV, "").split(os.pathsep) if p]
+    wanted = [str(Path(d).resolve()) for d in dirs]
+    os.environ[ROBOTS_ENV] = os.pathsep.join([*wanted, *[p for p in current if p not in wanted]])
+
+
+def _warn(lines: tuple[str, ...] | list[str]) -> None:
+    for line in lines:
+        err.print(f"[yellow]warning:[/] {line}", soft_wrap=True, highlight=False)
+
+
 def _guarded(action: Callable[[], T]) -> T:
     """Run a command body; a RobomaxError becomes one message and exit code 2."""
     try:
@@ -45,19 +73,25 @@ def robots() -> None:
     def run() -> None:
         from robomax_py.library import list_robots, list_tools
 
+        from robomax_py.robot_io import robot_library
+
+        out.print("library path: " + "  ".join(str(d) for d in robot_library()), soft_wrap=True)
         table = Table(title="Robots", title_justify="left")
-        for col in ("name", "axes", "flange reach (m)", "payload (kg)", "IK", "description"):
+        for col in ("name", "axes", "flange reach (m)", "payload (kg)", "IK", "controller", "from", "description"):
             table.add_column(col)
         for r in list_robots():
             payload = "-" if r.payload_kg is None else f"{r.payload_kg:g}"
-            table.add_row(r.name, str(r.axes), f"{r.reach_m:.3f}", payload, r.ik_solver, r.description)
+            table.add_row(r.name, str(r.axes), f"{r.reach_m:.3f}", payload, r.ik_solver, r.brand,
+                          str(r.source.parent.parent), r.description)
+            _warn([f"robot {r.name}: {s} is hidden by {r.source}" for s in r.shadowed])
         out.print(table)
         tools = Table(title="Tools", title_justify="left")
-        for col in ("name", "TCP offset from flange (m)", "TCP distance (m)"):
+        for col in ("name", "TCP offset from flange (m)", "TCP distance (m)", "from"):
             tools.add_column(col)
         for t in list_tools():
             xyz = ", ".join(f"{v:.3f}" for v in t.tcp_xyz_m)
-            tools.add_row(t.name, f"[{xyz}]", f"{t.tcp_distance_m:.3f}")
+            tools.add_row(t.name, f"[{xyz}]", f"{t.tcp_distance_m:.3f}", str(t.source.parent.parent.parent))
+            _warn([f"tool {t.name}: {s} is hidden by {t.source}" for s in t.shadowed])
         out.print(tools)
 
     _guarded(run)
@@ -71,9 +105,30 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")]) -> Non
         from robomax_py.cell_io import load_cell, load_cell_robot
         from robomax_py.summary import cell_summary
 
+        from robomax_py.errors import CellFileError
+        from robomax_py.robot_checks import reach_report, self_contacts
+
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
+        _warn(robot.warnings)
         out.print(cell_summary(spec, robot))
+        reach = reach_report(spec, robot)
+        far = [r for r in reach if not r.reachable]
+        if far:
+            worst = max(far, key=lambda r: r.out_by_m)
+            others = f" ({len(far) - 1} more spot(s) out of reach)" if len(far) > 1 else ""
+            raise CellFileError(cell, worst.key, f"spot {worst.seam}/{worst.name} is out of {robot.name}'s reach by "
+                                f"{worst.out_by_m:.3f} m at every allowed orientation (shoulder to wrist "
+                                f"{worst.distance_m:.3f} m, the arm reaches {worst.reach_m:.3f} m){others}")
+        if reach:
+            tight = min(reach, key=lambda r: -r.out_by_m)
+            out.print(f"reach: all {len(reach)} spots within reach (least margin {-tight.out_by_m * 1000:.0f} mm "
+                      f"at {tight.seam}/{tight.name})")
+        at_home, always = self_contacts(robot, spec.home)
+        _warn([f"{robot.name}: links {a} and {b} touch at home; if they touch by design, add "
+               f"[{a}, {b}] to collision.disable in {robot.source}" for a, b in at_home])
+        _warn([f"{robot.name}: links {a} and {b} touch in every sampled configuration; add [{a}, {b}] "
+               f"to collision.disable in {robot.source} (or give its SRDF as srdf:)" for a, b in always])
         out.print(f"[green]ok[/]: {cell} is a valid cell")
 
     _guarded(run)
@@ -106,6 +161,7 @@ def plan(
         t0 = time.perf_counter()
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
+        _warn(robot.warnings)
         with stage_bars(err, enabled=not verbose) as progress:
             result = plan_cell(spec, robot, PlanOptions(baseline=baseline, speed=speed), progress)
         seconds = time.perf_counter() - t0
@@ -129,8 +185,13 @@ def plan(
                 out.print(renderable)
         if result.status != "planned":
             err.print(f"[bold red]infeasible:[/] {result.message}", soft_wrap=True)
+            from robomax_py.robot_checks import reach_report
+
+            reach = {(r.seam, r.name): r for r in reach_report(spec, robot)} if result.failures else {}
             for f in result.failures:
-                err.print(f"  {f.seam}/{f.name}: {f.reason} ({f.detail})", soft_wrap=True)
+                r = reach.get((f.seam, f.name))
+                far = f"; {r.out_by_m:.3f} m out of reach at the best orientation" if r and not r.reachable else ""
+                err.print(f"  {f.seam}/{f.name}: {f.reason} ({f.detail}{far})", soft_wrap=True)
             return EXIT_INFEASIBLE
         return EXIT_OK
 
@@ -309,6 +370,40 @@ def variants(
     _guarded(run)
 
 
+@app.command("import-urdf")
+def import_urdf_command(
+    source: Annotated[Path, typer.Argument(help=".urdf or .xacro file (xacro is expanded without ROS)")],
+    out_dir: Annotated[Path, typer.Option("-o", "--out", help="the robot folder to write, e.g. robots/irb2400")],
+    packages: Annotated[list[Path] | None, typer.Option("--packages", metavar="DIR",
+                        help="a ROS package folder or a folder holding packages (repeatable)")] = None,
+    flange: Annotated[str, typer.Option("--flange", help="URDF frame the tool mounts on")] = "tool0",
+    srdf: Annotated[Path | None, typer.Option("--srdf", help="MoveIt SRDF whose disable_collisions are kept")] = None,
+    solver: Annotated[str | None, typer.Option("--solver", help="opw | ur | numeric (default: the first that fits)")] = None,
+    brand: Annotated[str | None, typer.Option("--brand", help="kuka | abb | fanuc | ur (default: guessed from the name)")] = None,
+    name: Annotated[str | None, typer.Option("--name", help="robot name (default: the folder name)")] = None,
+    force: Annotated[bool, typer.Option("--force", help="replace a folder that exists with other content")] = False,
+) -> None:
+    """Make a self-contained robot folder from a URDF or xacro: meshes copied, IK fitted and checked."""
+
+    def run() -> None:
+        from robomax_py.errors import RobotModelError
+        from robomax_py.urdf_import import import_urdf
+
+        if solver not in (None, "opw", "ur", "numeric"):
+            raise RobotModelError(None, "--solver", f"expected opw, ur or numeric, got {solver!r}")
+        if brand not in (None, "kuka", "abb", "fanuc", "ur"):
+            raise RobotModelError(None, "--brand", f"expected kuka, abb, fanuc or ur, got {brand!r}")
+        r = import_urdf(source, out_dir, packages or (), name=name, flange=flange, srdf=srdf, solver=solver,
+                        brand=brand, force=force)
+        _warn(r.warnings)
+        what = "unchanged" if r.unchanged else "wrote"
+        out.print(f"{what} {r.folder}: robot {r.name}, IK {r.solver} (FK agrees with the URDF within "
+                  f"{r.fk_error_m:.1e} m), controller {r.brand}, {r.meshes} meshes, {r.disabled_pairs} disabled "
+                  f"pairs from the SRDF ({r.seconds:.1f} s)")
+
+    _guarded(run)
+
+
 RAY_LOCAL = "local"
 
 
@@ -327,10 +422,29 @@ def _bare_ray_flag(argv: list[str]) -> list[str]:
     return args
 
 
+def _library_flags_first(argv: list[str]) -> list[str]:
+    """`--robots DIR` anywhere -> in front of the command name, where the app callback reads it."""
+    front: list[str] = []
+    rest: list[str] = []
+    k = 0
+    while k < len(argv):
+        arg = argv[k]
+        if arg == "--robots" and k + 1 < len(argv):
+            front += [arg, argv[k + 1]]
+            k += 2
+            continue
+        if arg.startswith("--robots="):
+            front.append(arg)
+        else:
+            rest.append(arg)
+        k += 1
+    return front + rest
+
+
 def main() -> None:
     """Console entry point."""
     try:
-        app(args=_bare_ray_flag(sys.argv[1:]))
+        app(args=_bare_ray_flag(_library_flags_first(sys.argv[1:])))
     except KeyboardInterrupt:
         err.print("interrupted")
         sys.exit(130)

@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 
 from robomax_py.robot import kinematic_model
-from robomax_py.robot_io import load_robot_spec, load_tool_spec, package_robots_dir
+from robomax_py.robot_io import load_robot_spec, load_tool_spec, robot_library
 from robomax_py.spec import RobotSpec
 
 REACH_SAMPLES = 20000
@@ -24,6 +24,8 @@ class RobotEntry:
     ik_solver: str
     description: str
     source: Path
+    brand: str = "kuka"
+    shadowed: tuple[Path, ...] = ()   # robot.yaml files of the same name later in the library path
 
 
 @dataclass(frozen=True, slots=True)
@@ -32,30 +34,43 @@ class ToolEntry:
     tcp_xyz_m: tuple[float, float, float]
     tcp_distance_m: float     # TCP distance from the flange centre
     source: Path
+    shadowed: tuple[Path, ...] = ()
 
 
-def list_robots(root: Path | None = None) -> list[RobotEntry]:
-    """Every robots/<name>/robot.yaml, sorted by name; a broken one raises its RobotModelError."""
-    root = root or package_robots_dir()
+def _found(roots: tuple[Path, ...], pattern: str) -> list[tuple[Path, tuple[Path, ...]]]:
+    """(first file, later files of the same folder name) per name over the library path, by name."""
+    by_name: dict[str, list[Path]] = {}
+    for root in roots:
+        for path in sorted(root.glob(pattern)):
+            by_name.setdefault(path.parent.name, []).append(path)
+    return [(paths[0], tuple(paths[1:])) for _, paths in sorted(by_name.items())]
+
+
+def list_robots(roots: tuple[Path, ...] | None = None) -> list[RobotEntry]:
+    """Every <library>/<name>/robot.yaml over the library path (first of a name wins), sorted by
+    name; a broken one raises its RobotModelError. The IK parameters are checked against the URDF."""
+    from robomax_py.robot import checked_ik_params
+
     entries = []
-    for path in sorted(root.glob("*/robot.yaml")):
+    for path, shadowed in _found(roots or robot_library(), "*/robot.yaml"):
         spec = load_robot_spec(path)
         model = kinematic_model(spec)
+        checked_ik_params(spec, model)
         entries.append(RobotEntry(
             name=spec.name, axes=int(model.nq), reach_m=flange_reach(spec, model),
-            payload_kg=spec.payload_kg, ik_solver=spec.ik_solver, description=spec.description, source=path,
+            payload_kg=spec.payload_kg, ik_solver=spec.ik_solver + ("" if spec.ik_params is not None else " (fitted)"),
+            description=spec.description, source=path, brand=spec.controller.brand, shadowed=shadowed,
         ))
     return entries
 
 
-def list_tools(root: Path | None = None) -> list[ToolEntry]:
-    root = root or package_robots_dir()
+def list_tools(roots: tuple[Path, ...] | None = None) -> list[ToolEntry]:
     entries = []
-    for path in sorted((root / "tools").glob("*/tool.yaml")):
+    for path, shadowed in _found(roots or robot_library(), "tools/*/tool.yaml"):
         tool = load_tool_spec(path)
         xyz = tool.T_flange_tcp[:3, 3]
         entries.append(ToolEntry(tool.name, (float(xyz[0]), float(xyz[1]), float(xyz[2])),
-                                 float(np.linalg.norm(xyz)), path))
+                                 float(np.linalg.norm(xyz)), path, shadowed))
     return entries
 
 
