@@ -53,8 +53,10 @@ def _prepend_library(dirs: list[str]) -> None:
 
 
 def _warn(lines: tuple[str, ...] | list[str]) -> None:
+    from rich.markup import escape
+
     for line in lines:
-        err.print(f"[yellow]warning:[/] {line}", soft_wrap=True, highlight=False)
+        err.print(f"[yellow]warning:[/] {escape(line)}", soft_wrap=True, highlight=False)
 
 
 def _guarded(action: Callable[[], T]) -> T:

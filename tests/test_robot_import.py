@@ -1,0 +1,289 @@
+"""Arms from ROS-Industrial support packages (tests/data/rosi, see SOURCES.md there), end to end:
+`import-urdf` from their xacro files, IK parameters fitted from the URDF against the packages'
+own OPW parameters, FK/IK agreement, disabled pairs from the SRDF, configuration data per brand,
+and (slow) cells planned on each arm whose `.srcl` and `.json` programs `verify` accepts.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from typer.testing import CliRunner
+
+from robomax_py.cli import app
+from robomax_py.errors import RobotModelError
+from robomax_py.ik import config_text, solve_all
+from robomax_py.ik.fit import FitError, fit_opw, fk_agreement
+from robomax_py.robot import fk_flange, load_robot
+from robomax_py.robot_io import ROBOTS_ENV, load_robot_spec
+from robomax_py.urdf_import import guess_brand, import_urdf
+
+ROSI = Path(__file__).parent / "data" / "rosi"
+ARMS = {
+    "irb2400": ROSI / "abb_irb2400_support/urdf/irb2400.xacro",
+    "m20ia": ROSI / "fanuc_m20ia_support/urdf/m20ia.xacro",
+    "kr120r2500pro": ROSI / "kuka_kr120_support/urdf/kr120r2500pro.xacro",
+}
+SRDF = {"irb2400": ROSI / "abb_irb2400_moveit_config/config/abb_irb2400.srdf"}
+# Round trips of a correct closed-form solver are at float64 round-off; 1e-9 m leaves room.
+ROUND_TRIP_M = 1e-9
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def arms(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    root = tmp_path_factory.mktemp("robots")
+    out = {}
+    for name, source in ARMS.items():
+        out[name] = import_urdf(source, root / name, srdf=SRDF.get(name)).folder
+    return out
+
+
+def _params(folder: Path) -> dict[str, object]:
+    data = yaml.safe_load((folder / "robot.yaml").read_text())
+    return dict(data["ik"]["params"])
+
+
+def test_import_writes_a_self_contained_folder(arms: dict[str, Path]) -> None:
+    for name, folder in arms.items():
+        urdf = (folder / f"{name}.urdf").read_text()
+        assert "package://" not in urdf
+        assert all((folder / m).is_file() for m in ("robot.yaml", f"{name}.urdf"))
+        assert list((folder / "meshes").rglob("*.stl"))
+        spec = load_robot_spec(folder / "robot.yaml")
+        assert spec.controller.brand == {"irb2400": "abb", "m20ia": "fanuc", "kr120r2500pro": "kuka"}[name]
+        robot = load_robot(spec)
+        # The test copies have no visual meshes: the collision meshes stand in, with a warning.
+        assert robot.visual_model.ngeoms == robot.collision_model.ngeoms
+
+
+def test_fitted_parameters_equal_the_packages_own(arms: dict[str, Path]) -> None:
+    # fanuc_m20ia_support/config/opw_parameters_m20ia.yaml (copied in tests/data/rosi)
+    m20 = yaml.safe_load((ROSI / "fanuc_m20ia_support/config/opw_parameters_m20ia.yaml").read_text()
+                         .replace("deg(-90.0)", "-90").replace("deg(180.0)", "180"))
+    got = _params(arms["m20ia"])
+    for k, v in m20["opw_kinematics_geometric_parameters"].items():
+        assert got[k] == pytest.approx(v, abs=1e-9)
+    assert got["offsets"] == pytest.approx(m20["opw_kinematics_joint_offsets"], abs=1e-7)
+    assert got["sign_corrections"] == m20["opw_kinematics_joint_sign_corrections"]
+    # opw_kinematics' opw_parameters_examples.h, makeIrb2400_10: a1 0.100, a2 -0.135, b 0, c1 0.615,
+    # c2 0.705, c3 0.755, c4 0.085, offsets (0, 0, -pi/2, 0, 0, 0), all signs +1.
+    irb = _params(arms["irb2400"])
+    assert [irb[k] for k in ("a1", "a2", "b", "c1", "c2", "c3", "c4")] == pytest.approx(
+        [0.1, -0.135, 0.0, 0.615, 0.705, 0.755, 0.085], abs=1e-9)
+    assert irb["offsets"] == pytest.approx([0, 0, -90, 0, 0, 0], abs=1e-7)
+
+
+@pytest.mark.parametrize("name", list(ARMS))
+def test_fk_agrees_and_ik_round_trips(arms: dict[str, Path], name: str) -> None:
+    robot = load_robot(load_robot_spec(arms[name] / "robot.yaml"))
+    assert fk_agreement(robot.model, robot.flange_frame_id, robot.ik_params).position_m < ROUND_TRIP_M
+
+    @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+    @given(st.lists(st.floats(0.02, 0.98), min_size=6, max_size=6))
+    def round_trip(u: list[float]) -> None:
+        q = robot.limits.lower + np.asarray(u) * (robot.limits.upper - robot.limits.lower)
+        if abs(math.sin(q[4])) < 1e-3:
+            return   # wrist singular: the branch is not unique
+        T = fk_flange(robot, q)
+        table = solve_all(robot, T)
+        sols = table.q[table.valid]
+        assert len(sols)
+        err = np.abs(fk_flange(robot, sols)[:, :3, 3] - T[:3, 3]).max()
+        assert err < ROUND_TRIP_M
+        wrapped = np.abs(np.angle(np.exp(1j * (sols - q)))).max(axis=1)
+        assert wrapped.min() < 1e-6
+
+    round_trip()
+
+
+def test_import_is_idempotent_and_never_overwrites(tmp_path: Path) -> None:
+    out = tmp_path / "m20ia"
+    first = import_urdf(ARMS["m20ia"], out)
+    assert not first.unchanged
+    assert import_urdf(ARMS["m20ia"], out).unchanged
+    (out / "robot.yaml").write_text((out / "robot.yaml").read_text() + "# edited\n")
+    with pytest.raises(RobotModelError, match="--force"):
+        import_urdf(ARMS["m20ia"], out)
+    assert (out / "robot.yaml").read_text().endswith("# edited\n")
+    assert not import_urdf(ARMS["m20ia"], out, force=True).unchanged
+    assert not (out / "robot.yaml").read_text().endswith("# edited\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m20ia"]     # no staging folders left
+
+
+def test_import_bad_input_leaves_nothing(tmp_path: Path) -> None:
+    broken = tmp_path / "broken.xacro"
+    broken.write_text('<robot xmlns:xacro="http://wiki.ros.org/xacro"><xacro:include filename="nope.xacro"/></robot>')
+    result = runner.invoke(app, ["import-urdf", str(broken), "-o", str(tmp_path / "out")])
+    assert result.exit_code == 2 and "xacro does not expand" in result.output and "broken.xacro" in result.output
+    # A chain that is not OPW up to the named frame (the flange at link_4: four joints).
+    result = runner.invoke(app, ["import-urdf", str(ARMS["m20ia"]), "-o", str(tmp_path / "out"),
+                                 "--flange", "link_4", "--solver", "opw"])
+    assert result.exit_code == 2 and "six revolute joints" in result.output
+    result = runner.invoke(app, ["import-urdf", str(ARMS["m20ia"]), "-o", str(tmp_path / "out"), "--flange", "nope"])
+    assert result.exit_code == 2 and "no frame 'nope'" in result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["broken.xacro"]
+
+
+def test_wrong_or_misnamed_robot_data_is_refused(arms: dict[str, Path], tmp_path: Path) -> None:
+    folder = tmp_path / "kr120r2500pro"
+    import shutil
+
+    shutil.copytree(arms["kr120r2500pro"], folder)
+    text = (folder / "robot.yaml").read_text()
+    a2 = _params(folder)["a2"]
+    (folder / "robot.yaml").write_text(text.replace(f"a2: {a2}", f"a2: {-float(a2)}"))   # type: ignore[arg-type]
+    with pytest.raises(RobotModelError, match=r"ik\.params: the opw solver's forward kinematics disagrees"):
+        load_robot(load_robot_spec(folder / "robot.yaml"))
+    (folder / "robot.yaml").write_text(text + "collision:\n  disable: [[link_4, link_9]]\n")
+    with pytest.raises(RobotModelError, match=r"collision\.disable\[0\]: link 'link_9' is not in the URDF"):
+        load_robot(load_robot_spec(folder / "robot.yaml"))
+
+
+def test_fit_refuses_a_chain_of_another_class(arms: dict[str, Path]) -> None:
+    robot = load_robot(load_robot_spec(arms["m20ia"] / "robot.yaml"))
+    model = robot.model.copy()
+    model.jointPlacements[5].translation = model.jointPlacements[5].translation + np.array([0.0, 0.05, 0.0])
+    with pytest.raises(FitError, match="wrist axes must meet"):
+        fit_opw(model, robot.flange_frame_id)
+
+
+def test_srdf_pairs_are_not_checked(arms: dict[str, Path]) -> None:
+    robot = load_robot(load_robot_spec(arms["irb2400"] / "robot.yaml"))
+    assert frozenset(("link_4", "link_6")) in robot.disabled_links
+
+
+def test_configuration_data_is_geometric_on_a_fanuc_arm(arms: dict[str, Path]) -> None:
+    # ROS-I FANUC arms turn J3 about -y. J2 = J3 = 0: upper arm vertical, forearm forward: the
+    # elbow is above the shoulder-wrist line (U), the wrist in front of J1 (T); J5 = -30 deg: flip.
+    robot = load_robot(load_robot_spec(arms["m20ia"] / "robot.yaml"))
+    q = np.radians([0.0, 0.0, 0.0, 0.0, -30.0, 0.0])
+    assert config_text(robot, q) == "F U T, 0, 0, 0"
+    # Independently of the solver: the elbow letter from the joint origins (A2, A3 and the wrist
+    # centre = the joint-5 origin of these URDFs) for J1 = 0, over the J3 range.
+    import pinocchio as pin
+
+    data = robot.model.createData()
+    letters = set()
+    for q3 in np.radians(np.linspace(-180, 260, 23)):
+        q = np.array([0.0, 0.3, q3, 0.2, 0.5, 4.0])
+        pin.forwardKinematics(robot.model, data, q)
+        a2, a3, w = (data.oMi[robot.model.getJointId(f"joint_{k}")].translation for k in (2, 3, 5))
+        up = np.cross(a3 - a2, w - a3)[1] > 0
+        front = w[0] > 0
+        want = f"N {'U' if up else 'D'} {'T' if front else 'B'}, 0, 0, 1"
+        assert config_text(robot, q) == want
+        letters.add(want[2])
+    assert letters == {"U", "D"}
+    # The KUKA arm's A3 turns about +y: the same posture reads elbow up as well.
+    kr = load_robot(load_robot_spec(arms["kr120r2500pro"] / "robot.yaml"))
+    assert config_text(kr, np.radians([0.0, -90.0, 90.0, 0.0, 30.0, 0.0])).startswith("S010")
+    abb = load_robot(load_robot_spec(arms["irb2400"] / "robot.yaml"))
+    assert config_text(abb, np.radians([100.0, 0.0, 0.0, -10.0, -30.0, 200.0])) == "[1,-1,2,1]"
+
+
+def test_brand_guess() -> None:
+    assert guess_brand("kr120r2500pro") == "kuka"
+    assert guess_brand("abb_irb4600") == "abb"
+    assert guess_brand("fanuc_m20ia") == "fanuc"
+    assert guess_brand("m20ia") == "fanuc"
+    assert guess_brand("ur10e") == "ur"
+
+
+def test_library_path_and_robots_flag(arms: dict[str, Path], tmp_path: Path) -> None:
+    lib = arms["m20ia"].parent
+    env = {**os.environ, ROBOTS_ENV: str(lib)}
+    done = subprocess.run([sys.executable, "-m", "robomax_py", "robots"], capture_output=True, text=True, env=env,
+                          check=False)
+    assert done.returncode == 0, done.stderr
+    for name in ("m20ia", "kr125", "spot_gun_c"):            # the shipped library stays searched
+        assert name in done.stdout
+    env.pop(ROBOTS_ENV)
+    done = subprocess.run([sys.executable, "-m", "robomax_py", "robots", "--robots", str(lib)],
+                          capture_output=True, text=True, env=env, check=False)
+    assert done.returncode == 0 and "irb2400" in done.stdout
+
+
+def _flange_cell(robot_yaml: Path, tool: str, x: float, z: float, home: str = "[0, 0, 0, 0, 30, 0]") -> str:
+    spots = "\n".join(
+        f"      - {{name: s{k + 1}, xyz: [{x}, {y}, {z}], normal: [-1, 0, 0], direction: [0, 1, 0]}}"
+        for k, y in enumerate((-0.3, -0.1, 0.1, 0.3)))
+    return f"""robomax: 1
+robot: {{model: {robot_yaml}, home: {home}}}
+tool: {tool}
+objects:
+  - {{name: flange, box: [0.002, 0.8, 0.06], pose: {{xyz: [{x}, 0, {z - 0.02}]}}, workpiece: true}}
+  - {{name: post, box: [0.1, 0.1, {z - 0.1:.3f}], pose: {{xyz: [{x + 0.15}, 0, {(z - 0.1) / 2:.3f}]}}}}
+seams:
+  - name: flange
+    ordered: false
+    tolerance: {{alpha: 10, beta: 10, gamma: [-180, 180]}}
+    grid: 3
+    spots:
+{spots}
+process: {{weld_time: 0.3, approach: 0.03, clearance: 0}}
+"""
+
+
+def _plan_and_verify(cell: Path, out: Path) -> None:
+    result = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    for ext in ("srcl", "json"):
+        program = out / f"{cell.stem}.{ext}"
+        verified = runner.invoke(app, ["verify", str(cell), str(program)])
+        assert verified.exit_code == 0, verified.output
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name, tool, x, z, home", [
+    ("irb2400", "spot_gun_light", 1.05, 0.95, "[0, 0, 0, 0, 30, 0]"),
+    ("m20ia", "spot_gun_light", 1.05, 0.95, "[0, 0, 0, 0, 30, 0]"),
+    ("kr120r2500pro", "spot_gun_c", 1.6, 1.2, "[0, -90, 90, 0, 30, 0]"),   # KUKA: A2 = -90 is upright
+])
+def test_each_arm_plans_and_verifies(arms: dict[str, Path], tmp_path: Path, name: str, tool: str, x: float, z: float,
+                                     home: str) -> None:
+    cell = tmp_path / f"{name}_flange.yaml"
+    cell.write_text(_flange_cell(arms[name] / "robot.yaml", tool, x, z, home))
+    assert runner.invoke(app, ["check", str(cell)]).exit_code == 0
+    _plan_and_verify(cell, tmp_path / "programs")
+
+
+@pytest.mark.slow
+def test_lin_whose_j2_changes_sign_states_each_targets_configuration(arms: dict[str, Path], tmp_path: Path) -> None:
+    """Regression (issue 14): the retract LIN was written with the spot's CONFIG; on this ABB arm
+    J2 is near 0 at the spot and changes sign over the 30 mm line, so KUKA turn bits differ."""
+    import shutil
+
+    from robomax_py.cell_io import load_cell, load_cell_robot
+    from robomax_py.plan import PlanOptions, plan_cell
+
+    folder = tmp_path / "irb2400k"
+    shutil.copytree(arms["irb2400"], folder)
+    text = (folder / "robot.yaml").read_text().replace("name: irb2400", "name: irb2400k").replace("brand: abb", "brand: kuka")
+    (folder / "robot.yaml").write_text(text)
+    cell = tmp_path / "j2_cross.yaml"
+    cell.write_text(_flange_cell(folder / "robot.yaml", "spot_gun_light", 0.85, 0.95))
+    spec = load_cell(cell)
+    result = plan_cell(spec, load_cell_robot(spec), PlanOptions())
+    crossing = [s for s in result.spots if s.config != s.config_app]
+    assert crossing, "the cell no longer has a LIN whose J2 changes sign"
+    assert all(np.sign(s.q_spot[1]) != np.sign(s.q_app[1]) or s.config != s.config_app for s in crossing)
+    _plan_and_verify(cell, tmp_path / "programs")
+
+
+def test_out_of_reach_spot_fails_check_with_the_distance(tmp_path: Path) -> None:
+    cell = tmp_path / "far.yaml"
+    text = _flange_cell(Path("kr125"), "spot_gun_c", 1.6, 1.2, "[0, -90, 90, 0, 30, 0]")
+    cell.write_text(text.replace("[1.6, 0.3, 1.2]", "[4.6, 0.3, 1.2]"))
+    result = runner.invoke(app, ["check", str(cell)])
+    assert result.exit_code == 2
+    assert "seams[0].spots[3]" in result.output and "out of kr125's reach by" in result.output
