@@ -179,7 +179,7 @@ def plan(
                 path = out_dir / f"{spec.name}.png"
                 write_atomic_bytes(path, png)
                 written.append(path)
-        report = plan_report(result, seconds, written)
+        report = plan_report(result, seconds, written, robot.defaulted_limits)
         if as_json:
             out.print_json(_json.dumps(report))
         else:

@@ -13,13 +13,16 @@ from robomax_py.plan import PlanResult
 KINDS = ("move", "detour", "approach", "weld", "retract", "wait")
 
 
-def plan_report(result: PlanResult, seconds: float, written: list[Path]) -> dict[str, Any]:
-    """A JSON-ready summary: status, cycle time and its split, spots, detours, planning time."""
+def plan_report(result: PlanResult, seconds: float, written: list[Path],
+                defaulted_limits: tuple[str, ...] = ()) -> dict[str, Any]:
+    """A JSON-ready summary: status, cycle time and its split, spots, detours, planning time, and
+    which of the robot's limits were derived rather than given (`RobotModel.defaulted_limits`)."""
     report: dict[str, Any] = {
         "cell": result.cell, "robot": result.robot, "status": result.status, "message": result.message,
         "method": "baseline" if result.baseline else "optimised", "planning_seconds": round(seconds, 3),
         "failures": [{"seam": f.seam, "spot": f.name, "reason": f.reason, "detail": f.detail} for f in result.failures],
         "files": [str(p) for p in written],
+        "defaulted_limits": list(defaulted_limits),
     }
     if result.trajectory is None:
         return report
@@ -60,6 +63,9 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
     stages = report.get("stats", {}).get("stage_seconds", {})
     split = ", ".join(f"{k} {v:.2f}" for k, v in stages.items())
     head.add_row("planning", f"{report['planning_seconds']:.2f} s" + (f"  ({split})" if split else ""))
+    if report.get("defaulted_limits"):
+        head.add_row("limits", "derived from the URDF velocities (not in robot.yaml): "
+                     + ", ".join(report["defaulted_limits"]))
     if "stats" in report:
         st = report["stats"]
         head.add_row("work", f"{st['candidates']} candidates, {st['collision_checks']:,} collision checks, "

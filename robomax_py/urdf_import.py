@@ -216,6 +216,8 @@ def import_urdf(
     source = Path(source)
     packages = tuple(Path(p).resolve() for p in packages)
     name = name or out.name
+    if name != out.name:
+        raise RobotModelError(out, None, f"the folder must be named after the robot (SPEC §1): {name!r}")
     if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", name):
         raise RobotModelError(out, None, f"robot name {name!r} must be letters, digits, '_', '.', '-'")
     text = expand(source, packages)
