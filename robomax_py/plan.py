@@ -29,7 +29,7 @@ from robomax_py.seams import OrientationGrid, approach_poses, orientation_grid, 
 from robomax_py.sequence import HOME, SeamBlock, Tour, choice_for_order, optimise
 from robomax_py.spec import CellSpec
 from robomax_py.junction import WeldEnd, time_junction
-from robomax_py.program import as_written_joints, as_written_pose, written_seconds, written_speed, written_tcp_speed
+from robomax_py.program import as_written_joints, as_written_pose_in, written_seconds, written_speed, written_tcp_speed
 from robomax_py.timing import Segment, TimingError, Trajectory, concatenate, dwell, ptp_time_estimate, resample
 from robomax_py.transforms import invert
 from robomax_py.waiting import WaitingError, WaitPlan, schedule_waits
@@ -144,6 +144,7 @@ class PlanResult:
     tool: str = ""
     T_flange_tcp: FloatArray | None = None   # (4, 4)
     T_world_base: FloatArray | None = None   # (4, 4)
+    T_root_controller: FloatArray | None = None   # (4, 4) the controller's base in the URDF root frame
     home: FloatArray | None = None
     options: PlanOptions = PlanOptions()
     weld_time: float = 0.0
@@ -252,7 +253,8 @@ def plan_cell(
     return PlanResult(cell.name, robot.name, "planned", "planned", spots=tuple(plans), transitions=tuple(transitions),
                       trajectory=trajectory, stats=stats, baseline=options.baseline, joint_names=robot.joint_names,
                       tool=cell.tool.name, T_flange_tcp=np.asarray(robot.T_flange_tcp),
-                      T_world_base=np.asarray(cell.T_world_base), home=np.asarray(cell.home), options=options,
+                      T_world_base=np.asarray(cell.T_world_base),
+                      T_root_controller=np.asarray(cell.robot.controller.T_root_base), home=np.asarray(cell.home), options=options,
                       weld_time=cell.process.weld_time)
 
 
@@ -715,8 +717,10 @@ def weld_end(cell: CellSpec, c: SpotCandidates, a: int, grids: list[OrientationG
     grids: `orientation_grid` of every seam of the cell."""
     seam = cell.seams[c.seam_index]
     T_world = spot_poses((seam.spots[c.spot_index],), grids[c.seam_index])[0, c.orient[a]]
-    T_spot = as_written_pose(invert(np.asarray(cell.T_world_base)) @ T_world)
-    T_app = as_written_pose(approach_poses(T_spot, cell.process.approach))
+    # Rounded as the program states them: in the controller's base frame (SPEC §6).
+    C = cell.robot.controller.T_root_base
+    T_spot = as_written_pose_in(invert(np.asarray(cell.T_world_base)) @ T_world, C)
+    T_app = as_written_pose_in(approach_poses(T_spot, cell.process.approach), C)
     return WeldEnd(T_spot, T_app, None, f"{seam.name}/{c.name}")
 
 

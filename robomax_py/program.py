@@ -34,11 +34,15 @@ from typing import Literal, TypeAlias
 import numpy as np
 
 from robomax_py._typing import FloatArray
-from robomax_py.transforms import pose_matrix, rpy_from_matrix
+from robomax_py.transforms import invert, pose_matrix, rpy_from_matrix
 
 __all__ = [
     "as_written_joints",
     "as_written_pose",
+    "as_written_pose_in",
+    "frame_in_world",
+    "from_frame",
+    "to_frame",
     "lin_pose",
     "pose_mm_zyx",
     "ptp_target",
@@ -371,6 +375,40 @@ def as_written_pose(T: FloatArray) -> FloatArray:
     """A TCP pose as a LIN statement gives it back."""
     xyz, zyx = pose_mm_zyx(T)
     return lin_pose(LinMove(xyz, zyx))
+
+
+def to_frame(T_root_frame: FloatArray, T: FloatArray) -> FloatArray:
+    """A pose given in the URDF root frame, expressed in another frame (the controller's base,
+    SPEC §6). An exactly identity frame returns T itself: no floating-point touch, so programs of
+    robots without `controller.base` stay byte for byte what they were."""
+    F = np.asarray(T_root_frame, dtype=float)
+    if np.array_equal(F, np.eye(4)):
+        return np.asarray(T, dtype=float)
+    out: FloatArray = invert(F) @ np.asarray(T, dtype=float)
+    return out
+
+
+def from_frame(T_root_frame: FloatArray, T: FloatArray) -> FloatArray:
+    """Inverse of `to_frame`: a pose stated in `T_root_frame`, in the URDF root frame."""
+    F = np.asarray(T_root_frame, dtype=float)
+    if np.array_equal(F, np.eye(4)):
+        return np.asarray(T, dtype=float)
+    out: FloatArray = F @ np.asarray(T, dtype=float)
+    return out
+
+
+def frame_in_world(T_world_root: FloatArray, T_root_frame: FloatArray) -> FloatArray:
+    """Where a frame given in the URDF root frame is in the world (identity frame: untouched)."""
+    F = np.asarray(T_root_frame, dtype=float)
+    if np.array_equal(F, np.eye(4)):
+        return np.asarray(T_world_root, dtype=float)
+    out: FloatArray = np.asarray(T_world_root, dtype=float) @ F
+    return out
+
+
+def as_written_pose_in(T: FloatArray, T_root_frame: FloatArray) -> FloatArray:
+    """A root-frame TCP pose as a LIN statement in `T_root_frame` gives it back (root frame)."""
+    return from_frame(T_root_frame, as_written_pose(to_frame(T_root_frame, T)))
 
 
 def written_speed(fraction: float) -> float:

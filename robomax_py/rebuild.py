@@ -22,7 +22,9 @@ import numpy as np
 from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
 from robomax_py.ik import config_text, same_config
-from robomax_py.program import Comment, FrameDef, LinMove, Program, PtpMove, Spot, Wait, WaitFor, lin_pose, ptp_target, pose_mm_zyx
+from robomax_py.program import (
+    Comment, FrameDef, LinMove, Program, PtpMove, Spot, Wait, WaitFor, frame_in_world, from_frame, lin_pose, pose_mm_zyx, ptp_target,
+)
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.timing import LinMoveError, Segment, TimingError, Trajectory, concatenate, dwell, resample
@@ -127,7 +129,7 @@ class _Builder:
         if isinstance(ins, PtpMove):
             return PtpStep(ptp_target(ins), speed=ins.speed, accel=ins.accel,
                            flyby=math.radians(ins.flyby), kind="move", label=label)
-        T = lin_pose(ins)
+        T = from_frame(self.robot.controller.T_root_base, lin_pose(ins))   # stated in the controller's base
         kind = "approach" if isinstance(following, Spot) else "retract"
         return LinStep(T, ins.speed_mm_s / 1000.0, None, flyby=math.radians(ins.flyby), kind=kind, label=label)
 
@@ -178,7 +180,8 @@ class _Builder:
 
 def _frame_problems(frames: tuple[FrameDef, ...], cell: CellSpec, robot: RobotModel) -> list[Problem]:
     out = []
-    wanted = {"tool": np.asarray(robot.T_flange_tcp), "base": np.asarray(cell.T_world_base)}
+    wanted = {"tool": np.asarray(robot.T_flange_tcp),
+              "base": frame_in_world(np.asarray(cell.T_world_base), robot.controller.T_root_base)}
     for kind, T in wanted.items():
         stated = [f for f in frames if f.kind == kind]
         if not stated:

@@ -287,3 +287,33 @@ def test_out_of_reach_spot_fails_check_with_the_distance(tmp_path: Path) -> None
     result = runner.invoke(app, ["check", str(cell)])
     assert result.exit_code == 2
     assert "seams[0].spots[3]" in result.output and "out of kr125's reach by" in result.output
+
+
+@pytest.mark.slow
+def test_cartesian_targets_are_stated_in_the_controller_base(arms: dict[str, Path], tmp_path: Path) -> None:
+    """SPEC §6: controller.base moves the frame LIN targets are written in; the rebuilt motion and
+    the verifier see the same robot motion as with the identity base."""
+    import re
+    import shutil
+
+    from robomax_py.transforms import invert, pose_matrix
+
+    folder = tmp_path / "kr120r2500pro"
+    shutil.copytree(arms["kr120r2500pro"], folder)
+    text = (folder / "robot.yaml").read_text().replace(
+        "controller:\n  brand: kuka\n", "controller:\n  brand: kuka\n  base: {xyz: [0.1, -0.2, 0.3], rpy: [0, 0, 90]}\n")
+    (folder / "robot.yaml").write_text(text)
+    cell = tmp_path / "based.yaml"
+    cell.write_text(_flange_cell(folder / "robot.yaml", "spot_gun_c", 1.6, 1.2, "[0, -90, 90, 0, 30, 0]"))
+    _plan_and_verify(cell, tmp_path / "programs")
+    srcl = (tmp_path / "programs" / "based.srcl").read_text()
+    first = re.search(r"MOVE LIN POS\(([^)]*)\)", srcl)
+    assert first is not None
+    x, y, z = (float(v) / 1000 for v in first.group(1).split(","))
+    C = pose_matrix([0.1, -0.2, 0.3], [0.0, 0.0, math.pi / 2])
+    root = C @ np.array([x, y, z, 1.0])
+    # The first spot welded is one of the four, in the root frame (within the program's 1e-3 mm).
+    spots = [np.array([1.6, yy, 1.2]) for yy in (-0.3, -0.1, 0.1, 0.3)]
+    assert min(np.linalg.norm(root[:3] - s) for s in spots) < 2e-6
+    assert np.linalg.norm(invert(C)[:3, 3]) > 0.1          # the frame really moved the numbers
+    assert "robot_base: BASE FRAME := (POS(100.000, -200.000, 300.000), ORI(90.0000, 0.0000, 0.0000))" in srcl

@@ -18,7 +18,8 @@ import numpy as np
 from robomax_py.errors import ExportError
 from robomax_py.plan import PlanResult
 from robomax_py.program import (
-    Comment, FrameDef, Header, Instruction, LinMove, Program, PtpMove, Spot, Wait, WaitFor, pose_mm_zyx,
+    Comment, FrameDef, Header, Instruction, LinMove, Program, PtpMove, Spot, Wait, WaitFor, frame_in_world, pose_mm_zyx,
+    to_frame,
 )
 from robomax_py.waiting import CLEAR_SUFFIX, WaitPlan
 
@@ -43,7 +44,9 @@ def program_from_plan(result: PlanResult) -> Program:
         raise ExportError(f"cell {result.cell} has no complete plan to export")
     opts = result.options
     tool_xyz, tool_zyx = pose_mm_zyx(result.T_flange_tcp)
-    base_xyz, base_zyx = pose_mm_zyx(result.T_world_base)
+    # Cartesian targets are stated in the controller's base frame (SPEC §6), declared as the base.
+    C = np.eye(4) if result.T_root_controller is None else result.T_root_controller
+    base_xyz, base_zyx = pose_mm_zyx(frame_in_world(result.T_world_base, C))
     frames = (
         FrameDef(identifier(result.tool) + "_tcp", "tool", tool_xyz, tool_zyx),
         FrameDef("robot_base", "base", base_xyz, base_zyx),
@@ -76,10 +79,10 @@ def program_from_plan(result: PlanResult) -> Program:
         alpha, beta, gamma = (math.degrees(v) for v in spot.angles)
         out.append(Comment(f"{spot.seam}/{spot.name}: arrive {spot.t_arrive - t0:.3f} s, leave "
                            f"{spot.t_leave - t0:.3f} s, alpha {alpha:.1f} beta {beta:.1f} gamma {gamma:.1f} deg"))
-        xyz, zyx = pose_mm_zyx(spot.T_spot)
+        xyz, zyx = pose_mm_zyx(to_frame(C, spot.T_spot))
         out.append(LinMove(xyz, zyx, spot.config, lin_mm_s, comment="approach"))
         out.append(Spot(identifier(spot.name), identifier(spot.seam), result.weld_time))
-        xyz, zyx = pose_mm_zyx(spot.T_app)
+        xyz, zyx = pose_mm_zyx(to_frame(C, spot.T_app))
         if k + 1 < len(transitions) and transitions[k + 1].wait is not None:
             out.extend(_wait(transitions[k + 1].wait))
         retract_radius = transitions[k + 1].flyby_radius if k + 1 < len(transitions) else 0.0
