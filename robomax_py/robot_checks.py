@@ -22,7 +22,7 @@ from robomax_py.ik._chain import chain_to_frame, joint_frames
 from robomax_py.robot import RobotModel
 from robomax_py.seams import orientation_grid, spot_poses
 from robomax_py.spec import CellSpec
-from robomax_py.transforms import invert
+from robomax_py.transforms import closest_on_line, invert
 
 WRIST_MEET_TOL_M = 1e-6
 CONTACT_SAMPLES = 200
@@ -79,16 +79,7 @@ def _reach_model(robot: RobotModel) -> _ReachModel:
 
 def _wrist_centre(p: list[FloatArray], u: list[FloatArray]) -> FloatArray | None:
     """Where axes 4, 5 and 6 meet at q = 0, or None when they do not meet in one point."""
-    def closest(a: int, b: int) -> FloatArray:
-        w = p[a] - p[b]
-        bb = float(u[a] @ u[b])
-        den = 1.0 - bb * bb
-        if den < 1e-12:
-            return p[a]
-        s = (bb * float(u[b] @ w) - float(u[a] @ w)) / den
-        return p[a] + s * u[a]
-
-    c = closest(3, 4)
+    c = closest_on_line(p[3], u[3] / np.linalg.norm(u[3]), p[4], u[4] / np.linalg.norm(u[4]))
     for k in (3, 4, 5):
         if np.linalg.norm(np.cross(c - p[k], u[k])) > WRIST_MEET_TOL_M * max(1.0, np.linalg.norm(u[k])):
             return None

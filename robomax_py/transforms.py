@@ -61,3 +61,20 @@ def rotation_angle(R_a: FloatArray, R_b: FloatArray) -> FloatArray:
     # arccos is ill-conditioned near 0; the skew part gives the small angles accurately.
     skew = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], -1)
     return np.arctan2(np.linalg.norm(skew, axis=-1) / 2.0, cos)
+
+
+def closest_on_line(p: FloatArray, a: FloatArray, p_ref: FloatArray, a_ref: FloatArray) -> FloatArray:
+    """Point of the line (p, a) closest to the line (p_ref, a_ref); p itself when they are parallel.
+
+    Lines are a point and a unit direction, (..., 3) each (broadcast), m.
+    """
+    p, a = np.asarray(p, dtype=float), np.asarray(a, dtype=float)
+    p_ref, a_ref = np.asarray(p_ref, dtype=float), np.asarray(a_ref, dtype=float)
+    w0 = p - p_ref
+    b = np.sum(a * a_ref, axis=-1)
+    d = np.sum(a * w0, axis=-1)
+    e = np.sum(a_ref * w0, axis=-1)
+    denom = 1.0 - b * b
+    t = np.where(denom > 1e-12, (b * e - d) / np.where(denom > 1e-12, denom, 1.0), 0.0)
+    out: FloatArray = p + t[..., None] * a
+    return out

@@ -51,6 +51,7 @@ from robomax_py._typing import BoolArray, FloatArray, IntArray
 from robomax_py.errors import ProgramError
 from robomax_py.ik._chain import chain_to_frame, joint_frames
 from robomax_py.ik.opw import OpwParams, to_paper_angles
+from robomax_py.transforms import closest_on_line
 
 TWO_PI = 2.0 * np.pi
 _PATTERN = re.compile(r"S([01]{3}) T([01]{1,6})")
@@ -190,8 +191,8 @@ def status_generic(model: pin.Model, frame_id: int, q: FloatArray) -> IntArray:
     n_axes = min(len(chain.joints), 6)
     axis = [F[:, i, :3, :3] @ (chain.A[i, :3, 2]) for i in range(n_axes)]   # world joint axes
     origin = [F[:, i, :3, 3] for i in range(n_axes)]
-    wrist = _closest_on_line(origin[4], axis[4], origin[3], axis[3])           # axes 4 and 5
-    wrist_56 = wrist if n_axes < 6 else _closest_on_line(origin[4], axis[4], origin[5], axis[5])
+    wrist = closest_on_line(origin[4], axis[4], origin[3], axis[3])           # axes 4 and 5
+    wrist_56 = wrist if n_axes < 6 else closest_on_line(origin[4], axis[4], origin[5], axis[5])
 
     x1 = F[:, 0, :3, 0]
     bit0 = np.einsum("mi,mi->m", wrist_56 - origin[0], x1) < 0
@@ -214,15 +215,6 @@ def status_generic(model: pin.Model, frame_id: int, q: FloatArray) -> IntArray:
     return np.where(nan_rows, -1, status).astype(np.int64).reshape(batch)
 
 
-def _closest_on_line(p: FloatArray, a: FloatArray, p_ref: FloatArray, a_ref: FloatArray) -> FloatArray:
-    """Point of the line (p, a) closest to the line (p_ref, a_ref); p itself when they are parallel."""
-    w0 = p - p_ref
-    b = np.einsum("mi,mi->m", a, a_ref)
-    d = np.einsum("mi,mi->m", a, w0)
-    e = np.einsum("mi,mi->m", a_ref, w0)
-    denom = 1.0 - b * b
-    t = np.where(denom > 1e-12, (b * e - d) / np.where(denom > 1e-12, denom, 1.0), 0.0)
-    return p + t[:, None] * a
 
 
 # ------------------------------------------------------------------ the controllers' own words

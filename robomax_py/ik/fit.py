@@ -25,7 +25,7 @@ from robomax_py.ik._chain import chain_to_frame, joint_frames
 from robomax_py.ik.opw import OpwParams, opw_fk
 from robomax_py.ik.ur import UrParams, ur_fk
 from robomax_py.tolerances import DEFAULT as TOL
-from robomax_py.transforms import rpy_from_matrix
+from robomax_py.transforms import closest_on_line, rpy_from_matrix
 
 # Structural conditions (parallel, perpendicular, intersecting axes) hold to this, in m or rad:
 # URDFs write pi/2 as 1.5708 or 1.57079632679, so 1e-4 accepts them; the FK check then decides.
@@ -79,17 +79,6 @@ def _axes_at_zero(model: pin.Model, frame_id: int) -> _Axes:
     return _Axes(u / np.linalg.norm(u, axis=1, keepdims=True), p, T[:3, :3], T[:3, 3])
 
 
-def _closest_points(p1: FloatArray, u1: FloatArray, p2: FloatArray, u2: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Closest points of two lines; for parallel lines, p1 and its foot on line 2."""
-    w = p1 - p2
-    b = float(u1 @ u2)
-    d, e = float(u1 @ w), float(u2 @ w)
-    den = 1.0 - b * b
-    if den < 1e-12:
-        return p1, p2 + e * u2
-    s = (b * e - d) / den
-    t = (e - b * d) / den
-    return p1 + s * u1, p2 + t * u2
 
 
 def _angle_between_lines(u1: FloatArray, u2: FloatArray) -> float:
@@ -159,8 +148,8 @@ def fit_opw(model: pin.Model, frame_id: int) -> OpwParams:
     _require_perpendicular(u[3], u[2], "axes 3 and 4")
     _require_perpendicular(u[4], u[3], "axes 4 and 5")
     _require_perpendicular(u[5], u[4], "axes 5 and 6")
-    c45, _ = _closest_points(p[3], u[3], p[4], u[4])
-    c56, _ = _closest_points(p[4], u[4], p[5], u[5])
+    c45 = closest_on_line(p[3], u[3], p[4], u[4])
+    c56 = closest_on_line(p[4], u[4], p[5], u[5])
     for (a, b), what in (((p[3], u[3]), "4"), ((p[4], u[4]), "5"), ((p[5], u[5]), "6")):
         off = np.linalg.norm(np.cross(c45 - a, b))
         if off > STRUCTURE_TOL:
@@ -171,7 +160,7 @@ def fit_opw(model: pin.Model, frame_id: int) -> OpwParams:
     _require_parallel(ax.R_flange[:, 2], u[5], "the flange z axis and axis 6")
 
     # The paper's x axis at q = 0: from axis 1 towards axis 2 (a1), else towards the wrist, else root x.
-    foot2, _ = _closest_points(p[1], u[1], np.zeros(3), ez)
+    foot2 = closest_on_line(p[1], u[1], np.zeros(3), ez)
     for v in (foot2, wrist, np.array([1.0, 0.0, 0.0])):
         h = np.array([v[0], v[1], 0.0])
         h -= (h @ u[1]) * u[1]
@@ -188,7 +177,7 @@ def fit_opw(model: pin.Model, frame_id: int) -> OpwParams:
     def in_plane_angle(v: FloatArray) -> float:
         return float(np.arctan2(v @ x_p, v @ ez))
 
-    p2, _ = _closest_points(p[1], u[1], p[2], u[2])
+    p2 = closest_on_line(p[1], u[1], p[2], u[2])
     p3 = p2 + (((p[2] - p2) @ x_p) * x_p + ((p[2] - p2) @ ez) * ez)
     th2 = in_plane_angle(p3 - p2)
     if abs(u[3] @ y_p) > STRUCTURE_TOL:
