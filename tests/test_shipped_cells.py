@@ -1,9 +1,12 @@
 """End to end on every shipped example cell (cells/*.yaml): `robomax plan` writes both program files
 and `robomax verify` passes on both; the frame's seams are all welded and its ordered pillar seam
-keeps its order. Slow: each cell plans in 10-40 s."""
+keeps its order; the programs are byte for byte the committed ones (tests/golden/shipped: the .srcl
+text and the .json's SHA-256), so a restructuring that changes no behaviour is shown to change no
+program. Slow: each cell plans in 10-40 s."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 from pathlib import Path
 
@@ -15,6 +18,7 @@ from robomax_py.cli import EXIT_OK, app
 
 REPO = Path(__file__).resolve().parents[1]
 CELLS = sorted((REPO / "cells").glob("*.yaml"))
+GOLDEN = REPO / "tests" / "golden" / "shipped"
 runner = CliRunner()
 
 
@@ -37,8 +41,19 @@ def _plan(cell: Path, out: Path) -> dict[str, object]:
 
 @pytest.mark.slow
 @pytest.mark.parametrize("cell", CELLS, ids=[p.stem for p in CELLS])
-def test_shipped_cell_plans_and_verifies(cell: Path, tmp_path: Path) -> None:
+def test_shipped_cell_plans_and_verifies(cell: Path, tmp_path: Path, update_golden: bool) -> None:
     data = _plan(cell, tmp_path)
+    name = yaml.safe_load(cell.read_text()).get("name", cell.stem)
+    srcl = (tmp_path / f"{name}.srcl").read_bytes()
+    digest = hashlib.sha256((tmp_path / f"{name}.json").read_bytes()).hexdigest()
+    sums_file = GOLDEN / "SHA256SUMS"
+    sums = dict(reversed(line.split("  ")) for line in sums_file.read_text().splitlines() if line)
+    if update_golden:
+        (GOLDEN / f"{name}.srcl").write_bytes(srcl)
+        sums[f"{name}.json"] = digest
+        sums_file.write_text("".join(f"{v}  {k}\n" for k, v in sorted(sums.items())))
+    assert srcl == (GOLDEN / f"{name}.srcl").read_bytes(), f"{name}.srcl differs from tests/golden/shipped"
+    assert digest == sums[f"{name}.json"], f"{name}.json differs from tests/golden/shipped/SHA256SUMS"
     spec = yaml.safe_load(cell.read_text())
     wanted = {(s["name"], p["name"]) for s in spec["seams"] for p in s["spots"]}
     welded = [(s["seam"], s["name"]) for s in data["spots"]]  # type: ignore[union-attr]
