@@ -36,16 +36,16 @@ def main() -> int:
 
     from playwright.sync_api import sync_playwright
 
-    from robomax_py.cell_io import load_cell, load_cell_robot
-    from robomax_py.files import write_atomic_bytes
-    from robomax_py.preview import write_html
-    from robomax_py.preview_program import load_program
+    from robomax_py.io.cell import load_cell, load_cell_robot
+    from robomax_py.io.files import write_atomic_bytes
+    from robomax_py.app.preview import write_html
+    from robomax_py.app.preview_program import load_program
 
     with tempfile.TemporaryDirectory() as tmp:
         cell = load_cell(args.cell)
         program = args.program
         if program is None:
-            subprocess.run([sys.executable, "-m", "robomax_py.cli", "plan", str(args.cell), "-o", tmp], check=True)
+            subprocess.run([sys.executable, "-m", "robomax_py.app.cli", "plan", str(args.cell), "-o", tmp], check=True)
             program = Path(tmp) / f"{cell.name}.json"
         robot = load_cell_robot(cell)
         shown = load_program(program, cell, robot)

@@ -1,6 +1,12 @@
 """robomax_py: offline programming for spot-welding robot cells."""
 
-from robomax_py.errors import CellFileError, ExportError, ProgramError, RobomaxError, RobotModelError
+from robomax_py.errors import (
+    CellFileError,
+    ExportError,
+    ProgramError,
+    RobomaxError,
+    RobotModelError,
+)
 
 __version__ = "0.1.0"
 

@@ -1,3 +1,3 @@
-from robomax_py.cli import main
+from robomax_py.app.cli import main
 
 main()

@@ -47,7 +47,7 @@ class RobotSpec:
     urdf: Path
     flange: str                       # URDF frame the tool mounts on
     ik_solver: str                    # "opw" | "ur" | "numeric"
-    ik_params: Any                    # typed params (robomax_py.ik); None: fitted from the URDF
+    ik_params: Any                    # typed params (robomax_py.robot.ik); None: fitted from the URDF
     acceleration: FloatArray | None   # (n,) rad/s^2, None: derived from velocity limits
     jerk: FloatArray | None           # (n,) rad/s^3, None: derived from acceleration limits
     payload_kg: float | None = None   # rated payload, for listings only

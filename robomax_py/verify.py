@@ -19,33 +19,22 @@ from typing import Any
 import numpy as np
 
 from robomax_py._typing import FloatArray
-from robomax_py.collision import CollisionWorld
 from robomax_py.errors import ProgramError
-from robomax_py.ik import config_text, same_config
+from robomax_py.plan.poses import nominal_rotation
 from robomax_py.robot import RobotModel, fk_tcp
-from robomax_py.scene import build_scene
-from robomax_py.seams import nominal_rotation
+from robomax_py.robot.ik import config_text, same_config
 from robomax_py.spec import CellSpec
 from robomax_py.tolerances import DEFAULT as TOL
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.motion import Violation, check_motion
+from robomax_py.world.scene import build_scene
 
-# Finite differences of 10 ms samples: velocity is exact for the linear interpolation the SPEC
-# prescribes; acceleration from second differences of a jerk-limited profile overshoots the
-# sampled peak slightly, hence the larger slack.
-VELOCITY_RTOL = 0.01
-ACCELERATION_RTOL = 0.05
 HOME_TOL_RAD = 1e-6
 REST_TOL_RAD = 1e-9          # joint change allowed while welding (file precision 1e-9 rad)
 ANGLE_TOL_RAD = 1e-6         # tolerance-window slack for the orientation angles
 TIME_TOL_S = 2e-6            # file times are written with 1 us resolution
-MAX_REPORTED_COLLISIONS = 20
 
 
-@dataclass(frozen=True, slots=True)
-class Violation:
-    t: float | None
-    kind: str                # collision | joint_limit | velocity | acceleration | spot | dwell | order | home | format
-    #                          (.srcl also: lin | config | flyby | frame | signal | timing)
-    detail: str
 
 
 @dataclass(frozen=True, slots=True)
@@ -120,8 +109,8 @@ def verify_trajectory_file(cell: CellSpec, robot: RobotModel, path: Path) -> Ver
 
 def verify_srcl_file(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
     """Parse an SRCL program, rebuild its motion (`rebuild.rebuild`) and check it like a trajectory."""
+    from robomax_py.export.rebuild import rebuild
     from robomax_py.export.srcl_parser import parse_program
-    from robomax_py.rebuild import rebuild
 
     try:
         text = path.read_text(encoding="utf-8")
@@ -145,62 +134,12 @@ def _verify_motion(cell: CellSpec, robot: RobotModel, name: str, data: dict[str,
         if np.abs(q[idx] - cell.home).max() > HOME_TOL_RAD:
             out.append(Violation(float(t[idx]), "home", f"program does not {end} at robot.home"))
     world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
-    motion, checks = check_motion(world, robot, t, q)
-    out.extend(motion)
+    motion = check_motion(world, robot, t, q)
+    out.extend(motion.violations)
     out.extend(_check_spots(cell, robot, data))
-    return VerifyReport(name, len(t), float(t[-1] - t[0]), checks, tuple(out))
+    return VerifyReport(name, len(t), float(t[-1] - t[0]), motion.checks, tuple(out))
 
 
-def check_motion(
-    world: CollisionWorld, robot: RobotModel, t: FloatArray, q: FloatArray,
-    max_collisions: int = MAX_REPORTED_COLLISIONS, stop_at_first: bool = False,
-    velocity_rtol: float = VELOCITY_RTOL,
-) -> tuple[list[Violation], int]:
-    """Limits and swept collisions of sampled motion, linear in joint space between samples.
-
-    Parameters
-    ----------
-    t : (k,) float, s, strictly increasing
-    q : (k, n) float, rad
-
-    velocity_rtol : relative slack on the velocity limits (the planner's own check is tighter).
-
-    Returns the violations (collisions in time order, at most `max_collisions`; with
-    `stop_at_first`, at most one violation and no collision check once a limit is broken) and
-    the number of collision checks spent.
-    """
-    lim = robot.limits
-    out: list[Violation] = []
-    outside = ~lim.contains(q, 1e-9)
-    for i in np.flatnonzero(outside)[:5]:
-        j = int(np.flatnonzero((q[i] < lim.lower - 1e-9) | (q[i] > lim.upper + 1e-9))[0])
-        out.append(Violation(float(t[i]), "joint_limit", f"{robot.joint_names[j]} = {math.degrees(q[i, j]):.3f} deg"))
-    dt = np.diff(t)
-    v = np.diff(q, axis=0) / dt[:, None]
-    for i, j in np.argwhere(np.abs(v) > lim.velocity * (1 + velocity_rtol))[:5]:
-        out.append(Violation(float(t[i]), "velocity", f"{robot.joint_names[j]} {abs(v[i, j]):.3f} rad/s > "
-                                                      f"{lim.velocity[j]:.3f}"))
-    a = np.diff(v, axis=0) / ((dt[:-1] + dt[1:]) / 2)[:, None]
-    for i, j in np.argwhere(np.abs(a) > lim.acceleration * (1 + ACCELERATION_RTOL))[:5]:
-        out.append(Violation(float(t[i + 1]), "acceleration", f"{robot.joint_names[j]} {abs(a[i, j]):.3f} rad/s^2 > "
-                                                              f"{lim.acceleration[j]:.3f}"))
-    if stop_at_first and out:
-        return out[:1], 0
-    checks = 0
-    collisions = 0
-    limit = 1 if stop_at_first else max_collisions
-    for i in range(len(t) - 1):
-        res = world.check_segment(q[i], q[i + 1], float(t[i]), float(t[i + 1]))
-        checks += res.checks
-        if not res.free:
-            s_hit = res.s_contact or 0.0
-            tc = float(t[i] + s_hit * (t[i + 1] - t[i]))
-            contact = world.first_contact(q[i] + s_hit * (q[i + 1] - q[i]), tc)
-            out.append(Violation(tc, "collision", contact.describe() if contact else "collision"))
-            collisions += 1
-            if collisions >= limit:
-                break
-    return out, checks
 
 
 def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> list[Violation]:

@@ -17,8 +17,8 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from typer.testing import CliRunner
 
-from robomax_py.cell_io import load_cell
-from robomax_py.cli import EXIT_BAD_INPUT, app
+from robomax_py.io.cell import load_cell
+from robomax_py.app.cli import EXIT_BAD_INPUT, app
 from robomax_py.errors import CellFileError, RobomaxError, RobotModelError
 from robomax_py.spec import Box, MeshShape
 
@@ -181,7 +181,7 @@ def test_missing_cell_file(tmp_path: Path) -> None:
 
 def test_robot_by_path_and_missing_flange(tmp_path: Path, good_cell: dict[str, Any], reference_cell_path: Path) -> None:
     """A robot named by path loads; a robot.yaml whose flange frame is not in the URDF is named."""
-    from robomax_py.robot_io import package_robots_dir
+    from robomax_py.io.robot import package_robots_dir
 
     robot_dir = tmp_path / "myarm"
     shutil.copytree(package_robots_dir() / "kr16", robot_dir)

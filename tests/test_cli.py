@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from robomax_py.cli import EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_OK, app
+from robomax_py.app.cli import EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_OK, app
 
 SmallCell = Callable[..., Path]   # conftest.write_small_cell
 MAX_DT_S = 0.010

@@ -1,4 +1,4 @@
-"""robomax_py.collision: configuration, batch and swept-segment collision queries.
+"""robomax_py.world.collision: configuration, batch and swept-segment collision queries.
 
 The UR10 of example-robot-data with a synthetic box gun runs everywhere; kr125 (with spot_gun_c,
 the reference cell) and kr16 run when robots/ has them. The broad phase and every other shortcut
@@ -18,7 +18,7 @@ import pytest
 import trimesh
 from numpy.testing import assert_allclose
 
-from robomax_py.collision import (
+from robomax_py.world.collision import (
     KIND_DYNAMIC,
     KIND_LINK,
     KIND_OBJECT,
@@ -31,8 +31,8 @@ from robomax_py.collision import (
     support_points,
 )
 from robomax_py.robot import RobotModel, fk_flange, load_robot
-from robomax_py.robot_io import load_robot_spec, resolve_package_uri
-from robomax_py.scene import build_scene
+from robomax_py.io.robot import load_robot_spec, resolve_package_uri
+from robomax_py.world.scene import build_scene
 from robomax_py.spec import (
     Box,
     Capsule,
@@ -153,7 +153,7 @@ def ur10_cell_world(ur10: RobotModel, gun: ToolSpec) -> CollisionWorld:
 def reference() -> tuple[CellSpec, RobotModel, CollisionWorld]:
     if not REFERENCE_CELL.is_file() or not (REPO / "robomax_py" / "robots" / "kr125" / "robot.yaml").is_file():
         pytest.skip("reference cell or robots/kr125 not available")
-    from robomax_py.cell_io import load_cell, load_cell_robot
+    from robomax_py.io.cell import load_cell, load_cell_robot
 
     cell = load_cell(REFERENCE_CELL)
     robot = load_cell_robot(cell)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from robomax_py.cell_io import load_cell, load_cell_robot
+from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.export import EXPORTERS, render
 from robomax_py.export.plan_program import identifier
 from robomax_py.export.srcl import write_program

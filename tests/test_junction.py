@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from robomax_py.cell_io import load_cell, load_cell_robot
-from robomax_py.collision import SegmentCheck
-from robomax_py import junction as junction_module
-from robomax_py.junction import time_junction
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.world.collision import SegmentCheck
+from robomax_py.plan import junction as junction_module
+from robomax_py.plan.junction import time_junction
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell
 from robomax_py.robot import JointLimits, fk_tcp
 from robomax_py.spec import CellSpec, frozen_array
@@ -185,7 +185,7 @@ def test_tcp_speed_holds_on_lines_and_their_joins(small_plan: Any) -> None:
 
 
 def test_without_flyby_every_junction_stops() -> None:
-    from robomax_py.junction import split_chains
+    from robomax_py.plan.junction import split_chains
     from robomax_py.timing.chain import LinStep, PtpStep
 
     steps = [LinStep(np.eye(4), 0.5, flyby=0.02), PtpStep(np.zeros(3), flyby=0.0), PtpStep(np.ones(3), flyby=0.1),
@@ -199,7 +199,7 @@ def test_per_move_speeds_are_planned_written_and_rebuilt(tmp_path: Path, write_s
     from robomax_py.export import render
     from robomax_py.export.srcl_parser import parse_program
     from robomax_py.program import LinMove, PtpMove
-    from robomax_py.rebuild import rebuild
+    from robomax_py.export.rebuild import rebuild
 
     path: Path = write_small_cell(tmp_path)
     data = yaml.safe_load(path.read_text())

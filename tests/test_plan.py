@@ -16,13 +16,13 @@ import pytest
 import yaml
 from numpy.testing import assert_allclose
 
-from robomax_py.cell_io import load_cell, load_cell_robot
-from robomax_py.collision import CollisionWorld
-from robomax_py.ik import solve_all
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.robot.ik import solve_all
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell, verify_trajectory
 from robomax_py.robot import fk_tcp, reach
-from robomax_py.scene import build_scene
-from robomax_py.seams import orientation_grid, spot_poses
+from robomax_py.world.scene import build_scene
+from robomax_py.plan.poses import orientation_grid, spot_poses
 from robomax_py.spec import CellSpec
 from robomax_py.timing import ptp_time_estimate
 from robomax_py.transforms import invert
@@ -159,8 +159,7 @@ def test_clamp_between_spots_gives_a_collision_free_detour(clamp_plan: tuple[Cel
         for p0, p1 in zip(trans.waypoints[:-1], trans.waypoints[1:]):
             assert world.check_segment(p0, p1).free, f"{trans.label}: blocked leg {p0} -> {p1}"
     assert result.trajectory is not None
-    problem, _ = verify_trajectory(world, robot, result.trajectory)
-    assert problem == ""
+    assert verify_trajectory(world, robot, result.trajectory).clean
 
 
 # ---------------------------------------------------------------------------------------------- 2

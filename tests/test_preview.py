@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from robomax_py import palette
-from robomax_py.cell_io import load_cell, load_cell_robot
-from robomax_py.cli import EXIT_BAD_INPUT, EXIT_OK, app
-from robomax_py.preview import DEFAULT_FPS, PreviewContent, frame_times, populate, write_html
-from robomax_py.preview_program import ShownProgram, home_program, load_program
+from robomax_py.app import palette
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.app.cli import EXIT_BAD_INPUT, EXIT_OK, app
+from robomax_py.app.preview import DEFAULT_FPS, PreviewContent, frame_times, populate, write_html
+from robomax_py.app.preview_program import ShownProgram, home_program, load_program
 
 SmallCell = Callable[..., Path]   # conftest.write_small_cell
 TIME_TOL_S = 1e-6
@@ -208,7 +208,7 @@ def test_json_phases_match_the_rebuilt_programs(planned: tuple[Path, Path]) -> N
 def test_serve_announces_its_url_and_ends_cleanly_on_ctrl_c(planned: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch) -> None:
     import time
 
-    from robomax_py import preview
+    from robomax_py.app import preview
 
     cell_path, _ = planned
     cell = load_cell(cell_path)

@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from robomax_py import palette
-from robomax_py.cli import EXIT_OK, app
+from robomax_py.app import palette
+from robomax_py.app.cli import EXIT_OK, app
 
 pytestmark = pytest.mark.slow
 

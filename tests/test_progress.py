@@ -9,10 +9,10 @@ from pathlib import Path
 import pytest
 from rich.console import Console
 
-from robomax_py.bench import lower_bound
-from robomax_py.cell_io import load_cell, load_cell_robot
+from robomax_py.app.bench import lower_bound
+from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell
-from robomax_py.progress_bars import configure_logging, stage_bars
+from robomax_py.app.progress import configure_logging, stage_bars
 from robomax_py.timing import ptp_time_estimate
 from tests.conftest import SmallCell
 
@@ -80,7 +80,7 @@ def test_lower_bound_is_below_the_cycle_and_sums_rest_to_rest_moves(
 def test_bench_command_prints_one_table(tmp_path: Path, write_small_cell: SmallCell) -> None:
     from typer.testing import CliRunner
 
-    from robomax_py.cli import app
+    from robomax_py.app.cli import app
 
     path = write_small_cell(tmp_path)
     res = CliRunner().invoke(app, ["bench", str(path), "--runs", "1", "--quick"], terminal_width=200)
@@ -92,7 +92,7 @@ def test_bench_command_prints_one_table(tmp_path: Path, write_small_cell: SmallC
 def test_bench_on_a_missing_cell_is_bad_input(tmp_path: Path) -> None:
     from typer.testing import CliRunner
 
-    from robomax_py.cli import app
+    from robomax_py.app.cli import app
 
     res = CliRunner().invoke(app, ["bench", str(tmp_path / "nope.yaml")])
     assert res.exit_code == 2

@@ -22,7 +22,7 @@ import pytest
 import trimesh
 import yaml
 
-from robomax_py.ik.opw import OpwParams, opw_fk
+from robomax_py.robot.ik.opw import OpwParams, opw_fk
 
 REPO = Path(__file__).resolve().parents[1]
 ROBOTS = REPO / "robomax_py" / "robots"

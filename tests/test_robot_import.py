@@ -19,13 +19,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
 
-from robomax_py.cli import app
+from robomax_py.app.cli import app
 from robomax_py.errors import RobotModelError
-from robomax_py.ik import config_text, solve_all
-from robomax_py.ik.fit import FitError, fit_opw, fk_agreement
+from robomax_py.robot.ik import config_text, solve_all
+from robomax_py.robot.ik.fit import FitError, fit_opw, fk_agreement
 from robomax_py.robot import fk_flange, load_robot
-from robomax_py.robot_io import ROBOTS_ENV, load_robot_spec
-from robomax_py.urdf_import import guess_brand, import_urdf
+from robomax_py.io.robot import ROBOTS_ENV, load_robot_spec
+from robomax_py.app.import_urdf import guess_brand, import_urdf
 
 ROSI = Path(__file__).parent / "data" / "rosi"
 ARMS = {
@@ -263,7 +263,7 @@ def test_lin_whose_j2_changes_sign_states_each_targets_configuration(arms: dict[
     J2 is near 0 at the spot and changes sign over the 30 mm line, so KUKA turn bits differ."""
     import shutil
 
-    from robomax_py.cell_io import load_cell, load_cell_robot
+    from robomax_py.io.cell import load_cell, load_cell_robot
     from robomax_py.plan import PlanOptions, plan_cell
 
     folder = tmp_path / "irb2400k"

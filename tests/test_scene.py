@@ -1,4 +1,4 @@
-"""robomax_py.scene: cell objects and tool -> coal geometry in the robot base frame.
+"""robomax_py.world.scene: cell objects and tool -> coal geometry in the robot base frame.
 
 Checks each shape's representation (primitive / convex pieces / exact BVH), the base-frame pose
 T_base_obj = inv(T_world_base) @ T_world_object, dynamic windows, and that a missing or unreadable
@@ -17,8 +17,8 @@ from numpy.testing import assert_allclose
 
 from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.robot import RobotModel, load_robot
-from robomax_py.robot_io import resolve_package_uri
-from robomax_py.scene import (
+from robomax_py.io.robot import resolve_package_uri
+from robomax_py.world.scene import (
     REPRESENTATION_BVH,
     REPRESENTATION_CONVEX,
     REPRESENTATION_PRIMITIVE,
@@ -169,7 +169,7 @@ def test_meshes_convex_shells_become_pieces_open_sheets_stay_exact(
 def test_reference_panel_stays_exact_and_gun_is_convex_pieces() -> None:
     if not REFERENCE_CELL.is_file() or not (REPO / "robomax_py" / "robots" / "kr125" / "robot.yaml").is_file():
         pytest.skip("reference cell or robots/kr125 not available")
-    from robomax_py.cell_io import load_cell, load_cell_robot
+    from robomax_py.io.cell import load_cell, load_cell_robot
 
     cell = load_cell(REFERENCE_CELL)
     robot = load_cell_robot(cell)

@@ -11,7 +11,7 @@ from types import ModuleType
 import pytest
 from typer.testing import CliRunner
 
-from robomax_py.cli import EXIT_OK, app
+from robomax_py.app.cli import EXIT_OK, app
 
 REPO = Path(__file__).resolve().parents[1]
 CELLS = sorted((REPO / "cells").glob("*.yaml"))

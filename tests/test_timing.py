@@ -473,11 +473,11 @@ def test_path_move_jerk_flyby(limits: JointLimits, radius: float) -> None:
 
 @pytest.fixture(scope="module")
 def ur10() -> RobotModel:
-    ik = pytest.importorskip("robomax_py.ik")
+    ik = pytest.importorskip("robomax_py.robot.ik")
     if not hasattr(ik, "solve_all") or not hasattr(ik, "params_from_mapping"):
-        pytest.skip("robomax_py.ik.solve_all is not available yet")
+        pytest.skip("robomax_py.robot.ik.solve_all is not available yet")
     from robomax_py.robot import load_robot, mount_tool
-    from robomax_py.robot_io import package_share_dirs
+    from robomax_py.io.robot import package_share_dirs
     from robomax_py.spec import RobotSpec
     from robomax_py.transforms import pose_matrix
 
@@ -498,7 +498,7 @@ Q_UR = np.array([0.3, -1.2, 1.5, -1.9, -1.5, 0.4])
 
 
 def _branch_of(robot: RobotModel, q: np.ndarray) -> int:
-    from robomax_py.ik import solve_all
+    from robomax_py.robot.ik import solve_all
     from robomax_py.robot import fk_tcp
 
     table = solve_all(robot, fk_tcp(robot, q)[None])
@@ -560,7 +560,7 @@ def test_lin_move_slerps_the_orientation(ur10: RobotModel) -> None:
 
 def test_lin_move_reports_leaving_the_branch(ur10: RobotModel) -> None:
     """A branch column that jumps (here: faked beyond 40 % of the line) is found by bisection."""
-    from robomax_py.ik import solve_all
+    from robomax_py.robot.ik import solve_all
     from robomax_py.robot import fk_tcp
     from robomax_py.timing import lin_path
 

@@ -12,9 +12,9 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from robomax_py.cell_io import load_cell, read_cell_file
-from robomax_py.cli import EXIT_OK, app
-from robomax_py.variants import VariantBounds, clamp_group, write_variants
+from robomax_py.io.cell import load_cell, read_cell_file
+from robomax_py.app.cli import EXIT_OK, app
+from robomax_py.io.variants import VariantBounds, clamp_group, write_variants
 
 SmallCell = Callable[..., Path]   # conftest.write_small_cell
 VALUE_TOL = 2e-6                  # values are written rounded to 1e-6

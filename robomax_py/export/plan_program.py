@@ -17,11 +17,22 @@ import numpy as np
 
 from robomax_py.errors import ExportError
 from robomax_py.plan import PlanResult
+from robomax_py.plan.waiting import CLEAR_SUFFIX, WaitPlan
 from robomax_py.program import (
-    Comment, FrameDef, Header, Instruction, LinMove, Program, PtpMove, Spot, Wait, WaitFor, frame_in_world, pose_mm_zyx,
+    Comment,
+    FrameDef,
+    Header,
+    Instruction,
+    LinMove,
+    Program,
+    PtpMove,
+    Spot,
+    Wait,
+    WaitFor,
+    frame_in_world,
+    pose_mm_zyx,
     to_frame,
 )
-from robomax_py.waiting import CLEAR_SUFFIX, WaitPlan
 
 _NOT_IDENT = re.compile(r"[^A-Za-z0-9_]")
 

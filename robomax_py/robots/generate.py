@@ -8,7 +8,7 @@ The output is deterministic: running the script twice gives byte-identical files
 Kinematics
 ----------
 Each URDF is generated from the OPW parameters in its ``robot.yaml`` so that Pinocchio's forward
-kinematics of frame ``tool0`` equals ``robomax_py.ik.opw.opw_fk`` to round-off. The OPW convention
+kinematics of frame ``tool0`` equals ``robomax_py.robot.ik.opw.opw_fk`` to round-off. The OPW convention
 (Brandstötter, Angerer, Hofbaur 2014; opw_kinematics) has the paper angle
 ``theta = q * sign - offset``; at ``theta = 0`` the arm points straight up. Every link frame of the
 URDF *is* the paper's link frame: joint ``i`` carries a fixed rotation ``-offset_i`` about its axis in

@@ -14,12 +14,27 @@ Module map:
 
 from __future__ import annotations
 
-from robomax_py.timing._common import DEFAULT_DT_S, SPEC_MAX_DT_S, LinMoveError, TimingError
+from robomax_py.timing._common import (
+    DEFAULT_DT_S,
+    SPEC_MAX_DT_S,
+    LinMoveError,
+    TimingError,
+)
+from robomax_py.timing.blend import (
+    BlendCorner,
+    blend_corner,
+    blend_join,
+    blended_polyline_path,
+)
 from robomax_py.timing.estimate import jerk_limited_time_estimate, ptp_time_estimate
 from robomax_py.timing.lin import LinPath, lin_move, lin_path, time_lin_path
-from robomax_py.timing.via import PathMove, path_move, polyline_distance
-from robomax_py.timing.blend import BlendCorner, blend_corner, blend_join, blended_polyline_path
-from robomax_py.timing.paths import GeometricPath, concatenate_paths, line_path, polyline_path, spline_path
+from robomax_py.timing.paths import (
+    GeometricPath,
+    concatenate_paths,
+    line_path,
+    polyline_path,
+    spline_path,
+)
 from robomax_py.timing.ptp import ptp_move
 from robomax_py.timing.topp import time_path
 from robomax_py.timing.trajectory import (
@@ -34,6 +49,7 @@ from robomax_py.timing.trajectory import (
     evaluate,
     resample,
 )
+from robomax_py.timing.via import PathMove, path_move, polyline_distance
 
 __all__ = [
     "DEFAULT_DT_S",

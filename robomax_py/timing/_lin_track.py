@@ -22,7 +22,7 @@ ZERO_LENGTH_M = 1e-9
 # Orientation error allowed halfway between samples, rad.
 LIN_PATH_TOL_RAD = 1e-4
 
-# (robot, T_base_tcp (..., 4, 4)) -> table with q (..., B, n) and valid (..., B); robomax_py.ik.solve_all.
+# (robot, T_base_tcp (..., 4, 4)) -> table with q (..., B, n) and valid (..., B); robomax_py.robot.ik.solve_all.
 IkSolver = Callable[[RobotModel, FloatArray], Any]
 
 

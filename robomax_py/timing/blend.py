@@ -28,7 +28,13 @@ import numpy as np
 from robomax_py._typing import FloatArray
 from robomax_py.spec import frozen_array
 from robomax_py.timing._common import ZERO_MOVE, TimingError
-from robomax_py.timing.paths import PATH_JOIN_TOL, GeometricPath, concatenate_paths, distinct_waypoints, elevate
+from robomax_py.timing.paths import (
+    PATH_JOIN_TOL,
+    GeometricPath,
+    concatenate_paths,
+    distinct_waypoints,
+    elevate,
+)
 
 # Turning angles above this (rad) are not blended: near a reversal the corner curve would have to
 # turn on the spot; the move stops at the waypoint instead.

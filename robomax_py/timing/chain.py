@@ -59,7 +59,7 @@ class PtpStep:
 class LinStep:
     """A Cartesian straight line of the TCP to T (4, 4, robot base frame) at up to tcp_speed m/s.
 
-    column : the IK table column (`robomax_py.ik.solve_all`) to follow; None: the one whose
+    column : the IK table column (`robomax_py.robot.ik.solve_all`) to follow; None: the one whose
     solution at the line's start is the configuration the line starts from.
     """
 

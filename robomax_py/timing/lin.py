@@ -29,7 +29,14 @@ from robomax_py._typing import FloatArray
 from robomax_py.robot import JointLimits, RobotModel
 from robomax_py.spec import frozen_array
 from robomax_py.timing._common import DEFAULT_DT_S, LIMIT_TOL, LinMoveError, TimingError
-from robomax_py.timing._lin_track import ROT_LENGTH_M, ZERO_LENGTH_M, IkSolver, Line, Tracker, off_line
+from robomax_py.timing._lin_track import (
+    ROT_LENGTH_M,
+    ZERO_LENGTH_M,
+    IkSolver,
+    Line,
+    Tracker,
+    off_line,
+)
 from robomax_py.timing.paths import GeometricPath, spline_path
 from robomax_py.timing.topp import time_path
 from robomax_py.timing.trajectory import Segment
@@ -125,7 +132,7 @@ def lin_path(
     T_start, T_end : (4, 4) float
         TCP poses in the robot base frame, m.
     branch_index : int
-        Column k of the IK table (`robomax_py.ik.solve_all`) to start in.
+        Column k of the IK table (`robomax_py.robot.ik.solve_all`) to start in.
     q_start : (n,) float, optional
         The configuration the move starts from, rad (e.g. the end of the previous move); it must
         solve T_start. Default: column k's solution at T_start.
@@ -136,7 +143,7 @@ def lin_path(
     path_tol : float
         m; largest TCP distance from the line between samples after refinement.
     ik : callable, optional
-        IK solver with `solve_all`'s signature (default `robomax_py.ik.solve_all`).
+        IK solver with `solve_all`'s signature (default `robomax_py.robot.ik.solve_all`).
 
     Returns
     -------
@@ -320,6 +327,6 @@ def _failed(line: Line, reason: str, detail: str, fraction: float, us: list[floa
 
 
 def _default_ik() -> IkSolver:
-    from robomax_py.ik import solve_all
+    from robomax_py.robot.ik import solve_all
 
     return solve_all

@@ -26,7 +26,14 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.robot import JointLimits
-from robomax_py.timing._common import DEFAULT_DT_S, KinematicLimits, TimingError, check_within_limits, scaled_limits, time_grid
+from robomax_py.timing._common import (
+    DEFAULT_DT_S,
+    KinematicLimits,
+    TimingError,
+    check_within_limits,
+    scaled_limits,
+    time_grid,
+)
 from robomax_py.timing.paths import GeometricPath, kinks
 from robomax_py.timing.trajectory import Segment, as_segment, concatenate
 

@@ -15,7 +15,13 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.spec import frozen_array
-from robomax_py.timing._common import DEFAULT_DT_S, SPEC_MAX_DT_S, TimingError, as_joint_vector, time_grid
+from robomax_py.timing._common import (
+    DEFAULT_DT_S,
+    SPEC_MAX_DT_S,
+    TimingError,
+    as_joint_vector,
+    time_grid,
+)
 
 # What a segment does. "move": PTP between configurations; "detour": a move through detour
 # waypoints; "approach"/"retract": LIN along the electrode axis; "weld": dwell at a spot;

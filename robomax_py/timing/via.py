@@ -42,7 +42,11 @@ from robomax_py.timing._common import (
     check_within_limits,
     scaled_limits,
 )
-from robomax_py.timing.blend import MAX_BLEND_TURN_RAD, MIN_BLEND_RADIUS, blended_polyline_path
+from robomax_py.timing.blend import (
+    MAX_BLEND_TURN_RAD,
+    MIN_BLEND_RADIUS,
+    blended_polyline_path,
+)
 from robomax_py.timing.paths import distinct_waypoints, polyline_path
 from robomax_py.timing.ptp import line_samples, line_speed_limits, state_samples
 from robomax_py.timing.topp import time_path

@@ -32,8 +32,8 @@ os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(REPO), os.environ.get
 
 from conftest import REFERENCE_CELL, _write_small_cell  # noqa: E402
 
-from robomax_py.batch import BatchOptions, CellOutcome, run_batch  # noqa: E402
-from robomax_py.variants import write_variants  # noqa: E402
+from robomax_py.app.batch import BatchOptions, CellOutcome, run_batch  # noqa: E402
+from robomax_py.io.variants import write_variants  # noqa: E402
 
 
 def one_batch(files: list[str], out: Path, jobs: int, use_ray: bool) -> tuple[float, tuple[CellOutcome, ...]]:

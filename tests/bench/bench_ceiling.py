@@ -32,14 +32,14 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from robomax_py.candidates import SpotCandidates, seam_candidates  # noqa: E402
-from robomax_py.cell_io import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.collision import CollisionWorld  # noqa: E402
-from robomax_py.junction import WeldEnd, time_junction  # noqa: E402
+from robomax_py.plan.candidates import SpotCandidates, seam_candidates  # noqa: E402
+from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
+from robomax_py.world.collision import CollisionWorld  # noqa: E402
+from robomax_py.plan.junction import WeldEnd, time_junction  # noqa: E402
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell, resolved_options, weld_end  # noqa: E402
 from robomax_py.program import as_written_joints, written_speed, written_tcp_speed  # noqa: E402
-from robomax_py.scene import build_scene  # noqa: E402
-from robomax_py.seams import orientation_grid  # noqa: E402
+from robomax_py.world.scene import build_scene  # noqa: E402
+from robomax_py.plan.poses import orientation_grid  # noqa: E402
 from robomax_py.spec import CellSpec  # noqa: E402
 from robomax_py.timing import ptp_time_estimate  # noqa: E402
 

@@ -25,10 +25,10 @@ import numpy as np  # noqa: E402
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))
 
-from robomax_py.bench import median_cpu_seconds  # noqa: E402
-from robomax_py.cell_io import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.collision import CollisionWorld  # noqa: E402
-from robomax_py.scene import build_scene  # noqa: E402
+from robomax_py.app.bench import median_cpu_seconds  # noqa: E402
+from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
+from robomax_py.world.collision import CollisionWorld  # noqa: E402
+from robomax_py.world.scene import build_scene  # noqa: E402
 
 RUNS = 5
 REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"

@@ -23,12 +23,12 @@ import pinocchio as pin  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from robomax_py.bench import median_cpu_seconds  # noqa: E402
-from robomax_py.ik._chain import chain_to_frame, frame_pose  # noqa: E402
-from robomax_py.ik.numeric import numeric_ik  # noqa: E402
-from robomax_py.ik.opw import OpwParams, opw_fk, opw_ik  # noqa: E402
-from robomax_py.ik.turns import expand, turn_shifts  # noqa: E402
-from robomax_py.ik.ur import UR10_EXAMPLE_ROBOT_DATA, ur_fk, ur_ik  # noqa: E402
+from robomax_py.app.bench import median_cpu_seconds  # noqa: E402
+from robomax_py.robot.ik._chain import chain_to_frame, frame_pose  # noqa: E402
+from robomax_py.robot.ik.numeric import numeric_ik  # noqa: E402
+from robomax_py.robot.ik.opw import OpwParams, opw_fk, opw_ik  # noqa: E402
+from robomax_py.robot.ik.turns import expand, turn_shifts  # noqa: E402
+from robomax_py.robot.ik.ur import UR10_EXAMPLE_ROBOT_DATA, ur_fk, ur_ik  # noqa: E402
 
 RUNS = 5
 KR16 = OpwParams(

@@ -25,11 +25,12 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from robomax_py.cell_io import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.collision import CollisionWorld  # noqa: E402
-from robomax_py.plan import PlanOptions, _Sequencer, plan_cell  # noqa: E402
-from robomax_py.roadmap import Roadmap  # noqa: E402
-from robomax_py.scene import build_scene  # noqa: E402
+from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
+from robomax_py.world.collision import CollisionWorld  # noqa: E402
+from robomax_py.plan.graph import Sequencer as _Sequencer
+from robomax_py.plan import PlanOptions, plan_cell  # noqa: E402
+from robomax_py.plan.roadmap import Roadmap  # noqa: E402
+from robomax_py.world.scene import build_scene  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
@@ -148,7 +149,7 @@ def main() -> None:
     seq = _Sequencer.__new__(_Sequencer)  # only for its lift detour, on the same world
     seq.cell, seq.robot, seq.world, seq.limits, seq.checks = cell, robot, world, robot.limits, 0
     seq.home = np.asarray(cell.home)[None, :]
-    from robomax_py.candidates import seam_candidates
+    from robomax_py.plan.candidates import seam_candidates
     spots, _ = seam_candidates(cell, robot, world, 0)
     seq.spots = spots
     i5 = next(k for k, c in enumerate(spots) if c.name == "s5")

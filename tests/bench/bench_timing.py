@@ -5,7 +5,7 @@
 The same planned tour timed three ways: (a) toppra, velocity and acceleration limits only, stopping
 at every waypoint; (b) jerk-limited (ruckig) moves, stopping at detour waypoints; (c) (b) with detour
 corners blended where the blended path checks free. Reports medians of the cycle time, the time
-spent timing, and the ratio of the cycle time to a straight-move lower bound (`robomax_py.bench.
+spent timing, and the ratio of the cycle time to a straight-move lower bound (`robomax_py.app.bench.
 lower_bound`): the weld times plus, for every rest-to-rest move (home -> spot -> spot ... -> home),
 the slowest joint's time-optimal trapezoid time (velocity and acceleration limits).
 """
@@ -19,8 +19,8 @@ from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-from robomax_py.cell_io import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.bench import lower_bound  # noqa: E402
+from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
+from robomax_py.app.bench import lower_bound  # noqa: E402
 from robomax_py.plan import PlanOptions, plan_cell  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]

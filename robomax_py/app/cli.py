@@ -1,0 +1,466 @@
+"""The `robomax` command: exit codes and messages per SPEC §4.
+
+A RobomaxError (a user's mistake) becomes one line on stderr and exit code 2, never a traceback.
+Heavy modules are imported inside commands so `robomax --help` stays fast.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Annotated, TypeVar
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from robomax_py.errors import RobomaxError
+
+EXIT_OK = 0
+EXIT_VIOLATIONS = 1
+EXIT_BAD_INPUT = 2
+EXIT_INFEASIBLE = 3
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, help="Offline programming for spot-welding robot cells.")
+out = Console(highlight=False)
+err = Console(stderr=True, highlight=False)
+
+T = TypeVar("T")
+
+
+@app.callback()
+def _library(
+    robots_dirs: Annotated[list[Path] | None, typer.Option(
+        "--robots", metavar="DIR",
+        help="a robot library folder searched before ROBOMAX_ROBOTS and the shipped library (repeatable; "
+             "any command takes it, before or after the command name)")] = None,
+) -> None:
+    """Offline programming for spot-welding robot cells."""
+    if robots_dirs:
+        _prepend_library([str(d) for d in robots_dirs])
+
+
+def _prepend_library(dirs: list[str]) -> None:
+    """Put folders in front of ROBOMAX_ROBOTS; batch workers and local Ray inherit the environment."""
+    import os
+
+    from robomax_py.io.robot import ROBOTS_ENV
+
+    current = [p for p in os.environ.get(ROBOTS_ENV, "").split(os.pathsep) if p]
+    wanted = [str(Path(d).resolve()) for d in dirs]
+    os.environ[ROBOTS_ENV] = os.pathsep.join([*wanted, *[p for p in current if p not in wanted]])
+
+
+def _warn(lines: tuple[str, ...] | list[str]) -> None:
+    from rich.markup import escape
+
+    for line in lines:
+        err.print(f"[yellow]warning:[/] {escape(line)}", soft_wrap=True, highlight=False)
+
+
+def _guarded(action: Callable[[], T]) -> T:
+    """Run a command body; a RobomaxError becomes one message and exit code 2."""
+    try:
+        return action()
+    except RobomaxError as exc:
+        err.print(f"[bold red]error:[/] {exc}", markup=True, soft_wrap=True)
+        raise typer.Exit(EXIT_BAD_INPUT) from None
+
+
+@app.command()
+def robots() -> None:
+    """List the robot and tool library: axes, reach, IK solver, tool TCP."""
+
+    def run() -> None:
+        from robomax_py.app.library import list_robots, list_tools
+        from robomax_py.io.robot import robot_library
+
+        out.print("library path: " + "  ".join(str(d) for d in robot_library()), soft_wrap=True)
+        table = Table(title="Robots", title_justify="left")
+        for col in ("name", "axes", "flange reach (m)", "payload (kg)", "IK", "controller", "from", "description"):
+            table.add_column(col)
+        for r in list_robots():
+            payload = "-" if r.payload_kg is None else f"{r.payload_kg:g}"
+            table.add_row(r.name, str(r.axes), f"{r.reach_m:.3f}", payload, r.ik_solver, r.brand,
+                          str(r.source.parent.parent), r.description)
+            _warn([f"robot {r.name}: {s} is hidden by {r.source}" for s in r.shadowed])
+        out.print(table)
+        tools = Table(title="Tools", title_justify="left")
+        for col in ("name", "TCP offset from flange (m)", "TCP distance (m)", "from"):
+            tools.add_column(col)
+        for t in list_tools():
+            xyz = ", ".join(f"{v:.3f}" for v in t.tcp_xyz_m)
+            tools.add_row(t.name, f"[{xyz}]", f"{t.tcp_distance_m:.3f}", str(t.source.parent.parent.parent))
+            _warn([f"tool {t.name}: {s} is hidden by {t.source}" for s in t.shadowed])
+        out.print(tools)
+
+    _guarded(run)
+
+
+@app.command()
+def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")]) -> None:
+    """Validate a cell (and its robot, tool and meshes) and print a summary."""
+
+    def run() -> None:
+        from robomax_py.app.summary import cell_summary
+        from robomax_py.errors import CellFileError
+        from robomax_py.io.cell import load_cell, load_cell_robot
+        from robomax_py.plan.reach import reach_report, self_contacts
+
+        spec = load_cell(cell)
+        robot = load_cell_robot(spec)
+        _warn(robot.warnings)
+        out.print(cell_summary(spec, robot))
+        reach = reach_report(spec, robot)
+        far = [r for r in reach if not r.reachable]
+        if far:
+            worst = max(far, key=lambda r: r.out_by_m)
+            others = f" ({len(far) - 1} more spot(s) out of reach)" if len(far) > 1 else ""
+            raise CellFileError(cell, worst.key, f"spot {worst.seam}/{worst.name} is out of {robot.name}'s reach by "
+                                f"{worst.out_by_m:.3f} m at every allowed orientation (shoulder to wrist "
+                                f"{worst.distance_m:.3f} m, the arm reaches {worst.reach_m:.3f} m){others}")
+        if reach:
+            tight = min(reach, key=lambda r: -r.out_by_m)
+            out.print(f"reach: all {len(reach)} spots within reach (least margin {-tight.out_by_m * 1000:.0f} mm "
+                      f"at {tight.seam}/{tight.name})")
+        at_home, always = self_contacts(robot, spec.home)
+        _warn([f"{robot.name}: links {a} and {b} touch at home; if they touch by design, add "
+               f"[{a}, {b}] to collision.disable in {robot.source}" for a, b in at_home])
+        _warn([f"{robot.name}: links {a} and {b} touch in every sampled configuration; add [{a}, {b}] "
+               f"to collision.disable in {robot.source} (or give its SRDF as srdf:)" for a, b in always])
+        out.print(f"[green]ok[/]: {cell} is a valid cell")
+
+    _guarded(run)
+
+
+@app.command()
+def plan(
+    cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
+    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder")] = Path("programs"),
+    baseline: Annotated[bool, typer.Option("--baseline", help="the published method: given order, nominal orientation, first branch")] = False,
+    as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable report instead of tables")] = False,
+    speed: Annotated[float | None, typer.Option("--speed", min=0.01, max=1.0, help="override of every programmed speed, fraction in (0, 1] (default: the cell's planner.speed, else 1)")] = None,
+    verbose: Annotated[bool, typer.Option("-v", "--verbose", help="debug logging: stage sizes, counts and times")] = False,
+    plot: Annotated[bool, typer.Option("--plot", help="also write DIR/<name>.png: a cycle-time Gantt chart, one row per spot")] = False,
+) -> None:
+    """Plan a cell and write its program files (only when the plan is complete and verified)."""
+
+    def run() -> int:
+        import json as _json
+        import time
+
+        from robomax_py.app.progress import configure_logging, stage_bars
+        from robomax_py.app.report import plan_report, report_tables
+        from robomax_py.export import render_programs
+        from robomax_py.io.cell import load_cell, load_cell_robot
+        from robomax_py.io.files import write_programs
+        from robomax_py.plan import PlanOptions, plan_cell
+
+        configure_logging(err, verbose)
+        t0 = time.perf_counter()
+        spec = load_cell(cell)
+        robot = load_cell_robot(spec)
+        _warn(robot.warnings)
+        with stage_bars(err, enabled=not verbose) as progress:
+            result = plan_cell(spec, robot, PlanOptions(baseline=baseline, speed=speed), progress)
+        seconds = time.perf_counter() - t0
+        written: list[Path] = []
+        if result.status == "planned":
+            from robomax_py.app.chart import cycle_chart, render_png
+            from robomax_py.io.files import write_atomic_bytes
+
+            texts = render_programs(result)   # everything rendered before any write
+            png = render_png(cycle_chart(result)) if plot else None
+            written = write_programs(out_dir, texts)
+            if png is not None:
+                path = out_dir / f"{spec.name}.png"
+                write_atomic_bytes(path, png)
+                written.append(path)
+        report = plan_report(result, seconds, written, robot.defaulted_limits)
+        if as_json:
+            out.print_json(_json.dumps(report))
+        else:
+            for renderable in report_tables(report):
+                out.print(renderable)
+        if result.status != "planned":
+            err.print(f"[bold red]infeasible:[/] {result.message}", soft_wrap=True)
+            from robomax_py.plan.reach import reach_report
+
+            reach = {(r.seam, r.name): r for r in reach_report(spec, robot)} if result.failures else {}
+            for f in result.failures:
+                r = reach.get((f.seam, f.name))
+                far = f"; {r.out_by_m:.3f} m out of reach at the best orientation" if r and not r.reachable else ""
+                err.print(f"  {f.seam}/{f.name}: {f.reason} ({f.detail}{far})", soft_wrap=True)
+            return EXIT_INFEASIBLE
+        return EXIT_OK
+
+    code = _guarded(run)
+    raise typer.Exit(code)
+
+
+@app.command()
+def verify(
+    cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
+    program: Annotated[Path, typer.Argument(help="program written by plan: .srcl (motion rebuilt from its statements) or .json")],
+) -> None:
+    """Re-simulate a program against the cell; report collisions, limit and tolerance violations."""
+
+    def run() -> int:
+        from robomax_py.io.cell import load_cell, load_cell_robot
+        from robomax_py.verify import verify_program
+
+        spec = load_cell(cell)
+        robot = load_cell_robot(spec)
+        report = verify_program(spec, robot, program)
+        out.print(f"{program}: {report.samples} samples, cycle {report.cycle_time:.3f} s, "
+                  f"{report.collision_checks} collision checks")
+        for v in report.violations:
+            when = "" if v.t is None else f"t = {v.t:.3f} s: "
+            out.print(f"  [red]{v.kind}[/]: {when}{v.detail}", soft_wrap=True)
+        if report.clean:
+            out.print("[green]clean[/]: no collisions, limits kept, every spot welded within tolerance")
+            return EXIT_OK
+        out.print(f"[red]{len(report.violations)} violation(s)[/]")
+        return EXIT_VIOLATIONS
+
+    code = _guarded(run)
+    raise typer.Exit(code)
+
+
+@app.command()
+def bench(
+    cell: Annotated[Path, typer.Argument(help="cell to plan (default: the shipped cabin_flange cell)")] = Path("cells/cabin_flange.yaml"),
+    runs: Annotated[int, typer.Option("--runs", min=1, help="planning runs (median)")] = 3,
+    quick: Annotated[bool, typer.Option("--quick", help="smaller IK and collision batches")] = False,
+) -> None:
+    """Measure this machine: IK/s, collision checks/s, planning time, cycle vs baseline vs lower bound."""
+
+    def run() -> None:
+        from rich.status import Status
+
+        from robomax_py.app.bench import run_bench
+        from robomax_py.io.cell import load_cell, load_cell_robot
+
+        spec = load_cell(cell)
+        robot = load_cell_robot(spec)
+        with Status("", console=err) as status:
+            rows = run_bench(spec, robot, runs=runs, quick=quick, on_step=lambda s: status.update(f"measuring {s}"))
+        table = Table(title=f"robomax bench: {spec.name} ({robot.name}), one process", title_justify="left")
+        for col, justify in (("figure", "left"), ("value", "right"), ("unit", "left"), ("note", "left")):
+            table.add_column(col, justify=justify)  # type: ignore[arg-type]
+        for r in rows:
+            value = f"{r.value:,.0f}" if r.value >= 1000 else f"{r.value:.3f}"
+            table.add_row(r.name, value, r.unit, r.note)
+        out.print(table)
+
+    _guarded(run)
+
+
+@app.command()
+def preview(
+    cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
+    program: Annotated[Path | None, typer.Argument(help="program written by plan (.json or .srcl); without it the robot stands at home")] = None,
+    html: Annotated[Path | None, typer.Option("--html", help="write one self-contained HTML page instead of serving")] = None,
+) -> None:
+    """Show the cell in meshcat, animated along a program (serves until Ctrl-C, or writes --html)."""
+
+    def run() -> None:
+        from robomax_py.app.preview import serve, write_html
+        from robomax_py.app.preview_program import home_program, load_program
+        from robomax_py.io.cell import load_cell, load_cell_robot
+
+        spec = load_cell(cell)
+        robot = load_cell_robot(spec)
+        shown = home_program(spec) if program is None else load_program(program, spec, robot)
+        if html is not None:
+            content = write_html(html, spec, robot, shown)
+            out.print(f"wrote {html} ({content.frames} animation frames, cycle {content.duration:.3f} s)")
+            return
+        serve(spec, robot, shown, lambda url: out.print(f"meshcat preview at {url}  (Ctrl-C to stop)"))
+        out.print("preview stopped")
+
+    _guarded(run)
+
+
+@app.command()
+def batch(
+    cells: Annotated[list[Path], typer.Argument(help="cell files (YAML)")],
+    jobs: Annotated[int | None, typer.Option("-j", "--jobs", min=1, help="cells planned at once (default: the number of CPUs)")] = None,
+    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder for programs and summary.csv / summary.md")] = Path("programs"),
+    timeout: Annotated[float | None, typer.Option("--timeout", min=0.0, help="seconds per cell before its worker is killed")] = None,
+    ray_address: Annotated[str | None, typer.Option("--ray", metavar="[ADDRESS]",
+                                                    help="plan on Ray: a local Ray without ADDRESS (or with `local`), else the cluster at ADDRESS")] = None,
+    baseline: Annotated[bool, typer.Option("--baseline", help="the published method: given order, nominal orientation, first branch")] = False,
+) -> None:
+    """Plan many cells in parallel (one process per cell); write their programs and a summary table.
+
+    Exit 0 all planned; 3 some infeasible, timed out or crashed; 2 a cell file is bad (reported in its
+    row, the others still plan) or does not exist (nothing is planned).
+    """
+
+    def run() -> int:
+        import os
+
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+        )
+
+        from robomax_py.app.batch import (
+            BAD_INPUT,
+            PLANNED,
+            BatchOptions,
+            CellOutcome,
+            run_batch,
+        )
+
+        files = [str(c) for c in cells]
+        use_ray = ray_address is not None
+        address = None if ray_address in (None, "", RAY_LOCAL) else ray_address
+        missing = [f for f in files if not Path(f).is_file()]
+        if missing:
+            for f in missing:
+                err.print(f"[bold red]error:[/] {f}: cell file not found", soft_wrap=True)
+            return EXIT_BAD_INPUT
+        if use_ray:
+            try:
+                import ray  # noqa: F401
+            except ImportError:
+                err.print("[bold red]error:[/] --ray needs Ray: pip install 'robomax-py[ray]'", soft_wrap=True)
+                return EXIT_BAD_INPUT
+        options = BatchOptions(jobs=jobs or os.cpu_count() or 1, timeout=timeout, baseline=baseline)
+        where = f"Ray ({address or 'local'})" if use_ray else f"{options.jobs} process(es)"
+        with Progress(TextColumn("planning"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                      console=err, transient=False) as progress:
+            task = progress.add_task("cells", total=len(files))
+            progress.console.print(f"{len(files)} cell(s) on {where}")
+
+            def done(i: int, o: CellOutcome) -> CellOutcome:
+                style = "green" if o.status == PLANNED else "red"
+                detail = f"cycle {o.cycle_time:.2f} s" if o.cycle_time is not None else o.reasons
+                progress.console.print(f"[{style}]{o.status}[/]: {o.file} ({o.seconds:.1f} s) {detail}",
+                                       soft_wrap=True, markup=True, highlight=False)
+                progress.advance(task)
+                return o
+
+            outcomes = run_batch(files, out_dir, options, use_ray=use_ray, ray_address=address, on_done=done)
+        table = Table(title=f"batch: {out_dir / 'summary.md'}", title_justify="left")
+        for col in ("cell", "status", "cycle (s)", "planning (s)", "spots", "detours"):
+            table.add_column(col)
+        for o in outcomes:
+            table.add_row(o.cell, o.status, "" if o.cycle_time is None else f"{o.cycle_time:.2f}",
+                          f"{o.seconds:.1f}", "" if o.spots is None else str(o.spots),
+                          "" if o.detours is None else str(o.detours))
+        out.print(table)
+        if all(o.status == PLANNED for o in outcomes):
+            return EXIT_OK
+        return EXIT_BAD_INPUT if any(o.status == BAD_INPUT for o in outcomes) else EXIT_INFEASIBLE
+
+    code = _guarded(run)
+    raise typer.Exit(code)
+
+
+@app.command()
+def variants(
+    cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
+    n: Annotated[int, typer.Option("--n", "-n", min=1, help="number of variants")] = 20,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="seed: the same seed writes the same files")] = 0,
+    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder")] = Path("variants"),
+) -> None:
+    """Write seeded perturbed copies of a cell (clamps ±15 mm, part ±5 mm / ±1°, spot order of free seams)."""
+
+    def run() -> None:
+        from robomax_py.io.variants import write_variants
+
+        made = write_variants(cell, n, seed, out_dir)
+        out.print(f"wrote {len(made)} variant(s) of {cell}: {made[0].path} ... {made[-1].path}")
+
+    _guarded(run)
+
+
+@app.command("import-urdf")
+def import_urdf_command(
+    source: Annotated[Path, typer.Argument(help=".urdf or .xacro file (xacro is expanded without ROS)")],
+    out_dir: Annotated[Path, typer.Option("-o", "--out", help="the robot folder to write, e.g. robots/irb2400")],
+    packages: Annotated[list[Path] | None, typer.Option("--packages", metavar="DIR",
+                        help="a ROS package folder or a folder holding packages (repeatable)")] = None,
+    flange: Annotated[str, typer.Option("--flange", help="URDF frame the tool mounts on")] = "tool0",
+    srdf: Annotated[Path | None, typer.Option("--srdf", help="MoveIt SRDF whose disable_collisions are kept")] = None,
+    solver: Annotated[str | None, typer.Option("--solver", help="opw | ur | numeric (default: the first that fits)")] = None,
+    brand: Annotated[str | None, typer.Option("--brand", help="kuka | abb | fanuc | ur (default: guessed from the name)")] = None,
+    name: Annotated[str | None, typer.Option("--name", help="robot name (default: the folder name)")] = None,
+    force: Annotated[bool, typer.Option("--force", help="replace a folder that exists with other content")] = False,
+) -> None:
+    """Make a self-contained robot folder from a URDF or xacro: meshes copied, IK fitted and checked."""
+
+    def run() -> None:
+        from robomax_py.app.import_urdf import import_urdf
+        from robomax_py.errors import RobotModelError
+
+        if solver not in (None, "opw", "ur", "numeric"):
+            raise RobotModelError(None, "--solver", f"expected opw, ur or numeric, got {solver!r}")
+        if brand not in (None, "kuka", "abb", "fanuc", "ur"):
+            raise RobotModelError(None, "--brand", f"expected kuka, abb, fanuc or ur, got {brand!r}")
+        r = import_urdf(source, out_dir, packages or (), name=name, flange=flange, srdf=srdf, solver=solver,
+                        brand=brand, force=force)
+        _warn(r.warnings)
+        what = "unchanged" if r.unchanged else "wrote"
+        out.print(f"{what} {r.folder}: robot {r.name}, IK {r.solver} (FK agrees with the URDF within "
+                  f"{r.fk_error_m:.1e} m), controller {r.brand}, {r.meshes} meshes, {r.disabled_pairs} disabled "
+                  f"pairs from the SRDF ({r.seconds:.1f} s)")
+
+    _guarded(run)
+
+
+RAY_LOCAL = "local"
+
+
+def _bare_ray_flag(argv: list[str]) -> list[str]:
+    """`batch ... --ray` without an address (last, or before an option or a cell file) -> `--ray=local`.
+
+    typer has no options with an optional value, so the console entry point spells the default out.
+    """
+    if "batch" not in argv:
+        return argv
+    args = list(argv)
+    for k, arg in enumerate(args):
+        nxt = args[k + 1] if k + 1 < len(args) else None
+        if arg == "--ray" and (nxt is None or nxt.startswith("-") or nxt.endswith((".yaml", ".yml"))):
+            args[k] = f"--ray={RAY_LOCAL}"
+    return args
+
+
+def _library_flags_first(argv: list[str]) -> list[str]:
+    """`--robots DIR` anywhere -> in front of the command name, where the app callback reads it."""
+    front: list[str] = []
+    rest: list[str] = []
+    k = 0
+    while k < len(argv):
+        arg = argv[k]
+        if arg == "--robots" and k + 1 < len(argv):
+            front += [arg, argv[k + 1]]
+            k += 2
+            continue
+        if arg.startswith("--robots="):
+            front.append(arg)
+        else:
+            rest.append(arg)
+        k += 1
+    return front + rest
+
+
+def main() -> None:
+    """Console entry point."""
+    try:
+        app(args=_bare_ray_flag(_library_flags_first(sys.argv[1:])))
+    except KeyboardInterrupt:
+        err.print("interrupted")
+        sys.exit(130)
+
+
+if __name__ == "__main__":
+    main()

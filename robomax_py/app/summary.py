@@ -1,0 +1,70 @@
+"""Human-readable summaries of a checked cell (for `robomax check`)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from rich.console import Group
+from rich.table import Table
+
+from robomax_py.spec import (
+    Box,
+    Capsule,
+    CellSpec,
+    Cylinder,
+    MeshShape,
+    ObjectSpec,
+    Sphere,
+)
+
+
+def describe_shape(obj: ObjectSpec) -> str:
+    s = obj.shape
+    if isinstance(s, Box):
+        return "box " + " x ".join(f"{v:.3f}" for v in s.extents) + " m"
+    if isinstance(s, Cylinder):
+        return f"cylinder r {s.radius:.3f} m, length {s.length:.3f} m"
+    if isinstance(s, Sphere):
+        return f"sphere r {s.radius:.3f} m"
+    if isinstance(s, Capsule):
+        return f"capsule r {s.radius:.3f} m, length {s.length:.3f} m"
+    if isinstance(s, MeshShape):
+        return f"mesh {s.path.name}"
+    return type(s).__name__
+
+
+def cell_summary(cell: CellSpec, robot: Any) -> Group:
+    """Robot, tool, objects, seams and spots of a cell, as rich tables."""
+    head = Table.grid(padding=(0, 2))
+    head.add_row("cell", f"{cell.name}  ({cell.source})")
+    home_deg = ", ".join(f"{v:.1f}" for v in np.degrees(cell.home))
+    head.add_row("robot", f"{robot.name}: {robot.dof} axes, IK {robot.ik_solver}, home [{home_deg}] deg")
+    tcp = cell.tool.T_flange_tcp[:3, 3]
+    head.add_row("tool", f"{cell.tool.name}: TCP at [{', '.join(f'{v:.3f}' for v in tcp)}] m from the flange")
+    p = cell.process
+    head.add_row("process", f"weld {p.weld_time:.2f} s, approach {p.approach * 1000:.1f} mm, "
+                            f"clearance {p.clearance * 1000:.1f} mm")
+
+    objects = Table(title="objects", title_justify="left")
+    for col in ("name", "shape", "position (m)", "role"):
+        objects.add_column(col)
+    for obj in (*cell.objects, *cell.dynamic):
+        role = "workpiece" if obj.workpiece else "obstacle"
+        if obj.present is not None:
+            role += " present " + ", ".join(f"[{a:g}, {b:g}] s" for a, b in obj.present)
+        xyz = ", ".join(f"{v:.3f}" for v in obj.T_world_object[:3, 3])
+        objects.add_row(obj.name, describe_shape(obj), f"[{xyz}]", role)
+
+    seams = Table(title="seams", title_justify="left")
+    for col in ("seam", "spots", "order", "alpha/beta (deg)", "gamma (deg)", "grid", "orientations"):
+        seams.add_column(col)
+    for seam in cell.seams:
+        g0, g1 = (math.degrees(a) for a in seam.gamma_range)
+        seams.add_row(
+            seam.name, str(len(seam.spots)), "given" if seam.ordered else "free",
+            f"±{math.degrees(seam.alpha_max):g} / ±{math.degrees(seam.beta_max):g}",
+            f"[{g0:g}, {g1:g}]", str(seam.grid), str(seam.grid ** 3),
+        )
+    return Group(head, objects, seams)

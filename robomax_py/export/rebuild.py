@@ -1,0 +1,216 @@
+"""A robot program -> the motion it commands, built the way the planner built it (`timing.chain`).
+
+Semantics (docs/srcl.md, "Motion semantics"): the first PTP is the start; moves are grouped into
+chains at their FLYBY radii; a chain of one PTP is a jerk-limited joint move, every other chain is
+timed by toppra on its blended path with the LIN lines' TCP speeds; SPOT and WAIT hold at rest;
+`WAIT FOR <object>_clear` holds until the dynamic object `<object>` is absent. What the program
+states that cannot be executed as stated (a LIN the arm cannot follow in its configuration, a
+SPOT while flying by, a LIN ending in another configuration than its CONFIG) is a problem of the
+program, reported with the time it happens; what makes the program unreadable for this cell
+(another robot, other joints) is bad input.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.errors import ProgramError
+from robomax_py.plan.waiting import CLEAR_SUFFIX, clear_wait
+from robomax_py.program import (
+    Comment,
+    FrameDef,
+    LinMove,
+    Program,
+    PtpMove,
+    Spot,
+    Wait,
+    WaitFor,
+    frame_in_world,
+    from_frame,
+    lin_pose,
+    pose_mm_zyx,
+    ptp_target,
+)
+from robomax_py.robot import RobotModel
+from robomax_py.robot.ik import config_text, same_config
+from robomax_py.spec import CellSpec
+from robomax_py.timing import (
+    LinMoveError,
+    Segment,
+    TimingError,
+    Trajectory,
+    concatenate,
+    dwell,
+    resample,
+)
+from robomax_py.timing.chain import LinStep, PtpStep, Step, chain_path, time_chain
+
+# Frame definitions must match the cell's tool and base within the program's decimals.
+FRAME_TOL_MM = 1.5e-3
+FRAME_TOL_DEG = 1.5e-4
+
+
+@dataclass(frozen=True, slots=True)
+class Problem:
+    t: float | None
+    kind: str
+    detail: str
+
+
+@dataclass(slots=True)
+class Rebuilt:
+    """The motion of a program: a trajectory (None when it could not be built to the end), the
+    spots it welds (as SPEC §5 `spots` entries) and what was wrong on the way."""
+
+    trajectory: Trajectory | None
+    spots: list[dict[str, Any]] = field(default_factory=list)
+    problems: list[Problem] = field(default_factory=list)
+
+
+def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | str) -> Rebuilt:
+    """Rebuild the motion; ProgramError when the program is not for this cell's robot."""
+    header = program.header
+    if header.robot != robot.name:
+        raise ProgramError(file, "ROBOT", f"program is for robot {header.robot!r}, the cell uses {robot.name!r}")
+    if tuple(header.joints) != tuple(robot.joint_names):
+        raise ProgramError(file, "AXES", f"expected {list(robot.joint_names)}, got {list(header.joints)}")
+    builder = _Builder(cell, robot)
+    builder.problems.extend(_frame_problems(program.frames, cell, robot))
+    moves = [ins for ins in program.instructions if not isinstance(ins, Comment)]
+    if not moves or not isinstance(moves[0], PtpMove):
+        raise ProgramError(file, "BEGIN", "the first statement must be a MOVE PTP: where the robot starts")
+    builder.start(ptp_target(moves[0]))
+    for k, ins in enumerate(moves[1:], start=1):
+        if not builder.add(ins, moves[k + 1] if k + 1 < len(moves) else None, k):
+            return Rebuilt(None, builder.spots, builder.problems)
+    if builder.pending:
+        builder.problems.append(Problem(builder.t, "flyby", "the program ends flying by: the last move has FLYBY"))
+        if not builder.flush():
+            return Rebuilt(None, builder.spots, builder.problems)
+    traj = resample(concatenate(builder.segments))
+    # Spot times from the trajectory's own weld phases (exactly on its samples), in program order.
+    welds: dict[str, list[Any]] = {}
+    for phase in traj.phases_of("weld"):
+        welds.setdefault(phase.label, []).append(phase)
+    for spot in builder.spots:
+        phase = welds[f"{spot['seam']}/{spot['name']}"].pop(0)
+        spot["t_arrive"], spot["t_leave"] = float(phase.t_start), float(phase.t_end)
+    return Rebuilt(traj, builder.spots, builder.problems)
+
+
+class _Builder:
+    def __init__(self, cell: CellSpec, robot: RobotModel) -> None:
+        self.cell, self.robot = cell, robot
+        self.segments: list[Segment] = []
+        self.spots: list[dict[str, Any]] = []
+        self.problems: list[Problem] = []
+        self.pending: list[Step] = []
+        self.configs: list[tuple[int, str]] = []          # (index in pending, CONFIG) of pending LINs
+        self.q = np.zeros(robot.dof)
+        self.t = 0.0
+        self.last_config = ""
+
+    def start(self, q: FloatArray) -> None:
+        self.q = np.asarray(q, dtype=float)
+        self.segments.append(dwell(self.q, 0.0, kind="wait", label="start"))
+
+    def add(self, ins: Any, following: Any, index: int) -> bool:
+        if isinstance(ins, (PtpMove, LinMove)):
+            self.pending.append(self._step(ins, following, index))
+            if isinstance(ins, LinMove):
+                self.configs.append((len(self.pending) - 1, ins.config))
+            return self.flush() if ins.flyby <= 0 else True
+        if self.pending:
+            what = "SPOT" if isinstance(ins, Spot) else "WAIT"
+            self.problems.append(Problem(self.t, "flyby", f"{what} after a FLYBY move: the robot is not at rest"))
+            if not self.flush():
+                return False
+        if isinstance(ins, Spot):
+            label = f"{ins.seam}/{ins.name}"
+            self.segments.append(dwell(self.q, ins.time_s, kind="weld", label=label))
+            config = self.last_config or config_text(self.robot, self.q)
+            self.spots.append({"seam": ins.seam, "name": ins.name, "t_arrive": self.t,
+                               "t_leave": self.t + ins.time_s, "config": config})
+            self.t += ins.time_s
+        elif isinstance(ins, Wait):
+            self._hold(ins.seconds, "WAIT")
+        elif isinstance(ins, WaitFor):
+            self._wait_for(ins.signal)
+        return True
+
+    def _step(self, ins: PtpMove | LinMove, following: Any, index: int) -> Step:
+        label = ins.comment or f"statement {index + 1}"
+        if isinstance(ins, PtpMove):
+            return PtpStep(ptp_target(ins), speed=ins.speed, accel=ins.accel,
+                           flyby=math.radians(ins.flyby), kind="move", label=label)
+        T = from_frame(self.robot.controller.T_root_base, lin_pose(ins))   # stated in the controller's base
+        kind = "approach" if isinstance(following, Spot) else "retract"
+        return LinStep(T, ins.speed_mm_s / 1000.0, None, flyby=math.radians(ins.flyby), kind=kind, label=label)
+
+    def flush(self) -> bool:
+        """Build and time the pending chain; False when it cannot be built (reported)."""
+        steps, configs = self.pending, self.configs
+        self.pending, self.configs = [], []
+        try:
+            path = chain_path(self.robot, self.q, steps)
+            segments = time_chain(path, steps, self.robot.limits)
+        except LinMoveError as exc:
+            self.problems.append(Problem(self.t, "lin", f"a LIN move cannot be followed: {exc}"))
+            return False
+        except TimingError as exc:
+            if "does not move" in str(exc):
+                return True
+            self.problems.append(Problem(self.t, "timing", f"the motion cannot be timed: {exc}"))
+            return False
+        t_end = self.t
+        for k, seg in enumerate(segments):
+            t_end += seg.duration
+            for idx, written in configs:
+                if idx == k:
+                    actual = config_text(self.robot, path.targets[k])
+                    self.last_config = actual
+                    if written and not same_config(written, actual):
+                        self.problems.append(Problem(t_end, "config", f"LIN ends in {actual}, the program says {written}"))
+        self.segments.extend(segments)
+        self.t = t_end
+        self.q = np.asarray(segments[-1].q[-1], dtype=float)
+        return True
+
+    def _hold(self, seconds: float, label: str) -> None:
+        if seconds > 0:
+            self.segments.append(dwell(self.q, seconds, kind="wait", label=label))
+            self.t += seconds
+
+    def _wait_for(self, signal: str) -> None:
+        from robomax_py.export.plan_program import identifier
+
+        obstacle = next((d for d in self.cell.dynamic if identifier(d.name) + CLEAR_SUFFIX == signal), None)
+        if obstacle is None:
+            known = ", ".join(identifier(d.name) + CLEAR_SUFFIX for d in self.cell.dynamic) or "none in this cell"
+            self.problems.append(Problem(self.t, "signal", f"WAIT FOR {signal}: unknown signal (known: {known})"))
+            return
+        self._hold(clear_wait(self.t, obstacle.present or ()), f"WAIT FOR {signal}")
+
+
+def _frame_problems(frames: tuple[FrameDef, ...], cell: CellSpec, robot: RobotModel) -> list[Problem]:
+    out = []
+    wanted = {"tool": np.asarray(robot.T_flange_tcp),
+              "base": frame_in_world(np.asarray(cell.T_world_base), robot.controller.T_root_base)}
+    for kind, T in wanted.items():
+        stated = [f for f in frames if f.kind == kind]
+        if not stated:
+            continue                       # not stated: the cell's frame is meant
+        xyz, zyx = pose_mm_zyx(T)
+        f = stated[0]
+        d_mm = max(abs(a - b) for a, b in zip(f.xyz_mm, xyz))
+        d_deg = max(abs((a - b + 180.0) % 360.0 - 180.0) for a, b in zip(f.zyx_deg, zyx))
+        if d_mm > FRAME_TOL_MM or d_deg > FRAME_TOL_DEG:
+            out.append(Problem(None, "frame", f"{kind} frame {f.name} differs from the cell's ({d_mm:.3f} mm, "
+                                              f"{d_deg:.4f} deg); the motion is rebuilt with the cell's"))
+    return out

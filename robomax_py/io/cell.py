@@ -1,0 +1,376 @@
+"""Cell files (SPEC §3) -> checked CellSpec in SI units.
+
+The only module that knows cell-file keys. Every user mistake becomes one CellFileError naming the
+file, the key path (e.g. `seams[0].spots[3].normal`) and the problem; nothing here prints.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
+
+from robomax_py.errors import CellFileError, RobotModelError
+from robomax_py.io.robot import (
+    load_robot_spec,
+    load_tool_spec,
+    resolve_robot_file,
+    resolve_tool_file,
+)
+from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
+from robomax_py.robot.geometry import load_mesh
+from robomax_py.spec import (
+    Box,
+    Capsule,
+    CellSpec,
+    Cylinder,
+    MeshShape,
+    ObjectSpec,
+    PlannerSpec,
+    ProcessSpec,
+    RobotSpec,
+    SeamSpec,
+    Shape,
+    Sphere,
+    SpotSpec,
+    frozen_array,
+)
+from robomax_py.transforms import pose_matrix
+from robomax_py.units import deg_to_rad
+
+SUPPORTED_VERSIONS = (1,)
+# A direction this close to parallel with the normal (sine of the angle) leaves no seam direction.
+MIN_DIRECTION_SINE = 1e-3
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
+Name = Annotated[str, Field(min_length=1)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+
+class PoseFile(_Strict):
+    xyz: Vec3 = [0.0, 0.0, 0.0]      # m
+    rpy: Vec3 = [0.0, 0.0, 0.0]      # deg
+
+
+class RobotRefFile(_Strict):
+    model: Name
+    base: PoseFile = PoseFile()
+    home: list[Finite]               # deg (m for a prismatic joint)
+
+
+class CylinderFile(_Strict):
+    radius: Positive
+    length: Positive
+
+
+class SphereFile(_Strict):
+    radius: Positive
+
+
+_SHAPE_KEYS = ("box", "cylinder", "sphere", "capsule", "mesh")
+
+
+class ObjectFile(_Strict):
+    name: Name
+    box: Annotated[list[Positive], Field(min_length=3, max_length=3)] | None = None
+    cylinder: CylinderFile | None = None
+    sphere: SphereFile | None = None
+    capsule: CylinderFile | None = None
+    mesh: Name | None = None
+    pose: PoseFile = PoseFile()
+    workpiece: bool = False
+
+    @model_validator(mode="after")
+    def _one_shape(self) -> ObjectFile:
+        given = [k for k in _SHAPE_KEYS if getattr(self, k) is not None]
+        if len(given) != 1:
+            got = ", ".join(given) if given else "none"
+            raise ValueError(f"exactly one of {', '.join(_SHAPE_KEYS)} is required, got {got}")
+        return self
+
+
+class DynamicObjectFile(ObjectFile):
+    present: Annotated[list[Annotated[list[NonNegative], Field(min_length=2, max_length=2)]], Field(min_length=1)]
+
+    @field_validator("present")
+    @classmethod
+    def _windows_in_order(cls, windows: list[list[float]]) -> list[list[float]]:
+        for i, (t0, t1) in enumerate(windows):
+            if not t0 < t1:
+                raise ValueError(f"window {i} [{t0}, {t1}]: start must be before end")
+            if i and t0 < windows[i - 1][1]:
+                raise ValueError(f"window {i} starts at {t0}, before window {i - 1} ends at {windows[i - 1][1]}")
+        return windows
+
+
+class ToleranceFile(_Strict):
+    alpha: Annotated[float, Field(ge=0, le=90, allow_inf_nan=False)] = 0.0   # deg
+    beta: Annotated[float, Field(ge=0, le=90, allow_inf_nan=False)] = 0.0    # deg
+    gamma: Annotated[list[Annotated[float, Field(ge=-360, le=360, allow_inf_nan=False)]],
+                     Field(min_length=2, max_length=2)] = [0.0, 0.0]          # deg
+
+    @field_validator("gamma")
+    @classmethod
+    def _range(cls, v: list[float]) -> list[float]:
+        if v[0] > v[1]:
+            raise ValueError(f"expected [min, max] with min <= max, got {v}")
+        if v[1] - v[0] > 360:
+            raise ValueError(f"range wider than 360 deg: {v}")
+        return v
+
+
+class SpotFile(_Strict):
+    name: Name
+    xyz: Vec3
+    normal: Vec3
+    direction: Vec3
+
+
+class SeamFile(_Strict):
+    name: Name
+    ordered: bool = False
+    tolerance: ToleranceFile = ToleranceFile()
+    grid: Annotated[int, Field(ge=1, le=64)] = 1
+    spots: Annotated[list[SpotFile], Field(min_length=1)]
+
+
+class ProcessFile(_Strict):
+    weld_time: NonNegative = 0.5
+    approach: NonNegative = 0.03
+    clearance: NonNegative = 0.0
+
+
+class PlannerFile(_Strict):
+    seed: Annotated[int, Field(ge=0)] = 0
+    # Extensions of SPEC §3 (README, "Cell file extensions"): speeds the program states per move.
+    speed: Annotated[float, Field(gt=0, le=1)] = 1.0
+    tcp_speed: Annotated[float, Field(gt=0, le=2)] = 0.5
+    detour_speed: Annotated[float, Field(gt=0, le=1)] = 1.0
+
+
+class CellFile(_Strict):
+    robomax: int
+    name: Name | None = None
+    robot: RobotRefFile
+    tool: Name
+    objects: list[ObjectFile] = []
+    seams: Annotated[list[SeamFile], Field(min_length=1)]
+    process: ProcessFile = ProcessFile()
+    planner: PlannerFile = PlannerFile()
+    dynamic: list[DynamicObjectFile] = []
+
+
+def load_cell(path: str | Path) -> CellSpec:
+    """Read and check a cell file and the robot.yaml / tool.yaml / meshes it names.
+
+    The robot's URDF is parsed for its kinematics (flange frame, joint limits for `robot.home`); link
+    meshes are read later, by `load_cell_robot`.
+    """
+    path = Path(path)
+    data = read_yaml_mapping(path, CellFileError, "cell file")
+    version = data.get("robomax")
+    if "robomax" in data and version not in SUPPORTED_VERSIONS:
+        supported = ", ".join(str(v) for v in SUPPORTED_VERSIONS)
+        raise CellFileError(path, "robomax", f"unsupported format version {version!r}; this robomax reads {supported}")
+    try:
+        parsed = CellFile.model_validate(data)
+    except ValidationError as exc:
+        raise validation_error(exc, CellFile, path, CellFileError) from None
+    _check_unique_names(parsed, path)
+
+    robot_file = resolve_robot_file(parsed.robot.model, path)
+    if not robot_file.is_file():
+        raise CellFileError(path, "robot.model", f"unknown robot '{parsed.robot.model}': no {robot_file}")
+    tool_file = resolve_tool_file(parsed.tool, path)
+    if not tool_file.is_file():
+        raise CellFileError(path, "tool", f"unknown tool '{parsed.tool}': no {tool_file}")
+    robot_spec = load_robot_spec(robot_file)
+    tool_spec = load_tool_spec(tool_file)
+    for key, mesh in (("body", tool_spec.body), ("tips", tool_spec.tips)):
+        _check_mesh_readable(mesh, RobotModelError(tool_file, key, f"cannot read mesh {mesh}"))
+
+    return CellSpec(
+        name=parsed.name or path.stem,
+        source=path.resolve(),
+        robot=robot_spec,
+        T_world_base=frozen_array(_pose(parsed.robot.base)),
+        home=frozen_array(_home(parsed, robot_spec, path)),
+        tool=tool_spec,
+        objects=tuple(_object(o, path, f"objects[{i}]") for i, o in enumerate(parsed.objects)),
+        seams=tuple(_seam(s, path, f"seams[{i}]") for i, s in enumerate(parsed.seams)),
+        process=ProcessSpec(
+            weld_time=parsed.process.weld_time,
+            approach=parsed.process.approach,
+            clearance=parsed.process.clearance,
+        ),
+        planner=PlannerSpec(seed=parsed.planner.seed, speed=parsed.planner.speed, tcp_speed=parsed.planner.tcp_speed,
+                            detour_speed=parsed.planner.detour_speed),
+        dynamic=tuple(_object(o, path, f"dynamic[{i}]") for i, o in enumerate(parsed.dynamic)),
+    )
+
+
+def load_cell_robot(cell: CellSpec) -> Any:
+    """The cell's `robomax_py.robot.RobotModel` with its tool mounted (imported lazily: Pinocchio is heavy)."""
+    from robomax_py.robot import load_robot, mount_tool
+
+    return mount_tool(load_robot(cell.robot), cell.tool.T_flange_tcp)
+
+
+def _home(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray:
+    """`robot.home` in SI, checked against the URDF: deg -> rad, prismatic joints stay in metres."""
+    from robomax_py.robot import kinematic_model, prismatic_mask
+
+    model = kinematic_model(robot)
+    given = np.asarray(parsed.robot.home, dtype=float)
+    if len(given) != model.nq:
+        raise CellFileError(path, "robot.home", f"expected {model.nq} joint values for {robot.name}, got {len(given)}")
+    prismatic = prismatic_mask(model)
+    home = np.where(prismatic, given, np.radians(given))
+    lower, upper = np.asarray(model.lowerPositionLimit), np.asarray(model.upperPositionLimit)
+    tol = 1e-9
+    outside = (home < lower - tol) | (home > upper + tol)
+    if outside.any():
+        i = int(np.flatnonzero(outside)[0])
+        unit, scale = ("m", 1.0) if prismatic[i] else ("deg", 180 / math.pi)
+        raise CellFileError(
+            path, f"robot.home[{i}]",
+            f"{model.names[i + 1]} = {given[i]:.3f} {unit} is outside its limits "
+            f"[{lower[i] * scale:.3f}, {upper[i] * scale:.3f}] {unit}",
+        )
+    return home
+
+
+def _check_unique_names(parsed: CellFile, path: Path) -> None:
+    seen: dict[str, str] = {}
+    for group, items in (("objects", parsed.objects), ("dynamic", parsed.dynamic)):
+        for i, obj in enumerate(items):
+            if obj.name in seen:
+                raise CellFileError(path, f"{group}[{i}].name", f"duplicate name '{obj.name}' (also {seen[obj.name]})")
+            seen[obj.name] = f"{group}[{i}]"
+    seams: dict[str, int] = {}
+    for i, seam in enumerate(parsed.seams):
+        if seam.name in seams:
+            raise CellFileError(path, f"seams[{i}].name", f"duplicate seam name '{seam.name}' (also seams[{seams[seam.name]}])")
+        seams[seam.name] = i
+        spots: dict[str, int] = {}
+        for j, spot in enumerate(seam.spots):
+            if spot.name in spots:
+                raise CellFileError(
+                    path, f"seams[{i}].spots[{j}].name",
+                    f"duplicate spot name '{spot.name}' (also spots[{spots[spot.name]}])",
+                )
+            spots[spot.name] = j
+
+
+def _pose(pose: PoseFile) -> np.ndarray:
+    return pose_matrix(pose.xyz, [deg_to_rad(a) for a in pose.rpy])
+
+
+def _object(obj: ObjectFile, path: Path, key: str) -> ObjectSpec:
+    shape: Shape
+    if obj.box is not None:
+        shape = Box(extents=(obj.box[0], obj.box[1], obj.box[2]))
+    elif obj.cylinder is not None:
+        shape = Cylinder(radius=obj.cylinder.radius, length=obj.cylinder.length)
+    elif obj.sphere is not None:
+        shape = Sphere(radius=obj.sphere.radius)
+    elif obj.capsule is not None:
+        shape = Capsule(radius=obj.capsule.radius, length=obj.capsule.length)
+    else:
+        assert obj.mesh is not None  # guaranteed by ObjectFile._one_shape
+        mesh = (path.parent / obj.mesh).resolve()
+        if not mesh.is_file():
+            raise CellFileError(path, f"{key}.mesh", f"mesh file not found: {mesh}")
+        _check_mesh_readable(mesh, CellFileError(path, f"{key}.mesh", f"cannot read mesh {mesh}"))
+        shape = MeshShape(path=mesh)
+    present = None
+    if isinstance(obj, DynamicObjectFile):
+        present = tuple((float(t0), float(t1)) for t0, t1 in obj.present)
+    return ObjectSpec(
+        name=obj.name, shape=shape, T_world_object=frozen_array(_pose(obj.pose)),
+        workpiece=obj.workpiece, present=present,
+    )
+
+
+def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError) -> None:
+    try:
+        load_mesh(mesh)
+    except Exception as exc:  # trimesh raises many kinds for unreadable files
+        raise type(error)(error.file, error.key, f"{error.problem}: {exc}") from None
+
+
+def _seam(seam: SeamFile, path: Path, key: str) -> SeamSpec:
+    spots = []
+    for j, spot in enumerate(seam.spots):
+        spot_key = f"{key}.spots[{j}]"
+        normal = _unit(spot.normal, path, f"{spot_key}.normal")
+        direction = _unit(spot.direction, path, f"{spot_key}.direction")
+        along = direction - np.dot(direction, normal) * normal
+        if np.linalg.norm(along) < MIN_DIRECTION_SINE:
+            raise CellFileError(path, f"{spot_key}.direction", f"parallel to the normal {spot.normal}: no seam direction")
+        spots.append(SpotSpec(
+            name=spot.name,
+            xyz=frozen_array(spot.xyz),
+            normal=frozen_array(normal),
+            direction=frozen_array(along / np.linalg.norm(along)),
+        ))
+    tol = seam.tolerance
+    return SeamSpec(
+        name=seam.name,
+        ordered=seam.ordered,
+        alpha_max=deg_to_rad(tol.alpha),
+        beta_max=deg_to_rad(tol.beta),
+        gamma_range=(deg_to_rad(tol.gamma[0]), deg_to_rad(tol.gamma[1])),
+        grid=seam.grid,
+        spots=tuple(spots),
+    )
+
+
+def _unit(v: list[float], path: Path, key: str) -> np.ndarray:
+    arr = np.asarray(v, dtype=float)
+    norm = float(np.linalg.norm(arr))
+    if norm < 1e-9:
+        raise CellFileError(path, key, f"zero-length vector {v}")
+    return arr / norm
+
+
+def read_cell_file(path: str | Path) -> CellFile:
+    """A cell file as its checked schema (file units, keys as written), for tools that rewrite cells.
+
+    Only the file itself is checked here; `load_cell` checks what it names (robot, tool, meshes).
+    """
+    path = Path(path)
+    data = read_yaml_mapping(path, CellFileError, "cell file")
+    try:
+        return CellFile.model_validate(data)
+    except ValidationError as exc:
+        raise validation_error(exc, CellFile, path, CellFileError) from None
+
+
+def dump_cell_file(cell: CellFile, header: str = "") -> str:
+    """Cell-file text of a schema object: the keys that were set, in schema order; `header` as comments.
+
+    Deterministic: the same object gives the same bytes. Lists of numbers are written inline.
+    """
+    import yaml
+
+    data = cell.model_dump(mode="json", exclude_unset=True)
+    comment = "".join(f"# {line}\n" if line else "#\n" for line in header.splitlines())
+    text: str = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, allow_unicode=True, width=120)
+    return comment + text

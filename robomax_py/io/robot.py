@@ -1,0 +1,346 @@
+"""robot.yaml and tool.yaml (SPEC §1, §2) -> checked RobotSpec / ToolSpec.
+
+Owns the keys of those two files. A robot or tool is named either by folder name (looked up in the
+robot library path: `--robots` folders, then `ROBOMAX_ROBOTS`, then the shipped library) or by a
+path, relative to the file that names it.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from robomax_py.errors import RobotModelError
+from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
+from robomax_py.spec import ControllerSpec, RobotSpec, ToolSpec, frozen_array
+from robomax_py.transforms import pose_matrix
+from robomax_py.units import degs_to_rads
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
+LinkName = Annotated[str, Field(min_length=1)]
+
+# Robot library folders searched before the shipped one, separated like PATH.
+ROBOTS_ENV = "ROBOMAX_ROBOTS"
+# Folders a `package://NAME/...` mesh is looked for below (ROS convention).
+ROS_PACKAGE_PATH_ENV = "ROS_PACKAGE_PATH"
+# How deep below the robot folder's parents and ROS_PACKAGE_PATH entries a folder named NAME is
+# looked for: deep enough for a checkout of a ROS-Industrial repository next to the robot folder.
+PACKAGE_SEARCH_DEPTH = 3
+PACKAGE_SEARCH_PARENTS = 3
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True)
+
+
+class PoseFile(_Strict):
+    xyz: Vec3 = [0.0, 0.0, 0.0]
+    rpy: Vec3 = [0.0, 0.0, 0.0]               # deg
+
+
+class IkFile(_Strict):
+    solver: str
+    # Optional for opw and ur: fitted from the URDF's joint origins and axes when absent.
+    params: dict[str, Any] | None = None
+
+
+class LimitsFile(_Strict):
+    acceleration: list[Finite] | None = None  # deg/s^2 (m/s^2 for a prismatic joint)
+    jerk: list[Finite] | None = None          # deg/s^3
+
+    @field_validator("acceleration", "jerk")
+    @classmethod
+    def _positive(cls, v: list[float] | None) -> list[float] | None:
+        if v is not None and any(x <= 0 for x in v):
+            raise ValueError(f"every value must be > 0, got {v}")
+        return v
+
+
+class ControllerFile(_Strict):
+    """SPEC §6: the controller's brand (its configuration data and native dialect) and base frame."""
+
+    brand: Literal["kuka", "abb", "fanuc", "ur"] = "kuka"
+    j23_coupling: bool = False                # FANUC: J3 counted from the horizontal
+    base: PoseFile = PoseFile()               # controller base frame in the URDF root frame
+
+
+class CollisionFile(_Strict):
+    disable: list[Annotated[list[LinkName], Field(min_length=2, max_length=2)]] = []
+
+
+class RobotFile(_Strict):
+    name: str
+    urdf: str
+    flange: str
+    ik: IkFile
+    limits: LimitsFile = LimitsFile()
+    # Extensions to SPEC §1, all optional.
+    controller: ControllerFile = ControllerFile()
+    collision: CollisionFile = CollisionFile()
+    srdf: str | None = None                   # MoveIt SRDF whose disable_collisions are honoured
+    payload: Annotated[float, Field(gt=0, allow_inf_nan=False)] | None = None   # kg, for listings
+    description: str = ""
+
+
+class ToolFile(_Strict):
+    name: str
+    body: str
+    tips: str
+    tcp: PoseFile = PoseFile()
+
+
+# ------------------------------------------------------------------------------ the library path
+
+
+def shipped_robots_dir() -> Path:
+    """The robot library shipped inside the package (package data)."""
+    return Path(__file__).resolve().parent.parent / "robots"
+
+
+def package_robots_dir() -> Path:
+    """The shipped robot library (kept for callers that want only it)."""
+    return shipped_robots_dir()
+
+
+def robot_library() -> tuple[Path, ...]:
+    """Folders searched for robots/tools by name, first match wins: ROBOMAX_ROBOTS entries, then shipped.
+
+    The CLI's `--robots DIR` options are put in front of ROBOMAX_ROBOTS, so batch workers inherit them.
+    """
+    extra = [Path(p).expanduser() for p in os.environ.get(ROBOTS_ENV, "").split(os.pathsep) if p.strip()]
+    out: list[Path] = []
+    for d in [*extra, shipped_robots_dir()]:
+        if d not in out:
+            out.append(d)
+    return tuple(out)
+
+
+def resolve_robot_file(ref: str, relative_to: Path) -> Path:
+    """A cell's `robot.model`: a folder name in the library path, or a path to a robot.yaml."""
+    return _resolve(ref, relative_to, (), "robot.yaml")
+
+
+def resolve_tool_file(ref: str, relative_to: Path) -> Path:
+    """A cell's `tool`: a folder name in the library path's `tools/`, or a path to a tool.yaml."""
+    return _resolve(ref, relative_to, ("tools",), "tool.yaml")
+
+
+def searched_for(ref: str, kind: Literal["robot", "tool"]) -> str:
+    """Where a name was looked for, for an 'unknown robot' message."""
+    sub = ("tools",) if kind == "tool" else ()
+    return ", ".join(str(Path(d, *sub)) for d in robot_library())
+
+
+def _resolve(ref: str, relative_to: Path, sub: tuple[str, ...], filename: str) -> Path:
+    looks_like_path = "/" in ref or "\\" in ref or ref.endswith((".yaml", ".yml"))
+    if not looks_like_path:
+        candidates = [Path(d, *sub, ref, filename) for d in robot_library()]
+        return next((c for c in candidates if c.is_file()), candidates[-1])
+    path = (relative_to.parent / ref).resolve()
+    return path / filename if path.is_dir() else path
+
+
+# ------------------------------------------------------------------------------ package:// meshes
+
+
+def package_share_dirs() -> list[Path]:
+    """`share` folders of installed packages, for URDFs naming meshes as package://<pkg>/...
+
+    example-robot-data installs under <site-packages>/cmeel.prefix/share; we locate it through the
+    installed distribution's file list rather than guessing a path.
+    """
+    from importlib import metadata
+
+    dirs: list[Path] = []
+    try:
+        files = metadata.files("example-robot-data") or []
+    except metadata.PackageNotFoundError:
+        files = []
+    for f in files:
+        parts = Path(str(f)).parts
+        if "share" in parts and "example-robot-data" in parts:
+            idx = parts.index("share")
+            located = Path(str(f.locate())).resolve()
+            share = located.parents[len(parts) - idx - 2]
+            dirs.append(share)
+            break
+    return dirs
+
+
+def package_dirs_for(name: str, near: Path) -> list[Path]:
+    """Folders P such that P/name is the ROS package `name`, best first.
+
+    Searched: the folder `near` and its parents (one of them named `name`, or holding a folder of
+    that name), folders named `name` up to PACKAGE_SEARCH_DEPTH levels below `near`'s first
+    PACKAGE_SEARCH_PARENTS parents, then each ROS_PACKAGE_PATH entry (and below it), then the
+    installed packages' share folders.
+    """
+    found: list[Path] = []
+
+    def add(p: Path) -> None:
+        if (p / name).is_dir() and p not in found:
+            found.append(p)
+
+    near = near.resolve()
+    ancestors = [near, *near.parents]
+    for a in ancestors:
+        if a.name == name:
+            add(a.parent)
+        add(a)
+    for a in ancestors[:PACKAGE_SEARCH_PARENTS + 1]:
+        for hit in _folders_named(a, name, PACKAGE_SEARCH_DEPTH):
+            add(hit.parent)
+    for entry in os.environ.get(ROS_PACKAGE_PATH_ENV, "").split(os.pathsep):
+        if not entry.strip():
+            continue
+        root = Path(entry).expanduser()
+        if root.name == name:
+            add(root.parent)
+        add(root)
+        for hit in _folders_named(root, name, PACKAGE_SEARCH_DEPTH):
+            add(hit.parent)
+    for share in package_share_dirs():
+        add(share)
+    return found
+
+
+def _folders_named(root: Path, name: str, depth: int) -> list[Path]:
+    """Folders called `name` at most `depth` levels below root (sorted, hidden folders skipped)."""
+    out: list[Path] = []
+    level = [root]
+    for _ in range(depth):
+        nxt: list[Path] = []
+        for d in level:
+            try:
+                children = sorted(c for c in d.iterdir() if c.is_dir() and not c.name.startswith("."))
+            except OSError:
+                continue
+            for c in children:
+                (out if c.name == name else nxt).append(c)
+        level = nxt
+    return out
+
+
+def resolve_package_uri(uri: str, file: Path, key: str, near: Path | None = None) -> Path:
+    """package://<pkg>/<rest> -> an existing file, searched as `package_dirs_for` says."""
+    rest = uri[len("package://"):]
+    name, _, tail = rest.partition("/")
+    for d in package_dirs_for(name, near if near is not None else file.parent):
+        candidate = d / name / tail
+        if candidate.exists():
+            return candidate
+    raise RobotModelError(file, key, f"{uri} not found (searched near {file.parent}, ROS_PACKAGE_PATH and installed packages)")
+
+
+_PACKAGE_URI = re.compile(r"package://([^/\"']+)/")
+
+
+def urdf_package_names(urdf_text: str) -> list[str]:
+    """The ROS package names a URDF's mesh filenames use, in first-use order."""
+    names: list[str] = []
+    for m in _PACKAGE_URI.finditer(urdf_text):
+        if m.group(1) not in names:
+            names.append(m.group(1))
+    return names
+
+
+# ------------------------------------------------------------------------------ SRDF
+
+
+def srdf_disabled_pairs(path: Path, file: Path) -> list[tuple[str, str]]:
+    """The `disable_collisions link1/link2` pairs of a MoveIt SRDF."""
+    try:
+        root = ET.parse(path).getroot()
+    except FileNotFoundError:
+        raise RobotModelError(file, "srdf", f"file not found: {path}") from None
+    except (ET.ParseError, OSError) as exc:
+        raise RobotModelError(file, "srdf", f"cannot read SRDF {path}: {exc}") from None
+    pairs = []
+    for el in root.iter("disable_collisions"):
+        a, b = el.get("link1"), el.get("link2")
+        if not a or not b:
+            raise RobotModelError(file, "srdf", f"{path.name}: disable_collisions needs link1 and link2")
+        pairs.append((a, b))
+    return pairs
+
+
+# ------------------------------------------------------------------------------ loading
+
+
+def load_robot_spec(path: Path) -> RobotSpec:
+    """Read and check a robot.yaml. What needs the URDF (limits' length, link names, fitted IK
+    parameters and their agreement with the URDF) is checked by `robot.load_robot`."""
+    from robomax_py.robot.ik import params_from_mapping
+
+    data = read_yaml_mapping(path, RobotModelError, "robot description")
+    try:
+        parsed = RobotFile.model_validate(data)
+    except ValidationError as exc:
+        raise validation_error(exc, RobotFile, path, RobotModelError) from None
+    if path.parent.name != parsed.name and path.name == "robot.yaml":
+        raise RobotModelError(path, "name", f"must equal the folder name '{path.parent.name}', got '{parsed.name}'")
+    if parsed.urdf.startswith("package://"):
+        urdf = resolve_package_uri(parsed.urdf, path, "urdf")
+    else:
+        urdf = (path.parent / parsed.urdf).resolve()
+    if not urdf.is_file():
+        raise RobotModelError(path, "urdf", f"file not found: {urdf}")
+    ik_params = None
+    if parsed.ik.params is not None or parsed.ik.solver not in ("opw", "ur"):
+        try:
+            ik_params = params_from_mapping(parsed.ik.solver, parsed.ik.params or {})
+        except RobotModelError as exc:
+            key = exc.key if exc.key != "ik.params.solver" else "ik.solver"
+            raise RobotModelError(path, key, exc.problem) from None
+    disabled = tuple((a, b) for a, b in parsed.collision.disable)
+    srdf = () if parsed.srdf is None else tuple(srdf_disabled_pairs((path.parent / parsed.srdf).resolve(), path))
+    ctrl = parsed.controller
+    limits = parsed.limits
+    return RobotSpec(
+        name=parsed.name,
+        source=path.resolve(),
+        urdf=urdf,
+        flange=parsed.flange,
+        ik_solver=parsed.ik.solver,
+        ik_params=ik_params,
+        acceleration=None if limits.acceleration is None else frozen_array(degs_to_rads(limits.acceleration)),
+        jerk=None if limits.jerk is None else frozen_array(degs_to_rads(limits.jerk)),
+        payload_kg=parsed.payload,
+        description=parsed.description,
+        controller=ControllerSpec(
+            brand=ctrl.brand, j23_coupling=ctrl.j23_coupling,
+            T_root_base=frozen_array(pose_matrix(ctrl.base.xyz, [math.radians(a) for a in ctrl.base.rpy])),
+        ),
+        disabled_links=disabled,
+        srdf_disabled_links=srdf,
+    )
+
+
+def load_tool_spec(path: Path) -> ToolSpec:
+    """Read and check a tool.yaml; its meshes must exist (they are read when the scene is built)."""
+    data = read_yaml_mapping(path, RobotModelError, "tool description")
+    try:
+        parsed = ToolFile.model_validate(data)
+    except ValidationError as exc:
+        raise validation_error(exc, ToolFile, path, RobotModelError) from None
+    meshes = {}
+    for key in ("body", "tips"):
+        mesh = (path.parent / getattr(parsed, key)).resolve()
+        if not mesh.is_file():
+            raise RobotModelError(path, key, f"mesh file not found: {mesh}")
+        meshes[key] = mesh
+    rpy = [math.radians(a) for a in parsed.tcp.rpy]
+    return ToolSpec(
+        name=parsed.name,
+        source=path.resolve(),
+        body=meshes["body"],
+        tips=meshes["tips"],
+        T_flange_tcp=frozen_array(pose_matrix(parsed.tcp.xyz, rpy)),
+    )

@@ -1,0 +1,21 @@
+"""Stage 5: planning. A cell -> candidates per spot (`candidates`, over `poses`), the configuration
+graph and detour learner (`graph`, with `sequence` and `roadmap`), the tour timed junction by
+junction (`tour_timing`, `junction`, `waiting`), checked (`pipeline`) -> a `PlanResult` (`results`)."""
+
+from robomax_py.plan.pipeline import plan_cell, verify_trajectory
+from robomax_py.plan.results import (
+    PlanOptions,
+    PlanResult,
+    PlanStats,
+    Progress,
+    SpotFailure,
+    SpotPlan,
+    Transition,
+    resolved_options,
+)
+from robomax_py.plan.tour_timing import weld_end
+
+__all__ = [
+    "PlanOptions", "PlanResult", "PlanStats", "Progress", "SpotFailure", "SpotPlan", "Transition",
+    "plan_cell", "resolved_options", "verify_trajectory", "weld_end",
+]

@@ -1,0 +1,226 @@
+"""Candidate robot configurations for every spot: orientation grid x IK branch, pruned with reasons.
+
+A candidate survives when it is within joint limits, collision-free at the spot, and its approach
+line (a straight TCP line of `process.approach` metres along the electrode axis) stays in the same
+IK branch and is collision-free along its whole length. Every rejection is counted by reason.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from robomax_py._typing import FloatArray, IntArray
+from robomax_py.plan.poses import (
+    OrientationGrid,
+    approach_poses,
+    orientation_grid,
+    spot_poses,
+)
+from robomax_py.robot import RobotModel, prismatic_mask
+from robomax_py.robot.ik import IkTable, solve_all
+from robomax_py.robot.ik.turns import wrap_to_pi
+from robomax_py.spec import CellSpec, SeamSpec
+from robomax_py.transforms import invert
+from robomax_py.world.collision import CollisionWorld
+
+# The approach line is solved by IK at this TCP spacing; the sweep between samples is then checked
+# by `check_path` with the collision world's own motion bound.
+APPROACH_SAMPLE_M = 0.01
+# Largest joint change between neighbouring approach samples before we call it a branch switch:
+# 10 mm of TCP motion moves a well-conditioned wrist by well under 0.2 rad.
+BRANCH_JUMP_RAD = 0.2
+# Turn variants kept per (orientation, IK branch): those nearest home in joint time. An arm whose six
+# joints all turn +-360 deg (UR10) has up to 64 variants of every solution, which multiplied the
+# candidates of a spot by ~16 and the sequencing time with them; 4 keeps every variant of a KUKA-class
+# arm (A4 and A6 beyond +-180 deg: at most 2 x 2).
+MAX_TURN_VARIANTS = 4
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SpotCandidates:
+    """The surviving configurations of one spot.
+
+    orient : (c,) int — index into the seam's OrientationGrid
+    angles : (c, 3) float, rad — alpha, beta, gamma of each candidate
+    column : (c,) int — IK table column (branch and turn variant)
+    q_spot : (c, n) float, rad — configuration with the TCP at the spot
+    q_app : (c, n) float, rad — configuration at the approach point (TCP `approach` m along +z)
+    app_path : (c, s, n) float, rad — the approach line, from q_app to q_spot
+    status, turn : (c,) int — configuration indicator bits
+    rejected : reason -> number of (orientation, branch) pairs rejected for it
+    """
+
+    seam_index: int
+    spot_index: int
+    name: str
+    orient: IntArray
+    angles: FloatArray
+    column: IntArray
+    q_spot: FloatArray
+    q_app: FloatArray
+    app_path: FloatArray
+    status: IntArray
+    turn: IntArray
+    rejected: Counter[str] = field(default_factory=Counter)
+
+    def __len__(self) -> int:
+        return len(self.orient)
+
+
+@dataclass(frozen=True, slots=True)
+class CandidateStats:
+    ik_poses: int
+    collision_checks: int
+
+
+def seam_candidates(
+    cell: CellSpec, robot: RobotModel, world: CollisionWorld, seam_index: int,
+    max_variants: int = MAX_TURN_VARIANTS, on_spot: Callable[[], None] | None = None,
+) -> tuple[list[SpotCandidates], CandidateStats]:
+    """Candidates for every spot of one seam; at most `max_variants` turn variants per orientation
+    and IK branch (those nearest home), the others counted as rejected `turn_variant`;
+    `on_spot()` is called as each spot is done."""
+    seam = cell.seams[seam_index]
+    grid = orientation_grid(seam)
+    T_base_world = invert(np.asarray(cell.T_world_base))
+    T_spot = T_base_world @ spot_poses(seam.spots, grid)                    # (S, m, 4, 4)
+    n_line = max(2, int(np.ceil(cell.process.approach / APPROACH_SAMPLE_M)) + 1)
+    fractions = np.linspace(1.0, 0.0, n_line)                               # approach point -> spot
+    T_line = np.stack([approach_poses(T_spot, cell.process.approach * f) for f in fractions], axis=2)
+    table = solve_all(robot, T_line)                                        # (S, m, L, B, n)
+    checks = 0
+    out: list[SpotCandidates] = []
+    for s in range(len(seam.spots)):
+        result, used = _spot_candidates(robot, world, seam, grid, s, table, seam_index)
+        checks += used
+        out.append(_nearest_variants(result, table.branch, np.asarray(cell.home), robot, max_variants))
+        if on_spot is not None:
+            on_spot()
+    return out, CandidateStats(ik_poses=int(np.prod(T_line.shape[:-2])), collision_checks=checks)
+
+
+def _spot_candidates(
+    robot: RobotModel, world: CollisionWorld, seam: SeamSpec, grid: OrientationGrid,
+    s: int, table: IkTable, seam_index: int,
+) -> tuple[SpotCandidates, int]:
+    q = table.q[s]                             # (m, L, B, n)
+    valid = table.valid[s]                     # (m, L, B)
+    status = table.status[s]
+    turn = table.turn[s]
+    reachable = table.reachable[s]             # a branch exists before limit filtering
+    limits = robot.limits
+    revolute = ~prismatic_mask(robot.model)
+    rejected: Counter[str] = Counter()
+    keep: list[tuple[int, int]] = []
+    lines: dict[tuple[int, int], FloatArray] = {}
+    checks = 0
+    verdicts: dict[tuple[int, ...], str] = {}   # wrapped spot q -> "" (free) or rejection reason
+    _, n_line, n_col = valid.shape
+    # The cheap tests for every (orientation, column) at once; collision checks only for survivors.
+    # IK columns are fixed 2 pi shifts of wrapped values, so a joint crossing +-180 deg along the
+    # line jumps within its column: unwrap revolute joints towards the spot value.
+    at_spot = reachable[:, -1, :]
+    within = at_spot & valid[:, -1, :]                               # (m, B)
+    oo, kk = np.nonzero(within)                                      # in scan order
+    sub = q[oo, :, kk]                                               # (c, L, n) their lines
+    spot_q = sub[:, -1:, :]
+    # Samples without a solution within the limits are NaN, and stay NaN (the line then fails the
+    # limit test below); they are wrapped as zeros, since np.mod of NaN is very slow.
+    missing = np.isnan(sub)
+    filled = np.where(missing, spot_q, sub)
+    filled[..., revolute] = spot_q[..., revolute] + wrap_to_pi(filled[..., revolute] - spot_q[..., revolute])
+    sub = np.where(missing, np.nan, filled)
+    with np.errstate(invalid="ignore"):
+        jump = np.abs(np.diff(sub, axis=1)).max(axis=(1, 2)) if len(sub) else np.zeros(0)
+    branch_ok = reachable[oo, :, kk].all(axis=1) & ~(jump > BRANCH_JUMP_RAD)
+    inside = limits.contains(sub).all(axis=1)
+    position = oo * n_col + kk                                       # of each line in the scan
+    # Reasons are counted in the order an (orientation, column) scan first meets them, so reports
+    # list equal counts in that order: reason -> (first position in the scan, count).
+    found: dict[str, tuple[float, int]] = {}
+
+    def count(reason: str, mask: np.ndarray, where: np.ndarray) -> None:
+        n = int(np.sum(mask))
+        if n:
+            found[reason] = (float(where[np.argmax(mask)]), n)
+
+    count("joint_limit", (at_spot & ~within).reshape(-1), np.arange(at_spot.size))
+    count("approach_branch", ~branch_ok, position)
+    count("approach_joint_limit", branch_ok & ~inside, position)
+    no_branch = ~at_spot.any(axis=1)
+    if no_branch.any():            # counted after its orientation's columns
+        found["unreachable"] = (int(np.argmax(no_branch)) * n_col + n_col - 0.5, n_col * int(np.sum(no_branch)))
+    for r in np.flatnonzero(branch_ok & inside):
+        o, k = int(oo[r]), int(kk[r])
+        line = sub[r]
+        # Turn variants (q +- 2 pi) share their geometry: check each wrapped line once.
+        key = tuple(np.round(np.where(revolute, wrap_to_pi(line[-1]), line[-1]), 9))
+        verdict = verdicts.get(key)
+        if verdict is None:
+            verdict, used = _line_verdict(world, line)
+            checks += used
+            verdicts[key] = verdict
+        if verdict:
+            first, n = found.get(verdict, (float(o * n_col + k), 0))
+            found[verdict] = (first, n + 1)
+            continue
+        keep.append((o, k))
+        lines[(o, k)] = line
+    for reason, (_, n) in sorted(found.items(), key=lambda item: item[1][0]):
+        rejected[reason] = n
+    idx_o = np.array([o for o, _ in keep], dtype=np.int64)
+    idx_k = np.array([k for _, k in keep], dtype=np.int64)
+    n = robot.dof
+    paths = np.array([lines[(o, k)] for o, k in keep]) if keep else np.zeros((0, n_line, n))
+    spot = seam.spots[s]
+    return SpotCandidates(
+        seam_index=seam_index, spot_index=s, name=spot.name,
+        orient=idx_o, angles=grid.angles[idx_o] if keep else np.zeros((0, 3)), column=idx_k,
+        q_spot=paths[:, -1] if keep else np.zeros((0, n)), q_app=paths[:, 0] if keep else np.zeros((0, n)),
+        app_path=paths, status=status[idx_o, -1, idx_k] if keep else np.zeros(0, dtype=np.int64),
+        turn=turn[idx_o, -1, idx_k] if keep else np.zeros(0, dtype=np.int64), rejected=rejected,
+    ), checks
+
+
+def _nearest_variants(
+    c: SpotCandidates, branch_of_column: IntArray, home: FloatArray, robot: RobotModel, max_variants: int
+) -> SpotCandidates:
+    """At most `max_variants` candidates per (orientation, IK branch): the nearest to home in joint
+    time (max over joints of |q_spot - home| / velocity limit); ties by column, so deterministic."""
+    if len(c) == 0:
+        return c
+    branch = np.asarray(branch_of_column)[c.column]
+    dist = np.max(np.abs(c.q_spot - home[None, :]) / robot.limits.velocity[None, :], axis=1)
+    order = np.lexsort((c.column, dist, branch, c.orient))
+    rank = np.zeros(len(c), dtype=np.int64)
+    prev: tuple[int, int] | None = None
+    n = 0
+    for idx in order:
+        key = (int(c.orient[idx]), int(branch[idx]))
+        n = n + 1 if key == prev else 0
+        prev = key
+        rank[idx] = n
+    sel = np.flatnonzero(rank < max_variants)
+    if len(sel) == len(c):
+        return c
+    rejected = Counter(c.rejected)
+    rejected["turn_variant"] += len(c) - len(sel)
+    return replace(
+        c, orient=c.orient[sel], angles=c.angles[sel], column=c.column[sel], q_spot=c.q_spot[sel],
+        q_app=c.q_app[sel], app_path=c.app_path[sel], status=c.status[sel], turn=c.turn[sel], rejected=rejected,
+    )
+
+
+def _line_verdict(world: CollisionWorld, line: FloatArray) -> tuple[str, int]:
+    """'' when the spot configuration and its approach line are free, else the rejection reason."""
+    contact = world.first_contact(line[-1])
+    checks = 1
+    if contact is not None:
+        return f"collision:{contact.describe()}", checks
+    res = world.check_path(line)
+    checks += res.checks
+    return ("" if res.free else "approach_blocked"), checks

@@ -1,0 +1,393 @@
+"""The configuration graph and detour learner: spot order and candidates by DP and local search on
+estimated motion times; straight moves verified lazily, blocked ones replaced by detours (a lift over
+the obstacle, else a path through the roadmap), rounds repeated until every move of the best tour is
+known free."""
+
+from __future__ import annotations
+
+import logging
+from collections import Counter
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.plan.candidates import SpotCandidates
+from robomax_py.plan.results import PlanOptions, Progress, Transition, _no_progress
+from robomax_py.plan.roadmap import Detour, Roadmap
+from robomax_py.plan.sequence import HOME, SeamBlock, Tour, choice_for_order, optimise
+from robomax_py.robot import RobotModel, fk_tcp
+from robomax_py.robot.ik import solve_all
+from robomax_py.robot.ik.turns import wrap_to_pi
+from robomax_py.spec import CellSpec
+from robomax_py.timing import (
+    ptp_time_estimate,
+)
+from robomax_py.transforms import invert
+from robomax_py.world.collision import CollisionWorld
+
+log = logging.getLogger(__name__)
+
+LIFT_HEIGHTS_M = (0.08, 0.15, 0.25, 0.4)
+# Cost of a detour not yet found, as a multiple of the straight move's estimate.
+DETOUR_PRIOR = 1.6
+# Blocked detour legs between two spots after which only verified legs are offered for that pair:
+# each blocked leg bans one (candidate, candidate, detour) triple, and two spots with hundreds of
+# candidates each would otherwise let the optimiser try a fresh unverified triple every round.
+MAX_BLOCKED_LEGS = 4
+# Placeholder keeping detour indices stable for pairs a detour cannot serve.
+_UNUSABLE = Detour(np.zeros((0, 0)), float("inf"), 0)
+
+
+
+
+class Sequencer:
+    """Spot order and candidates with lazily verified straight moves and roadmap detours.
+
+    Knowledge grows round by round: straight moves found blocked, detours found between two spots
+    (offered to every candidate pair of those spots as enter-leg + detour + leave-leg), and detour
+    legs found blocked. Cost matrices are cached per spot pair and recomputed only when what is
+    known about that pair changes. When a straight move between two spots is blocked, the cheapest
+    few other straight moves between them are checked at once; if all are blocked the spot pair is
+    treated as detour-only (this may miss a rare free straight move, never admits a blocked one).
+    A detour-only pair for which no detour is found gets a bounded number of further straight checks
+    (`_retry_straight`); a free one lifts the detour-only mark, so one unlucky probe cannot leave the
+    optimiser banning candidate pairs one round at a time.
+    """
+
+    def __init__(
+        self, cell: CellSpec, robot: RobotModel, world: CollisionWorld, roadmap: Roadmap,
+        spots: list[SpotCandidates], options: PlanOptions, rng: np.random.Generator,
+        progress: Progress = _no_progress,
+    ) -> None:
+        self.cell, self.robot, self.world, self.roadmap = cell, robot, world, roadmap
+        self.progress = progress
+        self.spots, self.options, self.rng = spots, options, rng
+        self.limits = robot.limits
+        self.home = np.asarray(cell.home)[None, :]
+        self.checks = 0
+        self.rounds = 0
+        self.dp_evaluations = 0
+        # Per spot: time of approach + weld + retract (joint-time estimate of the short LIN moves).
+        weld = cell.process.weld_time
+        self.node = [2 * ptp_time_estimate(c.q_app, c.q_spot, self.limits, options.speed) + weld for c in spots]
+        self.straight: dict[tuple[int, int], dict[tuple[int, int], bool]] = {}   # (i, j) -> (a, b) -> free
+        self.detour_only: set[tuple[int, int]] = set()                           # unordered spot pairs
+        self.no_way: dict[tuple[int, int], set[tuple[int, int]]] = {}            # (i, j) -> {(a, b)} unconnectable
+        self.detours: list[tuple[int, int, Detour]] = []                          # (from spot, to spot, path)
+        self.legs_bad: dict[tuple[int, int], set[tuple[int, int, int]]] = {}      # (i, j) -> {(a, b, v)}
+        self.legs_ok: dict[tuple[int, int], set[tuple[int, int, int]]] = {}
+        self._matrices: dict[tuple[int, int], FloatArray] = {}
+        self._estimates: dict[tuple[int, int], FloatArray] = {}
+        self.unresolved: Counter[str] = Counter()                                 # move label -> rounds left open
+
+    # ------------------------------------------------------------------ knowledge and costs
+
+    def q(self, i: int) -> FloatArray:
+        return self.home if i == HOME else self.spots[i].q_app
+
+    def _forget(self, i: int, j: int) -> None:
+        self._matrices.pop((i, j), None)
+        self._matrices.pop((j, i), None)
+
+    def estimate(self, i: int, j: int) -> FloatArray:
+        key = (i, j)
+        if key not in self._estimates:
+            back = self._estimates.get((j, i))
+            if back is not None:        # |qb - qa| = |qa - qb| bit for bit: the estimate is symmetric
+                self._estimates[key] = back.T
+            else:
+                qa, qb = self.q(i), self.q(j)
+                self._estimates[key] = ptp_time_estimate(qa[:, None, :], qb[None, :, :], self.limits,
+                                                         self.options.speed)
+        return self._estimates[key]
+
+    def vias_for(self, i: int, j: int) -> list[Detour]:
+        """Known detours usable from spot i to spot j, oriented i -> j: those found between i and j,
+        and those leaving i or reaching j (another leg then joins their far end to the other spot).
+        Indices are stable: new detours are only appended."""
+        out: list[Detour] = []
+        for di, dj, det in self.detours:
+            if di == i or dj == j:
+                out.append(det)
+            elif dj == i or di == j:
+                out.append(Detour(det.waypoints[::-1].copy(), det.time_estimate, det.checks))
+            else:
+                out.append(_UNUSABLE)
+        return out
+
+    def _via_costs(self, i: int, j: int, v: int) -> FloatArray:
+        det = self.vias_for(i, j)[v]
+        if det is _UNUSABLE:
+            return np.full((len(self.q(i)), len(self.q(j))), np.inf)
+        wp, sp = det.waypoints, self.options.speed * self.options.detour_speed
+        enter = ptp_time_estimate(self.q(i), wp[0][None, :], self.limits, sp)
+        leave = ptp_time_estimate(wp[-1][None, :], self.q(j), self.limits, sp)
+        inner = float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits, sp)))
+        via = enter[:, None] + inner + leave[None, :]
+        bad = self.legs_bad.get((i, j), set())
+        if len(bad) >= MAX_BLOCKED_LEGS:
+            verified = np.full_like(via, np.inf)
+            for a, b, vv in self.legs_ok.get((i, j), ()):
+                if vv == v:
+                    verified[a, b] = via[a, b]
+            return verified
+        for a, b, vv in bad:
+            if vv == v:
+                via[a, b] = np.inf
+        return via
+
+    def cost(self, i: int, j: int) -> FloatArray:
+        """Estimated move time between every candidate pair, using what is known about blockages."""
+        key = (i, j)
+        if key in self._matrices:
+            return self._matrices[key]
+        est = self.estimate(i, j).copy()
+        if (min(i, j), max(i, j)) in self.detour_only:
+            # Until a detour is known, price one at a multiple of the straight move: optimistic
+            # enough to be explored, costly enough not to be preferred.
+            usable = any(d is not _UNUSABLE for d in self.vias_for(i, j))
+            est = np.full_like(est, np.inf) if usable else est * DETOUR_PRIOR
+        else:
+            for (a, b), free in self.straight.get(key, {}).items():
+                if not free:
+                    est[a, b] = np.inf
+        for v in range(len(self.vias_for(i, j))):
+            est = np.minimum(est, self._via_costs(i, j, v))
+        for a, b in self.no_way.get(key, ()):
+            est[a, b] = np.inf
+        self._matrices[key] = est
+        return est
+
+    def _record_straight(self, i: int, a: int, j: int, b: int, free: bool) -> None:
+        self.straight.setdefault((i, j), {})[(a, b)] = free
+        self.straight.setdefault((j, i), {})[(b, a)] = free
+        self._forget(i, j)
+
+    def _record_leg(self, i: int, a: int, j: int, b: int, v: int, ok: bool) -> None:
+        table = self.legs_ok if ok else self.legs_bad
+        table.setdefault((i, j), set()).add((a, b, v))
+        table.setdefault((j, i), set()).add((b, a, v))
+        self._forget(i, j)
+
+    # ------------------------------------------------------------------ the loop
+
+    def _blocks(self) -> list[SeamBlock]:
+        blocks = []
+        start = 0
+        for seam in self.cell.seams:
+            ids = tuple(range(start, start + len(seam.spots)))
+            start += len(seam.spots)
+            blocks.append(SeamBlock(ids, seam.ordered or self.options.baseline))
+        return blocks
+
+    def _probe_pairs(self) -> None:
+        """One straight check per spot pair (its cheapest candidate pair): blocked pairs start detour-only."""
+        ids = [HOME, *range(len(self.spots))]
+        for x, i in enumerate(ids):
+            for j in ids[x + 1:]:
+                est = self.estimate(i, j)
+                a, b = np.unravel_index(int(np.argmin(est)), est.shape)
+                res = self.world.check_segment(self.q(i)[a], self.q(j)[b])
+                self.checks += res.checks
+                self._record_straight(i, int(a), j, int(b), res.free)
+                if not res.free:
+                    self.detour_only.add((min(i, j), max(i, j)))
+
+    def run(self) -> tuple[Tour, list[Transition]] | str:
+        blocks = self._blocks()
+        self._probe_pairs()
+        previous: tuple[tuple[int, ...], ...] = ()
+        for _ in range(self.options.max_rounds):
+            self.rounds += 1
+            # Rounds end when a tour's legs are all known free; the bar shows rounds so far.
+            self.progress("sequencing", self.rounds - 1, self.rounds)
+            if self.options.baseline:
+                order = tuple(s for b in blocks for s in b.spots)
+                choice, cost = choice_for_order(order, self.cost, self.node)
+                tour = Tour(order, choice, cost)
+            else:
+                budget = self.options.max_evaluations if self.rounds == 1 else max(50, self.options.max_evaluations // 4)
+                tour, stats = optimise(blocks, self.cost, self.node, rng=self.rng, max_evaluations=budget,
+                                       starts=previous)
+                self.dp_evaluations += stats.dp_evaluations
+                previous = (tour.order,)
+            if not np.isfinite(tour.cost):
+                return "no collision-free connection found between some spots (roadmap exhausted)"
+            transitions = self._verify(tour)
+            if transitions is not None:
+                self.progress("sequencing", self.rounds, self.rounds)
+                return tour, transitions
+        worst = ", ".join(f"{label} ({n} rounds)" for label, n in self.unresolved.most_common(5))
+        return (f"sequencing did not converge in {self.options.max_rounds} rounds; moves left without a "
+                f"verified connection most often: {worst}")
+
+    def _verify(self, tour: Tour) -> list[Transition] | None:
+        """Transitions of the tour if every leg is known free; else learn from every leg, return None."""
+        stops = [(HOME, 0), *zip(tour.order, tour.choice), (HOME, 0)]
+        out: list[Transition] = []
+        complete = True
+        for (i, a), (j, b) in zip(stops[:-1], stops[1:]):
+            qa, qb = self.q(i)[a], self.q(j)[b]
+            label = f"{self._name(i)} -> {self._name(j)}"
+            straight_ok = (min(i, j), max(i, j)) not in self.detour_only and \
+                self.straight.get((i, j), {}).get((a, b), True)
+            straight_cost = float(self.estimate(i, j)[a, b]) if straight_ok else np.inf
+            via_costs = [float(self._via_costs(i, j, v)[a, b]) for v in range(len(self.vias_for(i, j)))]
+            best_v = int(np.argmin(via_costs)) if via_costs else -1
+            if straight_ok and (best_v < 0 or straight_cost <= via_costs[best_v]):
+                if self._check_straight(i, a, j, b):
+                    out.append(Transition("move", np.array([qa, qb]), label))
+                else:
+                    complete = False
+                    self.unresolved[label] += 1
+                continue
+            if best_v < 0 or not np.isfinite(via_costs[best_v]):
+                self._new_detour(i, a, j, b)
+                complete = False
+                self.unresolved[label] += 1
+                continue
+            path = self._check_via(i, a, j, b, best_v)
+            if path is None:
+                complete = False
+                self.unresolved[label] += 1
+                continue
+            out.append(Transition("detour", path, label, self.vias_for(i, j)[best_v].checks))
+        return out if complete else None
+
+    def _check_straight(self, i: int, a: int, j: int, b: int) -> bool:
+        known = self.straight.get((i, j), {}).get((a, b))
+        if known is not None:
+            return known
+        res = self.world.check_segment(self.q(i)[a], self.q(j)[b])
+        self.checks += res.checks
+        self._record_straight(i, a, j, b, res.free)
+        if res.free:
+            return True
+        # Blocked: try the cheapest other straight moves between these two spots right away.
+        est = self.estimate(i, j)
+        known_pairs = self.straight.get((i, j), {})
+        tried = sum(1 for free in known_pairs.values() if not free)
+        for flat in np.argsort(est, axis=None, kind="stable"):
+            if tried >= self.options.straight_tries:
+                break
+            aa, bb = np.unravel_index(int(flat), est.shape)
+            if (int(aa), int(bb)) in known_pairs:
+                continue
+            r = self.world.check_segment(self.q(i)[aa], self.q(j)[bb])
+            self.checks += r.checks
+            self._record_straight(i, int(aa), j, int(bb), r.free)
+            if r.free:
+                return False          # a free alternative exists; let the optimiser weigh it
+            tried += 1
+        self.detour_only.add((min(i, j), max(i, j)))
+        self._forget(i, j)
+        self._new_detour(i, a, j, b)
+        return False
+
+    def _lift_detour(self, i: int, a: int, j: int, b: int) -> Detour | None:
+        """Up, across, down: the TCP raised by h at both ends in the same IK branch, for clamps.
+
+        The cheapest kind of detour an operator would teach; tried for rising h before the roadmap.
+        """
+        qa, qb = self.q(i)[a], self.q(j)[b]
+        up = invert(np.asarray(self.cell.T_world_base))[:3, :3] @ np.array([0.0, 0.0, 1.0])
+        checks = 0
+        for h in LIFT_HEIGHTS_M:
+            ends = []
+            for q, idx, col in ((qa, i, a), (qb, j, b)):
+                if idx == HOME:
+                    ends.append(q)
+                    continue
+                T = fk_tcp(self.robot, q)
+                T[:3, 3] += h * up
+                table = solve_all(self.robot, T[None], q_hint=q)
+                column = int(self.spots[idx].column[col])
+                if not table.valid[0, column]:
+                    break
+                lifted = table.q[0, column].copy()
+                ends.append(q + wrap_to_pi(lifted - q))
+            if len(ends) < 2 or not self.limits.contains(np.array(ends)).all():
+                continue
+            path = np.array([qa, ends[0], ends[1], qb])
+            ok = True
+            for p0, p1 in zip(path[:-1], path[1:]):
+                if np.allclose(p0, p1):
+                    continue
+                res = self.world.check_segment(p0, p1)
+                checks += res.checks
+                if not res.free:
+                    ok = False
+                    break
+            if ok:
+                keep = [0] + [k for k in range(1, 4) if not np.allclose(path[k], path[k - 1])]
+                wp = path[keep]
+                return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits))), checks)
+        self.checks += checks
+        return None
+
+    def _new_detour(self, i: int, a: int, j: int, b: int) -> None:
+        # Lift first: on clamp cells it is found in ~1,000 checks; the roadmap is the general fallback.
+        det = self._lift_detour(i, a, j, b) or self.roadmap.query(self.q(i)[a], self.q(j)[b])
+        if det is None:
+            # No way found for this exact pair: make sure the optimiser stops choosing it.
+            self.no_way.setdefault((i, j), set()).add((a, b))
+            self.no_way.setdefault((j, i), set()).add((b, a))
+            self._forget(i, j)
+            if (min(i, j), max(i, j)) in self.detour_only:
+                self._retry_straight(i, j)
+            return
+        self.checks += det.checks
+        self.detours.append((i, j, det))
+        # Every pair sharing an end spot with this detour may now use it.
+        self._matrices.clear()
+        self._record_leg(i, a, j, b, len(self.detours) - 1, True)   # its ends are this pair's configurations
+
+    def _retry_straight(self, i: int, j: int) -> bool:
+        """A detour-only spot pair without a detour: check up to `straight_tries` straight moves between
+        candidate pairs not yet checked, cheapest first; a free one lifts the detour-only mark.
+
+        The pair may have been marked detour-only after a single blocked probe (`_probe_pairs`) while
+        other candidate pairs of the same two spots move freely (a clamp beside one orientation only).
+        """
+        est = self.estimate(i, j)
+        known = self.straight.get((i, j), {})
+        banned = self.no_way.get((i, j), set())
+        tried = 0
+        for flat in np.argsort(est, axis=None, kind="stable"):
+            if tried >= self.options.straight_tries:
+                break
+            a, b = (int(x) for x in np.unravel_index(int(flat), est.shape))
+            if (a, b) in known or (a, b) in banned or not np.isfinite(est[a, b]):
+                continue
+            res = self.world.check_segment(self.q(i)[a], self.q(j)[b])
+            self.checks += res.checks
+            self._record_straight(i, a, j, b, res.free)
+            tried += 1
+            if res.free:
+                self.detour_only.discard((min(i, j), max(i, j)))
+                self._forget(i, j)
+                return True
+        return False
+
+    def _check_via(self, i: int, a: int, j: int, b: int, v: int) -> FloatArray | None:
+        wp = self.vias_for(i, j)[v].waypoints
+        qa, qb = self.q(i)[a], self.q(j)[b]
+        if (a, b, v) not in self.legs_ok.get((i, j), set()):
+            for p, r in ((qa, wp[0]), (wp[-1], qb)):
+                if np.allclose(p, r):
+                    continue
+                res = self.world.check_segment(p, r)
+                self.checks += res.checks
+                if not res.free:
+                    self._record_leg(i, a, j, b, v, False)
+                    self._new_detour(i, a, j, b)
+                    return None
+            self._record_leg(i, a, j, b, v, True)
+        path = np.vstack([qa[None, :], wp, qb[None, :]])
+        keep = [0] + [k for k in range(1, len(path)) if not np.allclose(path[k], path[k - 1])]
+        return path[keep]
+
+    def _name(self, i: int) -> str:
+        return "home" if i == HOME else self.spots[i].name
+
+

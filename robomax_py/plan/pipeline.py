@@ -1,0 +1,178 @@
+"""A cell -> a collision-free, cycle-time-optimised spot-welding trajectory (no file I/O, no printing).
+
+Stages: candidates per spot (orientation grid x IK branch, pruned) -> sequencing (spot order and
+candidates by DP and local search on estimated motion times, straight moves verified lazily, detours
+through a roadmap where they are blocked) -> timing (jerk-limited PTP moves, detours, LIN
+approach/retract, dwells) -> a dense re-check of the timed trajectory, which is only returned when
+every sample pair is collision-free and within limits.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections import Counter
+from dataclasses import replace
+
+import numpy as np
+
+from robomax_py.plan.candidates import SpotCandidates, seam_candidates
+from robomax_py.plan.graph import Sequencer
+from robomax_py.plan.results import (
+    PlanOptions,
+    PlanResult,
+    PlanStats,
+    Progress,
+    SpotFailure,
+    _no_progress,
+    resolved_options,
+)
+from robomax_py.plan.roadmap import Roadmap
+from robomax_py.plan.tour_timing import time_tour
+from robomax_py.plan.waiting import WaitingError
+from robomax_py.robot import RobotModel
+from robomax_py.spec import CellSpec
+from robomax_py.timing import (
+    TimingError,
+    Trajectory,
+)
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.motion import MotionCheck, check_motion
+from robomax_py.world.scene import build_scene
+
+log = logging.getLogger(__name__)
+
+# The planner's own check allows this relative velocity slack (toppra's output is within ~1e-5).
+PLAN_VELOCITY_RTOL = 1e-3
+
+
+def plan_cell(
+    cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOptions(), progress: Progress = _no_progress,
+) -> PlanResult:
+    """Plan a cell whose robot (with its tool mounted) is given; `progress` hears of each stage's advance."""
+    options = resolved_options(cell, options)
+    clock: dict[str, float] = {}
+    t0 = time.perf_counter()
+    full_world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+    # Planned as if the dynamic obstacles were absent; `waiting` then holds the robot where one is
+    # in the way. The final check is against everything, at its time.
+    world = CollisionWorld(robot, build_scene(replace(cell, dynamic=()), robot), cell.process.clearance) \
+        if cell.dynamic else full_world
+    clock["world"] = time.perf_counter() - t0
+    log.debug("%s: collision world of %d pieces, %d pairs in %.2f s", cell.name, world.geometry_model.ngeoms,
+              world.n_pairs, clock["world"])
+
+    home_contact = world.first_contact(cell.home)
+    if home_contact is not None:
+        return PlanResult(cell.name, robot.name, "infeasible", f"home is in collision: {home_contact.describe()}")
+
+    t0 = time.perf_counter()
+    spots: list[SpotCandidates] = []
+    candidate_checks = 0
+    n_spots = sum(len(seam.spots) for seam in cell.seams)
+    done = iter(range(1, n_spots + 1))
+    progress("candidates", 0, n_spots)
+    for s in range(len(cell.seams)):
+        found, stats = seam_candidates(cell, robot, world, s,
+                                       on_spot=lambda: progress("candidates", next(done), n_spots))
+        spots.extend(found)
+        candidate_checks += stats.collision_checks
+    clock["candidates"] = time.perf_counter() - t0
+    for c in spots:
+        log.debug("spot %s/%s: %d candidates; rejected %s", cell.seams[c.seam_index].name, c.name, len(c),
+                  dict(c.rejected.most_common()) or "none")
+    failures = tuple(_failure(cell, c) for c in spots if len(c) == 0)
+    if failures:
+        names = ", ".join(f"{f.seam}/{f.name} ({f.reason})" for f in failures)
+        return PlanResult(cell.name, robot.name, "infeasible", f"{len(failures)} spot(s) cannot be welded: {names}",
+                          failures=failures)
+    if options.baseline:
+        spots = [_baseline_candidate(c) for c in spots]
+
+    t0 = time.perf_counter()
+    rng = np.random.default_rng(cell.planner.seed)
+    anchors = np.vstack([cell.home[None, :], *[c.q_app for c in spots]])
+    roadmap = Roadmap(world, robot.limits, anchors, rng, options.roadmap_nodes, options.roadmap_k, seeds=anchors)
+    clock["roadmap"] = time.perf_counter() - t0
+    log.debug("roadmap: %d nodes in %.2f s", len(roadmap.nodes), clock["roadmap"])
+
+    t0 = time.perf_counter()
+    sequencer = Sequencer(cell, robot, world, roadmap, spots, options, rng, progress)
+    outcome = sequencer.run()
+    clock["sequencing"] = time.perf_counter() - t0
+    log.debug("sequencing: %d rounds, %d DP evaluations, %d collision checks in %.2f s", sequencer.rounds,
+              sequencer.dp_evaluations, sequencer.checks, clock["sequencing"])
+    if isinstance(outcome, str):
+        return PlanResult(cell.name, robot.name, "infeasible", outcome)
+    tour, transitions = outcome
+
+    t0 = time.perf_counter()
+    try:
+        trajectory, plans, transitions = time_tour(cell, robot, world, spots, tour, transitions, options, progress)
+    except TimingError as exc:
+        return PlanResult(cell.name, robot.name, "infeasible", f"timing failed: {exc}")
+    except WaitingError as exc:
+        return PlanResult(cell.name, robot.name, "infeasible", f"dynamic obstacles: {exc}")
+    clock["timing"] = time.perf_counter() - t0
+    log.debug("timing: cycle %.3f s, %d samples in %.2f s", trajectory.duration, len(trajectory.t), clock["timing"])
+
+    t0 = time.perf_counter()
+    progress("verify", 0, 1)
+    check = verify_trajectory(full_world, robot, trajectory)
+    verify_checks = check.checks
+    progress("verify", 1, 1)
+    clock["verify"] = time.perf_counter() - t0
+    log.debug("verify: %d collision checks in %.2f s, %d violations", verify_checks, clock["verify"], len(check.violations))
+    if not check.clean:
+        v = check.violations[0]
+        return PlanResult(cell.name, robot.name, "infeasible",
+                          f"the timed program failed its own check: {v.kind}: {v.detail} at t = {v.t:.3f} s")
+
+    stats = PlanStats(
+        candidates=sum(len(c) for c in spots), candidate_checks=candidate_checks,
+        sequencing_checks=sequencer.checks, roadmap_checks=roadmap.sampling_checks + roadmap.edge_checks,
+        verify_checks=verify_checks, detours=sum(1 for t in transitions if t.kind == "detour"),
+        rounds=sequencer.rounds, dp_evaluations=sequencer.dp_evaluations, seconds=clock,
+    )
+    return PlanResult(cell.name, robot.name, "planned", "planned", spots=tuple(plans), transitions=tuple(transitions),
+                      trajectory=trajectory, stats=stats, baseline=options.baseline, joint_names=robot.joint_names,
+                      tool=cell.tool.name, T_flange_tcp=np.asarray(robot.T_flange_tcp),
+                      T_world_base=np.asarray(cell.T_world_base),
+                      T_root_controller=np.asarray(cell.robot.controller.T_root_base), home=np.asarray(cell.home), options=options,
+                      weld_time=cell.process.weld_time)
+
+
+def verify_trajectory(world: CollisionWorld, robot: RobotModel, traj: Trajectory) -> MotionCheck:
+    """Every sample within limits and every straight step between samples free? The same check
+    `robomax verify` runs (`world.motion.check_motion`), stopping at the first problem."""
+    return check_motion(world, robot, traj.t, traj.q, stop_at_first=True, velocity_rtol=PLAN_VELOCITY_RTOL)
+
+
+def _failure(cell: CellSpec, c: SpotCandidates) -> SpotFailure:
+    """The dominant reason a spot has no candidate."""
+    seam = cell.seams[c.seam_index].name
+    if not c.rejected:
+        return SpotFailure(seam, c.name, "unreachable", "no IK solution at any orientation")
+    groups: Counter[str] = Counter()
+    for reason, n in c.rejected.items():
+        groups[reason.split(":")[0]] += n
+    order = ("approach_blocked", "collision", "approach_branch", "approach_joint_limit", "joint_limit", "unreachable")
+    for reason in order:
+        if groups.get(reason):
+            detail = ", ".join(f"{k} x{v}" for k, v in c.rejected.most_common(4))
+            label = {"approach_branch": "approach_blocked", "approach_joint_limit": "joint_limit"}.get(reason, reason)
+            return SpotFailure(seam, c.name, label, detail)
+    return SpotFailure(seam, c.name, "unreachable", "no IK solution at any orientation")
+
+
+def _baseline_candidate(c: SpotCandidates) -> SpotCandidates:
+    """The published method's choice: nearest-to-nominal orientation, then the first branch."""
+    # Grid orientations are ordered by distance from nominal, so the lowest index is the nearest.
+    best = int(np.lexsort((c.column, c.orient))[0])
+    sel = np.array([best])
+    return replace(
+        c, orient=c.orient[sel], angles=c.angles[sel], column=c.column[sel], q_spot=c.q_spot[sel],
+        q_app=c.q_app[sel], app_path=c.app_path[sel], status=c.status[sel], turn=c.turn[sel],
+    )
+
+

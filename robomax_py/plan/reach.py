@@ -1,0 +1,163 @@
+"""Quick checks of a cell's robot that `robomax check` runs before any planning.
+
+- Reach: whether each spot can be reached at all, by a bound that needs no IK. A point fixed in the
+  link that axis 4 turns (the wrist centre of a spherical wrist) stays within the upper arm plus
+  forearm length of the axis-2 origin, which itself turns on a circle about axis 1; a spot all of
+  whose grid orientations put that point farther from the circle is unreachable, and by how much
+  is a figure the user can act on. Arms without a spherical wrist use the whole chain's length to
+  the TCP instead (a weaker bound, still never wrong).
+- Self contact: link pairs (neither adjacent nor disabled) that touch at home, or in every one of a
+  few hundred random configurations: candidates for robot.yaml `collision.disable`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from robomax_py._typing import FloatArray
+from robomax_py.plan.poses import orientation_grid, spot_poses
+from robomax_py.robot import RobotModel
+from robomax_py.robot.ik._chain import chain_to_frame, joint_frames
+from robomax_py.spec import CellSpec
+from robomax_py.transforms import closest_on_line, invert
+
+WRIST_MEET_TOL_M = 1e-6
+CONTACT_SAMPLES = 200
+
+
+@dataclass(frozen=True, slots=True)
+class SpotReach:
+    """How far a spot's best grid orientation puts the arm's reference point from the shoulder circle."""
+
+    seam: str
+    name: str
+    key: str                 # seams[i].spots[j]
+    distance_m: float        # from the shoulder circle to the reference point, best orientation
+    reach_m: float           # the longest that distance can be
+
+    @property
+    def out_by_m(self) -> float:
+        return self.distance_m - self.reach_m
+
+    @property
+    def reachable(self) -> bool:
+        return self.out_by_m <= 0.0
+
+
+@dataclass(frozen=True, slots=True)
+class _ReachModel:
+    axis_point: FloatArray   # (3,) on axis 1
+    axis: FloatArray         # (3,) unit
+    shoulder: FloatArray     # (3,) the axis-2 origin at q = 0
+    p_tcp_ref: FloatArray    # (3,) the reference point in the TCP frame
+    reach: float
+
+
+def _reach_model(robot: RobotModel) -> _ReachModel:
+    model = robot.model
+    chain = chain_to_frame(model, robot.flange_frame_id)
+    F = joint_frames(chain, np.zeros((1, model.nq)))[0]
+    u = [F[i, :3, :3] @ chain.A[i, :3, 2] for i in range(len(chain.joints))]
+    p = [F[i, :3, 3] for i in range(len(chain.joints))]
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, np.zeros(model.nq))
+    T_flange = data.oMf[robot.flange_frame_id].homogeneous
+    T_tcp = T_flange @ np.asarray(robot.T_flange_tcp)
+    wrist = _wrist_centre(p, u) if len(p) >= 6 else None
+    if wrist is not None:
+        ref = wrist
+        reach = float(np.linalg.norm(p[2] - p[1]) + np.linalg.norm(wrist - p[2]))
+    else:
+        ref = T_tcp[:3, 3]
+        reach = float(sum(np.linalg.norm(p[i + 1] - p[i]) for i in range(1, len(p) - 1)) + np.linalg.norm(ref - p[-1]))
+    p_ref = (invert(T_tcp) @ np.append(ref, 1.0))[:3]
+    return _ReachModel(p[0], u[0] / np.linalg.norm(u[0]), p[1], p_ref, reach)
+
+
+def _wrist_centre(p: list[FloatArray], u: list[FloatArray]) -> FloatArray | None:
+    """Where axes 4, 5 and 6 meet at q = 0, or None when they do not meet in one point."""
+    c = closest_on_line(p[3], u[3] / np.linalg.norm(u[3]), p[4], u[4] / np.linalg.norm(u[4]))
+    for k in (3, 4, 5):
+        if np.linalg.norm(np.cross(c - p[k], u[k])) > WRIST_MEET_TOL_M * max(1.0, np.linalg.norm(u[k])):
+            return None
+    return c
+
+
+def reach_report(cell: CellSpec, robot: RobotModel) -> list[SpotReach]:
+    """Every spot's reach figure, in cell order (see the module docstring)."""
+    rm = _reach_model(robot)
+    T_base_world = invert(np.asarray(cell.T_world_base))
+    out = []
+    for i, seam in enumerate(cell.seams):
+        grid = orientation_grid(seam)
+        poses = spot_poses(seam.spots, grid)                      # (s, o, 4, 4) world
+        ref = np.einsum("...ij,j->...i", T_base_world @ poses, np.append(rm.p_tcp_ref, 1.0))[..., :3]
+        d = _distance_to_circle(ref, rm)                            # (s, o)
+        best = d.min(axis=1)
+        for j, spot in enumerate(seam.spots):
+            out.append(SpotReach(seam.name, spot.name, f"seams[{i}].spots[{j}]", float(best[j]), rm.reach))
+    return out
+
+
+def _distance_to_circle(points: FloatArray, rm: _ReachModel) -> FloatArray:
+    """Distance of points (..., 3) from the circle the shoulder point sweeps about axis 1."""
+    rel_s = rm.shoulder - rm.axis_point
+    h_s = float(rel_s @ rm.axis)
+    r_s = float(np.linalg.norm(rel_s - h_s * rm.axis))
+    rel = points - rm.axis_point
+    h = rel @ rm.axis
+    rho = np.linalg.norm(rel - h[..., None] * rm.axis, axis=-1)
+    dist: FloatArray = np.hypot(h - h_s, rho - r_s)
+    return dist
+
+
+def self_contacts(robot: RobotModel, home: FloatArray, samples: int = CONTACT_SAMPLES,
+                  seed: int = 0) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
+    """(link pairs touching at home, link pairs touching in every random sample); neither adjacent
+    nor disabled in robot.yaml. Link geometry only (the tool is checked by the planner)."""
+    model = robot.model
+    gm = robot.collision_model.copy()
+    objs = list(gm.geometryObjects)
+    pairs: list[tuple[int, int]] = []
+    for a in range(len(objs)):
+        for b in range(a + 1, len(objs)):
+            ja, jb = int(objs[a].parentJoint), int(objs[b].parentJoint)
+            if ja == jb or int(model.parents[ja]) == jb or int(model.parents[jb]) == ja:
+                continue
+            la, lb = model.frames[objs[a].parentFrame].name, model.frames[objs[b].parentFrame].name
+            if frozenset((la, lb)) in robot.disabled_links:
+                continue
+            gm.addCollisionPair(pin.CollisionPair(a, b))
+            pairs.append((a, b))
+    if not pairs:
+        return [], []
+    gdata = gm.createData()
+    for req in gdata.collisionRequests:
+        req.enable_contact = True      # coal reports overlapping convex hulls only with contacts on
+    data = model.createData()
+
+    def touching(q: FloatArray) -> set[int]:
+        pin.computeCollisions(model, data, gm, gdata, np.asarray(q, dtype=float), False)
+        return {k for k, r in enumerate(gdata.collisionResults) if r.isCollision()}
+
+    at_home = touching(home)
+    rng = np.random.default_rng(seed)
+    always = set(range(len(pairs)))
+    for q in rng.uniform(robot.limits.lower, robot.limits.upper, size=(samples, robot.dof)):
+        always &= touching(q)
+        if not always:
+            break
+
+    def names(ks: set[int]) -> list[tuple[str, str]]:
+        out = []
+        for k in sorted(ks):
+            a, b = pairs[k]
+            pair = (model.frames[objs[a].parentFrame].name, model.frames[objs[b].parentFrame].name)
+            if pair not in out:
+                out.append(pair)
+        return out
+
+    return names(at_home), names(always)

@@ -1,0 +1,131 @@
+"""What planning returns: options, per-spot plans and failures, transitions, statistics, the result."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+from robomax_py._typing import FloatArray
+from robomax_py.plan.waiting import WaitPlan
+from robomax_py.spec import CellSpec
+from robomax_py.timing import (
+    Trajectory,
+)
+
+Progress = Callable[[str, int, int], None]
+"""progress(stage, done, total): called as a long stage advances ("candidates", "sequencing",
+"timing", "verify"); the CLI draws progress bars from it. total may grow (sequencing rounds)."""
+
+
+def _no_progress(stage: str, done: int, total: int) -> None:
+    pass
+
+
+# Heights (m, world z) tried for up-across-down detours over clamps, lowest first.
+
+@dataclass(frozen=True, slots=True)
+class PlanOptions:
+    """How to plan; every field has a production default."""
+
+    baseline: bool = False           # the published method: given order, nominal orientation, first branch
+    # Speeds; None takes the cell's `planner` values (defaults 1.0, 0.5 m/s, 1.0).
+    speed: float | None = None       # global override in (0, 1] of every programmed speed
+    tcp_speed: float | None = None   # m/s on approach and retract lines (before the override)
+    detour_speed: float | None = None  # speed fraction of detour moves (before the override)
+    roadmap_nodes: int = 600
+    roadmap_k: int = 12
+    straight_tries: int = 12         # blocked straight moves between two spots before detours only
+    max_rounds: int = 80             # sequencing rounds (optimise, verify, repair)
+    max_evaluations: int = 400       # DP evaluations per sequencing round
+    jerk_limited: bool = True        # PTP moves and detour legs with ruckig; False: toppra (vel/acc only)
+    blend: bool = True               # fly by detour corners and approach points on checked G2 blends where faster
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SpotPlan:
+    """One welded spot: where and how."""
+
+    seam: str
+    name: str
+    angles: FloatArray               # (3,) alpha, beta, gamma, rad
+    config: str                      # the controller brand's configuration data at the spot
+    q_spot: FloatArray
+    q_app: FloatArray
+    t_arrive: float
+    t_leave: float
+    T_spot: FloatArray               # (4, 4) TCP at the spot, robot base frame
+    T_app: FloatArray                # (4, 4) TCP at the approach point, robot base frame
+    config_app: str = ""             # configuration data at the approach point (where the retract ends)
+
+
+@dataclass(frozen=True, slots=True)
+class SpotFailure:
+    seam: str
+    name: str
+    reason: str                      # unreachable | joint_limit | collision | approach_blocked
+    detail: str
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Transition:
+    """The joint path between two stops (home or an approach point); kind 'move' or 'detour'."""
+
+    kind: str
+    waypoints: FloatArray            # (m, n), both ends included
+    label: str
+    checks: int = 0                  # collision checks spent finding this detour (0 for a straight move)
+    blend_radius: float = 0.0        # rad: detour corners passed on G2 blends of this radius; 0: stops at each
+    flyby_radius: float = 0.0        # rad: the retract -> move and move -> approach joins flown by; 0: stops
+    wait: WaitPlan | None = None     # a wait at rest before it, for a dynamic obstacle to clear
+
+
+@dataclass(frozen=True, slots=True)
+class PlanStats:
+    candidates: int
+    candidate_checks: int
+    sequencing_checks: int
+    roadmap_checks: int
+    verify_checks: int
+    detours: int
+    rounds: int
+    dp_evaluations: int
+    seconds: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PlanResult:
+    cell: str
+    robot: str
+    status: str                      # "planned" | "infeasible"
+    message: str
+    spots: tuple[SpotPlan, ...] = ()
+    failures: tuple[SpotFailure, ...] = ()
+    transitions: tuple[Transition, ...] = ()
+    trajectory: Trajectory | None = None
+    stats: PlanStats | None = None
+    baseline: bool = False
+    joint_names: tuple[str, ...] = ()
+    tool: str = ""
+    T_flange_tcp: FloatArray | None = None   # (4, 4)
+    T_world_base: FloatArray | None = None   # (4, 4)
+    T_root_controller: FloatArray | None = None   # (4, 4) the controller's base in the URDF root frame
+    home: FloatArray | None = None
+    options: PlanOptions = PlanOptions()
+    weld_time: float = 0.0
+
+    @property
+    def cycle_time(self) -> float:
+        return float("nan") if self.trajectory is None else self.trajectory.duration
+
+
+def resolved_options(cell: CellSpec, options: PlanOptions) -> PlanOptions:
+    """The options with every speed left None taken from the cell's `planner` section."""
+    p = cell.planner
+    return replace(
+        options,
+        speed=p.speed if options.speed is None else options.speed,
+        tcp_speed=p.tcp_speed if options.tcp_speed is None else options.tcp_speed,
+        detour_speed=p.detour_speed if options.detour_speed is None else options.detour_speed,
+    )
+
+

@@ -1,0 +1,129 @@
+"""The chosen tour timed junction by junction (retract, move or detour, approach), dwells at the spots,
+waits for dynamic obstacles; the spot plans as the program states them."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.plan.candidates import SpotCandidates
+from robomax_py.plan.junction import WeldEnd, time_junction
+from robomax_py.plan.poses import (
+    OrientationGrid,
+    approach_poses,
+    orientation_grid,
+    spot_poses,
+)
+from robomax_py.plan.results import (
+    PlanOptions,
+    Progress,
+    SpotPlan,
+    Transition,
+    _no_progress,
+)
+from robomax_py.plan.sequence import Tour
+from robomax_py.plan.waiting import WaitPlan, schedule_waits
+from robomax_py.program import (
+    as_written_joints,
+    as_written_pose_in,
+    written_seconds,
+    written_speed,
+    written_tcp_speed,
+)
+from robomax_py.robot import RobotModel
+from robomax_py.robot.ik import config_text
+from robomax_py.spec import CellSpec
+from robomax_py.timing import (
+    Segment,
+    Trajectory,
+    concatenate,
+    dwell,
+    resample,
+)
+from robomax_py.transforms import invert
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.scene import build_scene
+
+
+def time_tour(
+    cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots: list[SpotCandidates], tour: Tour,
+    transitions: list[Transition], options: PlanOptions, progress: Progress = _no_progress,
+) -> tuple[Trajectory, list[SpotPlan], list[Transition]]:
+    """Junction by junction (retract, move or detour, approach; `junction.time_junction`) and dwells."""
+    grids = [orientation_grid(seam) for seam in cell.seams]
+    ends: list[WeldEnd] = []
+    welded: list[tuple[int, int, FloatArray, FloatArray]] = []
+    for i, a in zip(tour.order, tour.choice):
+        end = weld_end(cell, spots[i], a, grids)
+        ends.append(end)
+        welded.append((i, a, end.T_spot, end.T_app))
+    blocks: list[list[Segment]] = []
+    timed: list[Transition] = []
+    q_now = as_written_joints(cell.home)
+    weld_time = written_seconds(cell.process.weld_time)
+    for k, trans in enumerate(transitions):
+        progress("timing", k, len(transitions))
+        before = ends[k - 1] if k > 0 else None
+        after = ends[k] if k < len(ends) else None
+        waypoints = as_written_joints(trans.waypoints)      # the first row: where the retract ends
+        trans = replace(trans, waypoints=waypoints)
+        junction = time_junction(
+            robot, world, robot.limits, q_now, waypoints, trans.kind, trans.label, before, after,
+            tcp_speed=written_tcp_speed(options.tcp_speed * options.speed),
+            speed=written_speed(options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)),
+            jerk_limited=options.jerk_limited, flyby=options.blend,
+        )
+        block = list(junction.segments)
+        timed.append(replace(trans, blend_radius=junction.corner_radius, flyby_radius=junction.junction_radius))
+        q_now = block[-1].q[-1]
+        if after is not None:
+            block.append(dwell(q_now, weld_time, kind="weld", label=after.label))
+        blocks.append(block)
+    segments: list[Segment] = []
+    waits = {w.index: w for w in _waits(cell, robot, blocks)}
+    for k, block in enumerate(blocks):
+        if k in waits:
+            w = waits[k]
+            segments.append(dwell(block[0].q[0], w.seconds, kind="wait", label=f"wait for {w.obstacle}"))
+            timed[k] = replace(timed[k], wait=w)
+        segments.extend(block)
+    progress("timing", len(transitions), len(transitions))
+    traj = resample(concatenate(segments))
+    plans = []
+    for i, a, T_spot, T_app in welded:
+        c = spots[i]
+        seam = cell.seams[c.seam_index]
+        label = f"{seam.name}/{c.name}"
+        phase = traj.phases_of("weld", label)[0]
+        q_spot = np.asarray(traj.q[phase.i_start], dtype=float)
+        # Each target states its own configuration: on ABB and FANUC arms J2 is often near 0 at
+        # the spot and changes sign over the approach line (issue 14).
+        plans.append(SpotPlan(seam.name, c.name, c.angles[a], config_text(robot, c.q_spot[a]), q_spot,
+                              as_written_joints(c.q_app[a]), float(phase.t_start), float(phase.t_end), T_spot, T_app,
+                              config_text(robot, c.q_app[a])))
+    return traj, plans, timed
+
+
+def weld_end(cell: CellSpec, c: SpotCandidates, a: int, grids: list[OrientationGrid]) -> WeldEnd:
+    """Candidate a of spot c as a junction end: its TCP poses at the spot and the approach point
+    (robot base frame) as the program states them. Timed and checked rounded to the program's
+    decimals, so the written program is exactly the motion checked (`rebuild` gives it back).
+    grids: `orientation_grid` of every seam of the cell."""
+    seam = cell.seams[c.seam_index]
+    T_world = spot_poses((seam.spots[c.spot_index],), grids[c.seam_index])[0, c.orient[a]]
+    # Rounded as the program states them: in the controller's base frame (SPEC §6).
+    C = cell.robot.controller.T_root_base
+    T_spot = as_written_pose_in(invert(np.asarray(cell.T_world_base)) @ T_world, C)
+    T_app = as_written_pose_in(approach_poses(T_spot, cell.process.approach), C)
+    return WeldEnd(T_spot, T_app, None, f"{seam.name}/{c.name}")
+
+
+def _waits(cell: CellSpec, robot: RobotModel, blocks: list[list[Segment]]) -> list[WaitPlan]:
+    """Where the robot waits for dynamic obstacles (`waiting`), checked against them alone."""
+    if not cell.dynamic:
+        return []
+    world = CollisionWorld(robot, build_scene(replace(cell, objects=()), robot), cell.process.clearance)
+    windows = {d.name: d.present if d.present is not None else ((0.0, float("inf")),) for d in cell.dynamic}
+    return schedule_waits(world, blocks, windows)

@@ -1,0 +1,123 @@
+"""Waiting for dynamic obstacles (a machine door present in time windows) to clear.
+
+The planner plans the cell as if its dynamic obstacles were absent, then walks the timed program
+in time order: where a junction (retract, move or detour, approach, and the weld after it) would
+meet a dynamic obstacle inside one of its windows, the robot waits at rest where it is until that
+window is over, and the program says so (`WAIT FOR <name>_clear` when the obstacle is there when
+the wait begins, else `WAIT n SEC`). A robot that would itself be hit while waiting, or a window
+that never ends, makes the cell infeasible with a message naming the obstacle.
+
+`WAIT FOR <name>_clear` holds for `clear_wait`: until the window's end rounded up to the
+program's millisecond, plus one millisecond (windows include their end), so a rebuilt program
+waits exactly as planned.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomax_py.timing import Segment
+from robomax_py.world.collision import KIND_DYNAMIC, CollisionWorld
+
+# Programs state times in milliseconds (TIME_DECIMALS = 3).
+TIME_STEP_S = 0.001
+# Waits inserted per program before the planner gives up.
+MAX_WAITS = 50
+CLEAR_SUFFIX = "_clear"
+
+
+@dataclass(frozen=True, slots=True)
+class WaitPlan:
+    """A wait before junction `index`: seconds, the obstacle, and whether it is written as WAIT FOR."""
+
+    index: int
+    seconds: float
+    obstacle: str
+    for_signal: bool
+
+
+class WaitingError(Exception):
+    """The dynamic obstacles cannot be avoided by waiting; the message says which and when."""
+
+
+def clear_wait(t: float, windows: Sequence[tuple[float, float]]) -> float:
+    """Seconds `WAIT FOR <name>_clear` holds at time t: 0 when the obstacle is absent."""
+    for w0, w1 in windows:
+        if w0 <= t <= w1:
+            return _ceil_ms(w1 - t) + TIME_STEP_S
+    return 0.0
+
+
+def _ceil_ms(seconds: float) -> float:
+    return round(math.ceil(round(seconds / TIME_STEP_S, 6)) * TIME_STEP_S, 3)
+
+
+def schedule_waits(world: CollisionWorld, blocks: Sequence[Sequence[Segment]],
+                   windows: dict[str, tuple[tuple[float, float], ...]]) -> list[WaitPlan]:
+    """Waits (at most one per block, before it) that keep every block clear of dynamic obstacles.
+
+    blocks : the program's motion in order, each a list of segments starting at rest (a
+        junction and the weld after it). Times add up as the program's clock.
+    windows : each dynamic obstacle's presence windows, by name.
+    """
+    waits: dict[int, WaitPlan] = {}
+    starts = [0.0] * len(blocks)
+    k = 0
+    t = 0.0
+    for _ in range(MAX_WAITS + len(blocks)):
+        if k >= len(blocks):
+            return [waits[i] for i in sorted(waits)]
+        starts[k] = t
+        wait = waits[k].seconds if k in waits else 0.0
+        q_rest = np.asarray(blocks[k][0].q[0], dtype=float)
+        if wait > 0:
+            for spans in windows.values():
+                for w0, w1 in spans:
+                    if w0 <= t + wait and w1 >= t:
+                        t_in = max(w0, t)
+                        contact = world.first_contact(q_rest, t_in)
+                        if contact is not None and contact.kind_b == KIND_DYNAMIC:
+                            raise WaitingError(f"the robot would be hit while waiting at rest ({contact.describe()}) "
+                                               f"at t = {t_in:.3f} s")
+        hit = _first_dynamic_hit(world, blocks[k], t + wait)
+        if hit is None:
+            t += wait + sum(s.duration for s in blocks[k])
+            k += 1
+            continue
+        name, t_hit = hit
+        ends = [w1 for w0, w1 in windows[name] if w0 <= t_hit <= w1]
+        if not ends or not math.isfinite(ends[0]):
+            raise WaitingError(f"{name} is in the way at t = {t_hit:.3f} s and its window does not end")
+        needed = _ceil_ms(ends[0] - t) + TIME_STEP_S
+        if needed <= wait:
+            raise WaitingError(f"{name} is in the way at t = {t_hit:.3f} s even after waiting {wait:.3f} s")
+        for_signal = clear_wait(t, windows[name]) == needed
+        waits[k] = WaitPlan(k, needed, name, for_signal)
+        if len(waits) > MAX_WAITS:
+            break
+    raise WaitingError(f"more than {MAX_WAITS} waits would be needed for the dynamic obstacles")
+
+
+def _first_dynamic_hit(world: CollisionWorld, block: Sequence[Segment], t0: float) -> tuple[str, float] | None:
+    """(obstacle name, time) of the block's first contact with a dynamic obstacle, or None."""
+    t = t0
+    for seg in block:
+        times = t + np.asarray(seg.t)
+        q = np.asarray(seg.q)
+        pairs = [(q[0], q[0], times[0], times[-1])] if len(times) == 1 or seg.kind in ("weld", "wait") else \
+            [(q[i], q[i + 1], times[i], times[i + 1]) for i in range(len(times) - 1)]
+        for qa, qb, ta, tb in pairs:
+            res = world.check_segment(qa, qb, float(ta), float(tb))
+            if res.free:
+                continue
+            s = res.s_contact or 0.0
+            tc = float(ta + s * (tb - ta))
+            contact = world.first_contact(qa + s * (qb - qa), tc)
+            if contact is not None and contact.kind_b == KIND_DYNAMIC:
+                return contact.body_b, tc
+        t += seg.duration
+    return None

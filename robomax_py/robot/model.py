@@ -1,0 +1,263 @@
+"""URDF + robot.yaml -> RobotModel: Pinocchio kinematics, convex collision geometry, limits, TCP.
+
+A RobotModel is built once and read-only afterwards; Pinocchio `Data` is scratch made per call.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from robomax_py._typing import FloatArray
+from robomax_py.errors import RobotModelError
+from robomax_py.io.robot import package_dirs_for, urdf_package_names
+from robomax_py.robot.geometry import convex_hull_shape, load_mesh
+from robomax_py.spec import ControllerSpec, RobotSpec, frozen_array
+from robomax_py.tolerances import DEFAULT as TOL
+
+# When robot.yaml gives no acceleration or jerk limits (SPEC §1 makes them optional) we derive them
+# from the URDF velocity: full speed in 0.4 s, full acceleration in 0.1 s. Conservative for
+# industrial arms (data sheets imply 0.2-0.5 s to full speed), documented in the plan report.
+DEFAULT_TIME_TO_FULL_SPEED_S = 0.4
+DEFAULT_TIME_TO_FULL_ACCEL_S = 0.1
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class JointLimits:
+    """Per joint: position (rad or m), velocity (/s), acceleration (/s^2), jerk (/s^3); each (n,)."""
+
+    lower: FloatArray
+    upper: FloatArray
+    velocity: FloatArray
+    acceleration: FloatArray
+    jerk: FloatArray
+
+    def contains(self, q: FloatArray, tol: float = 0.0) -> np.ndarray:
+        """(..., n) -> (...) bool: every joint within [lower - tol, upper + tol]."""
+        q = np.asarray(q)
+        return np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=-1)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RobotModel:
+    """A robot ready for kinematics and collision queries; base frame = URDF root frame."""
+
+    name: str
+    source: Path
+    model: pin.Model
+    collision_model: pin.GeometryModel
+    visual_model: pin.GeometryModel
+    joint_names: tuple[str, ...]
+    flange_frame_id: int
+    limits: JointLimits
+    ik_solver: str
+    ik_params: Any
+    T_flange_tcp: FloatArray  # (4, 4); identity until a tool is mounted
+    controller: ControllerSpec = dataclasses.field(default_factory=ControllerSpec)
+    disabled_links: frozenset[frozenset[str]] = frozenset()   # link pairs robot.yaml / SRDF exempt
+    defaulted_limits: tuple[str, ...] = ()   # "acceleration", "jerk": derived, not given in robot.yaml
+    warnings: tuple[str, ...] = ()           # what the user should know (fallbacks taken at load)
+
+    @property
+    def dof(self) -> int:
+        return int(self.model.nq)
+
+
+def kinematic_model(spec: RobotSpec) -> pin.Model:
+    """The URDF's Pinocchio model, checked: single-axis joints, finite limits, the flange frame exists."""
+    try:
+        model = pin.buildModelFromUrdf(str(spec.urdf))
+    except Exception as exc:  # Pinocchio raises plain RuntimeError/ValueError for bad URDFs
+        raise RobotModelError(spec.urdf, None, f"cannot parse URDF: {exc}") from None
+    if not model.existFrame(spec.flange):
+        raise RobotModelError(spec.source, "flange", f"URDF {spec.urdf.name} has no frame '{spec.flange}'")
+    for j in range(1, model.njoints):
+        if model.joints[j].nq != 1 or model.joints[j].nv != 1:
+            raise RobotModelError(spec.urdf, f"joint {model.names[j]}", "only revolute and prismatic joints are supported")
+        i = model.joints[j].idx_q
+        lo, hi, v = model.lowerPositionLimit[i], model.upperPositionLimit[i], model.velocityLimit[i]
+        if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+            raise RobotModelError(spec.urdf, f"joint {model.names[j]}", "needs finite position limits lower < upper")
+        if not (np.isfinite(v) and v > 0):
+            raise RobotModelError(spec.urdf, f"joint {model.names[j]}", "needs a velocity limit > 0")
+    return model
+
+
+def prismatic_mask(model: pin.Model) -> np.ndarray:
+    """(n,) bool: which joints are prismatic (their values are metres, not radians)."""
+    return np.array([model.joints[j].shortname().startswith("JointModelP") for j in range(1, model.njoints)])
+
+
+def load_robot(spec: RobotSpec) -> RobotModel:
+    """Build the Pinocchio model and convex link geometry named by a checked robot.yaml.
+
+    The IK parameters (given, or fitted from the URDF when robot.yaml has none) must reproduce the
+    URDF's forward kinematics within TOL.ik_fit_m on random configurations, else RobotModelError.
+    """
+    model = kinematic_model(spec)
+    ik_params = checked_ik_params(spec, model)
+    disabled = _disabled_links(spec, model)
+    n = model.nq
+    lower = np.array(model.lowerPositionLimit, dtype=float)
+    upper = np.array(model.upperPositionLimit, dtype=float)
+    velocity = np.array(model.velocityLimit, dtype=float)
+    names = tuple(model.names[j] for j in range(1, model.njoints))
+    acceleration = _limit_vector(spec, "acceleration", spec.acceleration, velocity / DEFAULT_TIME_TO_FULL_SPEED_S, n)
+    jerk = _limit_vector(spec, "jerk", spec.jerk, acceleration / DEFAULT_TIME_TO_FULL_ACCEL_S, n)
+
+    package_dirs = [str(spec.urdf.parent), *[str(d) for d in urdf_package_dirs(spec)]]
+    warnings: list[str] = []
+    collision = _build_geometry(model, spec, pin.GeometryType.COLLISION, package_dirs)
+    _make_meshes_convex(collision, spec)
+    try:
+        visual = _build_geometry(model, spec, pin.GeometryType.VISUAL, package_dirs)
+    except RobotModelError as exc:
+        # Visual meshes only serve the preview: plan with the collision meshes shown instead.
+        warnings.append(f"{spec.urdf}: visual meshes not loaded ({exc.problem}); the preview shows the collision meshes")
+        visual = collision.copy()
+    defaulted = tuple(k for k, v in (("acceleration", spec.acceleration), ("jerk", spec.jerk)) if v is None)
+    if defaulted:
+        warnings.append(
+            f"{spec.source}: limits.{' and limits.'.join(defaulted)} not given; derived from the URDF velocities "
+            f"(full speed in {DEFAULT_TIME_TO_FULL_SPEED_S} s, full acceleration in {DEFAULT_TIME_TO_FULL_ACCEL_S} s)"
+        )
+
+    return RobotModel(
+        name=spec.name,
+        source=spec.source,
+        model=model,
+        collision_model=collision,
+        visual_model=visual,
+        joint_names=names,
+        flange_frame_id=int(model.getFrameId(spec.flange)),
+        limits=JointLimits(
+            lower=frozen_array(lower),
+            upper=frozen_array(upper),
+            velocity=frozen_array(velocity),
+            acceleration=frozen_array(acceleration),
+            jerk=frozen_array(jerk),
+        ),
+        ik_solver=spec.ik_solver,
+        ik_params=ik_params,
+        T_flange_tcp=frozen_array(np.eye(4)),
+        controller=spec.controller,
+        disabled_links=disabled,
+        defaulted_limits=defaulted,
+        warnings=tuple(warnings),
+    )
+
+
+def urdf_package_dirs(spec: RobotSpec) -> list[Path]:
+    """Package folders for the `package://NAME/...` meshes the robot's URDF names."""
+    try:
+        text = spec.urdf.read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise RobotModelError(spec.urdf, None, f"cannot read URDF: {exc}") from None
+    dirs: list[Path] = []
+    for name in urdf_package_names(text):
+        for d in package_dirs_for(name, spec.urdf.parent):
+            if d not in dirs:
+                dirs.append(d)
+    return dirs
+
+
+def checked_ik_params(spec: RobotSpec, model: pin.Model) -> Any:
+    """The robot's closed-form IK parameters, fitted when not given, and checked against the URDF."""
+    from robomax_py.robot.ik.fit import FitError, fit_opw, fit_ur, fk_agreement
+
+    if spec.ik_solver not in ("opw", "ur"):
+        return spec.ik_params
+    frame_id = int(model.getFrameId(spec.flange))
+    params = spec.ik_params
+    origin = "ik.params"
+    if params is None:
+        origin = "ik.params (fitted from the URDF)"
+        try:
+            params = fit_opw(model, frame_id) if spec.ik_solver == "opw" else fit_ur(model, frame_id)
+        except FitError as exc:
+            raise RobotModelError(spec.source, "ik.solver", f"the URDF {spec.urdf.name} is not a "
+                                  f"{spec.ik_solver.upper()}-class arm up to '{spec.flange}': {exc.problem}") from None
+    agreement = fk_agreement(model, frame_id, params)
+    if not agreement.ok:
+        raise RobotModelError(
+            spec.source, origin,
+            f"the {spec.ik_solver} solver's forward kinematics disagrees with the URDF {spec.urdf.name}: "
+            f"up to {agreement.position_m * 1000:.3f} mm and {np.degrees(agreement.rotation_rad):.4f} deg over "
+            f"{agreement.samples} random configurations (allowed {TOL.ik_fit_m:g} m); parameters {params}",
+        )
+    return params
+
+
+def _disabled_links(spec: RobotSpec, model: pin.Model) -> frozenset[frozenset[str]]:
+    links = {f.name for f in model.frames if f.type == pin.FrameType.BODY}
+    for key, pairs in (("collision.disable", spec.disabled_links), ("srdf", spec.srdf_disabled_links)):
+        for i, pair in enumerate(pairs):
+            for name in pair:
+                if name not in links:
+                    where = f"{key}[{i}]" if key == "collision.disable" else key
+                    raise RobotModelError(spec.source, where, f"link '{name}' is not in the URDF {spec.urdf.name} "
+                                          f"(links: {', '.join(sorted(links))})")
+    return frozenset(frozenset(p) for p in (*spec.disabled_links, *spec.srdf_disabled_links))
+
+
+def mount_tool(robot: RobotModel, T_flange_tcp: FloatArray) -> RobotModel:
+    """The same robot with its TCP moved to a tool's TCP (flange frame, m)."""
+    return dataclasses.replace(robot, T_flange_tcp=frozen_array(T_flange_tcp))
+
+
+def fk_flange(robot: RobotModel, q: FloatArray) -> FloatArray:
+    """Flange pose in the base frame for (n,) or (k, n) joint values -> (4, 4) or (k, 4, 4)."""
+    q = np.asarray(q, dtype=float)
+    single = q.ndim == 1
+    qs = q.reshape(-1, robot.dof)
+    data = robot.model.createData()
+    out = np.empty((len(qs), 4, 4))
+    for k, qk in enumerate(qs):
+        pin.framesForwardKinematics(robot.model, data, qk)
+        out[k] = data.oMf[robot.flange_frame_id].homogeneous
+    return out[0] if single else out.reshape(q.shape[:-1] + (4, 4))
+
+
+def fk_tcp(robot: RobotModel, q: FloatArray) -> FloatArray:
+    """TCP pose in the base frame, (n,) or (..., n) -> (4, 4) or (..., 4, 4)."""
+    return fk_flange(robot, q) @ robot.T_flange_tcp
+
+
+def reach(robot: RobotModel, samples: int = 4000, seed: int = 0) -> float:
+    """Largest flange distance from the axis-1 line over random configurations (m); for listings."""
+    rng = np.random.default_rng(seed)
+    qs = rng.uniform(robot.limits.lower, robot.limits.upper, size=(samples, robot.dof))
+    p = fk_flange(robot, qs)[:, :3, 3]
+    return float(np.max(np.hypot(p[:, 0], p[:, 1])))
+
+
+def _limit_vector(spec: RobotSpec, key: str, given: FloatArray | None, default: FloatArray, n: int) -> FloatArray:
+    if given is None:
+        return default
+    if len(given) != n:
+        raise RobotModelError(spec.source, f"limits.{key}", f"expected {n} values (one per joint), got {len(given)}")
+    return np.asarray(given, dtype=float)
+
+
+def _build_geometry(model: pin.Model, spec: RobotSpec, kind: Any, package_dirs: list[str]) -> pin.GeometryModel:
+    try:
+        return pin.buildGeomFromUrdf(model, str(spec.urdf), kind, package_dirs=package_dirs)
+    except Exception as exc:  # a missing or unreadable mesh surfaces here
+        raise RobotModelError(spec.urdf, None, f"cannot load link geometry: {exc}") from None
+
+
+def _make_meshes_convex(geom_model: pin.GeometryModel, spec: RobotSpec) -> None:
+    """Replace link meshes by their convex hulls: fast GJK instead of BVH, and conservative."""
+    for obj in geom_model.geometryObjects:
+        if not obj.meshPath or obj.meshPath in ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE"):
+            continue
+        try:
+            mesh = load_mesh(Path(obj.meshPath), np.asarray(obj.meshScale))
+        except Exception as exc:
+            raise RobotModelError(spec.urdf, f"link {obj.name}", f"cannot read mesh {obj.meshPath}: {exc}") from None
+        obj.geometry = convex_hull_shape(mesh.vertices)

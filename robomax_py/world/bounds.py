@@ -1,0 +1,114 @@
+"""Kinematic bounds: how far any point of a robot piece can move for a change of the joints, the
+Lipschitz constants behind swept checks and the never-close proof, and support points of coal shapes."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import coal
+import numpy as np
+import pinocchio as pin
+
+from robomax_py._typing import BoolArray, FloatArray
+
+
+def support_points(geom: coal.CollisionGeometry) -> FloatArray:
+    """(m, 3) points in a piece's own frame whose convex hull contains the piece, metres.
+
+    Convex polytope: its vertices; BVH: its vertices; anything else: its local AABB corners.
+    """
+    if isinstance(geom, coal.ConvexBase):
+        return np.asarray(geom.points(), dtype=float).reshape(-1, 3)
+    if isinstance(geom, coal.BVHModelBase):
+        return np.asarray(geom.vertices(), dtype=float).reshape(-1, 3)
+    geom.computeLocalAABB()
+    lo, hi = np.asarray(geom.aabb_local.min_, dtype=float), np.asarray(geom.aabb_local.max_, dtype=float)
+    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class KinematicBounds:
+    """Joint axes and prismatic travel, for bounds on how far points move per unit joint motion."""
+
+    model: pin.Model
+    axis: FloatArray          # (njoints, 3) unit axis of each joint in its own frame
+    prismatic: BoolArray      # (njoints,)
+    travel: FloatArray        # (njoints,) m, largest |q| of prismatic joints (0 for revolute)
+
+    @staticmethod
+    def of(model: pin.Model) -> KinematicBounds:
+        njoints = model.njoints
+        prismatic = np.array([model.joints[j].shortname().startswith("JointModelP") for j in range(njoints)])
+        # Axes in their own frames, from the LOCAL joint Jacobian at the neutral configuration.
+        data = model.createData()
+        pin.computeJointJacobians(model, data, pin.neutral(model))
+        axis = np.zeros((njoints, 3))
+        travel = np.zeros(njoints)
+        for j in range(1, njoints):
+            J = pin.getJointJacobian(model, data, j, pin.ReferenceFrame.LOCAL)
+            col = np.asarray(J[:, model.joints[j].idx_v], dtype=float)
+            vec = col[:3] if prismatic[j] else col[3:]
+            axis[j] = vec / np.linalg.norm(vec)
+            if prismatic[j]:
+                i = model.joints[j].idx_q
+                travel[j] = max(abs(model.lowerPositionLimit[i]), abs(model.upperPositionLimit[i]))
+        return KinematicBounds(model=model, axis=axis, prismatic=prismatic, travel=travel)
+
+    def piece_lever(self, k: int, geometry_object: Any) -> float:
+        """Bound (m per rad; 1 for a prismatic k) of dist(p, axis_k) over the piece's points p and all q.
+
+        Piece on joint k: exact largest distance of its support points from the axis. Piece on a
+        descendant j: dist(o_c, axis_k) + |offsets| from c down to j (+ prismatic travel) + largest
+        distance of its points from o_j, c being k's child towards j (triangle inequality). 0 when the
+        piece is not beyond joint k.
+        """
+        if self.prismatic[k]:
+            return 1.0
+        j = int(geometry_object.parentJoint)
+        placement = geometry_object.placement
+        pts = support_points(geometry_object.geometry) @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
+        if j == k:
+            radial = pts - np.outer(pts @ self.axis[k], self.axis[k])
+            return float(np.max(np.linalg.norm(radial, axis=1)))
+        path = _path_below(self.model, k, j)
+        if path is None:
+            return 0.0
+        c = path[0]
+        oc = np.asarray(self.model.jointPlacements[c].translation, dtype=float)
+        d_c = float(np.linalg.norm(oc - np.dot(oc, self.axis[k]) * self.axis[k])) + float(self.travel[c])
+        chain = sum(float(np.linalg.norm(self.model.jointPlacements[m].translation)) + float(self.travel[m]) for m in path[1:])
+        return d_c + chain + float(np.max(np.linalg.norm(pts, axis=1)))
+
+    def lever_arms(self, gm: pin.GeometryModel, moving: list[bool]) -> FloatArray:
+        """(n,) per joint: the largest `piece_lever` over every moving piece (robot and tool)."""
+        lever = np.zeros(self.model.nq)
+        for k in range(1, self.model.njoints):
+            idx = self.model.joints[k].idx_q
+            best = 1.0 if self.prismatic[k] else 0.0
+            for g, is_moving in zip(gm.geometryObjects, moving):
+                if is_moving and g.parentJoint != 0:
+                    best = max(best, self.piece_lever(k, g))
+            lever[idx] = best
+        return lever
+
+
+def joint_path(model: pin.Model, i: int, j: int) -> list[int] | None:
+    """The joints whose motion changes the relative pose of bodies on joints i and j (either order):
+    the path from the ancestor's child down to the descendant; None if neither is an ancestor."""
+    lo, hi = (i, j) if i < j else (j, i)
+    return _path_below(model, lo, hi)
+
+
+def _path_below(model: pin.Model, i: int, j: int) -> list[int] | None:
+    """Joints from the child of i down to j (inclusive) when j is a descendant of i, else None."""
+    path = []
+    k = j
+    while k > i:
+        path.append(k)
+        k = int(model.parents[k])
+    if k != i:
+        return None
+    return path[::-1]
+
+

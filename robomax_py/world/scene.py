@@ -1,0 +1,267 @@
+"""Cell objects and tool -> coal collision geometry, posed in the robot base frame.
+
+A `Scene` is what `collision.CollisionWorld` checks the robot against: static obstacles, dynamic
+obstacles with their presence windows, and the tool's body and tips pieces in the flange frame.
+Built once per cell; read-only afterwards (the coal geometries are shared, never modified).
+
+How each shape becomes collision geometry
+-----------------------------------------
+- Box, cylinder, sphere, capsule: the exact coal primitive (SPEC §3: centred, axis z).
+- Mesh (obstacle, workpiece or tool): `geometry.mesh_collision_shapes`: when *every* connected piece
+  of the mesh is a closed convex shell, one coal convex polytope per piece (exact, and fast GJK);
+  otherwise the whole mesh stays one exact triangle BVH (OBBRSS). Sheet-metal parts such as the
+  reference `cabin_panel.stl` are open, bent surfaces, so they stay BVH: a convex hull would fill the
+  space between the flange and the panel and forbid exactly the places the gun must reach.
+- A BVH is a triangle *surface*: a robot piece entirely inside a closed non-convex mesh without
+  touching its triangles is not reported. Swept motions (`CollisionWorld.segment_free`) cannot get
+  inside without crossing the surface, which is reported.
+- A perfectly flat mesh (zero thickness along a local axis) gets one extra triangle of
+  `FLAT_MESH_PAD_M` size standing off the plane, so its bounding box has non-zero volume: Pinocchio's
+  broad phase silently ignores geometry whose local bounding box has zero volume.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import coal
+import numpy as np
+import trimesh
+
+from robomax_py._typing import FloatArray
+from robomax_py.errors import CellFileError, RobotModelError
+from robomax_py.robot import RobotModel
+from robomax_py.robot.geometry import (
+    bvh_shape,
+    load_mesh,
+    mesh_collision_shapes,
+    primitive_shape,
+)
+from robomax_py.spec import (
+    Box,
+    Capsule,
+    CellSpec,
+    Cylinder,
+    MeshShape,
+    ObjectSpec,
+    Shape,
+    Sphere,
+    frozen_array,
+)
+from robomax_py.transforms import invert
+
+# Size (m) of the stand-off triangle added to a perfectly flat mesh (see module docstring).
+FLAT_MESH_PAD_M = 1e-7
+
+REPRESENTATION_PRIMITIVE = "primitive"
+REPRESENTATION_CONVEX = "convex pieces"
+REPRESENTATION_BVH = "exact mesh (BVH)"
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class SceneObject:
+    """One obstacle: coal pieces sharing one pose in the robot base frame.
+
+    Attributes
+    ----------
+    name : str
+        The cell's object name.
+    pieces : tuple of coal.CollisionGeometry
+        In the object's own frame, metres; never modified after the scene is built.
+    T_base_object : (4, 4) float
+        Object pose in the robot base frame, metres: inv(T_world_base) @ T_world_object.
+    workpiece : bool
+        The tool tips may touch it.
+    representation : str
+        "primitive", "convex pieces" or "exact mesh (BVH)" (module docstring says when each is used).
+    present : tuple of (start, end) windows in s, or None
+        None: a static obstacle, always present. Otherwise present at t iff start <= t <= end for one
+        window; `present_at(None)` is True (unknown time: conservatively present).
+    """
+
+    name: str
+    pieces: tuple[coal.CollisionGeometry, ...]
+    T_base_object: FloatArray
+    workpiece: bool
+    representation: str
+    present: tuple[tuple[float, float], ...] | None = None
+
+    @property
+    def dynamic(self) -> bool:
+        return self.present is not None
+
+    def present_at(self, t: float | None) -> bool:
+        """Whether the obstacle exists at time t (s from program start); t=None counts as present."""
+        if self.present is None or t is None:
+            return True
+        return any(t0 <= t <= t1 for t0, t1 in self.present)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ToolGeometry:
+    """The mounted tool: body and electrode-tip pieces in the flange frame, metres.
+
+    The body collides with everything; the tips may touch workpieces (SPEC §2).
+    """
+
+    name: str
+    body: tuple[coal.CollisionGeometry, ...]
+    tips: tuple[coal.CollisionGeometry, ...]
+    body_representation: str
+    tips_representation: str
+    T_flange_tcp: FloatArray          # (4, 4)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Scene:
+    """Everything the robot can hit, in the robot base frame.
+
+    Attributes
+    ----------
+    obstacles : tuple of SceneObject
+        Static obstacles (`present` is None), in cell order.
+    dynamic : tuple of SceneObject
+        Obstacles present only in time windows, in cell order.
+    tool : ToolGeometry
+        Mounted at `flange_frame_id` of the robot the scene was built for.
+    T_world_base : (4, 4) float
+        Robot base pose in the world (cell) frame, metres.
+    """
+
+    cell_name: str
+    obstacles: tuple[SceneObject, ...]
+    dynamic: tuple[SceneObject, ...]
+    tool: ToolGeometry
+    T_world_base: FloatArray
+    flange_frame_id: int
+
+    def object(self, name: str) -> SceneObject:
+        """The static or dynamic obstacle called `name`; KeyError if there is none."""
+        for obj in (*self.obstacles, *self.dynamic):
+            if obj.name == name:
+                return obj
+        raise KeyError(name)
+
+
+def build_scene(cell: CellSpec, robot: RobotModel) -> Scene:
+    """Collision geometry of a cell's objects and tool, posed for `robot`.
+
+    Parameters
+    ----------
+    cell : CellSpec
+        Objects in the world frame; the robot base at `cell.T_world_base`.
+    robot : RobotModel
+        The robot the tool is mounted on (its flange frame carries the tool pieces).
+
+    Returns
+    -------
+    Scene
+        Obstacles posed in the robot base frame; tool pieces in the flange frame.
+
+    Raises
+    ------
+    CellFileError
+        An object's mesh is missing or unreadable: key `objects[i].mesh` / `dynamic[i].mesh`.
+    RobotModelError
+        The tool's body or tips mesh is missing or unreadable: tool.yaml key `body` / `tips`.
+    """
+    T_base_world = invert(np.asarray(cell.T_world_base, dtype=float))
+    obstacles = tuple(
+        _scene_object(obj, T_base_world, cell.source, f"objects[{i}]") for i, obj in enumerate(cell.objects)
+    )
+    dynamic = tuple(
+        _scene_object(obj, T_base_world, cell.source, f"dynamic[{i}]", dynamic=True)
+        for i, obj in enumerate(cell.dynamic)
+    )
+    body, body_repr = _mesh_pieces(cell.tool.body, RobotModelError, cell.tool.source, "body")
+    tips, tips_repr = _mesh_pieces(cell.tool.tips, RobotModelError, cell.tool.source, "tips")
+    tool = ToolGeometry(
+        name=cell.tool.name,
+        body=body,
+        tips=tips,
+        body_representation=body_repr,
+        tips_representation=tips_repr,
+        T_flange_tcp=frozen_array(cell.tool.T_flange_tcp),
+    )
+    return Scene(
+        cell_name=cell.name,
+        obstacles=obstacles,
+        dynamic=dynamic,
+        tool=tool,
+        T_world_base=frozen_array(cell.T_world_base),
+        flange_frame_id=int(robot.flange_frame_id),
+    )
+
+
+def shape_pieces(shape: Shape, file: Path | None = None, key: str | None = None) -> tuple[tuple[coal.CollisionGeometry, ...], str]:
+    """coal pieces of one SPEC §3 shape in its own frame, and how it is represented.
+
+    Raises CellFileError(file, key, problem) when a mesh cannot be read.
+    """
+    if isinstance(shape, (Box, Cylinder, Sphere, Capsule)):
+        geom = primitive_shape(shape)
+        geom.computeLocalAABB()
+        return (geom,), REPRESENTATION_PRIMITIVE
+    if isinstance(shape, MeshShape):
+        return _mesh_pieces(shape.path, CellFileError, file, key)
+    raise TypeError(f"unknown shape: {shape!r}")
+
+
+def _scene_object(obj: ObjectSpec, T_base_world: FloatArray, source: Path, key: str, dynamic: bool = False) -> SceneObject:
+    pieces, representation = shape_pieces(obj.shape, source, f"{key}.mesh")
+    present = obj.present if dynamic else None
+    if dynamic and present is None:
+        present = ((-np.inf, np.inf),)
+    return SceneObject(
+        name=obj.name,
+        pieces=pieces,
+        T_base_object=frozen_array(T_base_world @ np.asarray(obj.T_world_object, dtype=float)),
+        workpiece=bool(obj.workpiece),
+        representation=representation,
+        present=None if present is None else tuple((float(a), float(b)) for a, b in present),
+    )
+
+
+def _mesh_pieces(
+    path: Path, error: type[CellFileError] | type[RobotModelError], file: Path | None, key: str | None
+) -> tuple[tuple[coal.CollisionGeometry, ...], str]:
+    """Convex pieces if the mesh is a set of closed convex shells, else one exact BVH (see module doc)."""
+    if not Path(path).is_file():
+        raise error(file, key, f"mesh file not found: {path}")
+    try:
+        mesh = load_mesh(Path(path))
+    except Exception as exc:  # trimesh raises many kinds for unreadable files
+        raise error(file, key, f"cannot read mesh {path}: {exc}") from None
+    pieces = mesh_collision_shapes(mesh)
+    convex = not any(isinstance(p, coal.BVHModelBase) for p in pieces)
+    if not convex and np.any(np.ptp(np.asarray(mesh.vertices, dtype=float), axis=0) <= 0.0):
+        pieces = [_flat_bvh(mesh)]
+    for p in pieces:
+        p.computeLocalAABB()
+    return tuple(pieces), (REPRESENTATION_CONVEX if convex else REPRESENTATION_BVH)
+
+
+def _flat_bvh(mesh: trimesh.Trimesh) -> coal.BVHModelOBBRSS:
+    """Exact BVH of a perfectly flat mesh plus a stand-off triangle, so its bounding box has volume."""
+    extents = np.ptp(np.asarray(mesh.vertices, dtype=float), axis=0)
+    flat = np.flatnonzero(extents <= 0.0)
+    v0 = np.asarray(mesh.vertices[0], dtype=float)
+    pad = np.zeros(3)
+    pad[flat] = FLAT_MESH_PAD_M
+    other = np.zeros(3)
+    other[int(np.argmax(extents))] = FLAT_MESH_PAD_M
+    vertices = np.vstack([mesh.vertices, v0 + pad, v0 + other])
+    n = len(mesh.vertices)
+    faces = np.vstack([mesh.faces, [[0, n, n + 1]]])
+    return bvh_shape(trimesh.Trimesh(vertices=vertices, faces=faces, process=False))
+
+
+__all__ = [
+    "FLAT_MESH_PAD_M",
+    "Scene",
+    "SceneObject",
+    "ToolGeometry",
+    "build_scene",
+    "shape_pieces",
+]
