@@ -36,10 +36,10 @@ def main() -> int:
 
     from playwright.sync_api import sync_playwright
 
-    from robomax_py.io.cell import load_cell, load_cell_robot
-    from robomax_py.io.files import write_atomic_bytes
     from robomax_py.app.preview import write_html
     from robomax_py.app.preview_program import load_program
+    from robomax_py.io.cell import load_cell, load_cell_robot
+    from robomax_py.io.files import write_atomic_bytes
 
     with tempfile.TemporaryDirectory() as tmp:
         cell = load_cell(args.cell)

@@ -55,6 +55,7 @@ class RobotSpec:
     controller: ControllerSpec = field(default_factory=ControllerSpec)
     disabled_links: tuple[tuple[str, str], ...] = ()        # robot.yaml collision.disable: never checked
     srdf_disabled_links: tuple[tuple[str, str], ...] = ()   # the SRDF's disable_collisions
+    package_dirs: tuple[Path, ...] = ()   # folders P with P/NAME the package of the URDF's package://NAME meshes
 
 
 @dataclass(frozen=True, slots=True, eq=False)

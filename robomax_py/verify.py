@@ -22,7 +22,8 @@ from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
 from robomax_py.plan.poses import nominal_rotation
 from robomax_py.robot import RobotModel, fk_tcp
-from robomax_py.robot.ik import config_text, same_config
+from robomax_py.robot.ik import same_config
+from robomax_py.robot.solve import config_text
 from robomax_py.spec import CellSpec
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision import CollisionWorld

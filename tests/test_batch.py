@@ -24,7 +24,13 @@ from robomax_py.app.batch import (
     run_local,
     run_ray,
 )
-from robomax_py.app.cli import EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_OK, _bare_ray_flag, app
+from robomax_py.app.cli import (
+    EXIT_BAD_INPUT,
+    EXIT_INFEASIBLE,
+    EXIT_OK,
+    _bare_ray_flag,
+    app,
+)
 
 SmallCell = Callable[..., Path]   # conftest.write_small_cell
 FAR_SPOT = {"name": "far", "xyz": [4.0, 0.0, 1.0], "normal": [-1, 0, 0], "direction": [0, 1, 0]}

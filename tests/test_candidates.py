@@ -10,15 +10,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robomax_py.plan.candidates import BRANCH_JUMP_RAD, _line_verdict, _spot_candidates
 from robomax_py.io.cell import load_cell, load_cell_robot
-from robomax_py.world.collision import CollisionWorld
-from robomax_py.robot.ik import solve_all
-from robomax_py.robot.ik.turns import wrap_to_pi
-from robomax_py.robot import prismatic_mask
-from robomax_py.world.scene import build_scene
+from robomax_py.plan.candidates import BRANCH_JUMP_RAD, _line_verdict, _spot_candidates
 from robomax_py.plan.poses import approach_poses, orientation_grid, spot_poses
+from robomax_py.robot import prismatic_mask
+from robomax_py.robot.ik.turns import wrap_to_pi
+from robomax_py.robot.solve import solve_all
 from robomax_py.transforms import invert
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[1]
 

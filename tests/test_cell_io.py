@@ -17,9 +17,9 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from typer.testing import CliRunner
 
-from robomax_py.io.cell import load_cell
 from robomax_py.app.cli import EXIT_BAD_INPUT, app
 from robomax_py.errors import CellFileError, RobomaxError, RobotModelError
+from robomax_py.io.cell import load_cell
 from robomax_py.spec import Box, MeshShape
 
 ANGLE_TOL_RAD = 1e-12

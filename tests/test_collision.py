@@ -18,21 +18,8 @@ import pytest
 import trimesh
 from numpy.testing import assert_allclose
 
-from robomax_py.world.collision import (
-    KIND_DYNAMIC,
-    KIND_LINK,
-    KIND_OBJECT,
-    KIND_TOOL_BODY,
-    KIND_TOOL_TIPS,
-    CollisionOptions,
-    CollisionWorld,
-    acm_samples,
-    bisection_order,
-    support_points,
-)
+from robomax_py.io.robot import urdf_package_dirs, load_robot_spec, resolve_package_uri
 from robomax_py.robot import RobotModel, fk_flange, load_robot
-from robomax_py.io.robot import load_robot_spec, resolve_package_uri
-from robomax_py.world.scene import build_scene
 from robomax_py.spec import (
     Box,
     Capsule,
@@ -47,6 +34,19 @@ from robomax_py.spec import (
     frozen_array,
 )
 from robomax_py.transforms import pose_matrix, rot_z
+from robomax_py.world.collision import (
+    KIND_DYNAMIC,
+    KIND_LINK,
+    KIND_OBJECT,
+    KIND_TOOL_BODY,
+    KIND_TOOL_TIPS,
+    CollisionOptions,
+    CollisionWorld,
+    acm_samples,
+    bisection_order,
+    support_points,
+)
+from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[1]
 REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
@@ -71,7 +71,7 @@ def ur10() -> RobotModel:
     urdf = resolve_package_uri(
         "package://example-robot-data/robots/ur_description/urdf/ur10_robot.urdf", Path("ur10"), "urdf"
     )
-    return load_robot(RobotSpec("ur10", urdf, urdf, "tool0", "numeric", None, None, None))
+    return load_robot(RobotSpec("ur10", urdf, urdf, "tool0", "numeric", None, None, None, package_dirs=urdf_package_dirs(urdf, urdf)))
 
 
 @pytest.fixture(scope="module")
@@ -93,7 +93,8 @@ def gun(tmp_path_factory: pytest.TempPathFactory) -> ToolSpec:
 
 def make_cell(robot: RobotModel, tool: ToolSpec, objects: tuple[ObjectSpec, ...] = (),
               dynamic: tuple[ObjectSpec, ...] = (), clearance: float = 0.0) -> CellSpec:
-    spec = RobotSpec(robot.name, robot.source, robot.source, "tool0", "numeric", None, None, None)
+    spec = RobotSpec(robot.name, robot.source, robot.source, "tool0", "numeric", None, None, None,
+                     package_dirs=urdf_package_dirs(robot.source, robot.source))
     return CellSpec(
         name="test", source=Path("cells/test.yaml"), robot=spec, T_world_base=frozen_array(np.eye(4)),
         home=frozen_array(np.zeros(robot.dof)), tool=tool, objects=objects, seams=(),

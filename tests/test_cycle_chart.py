@@ -13,9 +13,9 @@ from PIL import Image
 from typer.testing import CliRunner
 
 from robomax_py.app import palette
-from robomax_py.io.cell import load_cell, load_cell_robot
-from robomax_py.app.cli import EXIT_INFEASIBLE, EXIT_OK, app
 from robomax_py.app.chart import RETURN_ROW, chart_figure, cycle_chart, render_png
+from robomax_py.app.cli import EXIT_INFEASIBLE, EXIT_OK, app
+from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell
 
 SmallCell = Callable[..., Path]   # conftest.write_small_cell

@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.export import EXPORTERS, render
 from robomax_py.export.plan_program import identifier
 from robomax_py.export.srcl import write_program
 from robomax_py.export.srcl_parser import parse_program
+from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import plan_cell
 
 REPO = Path(__file__).resolve().parents[1]

@@ -9,10 +9,22 @@ import pinocchio as pin
 import pytest
 
 from robomax_py.errors import ProgramError
-from robomax_py.robot.ik import config_of, params_from_mapping, solve_all
-from robomax_py.robot.ik.config import ConfigIndicator, status_generic, status_opw, turn_bits
-from robomax_py.robot.ik.opw import OpwParams, from_paper_angles, opw_fk, opw_pin_model, to_paper_angles
+from robomax_py.io.ik_params import params_from_mapping
 from robomax_py.robot import JointLimits, RobotModel
+from robomax_py.robot.ik.config import (
+    ConfigIndicator,
+    status_generic,
+    status_opw,
+    turn_bits,
+)
+from robomax_py.robot.ik.opw import (
+    OpwParams,
+    from_paper_angles,
+    opw_fk,
+    opw_pin_model,
+    to_paper_angles,
+)
+from robomax_py.robot.solve import config_of, solve_all
 
 REPO = Path(__file__).resolve().parents[1]
 DEG = np.pi / 180.0

@@ -11,13 +11,19 @@ import pytest
 from numpy.testing import assert_allclose
 
 from robomax_py.errors import RobotModelError
-from robomax_py.robot.ik import params_from_mapping, solve_all
-from robomax_py.robot.ik._chain import chain_to_frame, frame_pose, frame_pose_and_jacobian, joint_frames
+from robomax_py.io.ik_params import params_from_mapping
+from robomax_py.robot import JointLimits, RobotModel
+from robomax_py.robot.ik._chain import (
+    chain_to_frame,
+    frame_pose,
+    frame_pose_and_jacobian,
+    joint_frames,
+)
 from robomax_py.robot.ik.numeric import DEDUPE_RAD, NumericIkParams, numeric_ik
 from robomax_py.robot.ik.opw import OpwParams, opw_fk, opw_ik, opw_pin_model
 from robomax_py.robot.ik.ur import UR10_EXAMPLE_ROBOT_DATA as UR10
 from robomax_py.robot.ik.ur import ur_fk, ur_ik
-from robomax_py.robot import JointLimits, RobotModel
+from robomax_py.robot.solve import solve_all
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.transforms import rotation_angle
 

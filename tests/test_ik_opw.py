@@ -12,9 +12,16 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from robomax_py.errors import RobotModelError
-from robomax_py.robot.ik import params_from_mapping
+from robomax_py.io.ik_params import params_from_mapping
 from robomax_py.robot.ik.config import status_opw
-from robomax_py.robot.ik.opw import OpwParams, from_paper_angles, opw_fk, opw_ik, opw_pin_model, to_paper_angles
+from robomax_py.robot.ik.opw import (
+    OpwParams,
+    from_paper_angles,
+    opw_fk,
+    opw_ik,
+    opw_pin_model,
+    to_paper_angles,
+)
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.transforms import rotation_angle
 

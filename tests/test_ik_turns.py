@@ -6,7 +6,13 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from robomax_py.robot.ik.turns import LIMIT_SLACK, expand, filter_limits, turn_shifts, wrap_to_pi
+from robomax_py.robot.ik.turns import (
+    LIMIT_SLACK,
+    expand,
+    filter_limits,
+    turn_shifts,
+    wrap_to_pi,
+)
 
 DEG = np.pi / 180.0
 KR_LOWER = np.array([-170, -190, -120, -350, -125, -350]) * DEG

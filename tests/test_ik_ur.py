@@ -13,11 +13,12 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from robomax_py.errors import RobotModelError
-from robomax_py.robot.ik import params_from_mapping, solve_all
+from robomax_py.io.ik_params import params_from_mapping
+from robomax_py.robot import JointLimits, RobotModel
 from robomax_py.robot.ik.config import status_generic
 from robomax_py.robot.ik.ur import UR10_EXAMPLE_ROBOT_DATA as UR10
 from robomax_py.robot.ik.ur import UrParams, ur_fk, ur_ik
-from robomax_py.robot import JointLimits, RobotModel
+from robomax_py.robot.solve import solve_all
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.transforms import pose_matrix, rotation_angle
 

@@ -10,13 +10,13 @@ import pytest
 from numpy.testing import assert_allclose
 
 from robomax_py.io.cell import load_cell, load_cell_robot
-from robomax_py.world.collision import SegmentCheck
+from robomax_py.plan import PlanOptions, PlanResult, plan_cell
 from robomax_py.plan import junction as junction_module
 from robomax_py.plan.junction import time_junction
-from robomax_py.plan import PlanOptions, PlanResult, plan_cell
 from robomax_py.robot import JointLimits, fk_tcp
 from robomax_py.spec import CellSpec, frozen_array
 from robomax_py.timing import concatenate
+from robomax_py.world.collision import SegmentCheck
 
 # Distance (rad) from the polyline beyond which the strict world reports a collision.
 OFF_POLYLINE_RAD = 1e-6
@@ -197,9 +197,9 @@ def test_per_move_speeds_are_planned_written_and_rebuilt(tmp_path: Path, write_s
     import yaml
 
     from robomax_py.export import render
+    from robomax_py.export.rebuild import rebuild
     from robomax_py.export.srcl_parser import parse_program
     from robomax_py.program import LinMove, PtpMove
-    from robomax_py.export.rebuild import rebuild
 
     path: Path = write_small_cell(tmp_path)
     data = yaml.safe_load(path.read_text())

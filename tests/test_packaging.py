@@ -12,7 +12,11 @@ from pathlib import Path
 import pytest
 
 from robomax_py.errors import RobotModelError
-from robomax_py.io.robot import ROS_PACKAGE_PATH_ENV, resolve_package_uri, shipped_robots_dir
+from robomax_py.io.robot import (
+    ROS_PACKAGE_PATH_ENV,
+    resolve_package_uri,
+    shipped_robots_dir,
+)
 
 REPO = Path(__file__).resolve().parent.parent
 

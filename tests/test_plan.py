@@ -17,15 +17,15 @@ import yaml
 from numpy.testing import assert_allclose
 
 from robomax_py.io.cell import load_cell, load_cell_robot
-from robomax_py.world.collision import CollisionWorld
-from robomax_py.robot.ik import solve_all
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell, verify_trajectory
-from robomax_py.robot import fk_tcp, reach
-from robomax_py.world.scene import build_scene
 from robomax_py.plan.poses import orientation_grid, spot_poses
+from robomax_py.robot import fk_tcp, reach
+from robomax_py.robot.solve import solve_all
 from robomax_py.spec import CellSpec
 from robomax_py.timing import ptp_time_estimate
 from robomax_py.transforms import invert
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[1]
 # Frozen copy of the reference cell (cells/cabin_flange.yaml is now our own cabin-panel cell).

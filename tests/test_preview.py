@@ -15,10 +15,16 @@ import pytest
 from typer.testing import CliRunner
 
 from robomax_py.app import palette
-from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.app.cli import EXIT_BAD_INPUT, EXIT_OK, app
-from robomax_py.app.preview import DEFAULT_FPS, PreviewContent, frame_times, populate, write_html
+from robomax_py.app.preview import (
+    DEFAULT_FPS,
+    PreviewContent,
+    frame_times,
+    populate,
+    write_html,
+)
 from robomax_py.app.preview_program import ShownProgram, home_program, load_program
+from robomax_py.io.cell import load_cell, load_cell_robot
 
 SmallCell = Callable[..., Path]   # conftest.write_small_cell
 TIME_TOL_S = 1e-6

@@ -10,9 +10,9 @@ import pytest
 from rich.console import Console
 
 from robomax_py.app.bench import lower_bound
+from robomax_py.app.progress import configure_logging, stage_bars
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell
-from robomax_py.app.progress import configure_logging, stage_bars
 from robomax_py.timing import ptp_time_estimate
 from tests.conftest import SmallCell
 

@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robomax_py.robot.ik import solve_all
-from robomax_py.robot import fk_flange, load_robot
 from robomax_py.io.robot import load_robot_spec
+from robomax_py.robot import fk_flange, load_robot
+from robomax_py.robot.solve import solve_all
 from robomax_py.transforms import rotation_angle
 
 POS_TOL_M = 1e-9

@@ -20,12 +20,12 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from robomax_py.app.cli import app
-from robomax_py.errors import RobotModelError
-from robomax_py.robot.ik import config_text, solve_all
-from robomax_py.robot.ik.fit import FitError, fit_opw, fk_agreement
-from robomax_py.robot import fk_flange, load_robot
-from robomax_py.io.robot import ROBOTS_ENV, load_robot_spec
 from robomax_py.app.import_urdf import guess_brand, import_urdf
+from robomax_py.errors import RobotModelError
+from robomax_py.io.robot import ROBOTS_ENV, load_robot_spec
+from robomax_py.robot import fk_flange, load_robot
+from robomax_py.robot.ik.fit import FitError, fit_opw, fk_agreement
+from robomax_py.robot.solve import config_text, solve_all
 
 ROSI = Path(__file__).parent / "data" / "rosi"
 ARMS = {

@@ -16,14 +16,8 @@ import trimesh
 from numpy.testing import assert_allclose
 
 from robomax_py.errors import CellFileError, RobotModelError
+from robomax_py.io.robot import urdf_package_dirs, resolve_package_uri
 from robomax_py.robot import RobotModel, load_robot
-from robomax_py.io.robot import resolve_package_uri
-from robomax_py.world.scene import (
-    REPRESENTATION_BVH,
-    REPRESENTATION_CONVEX,
-    REPRESENTATION_PRIMITIVE,
-    build_scene,
-)
 from robomax_py.spec import (
     Box,
     Capsule,
@@ -38,6 +32,12 @@ from robomax_py.spec import (
     frozen_array,
 )
 from robomax_py.transforms import invert, pose_matrix
+from robomax_py.world.scene import (
+    REPRESENTATION_BVH,
+    REPRESENTATION_CONVEX,
+    REPRESENTATION_PRIMITIVE,
+    build_scene,
+)
 
 REPO = Path(__file__).resolve().parents[1]
 REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
@@ -52,7 +52,7 @@ def ur10() -> RobotModel:
     urdf = resolve_package_uri(
         "package://example-robot-data/robots/ur_description/urdf/ur10_robot.urdf", Path("ur10"), "urdf"
     )
-    return load_robot(RobotSpec("ur10", urdf, urdf, "tool0", "numeric", None, None, None))
+    return load_robot(RobotSpec("ur10", urdf, urdf, "tool0", "numeric", None, None, None, package_dirs=urdf_package_dirs(urdf, urdf)))
 
 
 @pytest.fixture(scope="module")
@@ -75,7 +75,8 @@ def make_cell(
     robot: RobotModel, tool: ToolSpec, objects: tuple[ObjectSpec, ...] = (), dynamic: tuple[ObjectSpec, ...] = (),
     T_world_base: np.ndarray | None = None, source: Path = Path("cells/test.yaml"),
 ) -> CellSpec:
-    spec = RobotSpec(robot.name, robot.source, robot.source, "tool0", "numeric", None, None, None)
+    spec = RobotSpec(robot.name, robot.source, robot.source, "tool0", "numeric", None, None, None,
+                     package_dirs=urdf_package_dirs(robot.source, robot.source))
     return CellSpec(
         name="test", source=source, robot=spec,
         T_world_base=frozen_array(np.eye(4) if T_world_base is None else T_world_base),

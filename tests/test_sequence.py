@@ -9,7 +9,16 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robomax_py.plan.sequence import HOME, SeamBlock, admissible_orders, best_choice, exact_tour, optimise, _Costs, _PrefixCost
+from robomax_py.plan.sequence import (
+    HOME,
+    SeamBlock,
+    _Costs,
+    _PrefixCost,
+    admissible_orders,
+    best_choice,
+    exact_tour,
+    optimise,
+)
 
 COST_TOL_S = 1e-9
 

@@ -473,11 +473,9 @@ def test_path_move_jerk_flyby(limits: JointLimits, radius: float) -> None:
 
 @pytest.fixture(scope="module")
 def ur10() -> RobotModel:
-    ik = pytest.importorskip("robomax_py.robot.ik")
-    if not hasattr(ik, "solve_all") or not hasattr(ik, "params_from_mapping"):
-        pytest.skip("robomax_py.robot.ik.solve_all is not available yet")
+    from robomax_py.io.ik_params import params_from_mapping
+    from robomax_py.io.robot import package_share_dirs, urdf_package_dirs
     from robomax_py.robot import load_robot, mount_tool
-    from robomax_py.io.robot import package_share_dirs
     from robomax_py.spec import RobotSpec
     from robomax_py.transforms import pose_matrix
 
@@ -485,11 +483,12 @@ def ur10() -> RobotModel:
     urdf = next((p for p in shares if p.is_file()), None)
     if urdf is None:
         pytest.skip("example-robot-data's ur10_robot.urdf is not installed")
-    params = ik.params_from_mapping(
+    params = params_from_mapping(
         "ur", {"d1": 0.1273, "a2": -0.612, "a3": -0.5723, "d4": 0.163941, "d5": 0.1157, "d6": 0.0922, "base_rpy": [0, 0, 180]}
     )
     spec = RobotSpec(
-        name="ur10", source=urdf, urdf=urdf, flange="tool0", ik_solver="ur", ik_params=params, acceleration=None, jerk=None
+        name="ur10", source=urdf, urdf=urdf, flange="tool0", ik_solver="ur", ik_params=params, acceleration=None, jerk=None,
+        package_dirs=urdf_package_dirs(urdf, urdf),
     )
     return mount_tool(load_robot(spec), pose_matrix([0.0, 0.0, 0.2], [0.0, 0.0, 0.0]))
 
@@ -498,8 +497,8 @@ Q_UR = np.array([0.3, -1.2, 1.5, -1.9, -1.5, 0.4])
 
 
 def _branch_of(robot: RobotModel, q: np.ndarray) -> int:
-    from robomax_py.robot.ik import solve_all
     from robomax_py.robot import fk_tcp
+    from robomax_py.robot.solve import solve_all
 
     table = solve_all(robot, fk_tcp(robot, q)[None])
     err = np.where(table.valid[0], np.max(np.abs(table.q[0] - q), axis=1), np.inf)
@@ -560,8 +559,8 @@ def test_lin_move_slerps_the_orientation(ur10: RobotModel) -> None:
 
 def test_lin_move_reports_leaving_the_branch(ur10: RobotModel) -> None:
     """A branch column that jumps (here: faked beyond 40 % of the line) is found by bisection."""
-    from robomax_py.robot.ik import solve_all
     from robomax_py.robot import fk_tcp
+    from robomax_py.robot.solve import solve_all
     from robomax_py.timing import lin_path
 
     k = _branch_of(ur10, Q_UR)

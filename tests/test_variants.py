@@ -12,8 +12,8 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from robomax_py.io.cell import load_cell, read_cell_file
 from robomax_py.app.cli import EXIT_OK, app
+from robomax_py.io.cell import load_cell, read_cell_file
 from robomax_py.io.variants import VariantBounds, clamp_group, write_variants
 
 SmallCell = Callable[..., Path]   # conftest.write_small_cell

@@ -13,8 +13,8 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.app.cli import EXIT_BAD_INPUT, EXIT_OK, EXIT_VIOLATIONS, app
+from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.robot import fk_tcp
 from robomax_py.verify import verify_trajectory_file
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell
 from robomax_py.robot import JointLimits, RobotModel, fk_tcp
-from robomax_py.robot.ik import solve_all
+from robomax_py.robot.solve import solve_all
 from robomax_py.spec import CellSpec
 from robomax_py.timing import ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld

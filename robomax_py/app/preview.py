@@ -33,8 +33,8 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from robomax_py.app import palette
 from robomax_py._typing import FloatArray
+from robomax_py.app import palette
 from robomax_py.app.preview_program import ShownProgram
 from robomax_py.errors import RobotModelError
 from robomax_py.plan.poses import nominal_rotation

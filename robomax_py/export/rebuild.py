@@ -38,7 +38,8 @@ from robomax_py.program import (
     ptp_target,
 )
 from robomax_py.robot import RobotModel
-from robomax_py.robot.ik import config_text, same_config
+from robomax_py.robot.ik import same_config
+from robomax_py.robot.solve import config_text
 from robomax_py.spec import CellSpec
 from robomax_py.timing import (
     LinMoveError,

@@ -251,6 +251,20 @@ def urdf_package_names(urdf_text: str) -> list[str]:
     return names
 
 
+def urdf_package_dirs(urdf: Path, file: Path) -> tuple[Path, ...]:
+    """Package folders for the `package://NAME/...` meshes a URDF names (searched near the URDF)."""
+    try:
+        text = urdf.read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise RobotModelError(file, "urdf", f"cannot read URDF {urdf}: {exc}") from None
+    dirs: list[Path] = []
+    for name in urdf_package_names(text):
+        for d in package_dirs_for(name, urdf.parent):
+            if d not in dirs:
+                dirs.append(d)
+    return tuple(dirs)
+
+
 # ------------------------------------------------------------------------------ SRDF
 
 
@@ -277,7 +291,7 @@ def srdf_disabled_pairs(path: Path, file: Path) -> list[tuple[str, str]]:
 def load_robot_spec(path: Path) -> RobotSpec:
     """Read and check a robot.yaml. What needs the URDF (limits' length, link names, fitted IK
     parameters and their agreement with the URDF) is checked by `robot.load_robot`."""
-    from robomax_py.robot.ik import params_from_mapping
+    from robomax_py.io.ik_params import params_from_mapping
 
     data = read_yaml_mapping(path, RobotModelError, "robot description")
     try:
@@ -303,6 +317,7 @@ def load_robot_spec(path: Path) -> RobotSpec:
     srdf = () if parsed.srdf is None else tuple(srdf_disabled_pairs((path.parent / parsed.srdf).resolve(), path))
     ctrl = parsed.controller
     limits = parsed.limits
+    package_dirs = urdf_package_dirs(urdf, path)
     return RobotSpec(
         name=parsed.name,
         source=path.resolve(),
@@ -320,6 +335,7 @@ def load_robot_spec(path: Path) -> RobotSpec:
         ),
         disabled_links=disabled,
         srdf_disabled_links=srdf,
+        package_dirs=package_dirs,
     )
 
 

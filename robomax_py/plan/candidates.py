@@ -21,8 +21,8 @@ from robomax_py.plan.poses import (
     spot_poses,
 )
 from robomax_py.robot import RobotModel, prismatic_mask
-from robomax_py.robot.ik import IkTable, solve_all
 from robomax_py.robot.ik.turns import wrap_to_pi
+from robomax_py.robot.solve import IkTable, solve_all
 from robomax_py.spec import CellSpec, SeamSpec
 from robomax_py.transforms import invert
 from robomax_py.world.collision import CollisionWorld

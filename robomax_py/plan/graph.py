@@ -16,8 +16,8 @@ from robomax_py.plan.results import PlanOptions, Progress, Transition, _no_progr
 from robomax_py.plan.roadmap import Detour, Roadmap
 from robomax_py.plan.sequence import HOME, SeamBlock, Tour, choice_for_order, optimise
 from robomax_py.robot import RobotModel, fk_tcp
-from robomax_py.robot.ik import solve_all
 from robomax_py.robot.ik.turns import wrap_to_pi
+from robomax_py.robot.solve import solve_all
 from robomax_py.spec import CellSpec
 from robomax_py.timing import (
     ptp_time_estimate,

@@ -33,7 +33,7 @@ from robomax_py.program import (
     written_tcp_speed,
 )
 from robomax_py.robot import RobotModel
-from robomax_py.robot.ik import config_text
+from robomax_py.robot.solve import config_text
 from robomax_py.spec import CellSpec
 from robomax_py.timing import (
     Segment,

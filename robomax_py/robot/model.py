@@ -15,7 +15,6 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import RobotModelError
-from robomax_py.io.robot import package_dirs_for, urdf_package_names
 from robomax_py.robot.geometry import convex_hull_shape, load_mesh
 from robomax_py.spec import ControllerSpec, RobotSpec, frozen_array
 from robomax_py.tolerances import DEFAULT as TOL
@@ -110,7 +109,7 @@ def load_robot(spec: RobotSpec) -> RobotModel:
     acceleration = _limit_vector(spec, "acceleration", spec.acceleration, velocity / DEFAULT_TIME_TO_FULL_SPEED_S, n)
     jerk = _limit_vector(spec, "jerk", spec.jerk, acceleration / DEFAULT_TIME_TO_FULL_ACCEL_S, n)
 
-    package_dirs = [str(spec.urdf.parent), *[str(d) for d in urdf_package_dirs(spec)]]
+    package_dirs = [str(spec.urdf.parent), *[str(d) for d in spec.package_dirs]]
     warnings: list[str] = []
     collision = _build_geometry(model, spec, pin.GeometryType.COLLISION, package_dirs)
     _make_meshes_convex(collision, spec)
@@ -152,18 +151,6 @@ def load_robot(spec: RobotSpec) -> RobotModel:
     )
 
 
-def urdf_package_dirs(spec: RobotSpec) -> list[Path]:
-    """Package folders for the `package://NAME/...` meshes the robot's URDF names."""
-    try:
-        text = spec.urdf.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise RobotModelError(spec.urdf, None, f"cannot read URDF: {exc}") from None
-    dirs: list[Path] = []
-    for name in urdf_package_names(text):
-        for d in package_dirs_for(name, spec.urdf.parent):
-            if d not in dirs:
-                dirs.append(d)
-    return dirs
 
 
 def checked_ik_params(spec: RobotSpec, model: pin.Model) -> Any:

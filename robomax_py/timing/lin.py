@@ -327,6 +327,6 @@ def _failed(line: Line, reason: str, detail: str, fraction: float, us: list[floa
 
 
 def _default_ik() -> IkSolver:
-    from robomax_py.robot.ik import solve_all
+    from robomax_py.robot.solve import solve_all
 
     return solve_all

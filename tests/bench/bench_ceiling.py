@@ -32,16 +32,22 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from robomax_py.plan.candidates import SpotCandidates, seam_candidates  # noqa: E402
 from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.world.collision import CollisionWorld  # noqa: E402
+from robomax_py.plan import (  # noqa: E402
+    PlanOptions,
+    PlanResult,
+    plan_cell,
+    resolved_options,
+    weld_end,
+)
+from robomax_py.plan.candidates import SpotCandidates, seam_candidates  # noqa: E402
 from robomax_py.plan.junction import WeldEnd, time_junction  # noqa: E402
-from robomax_py.plan import PlanOptions, PlanResult, plan_cell, resolved_options, weld_end  # noqa: E402
-from robomax_py.program import as_written_joints, written_speed, written_tcp_speed  # noqa: E402
-from robomax_py.world.scene import build_scene  # noqa: E402
 from robomax_py.plan.poses import orientation_grid  # noqa: E402
+from robomax_py.program import as_written_joints, written_speed, written_tcp_speed  # noqa: E402
 from robomax_py.spec import CellSpec  # noqa: E402
 from robomax_py.timing import ptp_time_estimate  # noqa: E402
+from robomax_py.world.collision import CollisionWorld  # noqa: E402
+from robomax_py.world.scene import build_scene  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"

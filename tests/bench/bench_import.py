@@ -14,11 +14,11 @@ from pathlib import Path
 
 import numpy as np
 
-from robomax_py.robot.ik import solve_all
-from robomax_py.robot.ik.fit import fk_agreement
-from robomax_py.robot import fk_flange, load_robot
-from robomax_py.io.robot import load_robot_spec
 from robomax_py.app.import_urdf import import_urdf
+from robomax_py.io.robot import load_robot_spec
+from robomax_py.robot import fk_flange, load_robot
+from robomax_py.robot.ik.fit import fk_agreement
+from robomax_py.robot.solve import solve_all
 
 ROSI = Path(__file__).resolve().parent.parent / "data" / "rosi"
 ARMS = {

@@ -26,10 +26,10 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.world.collision import CollisionWorld  # noqa: E402
-from robomax_py.plan.graph import Sequencer as _Sequencer
 from robomax_py.plan import PlanOptions, plan_cell  # noqa: E402
+from robomax_py.plan.graph import Sequencer as _Sequencer
 from robomax_py.plan.roadmap import Roadmap  # noqa: E402
+from robomax_py.world.collision import CollisionWorld  # noqa: E402
 from robomax_py.world.scene import build_scene  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]

@@ -19,8 +19,8 @@ from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
 from robomax_py.app.bench import lower_bound  # noqa: E402
+from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
 from robomax_py.plan import PlanOptions, plan_cell  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]

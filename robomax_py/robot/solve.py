@@ -1,0 +1,177 @@
+"""A robot's inverse kinematics as a table: every solution of a batch of TCP poses, in a column
+order shared by all poses, and the configuration data of a joint vector.
+
+Table layout (`solve_all`): column = branch * V + variant. For opw and ur, branch k = 4 * wrist +
+2 * shoulder + elbow as documented in `opw.opw_ik` and `ur.ur_ik`; V = number of turn variants the
+joint limits allow (`turns.turn_shifts`, variant 0 = unshifted). For numeric arms with five or more
+revolute joints, branch = status bits (column k holds the first-found solution whose `status` is k);
+for other numeric arms branches are slots in the order solutions were found.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from robomax_py._typing import BoolArray, FloatArray, IntArray
+from robomax_py.errors import RobotModelError
+from robomax_py.robot.ik._chain import chain_to_frame, revolute_mask
+from robomax_py.robot.ik.config import (
+    ConfigIndicator,
+    brand_text,
+    status_generic,
+    status_opw,
+    turn_bits,
+)
+from robomax_py.robot.ik.numeric import NumericIkParams, numeric_ik
+from robomax_py.robot.ik.opw import OpwParams, opw_ik
+from robomax_py.robot.ik.turns import expand, turn_shifts, wrap_to_pi
+from robomax_py.robot.ik.ur import UrParams, ur_ik
+from robomax_py.robot.model import RobotModel
+from robomax_py.transforms import invert
+
+SOLVERS = ("opw", "ur", "numeric")
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class IkTable:
+    """Every IK solution of a batch of poses, in a column order shared by all poses.
+
+    q : (..., B, n) float
+        Joint values, rad (m for prismatic joints); NaN rows where not valid.
+    valid : (..., B) bool
+        The solution exists and lies within the joint limits.
+    status : (..., B) int
+        KUKA status bits (see `config`); -1 where not valid.
+    turn : (..., B) int
+        KUKA turn bits; -1 where not valid.
+    reachable : (..., B) bool
+        The column's IK branch exists for the pose, before joint-limit filtering (so
+        `reachable & ~valid` means: reachable, but only outside the limits).
+    branch : (B,) int
+        The IK branch of each column (column // V).
+    """
+
+    q: FloatArray
+    valid: BoolArray
+    status: IntArray
+    turn: IntArray
+    reachable: BoolArray
+    branch: IntArray
+
+
+def solve_all(
+    robot: RobotModel,
+    T_base_tcp: FloatArray,
+    q_hint: FloatArray | None = None,
+    rng: np.random.Generator | None = None,
+    *,
+    expand_turns: bool = True,
+) -> IkTable:
+    """Every IK solution within the joint limits, for a batch of TCP poses.
+
+    Parameters
+    ----------
+    robot : RobotModel
+        Base frame = URDF root frame; `T_flange_tcp` is the mounted tool.
+    T_base_tcp : (..., 4, 4) float
+        TCP poses in the robot base frame, metres.
+    q_hint : (..., n) or (n,) float, optional
+        Joint values, rad: the free angle at singularities (opw, ur); the first seed (numeric).
+    rng : np.random.Generator, optional
+        Seeds of the numeric solver; default `np.random.default_rng(0)`, so plans are repeatable.
+    expand_turns : bool
+        False: only the wrapped solutions (V = 1), still filtered by the limits.
+
+    Returns
+    -------
+    IkTable
+        q : (..., B, n) with B = branches * V (opw, ur: 8 * V; numeric: 8 * V or `solutions` * V).
+        Column k means the same branch and turn variant for every pose.
+    """
+    T = np.asarray(T_base_tcp, dtype=float)
+    T_base_flange = T @ invert(np.asarray(robot.T_flange_tcp, dtype=float))
+    model = robot.model
+    n = int(model.nq)
+    lower = np.asarray(robot.limits.lower, dtype=float)
+    upper = np.asarray(robot.limits.upper, dtype=float)
+    rev = revolute_mask(model)
+    params = robot.ik_params
+    solver = robot.ik_solver
+
+    if solver in ("opw", "ur"):
+        expected = OpwParams if solver == "opw" else UrParams
+        if not isinstance(params, expected):
+            raise RobotModelError(robot.source, "ik.params", f"solver '{solver}' needs {expected.__name__}, got {type(params).__name__}")
+        if n != 6 or not rev.all():
+            raise RobotModelError(robot.source, "ik.solver", f"solver '{solver}' needs six revolute joints, the URDF has {n} joints")
+        if isinstance(params, OpwParams):
+            q, valid = opw_ik(params, T_base_flange, q_hint)
+            status = status_opw(params, q)
+        else:
+            q, valid = ur_ik(params, T_base_flange, q_hint)
+            status = status_generic(model, robot.flange_frame_id, q)
+    elif solver == "numeric":
+        if not isinstance(params, NumericIkParams):
+            raise RobotModelError(robot.source, "ik.params", f"solver 'numeric' needs NumericIkParams, got {type(params).__name__}")
+        q, valid = numeric_ik(
+            model, robot.flange_frame_id, T_base_flange, lower, upper,
+            np.random.default_rng(0) if rng is None else rng,
+            params.seeds, q_hint, max_solutions=params.solutions, max_iterations=params.max_iterations,
+        )
+        q = np.where(rev, wrap_to_pi(q), q)
+        status = status_generic(model, robot.flange_frame_id, q)
+        if _has_status(model, robot.flange_frame_id):
+            q, valid, status = _by_status(q, valid, status)
+    else:
+        raise RobotModelError(robot.source, "ik.solver", f"unknown IK solver {solver!r}; expected one of {', '.join(SOLVERS)}")
+
+    variants = turn_shifts(lower, upper, rev) if expand_turns else turn_shifts(lower, upper, np.zeros(n, dtype=bool))
+    n_var = variants.count
+    q_all, valid_all = expand(q, valid, variants)
+    reachable = np.repeat(valid, n_var, axis=-1)
+    status_all = np.where(valid_all, np.repeat(status, n_var, axis=-1), -1)
+    turn_all = np.where(valid_all, turn_bits(q_all), -1)
+    return IkTable(
+        q=q_all,
+        valid=valid_all,
+        status=status_all.astype(np.int64),
+        turn=turn_all.astype(np.int64),
+        reachable=reachable,
+        branch=np.repeat(np.arange(q.shape[-2]), n_var),
+    )
+
+
+def _has_status(model: Any, frame_id: int) -> bool:
+    chain = chain_to_frame(model, frame_id)
+    return len(chain.joints) >= 5 and bool(np.all(chain.revolute[:5]))
+
+
+def _by_status(q: FloatArray, valid: BoolArray, status: IntArray) -> tuple[FloatArray, BoolArray, IntArray]:
+    """Numeric solutions (..., K, n) -> (..., 8, n) with column k = the first solution of status k."""
+    slots = np.arange(8)
+    match = valid[..., None, :] & (status[..., None, :] == slots[:, None])   # (..., 8, K)
+    has = match.any(axis=-1)
+    first = np.argmax(match, axis=-1)                                         # (..., 8)
+    q_out = np.take_along_axis(q, first[..., None], axis=-2)
+    q_out[~has] = np.nan
+    status_out = np.where(has, np.broadcast_to(slots, has.shape), -1)
+    return q_out, has, status_out
+
+
+def config_of(robot: RobotModel, q: FloatArray) -> ConfigIndicator:
+    """The configuration indicator of one joint configuration q (n,), rad."""
+    q = np.asarray(q, dtype=float)
+    if robot.ik_solver == "opw" and isinstance(robot.ik_params, OpwParams):
+        status = status_opw(robot.ik_params, q)
+    else:
+        status = status_generic(robot.model, robot.flange_frame_id, q)
+    return ConfigIndicator(status=int(status), turn=int(turn_bits(q)))
+
+
+def config_text(robot: RobotModel, q: FloatArray) -> str:
+    """The configuration data the robot's controller brand writes for q (n,), rad (`config.brand_text`)."""
+    ind = config_of(robot, q)
+    return brand_text(robot.controller.brand, ind.status, ind.turn, np.asarray(q, dtype=float))
