@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomax_py.errors import RobomaxError
 from robomax_py.timing import Segment
 from robomax_py.world.collision import KIND_DYNAMIC, CollisionWorld
 
@@ -40,7 +41,7 @@ class WaitPlan:
     for_signal: bool
 
 
-class WaitingError(Exception):
+class WaitingError(RobomaxError):
     """The dynamic obstacles cannot be avoided by waiting; the message says which and when."""
 
 

@@ -21,6 +21,7 @@ import numpy as np
 import pinocchio as pin
 
 from robomax_py._typing import FloatArray
+from robomax_py.errors import RobomaxError
 from robomax_py.robot.ik._chain import chain_to_frame, joint_frames
 from robomax_py.robot.ik.opw import OpwParams, opw_fk
 from robomax_py.robot.ik.ur import UrParams, ur_fk
@@ -34,7 +35,7 @@ FIT_SAMPLES = 48
 AGREEMENT_SAMPLES = 300
 
 
-class FitError(Exception):
+class FitError(RobomaxError):
     """The chain is not of the solver's class; `problem` says which condition fails."""
 
     def __init__(self, problem: str) -> None:
