@@ -3,7 +3,7 @@
 
 Run from anywhere:  ``python robots/generate.py [--out DIR]``  (DIR defaults to this file's folder).
 The output is deterministic: running the script twice gives byte-identical files, which
-``tests/test_robot_files.py`` checks against the committed copies.
+``tests/robot/test_robot_files.py`` checks against the committed copies.
 
 Kinematics
 ----------

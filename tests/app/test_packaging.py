@@ -18,7 +18,7 @@ from robomax_py.io.robot import (
     shipped_robots_dir,
 )
 
-REPO = Path(__file__).resolve().parent.parent
+REPO = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.slow

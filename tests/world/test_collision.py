@@ -48,7 +48,7 @@ from robomax_py.world.collision import (
 )
 from robomax_py.world.scene import build_scene
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
 PANEL = REFERENCE_CELL.parent / "parts" / "cabin_panel.stl"
 

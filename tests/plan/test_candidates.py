@@ -20,7 +20,7 @@ from robomax_py.transforms import invert
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.scene import build_scene
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 def _scan(robot, world, q, valid, reachable):  # type: ignore[no-untyped-def]

@@ -69,7 +69,7 @@ def test_lower_bound_is_below_the_cycle_and_sums_rest_to_rest_moves(
     planned: tuple[PlanResult, list[tuple[str, int, int]]],
 ) -> None:
     result, _ = planned
-    robot_limits = load_cell_robot(load_cell(Path(__file__).parent / "data" / "flange_cell" / "cabin_flange.yaml")).limits
+    robot_limits = load_cell_robot(load_cell(Path(__file__).parent.parent / "data" / "flange_cell" / "cabin_flange.yaml")).limits
     bound = lower_bound(result, robot_limits)
     assert 0 < bound <= result.cycle_time
     spots = result.spots

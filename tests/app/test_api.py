@@ -12,7 +12,7 @@ import pytest
 
 import robomax_py
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 
 
 def test_api_names_are_exported() -> None:

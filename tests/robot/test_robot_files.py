@@ -24,7 +24,7 @@ import yaml
 
 from robomax_py.robot.ik.opw import OpwParams, opw_fk
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 ROBOTS = REPO / "robomax_py" / "robots"
 ARMS = ("kr125", "kr16")
 LINKS = ("base_link", "link_1", "link_2", "link_3", "link_4", "link_5", "link_6")

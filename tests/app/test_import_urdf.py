@@ -27,7 +27,7 @@ from robomax_py.robot import fk_flange, load_robot
 from robomax_py.robot.ik.fit import FitError, fit_opw, fk_agreement
 from robomax_py.robot.solve import config_text, solve_all
 
-ROSI = Path(__file__).parent / "data" / "rosi"
+ROSI = Path(__file__).parent.parent / "data" / "rosi"
 ARMS = {
     "irb2400": ROSI / "abb_irb2400_support/urdf/irb2400.xacro",
     "m20ia": ROSI / "fanuc_m20ia_support/urdf/m20ia.xacro",

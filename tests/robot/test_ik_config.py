@@ -26,7 +26,7 @@ from robomax_py.robot.ik.opw import (
 )
 from robomax_py.robot.solve import config_of, solve_all
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 DEG = np.pi / 180.0
 KR6_R700 = OpwParams(
     a1=0.025, a2=-0.035, b=0.0, c1=0.400, c2=0.315, c3=0.365, c4=0.080,

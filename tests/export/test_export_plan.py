@@ -13,7 +13,7 @@ from robomax_py.export.srcl_parser import parse_program
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import plan_cell
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 GOLDEN = REPO / "tests" / "golden"
 
 

@@ -26,7 +26,7 @@ from robomax_py.program import (
     WaitFor,
 )
 
-GOLDEN = Path(__file__).parent / "golden" / "example.srcl"
+GOLDEN = Path(__file__).parent.parent / "golden" / "example.srcl"
 JOINTS = tuple(f"joint_a{i}" for i in range(1, 7))
 
 

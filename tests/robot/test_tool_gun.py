@@ -19,7 +19,7 @@ import pytest
 import trimesh
 import yaml
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 GUN_DIR = REPO / "robomax_py" / "robots" / "tools" / "spot_gun_c"
 # The reference cell: its frozen copy in tests/data (cells/cabin_flange.yaml is now our own cell), else
 # the contract's shared/ folder beside the clone (as in CI).

@@ -39,7 +39,7 @@ from robomax_py.world.scene import (
     build_scene,
 )
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
 POSE_ATOL = 1e-12  # pose products of a few 4x4 float64 matrices
 

@@ -27,7 +27,7 @@ from robomax_py.transforms import invert
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.scene import build_scene
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 # Frozen copy of the reference cell (cells/cabin_flange.yaml is now our own cabin-panel cell).
 REFERENCE_CELL = REPO / "tests" / "data" / "flange_cell" / "cabin_flange.yaml"
 PANEL_STL = REPO / "tests" / "data" / "flange_cell" / "parts" / "cabin_panel.stl"

@@ -25,7 +25,7 @@ from robomax_py.robot.ik.opw import (
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.transforms import rotation_angle
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 DEG = np.pi / 180.0
 
 KR6_R700 = OpwParams(
