@@ -18,7 +18,13 @@ from robomax_py.errors import (
 )
 
 if TYPE_CHECKING:
-    from robomax_py.app.api import LoadedCell, load_cell, plan_cell, verify_program, write_programs
+    from robomax_py.app.api import (
+        LoadedCell,
+        load_cell,
+        plan_cell,
+        verify_program,
+        write_programs,
+    )
 
 __version__ = "0.1.0"
 

@@ -10,7 +10,6 @@ seam's tolerance; the configuration indicator as written; ordered seams in their
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,6 +19,7 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
+from robomax_py.export.trajectory_json import load_trajectory_file
 from robomax_py.plan.poses import nominal_rotation
 from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.robot.ik import same_config
@@ -51,40 +51,6 @@ class VerifyReport:
         return not self.violations
 
 
-def load_trajectory_file(path: Path, robot: RobotModel) -> dict[str, Any]:
-    """Read and check the structure of a SPEC §5 file; ProgramError names what is wrong."""
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ProgramError(path, None, "program file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ProgramError(path, None, f"cannot read program: {exc}") from None
-    except json.JSONDecodeError as exc:
-        raise ProgramError(path, f"line {exc.lineno}, column {exc.colno}", f"not valid JSON: {exc.msg}") from None
-    if not isinstance(data, dict):
-        raise ProgramError(path, None, "expected a JSON object at the top level")
-    if data.get("format") != "robomax.trajectory/1":
-        raise ProgramError(path, "format", f"expected 'robomax.trajectory/1', got {data.get('format')!r}")
-    for key in ("joints", "t", "q", "spots"):
-        if key not in data:
-            raise ProgramError(path, key, "required key is missing")
-    if list(data["joints"]) != list(robot.joint_names):
-        raise ProgramError(path, "joints", f"expected {list(robot.joint_names)} for {robot.name}, got {data['joints']}")
-    try:
-        t = np.asarray(data["t"], dtype=float)
-        q = np.asarray(data["q"], dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ProgramError(path, "t/q", f"not numeric arrays: {exc}") from None
-    if t.ndim != 1 or len(t) < 2 or q.shape != (len(t), robot.dof) or not (np.isfinite(t).all() and np.isfinite(q).all()):
-        raise ProgramError(path, "q", f"expected {len(t)} rows of {robot.dof} finite joint values and as many times")
-    if not np.all(np.diff(t) > 0):
-        raise ProgramError(path, "t", "times must be strictly increasing")
-    for k, spot in enumerate(data["spots"]):
-        missing = [key for key in ("seam", "name", "t_arrive", "t_leave", "alpha", "beta", "gamma") if key not in spot]
-        if missing:
-            raise ProgramError(path, f"spots[{k}]", f"missing {', '.join(missing)}")
-    data["t"], data["q"] = t, q
-    return data
 
 
 def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
@@ -111,7 +77,7 @@ def verify_trajectory_file(cell: CellSpec, robot: RobotModel, path: Path) -> Ver
 def verify_srcl_file(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
     """Parse an SRCL program, rebuild its motion (`rebuild.rebuild`) and check it like a trajectory."""
     from robomax_py.export.rebuild import rebuild
-    from robomax_py.export.srcl_parser import parse_program
+    from robomax_py.export.srcl import parse_program
 
     try:
         text = path.read_text(encoding="utf-8")

@@ -112,7 +112,7 @@ def load_program(path: Path, cell: CellSpec, robot: RobotModel) -> ShownProgram:
 
 
 def _load_json(path: Path, cell: CellSpec, robot: RobotModel) -> ShownProgram:
-    from robomax_py.verify import load_trajectory_file
+    from robomax_py.export.trajectory_json import load_trajectory_file
 
     stated = _peek_json(path).get("robot", robot.name)
     if stated != robot.name:
@@ -143,7 +143,7 @@ def _peek_json(path: Path) -> dict[str, Any]:
 
 def _load_srcl(path: Path, cell: CellSpec, robot: RobotModel) -> ShownProgram:
     from robomax_py.export.rebuild import rebuild
-    from robomax_py.export.srcl_parser import parse_program
+    from robomax_py.export.srcl import parse_program
 
     try:
         text = path.read_text(encoding="utf-8")

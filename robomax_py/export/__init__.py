@@ -1,29 +1,56 @@
-"""Exporters: a planned result -> program text. Pure and deterministic (fixed float formats)."""
+"""Program formats, both directions, in one registry: a planned result -> program text (pure and
+deterministic, fixed float formats), and a program file -> what `robomax verify` checks.
+
+Each format is one module owning its writer and its reader (`srcl`, `trajectory_json`);
+`plan_program` turns a plan into the dialect-free `Program` the dialects write, `rebuild` turns a
+parsed `Program` back into motion.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from robomax_py.errors import ExportError
-from robomax_py.export import plan_program, trajectory_json
+from robomax_py.export import plan_program, srcl, trajectory_json
 from robomax_py.plan import PlanResult
 
 Exporter = Callable[[PlanResult], str]
 
-# format name -> (file extension, exporter)
-EXPORTERS: dict[str, tuple[str, Exporter]] = {
-    "json": (".json", trajectory_json.render),
-    "srcl": (".srcl", plan_program.render),
+
+@dataclass(frozen=True, slots=True)
+class Format:
+    """A program format: its file extension, its writer and (where it has one) its parser."""
+
+    name: str
+    extension: str
+    render: Exporter
+    parse: Callable[..., object]
+
+
+# Registry order is the order files are written in (the trajectory file first).
+FORMATS: dict[str, Format] = {
+    "json": Format("json", ".json", trajectory_json.render, trajectory_json.load_trajectory_file),
+    "srcl": Format("srcl", ".srcl", plan_program.render, srcl.parse_program),
 }
+
+
+def format_for(suffix: str) -> Format:
+    """The format of a program file by its extension (".srcl", ".json"), or ExportError."""
+    for f in FORMATS.values():
+        if f.extension == suffix.lower():
+            return f
+    known = ", ".join(f.extension for f in FORMATS.values())
+    raise ExportError(f"unknown program file type '{suffix}'; known: {known}")
 
 
 def render(result: PlanResult, fmt: str) -> str:
     """The program text of a planned result in the named format."""
-    if fmt not in EXPORTERS:
-        raise ExportError(f"unknown program format '{fmt}'; known: {', '.join(sorted(EXPORTERS))}")
+    if fmt not in FORMATS:
+        raise ExportError(f"unknown program format '{fmt}'; known: {', '.join(sorted(FORMATS))}")
     if result.status != "planned" or result.trajectory is None:
         raise ExportError(f"cell {result.cell} is not planned: {result.message}")
-    return EXPORTERS[fmt][1](result)
+    return FORMATS[fmt].render(result)
 
 
 def render_programs(result: PlanResult) -> dict[str, str]:
@@ -32,6 +59,6 @@ def render_programs(result: PlanResult) -> dict[str, str]:
     Returns
     -------
     dict[str, str]
-        File name (``<cell><ext>``, one per exporter, in registry order) -> text.
+        File name (``<cell><ext>``, one per format, in registry order) -> text.
     """
-    return {f"{result.cell}{ext}": render(result, fmt) for fmt, (ext, _) in EXPORTERS.items()}
+    return {f"{result.cell}{f.extension}": render(result, name) for name, f in FORMATS.items()}

@@ -1,17 +1,32 @@
-"""`Program` -> SRCL text: a small, regular, IRL-style (DIN 66312) dialect; see docs/srcl.md.
+"""SRCL, both directions: `Program` -> text (`write_program`) and text -> `Program` (`parse_program`,
+lark LALR). A small, regular, IRL-style (DIN 66312) dialect; see docs/srcl.md.
 
 One statement per line, upper-case keywords, numbers with the fixed decimals of `robomax_py.program`
 (joints 4, mm 3, angles 4, speeds 3, times 3), comments in ``{ ... }`` on one line. The text depends
-on the program only (no timestamps), and `robomax_py.export.srcl_parser.parse_program` reads it back
-to an equal `Program`; writing that again gives the same bytes.
+on the program only (no timestamps), and `parse_program` reads it back to an equal `Program`; writing
+that again gives the same bytes. Parse errors are a `ProgramError` whose key is "line L, column C"
+(1-based) and whose problem is written for people, e.g. "expected ';' after MOVE statement, got
+'SPOT'"; besides syntax the parser checks what the writer checks (plain decimal numbers, ranges via
+`find_problem`, one PTP value per declared axis, unique joint and frame names).
 """
 
 from __future__ import annotations
 
 import re
 from collections.abc import Iterable
+from functools import lru_cache
+from pathlib import Path
 
-from robomax_py.errors import ExportError
+from lark import Lark, Token, Tree
+from lark.exceptions import (
+    UnexpectedCharacters,
+    UnexpectedEOF,
+    UnexpectedInput,
+    UnexpectedToken,
+)
+from lark.lexer import PatternStr
+
+from robomax_py.errors import ExportError, ProgramError
 from robomax_py.program import (
     ANGLE_DECIMALS,
     JOINT_DECIMALS,
@@ -31,7 +46,7 @@ from robomax_py.program import (
     find_problem,
 )
 
-__all__ = ["DIALECT", "RESERVED", "write_program"]
+__all__ = ["DIALECT", "GRAMMAR", "RESERVED", "parse_program", "write_program"]
 
 DIALECT = "robomax SRCL/1"
 
@@ -189,3 +204,279 @@ def _check_program(program: Program) -> None:
         problem = find_problem(ins, len(h.joints))
         if problem:
             raise ExportError(f"{where}: {problem}")
+
+
+# ================================================================================== reading
+
+GRAMMAR = r"""
+start: "PROGRAM" IDENT ";" COMMENT* header frames "BEGIN" _stmt* "ENDPROGRAM" ";"
+
+header: "CELL" IDENT ";" COMMENT* \
+        "ROBOT" IDENT "AXES" "(" IDENT ("," IDENT)* ")" ";" COMMENT* \
+        "TOOL" IDENT ";" COMMENT* \
+        "CYCLE" NUMBER "SEC" ";" COMMENT*
+
+frames: ("VAR" COMMENT* frame*)?
+frame: IDENT ":" kind "FRAME" ":=" "(" pos "," ori ")" ";" COMMENT*
+kind: "TOOL" -> tool_kind
+    | "BASE" -> base_kind
+pos: "POS" "(" NUMBER "," NUMBER "," NUMBER ")"
+ori: "ORI" "(" NUMBER "," NUMBER "," NUMBER ")"
+
+_stmt: ptp | lin | spot | wait | wait_for | note
+ptp: "MOVE" "PTP" "AXIS" "(" NUMBER ("," NUMBER)* ")" "SPEED" NUMBER "ACCEL" NUMBER flyby? COMMENT? ";"
+lin: "MOVE" "LIN" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S flyby? COMMENT? ";"
+flyby: FLYBY NUMBER
+spot: "SPOT" IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ";"
+wait: "WAIT" NUMBER "SEC" ";"
+wait_for: "WAIT" "FOR" IDENT ";"
+note: COMMENT
+
+FLYBY: "FLYBY"
+_MM_S.2: "MM/S"
+IDENT: /[A-Za-z_][A-Za-z0-9_]*/
+NUMBER: /[+-]?\.?[0-9][A-Za-z0-9_.]*/
+STRING: /'[^'\n]*'/
+COMMENT: /\{[^{}\n]*\}/
+%ignore /[ \t\r\n]+/
+"""
+
+_PLAIN_NUMBER = re.compile(r"[+-]?[0-9]+(\.[0-9]+)?")
+
+# Statement keywords, for "... in/after MOVE statement" in messages.
+_CONTEXT = {
+    "PROGRAM": "PROGRAM heading", "CELL": "CELL line", "ROBOT": "ROBOT line", "TOOL": "TOOL line",
+    "CYCLE": "CYCLE line", "MOVE": "MOVE statement", "SPOT": "SPOT statement", "WAIT": "WAIT statement",
+    "ENDPROGRAM": "ENDPROGRAM",
+}
+_NAMED = {
+    "IDENT": "a name", "NUMBER": "a number", "STRING": "a quoted string", "COMMENT": "a comment",
+    "FLYBY": "FLYBY", "$END": "end of file",
+}
+
+
+@lru_cache(maxsize=1)
+def _parser() -> Lark:
+    return Lark(GRAMMAR, parser="lalr", lexer="basic", propagate_positions=True, maybe_placeholders=False)
+
+
+def parse_program(text: str, file: str | Path | None = None) -> Program:
+    """Read an SRCL program.
+
+    Parameters
+    ----------
+    text : str
+        The program text.
+    file : str | Path | None
+        Named in error messages only.
+
+    Returns
+    -------
+    Program
+
+    Raises
+    ------
+    ProgramError
+        With key "line L, column C" and a readable problem.
+    """
+    parser = _parser()
+    try:
+        tree = parser.parse(text)
+    except UnexpectedInput as exc:
+        line, column, problem = _describe(parser, text, exc)
+        raise ProgramError(file, f"line {line}, column {column}", problem) from None
+    return _Builder(file).program(tree)
+
+
+# --------------------------------------------------------------------------------------------------
+# syntax errors
+
+
+def _show(token: Token) -> str:
+    if token.type == "$END":
+        return "end of file"
+    return repr(str(token)) if "'" not in token else f'"{token}"'
+
+
+def _expected(parser: Lark, names: set[str]) -> str:
+    shown: list[str] = []
+    for name in names:
+        if name in _NAMED:
+            shown.append(_NAMED[name])
+            continue
+        pattern = parser.get_terminal(name).pattern
+        shown.append(f"'{pattern.value}'" if isinstance(pattern, PatternStr) else name)
+    shown = sorted(set(shown), key=lambda s: (not s.startswith("'"), s))
+    if len(shown) == 1:
+        return shown[0]
+    return "one of " + ", ".join(shown[:-1]) + " or " + shown[-1]
+
+
+def _context(parser: Lark, text: str, pos: int) -> tuple[str, bool]:
+    """The construct being read at `pos` and whether a ';' has closed it."""
+    last = ""
+    closed = False
+    try:
+        for tok in parser.lex(text[:pos]):
+            if tok.type == "SEMICOLON":
+                closed = True
+            elif str(tok) in _CONTEXT and tok.type != "IDENT":
+                last, closed = _CONTEXT[str(tok)], False
+            elif tok.type == "COMMENT" and closed:
+                last = ""
+    except UnexpectedInput:
+        return "", True
+    return last, closed
+
+
+def _end_position(text: str) -> tuple[int, int]:
+    body = text.rstrip()
+    line = body.count("\n") + 1
+    column = len(body) - (body.rfind("\n") + 1) + 1
+    return line, column
+
+
+def _describe(parser: Lark, text: str, exc: UnexpectedInput) -> tuple[int, int, str]:
+    if isinstance(exc, UnexpectedCharacters):
+        char = text[exc.pos_in_stream]
+        if char == "{":
+            problem = "unterminated comment: '{' has no '}' on the same line (comments are one line, no nested braces)"
+        elif char == "'":
+            problem = "unterminated string: quote has no closing quote on the same line"
+        else:
+            problem = f"unexpected character {char!r}"
+        return exc.line, exc.column, problem
+    if isinstance(exc, UnexpectedEOF):
+        line, column = _end_position(text)
+        return line, column, f"unexpected end of file; expected {_expected(parser, set(exc.expected))}"
+    if not isinstance(exc, UnexpectedToken):
+        return exc.line, exc.column, str(exc)
+    token: Token = exc.token
+    expected = set(exc.expected)
+    if token.type == "$END":
+        line, column = _end_position(text)
+        pos = len(text)
+    else:
+        line, column = token.line or 0, token.column or 0
+        pos = token.start_pos or 0
+    got = _show(token)
+    if token.type == "NUMBER" and not _PLAIN_NUMBER.fullmatch(str(token)):
+        return line, column, f"bad number {got}: write digits with an optional '.' and decimals, e.g. 12.500"
+    if token.type == "$END":
+        return line, column, f"unexpected end of file; expected {_expected(parser, expected)}"
+    if "MOVE" in expected and "ENDPROGRAM" in expected and token.type != "SEMICOLON":
+        hint = " (keywords are upper case)" if str(token).upper() in RESERVED else ""
+        return line, column, (
+            f"unknown statement {got}{hint}; expected MOVE, SPOT, WAIT, a {{ comment }} or ENDPROGRAM"
+        )
+    where, closed = _context(parser, text, pos)
+    if where and not closed:
+        if "SEMICOLON" in expected and (str(token) in _CONTEXT or token.type == "COMMENT"):
+            return line, column, f"expected ';' after {where}, got {got}"
+        return line, column, f"expected {_expected(parser, expected)} in {where}, got {got}"
+    return line, column, f"expected {_expected(parser, expected)}, got {got}"
+
+
+# --------------------------------------------------------------------------------------------------
+# tree -> Program
+
+
+class _Builder:
+    def __init__(self, file: str | Path | None) -> None:
+        self.file = file
+
+    def error(self, line: int | None, column: int | None, problem: str) -> ProgramError:
+        return ProgramError(self.file, f"line {line}, column {column}", problem)
+
+    def number(self, token: Token) -> float:
+        if not _PLAIN_NUMBER.fullmatch(str(token)):
+            raise self.error(
+                token.line, token.column,
+                f"bad number '{token}': write digits with an optional '.' and decimals, e.g. 12.500",
+            )
+        return float(token)
+
+    def tokens(self, tree: Tree[Token], kind: str) -> list[Token]:
+        return [c for c in tree.children if isinstance(c, Token) and c.type == kind]
+
+    def subtree(self, tree: Tree[Token], name: str) -> Tree[Token]:
+        return next(c for c in tree.children if isinstance(c, Tree) and c.data == name)
+
+    def triple(self, tree: Tree[Token]) -> tuple[float, ...]:
+        return tuple(self.number(t) for t in self.tokens(tree, "NUMBER"))
+
+    def check(self, tree: Tree[Token], item: Header | FrameDef | Instruction, n_joints: int) -> None:
+        problem = find_problem(item, n_joints)
+        if problem:
+            raise self.error(tree.meta.line, tree.meta.column, problem)
+
+    def program(self, tree: Tree[Token]) -> Program:
+        name = self.tokens(tree, "IDENT")[0]
+        header = self.header(self.subtree(tree, "header"))
+        n_joints = len(header.joints)
+        frames = self.frames(self.subtree(tree, "frames"), n_joints)
+        instructions: list[Instruction] = []
+        for child in tree.children:
+            if isinstance(child, Tree) and child.data not in ("header", "frames"):
+                ins = self.statement(child)
+                self.check(child, ins, n_joints)
+                instructions.append(ins)
+        return Program(str(name), header, tuple(frames), tuple(instructions))
+
+    def header(self, tree: Tree[Token]) -> Header:
+        idents = self.tokens(tree, "IDENT")
+        cell, robot, *joints, tool = idents
+        seen: set[str] = set()
+        for joint in joints:
+            if str(joint) in seen:
+                raise self.error(joint.line, joint.column, f"joint {str(joint)!r} is listed twice in AXES")
+            seen.add(str(joint))
+        (cycle,) = self.tokens(tree, "NUMBER")
+        header = Header(str(cell), str(robot), str(tool), self.number(cycle), tuple(str(j) for j in joints))
+        self.check(tree, header, len(joints))
+        return header
+
+    def frames(self, tree: Tree[Token], n_joints: int) -> list[FrameDef]:
+        frames: list[FrameDef] = []
+        for node in tree.children:
+            if not (isinstance(node, Tree) and node.data == "frame"):
+                continue
+            (name,) = self.tokens(node, "IDENT")
+            if any(f.name == str(name) for f in frames):
+                raise self.error(name.line, name.column, f"frame {str(name)!r} is already defined")
+            kind = "tool" if any(isinstance(c, Tree) and c.data == "tool_kind" for c in node.children) else "base"
+            frame = FrameDef(
+                str(name), kind, self.triple(self.subtree(node, "pos")), self.triple(self.subtree(node, "ori"))
+            )
+            self.check(node, frame, n_joints)
+            frames.append(frame)
+        return frames
+
+    def note(self, tree: Tree[Token]) -> str:
+        comments = self.tokens(tree, "COMMENT")
+        return str(comments[0])[1:-1].strip() if comments else ""
+
+    def statement(self, tree: Tree[Token]) -> Instruction:
+        fly = [c for c in tree.children if isinstance(c, Tree) and c.data == "flyby"]
+        flyby = self.number(self.tokens(fly[0], "NUMBER")[0]) if fly else 0.0
+        if tree.data == "ptp":
+            values = [self.number(t) for t in self.tokens(tree, "NUMBER")]
+            return PtpMove(tuple(values[:-2]), values[-2], values[-1], flyby, self.note(tree))
+        if tree.data == "lin":
+            (config,) = self.tokens(tree, "STRING")
+            (speed,) = self.tokens(tree, "NUMBER")
+            return LinMove(
+                self.triple(self.subtree(tree, "pos")), self.triple(self.subtree(tree, "ori")),
+                str(config)[1:-1], self.number(speed), flyby, self.note(tree),
+            )
+        if tree.data == "spot":
+            name, seam = self.tokens(tree, "IDENT")
+            (time,) = self.tokens(tree, "NUMBER")
+            return Spot(str(name), str(seam), self.number(time))
+        if tree.data == "wait":
+            (seconds,) = self.tokens(tree, "NUMBER")
+            return Wait(self.number(seconds))
+        if tree.data == "wait_for":
+            (signal,) = self.tokens(tree, "IDENT")
+            return WaitFor(str(signal))
+        return Comment(self.note(tree))

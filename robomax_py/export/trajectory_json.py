@@ -1,4 +1,5 @@
-"""SPEC §5 trajectory file: dense joint samples, spots with arrive/leave times, angles and indicators.
+"""SPEC §5 trajectory file, both directions: a plan -> text (`render`) and a file -> checked data
+(`load_trajectory_file`): dense joint samples, spots with arrive/leave times, angles and indicators.
 
 Numbers are written with fixed decimals (t: 1 µs, q: 1e-9 rad) so that the same plan gives the same
 bytes; angles in the file are degrees, as in every file people read.
@@ -8,8 +9,14 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
+from typing import Any
 
+import numpy as np
+
+from robomax_py.errors import ProgramError
 from robomax_py.plan import PlanResult
+from robomax_py.robot import RobotModel
 
 FORMAT = "robomax.trajectory/1"
 
@@ -49,3 +56,39 @@ def render(result: PlanResult) -> str:
 def _deg(rad: float) -> str:
     value = math.degrees(float(rad))
     return f"{0.0 if abs(value) < 5e-7 else value:.6f}"
+
+
+def load_trajectory_file(path: Path, robot: RobotModel) -> dict[str, Any]:
+    """Read and check the structure of a SPEC §5 file; ProgramError names what is wrong."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ProgramError(path, None, "program file not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ProgramError(path, None, f"cannot read program: {exc}") from None
+    except json.JSONDecodeError as exc:
+        raise ProgramError(path, f"line {exc.lineno}, column {exc.colno}", f"not valid JSON: {exc.msg}") from None
+    if not isinstance(data, dict):
+        raise ProgramError(path, None, "expected a JSON object at the top level")
+    if data.get("format") != FORMAT:
+        raise ProgramError(path, "format", f"expected 'robomax.trajectory/1', got {data.get('format')!r}")
+    for key in ("joints", "t", "q", "spots"):
+        if key not in data:
+            raise ProgramError(path, key, "required key is missing")
+    if list(data["joints"]) != list(robot.joint_names):
+        raise ProgramError(path, "joints", f"expected {list(robot.joint_names)} for {robot.name}, got {data['joints']}")
+    try:
+        t = np.asarray(data["t"], dtype=float)
+        q = np.asarray(data["q"], dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ProgramError(path, "t/q", f"not numeric arrays: {exc}") from None
+    if t.ndim != 1 or len(t) < 2 or q.shape != (len(t), robot.dof) or not (np.isfinite(t).all() and np.isfinite(q).all()):
+        raise ProgramError(path, "q", f"expected {len(t)} rows of {robot.dof} finite joint values and as many times")
+    if not np.all(np.diff(t) > 0):
+        raise ProgramError(path, "t", "times must be strictly increasing")
+    for k, spot in enumerate(data["spots"]):
+        missing = [key for key in ("seam", "name", "t_arrive", "t_leave", "alpha", "beta", "gamma") if key not in spot]
+        if missing:
+            raise ProgramError(path, f"spots[{k}]", f"missing {', '.join(missing)}")
+    data["t"], data["q"] = t, q
+    return data

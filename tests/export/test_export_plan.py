@@ -6,10 +6,9 @@ from pathlib import Path
 
 import pytest
 
-from robomax_py.export import EXPORTERS, render
+from robomax_py.export import FORMATS, render
 from robomax_py.export.plan_program import identifier
-from robomax_py.export.srcl import write_program
-from robomax_py.export.srcl_parser import parse_program
+from robomax_py.export.srcl import parse_program, write_program
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import plan_cell
 
@@ -26,10 +25,10 @@ def small_plan(tmp_path_factory: pytest.TempPathFactory, write_small_cell):  # t
     return result
 
 
-@pytest.mark.parametrize("fmt", sorted(EXPORTERS))
+@pytest.mark.parametrize("fmt", sorted(FORMATS))
 def test_golden(small_plan, fmt: str, update_golden: bool) -> None:  # type: ignore[no-untyped-def]
     text = render(small_plan, fmt)
-    golden = GOLDEN / f"small_cell{EXPORTERS[fmt][0]}"
+    golden = GOLDEN / f"small_cell{FORMATS[fmt].extension}"
     if update_golden:
         golden.write_text(text)
     assert golden.is_file(), f"missing {golden}: run pytest --update-golden and review the diff"

@@ -11,8 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from robomax_py.errors import ExportError, ProgramError
-from robomax_py.export.srcl import RESERVED, write_program
-from robomax_py.export.srcl_parser import parse_program
+from robomax_py.export.srcl import RESERVED, parse_program, write_program
 from robomax_py.program import (
     Comment,
     FrameDef,

@@ -198,7 +198,7 @@ def test_per_move_speeds_are_planned_written_and_rebuilt(tmp_path: Path, write_s
 
     from robomax_py.export import render
     from robomax_py.export.rebuild import rebuild
-    from robomax_py.export.srcl_parser import parse_program
+    from robomax_py.export.srcl import parse_program
     from robomax_py.program import LinMove, PtpMove
 
     path: Path = write_small_cell(tmp_path)

@@ -18,7 +18,7 @@ import pytest
 import trimesh
 from numpy.testing import assert_allclose
 
-from robomax_py.io.robot import urdf_package_dirs, load_robot_spec, resolve_package_uri
+from robomax_py.io.robot import load_robot_spec, resolve_package_uri, urdf_package_dirs
 from robomax_py.robot import RobotModel, fk_flange, load_robot
 from robomax_py.spec import (
     Box,

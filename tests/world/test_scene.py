@@ -16,7 +16,7 @@ import trimesh
 from numpy.testing import assert_allclose
 
 from robomax_py.errors import CellFileError, RobotModelError
-from robomax_py.io.robot import urdf_package_dirs, resolve_package_uri
+from robomax_py.io.robot import resolve_package_uri, urdf_package_dirs
 from robomax_py.robot import RobotModel, load_robot
 from robomax_py.spec import (
     Box,
