@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import Literal
 
 import numpy as np
 
@@ -40,6 +41,21 @@ BRANCH_JUMP_RAD = 0.2
 MAX_TURN_VARIANTS = 4
 
 
+RejectionKind = Literal["joint_limit", "approach_branch", "approach_joint_limit", "unreachable", "collision",
+                        "approach_blocked", "turn_variant"]
+
+
+@dataclass(frozen=True, slots=True)
+class Rejection:
+    """Why an (orientation, IK column) pair is not a candidate; `detail` names the bodies of a collision."""
+
+    kind: RejectionKind
+    detail: str = ""
+
+    def __str__(self) -> str:
+        return f"{self.kind}:{self.detail}" if self.detail else self.kind
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class SpotCandidates:
     """The surviving configurations of one spot.
@@ -65,7 +81,7 @@ class SpotCandidates:
     app_path: FloatArray
     status: IntArray
     turn: IntArray
-    rejected: Counter[str] = field(default_factory=Counter)
+    rejected: Counter[Rejection] = field(default_factory=Counter)
 
     def __len__(self) -> int:
         return len(self.orient)
@@ -114,11 +130,11 @@ def _spot_candidates(
     reachable = table.reachable[s]             # a branch exists before limit filtering
     limits = robot.limits
     revolute = ~prismatic_mask(robot.model)
-    rejected: Counter[str] = Counter()
+    rejected: Counter[Rejection] = Counter()
     keep: list[tuple[int, int]] = []
     lines: dict[tuple[int, int], FloatArray] = {}
     checks = 0
-    verdicts: dict[tuple[int, ...], str] = {}   # wrapped spot q -> "" (free) or rejection reason
+    verdicts: dict[tuple[int, ...], LineVerdict] = {}   # wrapped spot q -> its line's verdict
     _, n_line, n_col = valid.shape
     # The cheap tests for every (orientation, column) at once; collision checks only for survivors.
     # IK columns are fixed 2 pi shifts of wrapped values, so a joint crossing +-180 deg along the
@@ -141,32 +157,31 @@ def _spot_candidates(
     position = oo * n_col + kk                                       # of each line in the scan
     # Reasons are counted in the order an (orientation, column) scan first meets them, so reports
     # list equal counts in that order: reason -> (first position in the scan, count).
-    found: dict[str, tuple[float, int]] = {}
+    found: dict[Rejection, tuple[float, int]] = {}
 
-    def count(reason: str, mask: np.ndarray, where: np.ndarray) -> None:
+    def count(reason: Rejection, mask: np.ndarray, where: np.ndarray) -> None:
         n = int(np.sum(mask))
         if n:
             found[reason] = (float(where[np.argmax(mask)]), n)
 
-    count("joint_limit", (at_spot & ~within).reshape(-1), np.arange(at_spot.size))
-    count("approach_branch", ~branch_ok, position)
-    count("approach_joint_limit", branch_ok & ~inside, position)
+    count(Rejection("joint_limit"), (at_spot & ~within).reshape(-1), np.arange(at_spot.size))
+    count(Rejection("approach_branch"), ~branch_ok, position)
+    count(Rejection("approach_joint_limit"), branch_ok & ~inside, position)
     no_branch = ~at_spot.any(axis=1)
     if no_branch.any():            # counted after its orientation's columns
-        found["unreachable"] = (int(np.argmax(no_branch)) * n_col + n_col - 0.5, n_col * int(np.sum(no_branch)))
+        found[Rejection("unreachable")] = (int(np.argmax(no_branch)) * n_col + n_col - 0.5, n_col * int(np.sum(no_branch)))
     for r in np.flatnonzero(branch_ok & inside):
         o, k = int(oo[r]), int(kk[r])
         line = sub[r]
         # Turn variants (q +- 2 pi) share their geometry: check each wrapped line once.
         key = tuple(np.round(np.where(revolute, wrap_to_pi(line[-1]), line[-1]), 9))
-        verdict = verdicts.get(key)
-        if verdict is None:
-            verdict, used = _line_verdict(world, line)
-            checks += used
-            verdicts[key] = verdict
-        if verdict:
-            first, n = found.get(verdict, (float(o * n_col + k), 0))
-            found[verdict] = (first, n + 1)
+        if key not in verdicts:
+            verdicts[key] = _line_verdict(world, line)
+            checks += verdicts[key].checks
+        verdict = verdicts[key]
+        if not verdict.free:
+            first, n = found.get(verdict.reason, (float(o * n_col + k), 0))
+            found[verdict.reason] = (first, n + 1)
             continue
         keep.append((o, k))
         lines[(o, k)] = line
@@ -208,19 +223,27 @@ def _nearest_variants(
     if len(sel) == len(c):
         return c
     rejected = Counter(c.rejected)
-    rejected["turn_variant"] += len(c) - len(sel)
+    rejected[Rejection("turn_variant")] += len(c) - len(sel)
     return replace(
         c, orient=c.orient[sel], angles=c.angles[sel], column=c.column[sel], q_spot=c.q_spot[sel],
         q_app=c.q_app[sel], app_path=c.app_path[sel], status=c.status[sel], turn=c.turn[sel], rejected=rejected,
     )
 
 
-def _line_verdict(world: CollisionWorld, line: FloatArray) -> tuple[str, int]:
-    """'' when the spot configuration and its approach line are free, else the rejection reason."""
-    contact = world.first_contact(line[-1])
-    checks = 1
-    if contact is not None:
-        return f"collision:{contact.describe()}", checks
+@dataclass(frozen=True, slots=True)
+class LineVerdict:
+    """Whether a spot configuration and its approach line are free; the reason when not."""
+
+    free: bool
+    reason: Rejection
+    checks: int
+
+
+def _line_verdict(world: CollisionWorld, line: FloatArray) -> LineVerdict:
+    """The collision verdict of a spot configuration (the line's last row) and its approach line."""
+    check = world.check(line[-1])
+    if not check.free:
+        what = check.contact.describe() if check.contact is not None else "collision"
+        return LineVerdict(False, Rejection("collision", what), 1)
     res = world.check_path(line)
-    checks += res.checks
-    return ("" if res.free else "approach_blocked"), checks
+    return LineVerdict(res.free, Rejection("approach_blocked"), 1 + res.checks)

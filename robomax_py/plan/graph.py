@@ -8,6 +8,9 @@ from __future__ import annotations
 import logging
 from collections import Counter
 
+from dataclasses import dataclass
+from typing import Literal
+
 import numpy as np
 
 from robomax_py._typing import FloatArray
@@ -38,6 +41,26 @@ MAX_BLOCKED_LEGS = 4
 _UNUSABLE = Detour(np.zeros((0, 0)), float("inf"), 0)
 
 
+
+
+@dataclass(frozen=True, slots=True)
+class SequencingOutcome:
+    """What `Sequencer.run` found.
+
+    status : "found" (tour and transitions set, every leg known free), "disconnected" (some spots
+    have no collision-free connection) or "not_converged" (rounds ran out); `message` says why.
+    """
+
+    status: Literal["found", "disconnected", "not_converged"]
+    tour: Tour | None = None
+    transitions: tuple[Transition, ...] = ()
+    message: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class _TourCheck:
+    complete: bool                         # every leg of the tour is known free
+    transitions: tuple[Transition, ...]    # the legs known free so far, in tour order
 
 
 class Sequencer:
@@ -193,7 +216,8 @@ class Sequencer:
                 if not res.free:
                     self.detour_only.add((min(i, j), max(i, j)))
 
-    def run(self) -> tuple[Tour, list[Transition]] | str:
+    def run(self) -> SequencingOutcome:
+        """The best tour whose every leg is known free, or why there is none (a status, not None)."""
         blocks = self._blocks()
         self._probe_pairs()
         previous: tuple[tuple[int, ...], ...] = ()
@@ -212,17 +236,18 @@ class Sequencer:
                 self.dp_evaluations += stats.dp_evaluations
                 previous = (tour.order,)
             if not np.isfinite(tour.cost):
-                return "no collision-free connection found between some spots (roadmap exhausted)"
-            transitions = self._verify(tour)
-            if transitions is not None:
+                return SequencingOutcome("disconnected", message="no collision-free connection found between some "
+                                         "spots (roadmap exhausted)")
+            verified = self._verify(tour)
+            if verified.complete:
                 self.progress("sequencing", self.rounds, self.rounds)
-                return tour, transitions
+                return SequencingOutcome("found", tour, verified.transitions)
         worst = ", ".join(f"{label} ({n} rounds)" for label, n in self.unresolved.most_common(5))
-        return (f"sequencing did not converge in {self.options.max_rounds} rounds; moves left without a "
-                f"verified connection most often: {worst}")
+        return SequencingOutcome("not_converged", message=f"sequencing did not converge in {self.options.max_rounds} "
+                                 f"rounds; moves left without a verified connection most often: {worst}")
 
-    def _verify(self, tour: Tour) -> list[Transition] | None:
-        """Transitions of the tour if every leg is known free; else learn from every leg, return None."""
+    def _verify(self, tour: Tour) -> _TourCheck:
+        """Transitions of the tour, complete when every leg is known free; else learn from every leg."""
         stops = [(HOME, 0), *zip(tour.order, tour.choice), (HOME, 0)]
         out: list[Transition] = []
         complete = True
@@ -252,7 +277,7 @@ class Sequencer:
                 self.unresolved[label] += 1
                 continue
             out.append(Transition("detour", path, label, self.vias_for(i, j)[best_v].checks))
-        return out if complete else None
+        return _TourCheck(complete, tuple(out))
 
     def _check_straight(self, i: int, a: int, j: int, b: int) -> bool:
         known = self.straight.get((i, j), {}).get((a, b))

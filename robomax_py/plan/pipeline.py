@@ -102,9 +102,9 @@ def plan_cell(
     clock["sequencing"] = time.perf_counter() - t0
     log.debug("sequencing: %d rounds, %d DP evaluations, %d collision checks in %.2f s", sequencer.rounds,
               sequencer.dp_evaluations, sequencer.checks, clock["sequencing"])
-    if isinstance(outcome, str):
-        return PlanResult(cell.name, robot.name, "infeasible", outcome)
-    tour, transitions = outcome
+    if outcome.status != "found" or outcome.tour is None:
+        return PlanResult(cell.name, robot.name, "infeasible", outcome.message)
+    tour, transitions = outcome.tour, list(outcome.transitions)
 
     t0 = time.perf_counter()
     try:
@@ -155,7 +155,7 @@ def _failure(cell: CellSpec, c: SpotCandidates) -> SpotFailure:
         return SpotFailure(seam, c.name, "unreachable", "no IK solution at any orientation")
     groups: Counter[str] = Counter()
     for reason, n in c.rejected.items():
-        groups[reason.split(":")[0]] += n
+        groups[reason.kind] += n
     order = ("approach_blocked", "collision", "approach_branch", "approach_joint_limit", "joint_limit", "unreachable")
     for reason in order:
         if groups.get(reason):

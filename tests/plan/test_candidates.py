@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from robomax_py.io.cell import load_cell, load_cell_robot
-from robomax_py.plan.candidates import BRANCH_JUMP_RAD, _line_verdict, _spot_candidates
+from robomax_py.plan.candidates import BRANCH_JUMP_RAD, Rejection, _line_verdict, _spot_candidates
 from robomax_py.plan.poses import approach_poses, orientation_grid, spot_poses
 from robomax_py.robot import prismatic_mask
 from robomax_py.robot.ik.turns import wrap_to_pi
@@ -26,7 +26,7 @@ REPO = Path(__file__).resolve().parents[2]
 def _scan(robot, world, q, valid, reachable):  # type: ignore[no-untyped-def]
     """The filter as a plain loop (the reference the vectorised version must equal)."""
     revolute = ~prismatic_mask(robot.model)
-    rejected: Counter[str] = Counter()
+    rejected: Counter[Rejection] = Counter()
     keep = []
     m, _, n_col = valid.shape
     for o in range(m):
@@ -34,7 +34,7 @@ def _scan(robot, world, q, valid, reachable):  # type: ignore[no-untyped-def]
             if not reachable[o, -1, k]:
                 continue
             if not valid[o, -1, k]:
-                rejected["joint_limit"] += 1
+                rejected[Rejection("joint_limit")] += 1
                 continue
             line = q[o, :, k].copy()
             spot = line[-1].copy()
@@ -42,18 +42,18 @@ def _scan(robot, world, q, valid, reachable):  # type: ignore[no-untyped-def]
             with np.errstate(invalid="ignore"):
                 jump = np.abs(np.diff(line, axis=0)).max()
             if not reachable[o, :, k].all() or jump > BRANCH_JUMP_RAD:
-                rejected["approach_branch"] += 1
+                rejected[Rejection("approach_branch")] += 1
                 continue
             if not robot.limits.contains(line).all():
-                rejected["approach_joint_limit"] += 1
+                rejected[Rejection("approach_joint_limit")] += 1
                 continue
-            verdict, _ = _line_verdict(world, line)
-            if verdict:
-                rejected[verdict] += 1
+            verdict = _line_verdict(world, line)
+            if not verdict.free:
+                rejected[verdict.reason] += 1
                 continue
             keep.append((o, k))
         if not reachable[o, -1].any():
-            rejected["unreachable"] += n_col
+            rejected[Rejection("unreachable")] += n_col
     return keep, rejected
 
 
@@ -76,5 +76,5 @@ def test_filter_equals_a_plain_scan(cell_path: Path, spot: int) -> None:
     keep, rejected = _scan(robot, world, table.q[0], table.valid[0], table.reachable[0])
     assert list(zip(got.orient.tolist(), got.column.tolist())) == keep
     assert list(got.rejected.items()) == list(rejected.items())
-    assert "joint_limit" in rejected and any(r.startswith("collision:") for r in rejected)
-    assert {"approach_joint_limit", "approach_blocked"} & set(rejected)      # line tests exercised
+    assert Rejection("joint_limit") in rejected and any(r.kind == "collision" and r.detail for r in rejected)
+    assert {"approach_joint_limit", "approach_blocked"} & {r.kind for r in rejected}      # line tests exercised

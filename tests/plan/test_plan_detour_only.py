@@ -81,8 +81,8 @@ def test_blocked_first_probe_with_free_alternative_plans_straight(tmp_path: Path
     clamped = _ClampedWorld(world, spots[0].q_app[a], spots[1].q_app[b])
     seq = _sequencer(cell, robot, clamped, spots, 80)
     outcome = seq.run()
-    assert not isinstance(outcome, str), outcome
-    tour, transitions = outcome
+    assert outcome.status == "found", outcome.message
+    transitions = outcome.transitions
     assert clamped.blocked_asks >= 1                                 # the probe did hit the "clamp"
     between = [t for t in transitions if t.label in ("s7 -> s8", "s8 -> s7")]
     assert len(between) == 1 and between[0].kind == "move"
@@ -98,9 +98,9 @@ def test_non_convergence_names_the_moves(tmp_path: Path, write_small_cell: Small
     cell, robot, world, spots = _setup(tmp_path, write_small_cell)
     seq = _sequencer(cell, robot, _BlockEverything(world), spots, 2)
     outcome = seq.run()
-    assert isinstance(outcome, str)
-    assert "did not converge in 2 rounds" in outcome
-    assert "home -> s7" in outcome or "home -> s8" in outcome, outcome
+    assert outcome.status == "not_converged" and outcome.tour is None
+    assert "did not converge in 2 rounds" in outcome.message
+    assert "home -> s7" in outcome.message or "home -> s8" in outcome.message, outcome.message
 
 
 class _BlockEverything:
