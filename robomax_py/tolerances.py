@@ -22,5 +22,47 @@ class Tolerances:
     # Largest motion of any robot or tool point between two checked states of a swept move.
     sweep_step_m: float = 0.002
 
+    # --- Tolerances named where they are used (each module keeps NAME = TOL.<field>) -----------
+    # app.preview_program.REST_TOL_RAD: joint change below which consecutive samples stand still.
+    preview_rest_tol_rad: float = 1e-7
+    # export.rebuild: a program's frame definitions match the cell's within its decimals.
+    frame_tol_mm: float = 1.5e-3
+    frame_tol_deg: float = 1.5e-4
+    # plan.pipeline: the planner's own check's relative velocity slack (toppra is within ~1e-5).
+    plan_velocity_rtol: float = 1e-3
+    # plan.reach: wrist axes meeting within this count as a spherical wrist (m).
+    wrist_meet_tol_m: float = 1e-6
+    # robot.geometry: relative volume difference below which a closed piece counts as convex.
+    convex_volume_rtol: float = 1e-6
+    # robot.ik.fit: structural conditions of a URDF chain (m or rad); URDFs write pi/2 as 1.5708.
+    structure_tol: float = 1e-4
+    # timing._common: slack on boundary velocities read off another move; limits' round-off.
+    boundary_vel_rtol: float = 1e-9
+    limit_tol: float = 1e-9
+    # timing._lin_track: orientation error allowed halfway between LIN samples (rad).
+    lin_path_tol_rad: float = 1e-4
+    # timing.lin: TCP distance to the line halfway between samples (m); q_start an IK solution (rad).
+    lin_path_tol_m: float = 1e-5
+    start_tol_rad: float = 1e-6
+    # timing.paths: consecutive paths meet within this to be joined (rad or m).
+    path_join_tol: float = 1e-9
+    # timing.ptp: boundary velocities this collinear with the move count as along it (fraction).
+    collinear_rtol: float = 1e-9
+    # timing.trajectory: segments joined by `concatenate` meet within these (rad or m, and per s).
+    join_pos_tol: float = 1e-6
+    join_vel_tol: float = 1e-4
+    # timing.via: slack on the corner-ball check and on straight pieces' monotonicity.
+    jerk_ball_rtol: float = 1e-9
+    jerk_monotone_tol: float = 1e-9
+    # verify: home (rad), standing still while welding (rad, file precision), the orientation
+    # window (rad), file times (s, written to 1 us).
+    home_tol_rad: float = 1e-6
+    rest_tol_rad: float = 1e-9
+    angle_tol_rad: float = 1e-6
+    time_tol_s: float = 2e-6
+    # world.motion: finite differences of 10 ms samples; velocity exact for linear interpolation,
+    # acceleration from second differences overshoots a jerk-limited peak slightly.
+    velocity_rtol: float = 0.01
+    acceleration_rtol: float = 0.05
 
 DEFAULT = Tolerances()

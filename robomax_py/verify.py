@@ -30,10 +30,10 @@ from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.motion import Violation, check_motion
 from robomax_py.world.scene import build_scene
 
-HOME_TOL_RAD = 1e-6
-REST_TOL_RAD = 1e-9          # joint change allowed while welding (file precision 1e-9 rad)
-ANGLE_TOL_RAD = 1e-6         # tolerance-window slack for the orientation angles
-TIME_TOL_S = 2e-6            # file times are written with 1 us resolution
+HOME_TOL_RAD = TOL.home_tol_rad
+REST_TOL_RAD = TOL.rest_tol_rad
+ANGLE_TOL_RAD = TOL.angle_tol_rad
+TIME_TOL_S = TOL.time_tol_s
 
 
 

@@ -27,13 +27,14 @@ from robomax_py.errors import ProgramError
 from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.spec import CellSpec, frozen_array
 from robomax_py.timing.trajectory import Phase
+from robomax_py.tolerances import DEFAULT as TOL
 
 # A move straying further than this (rad, any joint) from its joint-space chord is a detour.
 DETOUR_DEVIATION_RAD = 0.05
 # A stand-still outside welds shorter than this (s) is a stop between moves, not a wait.
 MIN_WAIT_S = 0.02
 # Joint change (rad) below which consecutive samples count as standing still.
-REST_TOL_RAD = 1e-7
+REST_TOL_RAD = TOL.preview_rest_tol_rad
 # Slack (m) on the approach distance when recovering approach/retract phases of a .json file.
 APPROACH_SLACK_M = 1e-4
 

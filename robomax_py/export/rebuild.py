@@ -51,10 +51,11 @@ from robomax_py.timing import (
     resample,
 )
 from robomax_py.timing.chain import LinStep, PtpStep, Step, chain_path, time_chain
+from robomax_py.tolerances import DEFAULT as TOL
 
 # Frame definitions must match the cell's tool and base within the program's decimals.
-FRAME_TOL_MM = 1.5e-3
-FRAME_TOL_DEG = 1.5e-4
+FRAME_TOL_MM = TOL.frame_tol_mm
+FRAME_TOL_DEG = TOL.frame_tol_deg
 
 
 @dataclass(frozen=True, slots=True)

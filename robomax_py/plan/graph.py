@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import logging
 from collections import Counter
-
 from dataclasses import dataclass
 from typing import Literal
 

@@ -36,6 +36,7 @@ from robomax_py.timing import (
     TimingError,
     Trajectory,
 )
+from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.motion import MotionCheck, check_motion
 from robomax_py.world.scene import build_scene
@@ -43,7 +44,7 @@ from robomax_py.world.scene import build_scene
 log = logging.getLogger(__name__)
 
 # The planner's own check allows this relative velocity slack (toppra's output is within ~1e-5).
-PLAN_VELOCITY_RTOL = 1e-3
+PLAN_VELOCITY_RTOL = TOL.plan_velocity_rtol
 
 
 def plan_cell(

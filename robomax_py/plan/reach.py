@@ -22,9 +22,10 @@ from robomax_py.plan.poses import orientation_grid, spot_poses
 from robomax_py.robot import RobotModel
 from robomax_py.robot.ik._chain import chain_to_frame, joint_frames
 from robomax_py.spec import CellSpec
+from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.transforms import closest_on_line, invert
 
-WRIST_MEET_TOL_M = 1e-6
+WRIST_MEET_TOL_M = TOL.wrist_meet_tol_m
 CONTACT_SAMPLES = 200
 
 

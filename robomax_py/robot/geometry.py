@@ -15,9 +15,10 @@ import numpy as np
 import trimesh
 
 from robomax_py.spec import Box, Capsule, Cylinder, MeshShape, Shape, Sphere
+from robomax_py.tolerances import DEFAULT as TOL
 
 # Relative volume difference below which a closed piece counts as convex (mesh tessellation noise).
-CONVEX_VOLUME_RTOL = 1e-6
+CONVEX_VOLUME_RTOL = TOL.convex_volume_rtol
 
 
 def load_mesh(path: Path, scale: np.ndarray | None = None) -> trimesh.Trimesh:

@@ -9,6 +9,7 @@ import numpy as np
 from robomax_py._typing import FloatArray
 from robomax_py.errors import RobomaxError
 from robomax_py.robot import JointLimits
+from robomax_py.tolerances import DEFAULT as TOL
 
 # Sample period of the segments this package builds (s). 4 ms is a common controller interpolation
 # cycle (and the SPEC example's); `resample` turns a trajectory into the file's <= 10 ms grid.
@@ -16,9 +17,9 @@ DEFAULT_DT_S = 0.004
 # SPEC §5: trajectory samples at most this far apart (s).
 SPEC_MAX_DT_S = 0.010
 # Relative slack for boundary velocities given by a caller (rounding of values read off another move).
-BOUNDARY_VEL_RTOL = 1e-9
+BOUNDARY_VEL_RTOL = TOL.boundary_vel_rtol
 # A joint value this far outside its limit (rad or m) still counts as inside: round-off only.
-LIMIT_TOL = 1e-9
+LIMIT_TOL = TOL.limit_tol
 # Moves shorter than this (infinity norm over joints, rad or m) are treated as no motion.
 ZERO_MOVE = 1e-12
 

@@ -13,6 +13,7 @@ from robomax_py._typing import FloatArray
 from robomax_py.robot import RobotModel, fk_tcp, prismatic_mask
 from robomax_py.timing._common import TimingError
 from robomax_py.timing.paths import spline_path
+from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.transforms import rotation_angle
 
 # Path parameter per radian for a pure re-orientation (no TCP travel), m/rad.
@@ -20,7 +21,7 @@ ROT_LENGTH_M = 0.1
 # Below this the line has no translation, m.
 ZERO_LENGTH_M = 1e-9
 # Orientation error allowed halfway between samples, rad.
-LIN_PATH_TOL_RAD = 1e-4
+LIN_PATH_TOL_RAD = TOL.lin_path_tol_rad
 
 # (robot, T_base_tcp (..., 4, 4)) -> table with q (..., B, n) and valid (..., B); robomax_py.robot.ik.solve_all.
 IkSolver = Callable[[RobotModel, FloatArray], Any]

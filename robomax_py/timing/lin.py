@@ -40,6 +40,7 @@ from robomax_py.timing._lin_track import (
 from robomax_py.timing.paths import GeometricPath, spline_path
 from robomax_py.timing.topp import time_path
 from robomax_py.timing.trajectory import Segment
+from robomax_py.tolerances import DEFAULT as TOL
 
 # Sampling of the line: metres of TCP travel and radians of TCP rotation between IK samples.
 LIN_STEP_M = 0.001
@@ -50,10 +51,10 @@ LIN_MAX_JOINT_STEP_RAD = 0.02
 MIN_REFINE_M = 1e-6
 # The joint path is refined until the TCP is this close to the line halfway between samples (m),
 # in at most this many rounds.
-LIN_PATH_TOL_M = 1e-5
+LIN_PATH_TOL_M = TOL.lin_path_tol_m
 LIN_REFINE_ROUNDS = 8
 # q_start must be an IK solution of T_start within this (rad, any joint).
-START_TOL_RAD = 1e-6
+START_TOL_RAD = TOL.start_tol_rad
 # Below this the line has no rotation (rad).
 ZERO_ANGLE_RAD = 1e-9
 

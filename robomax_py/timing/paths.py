@@ -17,9 +17,10 @@ from scipy.interpolate import BPoly, CubicSpline
 from robomax_py._typing import FloatArray
 from robomax_py.spec import frozen_array
 from robomax_py.timing._common import ZERO_MOVE, TimingError
+from robomax_py.tolerances import DEFAULT as TOL
 
 # Consecutive paths must meet within this (rad or m) to be joined.
-PATH_JOIN_TOL = 1e-9
+PATH_JOIN_TOL = TOL.path_join_tol
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -41,10 +41,11 @@ from robomax_py.timing._common import (
     time_grid,
 )
 from robomax_py.timing.trajectory import Segment
+from robomax_py.tolerances import DEFAULT as TOL
 
 # Boundary velocities whose component across the move is below this fraction of their size count
 # as pointing along the move (the move is then an exact straight line).
-COLLINEAR_RTOL = 1e-9
+COLLINEAR_RTOL = TOL.collinear_rtol
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -22,6 +22,7 @@ from robomax_py.timing._common import (
     as_joint_vector,
     time_grid,
 )
+from robomax_py.tolerances import DEFAULT as TOL
 
 # What a segment does. "move": PTP between configurations; "detour": a move through detour
 # waypoints; "approach"/"retract": LIN along the electrode axis; "weld": dwell at a spot;
@@ -29,8 +30,8 @@ from robomax_py.timing._common import (
 SEGMENT_KINDS = frozenset({"move", "detour", "approach", "retract", "weld", "wait", "blend"})
 
 # Segments joined by `concatenate` must meet within these (rad or m, and per second).
-JOIN_POS_TOL = 1e-6
-JOIN_VEL_TOL = 1e-4
+JOIN_POS_TOL = TOL.join_pos_tol
+JOIN_VEL_TOL = TOL.join_vel_tol
 
 
 @dataclass(frozen=True, slots=True, eq=False)

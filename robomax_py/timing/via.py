@@ -51,6 +51,7 @@ from robomax_py.timing.paths import distinct_waypoints, polyline_path
 from robomax_py.timing.ptp import line_samples, line_speed_limits, state_samples
 from robomax_py.timing.topp import time_path
 from robomax_py.timing.trajectory import Segment, as_segment, concatenate, evaluate
+from robomax_py.tolerances import DEFAULT as TOL
 
 # Spacing of the returned geometric path samples, rad (Euclidean, joint space).
 PATH_STEP_RAD = 0.005
@@ -63,8 +64,8 @@ JERK_SPEED_BACKOFF = 0.7
 JERK_MIN_SPEED_FRACTION = 0.05
 JERK_MAX_ROUNDS = 40
 # Slack on the corner-ball check, relative to the radius, and on straight pieces' monotonicity.
-JERK_BALL_RTOL = 1e-9
-JERK_MONOTONE_TOL = 1e-9
+JERK_BALL_RTOL = TOL.jerk_ball_rtol
+JERK_MONOTONE_TOL = TOL.jerk_monotone_tol
 
 PathMode = Literal["stop", "blend", "jerk"]
 

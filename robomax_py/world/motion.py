@@ -10,13 +10,14 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.robot import RobotModel
+from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision import CollisionWorld
 
 # Finite differences of 10 ms samples: velocity is exact for the linear interpolation the SPEC
 # prescribes; acceleration from second differences of a jerk-limited profile overshoots the
 # sampled peak slightly, hence the larger slack.
-VELOCITY_RTOL = 0.01
-ACCELERATION_RTOL = 0.05
+VELOCITY_RTOL = TOL.velocity_rtol
+ACCELERATION_RTOL = TOL.acceleration_rtol
 MAX_REPORTED_COLLISIONS = 20
 
 

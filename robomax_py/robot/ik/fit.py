@@ -30,7 +30,7 @@ from robomax_py.transforms import closest_on_line, rpy_from_matrix
 
 # Structural conditions (parallel, perpendicular, intersecting axes) hold to this, in m or rad:
 # URDFs write pi/2 as 1.5708 or 1.57079632679, so 1e-4 accepts them; the FK check then decides.
-STRUCTURE_TOL = 1e-4
+STRUCTURE_TOL = TOL.structure_tol
 FIT_SAMPLES = 48
 AGREEMENT_SAMPLES = 300
 
