@@ -30,7 +30,7 @@ Allowed-collision matrix (pairs never checked), deterministic for a given `Colli
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import coal
@@ -116,7 +116,19 @@ class SharedGeometry:
     layout_contacts: tuple[tuple[str, str], ...]
 
 
-def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: CollisionOptions) -> SharedGeometry:
+@dataclass(slots=True)
+class _PairRules:
+    """Every piece pair sorted by the rules that need no sampling (see the module docstring)."""
+
+    disabled: list[DisabledPair] = field(default_factory=list)
+    obstacle_pairs: list[tuple[int, int]] = field(default_factory=list)   # robot/tool vs obstacle, checked
+    self_candidates: list[tuple[int, int]] = field(default_factory=list)  # left to the sampling and the proof
+    flange_candidates: set[tuple[int, int]] = field(default_factory=set)  # tool vs the link before the flange link
+    base_obstacle: list[tuple[int, int]] = field(default_factory=list)    # fixed base vs obstacle: layout
+
+
+def _pieces(robot: RobotModel, scene: Scene) -> tuple[pin.GeometryModel, list[Piece], tuple[Any, ...]]:
+    """One geometry model of link pieces, tool pieces and obstacle pieces, with their descriptions."""
     model = robot.model
     gm = pin.GeometryModel()
     pieces: list[Piece] = []
@@ -144,11 +156,15 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
             gm.addGeometryObject(pin.GeometryObject(name, 0, 0, placement, geom))
             pieces.append(Piece(name, obj.name, kind, 0, o))
 
-    disabled: list[DisabledPair] = []
-    obstacle_pairs: list[tuple[int, int]] = []
-    self_candidates: list[tuple[int, int]] = []
-    flange_candidates: set[tuple[int, int]] = set()
-    base_obstacle: list[tuple[int, int]] = []
+    return gm, pieces, obstacles
+
+
+def _classify_pairs(robot: RobotModel, scene: Scene, pieces: list[Piece], obstacles: tuple[Any, ...]) -> _PairRules:
+    model = robot.model
+    flange = model.frames[scene.flange_frame_id]
+    rules = _PairRules()
+    disabled, obstacle_pairs, self_candidates = rules.disabled, rules.obstacle_pairs, rules.self_candidates
+    flange_candidates, base_obstacle = rules.flange_candidates, rules.base_obstacle
     mount_joint = int(flange.parentJoint)
     mount_parent = int(model.parents[mount_joint])
     n_geom = len(pieces)
@@ -183,6 +199,18 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
             if (tool_a and pb.joint == mount_parent) or (tool_b and pa.joint == mount_parent):
                 flange_candidates.add((a, b))
             self_candidates.append((a, b))
+
+    return rules
+
+
+def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: CollisionOptions) -> SharedGeometry:
+    """The geometry, checked pairs (in exhaustive-mode order), margins and ACM of a world."""
+    model = robot.model
+    gm, pieces, obstacles = _pieces(robot, scene)
+    n_geom = len(pieces)
+    rules = _classify_pairs(robot, scene, pieces, obstacles)
+    disabled, obstacle_pairs, self_candidates = rules.disabled, rules.obstacle_pairs, rules.self_candidates
+    flange_candidates, base_obstacle = rules.flange_candidates, rules.base_obstacle
 
     bounds = KinematicBounds.of(model)
     provable = {
