@@ -24,6 +24,7 @@ from robomax_py.plan.poses import nominal_rotation
 from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.robot.ik import same_config
 from robomax_py.robot.solve import config_text
+from robomax_py.safe_files import LIMITS, read_text
 from robomax_py.spec import CellSpec
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision import CollisionWorld
@@ -79,12 +80,7 @@ def verify_srcl_file(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRep
     from robomax_py.export.rebuild import rebuild
     from robomax_py.export.srcl import parse_program
 
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ProgramError(path, None, "program file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ProgramError(path, None, f"cannot read program: {exc}") from None
+    text = read_text(path, LIMITS.program, ProgramError, "program file")
     rebuilt = rebuild(parse_program(text, path), cell, robot, path)
     out = [Violation(p.t, p.kind, p.detail) for p in rebuilt.problems]
     if rebuilt.trajectory is None:

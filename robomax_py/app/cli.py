@@ -453,8 +453,16 @@ def _library_flags_first(argv: list[str]) -> list[str]:
     return front + rest
 
 
+def _terminate(signum: int, frame: object) -> None:
+    # SIGTERM unwinds like Ctrl-C, so a write in progress removes its temporary file.
+    raise SystemExit(128 + signum)
+
+
 def main() -> None:
     """Console entry point."""
+    import signal
+
+    signal.signal(signal.SIGTERM, _terminate)
     try:
         app(args=_bare_ray_flag(_library_flags_first(sys.argv[1:])))
     except KeyboardInterrupt:

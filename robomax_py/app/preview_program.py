@@ -25,6 +25,7 @@ import numpy as np
 from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
 from robomax_py.robot import RobotModel, fk_tcp
+from robomax_py.safe_files import LIMITS, read_text
 from robomax_py.spec import CellSpec, frozen_array
 from robomax_py.timing.trajectory import Phase
 from robomax_py.tolerances import DEFAULT as TOL
@@ -136,8 +137,8 @@ def _peek_json(path: Path) -> dict[str, Any]:
     import json
 
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError):
+        data = json.loads(read_text(path, LIMITS.program, ProgramError, "program file"))
+    except (ProgramError, ValueError, RecursionError):
         return {}
     return data if isinstance(data, dict) else {}
 
@@ -146,11 +147,7 @@ def _load_srcl(path: Path, cell: CellSpec, robot: RobotModel) -> ShownProgram:
     from robomax_py.export.rebuild import rebuild
     from robomax_py.export.srcl import parse_program
 
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ProgramError(path, None, f"cannot read program: {exc}") from None
-    program = parse_program(text, path)
+    program = parse_program(read_text(path, LIMITS.program, ProgramError, "program file"), path)
     if program.header.cell != cell.name:
         raise ProgramError(path, "CELL", f"program is for cell {program.header.cell!r}, not {cell.name!r}")
     rebuilt = rebuild(program, cell, robot, path)

@@ -17,6 +17,7 @@ import numpy as np
 from robomax_py.errors import ProgramError
 from robomax_py.plan import PlanResult
 from robomax_py.robot import RobotModel
+from robomax_py.safe_files import LIMITS, read_text
 
 FORMAT = "robomax.trajectory/1"
 
@@ -60,14 +61,15 @@ def _deg(rad: float) -> str:
 
 def load_trajectory_file(path: Path, robot: RobotModel) -> dict[str, Any]:
     """Read and check the structure of a SPEC §5 file; ProgramError names what is wrong."""
+    text = read_text(path, LIMITS.program, ProgramError, "program file")
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ProgramError(path, None, "program file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ProgramError(path, None, f"cannot read program: {exc}") from None
+        data = json.loads(text)
     except json.JSONDecodeError as exc:
         raise ProgramError(path, f"line {exc.lineno}, column {exc.colno}", f"not valid JSON: {exc.msg}") from None
+    except RecursionError:
+        raise ProgramError(path, None, "not a trajectory file: nested too deeply") from None
+    except ValueError as exc:     # e.g. an integer of thousands of digits
+        raise ProgramError(path, None, f"not valid JSON: {exc}") from None
     if not isinstance(data, dict):
         raise ProgramError(path, None, "expected a JSON object at the top level")
     if data.get("format") != FORMAT:
@@ -80,15 +82,24 @@ def load_trajectory_file(path: Path, robot: RobotModel) -> dict[str, Any]:
     try:
         t = np.asarray(data["t"], dtype=float)
         q = np.asarray(data["q"], dtype=float)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise ProgramError(path, "t/q", f"not numeric arrays: {exc}") from None
     if t.ndim != 1 or len(t) < 2 or q.shape != (len(t), robot.dof) or not (np.isfinite(t).all() and np.isfinite(q).all()):
         raise ProgramError(path, "q", f"expected {len(t)} rows of {robot.dof} finite joint values and as many times")
     if not np.all(np.diff(t) > 0):
         raise ProgramError(path, "t", "times must be strictly increasing")
+    if not isinstance(data["spots"], list) or not all(isinstance(x, dict) for x in data["spots"]):
+        raise ProgramError(path, "spots", "expected a list of spot objects")
     for k, spot in enumerate(data["spots"]):
         missing = [key for key in ("seam", "name", "t_arrive", "t_leave", "alpha", "beta", "gamma") if key not in spot]
         if missing:
             raise ProgramError(path, f"spots[{k}]", f"missing {', '.join(missing)}")
+        for key in ("t_arrive", "t_leave", "alpha", "beta", "gamma"):
+            v = spot[key]
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise ProgramError(path, f"spots[{k}].{key}", f"expected a finite number, got {str(v)[:40]!r}")
+        for key in ("seam", "name", "config"):
+            if key in spot and not isinstance(spot[key], str):
+                raise ProgramError(path, f"spots[{k}].{key}", f"expected text, got {str(spot[key])[:40]!r}")
     data["t"], data["q"] = t, q
     return data

@@ -12,6 +12,7 @@ from typing import Annotated, Any
 
 import numpy as np
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Field,
@@ -29,6 +30,7 @@ from robomax_py.io.robot import (
 )
 from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
 from robomax_py.robot.geometry import load_mesh
+from robomax_py.safe_files import LIMITS, checked_file
 from robomax_py.spec import (
     Box,
     Capsule,
@@ -56,7 +58,42 @@ Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
-Name = Annotated[str, Field(min_length=1)]
+# Names end up in messages, program identifiers and (the cell's) file names: printable text of a
+# bounded length; a cell name is also a file stem, so no path separators and at most 100 characters.
+MAX_NAME_CHARS = 200
+MAX_CELL_NAME_CHARS = 100
+# Dynamic windows beyond a day of program time are a typo, and would overflow the time grid.
+MAX_WINDOW_S = 86_400.0
+
+
+def _printable_name(v: str) -> str:
+    if not v.strip():
+        raise ValueError("must not be blank")
+    bad = next((ch for ch in v if not ch.isprintable()), None)
+    if bad is not None:
+        raise ValueError(f"must be printable text, got the control character {ascii(bad)}")
+    return v
+
+
+def _file_stem(v: str) -> str:
+    _printable_name(v)
+    if any(sep in v for sep in "/\\") or v in (".", ".."):
+        raise ValueError(f"is the program's file name: no '/', '\\', '.' or '..', got {v!r}")
+    return v
+
+
+def _reference(v: str) -> str:
+    """A robot or tool: a library name or a path; printable, and short enough for the file system."""
+    _printable_name(v)
+    if len(v) > 4096 or any(len(part.encode()) > 255 for part in v.replace("\\", "/").split("/")):
+        raise ValueError("is longer than a file name or path can be")
+    return v
+
+
+Name = Annotated[str, Field(min_length=1, max_length=MAX_NAME_CHARS), AfterValidator(_printable_name)]
+CellName = Annotated[str, Field(min_length=1, max_length=MAX_CELL_NAME_CHARS), AfterValidator(_file_stem)]
+Reference = Annotated[str, Field(min_length=1), AfterValidator(_reference)]
+WindowTime = Annotated[float, Field(ge=0, le=MAX_WINDOW_S, allow_inf_nan=False)]
 
 
 class _Strict(BaseModel):
@@ -69,7 +106,7 @@ class PoseFile(_Strict):
 
 
 class RobotRefFile(_Strict):
-    model: Name
+    model: Reference
     base: PoseFile = PoseFile()
     home: list[Finite]               # deg (m for a prismatic joint)
 
@@ -92,7 +129,7 @@ class ObjectFile(_Strict):
     cylinder: CylinderFile | None = None
     sphere: SphereFile | None = None
     capsule: CylinderFile | None = None
-    mesh: Name | None = None
+    mesh: Reference | None = None
     pose: PoseFile = PoseFile()
     workpiece: bool = False
 
@@ -106,7 +143,7 @@ class ObjectFile(_Strict):
 
 
 class DynamicObjectFile(ObjectFile):
-    present: Annotated[list[Annotated[list[NonNegative], Field(min_length=2, max_length=2)]], Field(min_length=1)]
+    present: Annotated[list[Annotated[list[WindowTime], Field(min_length=2, max_length=2)]], Field(min_length=1)]
 
     @field_validator("present")
     @classmethod
@@ -166,9 +203,9 @@ class PlannerFile(_Strict):
 
 class CellFile(_Strict):
     robomax: int
-    name: Name | None = None
+    name: CellName | None = None
     robot: RobotRefFile
-    tool: Name
+    tool: Reference
     objects: list[ObjectFile] = []
     seams: Annotated[list[SeamFile], Field(min_length=1)]
     process: ProcessFile = ProcessFile()
@@ -183,7 +220,7 @@ def load_cell(path: str | Path) -> CellSpec:
     meshes are read later, by `load_cell_robot`.
     """
     path = Path(path)
-    data = read_yaml_mapping(path, CellFileError, "cell file")
+    data = read_yaml_mapping(path, CellFileError, "cell file", LIMITS.cell)
     version = data.get("robomax")
     if "robomax" in data and version not in SUPPORTED_VERSIONS:
         supported = ", ".join(str(v) for v in SUPPORTED_VERSIONS)
@@ -194,19 +231,17 @@ def load_cell(path: str | Path) -> CellSpec:
         raise validation_error(exc, CellFile, path, CellFileError) from None
     _check_unique_names(parsed, path)
 
-    robot_file = resolve_robot_file(parsed.robot.model, path)
-    if not robot_file.is_file():
-        raise CellFileError(path, "robot.model", f"unknown robot '{parsed.robot.model}': no {robot_file}")
-    tool_file = resolve_tool_file(parsed.tool, path)
-    if not tool_file.is_file():
-        raise CellFileError(path, "tool", f"unknown tool '{parsed.tool}': no {tool_file}")
+    robot_file = checked_file(resolve_robot_file(parsed.robot.model, path), LIMITS.description,
+                              _located(CellFileError, path, "robot.model"), f"unknown robot '{parsed.robot.model}':")
+    tool_file = checked_file(resolve_tool_file(parsed.tool, path), LIMITS.description,
+                             _located(CellFileError, path, "tool"), f"unknown tool '{parsed.tool}':")
     robot_spec = load_robot_spec(robot_file)
     tool_spec = load_tool_spec(tool_file)
     for key, mesh in (("body", tool_spec.body), ("tips", tool_spec.tips)):
         _check_mesh_readable(mesh, RobotModelError(tool_file, key, f"cannot read mesh {mesh}"))
 
     return CellSpec(
-        name=parsed.name or path.stem,
+        name=parsed.name or _stem_name(path),
         source=path.resolve(),
         robot=robot_spec,
         T_world_base=frozen_array(_pose(parsed.robot.base)),
@@ -294,9 +329,8 @@ def _object(obj: ObjectFile, path: Path, key: str) -> ObjectSpec:
         shape = Capsule(radius=obj.capsule.radius, length=obj.capsule.length)
     else:
         assert obj.mesh is not None  # guaranteed by ObjectFile._one_shape
-        mesh = (path.parent / obj.mesh).resolve()
-        if not mesh.is_file():
-            raise CellFileError(path, f"{key}.mesh", f"mesh file not found: {mesh}")
+        named = path.parent / obj.mesh
+        mesh = checked_file(named, LIMITS.mesh, _located(CellFileError, path, f"{key}.mesh"), f"mesh {named}")
         _check_mesh_readable(mesh, CellFileError(path, f"{key}.mesh", f"cannot read mesh {mesh}"))
         shape = MeshShape(path=mesh)
     present = None
@@ -306,6 +340,25 @@ def _object(obj: ObjectFile, path: Path, key: str) -> ObjectSpec:
         name=obj.name, shape=shape, T_world_object=frozen_array(_pose(obj.pose)),
         workpiece=obj.workpiece, present=present,
     )
+
+
+def _stem_name(path: Path) -> str:
+    """The cell's name when the file gives none: its file stem, under the rules of `name`."""
+    stem = path.stem
+    if len(stem) > MAX_CELL_NAME_CHARS:
+        raise CellFileError(path, "name", f"not given, and the file name is longer than {MAX_CELL_NAME_CHARS} "
+                            "characters (the programs are named after the cell); give a shorter name:")
+    return stem
+
+
+def _located(error: type[CellFileError] | type[RobotModelError], file: Path, key: str) -> Any:
+    """An error class for `safe_files` that names `file` and `key` (the file that names the path)
+    rather than the path itself, which may not be printable."""
+
+    def make(_path: object, _key: object, problem: str) -> CellFileError | RobotModelError:
+        return error(file, key, problem)
+
+    return make
 
 
 def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError) -> None:
@@ -344,10 +397,11 @@ def _seam(seam: SeamFile, path: Path, key: str) -> SeamSpec:
 
 def _unit(v: list[float], path: Path, key: str) -> np.ndarray:
     arr = np.asarray(v, dtype=float)
-    norm = float(np.linalg.norm(arr))
-    if norm < 1e-9:
-        raise CellFileError(path, key, f"zero-length vector {v}")
-    return arr / norm
+    scale = float(np.max(np.abs(arr)))           # scaled first: the norm of [1e308, 1e308, 0] overflows
+    if not 1e-9 <= scale <= 1e9:
+        raise CellFileError(path, key, f"expected a direction (not zero-length, components at most 1e9), got {v}")
+    arr = arr / scale
+    return arr / float(np.linalg.norm(arr))
 
 
 def read_cell_file(path: str | Path) -> CellFile:
@@ -356,7 +410,7 @@ def read_cell_file(path: str | Path) -> CellFile:
     Only the file itself is checked here; `load_cell` checks what it names (robot, tool, meshes).
     """
     path = Path(path)
-    data = read_yaml_mapping(path, CellFileError, "cell file")
+    data = read_yaml_mapping(path, CellFileError, "cell file", LIMITS.cell)
     try:
         return CellFile.model_validate(data)
     except ValidationError as exc:

@@ -18,6 +18,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from robomax_py.errors import RobotModelError
 from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
+from robomax_py.safe_files import LIMITS, checked_file, read_text
 from robomax_py.spec import ControllerSpec, RobotSpec, ToolSpec, frozen_array
 from robomax_py.transforms import pose_matrix
 from robomax_py.units import degs_to_rads
@@ -142,9 +143,18 @@ def _resolve(ref: str, relative_to: Path, sub: tuple[str, ...], filename: str) -
     looks_like_path = "/" in ref or "\\" in ref or ref.endswith((".yaml", ".yml"))
     if not looks_like_path:
         candidates = [Path(d, *sub, ref, filename) for d in robot_library()]
-        return next((c for c in candidates if c.is_file()), candidates[-1])
-    path = (relative_to.parent / ref).resolve()
-    return path / filename if path.is_dir() else path
+        return next((c for c in candidates if _is(c, Path.is_file)), candidates[-1])
+    path = relative_to.parent / ref
+    return path / filename if _is(path, Path.is_dir) else path
+
+
+def _is(path: Path, test: Any) -> bool:
+    """`path.is_file()` / `is_dir()` that says False for paths the OS refuses (too long, a loop);
+    the guard then names the problem when the file is opened."""
+    try:
+        return bool(test(path))
+    except (OSError, ValueError, RuntimeError):
+        return False
 
 
 # ------------------------------------------------------------------------------ package:// meshes
@@ -252,17 +262,36 @@ def urdf_package_names(urdf_text: str) -> list[str]:
 
 
 def urdf_package_dirs(urdf: Path, file: Path) -> tuple[Path, ...]:
-    """Package folders for the `package://NAME/...` meshes a URDF names (searched near the URDF)."""
-    try:
-        text = urdf.read_text(encoding="utf-8", errors="replace")
-    except OSError as exc:
-        raise RobotModelError(file, "urdf", f"cannot read URDF {urdf}: {exc}") from None
+    """Package folders for the `package://NAME/...` meshes a URDF names (searched near the URDF).
+
+    Every mesh file the URDF names that exists is checked by the guard here (a regular file within
+    the mesh size limit), so Pinocchio never opens a device, a pipe or a symlink loop."""
+    text = read_text(urdf, LIMITS.urdf, _named_by(file, "urdf"), f"URDF {urdf}")
     dirs: list[Path] = []
     for name in urdf_package_names(text):
         for d in package_dirs_for(name, urdf.parent):
             if d not in dirs:
                 dirs.append(d)
+    for uri in _MESH_FILENAME.findall(text):
+        for candidate in _mesh_candidates(uri, urdf, dirs):
+            if os.path.lexists(candidate):
+                checked_file(candidate, LIMITS.mesh, _named_by(urdf, f"mesh {uri}"), f"mesh {candidate}")
+                break
     return tuple(dirs)
+
+
+_MESH_FILENAME = re.compile(r"<mesh[^>]*\sfilename\s*=\s*[\"']([^\"']*)[\"']")
+
+
+def _mesh_candidates(uri: str, urdf: Path, dirs: list[Path]) -> list[Path]:
+    if "\x00" in uri:
+        return [Path(uri)]
+    if uri.startswith("package://"):
+        name, _, rest = uri[len("package://"):].partition("/")
+        return [d / name / rest for d in dirs]
+    if uri.startswith("file://"):
+        return [Path(uri[len("file://"):])]
+    return [urdf.parent / uri]
 
 
 # ------------------------------------------------------------------------------ SRDF
@@ -270,11 +299,10 @@ def urdf_package_dirs(urdf: Path, file: Path) -> tuple[Path, ...]:
 
 def srdf_disabled_pairs(path: Path, file: Path) -> list[tuple[str, str]]:
     """The `disable_collisions link1/link2` pairs of a MoveIt SRDF."""
+    text = read_text(path, LIMITS.description, _named_by(file, "srdf"), f"SRDF {path}")
     try:
-        root = ET.parse(path).getroot()
-    except FileNotFoundError:
-        raise RobotModelError(file, "srdf", f"file not found: {path}") from None
-    except (ET.ParseError, OSError) as exc:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
         raise RobotModelError(file, "srdf", f"cannot read SRDF {path}: {exc}") from None
     pairs = []
     for el in root.iter("disable_collisions"):
@@ -285,6 +313,15 @@ def srdf_disabled_pairs(path: Path, file: Path) -> list[tuple[str, str]]:
     return pairs
 
 
+def _named_by(file: Path, key: str) -> Any:
+    """An error class for `safe_files` naming the file and key that name the path."""
+
+    def make(_path: object, _key: object, problem: str) -> RobotModelError:
+        return RobotModelError(file, key, problem)
+
+    return make
+
+
 # ------------------------------------------------------------------------------ loading
 
 
@@ -293,7 +330,7 @@ def load_robot_spec(path: Path) -> RobotSpec:
     parameters and their agreement with the URDF) is checked by `robot.load_robot`."""
     from robomax_py.io.ik_params import params_from_mapping
 
-    data = read_yaml_mapping(path, RobotModelError, "robot description")
+    data = read_yaml_mapping(path, RobotModelError, "robot description", LIMITS.description)
     try:
         parsed = RobotFile.model_validate(data)
     except ValidationError as exc:
@@ -304,8 +341,7 @@ def load_robot_spec(path: Path) -> RobotSpec:
         urdf = resolve_package_uri(parsed.urdf, path, "urdf")
     else:
         urdf = (path.parent / parsed.urdf).resolve()
-    if not urdf.is_file():
-        raise RobotModelError(path, "urdf", f"file not found: {urdf}")
+    urdf = checked_file(urdf, LIMITS.urdf, _named_by(path, "urdf"), f"URDF {urdf}")
     ik_params = None
     if parsed.ik.params is not None or parsed.ik.solver not in ("opw", "ur"):
         try:
@@ -341,17 +377,15 @@ def load_robot_spec(path: Path) -> RobotSpec:
 
 def load_tool_spec(path: Path) -> ToolSpec:
     """Read and check a tool.yaml; its meshes must exist (they are read when the scene is built)."""
-    data = read_yaml_mapping(path, RobotModelError, "tool description")
+    data = read_yaml_mapping(path, RobotModelError, "tool description", LIMITS.description)
     try:
         parsed = ToolFile.model_validate(data)
     except ValidationError as exc:
         raise validation_error(exc, ToolFile, path, RobotModelError) from None
     meshes = {}
     for key in ("body", "tips"):
-        mesh = (path.parent / getattr(parsed, key)).resolve()
-        if not mesh.is_file():
-            raise RobotModelError(path, key, f"mesh file not found: {mesh}")
-        meshes[key] = mesh
+        named = path.parent / getattr(parsed, key)
+        meshes[key] = checked_file(named, LIMITS.mesh, _named_by(path, key), f"mesh {named}")
     rpy = [math.radians(a) for a in parsed.tcp.rpy]
     return ToolSpec(
         name=parsed.name,

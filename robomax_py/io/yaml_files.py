@@ -1,4 +1,6 @@
-"""Reading the YAML files people write, and turning schema errors into one located message.
+"""Reading the YAML files people write, bounded (`load_yaml`: aliases that expand beyond a bound or
+refer to themselves, nesting beyond a depth, complex or non-string keys, integers longer than any
+quantity, duplicate keys are refused), and turning schema errors into one located message.
 
 Shared by `cell_io` and `robot_io`, the only modules that know file keys.
 """
@@ -13,44 +15,125 @@ import yaml
 from pydantic import BaseModel, ValidationError
 
 from robomax_py.errors import _LocatedError
+from robomax_py.safe_files import LIMITS, read_text
 
 
-class _UniqueKeyLoader(yaml.SafeLoader):
-    """safe_load that refuses duplicate mapping keys, which plain YAML silently lets the last one win."""
+class _GuardedLoader(yaml.SafeLoader):
+    """safe_load with bounds: nesting depth, alias expansion, keys, integer length, duplicate keys."""
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent: Any, index: Any) -> Any:  # type: ignore[override]
+        self._depth += 1
+        try:
+            if self._depth > LIMITS.yaml_depth:
+                mark = self.peek_event().start_mark
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"nested more than {LIMITS.yaml_depth} levels deep", mark)
+            return super().compose_node(parent, index)  # type: ignore[no-untyped-call]
+        finally:
+            self._depth -= 1
 
 
-def _construct_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+def _construct_mapping(loader: _GuardedLoader, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
     seen: set[Any] = set()
     for key_node, _ in node.value:
+        mark = key_node.start_mark
+        if not isinstance(key_node, yaml.ScalarNode):
+            raise yaml.constructor.ConstructorError(None, None, "a key must be plain text, not a list or mapping", mark)
         key = loader.construct_object(key_node, deep=deep)  # type: ignore[no-untyped-call]
-        if key in seen:
-            mark = key_node.start_mark
+        if not isinstance(key, str):
             raise yaml.constructor.ConstructorError(
-                None, None, f"duplicate key {key!r} (line {mark.line + 1})", mark
-            )
+                None, None, f"key {key_node.value!r} must be text (it reads as {type(key).__name__}; quote it)", mark)
+        if key in seen:
+            raise yaml.constructor.ConstructorError(None, None, f"duplicate key {key!r} (line {mark.line + 1})", mark)
         seen.add(key)
     return loader.construct_mapping(node, deep=deep)
 
 
-_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+def _construct_int(loader: _GuardedLoader, node: yaml.ScalarNode) -> int:
+    digits = sum(ch.isdigit() for ch in str(node.value))
+    if digits > LIMITS.int_digits:
+        raise yaml.constructor.ConstructorError(
+            None, None, f"integer of {digits} digits (at most {LIMITS.int_digits})", node.start_mark)
+    return int(loader.construct_yaml_int(node))  # type: ignore[no-untyped-call]
 
 
-def read_yaml_mapping(path: Path, error: type[_LocatedError], what: str) -> dict[str, Any]:
-    """The top-level mapping of a YAML file, or `error` naming the file and what is wrong."""
+_GuardedLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+_GuardedLoader.add_constructor("tag:yaml.org,2002:int", _construct_int)
+
+
+def _expanded_size(root: yaml.Node) -> int:
+    """Nodes the document has once every alias is expanded (shared nodes counted each time they
+    are used), computed without expanding; ConstructorError for an alias that contains itself."""
+    size: dict[int, int] = {}
+    on_path: set[int] = set()
+    stack: list[tuple[yaml.Node, bool]] = [(root, False)]
+    while stack:
+        node, done = stack.pop()
+        nid = id(node)
+        if done:
+            on_path.discard(nid)
+            children = _children(node)
+            total = 1 + sum(size[id(c)] for c in children)
+            size[nid] = min(total, LIMITS.yaml_nodes + 1)
+            continue
+        if nid in size:
+            continue
+        if nid in on_path:
+            raise yaml.constructor.ConstructorError(None, None, "an alias refers to the node that contains it", node.start_mark)
+        on_path.add(nid)
+        stack.append((node, True))
+        for c in _children(node):
+            if id(c) in on_path:
+                raise yaml.constructor.ConstructorError(
+                    None, None, "an alias refers to the node that contains it (recursive alias)", c.start_mark)
+            if id(c) not in size:
+                stack.append((c, False))
+    return size[id(root)]
+
+
+def _children(node: yaml.Node) -> list[yaml.Node]:
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    if isinstance(node, yaml.MappingNode):
+        return [n for pair in node.value for n in pair]
+    return []
+
+
+def load_yaml(text: str, path: Path, error: type[_LocatedError], what: str) -> Any:
+    """The document of YAML text under the bounds of `_GuardedLoader` and `FileLimits.yaml_nodes`."""
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise error(path, None, f"{what} not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise error(path, None, f"cannot read {what}: {exc}") from None
-    try:
-        data = yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 - a SafeLoader subclass
+        loader = _GuardedLoader(text)      # the reader refuses control characters here already
+        try:
+            root = loader.get_single_node()
+            if root is None:
+                return None
+            nodes = _expanded_size(root)
+            if nodes > LIMITS.yaml_nodes:
+                raise error(path, None, f"{what}: aliases expand to more than {LIMITS.yaml_nodes:,} values")
+            return loader.construct_document(root)
+        finally:
+            loader.dispose()
     except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark
+        mark = exc.problem_mark or exc.context_mark
         where = f"line {mark.line + 1}, column {mark.column + 1}" if mark else None
-        raise error(path, where, f"not valid YAML: {exc.problem or exc}") from None
+        raise error(path, where, f"not valid YAML: {exc.problem or exc.context or exc}") from None
+    except yaml.reader.ReaderError as exc:
+        char = f"0x{exc.character:02x}" if isinstance(exc.character, int) else repr(exc.character)
+        raise error(path, f"offset {exc.position}", f"not valid YAML: character {char} is not allowed in YAML text") from None
     except yaml.YAMLError as exc:
-        raise error(path, None, f"not valid YAML: {exc}") from None
+        raise error(path, None, "not valid YAML: " + " ".join(str(exc).split())) from None
+    except RecursionError:
+        raise error(path, None, f"{what}: nested too deeply") from None
+
+
+def read_yaml_mapping(path: Path, error: type[_LocatedError], what: str, limit: int) -> dict[str, Any]:
+    """The top-level mapping of a YAML file read through the guard (`safe_files.read_text`, at most
+    `limit` bytes, then `load_yaml`), or `error` naming the file and what is wrong."""
+    data = load_yaml(read_text(path, limit, error, what), path, error, what)
     if not isinstance(data, dict):
         raise error(path, None, f"expected a mapping of keys at the top level, got {_kind(data)}")
     return data
