@@ -373,7 +373,7 @@ def test_every_mutant_is_refused_cleanly_by_check(tmp_path: Path) -> None:
         folder.mkdir()
         try:
             target = m.build(folder)
-        except OSError as exc:           # the file system refused to make the mutant (e.g. a name too long)
+        except OSError:                  # the file system refused to make the mutant (e.g. a name too long)
             codes[-1] += 1
             continue
         before = _files(folder)
