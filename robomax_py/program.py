@@ -377,32 +377,33 @@ def as_written_pose(T: FloatArray) -> FloatArray:
     return lin_pose(LinMove(xyz, zyx))
 
 
+def _identity(T: FloatArray) -> bool:
+    return bool(np.array_equal(np.asarray(T, dtype=float), np.eye(4)))
+
+
 def to_frame(T_root_frame: FloatArray, T: FloatArray) -> FloatArray:
     """A pose given in the URDF root frame, expressed in another frame (the controller's base,
     SPEC §6). An exactly identity frame returns T itself: no floating-point touch, so programs of
     robots without `controller.base` stay byte for byte what they were."""
-    F = np.asarray(T_root_frame, dtype=float)
-    if np.array_equal(F, np.eye(4)):
+    if _identity(T_root_frame):
         return np.asarray(T, dtype=float)
-    out: FloatArray = invert(F) @ np.asarray(T, dtype=float)
+    out: FloatArray = invert(np.asarray(T_root_frame, dtype=float)) @ np.asarray(T, dtype=float)
     return out
 
 
 def from_frame(T_root_frame: FloatArray, T: FloatArray) -> FloatArray:
     """Inverse of `to_frame`: a pose stated in `T_root_frame`, in the URDF root frame."""
-    F = np.asarray(T_root_frame, dtype=float)
-    if np.array_equal(F, np.eye(4)):
+    if _identity(T_root_frame):
         return np.asarray(T, dtype=float)
-    out: FloatArray = F @ np.asarray(T, dtype=float)
+    out: FloatArray = np.asarray(T_root_frame, dtype=float) @ np.asarray(T, dtype=float)
     return out
 
 
 def frame_in_world(T_world_root: FloatArray, T_root_frame: FloatArray) -> FloatArray:
     """Where a frame given in the URDF root frame is in the world (identity frame: untouched)."""
-    F = np.asarray(T_root_frame, dtype=float)
-    if np.array_equal(F, np.eye(4)):
+    if _identity(T_root_frame):
         return np.asarray(T_world_root, dtype=float)
-    out: FloatArray = np.asarray(T_world_root, dtype=float) @ F
+    out: FloatArray = np.asarray(T_world_root, dtype=float) @ np.asarray(T_root_frame, dtype=float)
     return out
 
 

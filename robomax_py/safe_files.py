@@ -42,6 +42,16 @@ class FileLimits:
 LIMITS = FileLimits()
 
 
+def named_by(error: Callable[[Any, Any, str], _LocatedError], file: Path, key: str) -> ErrorFactory:
+    """An ErrorFactory that names `file` and `key` (the file and key that name the path) rather than
+    the path itself, which may not be printable."""
+
+    def make(_path: object, _key: object, problem: str) -> _LocatedError:
+        return error(file, key, problem)
+
+    return make
+
+
 def checked_file(path: Path, limit: int, error: ErrorFactory, what: str, key: str | None = None) -> Path:
     """`path` made safe to open: the located `error` (file, key, problem) for a NUL byte, a path or
     name too long, a symlink loop, something that is not a regular file, or more than `limit` bytes."""

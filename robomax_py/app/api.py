@@ -16,7 +16,6 @@ import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
-from robomax_py.errors import ExportError
 from robomax_py.plan import PlanOptions, PlanResult
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
@@ -62,8 +61,6 @@ def write_programs(result: PlanResult, out_dir: str | Path) -> list[Path]:
     from robomax_py.export import render_programs
     from robomax_py.io.files import write_programs as write
 
-    if result.status != "planned":
-        raise ExportError(f"cell {result.cell} is not planned ({result.status}): {result.message}")
     return write(Path(out_dir), render_programs(result))
 
 

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from robomax_py.errors import RobotModelError
-from robomax_py.io.robot import package_dirs_for
+from robomax_py.io.robot import mesh_candidates, package_dirs_for
 
 MESH_SUFFIXES = (".stl", ".dae", ".obj", ".ply", ".off", ".glb", ".gltf")
 _BRAND_PATTERNS = (
@@ -108,16 +108,12 @@ def expand(source: Path, packages: Sequence[Path]) -> str:
 
 
 def _resolve_mesh(uri: str, source: Path, packages: Sequence[Path]) -> Path | None:
+    """The file a mesh `filename` names: under the --packages folders first, then as any URDF's."""
+    dirs: list[Path] = []
     if uri.startswith("package://"):
-        name, _, rest = uri[len("package://"):].partition("/")
-        dirs = [r.parent if r.name == name else r for r in packages]
-        dirs += package_dirs_for(name, source.parent)
-        for d in dirs:
-            if (d / name / rest).is_file():
-                return d / name / rest
-        return None
-    path = Path(uri[len("file://"):]) if uri.startswith("file://") else source.parent / uri
-    return path if path.is_file() else None
+        name = uri[len("package://"):].partition("/")[0]
+        dirs = [r.parent if r.name == name else r for r in packages] + package_dirs_for(name, source.parent)
+    return next((c for c in mesh_candidates(uri, source, dirs) if c.is_file()), None)
 
 
 def _local_name(uri: str) -> str:

@@ -35,13 +35,6 @@ FORMATS: dict[str, Format] = {
 }
 
 
-def format_for(suffix: str) -> Format:
-    """The format of a program file by its extension (".srcl", ".json"), or ExportError."""
-    for f in FORMATS.values():
-        if f.extension == suffix.lower():
-            return f
-    known = ", ".join(f.extension for f in FORMATS.values())
-    raise ExportError(f"unknown program file type '{suffix}'; known: {known}")
 
 
 def render(result: PlanResult, fmt: str) -> str:

@@ -30,7 +30,7 @@ from robomax_py.io.robot import (
 )
 from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
 from robomax_py.robot.geometry import load_mesh
-from robomax_py.safe_files import LIMITS, checked_file
+from robomax_py.safe_files import LIMITS, checked_file, named_by
 from robomax_py.spec import (
     Box,
     Capsule,
@@ -232,9 +232,9 @@ def load_cell(path: str | Path) -> CellSpec:
     _check_unique_names(parsed, path)
 
     robot_file = checked_file(resolve_robot_file(parsed.robot.model, path), LIMITS.description,
-                              _located(CellFileError, path, "robot.model"), f"unknown robot '{parsed.robot.model}':")
+                              named_by(CellFileError, path, "robot.model"), f"unknown robot '{parsed.robot.model}':")
     tool_file = checked_file(resolve_tool_file(parsed.tool, path), LIMITS.description,
-                             _located(CellFileError, path, "tool"), f"unknown tool '{parsed.tool}':")
+                             named_by(CellFileError, path, "tool"), f"unknown tool '{parsed.tool}':")
     robot_spec = load_robot_spec(robot_file)
     tool_spec = load_tool_spec(tool_file)
     for key, mesh in (("body", tool_spec.body), ("tips", tool_spec.tips)):
@@ -330,7 +330,7 @@ def _object(obj: ObjectFile, path: Path, key: str) -> ObjectSpec:
     else:
         assert obj.mesh is not None  # guaranteed by ObjectFile._one_shape
         named = path.parent / obj.mesh
-        mesh = checked_file(named, LIMITS.mesh, _located(CellFileError, path, f"{key}.mesh"), f"mesh {named}")
+        mesh = checked_file(named, LIMITS.mesh, named_by(CellFileError, path, f"{key}.mesh"), f"mesh {named}")
         _check_mesh_readable(mesh, CellFileError(path, f"{key}.mesh", f"cannot read mesh {mesh}"))
         shape = MeshShape(path=mesh)
     present = None
@@ -351,14 +351,6 @@ def _stem_name(path: Path) -> str:
     return stem
 
 
-def _located(error: type[CellFileError] | type[RobotModelError], file: Path, key: str) -> Any:
-    """An error class for `safe_files` that names `file` and `key` (the file that names the path)
-    rather than the path itself, which may not be printable."""
-
-    def make(_path: object, _key: object, problem: str) -> CellFileError | RobotModelError:
-        return error(file, key, problem)
-
-    return make
 
 
 def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError) -> None:

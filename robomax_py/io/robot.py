@@ -11,6 +11,7 @@ import math
 import os
 import re
 import xml.etree.ElementTree as ET
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -18,7 +19,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from robomax_py.errors import RobotModelError
 from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
-from robomax_py.safe_files import LIMITS, checked_file, read_text
+from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
 from robomax_py.spec import ControllerSpec, RobotSpec, ToolSpec, frozen_array
 from robomax_py.transforms import pose_matrix
 from robomax_py.units import degs_to_rads
@@ -105,11 +106,6 @@ def shipped_robots_dir() -> Path:
     return Path(__file__).resolve().parent.parent / "robots"
 
 
-def package_robots_dir() -> Path:
-    """The shipped robot library (kept for callers that want only it)."""
-    return shipped_robots_dir()
-
-
 def robot_library() -> tuple[Path, ...]:
     """Folders searched for robots/tools by name, first match wins: ROBOMAX_ROBOTS entries, then shipped.
 
@@ -133,10 +129,6 @@ def resolve_tool_file(ref: str, relative_to: Path) -> Path:
     return _resolve(ref, relative_to, ("tools",), "tool.yaml")
 
 
-def searched_for(ref: str, kind: Literal["robot", "tool"]) -> str:
-    """Where a name was looked for, for an 'unknown robot' message."""
-    sub = ("tools",) if kind == "tool" else ()
-    return ", ".join(str(Path(d, *sub)) for d in robot_library())
 
 
 def _resolve(ref: str, relative_to: Path, sub: tuple[str, ...], filename: str) -> Path:
@@ -266,16 +258,16 @@ def urdf_package_dirs(urdf: Path, file: Path) -> tuple[Path, ...]:
 
     Every mesh file the URDF names that exists is checked by the guard here (a regular file within
     the mesh size limit), so Pinocchio never opens a device, a pipe or a symlink loop."""
-    text = read_text(urdf, LIMITS.urdf, _named_by(file, "urdf"), f"URDF {urdf}")
+    text = read_text(urdf, LIMITS.urdf, named_by(RobotModelError, file, "urdf"), f"URDF {urdf}")
     dirs: list[Path] = []
     for name in urdf_package_names(text):
         for d in package_dirs_for(name, urdf.parent):
             if d not in dirs:
                 dirs.append(d)
     for uri in _MESH_FILENAME.findall(text):
-        for candidate in _mesh_candidates(uri, urdf, dirs):
+        for candidate in mesh_candidates(uri, urdf, dirs):
             if os.path.lexists(candidate):
-                checked_file(candidate, LIMITS.mesh, _named_by(urdf, f"mesh {uri}"), f"mesh {candidate}")
+                checked_file(candidate, LIMITS.mesh, named_by(RobotModelError, urdf, f"mesh {uri}"), f"mesh {candidate}")
                 break
     return tuple(dirs)
 
@@ -283,7 +275,9 @@ def urdf_package_dirs(urdf: Path, file: Path) -> tuple[Path, ...]:
 _MESH_FILENAME = re.compile(r"<mesh[^>]*\sfilename\s*=\s*[\"']([^\"']*)[\"']")
 
 
-def _mesh_candidates(uri: str, urdf: Path, dirs: list[Path]) -> list[Path]:
+def mesh_candidates(uri: str, urdf: Path, dirs: Sequence[Path]) -> list[Path]:
+    """Where a URDF's mesh `filename` may be: package:// under each package folder, file://, or
+    relative to the URDF."""
     if "\x00" in uri:
         return [Path(uri)]
     if uri.startswith("package://"):
@@ -299,7 +293,7 @@ def _mesh_candidates(uri: str, urdf: Path, dirs: list[Path]) -> list[Path]:
 
 def srdf_disabled_pairs(path: Path, file: Path) -> list[tuple[str, str]]:
     """The `disable_collisions link1/link2` pairs of a MoveIt SRDF."""
-    text = read_text(path, LIMITS.description, _named_by(file, "srdf"), f"SRDF {path}")
+    text = read_text(path, LIMITS.description, named_by(RobotModelError, file, "srdf"), f"SRDF {path}")
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:
@@ -313,13 +307,6 @@ def srdf_disabled_pairs(path: Path, file: Path) -> list[tuple[str, str]]:
     return pairs
 
 
-def _named_by(file: Path, key: str) -> Any:
-    """An error class for `safe_files` naming the file and key that name the path."""
-
-    def make(_path: object, _key: object, problem: str) -> RobotModelError:
-        return RobotModelError(file, key, problem)
-
-    return make
 
 
 # ------------------------------------------------------------------------------ loading
@@ -341,7 +328,7 @@ def load_robot_spec(path: Path) -> RobotSpec:
         urdf = resolve_package_uri(parsed.urdf, path, "urdf")
     else:
         urdf = (path.parent / parsed.urdf).resolve()
-    urdf = checked_file(urdf, LIMITS.urdf, _named_by(path, "urdf"), f"URDF {urdf}")
+    urdf = checked_file(urdf, LIMITS.urdf, named_by(RobotModelError, path, "urdf"), f"URDF {urdf}")
     ik_params = None
     if parsed.ik.params is not None or parsed.ik.solver not in ("opw", "ur"):
         try:
@@ -385,7 +372,7 @@ def load_tool_spec(path: Path) -> ToolSpec:
     meshes = {}
     for key in ("body", "tips"):
         named = path.parent / getattr(parsed, key)
-        meshes[key] = checked_file(named, LIMITS.mesh, _named_by(path, key), f"mesh {named}")
+        meshes[key] = checked_file(named, LIMITS.mesh, named_by(RobotModelError, path, key), f"mesh {named}")
     rpy = [math.radians(a) for a in parsed.tcp.rpy]
     return ToolSpec(
         name=parsed.name,

@@ -20,7 +20,7 @@ import pinocchio as pin
 from robomax_py._typing import FloatArray
 from robomax_py.plan.poses import orientation_grid, spot_poses
 from robomax_py.robot import RobotModel
-from robomax_py.robot.ik._chain import chain_to_frame, joint_frames
+from robomax_py.robot.ik._chain import joint_axes_at_zero
 from robomax_py.spec import CellSpec
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.transforms import closest_on_line, invert
@@ -58,15 +58,9 @@ class _ReachModel:
 
 
 def _reach_model(robot: RobotModel) -> _ReachModel:
-    model = robot.model
-    chain = chain_to_frame(model, robot.flange_frame_id)
-    F = joint_frames(chain, np.zeros((1, model.nq)))[0]
-    u = [F[i, :3, :3] @ chain.A[i, :3, 2] for i in range(len(chain.joints))]
-    p = [F[i, :3, 3] for i in range(len(chain.joints))]
-    data = model.createData()
-    pin.framesForwardKinematics(model, data, np.zeros(model.nq))
-    T_flange = data.oMf[robot.flange_frame_id].homogeneous
-    T_tcp = T_flange @ np.asarray(robot.T_flange_tcp)
+    axes = joint_axes_at_zero(robot.model, robot.flange_frame_id)
+    u, p = list(axes.u), list(axes.p)
+    T_tcp = axes.T_flange @ np.asarray(robot.T_flange_tcp)
     wrist = _wrist_centre(p, u) if len(p) >= 6 else None
     if wrist is not None:
         ref = wrist
@@ -75,14 +69,14 @@ def _reach_model(robot: RobotModel) -> _ReachModel:
         ref = T_tcp[:3, 3]
         reach = float(sum(np.linalg.norm(p[i + 1] - p[i]) for i in range(1, len(p) - 1)) + np.linalg.norm(ref - p[-1]))
     p_ref = (invert(T_tcp) @ np.append(ref, 1.0))[:3]
-    return _ReachModel(p[0], u[0] / np.linalg.norm(u[0]), p[1], p_ref, reach)
+    return _ReachModel(p[0], u[0], p[1], p_ref, reach)
 
 
 def _wrist_centre(p: list[FloatArray], u: list[FloatArray]) -> FloatArray | None:
     """Where axes 4, 5 and 6 meet at q = 0, or None when they do not meet in one point."""
-    c = closest_on_line(p[3], u[3] / np.linalg.norm(u[3]), p[4], u[4] / np.linalg.norm(u[4]))
+    c = closest_on_line(p[3], u[3], p[4], u[4])            # u: unit axes
     for k in (3, 4, 5):
-        if np.linalg.norm(np.cross(c - p[k], u[k])) > WRIST_MEET_TOL_M * max(1.0, np.linalg.norm(u[k])):
+        if np.linalg.norm(np.cross(c - p[k], u[k])) > WRIST_MEET_TOL_M:
             return None
     return c
 

@@ -181,10 +181,10 @@ def test_missing_cell_file(tmp_path: Path) -> None:
 
 def test_robot_by_path_and_missing_flange(tmp_path: Path, good_cell: dict[str, Any], reference_cell_path: Path) -> None:
     """A robot named by path loads; a robot.yaml whose flange frame is not in the URDF is named."""
-    from robomax_py.io.robot import package_robots_dir
+    from robomax_py.io.robot import shipped_robots_dir
 
     robot_dir = tmp_path / "myarm"
-    shutil.copytree(package_robots_dir() / "kr16", robot_dir)
+    shutil.copytree(shipped_robots_dir() / "kr16", robot_dir)
     text = (robot_dir / "robot.yaml").read_text().replace("name: kr16", "name: myarm")
     (robot_dir / "robot.yaml").write_text(text)
     data = copy.deepcopy(good_cell)

@@ -11,7 +11,12 @@ import numpy as np
 import pytest
 
 from robomax_py.io.cell import load_cell, load_cell_robot
-from robomax_py.plan.candidates import BRANCH_JUMP_RAD, Rejection, _line_verdict, _spot_candidates
+from robomax_py.plan.candidates import (
+    BRANCH_JUMP_RAD,
+    Rejection,
+    _line_verdict,
+    _spot_candidates,
+)
 from robomax_py.plan.poses import approach_poses, orientation_grid, spot_poses
 from robomax_py.robot import prismatic_mask
 from robomax_py.robot.ik.turns import wrap_to_pi

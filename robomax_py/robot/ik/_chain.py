@@ -212,3 +212,24 @@ def frame_pose_and_jacobian(chain: Chain, q: FloatArray) -> tuple[FloatArray, Fl
         else:
             J[:, :3, col] = w.T
     return T[:3].transpose(1, 0, 2), p, J
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class JointAxes:
+    """The chain to a frame at q = 0, in the root frame: unit joint axes (k, 3), their origins (k, 3)
+    and the frame's pose (4, 4)."""
+
+    u: FloatArray
+    p: FloatArray
+    T_flange: FloatArray
+
+
+def joint_axes_at_zero(model: pin.Model, frame_id: int) -> JointAxes:
+    """The joint axes and origins of the chain to `frame_id` at q = 0 (for fitting and reach bounds)."""
+    chain = chain_to_frame(model, frame_id)
+    F = joint_frames(chain, np.zeros((1, model.nq)))[0]
+    u = np.array([F[i, :3, :3] @ chain.A[i, :3, 2] for i in range(len(chain.joints))])
+    p = np.array([F[i, :3, 3] for i in range(len(chain.joints))])
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, np.zeros(model.nq))
+    return JointAxes(u / np.linalg.norm(u, axis=1, keepdims=True), p, np.asarray(data.oMf[frame_id].homogeneous))

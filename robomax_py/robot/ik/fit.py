@@ -22,11 +22,11 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import RobomaxError
-from robomax_py.robot.ik._chain import chain_to_frame, joint_frames
+from robomax_py.robot.ik._chain import chain_to_frame, joint_axes_at_zero
 from robomax_py.robot.ik.opw import OpwParams, opw_fk
 from robomax_py.robot.ik.ur import UrParams, ur_fk
 from robomax_py.tolerances import DEFAULT as TOL
-from robomax_py.transforms import closest_on_line, rpy_from_matrix
+from robomax_py.transforms import closest_on_line, rot_x, rot_y, rot_z, rpy_from_matrix
 
 # Structural conditions (parallel, perpendicular, intersecting axes) hold to this, in m or rad:
 # URDFs write pi/2 as 1.5708 or 1.57079632679, so 1e-4 accepts them; the FK check then decides.
@@ -71,13 +71,9 @@ def _axes_at_zero(model: pin.Model, frame_id: int) -> _Axes:
     if len(chain.joints) != 6 or not np.all(chain.revolute):
         raise FitError(f"needs a chain of six revolute joints to the flange, found {len(chain.joints)} joints "
                        f"({int(np.sum(chain.revolute))} revolute)")
-    F = joint_frames(chain, np.zeros((1, model.nq)))[0]
-    u = np.array([F[i, :3, :3] @ chain.A[i, :3, 2] for i in range(6)])
-    p = np.array([F[i, :3, 3] for i in range(6)])
-    data = model.createData()
-    pin.framesForwardKinematics(model, data, np.zeros(model.nq))
-    T = data.oMf[frame_id].homogeneous
-    return _Axes(u / np.linalg.norm(u, axis=1, keepdims=True), p, T[:3, :3], T[:3, 3])
+    axes = joint_axes_at_zero(model, frame_id)
+    T = axes.T_flange
+    return _Axes(axes.u, axes.p, T[:3, :3], T[:3, 3])
 
 
 
@@ -96,14 +92,8 @@ def _require_perpendicular(u1: FloatArray, u2: FloatArray, what: str) -> None:
         raise FitError(f"{what} must be perpendicular (cos {float(u1 @ u2):.2e})")
 
 
-def _rz(a: float) -> FloatArray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-def _ry(a: float) -> FloatArray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 def _wrap(a: float) -> float:
@@ -186,18 +176,18 @@ def fit_opw(model: pin.Model, frame_id: int) -> OpwParams:
     f = u[3] if u[3] @ (wrist - p3) > 0 else -u[3]
     s4 = 1 if u[3] @ f > 0 else -1
     th23 = in_plane_angle(f)
-    R_c = _rz(th1) @ _ry(th23)
+    R_c = rot_z(th1) @ rot_y(th23)
     u5c = R_c.T @ u[4]
     options = [(1, float(np.arctan2(-u5c[0], u5c[1]))), (-1, float(np.arctan2(u5c[0], -u5c[1])))]
     s5, th4 = min(options, key=lambda o: abs(o[1]))
-    R_4 = R_c @ _rz(th4)
+    R_4 = R_c @ rot_z(th4)
     zf = R_4.T @ ax.R_flange[:, 2]
     th5 = float(np.arctan2(zf[0], zf[2]))
-    R_5 = R_4 @ _ry(th5)
+    R_5 = R_4 @ rot_y(th5)
     s6 = 1 if u[5] @ ax.R_flange[:, 2] > 0 else -1
     M = R_5.T @ ax.R_flange
     th6 = float(np.arctan2(M[1, 0], M[0, 0]))
-    if np.linalg.norm(M - _rz(th6)) > STRUCTURE_TOL:
+    if np.linalg.norm(M - rot_z(th6)) > STRUCTURE_TOL:
         raise FitError("the flange frame is not a rotation about axis 6 of the wrist")
 
     signs = (s1, s2, s3, s4, s5, s6)
@@ -216,7 +206,7 @@ def _opw_lengths(model: pin.Model, frame_id: int, signs: tuple[int, ...], offset
     R = opw_fk(zero, qs)[:, :3, :3]
     for k in range(len(qs)):
         t1, t2, t23 = th[k, 0], th[k, 1], th[k, 1] + th[k, 2]
-        Rz1 = _rz(t1)
+        Rz1 = rot_z(t1)
         cols = [
             Rz1 @ [1.0, 0.0, 0.0],                            # a1
             Rz1 @ [np.cos(t23), 0.0, -np.sin(t23)],           # a2
@@ -235,9 +225,6 @@ def _opw_lengths(model: pin.Model, frame_id: int, signs: tuple[int, ...], offset
 _UR_ALPHA = (np.pi / 2, 0.0, 0.0, np.pi / 2, -np.pi / 2, 0.0)
 
 
-def _rx(a: float) -> FloatArray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
 def fit_ur(model: pin.Model, frame_id: int) -> UrParams:
@@ -270,10 +257,10 @@ def fit_ur(model: pin.Model, frame_id: int) -> UrParams:
         R = R0.copy()
         cols_a, cols_d = [], []
         for i in range(6):
-            R = R @ _rz(q[i])
+            R = R @ rot_z(q[i])
             cols_d.append(R[:, 2])      # d_i along z before Tx and Rx
             cols_a.append(R[:, 0])      # a_i along the new x
-            R = R @ _rx(_UR_ALPHA[i])
+            R = R @ rot_x(_UR_ALPHA[i])
         if k == 0:
             R6_zero = R
         # unknowns: base x, y (root frame, along x0 and y0), d1, a2, a3, d4, d5, d6, flange x, y (in DH 6)
