@@ -26,7 +26,7 @@ if TYPE_CHECKING:
         write_programs,
     )
 
-__version__ = "0.1.0"
+from robomax_py._version import __version__  # noqa: E402
 
 _API = ("LoadedCell", "load_cell", "plan_cell", "verify_program", "write_programs")
 

@@ -104,6 +104,12 @@ class Header:
         Planned cycle time, s (3 decimals).
     joints : tuple[str, ...]
         Joint names in controller order; every `PtpMove` gives one value per joint.
+    generator : str
+        What wrote the program and its version ("robomax_py 0.1.0"); "" when not stated.
+    cell_sha256 : str
+        SHA-256 (hex) of the cell file's bytes the program was planned from; "" when not stated.
+    stamp : str
+        The date of writing, only when asked for (`plan --stamp`); "" keeps programs byte-identical.
     """
 
     cell: str
@@ -111,6 +117,9 @@ class Header:
     tool: str
     cycle_time_s: float
     joints: tuple[str, ...]
+    generator: str = ""
+    cell_sha256: str = ""
+    stamp: str = ""
 
     def __post_init__(self) -> None:
         _set(self, "cycle_time_s", _fixed(self.cycle_time_s, TIME_DECIMALS))
@@ -158,6 +167,10 @@ class PtpMove:
         joining the next move; 0 stops exactly.
     comment : str
         Note carried with the move; surrounding whitespace is stripped; "" for none.
+    flyby_mm : float
+        The fly-by stated as a TCP distance instead, mm (3 decimals), as KRL `C_DIS`, RAPID
+        zones and URScript `r` state it: the joint-space radius is this distance times the
+        move's joint-to-TCP chord ratio (`timing.chain`). At most one of the two is non-zero.
     """
 
     target_deg: tuple[float, ...]
@@ -165,6 +178,7 @@ class PtpMove:
     accel: float = 1.0
     flyby: float = 0.0
     comment: str = ""
+    flyby_mm: float = 0.0
 
     def __post_init__(self) -> None:
         _set(self, "target_deg", _fixed_all(self.target_deg, JOINT_DECIMALS))
@@ -172,6 +186,12 @@ class PtpMove:
         _set(self, "accel", _fixed(self.accel, SPEED_DECIMALS))
         _set(self, "flyby", _fixed(self.flyby, ANGLE_DECIMALS))
         _set(self, "comment", str(self.comment).strip())
+        _set(self, "flyby_mm", _fixed(self.flyby_mm, MM_DECIMALS))
+
+    @property
+    def flies(self) -> bool:
+        """Whether the move passes its target without stopping."""
+        return self.flyby > 0 or self.flyby_mm > 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -191,6 +211,8 @@ class LinMove:
     flyby : float
         As for `PtpMove` (deg, joint space; 0 stops exactly).
     comment : str
+    flyby_mm : float
+        As for `PtpMove` (mm of TCP distance).
     """
 
     position_mm: tuple[float, ...]
@@ -199,6 +221,7 @@ class LinMove:
     speed_mm_s: float = 250.0
     flyby: float = 0.0
     comment: str = ""
+    flyby_mm: float = 0.0
 
     def __post_init__(self) -> None:
         _set(self, "position_mm", _fixed_all(self.position_mm, MM_DECIMALS))
@@ -207,6 +230,12 @@ class LinMove:
         _set(self, "speed_mm_s", _fixed(self.speed_mm_s, SPEED_DECIMALS))
         _set(self, "flyby", _fixed(self.flyby, ANGLE_DECIMALS))
         _set(self, "comment", str(self.comment).strip())
+        _set(self, "flyby_mm", _fixed(self.flyby_mm, MM_DECIMALS))
+
+    @property
+    def flies(self) -> bool:
+        """Whether the move passes its target without stopping."""
+        return self.flyby > 0 or self.flyby_mm > 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -278,9 +307,15 @@ def _triple(label: str, values: tuple[float, ...]) -> str | None:
     return _finite(label, values)
 
 
-def _flyby_problem(radius: float) -> str | None:
-    problem = _finite("fly-by radius", (radius,))
-    return problem or (f"fly-by radius {radius:.4f} deg is negative" if radius < 0 else None)
+def _flyby_problem(move: PtpMove | LinMove) -> str | None:
+    problem = _finite("fly-by radius", (move.flyby, move.flyby_mm))
+    if problem:
+        return problem
+    if move.flyby < 0 or move.flyby_mm < 0:
+        return f"fly-by radius {min(move.flyby, move.flyby_mm):.4f} is negative"
+    if move.flyby > 0 and move.flyby_mm > 0:
+        return "a fly-by is stated both as a joint-space radius and as a TCP distance"
+    return None
 
 
 def find_problem(item: Header | FrameDef | Instruction, n_joints: int) -> str | None:
@@ -318,7 +353,7 @@ def find_problem(item: Header | FrameDef | Instruction, n_joints: int) -> str | 
         for label, v in (("speed", item.speed), ("accel", item.accel)):
             if not 0.0 < v <= 1.0:
                 return f"PTP {label} {v:.3f} is outside (0, 1] (a fraction of the maximum)"
-        return _flyby_problem(item.flyby)
+        return _flyby_problem(item)
     if isinstance(item, LinMove):
         problem = (
             _triple("LIN position", item.position_mm)
@@ -329,7 +364,7 @@ def find_problem(item: Header | FrameDef | Instruction, n_joints: int) -> str | 
             return problem
         if item.speed_mm_s <= 0:
             return f"LIN speed {item.speed_mm_s:.3f} mm/s must be > 0"
-        return _flyby_problem(item.flyby)
+        return _flyby_problem(item)
     if isinstance(item, Spot):
         problem = _finite("weld time", (item.time_s,))
         return problem or (f"weld time {item.time_s:.3f} s is negative" if item.time_s < 0 else None)

@@ -158,3 +158,4 @@ class CellSpec:
     process: ProcessSpec = field(default_factory=ProcessSpec)
     planner: PlannerSpec = field(default_factory=PlannerSpec)
     dynamic: tuple[ObjectSpec, ...] = ()
+    digest: str = ""                          # SHA-256 (hex) of the cell file's bytes

@@ -64,5 +64,17 @@ class Tolerances:
     # acceleration from second differences overshoots a jerk-limited peak slightly.
     velocity_rtol: float = 0.01
     acceleration_rtol: float = 0.05
+    # publish: a written program's rebuilt motion may differ from the planned one by this much
+    # (joint deg and TCP mm at the same fraction of every interval between welds, weld times s):
+    # FANUC TP's 3 decimals move a target by < 0.001 deg, its 0.01 s waits shift welds by < 10 ms.
+    rebuilt_joint_deg: float = 0.01
+    rebuilt_tcp_mm: float = 0.1
+    rebuilt_time_s: float = 0.02
+    # A Cartesian target read back equals the written one when its rotation is within this (deg):
+    # ZYX angles near B = ±90 deg can come back as other angles of the same rotation.
+    readback_angle_deg: float = 1e-4
+    # Configuration data names a branch as far as the joints are this far from where it changes
+    # (SPEC §6: re-solving a target in its configuration gives the planned joints within 0.01 deg).
+    config_tol_deg: float = 0.01
 
 DEFAULT = Tolerances()

@@ -10,6 +10,7 @@ seam's tolerance; the configuration indicator as written; ordered seams in their
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,7 +24,7 @@ from robomax_py.export.trajectory_json import load_trajectory_file
 from robomax_py.plan.poses import nominal_rotation
 from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.robot.ik import same_config
-from robomax_py.robot.solve import config_text
+from robomax_py.robot.solve import brand_text_of, config_texts_near
 from robomax_py.safe_files import LIMITS, read_text
 from robomax_py.spec import CellSpec
 from robomax_py.tolerances import DEFAULT as TOL
@@ -40,27 +41,80 @@ TIME_TOL_S = TOL.time_tol_s
 
 
 @dataclass(frozen=True, slots=True)
+class Clearance:
+    """The smallest distance between the robot (or tool) and an obstacle over a motion."""
+
+    distance_m: float
+    t: float
+    between: str
+    line: int | None = None
+
+
+@dataclass(frozen=True, slots=True)
 class VerifyReport:
     program: str
     samples: int
     cycle_time: float
     collision_checks: int
     violations: tuple[Violation, ...]
+    ignored: tuple[tuple[int, str], ...] = ()     # (line, statement) read but without effect on motion
+    clearance: Clearance | None = None            # the smallest distance to an obstacle reached
 
     @property
     def clean(self) -> bool:
         return not self.violations
 
 
-
-
 def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
-    """Verify a `.json` trajectory file or a `.srcl` program (its motion rebuilt from its statements)."""
-    if path.suffix.lower() == ".srcl":
-        return verify_srcl_file(cell, robot, path)
-    if path.suffix.lower() == ".json":
+    """Verify a trajectory file (.json) or a program of any dialect robomax writes (its motion
+    rebuilt from its statements alone)."""
+    from robomax_py.export import DIALECTS, dialect_for_file
+
+    suffix = path.suffix.lower()
+    if suffix == ".json":
         return verify_trajectory_file(cell, robot, path)
-    raise ProgramError(path, None, "expected a trajectory file (.json) or an SRCL program (.srcl)")
+    dialect = dialect_for_file(suffix)
+    if dialect is None:
+        known = ", ".join(sorted({e for d in DIALECTS.values() for e in d.extensions}))
+        raise ProgramError(path, None, f"expected a trajectory file (.json) or a program ({known})")
+    texts = {}
+    for ext in dialect.extensions:
+        sibling = path.with_suffix(ext) if suffix != ext else path
+        if sibling == path or sibling.exists():
+            texts[ext] = read_text(sibling, LIMITS.program, ProgramError, "program file")
+    main = path.with_suffix(dialect.extensions[0])
+    if dialect.extensions[0] not in texts:
+        raise ProgramError(main, None, f"{path.name} needs its main file {main.name} beside it")
+    from robomax_py.export.rebuild import rebuild
+
+    parsed = dialect.parse(texts, str(main), robot)
+    rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand)
+    report = verify_rebuilt(cell, robot, str(path), rebuilt)
+    unsimulated = tuple(Violation(None, "unsupported", f"{text} is not simulated: the program cannot be verified", line)
+                        for line, text in parsed.ignored if _is_motion(parsed, line))
+    return dataclasses.replace(report, violations=unsimulated + report.violations,
+                               ignored=tuple(i for i in parsed.ignored if not _is_motion(parsed, i[0])))
+
+
+def _is_motion(parsed: Any, line: int) -> bool:
+    from robomax_py.program import Comment
+
+    return any(isinstance(ins, Comment) and ins.text.startswith("not simulated:") and at == line
+               for ins, at in zip(parsed.program.instructions, parsed.lines))
+
+
+def verify_rebuilt(cell: CellSpec, robot: RobotModel, name: str, rebuilt: Any) -> VerifyReport:
+    """Check a rebuilt motion (`export.rebuild.Rebuilt`) like a trajectory, with the program line
+    of each violation."""
+    out = [Violation(p.t, p.kind, p.detail, p.line) for p in rebuilt.problems]
+    if rebuilt.trajectory is None:
+        return VerifyReport(name, 0, float("nan"), 0, tuple(out))
+    traj = rebuilt.trajectory
+    data = {"t": np.asarray(traj.t), "q": np.asarray(traj.q), "spots": rebuilt.spots}
+    report = _verify_motion(cell, robot, name, data, out)
+    lined = tuple(v if v.line is not None else dataclasses.replace(v, line=rebuilt.line_at(v.t))
+                  for v in report.violations)
+    return dataclasses.replace(report, violations=lined)
 
 
 def verify_trajectory_file(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
@@ -76,18 +130,8 @@ def verify_trajectory_file(cell: CellSpec, robot: RobotModel, path: Path) -> Ver
 
 
 def verify_srcl_file(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
-    """Parse an SRCL program, rebuild its motion (`rebuild.rebuild`) and check it like a trajectory."""
-    from robomax_py.export.rebuild import rebuild
-    from robomax_py.export.srcl import parse_program
-
-    text = read_text(path, LIMITS.program, ProgramError, "program file")
-    rebuilt = rebuild(parse_program(text, path), cell, robot, path)
-    out = [Violation(p.t, p.kind, p.detail) for p in rebuilt.problems]
-    if rebuilt.trajectory is None:
-        return VerifyReport(str(path), 0, float("nan"), 0, tuple(out))
-    traj = rebuilt.trajectory
-    data = {"t": np.asarray(traj.t), "q": np.asarray(traj.q), "spots": rebuilt.spots}
-    return _verify_motion(cell, robot, str(path), data, out)
+    """Parse an SRCL program, rebuild its motion and check it like a trajectory."""
+    return verify_program(cell, robot, path)
 
 
 def _verify_motion(cell: CellSpec, robot: RobotModel, name: str, data: dict[str, Any], out: list[Violation]) -> VerifyReport:
@@ -144,8 +188,10 @@ def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> lis
                                              f"{math.degrees(beta):.2f} gamma {math.degrees(gamma):.2f} deg outside the tolerance"))
         written = entry.get("config")
         if written is not None:
-            actual = config_text(robot, qs[0])
-            if not same_config(str(written), actual):
+            brand = str(entry.get("brand", robot.controller.brand))
+            nearby = config_texts_near(robot, qs[0], brand, math.radians(TOL.config_tol_deg))
+            actual = brand_text_of(robot, qs[0], brand)
+            if not any(same_config(str(written), text) for text in nearby):
                 out.append(Violation(t0, "spot", f"{label}: configuration written as {written}, robot is in {actual}"))
     for key in wanted:
         if key not in seen:

@@ -3,7 +3,7 @@
     import robomax_py as rm
     cell = rm.load_cell("cells/cabin_flange.yaml")
     result = rm.plan_cell(cell)
-    files = rm.write_programs(result, "programs")
+    files = rm.write_programs(cell, result, "programs", formats="srcl,krl")
     report = rm.verify_program(cell, files[-1])
 
 Bad input raises a `RobomaxError` (file, key and problem in its message); infeasibility is a
@@ -53,15 +53,22 @@ def plan_cell(cell: LoadedCell, options: PlanOptions | None = None, **overrides:
     return plan(cell.spec, cell.robot, opts)
 
 
-def write_programs(result: PlanResult, out_dir: str | Path) -> list[Path]:
-    """Render every program file of a complete plan, then write each atomically; the paths written.
+def write_programs(cell: LoadedCell, result: PlanResult, out_dir: str | Path, formats: str = "srcl",
+                   stamp: str = "") -> list[Path]:
+    """Render the program files of a complete plan (the trajectory file and each of `formats`, as
+    `plan --format` takes them), prove each (read back, rebuilt, compared and verified), then
+    write them as one set; the paths written.
 
-    Raises ExportError for a plan that is not complete: nothing is written then.
+    Raises ExportError for a plan that is not complete or a program that does not prove: nothing
+    is written then.
     """
-    from robomax_py.export import render_programs
+    from robomax_py.export import format_names
     from robomax_py.io.files import write_programs as write
+    from robomax_py.publish import publish
 
-    return write(Path(out_dir), render_programs(result))
+    names = format_names(formats, cell.robot.controller.brand)
+    files, _ = publish(result, cell.spec, cell.robot, names, stamp=stamp, baseline=result.baseline)
+    return write(Path(out_dir), files)
 
 
 def verify_program(cell: LoadedCell, path: str | Path) -> VerifyReport:

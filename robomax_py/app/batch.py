@@ -81,16 +81,17 @@ OnDone = Callable[[int, CellOutcome], CellOutcome]
 def plan_cell_file(file: str, baseline: bool) -> CellOutcome:
     """The worker: load a cell file, plan it and render its programs (no file is written here)."""
     from robomax_py.errors import RobomaxError
-    from robomax_py.export import render_programs
     from robomax_py.io.cell import load_cell, load_cell_robot
     from robomax_py.plan import PlanOptions, plan_cell
+    from robomax_py.publish import publish
 
     t0 = time.perf_counter()
     try:
         spec = load_cell(file)
         robot = load_cell_robot(spec)
         result = plan_cell(spec, robot, PlanOptions(baseline=baseline))
-        programs = tuple(render_programs(result).items()) if result.status == PLANNED else ()
+        programs = (tuple(publish(result, spec, robot, ("srcl",), baseline=baseline)[0].items())
+                    if result.status == PLANNED else ())
     except RobomaxError as exc:
         return CellOutcome(file, Path(file).stem, BAD_INPUT, time.perf_counter() - t0, reasons=str(exc))
     seconds = time.perf_counter() - t0
@@ -324,13 +325,15 @@ def write_outcome_programs(out_dir: Path, outcome: CellOutcome, taken: dict[str,
 
     if outcome.status != PLANNED:
         return outcome
-    clash = next((taken[name] for name, _ in outcome.programs if name in taken), None)
+    # Files every cell writes alike (FANUC's spot_weld.ls) do not belong to one cell.
+    own = [name for name, _ in outcome.programs if name.startswith(outcome.cell)]
+    clash = next((taken[name] for name in own if name in taken), None)
     if clash is not None:
         return replace(outcome, status=BAD_INPUT, programs=(), cycle_time=None, detours=None,
                        reasons=f"{outcome.file}: name: cell name '{outcome.cell}' is also that of {clash}; "
                                "its programs would overwrite those")
     written = write_programs(out_dir, dict(outcome.programs))
-    for name, _ in outcome.programs:
+    for name in own:
         taken[name] = outcome.file
     return replace(outcome, programs=(), written=tuple(str(p) for p in written))
 

@@ -138,46 +138,53 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")]) -> Non
 def plan(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
     out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder")] = Path("programs"),
-    baseline: Annotated[bool, typer.Option("--baseline", help="the published method: given order, nominal orientation, first branch")] = False,
+    baseline: Annotated[bool, typer.Option("--baseline", help="the published method: given order, nominal orientation, first branch; writes <name>_baseline.*")] = False,
     as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable report instead of tables")] = False,
     speed: Annotated[float | None, typer.Option("--speed", min=0.01, max=1.0, help="override of every programmed speed, fraction in (0, 1] (default: the cell's planner.speed, else 1)")] = None,
     verbose: Annotated[bool, typer.Option("-v", "--verbose", help="debug logging: stage sizes, counts and times")] = False,
     plot: Annotated[bool, typer.Option("--plot", help="also write DIR/<name>.png: a cycle-time Gantt chart, one row per spot")] = False,
+    formats: Annotated[str, typer.Option("--format", help="program dialects, comma-separated: srcl, krl, rapid, fanuc, urscript, native (the robot's controller brand) or all")] = "srcl",
+    stamp: Annotated[bool, typer.Option("--stamp", help="write the date into each program's header (otherwise the same cell gives the same bytes)")] = False,
 ) -> None:
-    """Plan a cell and write its program files (only when the plan is complete and verified)."""
+    """Plan a cell and write its program files (only when the plan is complete and every program proven)."""
 
     def run() -> int:
+        import datetime
         import json as _json
         import time
 
         from robomax_py.app.progress import configure_logging, stage_bars
         from robomax_py.app.report import plan_report, report_tables
-        from robomax_py.export import render_programs
+        from robomax_py.export import format_names
         from robomax_py.io.cell import load_cell, load_cell_robot
         from robomax_py.io.files import write_programs
         from robomax_py.plan import PlanOptions, plan_cell
+        from robomax_py.publish import publish
 
         configure_logging(err, verbose)
         t0 = time.perf_counter()
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
         _warn(robot.warnings)
+        names = format_names(formats, robot.controller.brand)
         with stage_bars(err, enabled=not verbose) as progress:
             result = plan_cell(spec, robot, PlanOptions(baseline=baseline, speed=speed), progress)
         seconds = time.perf_counter() - t0
         written: list[Path] = []
+        checked = []
         if result.status == "planned":
             from robomax_py.app.chart import cycle_chart, render_png
             from robomax_py.io.files import write_atomic_bytes
 
-            texts = render_programs(result)   # everything rendered before any write
+            date = datetime.date.today().isoformat() if stamp else ""
+            texts, checked = publish(result, spec, robot, names, stamp=date, baseline=baseline)  # all proven before any write
             png = render_png(cycle_chart(result)) if plot else None
             written = write_programs(out_dir, texts)
             if png is not None:
-                path = out_dir / f"{spec.name}.png"
+                path = out_dir / f"{spec.name}{'_baseline' if baseline else ''}.png"
                 write_atomic_bytes(path, png)
                 written.append(path)
-        report = plan_report(result, seconds, written, robot.defaulted_limits)
+        report = plan_report(result, seconds, written, robot.defaulted_limits, checked)
         if as_json:
             out.print_json(_json.dumps(report))
         else:
@@ -192,6 +199,10 @@ def plan(
                 r = reach.get((f.seam, f.name))
                 far = f"; {r.out_by_m:.3f} m out of reach at the best orientation" if r and not r.reachable else ""
                 err.print(f"  {f.seam}/{f.name}: {f.reason} ({f.detail}{far})", soft_wrap=True)
+            stale = _stale_programs(out_dir, spec.name + ("_baseline" if baseline else ""))
+            if stale:
+                err.print(f"[yellow]note:[/] {', '.join(stale)} in {out_dir} are from an earlier plan, not this one "
+                          "(nothing was written)", soft_wrap=True)
             return EXIT_INFEASIBLE
         return EXIT_OK
 
@@ -199,10 +210,21 @@ def plan(
     raise typer.Exit(code)
 
 
+def _stale_programs(out_dir: Path, name: str) -> list[str]:
+    """Program files of an earlier plan of the cell in the output folder."""
+    from robomax_py.export import DIALECTS
+
+    suffixes = {".json", ".png", *(e for d in DIALECTS.values() for e in d.extensions)}
+    try:
+        return sorted(p.name for p in out_dir.iterdir() if p.stem == name and p.suffix in suffixes)
+    except OSError:
+        return []
+
+
 @app.command()
 def verify(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
-    program: Annotated[Path, typer.Argument(help="program written by plan: .srcl (motion rebuilt from its statements) or .json")],
+    program: Annotated[Path, typer.Argument(help="a program (.srcl, .src, .mod, .ls, .script: the motion rebuilt from its statements) or a trajectory file (.json)")],
 ) -> None:
     """Re-simulate a program against the cell; report collisions, limit and tolerance violations."""
 

@@ -3,26 +3,36 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from rich.table import Table
 
 from robomax_py.plan import PlanResult
+from robomax_py.publish import CheckedProgram
 
 KINDS = ("move", "detour", "approach", "weld", "retract", "wait")
 
 
 def plan_report(result: PlanResult, seconds: float, written: list[Path],
-                defaulted_limits: tuple[str, ...] = ()) -> dict[str, Any]:
-    """A JSON-ready summary: status, cycle time and its split, spots, detours, planning time, and
-    which of the robot's limits were derived rather than given (`RobotModel.defaulted_limits`)."""
+                defaulted_limits: tuple[str, ...] = (), checked: Sequence[CheckedProgram] = ()) -> dict[str, Any]:
+    """A JSON-ready summary: status, cycle time and its split, spots, detours, planning time,
+    which of the robot's limits were derived rather than given (`RobotModel.defaulted_limits`),
+    and how each written program proved (`publish.CheckedProgram`)."""
     report: dict[str, Any] = {
         "cell": result.cell, "robot": result.robot, "status": result.status, "message": result.message,
         "method": "baseline" if result.baseline else "optimised", "planning_seconds": round(seconds, 3),
         "failures": [{"seam": f.seam, "spot": f.name, "reason": f.reason, "detail": f.detail} for f in result.failures],
         "files": [str(p) for p in written],
         "defaulted_limits": list(defaulted_limits),
+        "programs": [
+            {"format": c.format, "files": list(c.files), "bytes": sum(len(t.encode()) for t in c.files.values()),
+             "rebuilt_joint_deg": round(c.difference.joint_deg, 6), "rebuilt_tcp_mm": round(c.difference.tcp_mm, 6),
+             "rebuilt_time_ms": round(c.difference.time_s * 1000, 3), "write_cpu_s": round(c.write_seconds, 3),
+             "prove_cpu_s": round(c.check_seconds, 3)}
+            for c in checked
+        ],
     }
     if result.trajectory is None:
         return report
@@ -70,6 +80,9 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
         st = report["stats"]
         head.add_row("work", f"{st['candidates']} candidates, {st['collision_checks']:,} collision checks, "
                              f"{st['sequencing_rounds']} sequencing rounds")
+    for p in report.get("programs", []):
+        head.add_row("proven", f"{p['format']}: read back, rebuilt within {p['rebuilt_joint_deg']:.4f} deg, "
+                               f"{p['rebuilt_tcp_mm']:.3f} mm, {p['rebuilt_time_ms']:.1f} ms of the plan")
     for f in report["files"]:
         head.add_row("wrote", f)
     out: list[Any] = [head]

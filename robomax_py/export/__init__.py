@@ -1,57 +1,60 @@
 """Program formats, both directions, in one registry: a planned result -> program text (pure and
-deterministic, fixed float formats), and a program file -> what `robomax verify` checks.
+deterministic, fixed float formats), and program files -> what `robomax verify` checks.
 
-Each format is one module owning its writer and its reader (`srcl`, `trajectory_json`);
-`plan_program` turns a plan into the dialect-free `Program` the dialects write, `rebuild` turns a
-parsed `Program` back into motion.
+`plan_program` turns a plan into the dialect-free `Program` (`planned_program`); each dialect
+module owns its adapter, writer and reader (`srcl`, `krl`, `rapid`, `fanuc`, `urscript`;
+`dialect` holds what they share); `trajectory_json` is the sampled trajectory file (SPEC §5);
+`rebuild` turns a parsed program back into motion.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
-
 from robomax_py.errors import ExportError
-from robomax_py.export import plan_program, srcl, trajectory_json
+from robomax_py.export import fanuc, krl, rapid, srcl, trajectory_json, urscript
+from robomax_py.export.dialect import Dialect
 from robomax_py.plan import PlanResult
 
-Exporter = Callable[[PlanResult], str]
+__all__ = ["DIALECTS", "Dialect", "dialect_for_file", "format_names", "render_trajectory"]
 
-
-@dataclass(frozen=True, slots=True)
-class Format:
-    """A program format: its file extension, its writer and (where it has one) its parser."""
-
-    name: str
-    extension: str
-    render: Exporter
-    parse: Callable[..., object]
-
-
-# Registry order is the order files are written in (the trajectory file first).
-FORMATS: dict[str, Format] = {
-    "json": Format("json", ".json", trajectory_json.render, trajectory_json.load_trajectory_file),
-    "srcl": Format("srcl", ".srcl", plan_program.render, srcl.parse_program),
+# Registry order is the order files are written in (after the trajectory file).
+DIALECTS: dict[str, Dialect] = {
+    "srcl": Dialect("srcl", (".srcl",), "", srcl.adapt, srcl.write, srcl.parse),
+    "krl": Dialect("krl", (".src", ".dat"), "kuka", krl.adapt, krl.write, krl.parse),
+    "rapid": Dialect("rapid", (".mod",), "abb", rapid.adapt, rapid.write, rapid.parse),
+    "fanuc": Dialect("fanuc", (".ls",), "fanuc", fanuc.adapt, fanuc.write, fanuc.parse),
+    "urscript": Dialect("urscript", (".script",), "ur", urscript.adapt, urscript.write, urscript.parse),
 }
+NATIVE = {"kuka": "krl", "abb": "rapid", "fanuc": "fanuc", "ur": "urscript"}
 
 
+def format_names(spec: str, brand: str) -> tuple[str, ...]:
+    """`--format` LIST (SPEC §6): names, `all` or `native` (the robot's brand), comma-separated,
+    in registry order without repeats; ExportError for an unknown name."""
+    wanted: set[str] = set()
+    for part in (p.strip().lower() for p in spec.split(",")):
+        if part == "all":
+            wanted.update(DIALECTS)
+        elif part == "native":
+            if brand not in NATIVE:
+                raise ExportError("--format native: the robot names no controller brand (controller.brand in robot.yaml)")
+            wanted.add(NATIVE[brand])
+        elif part in DIALECTS:
+            wanted.add(part)
+        else:
+            known = ", ".join([*DIALECTS, "native", "all"])
+            raise ExportError(f"unknown program format '{part}'; known: {known}")
+    if not wanted:
+        raise ExportError("--format names no program format")
+    return tuple(name for name in DIALECTS if name in wanted)
 
 
-def render(result: PlanResult, fmt: str) -> str:
-    """The program text of a planned result in the named format."""
-    if fmt not in FORMATS:
-        raise ExportError(f"unknown program format '{fmt}'; known: {', '.join(sorted(FORMATS))}")
+def dialect_for_file(suffix: str) -> Dialect | None:
+    """The dialect whose files end in `suffix` (".src" and ".dat" are both KRL)."""
+    return next((d for d in DIALECTS.values() if suffix.lower() in d.extensions), None)
+
+
+def render_trajectory(result: PlanResult) -> str:
+    """The trajectory file (SPEC §5) of a planned result."""
     if result.status != "planned" or result.trajectory is None:
         raise ExportError(f"cell {result.cell} is not planned: {result.message}")
-    return FORMATS[fmt].render(result)
-
-
-def render_programs(result: PlanResult) -> dict[str, str]:
-    """Every program file of a planned result, all rendered before anything is written.
-
-    Returns
-    -------
-    dict[str, str]
-        File name (``<cell><ext>``, one per format, in registry order) -> text.
-    """
-    return {f"{result.cell}{f.extension}": render(result, name) for name, f in FORMATS.items()}
+    return trajectory_json.render(result)

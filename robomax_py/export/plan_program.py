@@ -15,7 +15,10 @@ import re
 
 import numpy as np
 
+from robomax_py._version import __version__
+from robomax_py._typing import FloatArray
 from robomax_py.errors import ExportError
+from robomax_py.export.dialect import PlannedProgram
 from robomax_py.plan import PlanResult
 from robomax_py.plan.waiting import CLEAR_SUFFIX, WaitPlan
 from robomax_py.program import (
@@ -49,7 +52,16 @@ def identifier(name: str) -> str:
     return ident
 
 
-def program_from_plan(result: PlanResult) -> Program:
+def program_from_plan(result: PlanResult, cell_sha256: str = "", stamp: str = "") -> Program:
+    """The dialect-free program of a complete plan (`planned_program` without the joint values)."""
+    return planned_program(result, cell_sha256, stamp).program
+
+
+def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") -> PlannedProgram:
+    """The dialect-free program of a complete plan, and the planned joint values at each statement.
+
+    cell_sha256 : SHA-256 of the cell file, for the header; stamp : a date for the header, or "".
+    """
     traj = result.trajectory
     if traj is None or result.T_flange_tcp is None or result.T_world_base is None or result.home is None:
         raise ExportError(f"cell {result.cell} has no complete plan to export")
@@ -63,13 +75,19 @@ def program_from_plan(result: PlanResult) -> Program:
         FrameDef("robot_base", "base", base_xyz, base_zyx),
     )
     t0 = float(traj.t[0])
-    out: list[Instruction] = [
-        Comment(f"start at home; {len(result.spots)} spots, planned cycle {traj.duration:.3f} s"),
-        PtpMove(tuple(np.degrees(result.home)), opts.speed, 1.0, comment="home"),
-    ]
+    out: list[Instruction] = []
+    joints: list[FloatArray] = []
+
+    def emit(q: FloatArray, *items: Instruction) -> None:
+        out.extend(items)
+        joints.extend(np.asarray(q, dtype=float) for _ in items)
+
+    home = np.asarray(result.home, dtype=float)
+    emit(home, Comment(f"start at home; {len(result.spots)} spots, planned cycle {traj.duration:.3f} s"),
+         PtpMove(tuple(np.degrees(home)), opts.speed, 1.0, comment="home"))
     transitions = result.transitions
     if transitions and transitions[0].wait is not None:
-        out.extend(_wait(transitions[0].wait))
+        emit(home, *_wait(transitions[0].wait))
     lin_mm_s = opts.tcp_speed * opts.speed * 1000.0     # the override scales LIN speeds too
     for k, trans in enumerate(transitions):
         phases = traj.phases_of(trans.kind, trans.label)
@@ -82,26 +100,26 @@ def program_from_plan(result: PlanResult) -> Program:
             # Radii as planned: detour corners and the join into the approach (joint space, deg).
             radius = (trans.flyby_radius if approach_follows else 0.0) if last else trans.blend_radius
             speed = opts.speed * (opts.detour_speed if trans.kind == "detour" else 1.0)
-            out.append(PtpMove(tuple(np.degrees(q)), speed, 1.0, flyby=math.degrees(radius),
-                               comment=note.strip(", ")))
+            emit(q, PtpMove(tuple(np.degrees(q)), speed, 1.0, flyby=math.degrees(radius), comment=note.strip(", ")))
         if not approach_follows:
             break
         spot = result.spots[k]
         alpha, beta, gamma = (math.degrees(v) for v in spot.angles)
-        out.append(Comment(f"{spot.seam}/{spot.name}: arrive {spot.t_arrive - t0:.3f} s, leave "
-                           f"{spot.t_leave - t0:.3f} s, alpha {alpha:.1f} beta {beta:.1f} gamma {gamma:.1f} deg"))
+        q_before = joints[-1]
+        emit(q_before, Comment(f"{spot.seam}/{spot.name}: arrive {spot.t_arrive - t0:.3f} s, leave "
+                               f"{spot.t_leave - t0:.3f} s, alpha {alpha:.1f} beta {beta:.1f} gamma {gamma:.1f} deg"))
         xyz, zyx = pose_mm_zyx(to_frame(C, spot.T_spot))
-        out.append(LinMove(xyz, zyx, spot.config, lin_mm_s, comment="approach"))
-        out.append(Spot(identifier(spot.name), identifier(spot.seam), result.weld_time))
+        emit(spot.q_spot, LinMove(xyz, zyx, spot.config, lin_mm_s, comment="approach"),
+             Spot(identifier(spot.name), identifier(spot.seam), result.weld_time))
         xyz, zyx = pose_mm_zyx(to_frame(C, spot.T_app))
         if k + 1 < len(transitions) and transitions[k + 1].wait is not None:
-            out.extend(_wait(transitions[k + 1].wait))
+            emit(spot.q_spot, *_wait(transitions[k + 1].wait))
         retract_radius = transitions[k + 1].flyby_radius if k + 1 < len(transitions) else 0.0
-        out.append(LinMove(xyz, zyx, spot.config_app, lin_mm_s, flyby=math.degrees(retract_radius),
-                           comment="retract"))
+        emit(spot.q_app, LinMove(xyz, zyx, spot.config_app, lin_mm_s, flyby=math.degrees(retract_radius),
+                                 comment="retract"))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
-                    tuple(identifier(j) for j in result.joint_names))
-    return Program(identifier(result.cell), header, frames, tuple(out))
+                    tuple(identifier(j) for j in result.joint_names), f"robomax_py {__version__}", cell_sha256, stamp)
+    return PlannedProgram(Program(identifier(result.cell), header, frames, tuple(out)), tuple(joints))
 
 
 def _wait(w: WaitPlan) -> list[Instruction]:
@@ -112,7 +130,3 @@ def _wait(w: WaitPlan) -> list[Instruction]:
     return [note, Wait(w.seconds)]
 
 
-def render(result: PlanResult) -> str:
-    from robomax_py.export.srcl import write_program
-
-    return write_program(program_from_plan(result))

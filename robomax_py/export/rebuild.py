@@ -39,7 +39,8 @@ from robomax_py.program import (
 )
 from robomax_py.robot import RobotModel
 from robomax_py.robot.ik import same_config
-from robomax_py.robot.solve import config_text
+from robomax_py.robot.ik.config import brand_text
+from robomax_py.robot.solve import config_of, config_texts_near
 from robomax_py.spec import CellSpec
 from robomax_py.timing import (
     LinMoveError,
@@ -56,6 +57,8 @@ from robomax_py.tolerances import DEFAULT as TOL
 # Frame definitions must match the cell's tool and base within the program's decimals.
 FRAME_TOL_MM = TOL.frame_tol_mm
 FRAME_TOL_DEG = TOL.frame_tol_deg
+# A target's configuration data may name either side of a boundary the joint is this close to.
+CONFIG_TOL_RAD = math.radians(TOL.config_tol_deg)
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,6 +66,16 @@ class Problem:
     t: float | None
     kind: str
     detail: str
+    line: int | None = None          # the program line of the statement, where known
+
+
+@dataclass(frozen=True, slots=True)
+class Span:
+    """The time a statement's motion takes in the rebuilt trajectory (s, from program start)."""
+
+    t_start: float
+    t_end: float
+    line: int | None
 
 
 @dataclass(slots=True)
@@ -73,28 +86,57 @@ class Rebuilt:
     trajectory: Trajectory | None
     spots: list[dict[str, Any]] = field(default_factory=list)
     problems: list[Problem] = field(default_factory=list)
+    spans: list[Span] = field(default_factory=list)
+
+    def line_at(self, t: float | None) -> int | None:
+        """The program line whose statement commands the motion at time t (s)."""
+        if t is None:
+            return None
+        for span in self.spans:
+            if span.t_start - 1e-9 <= t <= span.t_end + 1e-9:
+                return span.line
+        return None
 
 
-def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | str) -> Rebuilt:
-    """Rebuild the motion; ProgramError when the program is not for this cell's robot."""
+def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | str,
+            lines: tuple[int, ...] | None = None, brand: str | None = None) -> Rebuilt:
+    """Rebuild the motion; ProgramError when the program is not for this cell's robot.
+
+    lines : the program line of each instruction (as the parser read them), for messages.
+    brand : whose configuration data the program's Cartesian targets carry (SPEC §6);
+        None: the robot's controller brand.
+    A program that does not name its robot (a header with robot "" and no joints, as
+    programs written by others) is taken to be for the cell's robot, joints in URDF order.
+    """
     header = program.header
-    if header.robot != robot.name:
+    if header.robot and header.robot != robot.name:
         raise ProgramError(file, "ROBOT", f"program is for robot {header.robot!r}, the cell uses {robot.name!r}")
-    if tuple(header.joints) != tuple(robot.joint_names):
+    if header.joints and tuple(header.joints) != tuple(robot.joint_names):
         raise ProgramError(file, "AXES", f"expected {list(robot.joint_names)}, got {list(header.joints)}")
-    builder = _Builder(cell, robot)
+    builder = _Builder(cell, robot, brand or robot.controller.brand)
     builder.problems.extend(_frame_problems(program.frames, cell, robot))
-    moves = [ins for ins in program.instructions if not isinstance(ins, Comment)]
-    if not moves or not isinstance(moves[0], PtpMove):
-        raise ProgramError(file, "BEGIN", "the first statement must be a MOVE PTP: where the robot starts")
-    builder.start(ptp_target(moves[0]))
-    for k, ins in enumerate(moves[1:], start=1):
-        if not builder.add(ins, moves[k + 1] if k + 1 < len(moves) else None, k):
-            return Rebuilt(None, builder.spots, builder.problems)
+    numbered = [(ins, None if lines is None else lines[i]) for i, ins in enumerate(program.instructions)]
+    moves = [(ins, line) for ins, line in numbered if not isinstance(ins, Comment)]
+    if not moves or not isinstance(moves[0][0], PtpMove):
+        raise ProgramError(file, "BEGIN", "the first statement must be a joint move (PTP): where the robot starts")
+    first = moves[0][0]
+    if len(first.target_deg) != robot.dof:
+        raise ProgramError(file, f"line {moves[0][1]}" if moves[0][1] else "BEGIN",
+                           f"the first move gives {len(first.target_deg)} axis values, the robot has {robot.dof} joints")
+    builder.start(ptp_target(first))
+    for k in range(1, len(moves)):
+        ins, builder.line = moves[k]
+        if isinstance(ins, PtpMove) and len(ins.target_deg) != robot.dof:
+            builder.problems.append(Problem(builder.t, "format", f"a joint move gives {len(ins.target_deg)} axis "
+                                            f"values, the robot has {robot.dof} joints", builder.line))
+            return Rebuilt(None, builder.spots, builder.problems, builder.spans)
+        if not builder.add(ins, moves[k + 1][0] if k + 1 < len(moves) else None, k):
+            return Rebuilt(None, builder.spots, builder.problems, builder.spans)
     if builder.pending:
-        builder.problems.append(Problem(builder.t, "flyby", "the program ends flying by: the last move has FLYBY"))
+        builder.problems.append(Problem(builder.t, "flyby", "the program ends flying by: the last move has FLYBY",
+                                        builder.line))
         if not builder.flush():
-            return Rebuilt(None, builder.spots, builder.problems)
+            return Rebuilt(None, builder.spots, builder.problems, builder.spans)
     traj = resample(concatenate(builder.segments))
     # Spot times from the trajectory's own weld phases (exactly on its samples), in program order.
     welds: dict[str, list[Any]] = {}
@@ -103,12 +145,12 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
     for spot in builder.spots:
         phase = welds[f"{spot['seam']}/{spot['name']}"].pop(0)
         spot["t_arrive"], spot["t_leave"] = float(phase.t_start), float(phase.t_end)
-    return Rebuilt(traj, builder.spots, builder.problems)
+    return Rebuilt(traj, builder.spots, builder.problems, builder.spans)
 
 
 class _Builder:
-    def __init__(self, cell: CellSpec, robot: RobotModel) -> None:
-        self.cell, self.robot = cell, robot
+    def __init__(self, cell: CellSpec, robot: RobotModel, brand: str) -> None:
+        self.cell, self.robot, self.brand = cell, robot, brand
         self.segments: list[Segment] = []
         self.spots: list[dict[str, Any]] = []
         self.problems: list[Problem] = []
@@ -117,6 +159,9 @@ class _Builder:
         self.q = np.zeros(robot.dof)
         self.t = 0.0
         self.last_config = ""
+        self.line: int | None = None                      # of the statement being added
+        self.step_lines: list[int | None] = []            # of the pending steps
+        self.spans: list[Span] = []
 
     def start(self, q: FloatArray) -> None:
         self.q = np.asarray(q, dtype=float)
@@ -125,20 +170,24 @@ class _Builder:
     def add(self, ins: Any, following: Any, index: int) -> bool:
         if isinstance(ins, (PtpMove, LinMove)):
             self.pending.append(self._step(ins, following, index))
+            self.step_lines.append(self.line)
             if isinstance(ins, LinMove):
                 self.configs.append((len(self.pending) - 1, ins.config))
-            return self.flush() if ins.flyby <= 0 else True
+            return True if ins.flies else self.flush()
         if self.pending:
-            what = "SPOT" if isinstance(ins, Spot) else "WAIT"
-            self.problems.append(Problem(self.t, "flyby", f"{what} after a FLYBY move: the robot is not at rest"))
+            what = "weld" if isinstance(ins, Spot) else "wait"
+            self.problems.append(Problem(self.t, "flyby", f"a {what} after a move that flies by (blended): the robot "
+                                                          "is not at rest", self.line))
             if not self.flush():
                 return False
         if isinstance(ins, Spot):
             label = f"{ins.seam}/{ins.name}"
             self.segments.append(dwell(self.q, ins.time_s, kind="weld", label=label))
-            config = self.last_config or config_text(self.robot, self.q)
+            config = self.last_config or self.config_text(self.q)
             self.spots.append({"seam": ins.seam, "name": ins.name, "t_arrive": self.t,
-                               "t_leave": self.t + ins.time_s, "config": config})
+                               "t_leave": self.t + ins.time_s, "config": config, "line": self.line,
+                               "brand": self.brand})
+            self.spans.append(Span(self.t, self.t + ins.time_s, self.line))
             self.t += ins.time_s
         elif isinstance(ins, Wait):
             self._hold(ins.seconds, "WAIT")
@@ -150,43 +199,53 @@ class _Builder:
         label = ins.comment or f"statement {index + 1}"
         if isinstance(ins, PtpMove):
             return PtpStep(ptp_target(ins), speed=ins.speed, accel=ins.accel,
-                           flyby=math.radians(ins.flyby), kind="move", label=label)
+                           flyby=math.radians(ins.flyby), kind="move", label=label, flyby_tcp=ins.flyby_mm / 1000.0)
         T = from_frame(self.robot.controller.T_root_base, lin_pose(ins))   # stated in the controller's base
         kind = "approach" if isinstance(following, Spot) else "retract"
-        return LinStep(T, ins.speed_mm_s / 1000.0, None, flyby=math.radians(ins.flyby), kind=kind, label=label)
+        return LinStep(T, ins.speed_mm_s / 1000.0, None, flyby=math.radians(ins.flyby), kind=kind, label=label,
+                       flyby_tcp=ins.flyby_mm / 1000.0)
 
     def flush(self) -> bool:
         """Build and time the pending chain; False when it cannot be built (reported)."""
-        steps, configs = self.pending, self.configs
-        self.pending, self.configs = [], []
+        steps, configs, lines = self.pending, self.configs, self.step_lines
+        self.pending, self.configs, self.step_lines = [], [], []
         try:
             path = chain_path(self.robot, self.q, steps)
             segments = time_chain(path, steps, self.robot.limits)
         except LinMoveError as exc:
-            self.problems.append(Problem(self.t, "lin", f"a LIN move cannot be followed: {exc}"))
+            self.problems.append(Problem(self.t, "lin", f"a LIN move cannot be followed: {exc}", lines[-1]))
             return False
         except TimingError as exc:
             if "does not move" in str(exc):
                 return True
-            self.problems.append(Problem(self.t, "timing", f"the motion cannot be timed: {exc}"))
+            self.problems.append(Problem(self.t, "timing", f"the motion cannot be timed: {exc}", lines[-1]))
             return False
         t_end = self.t
         for k, seg in enumerate(segments):
+            self.spans.append(Span(t_end, t_end + seg.duration, lines[k] if k < len(lines) else None))
             t_end += seg.duration
             for idx, written in configs:
                 if idx == k:
-                    actual = config_text(self.robot, path.targets[k])
+                    actual = self.config_text(path.targets[k])
                     self.last_config = actual
-                    if written and not same_config(written, actual):
-                        self.problems.append(Problem(t_end, "config", f"LIN ends in {actual}, the program says {written}"))
+                    nearby = config_texts_near(self.robot, path.targets[k], self.brand, CONFIG_TOL_RAD)
+                    if written and not any(same_config(written, text) for text in nearby):
+                        self.problems.append(Problem(t_end, "config", f"LIN ends in {actual}, the program says {written}",
+                                                     lines[k]))
         self.segments.extend(segments)
         self.t = t_end
         self.q = np.asarray(segments[-1].q[-1], dtype=float)
         return True
 
+    def config_text(self, q: FloatArray) -> str:
+        """The configuration data, in the program's brand, of joint values q."""
+        ind = config_of(self.robot, q)
+        return brand_text(self.brand, ind.status, ind.turn, np.asarray(q, dtype=float))
+
     def _hold(self, seconds: float, label: str) -> None:
         if seconds > 0:
             self.segments.append(dwell(self.q, seconds, kind="wait", label=label))
+            self.spans.append(Span(self.t, self.t + seconds, self.line))
             self.t += seconds
 
     def _wait_for(self, signal: str) -> None:
@@ -195,7 +254,8 @@ class _Builder:
         obstacle = next((d for d in self.cell.dynamic if identifier(d.name) + CLEAR_SUFFIX == signal), None)
         if obstacle is None:
             known = ", ".join(identifier(d.name) + CLEAR_SUFFIX for d in self.cell.dynamic) or "none in this cell"
-            self.problems.append(Problem(self.t, "signal", f"WAIT FOR {signal}: unknown signal (known: {known})"))
+            self.problems.append(Problem(self.t, "signal", f"WAIT FOR {signal}: unknown signal (known: {known})",
+                                         self.line))
             return
         self._hold(clear_wait(self.t, obstacle.present or ()), f"WAIT FOR {signal}")
 

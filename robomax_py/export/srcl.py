@@ -12,6 +12,7 @@ that again gives the same bytes. Parse errors are a `ProgramError` whose key is 
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from collections.abc import Iterable
 from functools import lru_cache
@@ -27,6 +28,7 @@ from lark.exceptions import (
 from lark.lexer import PatternStr
 
 from robomax_py.errors import ExportError, ProgramError
+from robomax_py.export.dialect import Parsed, PlannedProgram
 from robomax_py.program import (
     ANGLE_DECIMALS,
     JOINT_DECIMALS,
@@ -45,8 +47,10 @@ from robomax_py.program import (
     WaitFor,
     find_problem,
 )
+from robomax_py.robot import RobotModel
 
-__all__ = ["DIALECT", "GRAMMAR", "RESERVED", "parse_program", "write_program"]
+__all__ = ["DIALECT", "GRAMMAR", "RESERVED", "adapt", "parse", "parse_program", "parse_with_lines", "write",
+           "write_program"]
 
 DIALECT = "robomax SRCL/1"
 
@@ -84,6 +88,7 @@ def write_program(program: Program) -> str:
     lines = [
         f"PROGRAM {program.name};",
         f"{{ {DIALECT}; lengths mm, angles deg, times s, PTP speed and accel as fractions }}",
+        *(f"{{ {text} }}" for text in _provenance(h)),
         f"CELL {h.cell};",
         f"ROBOT {h.robot} AXES({', '.join(h.joints)});",
         f"TOOL {h.tool};",
@@ -96,6 +101,20 @@ def write_program(program: Program) -> str:
     lines.extend(_INDENT + _statement(ins) for ins in program.instructions)
     lines.append("ENDPROGRAM;")
     return "\n".join(lines) + "\n"
+
+
+def _provenance(h: Header) -> list[str]:
+    """Generator, cell file hash and stamp as comment texts (the rest of the header is statements)."""
+    out = []
+    if h.generator or h.cell_sha256:
+        out.append(f"{h.generator or 'robomax_py ?'} | cell file sha256 {h.cell_sha256 or 'unknown'}")
+    if h.stamp:
+        out.append(f"written {h.stamp}")
+    return out
+
+
+_PROVENANCE = re.compile(r"^(?P<gen>\S+ \S+) \| cell file sha256 (?P<sha>[0-9a-f]+|unknown)$")
+_STAMP = re.compile(r"^written (?P<stamp>\S.*)$")
 
 
 def _num(value: float, decimals: int) -> str:
@@ -201,6 +220,8 @@ def _check_program(program: Program) -> None:
             _check_text(where, ins.text, "{}")
         elif not isinstance(ins, (PtpMove, Wait)):
             raise ExportError(f"{where}: SRCL cannot write {type(ins).__name__}")
+        if isinstance(ins, (PtpMove, LinMove)) and ins.flyby_mm > 0:
+            raise ExportError(f"{where}: SRCL states fly-by radii in joint space (FLYBY deg), not as a TCP distance")
         problem = find_problem(ins, len(h.joints))
         if problem:
             raise ExportError(f"{where}: {problem}")
@@ -286,6 +307,19 @@ def parse_program(text: str, file: str | Path | None = None) -> Program:
         line, column, problem = _describe(parser, text, exc)
         raise ProgramError(file, f"line {line}, column {column}", problem) from None
     return _Builder(file).program(tree)
+
+
+def parse_with_lines(text: str, file: str | Path | None = None) -> tuple[Program, tuple[int, ...]]:
+    """`parse_program`, and the line of each instruction."""
+    parser = _parser()
+    try:
+        tree = parser.parse(text)
+    except UnexpectedInput as exc:
+        line, column, problem = _describe(parser, text, exc)
+        raise ProgramError(file, f"line {line}, column {column}", problem) from None
+    builder = _Builder(file)
+    program = builder.program(tree)
+    return program, tuple(builder.lines)
 
 
 # --------------------------------------------------------------------------------------------------
@@ -384,6 +418,7 @@ def _describe(parser: Lark, text: str, exc: UnexpectedInput) -> tuple[int, int, 
 class _Builder:
     def __init__(self, file: str | Path | None) -> None:
         self.file = file
+        self.lines: list[int] = []
 
     def error(self, line: int | None, column: int | None, problem: str) -> ProgramError:
         return ProgramError(self.file, f"line {line}, column {column}", problem)
@@ -413,6 +448,15 @@ class _Builder:
     def program(self, tree: Tree[Token]) -> Program:
         name = self.tokens(tree, "IDENT")[0]
         header = self.header(self.subtree(tree, "header"))
+        for comment in self.tokens(tree, "COMMENT"):
+            text = str(comment)[1:-1].strip()
+            match = _PROVENANCE.match(text)
+            if match:
+                sha = "" if match["sha"] == "unknown" else match["sha"]
+                header = dataclasses.replace(header, generator=match["gen"], cell_sha256=sha)
+            match = _STAMP.match(text)
+            if match:
+                header = dataclasses.replace(header, stamp=match["stamp"])
         n_joints = len(header.joints)
         frames = self.frames(self.subtree(tree, "frames"), n_joints)
         instructions: list[Instruction] = []
@@ -421,6 +465,7 @@ class _Builder:
                 ins = self.statement(child)
                 self.check(child, ins, n_joints)
                 instructions.append(ins)
+                self.lines.append(child.meta.line)
         return Program(str(name), header, tuple(frames), tuple(instructions))
 
     def header(self, tree: Tree[Token]) -> Header:
@@ -480,3 +525,20 @@ class _Builder:
             (signal,) = self.tokens(tree, "IDENT")
             return WaitFor(str(signal))
         return Comment(self.note(tree))
+
+
+# ================================================================================== as a dialect
+
+
+def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
+    """SRCL states the planned program as it is."""
+    return planned.program
+
+
+def write(program: Program, robot: RobotModel) -> dict[str, str]:
+    return {".srcl": write_program(program)}
+
+
+def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
+    program, lines = parse_with_lines(texts[".srcl"], file)
+    return Parsed(program, lines, robot.controller.brand)

@@ -6,6 +6,7 @@ file, the key path (e.g. `seams[0].spots[3].normal`) and the problem; nothing he
 
 from __future__ import annotations
 
+import hashlib
 import math
 from pathlib import Path
 from typing import Annotated, Any
@@ -30,7 +31,7 @@ from robomax_py.io.robot import (
 )
 from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
 from robomax_py.robot.geometry import load_mesh
-from robomax_py.safe_files import LIMITS, checked_file, named_by
+from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
 from robomax_py.spec import (
     Box,
     Capsule,
@@ -221,6 +222,8 @@ def load_cell(path: str | Path) -> CellSpec:
     """
     path = Path(path)
     data = read_yaml_mapping(path, CellFileError, "cell file", LIMITS.cell)
+    # Programs name the exact cell file they were planned from (their header).
+    digest = hashlib.sha256(read_text(path, LIMITS.cell, CellFileError, "cell file").encode("utf-8")).hexdigest()
     version = data.get("robomax")
     if "robomax" in data and version not in SUPPORTED_VERSIONS:
         supported = ", ".join(str(v) for v in SUPPORTED_VERSIONS)
@@ -257,6 +260,7 @@ def load_cell(path: str | Path) -> CellSpec:
         planner=PlannerSpec(seed=parsed.planner.seed, speed=parsed.planner.speed, tcp_speed=parsed.planner.tcp_speed,
                             detour_speed=parsed.planner.detour_speed),
         dynamic=tuple(_object(o, path, f"dynamic[{i}]") for i, o in enumerate(parsed.dynamic)),
+        digest=digest,
     )
 
 

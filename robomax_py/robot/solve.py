@@ -175,3 +175,29 @@ def config_text(robot: RobotModel, q: FloatArray) -> str:
     """The configuration data the robot's controller brand writes for q (n,), rad (`config.brand_text`)."""
     ind = config_of(robot, q)
     return brand_text(robot.controller.brand, ind.status, ind.turn, np.asarray(q, dtype=float))
+
+
+def brand_text_of(robot: RobotModel, q: FloatArray, brand: str) -> str:
+    """The configuration data `brand`'s controller writes for q (n,), rad."""
+    ind = config_of(robot, q)
+    return brand_text(brand, ind.status, ind.turn, np.asarray(q, dtype=float))
+
+
+def config_texts_near(robot: RobotModel, q: FloatArray, brand: str, tol_rad: float) -> set[str]:
+    """The configuration data of `brand` for q and for q with each joint that lies within tol_rad
+    of a boundary the data changes at (0 and multiples of 90 deg: turn signs, ABB quadrants,
+    FANUC turns at 180 deg) moved to either side: a target written with one of them names the
+    branch q is in, as far as the program's decimals can tell (SPEC §6: within 0.01 deg)."""
+    q = np.asarray(q, dtype=float)
+    quarter = np.pi / 2.0
+    near = [j for j in range(len(q)) if abs(q[j] - quarter * round(q[j] / quarter)) <= tol_rad]
+    texts = set()
+    for mask in range(1 << len(near)):
+        for sign in (1.0, -1.0):
+            p = q.copy()
+            for bit, j in enumerate(near):
+                if mask >> bit & 1:
+                    p[j] = quarter * round(q[j] / quarter) + sign * 2.0 * tol_rad
+            ind = config_of(robot, p)
+            texts.add(brand_text(brand, ind.status, ind.turn, p))
+    return texts

@@ -39,6 +39,8 @@ from robomax_py.timing.trajectory import Segment
 # difference speed times this safety factor (the joins are short quintics, smooth on this scale).
 JOIN_TCP_SAMPLES = 41
 JOIN_TCP_SAFETY = 1.05
+# A TCP-distance fly-by needs a move that displaces the TCP at least this much (m).
+MIN_TCP_CHORD_M = 1e-3
 # Stands for "no limit" in the path speed limit toppra receives (it needs finite values).
 UNLIMITED_PATH_SPEED = 1e9
 
@@ -53,6 +55,7 @@ class PtpStep:
     flyby: float = 0.0               # rad; 0: stop exactly at q
     kind: str = "move"
     label: str = ""
+    flyby_tcp: float = 0.0           # m: the fly-by as a TCP distance (`tcp_flyby_radius`)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -69,6 +72,7 @@ class LinStep:
     flyby: float = 0.0
     kind: str = "approach"
     label: str = ""
+    flyby_tcp: float = 0.0
 
 
 Step = PtpStep | LinStep
@@ -115,7 +119,9 @@ def chain_path(
     pieces: list[GeometricPath | None] = []
     tcp_rate: list[float | None] = []             # per step: largest ds/dt from its TCP speed
     targets = []
+    radii_by_step: list[float] = []
     for step in steps:
+        q_before = q
         if isinstance(step, PtpStep):
             target = np.asarray(step.q, dtype=float).reshape(-1)
             moved = float(np.linalg.norm(target - q)) > ZERO_MOVE
@@ -141,10 +147,11 @@ def chain_path(
                 tcp_rate.append(step.tcp_speed * per_m)
             q = np.asarray(lp.q[-1], dtype=float)
         targets.append(q.copy())
+        radii_by_step.append(step.flyby if step.flyby_tcp <= 0 else tcp_flyby_radius(robot, q_before, q, step.flyby_tcp))
     moving = [k for k, p in enumerate(pieces) if p is not None]
     if not moving:
         raise TimingError("the chain does not move")
-    radii_in = [steps[k].flyby for k in moving[:-1]]
+    radii_in = [radii_by_step[k] for k in moving[:-1]]
     blended = blend_chain([pieces[k] for k in moving], radii_in)
     m = len(steps)
     ranges = np.zeros((m, 2))
@@ -178,6 +185,34 @@ def chain_path(
                 limits.append((lo, hi, _tcp_rate_bound(robot, blended.path, lo, hi, steps[k])))
     return ChainPath(blended.path, frozen_array(ranges), frozen_array(radii), frozen_array(np.array(targets)),
                      frozen_array(cuts), tuple(limits))
+
+
+def tcp_flyby_radius(robot: RobotModel, q_from: FloatArray, q_to: FloatArray, distance_m: float) -> float:
+    """The joint-space fly-by radius (rad) of a move q_from -> q_to whose fly-by is stated as a TCP
+    distance (KRL `C_DIS`, RAPID zones, URScript `r`): the distance times the move's ratio of
+    joint-space chord to TCP chord. Writers state distance = radius / ratio with the same ratio,
+    so the radius comes back as planned. A move that does not displace the TCP has no such
+    ratio; its fly-by cannot be stated this way (radius 0: it stops).
+    """
+    q_from = np.asarray(q_from, dtype=float)
+    q_to = np.asarray(q_to, dtype=float)
+    tcp = float(np.linalg.norm(fk_tcp(robot, q_to)[:3, 3] - fk_tcp(robot, q_from)[:3, 3]))
+    if tcp < MIN_TCP_CHORD_M:
+        return 0.0
+    return distance_m * float(np.linalg.norm(q_to - q_from)) / tcp
+
+
+def flyby_tcp_distance(robot: RobotModel, q_from: FloatArray, q_to: FloatArray, radius_rad: float) -> float:
+    """Inverse of `tcp_flyby_radius`: the TCP distance (m) that states a joint-space radius;
+    raises TimingError for a move that does not displace the TCP."""
+    q_from = np.asarray(q_from, dtype=float)
+    q_to = np.asarray(q_to, dtype=float)
+    tcp = float(np.linalg.norm(fk_tcp(robot, q_to)[:3, 3] - fk_tcp(robot, q_from)[:3, 3]))
+    joint = float(np.linalg.norm(q_to - q_from))
+    if tcp < MIN_TCP_CHORD_M or joint <= 0.0:
+        raise TimingError(f"the move displaces the TCP by {tcp * 1000:.3f} mm only: its fly-by cannot be "
+                          "stated as a TCP distance")
+    return radius_rad * tcp / joint
 
 
 def _tcp_rate_bound(robot: RobotModel, path: GeometricPath, s0: float, s1: float, step: Step) -> float:

@@ -27,6 +27,8 @@ class Violation:
     kind: str                # collision | joint_limit | velocity | acceleration | spot | dwell | order | home | format
     #                          (.srcl also: lin | config | flyby | frame | signal | timing)
     detail: str
+    line: int | None = None  # the program line whose statement commands the motion then
+    t_end: float | None = None  # the end of the interval it lasts (s); None: an instant
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,0 +1,197 @@
+"""What the controller dialects share (SPEC §6): the program a plan becomes before a dialect
+states it, the header every program carries, and the conversions of blends and configuration
+data into the terms of a controller brand.
+
+A dialect module owns both directions for its files: `adapt` (the dialect-free `Program` as
+this dialect can state it: its decimals, its kind of blend, its brand's configuration data),
+`write` (that program -> file texts) and `parse` (file texts -> `Parsed`: the program and the line
+of each statement). `export.checked` proves, before anything is written, that parsing the written
+text gives back the adapted program and that its rebuilt motion is the planned one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.errors import ExportError, ProgramError
+from robomax_py.program import (
+    Comment,
+    Header,
+    Instruction,
+    LinMove,
+    Program,
+    PtpMove,
+    Spot,
+)
+from robomax_py.robot import RobotModel
+from robomax_py.robot.ik.config import brand_text
+from robomax_py.robot.solve import config_of
+from robomax_py.timing import TimingError
+from robomax_py.timing.chain import flyby_tcp_distance
+
+__all__ = [
+    "Dialect",
+    "Parsed",
+    "PlannedProgram",
+    "header_lines",
+    "is_header_comment",
+    "read_header",
+    "spot_label",
+    "with_brand_configs",
+    "with_tcp_blends",
+    "without_comments",
+]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PlannedProgram:
+    """A plan as a dialect-free program, with the planned joint values at each instruction.
+
+    joints[i] is the configuration (rad) the robot is in at the end of instruction i: the
+    target of a move, the rest point of a weld or wait; it lets a dialect state a blend as a TCP
+    distance and a target's configuration data in another brand's terms.
+    """
+
+    program: Program
+    joints: tuple[FloatArray, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Parsed:
+    """A program read from a dialect's files.
+
+    lines[i] is the line (1-based, in the main file) of instruction i; `ignored` are the statements
+    (line, text) read but not simulated: the motion is rebuilt without them and verify reports them.
+    brand is whose configuration data the program's Cartesian targets carry.
+    """
+
+    program: Program
+    lines: tuple[int, ...]
+    brand: str
+    ignored: tuple[tuple[int, str], ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class Dialect:
+    """A controller dialect: its files (the first is the main one), its brand, both directions."""
+
+    name: str
+    extensions: tuple[str, ...]
+    brand: str
+    adapt: Callable[[PlannedProgram, RobotModel], Program]
+    write: Callable[[Program, RobotModel], dict[str, str]]
+    parse: Callable[[dict[str, str], str, RobotModel], Parsed]
+
+
+# ------------------------------------------------------------------ the header
+
+
+_GEN = re.compile(r"^(?P<gen>\S+ \S+) \| cell (?P<cell>\S+) \| cell file sha256 (?P<sha>[0-9a-f]+|unknown) "
+                  r"\| planned cycle (?P<cycle>[0-9]+\.[0-9]+) s$")
+_ROBOT = re.compile(r"^robot (?P<robot>\S+) \| tool (?P<tool>\S+) \| axes (?P<axes>\S+(?: \S+)*)$")
+_STAMP = re.compile(r"^written (?P<stamp>\S.*)$")
+
+
+def header_lines(h: Header) -> list[str]:
+    """The header as comment texts (without the dialect's comment marks), in every dialect alike."""
+    lines = [
+        f"{h.generator or 'robomax_py ?'} | cell {h.cell} | cell file sha256 {h.cell_sha256 or 'unknown'} "
+        f"| planned cycle {h.cycle_time_s:.3f} s",
+        f"robot {h.robot} | tool {h.tool} | axes {' '.join(h.joints)}",
+    ]
+    if h.stamp:
+        lines.append(f"written {h.stamp}")
+    return lines
+
+
+def is_header_comment(text: str) -> bool:
+    """Whether a comment text is one of the header's lines."""
+    return any(p.match(text.strip()) for p in (_GEN, _ROBOT, _STAMP))
+
+
+def read_header(comments: Sequence[str]) -> Header:
+    """The header from a program's comment texts; a program without one (written by others) gets
+    an empty header: it is then taken to be for the cell's robot (`rebuild`)."""
+    found: dict[str, str] = {}
+    for text in comments:
+        for pattern in (_GEN, _ROBOT, _STAMP):
+            match = pattern.match(text.strip())
+            if match:
+                found.update(match.groupdict())
+    if "robot" not in found:
+        return Header("", "", "", 0.0, ())
+    sha = found.get("sha", "")
+    return Header(found.get("cell", ""), found["robot"], found["tool"], float(found.get("cycle", 0.0)),
+                  tuple(found["axes"].split()), found.get("gen", ""), "" if sha == "unknown" else sha,
+                  found.get("stamp", ""))
+
+
+# ------------------------------------------------------------------ conversions
+
+
+def spot_label(spot: Spot) -> str:
+    """`seam/name`, the comment a weld call carries (SPEC §6)."""
+    return f"{spot.seam}/{spot.name}"
+
+
+def read_spot_label(text: str, n: int, time_s: float, file: str, line: int) -> Spot:
+    """A weld call's comment `seam/name` -> Spot; a call without one is weld n of an unknown seam."""
+    text = text.strip()
+    if not text:
+        return Spot(f"spot{n}", "unnamed", time_s)
+    seam, sep, name = text.partition("/")
+    if not sep or not seam or not name or " " in text:
+        raise ProgramError(file, f"line {line}", f"the weld call's comment must be 'seam/name', got {text!r}")
+    return Spot(name, seam, time_s)
+
+
+def with_tcp_blends(planned: PlannedProgram, robot: RobotModel) -> Program:
+    """The program with every joint-space fly-by radius stated as a TCP distance (mm), as KRL
+    `C_DIS`, RAPID zones and URScript `r` state blends (`timing.chain.tcp_flyby_radius`)."""
+    program = planned.program
+    out: list[Instruction] = []
+    q_prev = planned.joints[0]
+    for i, ins in enumerate(program.instructions):
+        q = planned.joints[i]
+        if isinstance(ins, (PtpMove, LinMove)) and ins.flyby > 0:
+            try:
+                mm = 1000.0 * flyby_tcp_distance(robot, q_prev, q, math.radians(ins.flyby))
+            except TimingError as exc:
+                raise ExportError(f"instruction {i + 1} ({ins.comment or 'move'}): {exc}") from None
+            ins = dataclasses.replace(ins, flyby=0.0, flyby_mm=mm)
+        out.append(ins)
+        q_prev = q
+    return dataclasses.replace(program, instructions=tuple(out))
+
+
+def with_brand_configs(program: Program, joints: Sequence[FloatArray], robot: RobotModel, brand: str) -> Program:
+    """Every Cartesian target's configuration data in `brand`'s terms (SPEC §6); the robot's own
+    brand keeps the data the planner wrote (taken from the unrounded joints)."""
+    if brand == robot.controller.brand:
+        return program
+    out: list[Instruction] = []
+    for ins, q in zip(program.instructions, joints):
+        if isinstance(ins, LinMove):
+            ind = config_of(robot, q)
+            ins = dataclasses.replace(ins, config=brand_text(brand, ind.status, ind.turn, np.asarray(q, dtype=float)))
+        out.append(ins)
+    return dataclasses.replace(program, instructions=tuple(out))
+
+
+def without_comments(program: Program) -> Program:
+    """The program without its comment lines and move notes (for dialects that cannot carry them)."""
+    kept = tuple(dataclasses.replace(i, comment="") if isinstance(i, (PtpMove, LinMove)) else i
+                 for i in program.instructions if not isinstance(i, Comment))
+    return dataclasses.replace(program, instructions=kept)
+
+
+def require_six_axes(robot: RobotModel, dialect: str) -> None:
+    if robot.dof != 6:
+        raise ExportError(f"{dialect} programs are for 6-axis arms; {robot.name} has {robot.dof} joints")

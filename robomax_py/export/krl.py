@@ -1,0 +1,396 @@
+"""KUKA KRL (KSS 8.x), both directions: `<name>.src` (the motion) and `<name>.dat` (its points).
+
+What a program states, in KRL's own terms:
+- joint targets as E6AXIS (deg), Cartesian targets as E6POS: X, Y, Z mm; A, B, C deg with
+  R = Rz(A)·Ry(B)·Rx(C); S and T the KUKA Status and Turn of the planned configuration (SPEC §6);
+- `$TOOL` (TCP in the flange frame) and `$BASE` (the robot base in the cell's world, so that
+  targets are relative to the robot base when `$ROBROOT` is placed as the cell places the robot)
+  before the first motion;
+- `$VEL_AXIS[i]` / `$ACC_AXIS[i]` in whole percent for PTP, `$VEL.CP` in m/s for LIN;
+- blends as `C_DIS` with `$APO.CDIS` in mm, for PTP moves too, as KSS 8.2 and later write them
+  from inline forms (`$APO.CPTP` is a whole percentage of half the move, too coarse to state the
+  planned radius; `$APO.CDIS` is a REAL distance: KUKA.PLC mxAutomation manual, "APO" structure);
+- a weld as an exact LIN to the spot followed by `spot_weld(n, weld_time) ; seam/name`, and
+  `spot_weld` defined after the main program (rest for `weld_time`; the integrator replaces it);
+- `WAIT SEC t`, and `WAIT FOR <signal>` with `SIGNAL <signal> $IN[k]` declared (k in order of use).
+
+The reader takes the motion subset of any KRL program: PTP and LIN to points declared in the
+.dat or the .src, or written in place (E6AXIS/AXIS, E6POS/POS/FRAME aggregates, missing
+components keeping their last value), `$VEL`, `$ACC`, `$APO` assignments, `C_DIS`/`C_PTP`,
+`WAIT SEC`, `WAIT FOR` and calls of `spot_weld`; other motions (CIRC, SPTP, *_REL ...) are
+reported as not simulated, everything else as ignored.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from functools import lru_cache
+
+from lark import Lark, Token, Tree
+from lark.exceptions import UnexpectedInput
+
+from robomax_py.errors import ExportError, ProgramError
+from robomax_py.export.dialect import (
+    Parsed,
+    PlannedProgram,
+    header_lines,
+    is_header_comment,
+    read_header,
+    read_spot_label,
+    require_six_axes,
+    spot_label,
+    with_brand_configs,
+    with_tcp_blends,
+)
+from robomax_py.program import (
+    Comment,
+    FrameDef,
+    Instruction,
+    LinMove,
+    Program,
+    PtpMove,
+    Spot,
+    Wait,
+    WaitFor,
+)
+from robomax_py.robot import RobotModel
+from robomax_py.robot.ik.config import ConfigIndicator
+
+__all__ = ["adapt", "parse", "write"]
+
+_NOTE = "KRL of KSS 8.x"
+_AXES = ("A1", "A2", "A3", "A4", "A5", "A6")
+_EXTERNAL = ", ".join(f"E{i} 0.0" for i in range(1, 7))
+
+
+def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
+    """The program as KRL states it: KUKA configuration data, TCP-distance blends, whole-percent
+    PTP speeds and accelerations."""
+    require_six_axes(robot, "KRL")
+    program = with_brand_configs(planned.program, planned.joints, robot, "kuka")
+    program = with_tcp_blends(dataclasses.replace(planned, program=program), robot)
+    out: list[Instruction] = []
+    for ins in program.instructions:
+        if isinstance(ins, PtpMove):
+            ins = dataclasses.replace(ins, speed=_percent(ins.speed) / 100, accel=_percent(ins.accel) / 100)
+        out.append(ins)
+    return dataclasses.replace(program, instructions=tuple(out))
+
+
+def _percent(fraction: float) -> int:
+    return max(1, min(100, int(round(fraction * 100))))
+
+
+# ================================================================================== writing
+
+
+def write(program: Program, robot: RobotModel) -> dict[str, str]:
+    """`.src` and `.dat` texts of an adapted program."""
+    name = program.name
+    src: list[str] = ["&ACCESS RVP", "&REL 1", f"DEF {name}( )"]
+    src += [f"; {text}" for text in header_lines(program.header)]
+    src.append(f"; {_NOTE}: mm, deg, $VEL.CP m/s, $VEL_AXIS and $ACC_AXIS %, blends C_DIS with $APO.CDIS mm")
+    signals = _signals(program)
+    src += [f"SIGNAL {sig} $IN[{k}]" for sig, k in signals.items()]
+    dat: list[str] = [f"DEFDAT {name}", f"; points of {name}.src"]
+    for f in program.frames:
+        var = "$TOOL" if f.kind == "tool" else "$BASE"
+        src.append(f"{var} = {_frame(f.xyz_mm, f.zyx_deg)} ; {f.kind} frame {f.name}")
+    speed = accel = None
+    cp_speed = None
+    apo = None
+    n_point = n_weld = 0
+    for ins in program.instructions:
+        if isinstance(ins, Comment):
+            src.append(f"; {ins.text}" if ins.text else ";")
+            continue
+        if isinstance(ins, (PtpMove, LinMove)):
+            n_point += 1
+            point = f"XP{n_point}"
+            if isinstance(ins, PtpMove):
+                if ins.speed != speed:
+                    speed = ins.speed
+                    src += [f"$VEL_AXIS[{i}] = {_percent(speed)}" for i in range(1, 7)]
+                if ins.accel != accel:
+                    accel = ins.accel
+                    src += [f"$ACC_AXIS[{i}] = {_percent(accel)}" for i in range(1, 7)]
+                values = ", ".join(f"{a} {v:.4f}" for a, v in zip(_AXES, ins.target_deg))
+                dat.append(f"DECL E6AXIS {point}={{{values}, {_EXTERNAL}}}")
+            else:
+                if ins.speed_mm_s != cp_speed:
+                    cp_speed = ins.speed_mm_s
+                    src.append(f"$VEL.CP = {cp_speed / 1000:.6f}")
+                dat.append(f"DECL E6POS {point}={_pose(ins)}")
+            if ins.flyby_mm > 0 and ins.flyby_mm != apo:
+                apo = ins.flyby_mm
+                src.append(f"$APO.CDIS = {apo:.3f}")
+            motion = "PTP" if isinstance(ins, PtpMove) else "LIN"
+            line = f"{motion} {point}" + (" C_DIS" if ins.flyby_mm > 0 else "")
+            src.append(line + (f" ; {ins.comment}" if ins.comment else ""))
+        elif isinstance(ins, Spot):
+            n_weld += 1
+            src.append(f"spot_weld({n_weld}, {ins.time_s:.3f}) ; {spot_label(ins)}")
+        elif isinstance(ins, Wait):
+            src.append(f"WAIT SEC {ins.seconds:.3f}")
+        elif isinstance(ins, WaitFor):
+            src.append(f"WAIT FOR {ins.signal}")
+        else:
+            raise ExportError(f"KRL cannot write {type(ins).__name__}")
+    src += ["END", "", "DEF spot_weld(n:IN, weld_time:IN)", "  INT n", "  REAL weld_time",
+            "  ; default weld: rest for weld_time s; replace with the gun's technology package",
+            "  WAIT SEC weld_time", "END"]
+    dat.append("ENDDAT")
+    return {".src": "\n".join(src) + "\n", ".dat": "\n".join(dat) + "\n"}
+
+
+def _signals(program: Program) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for ins in program.instructions:
+        if isinstance(ins, WaitFor) and ins.signal not in out:
+            out[ins.signal] = len(out) + 1
+    return out
+
+
+def _frame(xyz: tuple[float, ...], zyx: tuple[float, ...]) -> str:
+    x, y, z = xyz
+    a, b, c = zyx
+    return f"{{X {x:.3f}, Y {y:.3f}, Z {z:.3f}, A {a:.4f}, B {b:.4f}, C {c:.4f}}}"
+
+
+def _pose(move: LinMove) -> str:
+    x, y, z = move.position_mm
+    a, b, c = move.zyx_deg
+    ind = ConfigIndicator.parse(move.config)
+    return (f"{{X {x:.3f}, Y {y:.3f}, Z {z:.3f}, A {a:.4f}, B {b:.4f}, C {c:.4f}, "
+            f"S {ind.status}, T {ind.turn}, {_EXTERNAL}}}")
+
+
+# ================================================================================== reading
+
+_GRAMMAR = r"""
+?start: motion | assign | weld | wait_sec | wait_for | signal | decl
+motion: MOTION target APPROX?
+target: NAME | aggregate
+aggregate: "{" (NAME ":")? [field ("," field)*] "}"
+field: NAME value
+?value: NUMBER | BITS | NAME
+assign: SYSVAR ("." NAME)? ("[" NUMBER "]")? "=" (NUMBER | aggregate | SYSVAR)
+weld: "spot_weld"i "(" NUMBER "," NUMBER ")"
+wait_sec: "WAIT"i "SEC"i NUMBER
+wait_for: "WAIT"i "FOR"i NAME
+signal: "SIGNAL"i NAME SYSVAR "[" NUMBER "]"
+decl: "DECL"i NAME NAME "=" aggregate
+
+MOTION.2: /(PTP|LIN)\b/i
+APPROX.2: /C_(DIS|PTP|VEL|ORI)\b/i
+SYSVAR: /\$[A-Za-z_][A-Za-z0-9_]*/
+NAME: /[A-Za-z_][A-Za-z0-9_]*/
+BITS: /'[Bb][01]+'/
+NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
+%ignore /[ \t]+/
+"""
+
+# Motions KRL has that this reader does not simulate: a program with one is not verified clean.
+_UNSIMULATED = re.compile(r"^(CIRC|SPTP|SLIN|SCIRC|PTP_REL|LIN_REL|CIRC_REL|SPTP_REL|SLIN_REL|SPLINE|PTP_SPLINE)\b", re.I)
+_KNOWN = re.compile(r"^(PTP|LIN|\$|spot_weld\s*\(|WAIT\s+(SEC|FOR)\b|SIGNAL\b|DECL\s+(E6AXIS|AXIS|E6POS|POS|FRAME)\b)", re.I)
+
+
+@lru_cache(maxsize=1)
+def _parser() -> Lark:
+    return Lark(_GRAMMAR, parser="lalr", lexer="contextual")
+
+
+def _statement(text: str) -> tuple[str, str]:
+    """A KRL line -> (statement, comment): the comment is what follows the first ';' outside quotes."""
+    in_quote = False
+    for i, c in enumerate(text):
+        if c == "'":
+            in_quote = not in_quote
+        elif c == ";" and not in_quote:
+            return text[:i].strip(), text[i + 1:].strip()
+    return text.strip(), ""
+
+
+class _Reader:
+    def __init__(self, file: str, robot: RobotModel) -> None:
+        self.file, self.robot = file, robot
+        self.points: dict[str, dict[str, object]] = {}
+        self.instructions: list[Instruction] = []
+        self.lines: list[int] = []
+        self.ignored: list[tuple[int, str]] = []
+        self.frames: list[FrameDef] = []
+        self.vel_axis = [100.0] * 6
+        self.acc_axis = [100.0] * 6
+        self.vel_cp = 2.0                      # m/s, KSS default $VEL.CP
+        self.cdis = 0.0
+        self.last_axes: dict[str, float] = {}
+        self.last_pose: dict[str, float] = {}
+
+    def error(self, line: int, problem: str) -> ProgramError:
+        return ProgramError(self.file, f"line {line}", problem)
+
+    def tree(self, text: str, line: int) -> Tree[Token]:
+        try:
+            return _parser().parse(text)
+        except UnexpectedInput as exc:
+            raise self.error(line, f"cannot read {text!r} (column {getattr(exc, 'column', '?')})") from None
+
+    def aggregate(self, node: Tree[Token], line: int) -> dict[str, object]:
+        out: dict[str, object] = {}
+        for f in node.children:
+            if isinstance(f, Tree) and f.data == "field":
+                key, value = f.children
+                out[str(key).upper()] = self.value(value, line)
+        return out
+
+    def value(self, tok: object, line: int) -> object:
+        text = str(tok)
+        if isinstance(tok, Token) and tok.type == "BITS":
+            return int(text[2:-1], 2)
+        if isinstance(tok, Token) and tok.type == "NUMBER":
+            value = float(text)
+            if not math.isfinite(value):
+                raise self.error(line, f"number {text} is not finite")
+            return value
+        return text
+
+    def declare(self, text: str, line: int) -> None:
+        tree = self.tree(text, line)
+        _, name, agg = tree.children
+        self.points[str(name).upper()] = self.aggregate(agg, line)
+
+    def add(self, ins: Instruction, line: int) -> None:
+        self.instructions.append(ins)
+        self.lines.append(line)
+
+    def statement(self, text: str, comment: str, line: int) -> None:
+        if _UNSIMULATED.match(text):
+            self.ignored.append((line, text))
+            self.add(Comment(f"not simulated: {text}"), line)
+            return
+        if not _KNOWN.match(text):
+            self.ignored.append((line, text))
+            return
+        if text.upper().startswith("DECL"):
+            self.declare(text, line)
+            return
+        tree = self.tree(text, line)
+        getattr(self, "on_" + tree.data)(tree, comment, line)
+
+    def on_signal(self, tree: Tree[Token], comment: str, line: int) -> None:
+        return None
+
+    def on_assign(self, tree: Tree[Token], comment: str, line: int) -> None:
+        toks = [c for c in tree.children if isinstance(c, Token)]
+        var = str(toks[0]).upper()
+        member = str(toks[1]).upper() if len(toks) > 2 and toks[1].type == "NAME" else ""
+        index = next((int(float(t)) for t in toks[1:-1] if t.type == "NUMBER"), None)
+        rhs = tree.children[-1]
+        number = float(rhs) if isinstance(rhs, Token) and rhs.type == "NUMBER" else None
+        if var in ("$TOOL", "$BASE") and isinstance(rhs, Tree):
+            agg = self.aggregate(rhs, line)
+            xyz = tuple(float(agg.get(k, 0.0)) for k in "XYZ")       # type: ignore[arg-type]
+            zyx = tuple(float(agg.get(k, 0.0)) for k in "ABC")       # type: ignore[arg-type]
+            kind = "tool" if var == "$TOOL" else "base"
+            name = comment.split()[-1] if comment.startswith(f"{kind} frame ") else kind
+            self.frames = [f for f in self.frames if f.kind != kind] + [FrameDef(name, kind, xyz, zyx)]
+        elif number is None:
+            return
+        elif var in ("$VEL_AXIS", "$ACC_AXIS") and index is not None and 1 <= index <= 6:
+            (self.vel_axis if var == "$VEL_AXIS" else self.acc_axis)[index - 1] = number
+        elif var == "$VEL" and member == "CP":
+            self.vel_cp = number
+        elif var == "$APO" and member == "CDIS":
+            self.cdis = number
+
+    def on_motion(self, tree: Tree[Token], comment: str, line: int) -> None:
+        kind = str(tree.children[0]).upper()
+        target = tree.children[1]
+        approx = str(tree.children[2]).upper() if len(tree.children) > 2 and tree.children[2] is not None else ""
+        node = target.children[0]
+        if isinstance(node, Token):
+            key = str(node).upper()
+            if key not in self.points:
+                raise self.error(line, f"point {node} is not declared in the .dat or the .src")
+            values = self.points[key]
+        else:
+            values = self.aggregate(node, line)
+        flyby_mm = self.cdis if approx in ("C_DIS", "C_PTP", "C_VEL", "C_ORI") else 0.0
+        if approx == "C_DIS" and self.cdis <= 0:
+            flyby_mm = 0.0
+        if kind == "PTP" and any(a in values for a in _AXES):
+            self.last_axes.update({k: float(v) for k, v in values.items() if k in _AXES})  # type: ignore[arg-type]
+            missing = [a for a in _AXES if a not in self.last_axes]
+            if missing:
+                raise self.error(line, f"the first joint target must give every axis; {', '.join(missing)} missing")
+            speed = min(self.vel_axis) / 100.0
+            accel = min(self.acc_axis) / 100.0
+            self.add(PtpMove(tuple(self.last_axes[a] for a in _AXES), speed, accel, comment=comment,
+                             flyby_mm=flyby_mm), line)
+            return
+        if kind == "PTP":
+            raise self.error(line, "a PTP to a Cartesian point is not simulated: robomax programs state joint targets for PTP")
+        self.last_pose.update({k: float(v) for k, v in values.items() if k in ("X", "Y", "Z", "A", "B", "C", "S", "T")})  # type: ignore[arg-type]
+        missing = [k for k in "XYZABC" if k not in self.last_pose]
+        if missing:
+            raise self.error(line, f"the first Cartesian target must give {', '.join(missing)}")
+        config = ""
+        if "S" in values and "T" in values:
+            config = str(ConfigIndicator(int(self.last_pose["S"]), int(self.last_pose["T"])))
+        xyz = tuple(self.last_pose[k] for k in "XYZ")
+        zyx = tuple(self.last_pose[k] for k in "ABC")
+        self.add(LinMove(xyz, zyx, config, self.vel_cp * 1000.0, comment=comment, flyby_mm=flyby_mm), line)
+
+    def on_weld(self, tree: Tree[Token], comment: str, line: int) -> None:
+        n, seconds = (float(t) for t in tree.children)
+        self.add(read_spot_label(comment, int(n), seconds, self.file, line), line)
+
+    def on_wait_sec(self, tree: Tree[Token], comment: str, line: int) -> None:
+        self.add(Wait(float(tree.children[0])), line)
+
+    def on_wait_for(self, tree: Tree[Token], comment: str, line: int) -> None:
+        self.add(WaitFor(str(tree.children[0])), line)
+
+
+def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
+    """A KRL program from its `.src` (and `.dat`, when given) texts."""
+    reader = _Reader(file, robot)
+    for raw in texts.get(".dat", "").splitlines():
+        stmt, _ = _statement(raw)
+        if re.match(r"^DECL\s+(E6AXIS|AXIS|E6POS|POS|FRAME)\b", stmt, re.I):
+            reader.declare(stmt, 0)
+    src = texts.get(".src", "").splitlines()
+    main_name = ""
+    in_main = False
+    header_comments: list[str] = []
+    for number, raw in enumerate(src, start=1):
+        stmt, comment = _statement(raw)
+        head = re.match(r"^(GLOBAL\s+)?DEF\s+([A-Za-z_][A-Za-z0-9_]*)\s*\(", stmt, re.I)
+        if head:
+            if main_name:
+                break                                   # the main program ends; local routines follow
+            main_name, in_main = head.group(2), True
+            continue
+        if not in_main or stmt.startswith("&"):
+            continue
+        if re.match(r"^END\b", stmt, re.I):
+            in_main = False
+            continue
+        if not stmt:
+            if raw.strip().startswith(";"):
+                if is_header_comment(comment) or comment.startswith(_NOTE):
+                    header_comments.append(comment)
+                else:
+                    reader.add(Comment(comment), number)
+            continue
+        if stmt.upper().startswith(("$TOOL", "$BASE")):
+            comment = comment if " frame " in comment else ""
+        reader.statement(stmt, comment, number)
+    if not main_name:
+        raise ProgramError(file, None, "no DEF line: not a KRL program")
+    header = read_header(header_comments)
+    instructions = reader.instructions
+    return Parsed(Program(main_name, header, tuple(reader.frames), tuple(instructions)), tuple(reader.lines),
+                  "kuka", tuple(reader.ignored))

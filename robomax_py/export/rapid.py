@@ -1,0 +1,420 @@
+"""ABB RAPID, both directions: one module `<name>.mod`.
+
+What a program states, in RAPID's terms (RAPID Reference Manual, data types robtarget,
+jointtarget, speeddata, zonedata, tooldata, wobjdata; instructions MoveAbsJ, MoveL, VelSet, AccSet):
+- joint targets as `jointtarget` (deg), Cartesian targets as `robtarget`: [x, y, z] mm, a unit
+  quaternion [q1, q2, q3, q4] with q1 = w, confdata [cf1, cf4, cf6, cfx] of the planned
+  configuration (SPEC §6), external axes 9E9;
+- `tooldata` (TCP in the flange frame) and `wobjdata` (user frame = the robot base in the cell's
+  world) declared in the module and named by every move;
+- PTP moves as `MoveAbsJ ... vmax` under `VelSet` (the speed fraction, %) and `AccSet`; LIN moves as
+  `MoveL` with a `speeddata` whose v_tcp is the planned TCP speed (mm/s, at `VelSet 100`);
+- blends as `zonedata` with pzone_tcp the TCP distance (mm) of the planned radius (the other
+  zone sizes in the proportions of ABB's predefined zones), `fine` at every stop and weld;
+- a weld as `MoveL ... fine` followed by `spot_weld n, weld_time;  ! seam/name`, with `PROC
+  spot_weld` defined in the module (rest for weld_time; the integrator replaces it);
+- `WaitTime t;` and `WaitDI <signal>, 1;`.
+
+The tool's load is not known to robomax: tooldata carries a 1 kg load at the TCP that the
+integrator must replace with the gun's (LoadIdentify). The reader takes the motion subset of any
+module: MoveAbsJ and MoveL with declared or in-place targets, predefined and declared speed and
+zone data, VelSet, AccSet, WaitTime, WaitDI and calls of spot_weld; other motions (MoveJ, MoveC ...)
+are reported as not simulated, everything else as ignored.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import re
+from functools import lru_cache
+
+from lark import Lark, Token, Tree
+from lark.exceptions import UnexpectedInput
+
+from robomax_py.errors import ExportError, ProgramError
+from robomax_py.export.dialect import (
+    Parsed,
+    PlannedProgram,
+    header_lines,
+    is_header_comment,
+    read_header,
+    read_spot_label,
+    require_six_axes,
+    spot_label,
+    with_brand_configs,
+    with_tcp_blends,
+)
+from robomax_py.export.quaternions import quaternion_from_zyx, zyx_from_quaternion
+from robomax_py.program import (
+    Comment,
+    FrameDef,
+    Instruction,
+    LinMove,
+    Program,
+    PtpMove,
+    Spot,
+    Wait,
+    WaitFor,
+)
+from robomax_py.robot import RobotModel
+
+__all__ = ["adapt", "parse", "write"]
+
+_NOTE = "RAPID module"
+_EAX = "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]"
+# A quaternion is unit when its norm is within this of 1 (written with 9 decimals: ~1e-9).
+UNIT_QUATERNION_TOL = 1e-6
+# `vmax` in a MoveL: the largest predefined TCP speed (v7000, RAPID reference "speeddata").
+VMAX_TCP_MM_S = 7000.0
+
+
+def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
+    """The program as RAPID states it: ABB confdata and TCP-distance zones."""
+    require_six_axes(robot, "RAPID")
+    program = with_brand_configs(planned.program, planned.joints, robot, "abb")
+    return with_tcp_blends(dataclasses.replace(planned, program=program), robot)
+
+
+# ================================================================================== writing
+
+
+def _q(zyx: tuple[float, ...]) -> str:
+    return "[" + ", ".join(f"{v:.9f}" for v in quaternion_from_zyx(zyx)) + "]"
+
+
+def _xyz(xyz: tuple[float, ...]) -> str:
+    return "[" + ", ".join(f"{v:.3f}" for v in xyz) + "]"
+
+
+def _zone(mm: float) -> str:
+    # ABB's predefined zones keep pzone_ori = pzone_eout = 1.5 pzone_tcp, zone_ori = 0.15 pzone_tcp (deg).
+    return f"[FALSE, {mm:.3f}, {1.5 * mm:.3f}, {1.5 * mm:.3f}, {0.15 * mm:.4f}, {1.5 * mm:.3f}, {0.15 * mm:.4f}]"
+
+
+def write(program: Program, robot: RobotModel) -> dict[str, str]:
+    tool = next((f for f in program.frames if f.kind == "tool"), None)
+    base = next((f for f in program.frames if f.kind == "base"), None)
+    tool_name = tool.name if tool else "tool0"
+    wobj_name = base.name if base else "wobj0"
+    decl: list[str] = []
+    body: list[str] = []
+    if tool:
+        decl.append(f"  PERS tooldata {tool.name} := [TRUE, [{_xyz(tool.xyz_mm)}, {_q(tool.zyx_deg)}], "
+                    "[1, [0, 0, 0.001], [1, 0, 0, 0], 0, 0, 0]];  ! load: replace with the gun's (LoadIdentify)")
+    if base:
+        decl.append(f"  PERS wobjdata {base.name} := [FALSE, TRUE, \"\", [{_xyz(base.xyz_mm)}, {_q(base.zyx_deg)}], "
+                    "[[0, 0, 0], [1, 0, 0, 0]]];")
+    tail = f", {tool_name} \\WObj:={wobj_name};"
+    speeds: dict[float, str] = {}
+    zones: dict[float, str] = {}
+    override = accel = None
+    n_point = n_weld = 0
+    for ins in program.instructions:
+        if isinstance(ins, Comment):
+            body.append(f"    ! {ins.text}" if ins.text else "    !")
+            continue
+        note = f"  ! {ins.comment}" if isinstance(ins, (PtpMove, LinMove)) and ins.comment else ""
+        if isinstance(ins, (PtpMove, LinMove)):
+            n_point += 1
+            zone = "fine"
+            if ins.flyby_mm > 0:
+                if ins.flyby_mm not in zones:
+                    zones[ins.flyby_mm] = f"z_{len(zones) + 1}"
+                    decl.append(f"  CONST zonedata {zones[ins.flyby_mm]} := {_zone(ins.flyby_mm)};")
+                zone = zones[ins.flyby_mm]
+            want = ins.speed if isinstance(ins, PtpMove) else 1.0
+            if want != override:
+                override = want
+                body.append(f"    VelSet {100 * want:.1f}, 5000;")
+            if isinstance(ins, PtpMove):
+                if ins.accel != accel:
+                    accel = ins.accel
+                    body.append(f"    AccSet {100 * accel:.1f}, 100;")
+                name = f"jt{n_point}"
+                joints = ", ".join(f"{v:.4f}" for v in ins.target_deg)
+                decl.append(f"  CONST jointtarget {name} := [[{joints}], {_EAX}];")
+                body.append(f"    MoveAbsJ {name}, vmax, {zone}{tail}{note}")
+            else:
+                if ins.speed_mm_s not in speeds:
+                    speeds[ins.speed_mm_s] = f"v_lin{len(speeds) + 1}"
+                    decl.append(f"  CONST speeddata {speeds[ins.speed_mm_s]} := [{ins.speed_mm_s:.3f}, 500, 5000, 1000];")
+                name = f"p{n_point}"
+                decl.append(f"  CONST robtarget {name} := [{_xyz(ins.position_mm)}, {_q(ins.zyx_deg)}, "
+                            f"{ins.config.replace(',', ', ')}, {_EAX}];")
+                body.append(f"    MoveL {name}, {speeds[ins.speed_mm_s]}, {zone}{tail}{note}")
+        elif isinstance(ins, Spot):
+            n_weld += 1
+            body.append(f"    spot_weld {n_weld}, {ins.time_s:.3f};  ! {spot_label(ins)}")
+        elif isinstance(ins, Wait):
+            body.append(f"    WaitTime {ins.seconds:.3f};")
+        elif isinstance(ins, WaitFor):
+            body.append(f"    WaitDI {ins.signal}, 1;")
+        else:
+            raise ExportError(f"RAPID cannot write {type(ins).__name__}")
+    lines = ["%%%", "  VERSION:1", "  LANGUAGE:ENGLISH", "%%%", "", f"MODULE {program.name}"]
+    lines += [f"  ! {text}" for text in header_lines(program.header)]
+    lines.append(f"  ! {_NOTE}: mm, deg, quaternions [w, x, y, z], speeddata mm/s, zonedata mm")
+    lines += decl
+    lines += ["", "  PROC main()", *body, "  ENDPROC", "",
+              "  PROC spot_weld(num n, num weld_time)",
+              "    ! default weld: rest for weld_time s; replace with the gun's technology package",
+              "    WaitTime \\InPos, weld_time;", "  ENDPROC", "ENDMODULE"]
+    return {".mod": "\n".join(lines) + "\n"}
+
+
+# ================================================================================== reading
+
+_GRAMMAR = r"""
+?start: decl | move | velset | accset | waittime | waitdi | weld
+decl: ("CONST"i | "PERS"i | "VAR"i) NAME NAME ":=" value
+move: MOVE arg ("," arg | opt)*
+velset: "VelSet"i NUMBER "," NUMBER
+accset: "AccSet"i NUMBER "," NUMBER ("\\" NAME ":=" NUMBER)?
+waittime: "WaitTime"i ("\\" NAME ",")? NUMBER
+waitdi: "WaitDI"i NAME "," NUMBER
+weld: "spot_weld"i NUMBER "," NUMBER
+?arg: value | opt
+opt: "\\" NAME (":=" value)?
+?value: NUMBER | NAME | STRING | list | BOOL
+list: "[" [value ("," value)*] "]"
+MOVE.2: /(MoveAbsJ|MoveL)\b/i
+BOOL.2: /(TRUE|FALSE)\b/i
+NAME: /[A-Za-z_][A-Za-z0-9_]*/
+STRING: /"[^"]*"/
+NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
+%ignore /[ \t\r\n]+/
+"""
+
+_UNSIMULATED = re.compile(r"^(MoveJ|MoveC|MoveLDO|MoveJDO|MoveLSync|MoveJSync|MoveCSync|MoveExtJ|SearchL|SearchC|"
+                          r"TriggL|TriggJ|TriggC|MoveLRel|MoveAbsJDO|MoveAbsJSync|SpotL|SpotJ)\b", re.I)
+_KNOWN = re.compile(r"^(CONST|PERS|VAR|MoveAbsJ|MoveL|VelSet|AccSet|WaitTime|WaitDI|spot_weld)\b", re.I)
+_PREDEFINED_SPEED = re.compile(r"^v([0-9]+)$", re.I)
+_PREDEFINED_ZONE = re.compile(r"^z([0-9]+)$", re.I)
+
+
+@lru_cache(maxsize=1)
+def _parser() -> Lark:
+    return Lark(_GRAMMAR, parser="lalr", lexer="contextual")
+
+
+def _statements(text: str) -> list[tuple[int, str, str]]:
+    """(line, statement, comment) for every ';'-terminated statement; comment lines as ("", text)."""
+    out: list[tuple[int, str, str]] = []
+    pending: list[str] = []
+    start = 0
+    for number, raw in enumerate(text.splitlines(), start=1):
+        if re.match(r"^\s*(%%%|VERSION:|LANGUAGE:)", raw):
+            continue
+        code, comment = _split_comment(raw)
+        if not code.strip():
+            if comment is not None and not pending:
+                out.append((number, "", comment))
+            continue
+        if not pending:
+            start = number
+        pending.append(code)
+        joined = " ".join(pending).strip()
+        if joined.endswith(";") or re.match(r"^(MODULE|ENDMODULE|PROC|ENDPROC|FUNC|ENDFUNC|TRAP|ENDTRAP)\b", joined, re.I):
+            out.append((start, joined.rstrip(";").strip(), comment or ""))
+            pending = []
+    return out
+
+
+def _split_comment(raw: str) -> tuple[str, str | None]:
+    in_string = False
+    for i, c in enumerate(raw):
+        if c == '"':
+            in_string = not in_string
+        elif c == "!" and not in_string:
+            return raw[:i], raw[i + 1:].strip()
+    return raw, None
+
+
+def _numbers(node: object, file: str, line: int) -> list[float]:
+    if isinstance(node, Token) and node.type == "NUMBER":
+        value = float(node)
+        if not math.isfinite(value):
+            raise ProgramError(file, f"line {line}", f"number {node} is not finite")
+        return [value]
+    if isinstance(node, Tree) and node.data == "list":
+        return [v for c in node.children for v in _numbers(c, file, line)]
+    raise ProgramError(file, f"line {line}", f"expected numbers, got {node}")
+
+
+class _Reader:
+    def __init__(self, file: str) -> None:
+        self.file = file
+        self.data: dict[str, tuple[str, object, int]] = {}   # name -> (type, value, line)
+        self.instructions: list[Instruction] = []
+        self.lines: list[int] = []
+        self.ignored: list[tuple[int, str]] = []
+        self.frames: list[FrameDef] = []
+        self.override = 100.0
+        self.accel = 100.0
+
+    def error(self, line: int, problem: str) -> ProgramError:
+        return ProgramError(self.file, f"line {line}", problem)
+
+    def add(self, ins: Instruction, line: int) -> None:
+        self.instructions.append(ins)
+        self.lines.append(line)
+
+    def tree(self, text: str, line: int) -> Tree[Token]:
+        try:
+            return _parser().parse(text)
+        except UnexpectedInput as exc:
+            raise self.error(line, f"cannot read {text!r} (column {getattr(exc, 'column', '?')})") from None
+
+    def quaternion(self, node: object, line: int) -> tuple[float, float, float]:
+        q = _numbers(node, self.file, line)
+        if len(q) != 4:
+            raise self.error(line, f"an orientation needs 4 quaternion values, got {len(q)}")
+        norm = math.sqrt(sum(v * v for v in q))
+        if abs(norm - 1.0) > UNIT_QUATERNION_TOL:
+            raise self.error(line, f"quaternion {q} is not unit (norm {norm:.9f}; at most {UNIT_QUATERNION_TOL:g} from 1)")
+        return zyx_from_quaternion(tuple(q))
+
+    def pose(self, node: object, line: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        if not (isinstance(node, Tree) and node.data == "list" and len(node.children) >= 2):
+            raise self.error(line, "a frame needs [[x, y, z], [q1, q2, q3, q4]]")
+        xyz = _numbers(node.children[0], self.file, line)
+        if len(xyz) != 3:
+            raise self.error(line, f"a position needs 3 values, got {len(xyz)}")
+        return tuple(xyz), self.quaternion(node.children[1], line)
+
+    def declare(self, tree: Tree[Token], comment: str, line: int) -> None:
+        kind, name, value = tree.children
+        kind_l = str(kind).lower()
+        self.data[str(name).lower()] = (kind_l, value, line)
+        if kind_l == "tooldata" and isinstance(value, Tree) and len(value.children) >= 2:
+            xyz, zyx = self.pose(value.children[1], line)
+            self.frames = [f for f in self.frames if f.kind != "tool"] + [FrameDef(str(name), "tool", xyz, zyx)]
+        elif kind_l == "wobjdata" and isinstance(value, Tree) and len(value.children) >= 4:
+            xyz, zyx = self.pose(value.children[3], line)
+            self.frames = [f for f in self.frames if f.kind != "base"] + [FrameDef(str(name), "base", xyz, zyx)]
+
+    def resolve(self, node: object, kind: str, line: int) -> object:
+        if isinstance(node, Token) and node.type == "NAME":
+            entry = self.data.get(str(node).lower())
+            if entry is None:
+                raise self.error(line, f"{node} is not declared in the module")
+            if entry[0] != kind:
+                raise self.error(line, f"{node} is a {entry[0]}, expected a {kind}")
+            return entry[1]
+        return node
+
+    def speed(self, node: object, line: int) -> float | None:
+        """v_tcp (mm/s) of a speeddata; None for vmax."""
+        if isinstance(node, Token) and node.type == "NAME":
+            if str(node).lower() == "vmax":
+                return None
+            match = _PREDEFINED_SPEED.match(str(node))
+            if match and str(node).lower() not in self.data:
+                return float(match.group(1))
+        values = _numbers(self.resolve(node, "speeddata", line), self.file, line)
+        return values[0]
+
+    def zone(self, node: object, line: int) -> float:
+        if isinstance(node, Token) and node.type == "NAME":
+            if str(node).lower() == "fine":
+                return 0.0
+            match = _PREDEFINED_ZONE.match(str(node))
+            if match and str(node).lower() not in self.data:
+                return float(match.group(1))
+        value = self.resolve(node, "zonedata", line)
+        if isinstance(value, Tree) and len(value.children) >= 2:
+            fine = str(value.children[0]).upper() == "TRUE"
+            return 0.0 if fine else _numbers(value.children[1], self.file, line)[0]
+        raise self.error(line, f"cannot read zone {node}")
+
+    def move(self, tree: Tree[Token], comment: str, line: int) -> None:
+        kind = str(tree.children[0]).lower()
+        args = [c for c in tree.children[1:] if not (isinstance(c, Tree) and c.data == "opt")]
+        if len(args) < 3:
+            raise self.error(line, f"{tree.children[0]} needs a target, a speed and a zone")
+        target, speed, zone = args[0], args[1], args[2]
+        flyby_mm = self.zone(zone, line)
+        v = self.speed(speed, line)
+        if kind == "moveabsj":
+            value = self.resolve(target, "jointtarget", line)
+            if not (isinstance(value, Tree) and value.children):
+                raise self.error(line, "a jointtarget needs [[j1, ..., j6], [external axes]]")
+            joints = _numbers(value.children[0], self.file, line)
+            self.add(PtpMove(tuple(joints), self.override / 100.0, self.accel / 100.0, comment=comment,
+                             flyby_mm=flyby_mm), line)
+            return
+        value = self.resolve(target, "robtarget", line)
+        if not (isinstance(value, Tree) and len(value.children) >= 3):
+            raise self.error(line, "a robtarget needs [[x, y, z], [q1, q2, q3, q4], [confdata], [external axes]]")
+        xyz, zyx = self.pose(value, line)
+        conf = [int(round(c)) for c in _numbers(value.children[2], self.file, line)]
+        config = "[" + ",".join(str(c) for c in conf) + "]"
+        v_tcp = VMAX_TCP_MM_S if v is None else v
+        self.add(LinMove(xyz, zyx, config, v_tcp * self.override / 100.0, comment=comment, flyby_mm=flyby_mm), line)
+
+    def statement(self, text: str, comment: str, line: int) -> None:
+        if _UNSIMULATED.match(text):
+            self.ignored.append((line, text))
+            self.add(Comment(f"not simulated: {text}"), line)
+            return
+        if not _KNOWN.match(text):
+            self.ignored.append((line, text))
+            return
+        tree = self.tree(text, line)
+        if tree.data == "decl":
+            self.declare(tree, comment, line)
+        elif tree.data == "move":
+            self.move(tree, comment, line)
+        elif tree.data == "velset":
+            self.override = float(tree.children[0])
+        elif tree.data == "accset":
+            self.accel = float(tree.children[0])
+        elif tree.data == "waittime":
+            self.add(Wait(float(tree.children[-1])), line)
+        elif tree.data == "waitdi":
+            self.add(WaitFor(str(tree.children[0])), line)
+        elif tree.data == "weld":
+            n, seconds = (float(t) for t in tree.children)
+            self.add(read_spot_label(comment, int(n), seconds, self.file, line), line)
+
+
+def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
+    """A RAPID module's motion (the `main` procedure, else the first one)."""
+    reader = _Reader(file)
+    module = ""
+    header_comments: list[str] = []
+    procs: dict[str, list[tuple[int, str, str]]] = {}
+    current: str | None = None
+    for line, stmt, comment in _statements(texts.get(".mod", "")):
+        head = re.match(r"^MODULE\s+([A-Za-z_][A-Za-z0-9_]*)", stmt, re.I)
+        if head:
+            module = head.group(1)
+            continue
+        proc = re.match(r"^(?:LOCAL\s+)?PROC\s+([A-Za-z_][A-Za-z0-9_]*)", stmt, re.I)
+        if proc:
+            current = proc.group(1).lower()
+            procs[current] = []
+            continue
+        if re.match(r"^END(PROC|FUNC|TRAP)\b", stmt, re.I):
+            current = None
+            continue
+        if current is not None:
+            procs[current].append((line, stmt, comment))
+        elif stmt:
+            reader.statement(stmt, comment, line)
+        elif is_header_comment(comment) or comment.startswith(_NOTE):
+            header_comments.append(comment)
+    if not module:
+        raise ProgramError(file, None, "no MODULE line: not a RAPID module")
+    main = procs.get("main") or next((body for name, body in procs.items() if name != "spot_weld"), None)
+    if main is None:
+        raise ProgramError(file, None, "the module has no PROC main()")
+    for line, stmt, comment in main:
+        if stmt:
+            reader.statement(stmt, comment, line)
+        else:
+            reader.add(Comment(comment), line)
+    header = read_header(header_comments)
+    return Parsed(Program(module, header, tuple(reader.frames), tuple(reader.instructions)), tuple(reader.lines),
+                  "abb", tuple(reader.ignored))

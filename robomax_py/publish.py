@@ -1,0 +1,196 @@
+"""A planned result -> the program files `plan` writes, each proven before anything is written.
+
+For every requested dialect: the plan becomes the dialect-free program (`export.plan_program`),
+the dialect adapts and writes it, and then, in memory, the written text is read back with the
+dialect's own parser, the reading must give the adapted program statement for statement, its
+motion is rebuilt from those statements alone (`export.rebuild`) and compared with the planned
+motion (largest joint and TCP difference, time shift of every weld), and, when it is not the
+planned motion sample for sample, verified against the cell as `robomax verify` would. Any
+failure is an ExportError naming the dialect and the statement (file line): then nothing is
+written.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.errors import ExportError, ProgramError
+from robomax_py.export import DIALECTS, render_trajectory
+from robomax_py.export.dialect import Parsed, PlannedProgram
+from robomax_py.export.plan_program import planned_program
+from robomax_py.export.rebuild import rebuild
+from robomax_py.plan import PlanResult
+from robomax_py.program import LinMove, Program, lin_pose
+from robomax_py.robot import RobotModel, fk_tcp
+from robomax_py.spec import CellSpec
+from robomax_py.timing import Trajectory
+from robomax_py.timing.trajectory import evaluate
+from robomax_py.tolerances import DEFAULT as TOL
+from robomax_py.verify import VerifyReport, verify_rebuilt
+
+__all__ = ["CheckedProgram", "MotionDifference", "file_names", "motion_difference", "publish"]
+
+# Samples per interval between weld boundaries when comparing rebuilt and planned motion.
+COMPARE_SAMPLES = 40
+
+
+@dataclass(frozen=True, slots=True)
+class MotionDifference:
+    """Largest difference between a rebuilt and the planned motion: joint (deg) and TCP (mm) at
+    the same fraction of every interval between weld boundaries, and the largest shift of those
+    boundaries and of the end (s)."""
+
+    joint_deg: float
+    tcp_mm: float
+    time_s: float
+    t_worst: float | None = None
+
+    @property
+    def identical(self) -> bool:
+        return self.joint_deg == 0.0 and self.time_s == 0.0
+
+    def within(self) -> bool:
+        return (self.joint_deg <= TOL.rebuilt_joint_deg and self.tcp_mm <= TOL.rebuilt_tcp_mm
+                and self.time_s <= TOL.rebuilt_time_s)
+
+
+@dataclass(frozen=True, slots=True)
+class CheckedProgram:
+    """One dialect's files, proven: file name -> text, and what the proof measured."""
+
+    format: str
+    files: dict[str, str]
+    difference: MotionDifference
+    write_seconds: float
+    check_seconds: float
+    report: VerifyReport | None       # the rebuilt motion's verification (None: identical to the plan)
+
+
+def file_names(name: str, files: dict[str, str]) -> dict[str, str]:
+    """Dialect keys (".src", or a whole file name such as "spot_weld.ls") -> file names."""
+    return {(f"{name}{key}" if key.startswith(".") else key): text for key, text in files.items()}
+
+
+def publish(result: PlanResult, cell: CellSpec, robot: RobotModel, formats: tuple[str, ...], *,
+            stamp: str = "", baseline: bool = False) -> tuple[dict[str, str], list[CheckedProgram]]:
+    """Every file of a planned result (the trajectory file first, then each format's files), all
+    proven; ExportError when any is not.
+
+    baseline : name the files `<cell>_baseline.*`, so that a baseline run never replaces the
+        optimised program.
+    """
+    name = result.cell + ("_baseline" if baseline else "")
+    files = {f"{name}.json": render_trajectory(result)}
+    planned = planned_program(result, cell.digest, stamp)
+    checked = []
+    for fmt in formats:
+        one = _checked(fmt, planned, result, cell, robot, name)
+        for file_name in one.files:
+            if file_name in files and files[file_name] != one.files[file_name]:
+                raise ExportError(f"two formats write {file_name} with different contents")
+        files.update(one.files)
+        checked.append(one)
+    return files, checked
+
+
+def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSpec, robot: RobotModel,
+             name: str) -> CheckedProgram:
+    dialect = DIALECTS[fmt]
+    t0 = time.process_time()
+    adapted = dialect.adapt(planned, robot)
+    if name != result.cell:
+        adapted = dataclasses.replace(adapted, name=adapted.name + ("_BASELINE" if adapted.name.isupper() else "_baseline"))
+    texts = dialect.write(adapted, robot)
+    t1 = time.process_time()
+    main = f"{name}{dialect.extensions[0]}"
+    try:
+        parsed = dialect.parse(texts, main, robot)
+    except ProgramError as exc:
+        raise ExportError(f"{fmt}: the written program does not read back: {exc}") from None
+    _same_program(fmt, main, adapted, parsed)
+    rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand)
+    if rebuilt.problems or rebuilt.trajectory is None:
+        p = rebuilt.problems[0] if rebuilt.problems else None
+        where = f"line {p.line}: " if p and p.line else ""
+        raise ExportError(f"{fmt}: the written program's motion cannot be rebuilt: {where}{p.detail if p else ''}")
+    assert result.trajectory is not None
+    diff = motion_difference(result.trajectory, rebuilt.trajectory, robot)
+    if not diff.within():
+        line = rebuilt.line_at(diff.t_worst)
+        raise ExportError(
+            f"{fmt}: the rebuilt motion differs from the planned one by {diff.joint_deg:.4f} deg, {diff.tcp_mm:.3f} mm, "
+            f"{diff.time_s * 1000:.1f} ms (at most {TOL.rebuilt_joint_deg} deg, {TOL.rebuilt_tcp_mm} mm, "
+            f"{TOL.rebuilt_time_s * 1000:.0f} ms){f', at line {line} of {main}' if line else ''}")
+    report = None
+    if not diff.identical:
+        report = verify_rebuilt(cell, robot, main, rebuilt)
+        if not report.clean:
+            v = report.violations[0]
+            raise ExportError(f"{fmt}: the written program's motion is not clean: {v.kind}: {v.detail}"
+                              f"{f' (line {v.line} of {main})' if v.line else ''}")
+    return CheckedProgram(fmt, file_names(name, texts), diff, t1 - t0, time.process_time() - t1, report)
+
+
+def _same_program(fmt: str, main: str, adapted: Program, parsed: Parsed) -> None:
+    """The program read back must be the one written: the same header, frames and statements."""
+    got = parsed.program
+    if got.name != adapted.name or got.header != adapted.header:
+        raise ExportError(f"{fmt}: {main} reads back with another name or header ({got.name}, {got.header})")
+    if len(got.frames) != len(adapted.frames) or any(not _same(a, b) for a, b in zip(adapted.frames, got.frames)):
+        raise ExportError(f"{fmt}: {main} reads back with other frames: {got.frames} instead of {adapted.frames}")
+    if len(got.instructions) != len(adapted.instructions):
+        raise ExportError(f"{fmt}: {main} reads back {len(got.instructions)} statements, "
+                          f"{len(adapted.instructions)} were written")
+    for k, (a, b) in enumerate(zip(adapted.instructions, got.instructions)):
+        if not _same(a, b):
+            raise ExportError(f"{fmt}: line {parsed.lines[k]} of {main} reads back as {b}, {a} was written")
+
+
+def _same(a: object, b: object) -> bool:
+    """Equal, or Cartesian values equal up to the ZYX angles' own ambiguity (B = ±90 deg)."""
+    if a == b:
+        return True
+    if type(a) is not type(b) or not dataclasses.is_dataclass(a):
+        return False
+    fields = {f.name for f in dataclasses.fields(a)}     # type: ignore[arg-type]
+    if "zyx_deg" not in fields:
+        return False
+    rest = [f for f in fields if f != "zyx_deg"]
+    if any(getattr(a, f) != getattr(b, f) for f in rest):
+        return False
+    Ra = lin_pose(LinMove((0.0, 0.0, 0.0), a.zyx_deg))[:3, :3]   # type: ignore[attr-defined]
+    Rb = lin_pose(LinMove((0.0, 0.0, 0.0), b.zyx_deg))[:3, :3]   # type: ignore[attr-defined]
+    angle = math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(Ra.T @ Rb) - 1.0) / 2.0))))
+    return angle <= TOL.readback_angle_deg
+
+
+def _anchors(traj: Trajectory) -> FloatArray:
+    times = [float(traj.t[0])]
+    for phase in traj.phases_of("weld"):
+        times += [float(phase.t_start), float(phase.t_end)]
+    times.append(float(traj.t[-1]))
+    return np.array(times)
+
+
+def motion_difference(planned: Trajectory, rebuilt: Trajectory, robot: RobotModel) -> MotionDifference:
+    """How far a rebuilt motion is from the planned one (`MotionDifference`)."""
+    if len(planned.t) == len(rebuilt.t) and np.array_equal(planned.t, rebuilt.t) and np.array_equal(planned.q, rebuilt.q):
+        return MotionDifference(0.0, 0.0, 0.0)
+    a, b = _anchors(planned), _anchors(rebuilt)
+    if len(a) != len(b):
+        return MotionDifference(math.inf, math.inf, math.inf, float(planned.t[0]))
+    u = np.linspace(0.0, 1.0, COMPARE_SAMPLES)
+    ta = np.concatenate([a[i] + u * (a[i + 1] - a[i]) for i in range(len(a) - 1)])
+    tb = np.concatenate([b[i] + u * (b[i + 1] - b[i]) for i in range(len(b) - 1)])
+    qa, qb = evaluate(planned, ta).q, evaluate(rebuilt, tb).q
+    joint = np.abs(qa - qb).max(axis=1)
+    tcp = np.linalg.norm(fk_tcp(robot, qa)[:, :3, 3] - fk_tcp(robot, qb)[:, :3, 3], axis=1)
+    worst = int(np.argmax(joint))
+    return MotionDifference(float(np.degrees(joint.max())), float(tcp.max() * 1000.0), float(np.abs(a - b).max()),
+                            float(tb[worst]))
