@@ -240,11 +240,14 @@ class LinMove:
 
 @dataclass(frozen=True, slots=True)
 class Spot:
-    """Weld spot `name` of seam `seam` at the current point, holding for `time_s` s (3 decimals)."""
+    """Weld spot `name` of seam `seam` at the current point, holding for `time_s` s (3 decimals),
+    with weld gun `gun` and weld schedule `schedule`."""
 
     name: str
     seam: str
     time_s: float
+    gun: int = 1
+    schedule: int = 1
 
     def __post_init__(self) -> None:
         _set(self, "time_s", _fixed(self.time_s, TIME_DECIMALS))

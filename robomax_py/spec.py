@@ -109,6 +109,8 @@ class ObjectSpec:
     workpiece: bool = False
     # Time windows (s from program start) in which a dynamic obstacle exists; None: always.
     present: tuple[tuple[float, float], ...] | None = None
+    # Clamp interlock: the input the program waits for before the first weld near this object.
+    signal: str | None = None
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -117,6 +119,11 @@ class SpotSpec:
     xyz: FloatArray                           # (3,) world, m
     normal: FloatArray                        # (3,) unit, outward: the moving electrode's side
     direction: FloatArray                     # (3,) unit, orthogonal to normal
+    # Per-spot overrides (cell-file extensions): None takes the process's or the planner's choice.
+    weld_time: float | None = None            # s
+    schedule: int | None = None               # weld schedule number
+    angles: tuple[float, float, float] | None = None   # pinned alpha, beta, gamma, rad
+    config: str | None = None                 # pinned configuration data (the controller brand's)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -135,6 +142,16 @@ class ProcessSpec:
     weld_time: float = 0.5                    # s
     approach: float = 0.03                    # m, along the electrode axis
     clearance: float = 0.0                    # m, safety margin to obstacles
+    gun: int = 1                              # weld gun number the programs name
+    schedule: int = 1                         # default weld schedule
+    interlock_distance: float = 0.2           # m: a spot this close to a clamp with a signal waits for it
+
+    def weld_time_of(self, spot: SpotSpec) -> float:
+        """The weld time of a spot: its own, else the process's."""
+        return self.weld_time if spot.weld_time is None else spot.weld_time
+
+    def schedule_of(self, spot: SpotSpec) -> int:
+        return self.schedule if spot.schedule is None else spot.schedule
 
 
 @dataclass(frozen=True, slots=True)

@@ -28,6 +28,7 @@ from robomax_py.robot.solve import brand_text_of, config_texts_near
 from robomax_py.safe_files import LIMITS, read_text
 from robomax_py.spec import CellSpec
 from robomax_py.tolerances import DEFAULT as TOL
+from robomax_py.transforms import rot_x, rot_y, rot_z
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.motion import Violation, check_motion
 from robomax_py.world.scene import build_scene
@@ -36,6 +37,8 @@ HOME_TOL_RAD = TOL.home_tol_rad
 REST_TOL_RAD = TOL.rest_tol_rad
 ANGLE_TOL_RAD = TOL.angle_tol_rad
 TIME_TOL_S = TOL.time_tol_s
+# A pinned orientation is kept when the rotation matrices agree to this (file precision: 1e-4 deg).
+PIN_TOL = 1e-5
 
 
 
@@ -166,8 +169,9 @@ def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> lis
         seam, spot = wanted[key]
         t0, t1 = float(entry["t_arrive"]), float(entry["t_leave"])
         seen[key] = t0
-        if t1 - t0 < cell.process.weld_time - TIME_TOL_S:
-            out.append(Violation(t0, "dwell", f"{label}: dwell {t1 - t0:.3f} s < weld time {cell.process.weld_time:.3f} s"))
+        weld_time = cell.process.weld_time_of(spot)
+        if t1 - t0 < weld_time - TIME_TOL_S:
+            out.append(Violation(t0, "dwell", f"{label}: dwell {t1 - t0:.3f} s < weld time {weld_time:.3f} s"))
         inside = (t >= t0 - TIME_TOL_S) & (t <= t1 + TIME_TOL_S)
         if inside.sum() < 2:
             out.append(Violation(t0, "dwell", f"{label}: no samples between arrive and leave"))
@@ -183,6 +187,13 @@ def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> lis
         g0, g1 = seam.gamma_range
         gamma_ok = g1 - g0 >= 2 * math.pi - ANGLE_TOL_RAD or any(
             g0 - ANGLE_TOL_RAD <= gamma + k * 2 * math.pi <= g1 + ANGLE_TOL_RAD for k in (-1, 0, 1))
+        if spot.angles is not None:
+            R_pin = rot_x(spot.angles[0]) @ rot_y(spot.angles[1]) @ rot_z(spot.angles[2])
+            R_got = rot_x(alpha) @ rot_y(beta) @ rot_z(gamma)
+            if np.abs(R_pin - R_got).max() > PIN_TOL:
+                out.append(Violation(t0, "spot", f"{label}: orientation alpha {math.degrees(alpha):.2f} beta "
+                                                 f"{math.degrees(beta):.2f} gamma {math.degrees(gamma):.2f} deg is not the "
+                                                 "pinned one"))
         if abs(alpha) > seam.alpha_max + ANGLE_TOL_RAD or abs(beta) > seam.beta_max + ANGLE_TOL_RAD or not gamma_ok:
             out.append(Violation(t0, "spot", f"{label}: orientation alpha {math.degrees(alpha):.2f} beta "
                                              f"{math.degrees(beta):.2f} gamma {math.degrees(gamma):.2f} deg outside the tolerance"))
@@ -191,6 +202,8 @@ def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> lis
             brand = str(entry.get("brand", robot.controller.brand))
             nearby = config_texts_near(robot, qs[0], brand, math.radians(TOL.config_tol_deg))
             actual = brand_text_of(robot, qs[0], brand)
+            if spot.config is not None and brand == robot.controller.brand and not same_config(spot.config, str(written)):
+                out.append(Violation(t0, "spot", f"{label}: configuration {written}, pinned {spot.config}"))
             if not any(same_config(str(written), text) for text in nearby):
                 out.append(Violation(t0, "spot", f"{label}: configuration written as {written}, robot is in {actual}"))
     for key in wanted:

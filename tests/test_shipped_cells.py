@@ -1,8 +1,9 @@
-"""End to end on every shipped example cell (cells/*.yaml): `robomax plan` writes both program files
-and `robomax verify` passes on both; the frame's seams are all welded and its ordered pillar seam
-keeps its order; the programs are byte for byte the committed ones (tests/golden/shipped: the .srcl
-text and the .json's SHA-256), so a restructuring that changes no behaviour is shown to change no
-program. Slow: each cell plans in 10-40 s."""
+"""End to end on every shipped example cell (cells/*.yaml): `robomax plan --format all` writes the
+trajectory file and every dialect's program, and `robomax verify` passes on each (its motion
+rebuilt from the program's own statements); the frame's seams are all welded and its ordered
+pillar seam keeps its order; the programs are byte for byte the committed ones
+(tests/golden/shipped: the .srcl text, and the SHA-256 of every other file), so a restructuring
+that changes no behaviour is shown to change no program. Slow: each cell plans in 10-40 s."""
 
 from __future__ import annotations
 
@@ -20,6 +21,8 @@ REPO = Path(__file__).resolve().parents[1]
 CELLS = sorted((REPO / "cells").glob("*.yaml"))
 GOLDEN = REPO / "tests" / "golden" / "shipped"
 runner = CliRunner()
+MAIN_FILES = (".json", ".srcl", ".src", ".mod", ".ls", ".script")
+HASHED = (".json", ".src", ".dat", ".mod", ".ls", ".script")
 
 
 def test_at_least_three_shipped_cells() -> None:
@@ -27,10 +30,10 @@ def test_at_least_three_shipped_cells() -> None:
 
 
 def _plan(cell: Path, out: Path) -> dict[str, object]:
-    result = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
+    result = runner.invoke(app, ["plan", str(cell), "-o", str(out), "--format", "all"])
     assert result.exit_code == EXIT_OK, result.output
     name = yaml.safe_load(cell.read_text()).get("name", cell.stem)
-    for ext in (".json", ".srcl"):
+    for ext in MAIN_FILES:
         program = out / f"{name}{ext}"
         assert program.is_file(), f"{program} not written"
         check = runner.invoke(app, ["verify", str(cell), str(program)])
@@ -45,15 +48,16 @@ def test_shipped_cell_plans_and_verifies(cell: Path, tmp_path: Path, update_gold
     data = _plan(cell, tmp_path)
     name = yaml.safe_load(cell.read_text()).get("name", cell.stem)
     srcl = (tmp_path / f"{name}.srcl").read_bytes()
-    digest = hashlib.sha256((tmp_path / f"{name}.json").read_bytes()).hexdigest()
+    digests = {f"{name}{ext}": hashlib.sha256((tmp_path / f"{name}{ext}").read_bytes()).hexdigest() for ext in HASHED}
     sums_file = GOLDEN / "SHA256SUMS"
     sums = dict(reversed(line.split("  ")) for line in sums_file.read_text().splitlines() if line)
     if update_golden:
         (GOLDEN / f"{name}.srcl").write_bytes(srcl)
-        sums[f"{name}.json"] = digest
+        sums.update(digests)
         sums_file.write_text("".join(f"{v}  {k}\n" for k, v in sorted(sums.items())))
     assert srcl == (GOLDEN / f"{name}.srcl").read_bytes(), f"{name}.srcl differs from tests/golden/shipped"
-    assert digest == sums[f"{name}.json"], f"{name}.json differs from tests/golden/shipped/SHA256SUMS"
+    for file, digest in digests.items():
+        assert digest == sums.get(file), f"{file} differs from tests/golden/shipped/SHA256SUMS"
     spec = yaml.safe_load(cell.read_text())
     wanted = {(s["name"], p["name"]) for s in spec["seams"] for p in s["spots"]}
     welded = [(s["seam"], s["name"]) for s in data["spots"]]  # type: ignore[union-attr]

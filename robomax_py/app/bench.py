@@ -68,7 +68,7 @@ def lower_bound(result: PlanResult, limits: JointLimits) -> float:
         raise ValueError("lower_bound needs a planned result")
     rests = np.array([result.home, *[s.q_spot for s in result.spots], result.home])
     moves = float(np.sum(ptp_time_estimate(rests[:-1], rests[1:], limits, straight=False)))
-    return moves + result.weld_time * len(result.spots)
+    return moves + sum(s.weld_time for s in result.spots)
 
 
 def run_bench(

@@ -136,20 +136,25 @@ def read_header(comments: Sequence[str]) -> Header:
 # ------------------------------------------------------------------ conversions
 
 
+_LABEL = re.compile(r"^(?P<seam>[^/\s]+)/(?P<name>[^/\s]+)(?: gun (?P<gun>[0-9]+) schedule (?P<schedule>[0-9]+))?$")
+
+
 def spot_label(spot: Spot) -> str:
-    """`seam/name`, the comment a weld call carries (SPEC §6)."""
-    return f"{spot.seam}/{spot.name}"
+    """`seam/name gun G schedule S`, the comment a weld call carries (SPEC §6: `seam/name` first)."""
+    return f"{spot.seam}/{spot.name} gun {spot.gun} schedule {spot.schedule}"
 
 
 def read_spot_label(text: str, n: int, time_s: float, file: str, line: int) -> Spot:
-    """A weld call's comment `seam/name` -> Spot; a call without one is weld n of an unknown seam."""
+    """A weld call's comment -> Spot; a call without one is weld n of an unnamed seam."""
     text = text.strip()
     if not text:
         return Spot(f"spot{n}", "unnamed", time_s)
-    seam, sep, name = text.partition("/")
-    if not sep or not seam or not name or " " in text:
-        raise ProgramError(file, f"line {line}", f"the weld call's comment must be 'seam/name', got {text!r}")
-    return Spot(name, seam, time_s)
+    match = _LABEL.match(text)
+    if match is None:
+        raise ProgramError(file, f"line {line}", f"the weld call's comment must be 'seam/name' "
+                                                 f"(optionally 'gun G schedule S'), got {text!r}")
+    gun, schedule = int(match["gun"] or 1), int(match["schedule"] or 1)
+    return Spot(match["name"], match["seam"], time_s, gun, schedule)
 
 
 def with_tcp_blends(planned: PlannedProgram, robot: RobotModel) -> Program:

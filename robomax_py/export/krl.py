@@ -94,7 +94,8 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     src.append(f"; {_NOTE}: mm, deg, $VEL.CP m/s, $VEL_AXIS and $ACC_AXIS %, blends C_DIS with $APO.CDIS mm")
     signals = _signals(program)
     src += [f"SIGNAL {sig} $IN[{k}]" for sig, k in signals.items()]
-    dat: list[str] = [f"DEFDAT {name}", f"; points of {name}.src"]
+    dat: list[str] = [f"DEFDAT {name}", *(f"; {text}" for text in header_lines(program.header)),
+                      f"; points of {name}.src"]
     for f in program.frames:
         var = "$TOOL" if f.kind == "tool" else "$BASE"
         src.append(f"{var} = {_frame(f.xyz_mm, f.zyx_deg)} ; {f.kind} frame {f.name}")

@@ -15,8 +15,8 @@ import re
 
 import numpy as np
 
-from robomax_py._version import __version__
 from robomax_py._typing import FloatArray
+from robomax_py._version import __version__
 from robomax_py.errors import ExportError
 from robomax_py.export.dialect import PlannedProgram
 from robomax_py.plan import PlanResult
@@ -86,6 +86,8 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
     emit(home, Comment(f"start at home; {len(result.spots)} spots, planned cycle {traj.duration:.3f} s"),
          PtpMove(tuple(np.degrees(home)), opts.speed, 1.0, comment="home"))
     transitions = result.transitions
+    if result.spots and result.spots[0].interlocks:
+        emit(home, *_interlocks(result.spots[0].interlocks))
     if transitions and transitions[0].wait is not None:
         emit(home, *_wait(transitions[0].wait))
     lin_mm_s = opts.tcp_speed * opts.speed * 1000.0     # the override scales LIN speeds too
@@ -110,8 +112,10 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
                                f"{spot.t_leave - t0:.3f} s, alpha {alpha:.1f} beta {beta:.1f} gamma {gamma:.1f} deg"))
         xyz, zyx = pose_mm_zyx(to_frame(C, spot.T_spot))
         emit(spot.q_spot, LinMove(xyz, zyx, spot.config, lin_mm_s, comment="approach"),
-             Spot(identifier(spot.name), identifier(spot.seam), result.weld_time))
+             Spot(identifier(spot.name), identifier(spot.seam), spot.weld_time, spot.gun, spot.schedule))
         xyz, zyx = pose_mm_zyx(to_frame(C, spot.T_app))
+        if k + 1 < len(result.spots) and result.spots[k + 1].interlocks:
+            emit(spot.q_spot, *_interlocks(result.spots[k + 1].interlocks))
         if k + 1 < len(transitions) and transitions[k + 1].wait is not None:
             emit(spot.q_spot, *_wait(transitions[k + 1].wait))
         retract_radius = transitions[k + 1].flyby_radius if k + 1 < len(transitions) else 0.0
@@ -120,6 +124,14 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
                     tuple(identifier(j) for j in result.joint_names), f"robomax_py {__version__}", cell_sha256, stamp)
     return PlannedProgram(Program(identifier(result.cell), header, frames, tuple(out)), tuple(joints))
+
+
+def _interlocks(signals: tuple[str, ...]) -> list[Instruction]:
+    """Waits for clamp inputs before moving to the first weld near each clamp (at rest)."""
+    out: list[Instruction] = []
+    for signal in signals:
+        out += [Comment(f"wait for clamp input {signal}"), WaitFor(identifier(signal))]
+    return out
 
 
 def _wait(w: WaitPlan) -> list[Instruction]:

@@ -53,6 +53,7 @@ from robomax_py.timing import (
 )
 from robomax_py.timing.chain import LinStep, PtpStep, Step, chain_path, time_chain
 from robomax_py.tolerances import DEFAULT as TOL
+from robomax_py.world.scene import distance_to_object
 
 # Frame definitions must match the cell's tool and base within the program's decimals.
 FRAME_TOL_MM = TOL.frame_tol_mm
@@ -162,6 +163,7 @@ class _Builder:
         self.line: int | None = None                      # of the statement being added
         self.step_lines: list[int | None] = []            # of the pending steps
         self.spans: list[Span] = []
+        self.waited: set[str] = set()                      # clamp inputs waited for so far
 
     def start(self, q: FloatArray) -> None:
         self.q = np.asarray(q, dtype=float)
@@ -182,6 +184,7 @@ class _Builder:
                 return False
         if isinstance(ins, Spot):
             label = f"{ins.seam}/{ins.name}"
+            self._check_interlocks(ins, label)
             self.segments.append(dwell(self.q, ins.time_s, kind="weld", label=label))
             config = self.last_config or self.config_text(self.q)
             self.spots.append({"seam": ins.seam, "name": ins.name, "t_arrive": self.t,
@@ -248,12 +251,31 @@ class _Builder:
             self.spans.append(Span(self.t, self.t + seconds, self.line))
             self.t += seconds
 
+    def _check_interlocks(self, spot: Spot, label: str) -> None:
+        """A weld near a clamp with an input comes after waiting for that input."""
+        from robomax_py.export.plan_program import identifier
+
+        seam = next((s for s in self.cell.seams if identifier(s.name) == spot.seam), None)
+        spec = next((p for p in seam.spots if identifier(p.name) == spot.name), None) if seam else None
+        if spec is None:
+            return
+        for obj in self.cell.objects:
+            if obj.signal and identifier(obj.signal) not in self.waited and \
+                    distance_to_object(obj, spec.xyz) <= self.cell.process.interlock_distance:
+                self.problems.append(Problem(self.t, "interlock", f"{label} is welded near clamp {obj.name} before "
+                                                                  f"waiting for its input {obj.signal}", self.line))
+                self.waited.add(identifier(obj.signal))
+
     def _wait_for(self, signal: str) -> None:
         from robomax_py.export.plan_program import identifier
 
+        if any(obj.signal and identifier(obj.signal) == signal for obj in self.cell.objects):
+            self.waited.add(signal)           # a clamp input: set once the clamp is closed, no time planned
+            return
         obstacle = next((d for d in self.cell.dynamic if identifier(d.name) + CLEAR_SUFFIX == signal), None)
         if obstacle is None:
-            known = ", ".join(identifier(d.name) + CLEAR_SUFFIX for d in self.cell.dynamic) or "none in this cell"
+            known = ", ".join([*(identifier(d.name) + CLEAR_SUFFIX for d in self.cell.dynamic),
+                               *(identifier(str(o.signal)) for o in self.cell.objects if o.signal)]) or "none in this cell"
             self.problems.append(Problem(self.t, "signal", f"WAIT FOR {signal}: unknown signal (known: {known})",
                                          self.line))
             return

@@ -57,7 +57,7 @@ DIALECT = "robomax SRCL/1"
 # Upper-case keywords; they cannot be used as names (names are case-sensitive, so `spot` is a name).
 RESERVED: frozenset[str] = frozenset(
     "PROGRAM CELL ROBOT AXES TOOL CYCLE SEC VAR FRAME BASE POS ORI BEGIN ENDPROGRAM "
-    "MOVE PTP LIN AXIS SPEED ACCEL FLYBY CONFIG SPOT SEAM TIME WAIT FOR".split()
+    "MOVE PTP LIN AXIS SPEED ACCEL FLYBY CONFIG SPOT SEAM TIME WAIT FOR GUN SCHEDULE".split()
 )
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -153,7 +153,8 @@ def _statement(ins: Instruction) -> str:
             f"SPEED {_num(ins.speed_mm_s, SPEED_DECIMALS)} MM/S" + _tail(ins.flyby, ins.comment)
         )
     if isinstance(ins, Spot):
-        return f"SPOT {ins.name} SEAM {ins.seam} TIME {_num(ins.time_s, TIME_DECIMALS)} SEC;"
+        return (f"SPOT {ins.name} SEAM {ins.seam} TIME {_num(ins.time_s, TIME_DECIMALS)} SEC "
+                f"GUN {ins.gun} SCHEDULE {ins.schedule};")
     if isinstance(ins, Wait):
         return f"WAIT {_num(ins.seconds, TIME_DECIMALS)} SEC;"
     if isinstance(ins, WaitFor):
@@ -248,7 +249,7 @@ _stmt: ptp | lin | spot | wait | wait_for | note
 ptp: "MOVE" "PTP" "AXIS" "(" NUMBER ("," NUMBER)* ")" "SPEED" NUMBER "ACCEL" NUMBER flyby? COMMENT? ";"
 lin: "MOVE" "LIN" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S flyby? COMMENT? ";"
 flyby: FLYBY NUMBER
-spot: "SPOT" IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ";"
+spot: "SPOT" IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ("GUN" NUMBER "SCHEDULE" NUMBER)? ";"
 wait: "WAIT" NUMBER "SEC" ";"
 wait_for: "WAIT" "FOR" IDENT ";"
 note: COMMENT
@@ -431,6 +432,11 @@ class _Builder:
             )
         return float(token)
 
+    def whole(self, token: Token) -> int:
+        if not re.fullmatch(r"[0-9]+", str(token)) or int(str(token)) < 1:
+            raise self.error(token.line, token.column, f"expected a whole number from 1, got '{token}'")
+        return int(str(token))
+
     def tokens(self, tree: Tree[Token], kind: str) -> list[Token]:
         return [c for c in tree.children if isinstance(c, Token) and c.type == kind]
 
@@ -516,8 +522,9 @@ class _Builder:
             )
         if tree.data == "spot":
             name, seam = self.tokens(tree, "IDENT")
-            (time,) = self.tokens(tree, "NUMBER")
-            return Spot(str(name), str(seam), self.number(time))
+            numbers = self.tokens(tree, "NUMBER")
+            gun, schedule = (self.whole(t) for t in numbers[1:]) if len(numbers) == 3 else (1, 1)
+            return Spot(str(name), str(seam), self.number(numbers[0]), gun, schedule)
         if tree.data == "wait":
             (seconds,) = self.tokens(tree, "NUMBER")
             return Wait(self.number(seconds))

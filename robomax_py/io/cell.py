@@ -133,6 +133,7 @@ class ObjectFile(_Strict):
     mesh: Reference | None = None
     pose: PoseFile = PoseFile()
     workpiece: bool = False
+    signal: Name | None = None          # extension: clamp interlock input (README, cell file extensions)
 
     @model_validator(mode="after")
     def _one_shape(self) -> ObjectFile:
@@ -145,6 +146,13 @@ class ObjectFile(_Strict):
 
 class DynamicObjectFile(ObjectFile):
     present: Annotated[list[Annotated[list[WindowTime], Field(min_length=2, max_length=2)]], Field(min_length=1)]
+
+    @field_validator("signal")
+    @classmethod
+    def _no_signal(cls, v: str | None) -> str | None:
+        if v is not None:
+            raise ValueError("a dynamic object has no clamp signal (the program waits for <name>_clear instead)")
+        return v
 
     @field_validator("present")
     @classmethod
@@ -173,11 +181,30 @@ class ToleranceFile(_Strict):
         return v
 
 
+Angle = Annotated[float, Field(ge=-360, le=360, allow_inf_nan=False)]
+
+
 class SpotFile(_Strict):
     name: Name
     xyz: Vec3
     normal: Vec3
     direction: Vec3
+    # Extensions (README, cell file extensions): per-spot process and pinned choices.
+    weld_time: NonNegative | None = None
+    schedule: Annotated[int, Field(ge=1, le=9999)] | None = None
+    alpha: Angle | None = None
+    beta: Angle | None = None
+    gamma: Angle | None = None
+    config: Annotated[str, Field(min_length=1, max_length=64)] | None = None
+    skip: bool = False
+
+    @model_validator(mode="after")
+    def _pinned_together(self) -> SpotFile:
+        given = [k for k in ("alpha", "beta", "gamma") if getattr(self, k) is not None]
+        if given and len(given) != 3:
+            missing = ", ".join(k for k in ("alpha", "beta", "gamma") if k not in given)
+            raise ValueError(f"a pinned orientation needs alpha, beta and gamma; {missing} missing")
+        return self
 
 
 class SeamFile(_Strict):
@@ -192,6 +219,10 @@ class ProcessFile(_Strict):
     weld_time: NonNegative = 0.5
     approach: NonNegative = 0.03
     clearance: NonNegative = 0.0
+    # Extensions (README, cell file extensions).
+    gun: Annotated[int, Field(ge=1, le=99)] = 1
+    schedule: Annotated[int, Field(ge=1, le=9999)] = 1
+    interlock_distance: Annotated[float, Field(ge=0, le=10, allow_inf_nan=False)] = 0.2
 
 
 class PlannerFile(_Strict):
@@ -251,11 +282,14 @@ def load_cell(path: str | Path) -> CellSpec:
         home=frozen_array(_home(parsed, robot_spec, path)),
         tool=tool_spec,
         objects=tuple(_object(o, path, f"objects[{i}]") for i, o in enumerate(parsed.objects)),
-        seams=tuple(_seam(s, path, f"seams[{i}]") for i, s in enumerate(parsed.seams)),
+        seams=_seams(parsed, path),
         process=ProcessSpec(
             weld_time=parsed.process.weld_time,
             approach=parsed.process.approach,
             clearance=parsed.process.clearance,
+            gun=parsed.process.gun,
+            schedule=parsed.process.schedule,
+            interlock_distance=parsed.process.interlock_distance,
         ),
         planner=PlannerSpec(seed=parsed.planner.seed, speed=parsed.planner.speed, tcp_speed=parsed.planner.tcp_speed,
                             detour_speed=parsed.planner.detour_speed),
@@ -342,8 +376,20 @@ def _object(obj: ObjectFile, path: Path, key: str) -> ObjectSpec:
         present = tuple((float(t0), float(t1)) for t0, t1 in obj.present)
     return ObjectSpec(
         name=obj.name, shape=shape, T_world_object=frozen_array(_pose(obj.pose)),
-        workpiece=obj.workpiece, present=present,
+        workpiece=obj.workpiece, present=present, signal=obj.signal,
     )
+
+
+def _check_pinned(spot: SpotFile, tol: ToleranceFile, path: Path, key: str) -> None:
+    """A pinned orientation must lie inside its seam's tolerance window."""
+    for name, value, lo, hi in (("alpha", spot.alpha, -tol.alpha, tol.alpha), ("beta", spot.beta, -tol.beta, tol.beta)):
+        if value is not None and not lo - 1e-9 <= value <= hi + 1e-9:
+            raise CellFileError(path, f"{key}.{name}", f"pinned {name} {value:g} deg is outside the seam's tolerance "
+                                                      f"[{lo:g}, {hi:g}]")
+    g0, g1 = tol.gamma
+    g = spot.gamma
+    if g is not None and g1 - g0 < 360 and not any(g0 - 1e-9 <= g + k * 360 <= g1 + 1e-9 for k in (-1, 0, 1)):
+        raise CellFileError(path, f"{key}.gamma", f"pinned gamma {g:g} deg is outside the seam's tolerance [{g0:g}, {g1:g}]")
 
 
 def _stem_name(path: Path) -> str:
@@ -364,22 +410,38 @@ def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError) -> 
         raise type(error)(error.file, error.key, f"{error.problem}: {exc}") from None
 
 
+def _seams(parsed: CellFile, path: Path) -> tuple[SeamSpec, ...]:
+    """The seams with their spots to weld: spots marked `skip` are left out, and so is a seam
+    left without spots; a cell left without any is an error."""
+    seams = tuple(s for s in (_seam(s, path, f"seams[{i}]") for i, s in enumerate(parsed.seams)) if s.spots)
+    if not seams:
+        raise CellFileError(path, "seams", "every spot is marked skip: nothing to weld")
+    return seams
+
+
 def _seam(seam: SeamFile, path: Path, key: str) -> SeamSpec:
     spots = []
+    tol = seam.tolerance
     for j, spot in enumerate(seam.spots):
         spot_key = f"{key}.spots[{j}]"
+        if spot.skip:
+            continue
         normal = _unit(spot.normal, path, f"{spot_key}.normal")
         direction = _unit(spot.direction, path, f"{spot_key}.direction")
         along = direction - np.dot(direction, normal) * normal
         if np.linalg.norm(along) < MIN_DIRECTION_SINE:
             raise CellFileError(path, f"{spot_key}.direction", f"parallel to the normal {spot.normal}: no seam direction")
+        angles = None
+        if spot.alpha is not None and spot.beta is not None and spot.gamma is not None:
+            angles = (deg_to_rad(spot.alpha), deg_to_rad(spot.beta), deg_to_rad(spot.gamma))
+            _check_pinned(spot, tol, path, spot_key)
         spots.append(SpotSpec(
             name=spot.name,
             xyz=frozen_array(spot.xyz),
             normal=frozen_array(normal),
             direction=frozen_array(along / np.linalg.norm(along)),
+            weld_time=spot.weld_time, schedule=spot.schedule, angles=angles, config=spot.config,
         ))
-    tol = seam.tolerance
     return SeamSpec(
         name=seam.name,
         ordered=seam.ordered,

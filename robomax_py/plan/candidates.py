@@ -19,11 +19,13 @@ from robomax_py.plan.poses import (
     OrientationGrid,
     approach_poses,
     orientation_grid,
+    pinned_index,
     spot_poses,
 )
 from robomax_py.robot import RobotModel, prismatic_mask
+from robomax_py.robot.ik import same_config
 from robomax_py.robot.ik.turns import wrap_to_pi
-from robomax_py.robot.solve import IkTable, solve_all
+from robomax_py.robot.solve import IkTable, config_text, solve_all
 from robomax_py.spec import CellSpec, SeamSpec
 from robomax_py.transforms import invert
 from robomax_py.world.collision import CollisionWorld
@@ -42,7 +44,7 @@ MAX_TURN_VARIANTS = 4
 
 
 RejectionKind = Literal["joint_limit", "approach_branch", "approach_joint_limit", "unreachable", "collision",
-                        "approach_blocked", "turn_variant"]
+                        "approach_blocked", "turn_variant", "pinned_orientation", "pinned_config"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -141,6 +143,19 @@ def _spot_candidates(
     # line jumps within its column: unwrap revolute joints towards the spot value.
     at_spot = reachable[:, -1, :]
     within = at_spot & valid[:, -1, :]                               # (m, B)
+    spot = seam.spots[s]
+    pinned = pinned_index(grid, spot)
+    if pinned is not None:                                           # only the pinned orientation
+        others = np.ones(len(within), dtype=bool)
+        others[pinned] = False
+        n_other = int(within[others].sum())
+        within = within & ~others[:, None]
+    if spot.config is not None:                                      # only the pinned configuration
+        ok = np.zeros_like(within)
+        for o, k in zip(*np.nonzero(within)):
+            ok[o, k] = same_config(spot.config, config_text(robot, q[o, -1, k]))
+        n_config = int((within & ~ok).sum())
+        within = ok
     oo, kk = np.nonzero(within)                                      # in scan order
     sub = q[oo, :, kk]                                               # (c, L, n) their lines
     spot_q = sub[:, -1:, :]
@@ -164,7 +179,11 @@ def _spot_candidates(
         if n:
             found[reason] = (float(where[np.argmax(mask)]), n)
 
-    count(Rejection("joint_limit"), (at_spot & ~within).reshape(-1), np.arange(at_spot.size))
+    if pinned is not None and n_other:
+        found[Rejection("pinned_orientation")] = (-2.0, n_other)
+    if spot.config is not None and n_config:
+        found[Rejection("pinned_config", spot.config)] = (-1.0, n_config)
+    count(Rejection("joint_limit"), (at_spot & ~valid[:, -1, :]).reshape(-1), np.arange(at_spot.size))
     count(Rejection("approach_branch"), ~branch_ok, position)
     count(Rejection("approach_joint_limit"), branch_ok & ~inside, position)
     no_branch = ~at_spot.any(axis=1)
@@ -191,7 +210,6 @@ def _spot_candidates(
     idx_k = np.array([k for _, k in keep], dtype=np.int64)
     n = robot.dof
     paths = np.array([lines[(o, k)] for o, k in keep]) if keep else np.zeros((0, n_line, n))
-    spot = seam.spots[s]
     return SpotCandidates(
         seam_index=seam_index, spot_index=s, name=spot.name,
         orient=idx_o, angles=grid.angles[idx_o] if keep else np.zeros((0, 3)), column=idx_k,

@@ -90,8 +90,8 @@ class Sequencer:
         self.rounds = 0
         self.dp_evaluations = 0
         # Per spot: time of approach + weld + retract (joint-time estimate of the short LIN moves).
-        weld = cell.process.weld_time
-        self.node = [2 * ptp_time_estimate(c.q_app, c.q_spot, self.limits, options.speed) + weld for c in spots]
+        weld = [cell.process.weld_time_of(cell.seams[c.seam_index].spots[c.spot_index]) for c in spots]
+        self.node = [2 * ptp_time_estimate(c.q_app, c.q_spot, self.limits, options.speed) + w for c, w in zip(spots, weld)]
         self.straight: dict[tuple[int, int], dict[tuple[int, int], bool]] = {}   # (i, j) -> (a, b) -> free
         self.detour_only: set[tuple[int, int]] = set()                           # unordered spot pairs
         self.no_way: dict[tuple[int, int], set[tuple[int, int]]] = {}            # (i, j) -> {(a, b)} unconnectable

@@ -157,7 +157,8 @@ def _failure(cell: CellSpec, c: SpotCandidates) -> SpotFailure:
     groups: Counter[str] = Counter()
     for reason, n in c.rejected.items():
         groups[reason.kind] += n
-    order = ("approach_blocked", "collision", "approach_branch", "approach_joint_limit", "joint_limit", "unreachable")
+    order = ("approach_blocked", "collision", "approach_branch", "approach_joint_limit", "joint_limit", "unreachable",
+             "pinned_config", "pinned_orientation")
     for reason in order:
         if groups.get(reason):
             detail = ", ".join(f"{k} x{v}" for k, v in c.rejected.most_common(4))

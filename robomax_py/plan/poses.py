@@ -55,6 +55,10 @@ def orientation_grid(seam: SeamSpec) -> OrientationGrid:
     # towards the nominal one (the published baseline's choice); stable for equal distances.
     order = np.argsort(np.abs(combos).sum(axis=1), kind="stable")
     combos = combos[order]
+    # Orientations pinned by a spot (cell-file extension) join the grid after its own samples.
+    pins = [np.array(spot.angles) for spot in seam.spots if spot.angles is not None]
+    if pins:
+        combos = np.vstack([combos, *pins])
     kept_angles: list[FloatArray] = []
     kept_R: list[FloatArray] = []
     for a, b, g in combos:
@@ -64,6 +68,15 @@ def orientation_grid(seam: SeamSpec) -> OrientationGrid:
         kept_angles.append(np.array([a, b, g]))
         kept_R.append(R)
     return OrientationGrid(angles=np.array(kept_angles), R_offset=np.array(kept_R))
+
+
+def pinned_index(grid: OrientationGrid, spot: SpotSpec) -> int | None:
+    """The grid orientation a spot's pinned angles name (None: not pinned)."""
+    if spot.angles is None:
+        return None
+    a, b, g = spot.angles
+    R = rot_x(a) @ rot_y(b) @ rot_z(g)
+    return int(np.argmin(np.abs(grid.R_offset - R).reshape(len(grid), -1).max(axis=1)))
 
 
 def nominal_rotation(spot: SpotSpec) -> FloatArray:

@@ -56,6 +56,10 @@ class SpotPlan:
     T_spot: FloatArray               # (4, 4) TCP at the spot, robot base frame
     T_app: FloatArray                # (4, 4) TCP at the approach point, robot base frame
     config_app: str = ""             # configuration data at the approach point (where the retract ends)
+    weld_time: float = 0.0           # s, as the program states it
+    gun: int = 1
+    schedule: int = 1
+    interlocks: tuple[str, ...] = ()  # clamp signals the program waits for before moving to this spot
 
 
 @dataclass(frozen=True, slots=True)

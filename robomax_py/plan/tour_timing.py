@@ -44,7 +44,7 @@ from robomax_py.timing import (
 )
 from robomax_py.transforms import invert
 from robomax_py.world.collision import CollisionWorld
-from robomax_py.world.scene import build_scene
+from robomax_py.world.scene import build_scene, distance_to_object
 
 
 def time_tour(
@@ -62,7 +62,8 @@ def time_tour(
     blocks: list[list[Segment]] = []
     timed: list[Transition] = []
     q_now = as_written_joints(cell.home)
-    weld_time = written_seconds(cell.process.weld_time)
+    spec_of = [cell.seams[spots[i].seam_index].spots[spots[i].spot_index] for i in tour.order]
+    weld_times = [written_seconds(cell.process.weld_time_of(spot)) for spot in spec_of]
     for k, trans in enumerate(transitions):
         progress("timing", k, len(transitions))
         before = ends[k - 1] if k > 0 else None
@@ -79,7 +80,7 @@ def time_tour(
         timed.append(replace(trans, blend_radius=junction.corner_radius, flyby_radius=junction.junction_radius))
         q_now = block[-1].q[-1]
         if after is not None:
-            block.append(dwell(q_now, weld_time, kind="weld", label=after.label))
+            block.append(dwell(q_now, weld_times[k], kind="weld", label=after.label))
         blocks.append(block)
     segments: list[Segment] = []
     waits = {w.index: w for w in _waits(cell, robot, blocks)}
@@ -92,7 +93,8 @@ def time_tour(
     progress("timing", len(transitions), len(transitions))
     traj = resample(concatenate(segments))
     plans = []
-    for i, a, T_spot, T_app in welded:
+    waits_for = interlocks(cell, [spots[i] for i in tour.order])
+    for k, (i, a, T_spot, T_app) in enumerate(welded):
         c = spots[i]
         seam = cell.seams[c.seam_index]
         label = f"{seam.name}/{c.name}"
@@ -102,8 +104,24 @@ def time_tour(
         # the spot and changes sign over the approach line (issue 14).
         plans.append(SpotPlan(seam.name, c.name, c.angles[a], config_text(robot, c.q_spot[a]), q_spot,
                               as_written_joints(c.q_app[a]), float(phase.t_start), float(phase.t_end), T_spot, T_app,
-                              config_text(robot, c.q_app[a])))
+                              config_text(robot, c.q_app[a]), weld_times[k], cell.process.gun,
+                              cell.process.schedule_of(spec_of[k]), waits_for[k]))
     return traj, plans, timed
+
+
+def interlocks(cell: CellSpec, order: list[SpotCandidates]) -> list[tuple[str, ...]]:
+    """Per spot in weld order, the clamp signals to wait for before moving to it: each clamp
+    (an object with `signal`) before the first weld within `process.interlock_distance` of it."""
+    out: list[tuple[str, ...]] = [() for _ in order]
+    clamps = [o for o in cell.objects if o.signal]
+    if not clamps:
+        return out
+    points = [np.asarray(cell.seams[c.seam_index].spots[c.spot_index].xyz, dtype=float) for c in order]
+    for obj in clamps:
+        near = [k for k, p in enumerate(points) if distance_to_object(obj, p) <= cell.process.interlock_distance]
+        if near:
+            out[near[0]] = (*out[near[0]], str(obj.signal))
+    return out
 
 
 def weld_end(cell: CellSpec, c: SpotCandidates, a: int, grids: list[OrientationGrid]) -> WeldEnd:

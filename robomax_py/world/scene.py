@@ -265,3 +265,18 @@ __all__ = [
     "build_scene",
     "shape_pieces",
 ]
+
+
+def distance_to_object(obj: ObjectSpec, point: FloatArray) -> float:
+    """Distance (m) from a world point to an object's geometry (0 inside or touching)."""
+    probe = coal.Sphere(1e-6)
+    T_probe = coal.Transform3s(np.eye(3), np.asarray(point, dtype=float))
+    T = np.asarray(obj.T_world_object, dtype=float)
+    T_obj = coal.Transform3s(T[:3, :3], T[:3, 3])
+    pieces, _ = shape_pieces(obj.shape)
+    best = np.inf
+    for piece in pieces:
+        result = coal.DistanceResult()
+        coal.distance(piece, T_obj, probe, T_probe, coal.DistanceRequest(), result)
+        best = min(best, max(0.0, float(result.min_distance) + 1e-6))
+    return float(best)

@@ -1,47 +1,133 @@
-"""Program exporters on a real plan: golden files, and the SRCL text parses back to the same bytes."""
+"""Program exporters on real plans: golden files for every dialect, for the small cell and for a cell
+with a dynamic obstacle (a WAIT), a clamp interlock signal and per-spot process overrides; each
+written program reads back to the program it was written from (`publish` proves it)."""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import pytest
+import yaml
 
-from robomax_py.export import FORMATS, render
-from robomax_py.export.plan_program import identifier
+from robomax_py.export import DIALECTS
+from robomax_py.export.plan_program import identifier, program_from_plan
 from robomax_py.export.srcl import parse_program, write_program
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import plan_cell
+from robomax_py.program import Spot, WaitFor
+from robomax_py.publish import publish
 
 REPO = Path(__file__).resolve().parents[2]
 GOLDEN = REPO / "tests" / "golden"
+ALL = tuple(DIALECTS)
+# Where the small cell's robot passes about 0.8 s into its first move (tests/plan/test_waiting.py
+# derives it from the plan; frozen here so the golden cell is a fixed file).
+DOOR = {"name": "door", "box": [0.12, 0.12, 0.12], "pose": {"xyz": [1.4616, -0.0182, 1.2151]}, "present": [[0, 1.5]]}
+
+
+def _planned(path: Path) -> dict[str, Any]:
+    cell = load_cell(path)
+    robot = load_cell_robot(cell)
+    result = plan_cell(cell, robot)
+    assert result.status == "planned", result.message
+    files, checked = publish(result, cell, robot, ALL)
+    return {"cell": cell, "robot": robot, "result": result, "files": files, "checked": checked}
 
 
 @pytest.fixture(scope="module")
-def small_plan(tmp_path_factory: pytest.TempPathFactory, write_small_cell):  # type: ignore[no-untyped-def]
-    """The plan of the small test cell (conftest.write_small_cell)."""
-    cell = load_cell(write_small_cell(tmp_path_factory.mktemp("small")))
-    result = plan_cell(cell, load_cell_robot(cell))
-    assert result.status == "planned", result.message
-    return result
+def small(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> dict[str, Any]:  # type: ignore[no-untyped-def]
+    return _planned(write_small_cell(tmp_path_factory.mktemp("small")))
 
 
-@pytest.mark.parametrize("fmt", sorted(FORMATS))
-def test_golden(small_plan, fmt: str, update_golden: bool) -> None:  # type: ignore[no-untyped-def]
-    text = render(small_plan, fmt)
-    golden = GOLDEN / f"small_cell{FORMATS[fmt].extension}"
-    if update_golden:
-        golden.write_text(text)
-    assert golden.is_file(), f"missing {golden}: run pytest --update-golden and review the diff"
-    assert text == golden.read_text(), f"{golden.name} changed: review, then pytest --update-golden"
+@pytest.fixture(scope="module")
+def process_cell(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> dict[str, Any]:  # type: ignore[no-untyped-def]
+    """The small cell with a door to wait for, clamp 1 behind an input, gun 2 and s8 welded longer
+    with its own schedule."""
+    tmp = tmp_path_factory.mktemp("process")
+    path = write_small_cell(tmp, name="process_cell")
+    data = yaml.safe_load(path.read_text())
+    data["dynamic"] = [DOOR]
+    data["process"]["gun"] = 2
+    data["process"]["schedule"] = 4
+    for obj in data["objects"]:
+        if obj["name"] == "clamp1_jaw":
+            obj["signal"] = "clamp1_closed"
+    for spot in data["seams"][0]["spots"]:
+        if spot["name"] == "s8":
+            spot.update(weld_time=0.8, schedule=7)
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return _planned(path)
 
 
-def test_srcl_of_a_plan_parses_back_byte_identical(small_plan) -> None:  # type: ignore[no-untyped-def]
-    text = render(small_plan, "srcl")
+def _golden(planned: dict[str, Any], update: bool) -> None:
+    name = planned["result"].cell
+    folder = GOLDEN / name
+    for file, text in planned["files"].items():
+        golden = folder / file
+        if update:
+            folder.mkdir(exist_ok=True)
+            golden.write_text(text)
+        assert golden.is_file(), f"missing {golden}: run pytest --update-golden and review the diff"
+        assert text == golden.read_text(), f"{name}/{file} changed: review, then pytest --update-golden"
+    assert sorted(p.name for p in folder.iterdir()) == sorted(planned["files"])
+
+
+def test_golden_small_cell(small: dict[str, Any], update_golden: bool) -> None:
+    _golden(small, update_golden)
+
+
+def test_golden_process_cell(process_cell: dict[str, Any], update_golden: bool) -> None:
+    _golden(process_cell, update_golden)
+
+
+def test_every_dialect_is_proven_and_close_to_the_plan(small: dict[str, Any], process_cell: dict[str, Any]) -> None:
+    for planned in (small, process_cell):
+        by_format = {c.format: c for c in planned["checked"]}
+        assert set(by_format) == set(ALL)
+        assert by_format["srcl"].difference.identical            # SRCL states the planned values as they are
+        for c in planned["checked"]:
+            assert c.difference.within()
+            assert c.report is None or c.report.clean
+
+
+def test_the_process_cell_waits_and_welds_as_asked(process_cell: dict[str, Any]) -> None:
+    program = program_from_plan(process_cell["result"], process_cell["cell"].digest)
+    waits = [i.signal for i in program.instructions if isinstance(i, WaitFor)]
+    assert "clamp1_closed" in waits and "door_clear" in waits
+    spots = {i.name: i for i in program.instructions if isinstance(i, Spot)}
+    assert (spots["s8"].time_s, spots["s8"].schedule, spots["s8"].gun) == (0.8, 7, 2)
+    assert (spots["s7"].time_s, spots["s7"].schedule, spots["s7"].gun) == (0.5, 4, 2)
+    first_weld = next(k for k, i in enumerate(program.instructions) if isinstance(i, Spot))
+    clamp_wait = next(k for k, i in enumerate(program.instructions) if isinstance(i, WaitFor) and i.signal == "clamp1_closed")
+    assert clamp_wait < first_weld
+    weld = [p for p in process_cell["result"].trajectory.phases_of("weld") if p.label.endswith("/s8")][0]
+    assert weld.t_end - weld.t_start == pytest.approx(0.8, abs=1e-9)
+
+
+def test_srcl_of_a_plan_parses_back_byte_identical(small: dict[str, Any]) -> None:
+    text = small["files"][f"{small['result'].cell}.srcl"]
     program = parse_program(text, "small_cell.srcl")
     assert write_program(program) == text
-    assert program.header.joints == small_plan.joint_names
+    assert program.header.joints == small["result"].joint_names
+    assert program.header.cell_sha256 == small["cell"].digest
     spots = [i for i in program.instructions if type(i).__name__ == "Spot"]
-    assert [s.name for s in spots] == [s.name for s in small_plan.spots]
+    assert [s.name for s in spots] == [s.name for s in small["result"].spots]
+
+
+def test_stamp_only_when_asked(small: dict[str, Any]) -> None:
+    files, _ = publish(small["result"], small["cell"], small["robot"], ALL, stamp="2026-12-02")
+    for file, text in files.items():
+        if file.endswith(".json") or file == "spot_weld.ls":
+            continue
+        assert "written 2026-12-02" in text, file
+        assert "written " not in small["files"][file], file
+
+
+def test_baseline_files_are_named_apart(small: dict[str, Any]) -> None:
+    files, _ = publish(small["result"], small["cell"], small["robot"], ("srcl", "krl"), baseline=True)
+    assert sorted(files) == ["small_cell_baseline.dat", "small_cell_baseline.json", "small_cell_baseline.src",
+                             "small_cell_baseline.srcl"]
 
 
 @pytest.mark.parametrize(("name", "ident"), [("door-L 2", "door_L_2"), ("7up", "_7up"), ("s1", "s1")])

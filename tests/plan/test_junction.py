@@ -196,7 +196,8 @@ def test_without_flyby_every_junction_stops() -> None:
 def test_per_move_speeds_are_planned_written_and_rebuilt(tmp_path: Path, write_small_cell: Any, small_plan: Any) -> None:
     import yaml
 
-    from robomax_py.export import render
+    from robomax_py.export.plan_program import program_from_plan
+    from robomax_py.export.srcl import write_program
     from robomax_py.export.rebuild import rebuild
     from robomax_py.export.srcl import parse_program
     from robomax_py.program import LinMove, PtpMove
@@ -210,7 +211,7 @@ def test_per_move_speeds_are_planned_written_and_rebuilt(tmp_path: Path, write_s
     slow = plan_cell(cell, robot, PlanOptions())
     assert slow.status == "planned", slow.message
     assert slow.cycle_time > small_plan[2].cycle_time
-    program = parse_program(render(slow, "srcl"))
+    program = parse_program(write_program(program_from_plan(slow)))
     ptp = [i for i in program.instructions if isinstance(i, PtpMove)]
     assert {i.speed for i in ptp if "detour point" in i.comment} == {0.25}
     assert {i.speed for i in ptp[1:] if "detour point" not in i.comment and "->" in i.comment} == {0.5}

@@ -12,7 +12,8 @@ import yaml
 from typer.testing import CliRunner
 
 from robomax_py.app.cli import EXIT_OK, app
-from robomax_py.export import render
+from robomax_py.export.plan_program import program_from_plan
+from robomax_py.export.srcl import write_program
 from robomax_py.export.rebuild import rebuild
 from robomax_py.export.srcl import parse_program
 from robomax_py.io.cell import load_cell, load_cell_robot
@@ -67,7 +68,7 @@ def test_robot_waits_for_the_door_and_the_program_says_so(door_cell: dict[str, A
     assert result.cycle_time == pytest.approx(door_cell["free"].cycle_time + wait.seconds, abs=1e-9)
     (phase,) = result.trajectory.phases_of("wait")
     assert phase.t_start == 0.0 and phase.t_end == pytest.approx(1.501, abs=1e-9)
-    program = parse_program(render(result, "srcl"))
+    program = parse_program(write_program(program_from_plan(result)))
     assert WaitFor("door_clear") in program.instructions
     rebuilt = rebuild(program, cell, robot, "door.srcl")
     assert rebuilt.problems == []

@@ -16,7 +16,7 @@ import pytest
 from typer.testing import CliRunner
 
 from robomax_py.app.cli import EXIT_BAD_INPUT, EXIT_OK, EXIT_VIOLATIONS, app
-from robomax_py.export import render
+from robomax_py.export.plan_program import program_from_plan
 from robomax_py.export.rebuild import rebuild
 from robomax_py.export.srcl import parse_program
 from robomax_py.io.cell import load_cell, load_cell_robot
@@ -35,7 +35,7 @@ def planned(tmp_path_factory: pytest.TempPathFactory, write_small_cell: SmallCel
     robot = load_cell_robot(cell)
     result = plan_cell(cell, robot, PlanOptions())
     assert result.status == "planned", result.message
-    text = render(result, "srcl")
+    text = write_program(program_from_plan(result))
     (tmp / "small_cell.srcl").write_text(text)
     return {"tmp": tmp, "cell_path": cell_path, "cell": cell, "robot": robot, "result": result, "text": text}
 

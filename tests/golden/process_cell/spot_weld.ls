@@ -1,0 +1,25 @@
+/PROG  SPOT_WELD
+/ATTR
+OWNER		= MNEDITOR;
+COMMENT		= "default weld";
+PROG_SIZE	= 0;
+FILE_NAME	= SPOT_WELD;
+VERSION		= 0;
+LINE_COUNT	= 4;
+MEMORY_SIZE	= 0;
+PROTECT		= READ_WRITE;
+TCD:  STACK_SIZE	= 0,
+      TASK_PRIORITY	= 50,
+      TIME_SLICE	= 0,
+      BUSY_LAMP_OFF	= 0,
+      ABORT_REQUEST	= 0,
+      PAUSE_REQUEST	= 0;
+DEFAULT_GROUP	= 1,*,*,*,*;
+CONTROL_CODE	= 00000000 00000000;
+/MN
+   1:  ! default weld: rest AR[2] s ;
+   2:  ! replace with the gun's package ;
+   3:  R[1:weld_time]=AR[2] ;
+   4:  WAIT R[1] ;
+/POS
+/END
