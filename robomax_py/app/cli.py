@@ -238,8 +238,12 @@ def verify(
         out.print(f"{program}: {report.samples} samples, cycle {report.cycle_time:.3f} s, "
                   f"{report.collision_checks} collision checks")
         for v in report.violations:
-            when = "" if v.t is None else f"t = {v.t:.3f} s: "
-            out.print(f"  [red]{v.kind}[/]: {when}{v.detail}", soft_wrap=True)
+            where = f"line {v.line}, " if v.line is not None else ""
+            when = "" if v.t is None else (f"t = {v.t:.3f}-{v.t_end:.3f} s" if v.t_end is not None else f"t = {v.t:.3f} s")
+            place = f"{where}{when}".rstrip(", ")
+            out.print(f"  [red]{v.kind}[/]: {place + ': ' if place else ''}{v.detail}", soft_wrap=True)
+        if report.ignored:
+            out.print(f"  {len(report.ignored)} statement(s) read but without effect on the motion (I/O, declarations ...)")
         if report.clean:
             out.print("[green]clean[/]: no collisions, limits kept, every spot welded within tolerance")
             return EXIT_OK

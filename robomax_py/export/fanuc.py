@@ -189,7 +189,9 @@ _UTOOL = re.compile(r"^UTOOL\[([0-9]+)\]\s*=\s*PR\[([0-9]+)\]$", re.I)
 _POS_HEAD = re.compile(r"^P\[([0-9]+)(?::[^\]]*)?\]\s*\{", re.I)
 _FIELD = re.compile(r"\b(X|Y|Z|W|P|R|J[1-6])\s*=\s*([+-]?[0-9]*\.?[0-9]+)\s*(mm|deg)", re.I)
 _CONFIG = re.compile(r"CONFIG\s*:\s*'([^']*)'", re.I)
-_UNSIMULATED = re.compile(r"^(C|A)\s+P\[|^(J|L)\s+PR\[|^.*\bOffset\b|^.*\bTool_Offset\b|^.*\bINC\b", re.I)
+# Motions this reader does not simulate, and control flow (jumps, conditions): the program's
+# motion then depends on what the reader cannot follow.
+_UNSIMULATED = re.compile(r"^(C|A)\s+P\[|^(J|L)\s+PR\[|^JMP\b|^IF\b|^SELECT\b|^FOR\b|^CALL\s+(?!SPOT_WELD\b)", re.I)
 
 
 def _positions(text: str, file: str, start_line: int) -> dict[int, tuple[dict[str, float], str, int]]:
@@ -199,8 +201,9 @@ def _positions(text: str, file: str, start_line: int) -> dict[int, tuple[dict[st
     for block in blocks:
         head = _POS_HEAD.match(block)
         if head:
-            fields = {m.group(1).upper(): float(m.group(2)) for m in _FIELD.finditer(block)}
-            config = _CONFIG.search(block)
+            group1 = re.split(r"\bGP[2-9]\s*:", block)[0]         # the robot's group; others are positioners
+            fields = {m.group(1).upper(): float(m.group(2)) for m in _FIELD.finditer(group1)}
+            config = _CONFIG.search(group1)
             out[int(head.group(1))] = (fields, config.group(1) if config else "", line)
         line += block.count("\n")
     return out
@@ -244,13 +247,14 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
                 n = int(instructions[-1].name[4:]) if instructions[-1].seam == "unnamed" else 0
                 instructions[-1] = read_spot_label(remark, n, instructions[-1].time_s, file, number)
             continue
-        if _UNSIMULATED.match(stmt) or (_MOVE.match(stmt) and re.search(r"\b(Offset|Tool_Offset|INC|VOFFSET|TB|TA|DB)\b",
-                                                                     _MOVE.match(stmt).group(7) or "", re.I)):
+        move = _MOVE.match(stmt)
+        # Offsets and incremental moves change the target; TB/TA/DB triggers and ACC do not.
+        if _UNSIMULATED.match(stmt) or (move and re.search(r"\b(Offset|Tool_Offset|INC|VOFFSET|Skip)\b",
+                                                           move.group(7) or "", re.I)):
             ignored.append((number, stmt))
             instructions.append(Comment(f"not simulated: {stmt}"))
             where.append(number)
             continue
-        move = _MOVE.match(stmt)
         if move:
             kind, k, speed, unit = move.group(1).upper(), int(move.group(2)), float(move.group(3)), move.group(4).lower()
             cnt = 0 if move.group(5).upper() == "FINE" else int(move.group(6))
@@ -269,9 +273,9 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
                     raise error(number, f"a linear move's speed must be in mm/sec here, got {unit}")
                 instructions.append(LinMove((fields["X"], fields["Y"], fields["Z"]), (fields["R"], fields["P"], fields["W"]),
                                             config, speed, flyby=cnt * CNT_DEG))
-            else:
+            else:                          # a joint move to a Cartesian point, or the other way round
                 ignored.append((number, stmt))
-                continue
+                instructions.append(Comment(f"not simulated: {stmt}"))
             where.append(number)
             continue
         call = _CALL.match(stmt)

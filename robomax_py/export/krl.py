@@ -194,8 +194,13 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 """
 
 # Motions KRL has that this reader does not simulate: a program with one is not verified clean.
-_UNSIMULATED = re.compile(r"^(CIRC|SPTP|SLIN|SCIRC|PTP_REL|LIN_REL|CIRC_REL|SPTP_REL|SLIN_REL|SPLINE|PTP_SPLINE)\b", re.I)
+_UNSIMULATED = re.compile(r"^(CIRC|SPTP|SLIN|SCIRC|PTP_REL|LIN_REL|CIRC_REL|SPTP_REL|SLIN_REL|SPLINE|PTP_SPLINE|RSI_MOVECORR)\b",
+                          re.I)
 _KNOWN = re.compile(r"^(PTP|LIN|\$|spot_weld\s*\(|WAIT\s+(SEC|FOR)\b|SIGNAL\b|DECL\s+(E6AXIS|AXIS|E6POS|POS|FRAME)\b)", re.I)
+
+
+_BLOCK_START = re.compile(r"^(IF\b.*\bTHEN|LOOP|WHILE\b.*|FOR\b.*|REPEAT|SWITCH\b.*)$", re.I)
+_BLOCK_END = re.compile(r"^(ENDIF|ENDLOOP|ENDWHILE|ENDFOR|UNTIL\b.*|ENDSWITCH)$", re.I)
 
 
 @lru_cache(maxsize=1)
@@ -226,6 +231,7 @@ class _Reader:
         self.acc_axis = [100.0] * 6
         self.vel_cp = 2.0                      # m/s, KSS default $VEL.CP
         self.cdis = 0.0
+        self.depth = 0                         # of control-flow blocks
         self.last_axes: dict[str, float] = {}
         self.last_pose: dict[str, float] = {}
 
@@ -267,6 +273,18 @@ class _Reader:
         self.lines.append(line)
 
     def statement(self, text: str, comment: str, line: int) -> None:
+        if _BLOCK_END.match(text):
+            self.depth = max(0, self.depth - 1)
+            return
+        if _BLOCK_START.match(text):
+            self.depth += 1
+            self.ignored.append((line, text))
+            return
+        if self.depth > 0 and (_UNSIMULATED.match(text) or _KNOWN.match(text)) and not text.upper().startswith("DECL"):
+            # Inside IF / LOOP / WHILE / FOR / REPEAT / SWITCH: the reader does not follow control flow.
+            self.ignored.append((line, text))
+            self.add(Comment(f"not simulated: {text}"), line)
+            return
         if _UNSIMULATED.match(text):
             self.ignored.append((line, text))
             self.add(Comment(f"not simulated: {text}"), line)

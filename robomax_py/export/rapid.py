@@ -63,8 +63,9 @@ __all__ = ["adapt", "parse", "write"]
 
 _NOTE = "RAPID module"
 _EAX = "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]"
-# A quaternion is unit when its norm is within this of 1 (written with 9 decimals: ~1e-9).
-UNIT_QUATERNION_TOL = 1e-6
+# A quaternion is unit when its norm is within this of 1: robomax writes 9 decimals (~1e-9 off);
+# programs with 4-decimal quaternions, as many ABB programs carry, are within 1e-4. It is then normalised.
+UNIT_QUATERNION_TOL = 1e-4
 # `vmax` in a MoveL: the largest predefined TCP speed (v7000, RAPID reference "speeddata").
 VMAX_TCP_MM_S = 7000.0
 
@@ -167,12 +168,12 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
 
 _GRAMMAR = r"""
 ?start: decl | move | velset | accset | waittime | waitdi | weld
-decl: ("CONST"i | "PERS"i | "VAR"i) NAME NAME ":=" value
+decl: ("CONST"i | "PERS"i | "VAR"i) NAME NAME (":=" value)?
 move: MOVE arg ("," arg | opt)*
 velset: "VelSet"i NUMBER "," NUMBER
 accset: "AccSet"i NUMBER "," NUMBER ("\\" NAME ":=" NUMBER)?
 waittime: "WaitTime"i ("\\" NAME ",")? NUMBER
-waitdi: "WaitDI"i NAME "," NUMBER
+waitdi: "WaitDI"i NAME "," NUMBER ("\\" NAME (":=" value)?)*
 weld: "spot_weld"i NUMBER "," NUMBER
 ?arg: value | opt
 opt: "\\" NAME (":=" value)?
@@ -188,7 +189,14 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 
 _UNSIMULATED = re.compile(r"^(MoveJ|MoveC|MoveLDO|MoveJDO|MoveLSync|MoveJSync|MoveCSync|MoveExtJ|SearchL|SearchC|"
                           r"TriggL|TriggJ|TriggC|MoveLRel|MoveAbsJDO|MoveAbsJSync|SpotL|SpotJ)\b", re.I)
-_KNOWN = re.compile(r"^(CONST|PERS|VAR|MoveAbsJ|MoveL|VelSet|AccSet|WaitTime|WaitDI|spot_weld)\b", re.I)
+_KNOWN = re.compile(r"^(MoveAbsJ|MoveL|VelSet|AccSet|WaitTime|WaitDI|spot_weld)\b", re.I)
+# Lines that end a statement without ';': routine heads and ends, and control-flow lines.
+_HEADLINE = re.compile(r"^(MODULE|ENDMODULE|(LOCAL\s+)?PROC|ENDPROC|(LOCAL\s+)?FUNC|ENDFUNC|(LOCAL\s+)?TRAP|ENDTRAP)\b", re.I)
+_OPENS = re.compile(r"\b(THEN|DO)\s*$|^(TEST\b.*|ELSE|DEFAULT\s*:|CASE\b.*:)\s*$", re.I)
+_CLOSES = re.compile(r"^(ENDIF|ENDWHILE|ENDFOR|ENDTEST|ELSE)\s*$", re.I)
+# The declarations the motion depends on; others (num, confdata, syncident, arrays ...) are ignored.
+_MOTION_DATA = re.compile(r"^((LOCAL|TASK)\s+)*(CONST|PERS|VAR)\s+(robtarget|jointtarget|speeddata|zonedata|tooldata|wobjdata)\b",
+                          re.I)
 _PREDEFINED_SPEED = re.compile(r"^v([0-9]+)$", re.I)
 _PREDEFINED_ZONE = re.compile(r"^z([0-9]+)$", re.I)
 
@@ -215,7 +223,7 @@ def _statements(text: str) -> list[tuple[int, str, str]]:
             start = number
         pending.append(code)
         joined = " ".join(pending).strip()
-        if joined.endswith(";") or re.match(r"^(MODULE|ENDMODULE|PROC|ENDPROC|FUNC|ENDFUNC|TRAP|ENDTRAP)\b", joined, re.I):
+        if joined.endswith(";") or _HEADLINE.match(joined) or _OPENS.search(joined) or _CLOSES.match(joined):
             out.append((start, joined.rstrip(";").strip(), comment or ""))
             pending = []
     return out
@@ -252,6 +260,7 @@ class _Reader:
         self.frames: list[FrameDef] = []
         self.override = 100.0
         self.accel = 100.0
+        self.depth = 0                        # of IF / WHILE / FOR / TEST blocks
 
     def error(self, line: int, problem: str) -> ProgramError:
         return ProgramError(self.file, f"line {line}", problem)
@@ -284,7 +293,8 @@ class _Reader:
         return tuple(xyz), self.quaternion(node.children[1], line)
 
     def declare(self, tree: Tree[Token], comment: str, line: int) -> None:
-        kind, name, value = tree.children
+        kind, name, *rest = tree.children
+        value = rest[0] if rest else None
         kind_l = str(kind).lower()
         self.data[str(name).lower()] = (kind_l, value, line)
         if kind_l == "tooldata" and isinstance(value, Tree) and len(value.children) >= 2:
@@ -301,6 +311,8 @@ class _Reader:
                 raise self.error(line, f"{node} is not declared in the module")
             if entry[0] != kind:
                 raise self.error(line, f"{node} is a {entry[0]}, expected a {kind}")
+            if entry[1] is None:
+                raise self.error(line, f"{node} is declared without a value (line {entry[2]})")
             return entry[1]
         return node
 
@@ -354,7 +366,19 @@ class _Reader:
         self.add(LinMove(xyz, zyx, config, v_tcp * self.override / 100.0, comment=comment, flyby_mm=flyby_mm), line)
 
     def statement(self, text: str, comment: str, line: int) -> None:
-        if _UNSIMULATED.match(text):
+        if _CLOSES.match(text) and not text.upper().startswith("ELSE"):
+            self.depth = max(0, self.depth - 1)
+            return
+        if re.match(r"^(IF|WHILE|FOR|TEST)\b", text, re.I) and (_OPENS.search(text) or text.upper().startswith("TEST")):
+            self.depth += 1
+            self.ignored.append((line, text))
+            return
+        if _MOTION_DATA.match(text):
+            self.declare(self.tree(re.sub(r"^((LOCAL|TASK)\s+)*", "", text, flags=re.I), line), comment, line)
+            return
+        conditional = self.depth > 0 and (_KNOWN.match(text) or _UNSIMULATED.match(text))
+        if _UNSIMULATED.match(text) or conditional:
+            # A motion inside IF / WHILE / FOR / TEST: the reader does not follow control flow.
             self.ignored.append((line, text))
             self.add(Comment(f"not simulated: {text}"), line)
             return
@@ -362,9 +386,7 @@ class _Reader:
             self.ignored.append((line, text))
             return
         tree = self.tree(text, line)
-        if tree.data == "decl":
-            self.declare(tree, comment, line)
-        elif tree.data == "move":
+        if tree.data == "move":
             self.move(tree, comment, line)
         elif tree.data == "velset":
             self.override = float(tree.children[0])
@@ -373,7 +395,11 @@ class _Reader:
         elif tree.data == "waittime":
             self.add(Wait(float(tree.children[-1])), line)
         elif tree.data == "waitdi":
-            self.add(WaitFor(str(tree.children[0])), line)
+            if float(tree.children[1]) != 1.0:
+                self.ignored.append((line, text))
+                self.add(Comment(f"not simulated: {text} (waits for the input to be 0)"), line)
+            else:
+                self.add(WaitFor(str(tree.children[0])), line)
         elif tree.data == "weld":
             n, seconds = (float(t) for t in tree.children)
             self.add(read_spot_label(comment, int(n), seconds, self.file, line), line)

@@ -141,6 +141,7 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 _CALLS = ("movej", "movel", "set_tcp", "sleep", "spot_weld", "wait_for_signal")
 _UNSIMULATED = ("movep", "movec", "servoj", "servoc", "speedj", "speedl", "move_path", "movej_pose")
 _BLOCK = re.compile(r"^(def|thread|while|if|for)\b.*:\s*$")
+# elif / else continue a block rather than open one.
 
 
 @lru_cache(maxsize=1)
@@ -175,7 +176,7 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
     v_ref, a_ref = reference_limits(robot)
     lines = texts.get(".script", "").splitlines()
     name = ""
-    depth = 0
+    blocks: list[str] = []           # open blocks inside the program's def
     instructions: list[Instruction] = []
     where: list[int] = []
     ignored: list[tuple[int, str]] = []
@@ -194,19 +195,26 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         if not name:
             head = re.match(r"^def\s+([A-Za-z_][A-Za-z0-9_]*)\s*\(\s*\)\s*:$", stmt)
             if head:
-                name, depth = head.group(1), 1
+                name = head.group(1)
             elif stmt:
                 ignored.append((number, stmt))
             continue
         if _BLOCK.match(stmt):
-            depth += 1
+            blocks.append(stmt.split()[0].split("(")[0])
             continue
         if stmt == "end":
-            depth -= 1
-            if depth == 0:
+            if not blocks:
                 break
+            blocks.pop()
             continue
-        if depth > 1:
+        if "def" in blocks:             # a function's body runs when it is called: not here
+            continue
+        if blocks and re.match(r"^(move\w*|servo\w*|speed\w*|sleep|spot_weld|wait_for_signal)\s*\(", stmt):
+            # Inside while / if / for / thread: the reader does not follow control flow.
+            ignored.append((number, stmt))
+            add(Comment(f"not simulated: {stmt}"), number)
+            continue
+        if blocks:
             continue
         if not stmt:
             if raw.strip().startswith("#"):

@@ -197,9 +197,8 @@ def test_per_move_speeds_are_planned_written_and_rebuilt(tmp_path: Path, write_s
     import yaml
 
     from robomax_py.export.plan_program import program_from_plan
-    from robomax_py.export.srcl import write_program
     from robomax_py.export.rebuild import rebuild
-    from robomax_py.export.srcl import parse_program
+    from robomax_py.export.srcl import parse_program, write_program
     from robomax_py.program import LinMove, PtpMove
 
     path: Path = write_small_cell(tmp_path)

@@ -13,9 +13,8 @@ from typer.testing import CliRunner
 
 from robomax_py.app.cli import EXIT_OK, app
 from robomax_py.export.plan_program import program_from_plan
-from robomax_py.export.srcl import write_program
 from robomax_py.export.rebuild import rebuild
-from robomax_py.export.srcl import parse_program
+from robomax_py.export.srcl import parse_program, write_program
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions, plan_cell
 from robomax_py.plan.waiting import clear_wait

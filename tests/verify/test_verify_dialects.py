@@ -1,0 +1,182 @@
+"""`robomax verify` on every dialect's program: the written programs verify clean, and programs
+edited the ways that matter on a shop floor (a target 1 mm off, another configuration, a blended
+weld point, lengths in the wrong unit, a quaternion that is not unit) are rejected, naming the line."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+from typer.testing import CliRunner
+
+from robomax_py.app.cli import EXIT_BAD_INPUT, EXIT_OK, EXIT_VIOLATIONS, app
+from robomax_py.errors import ProgramError
+from robomax_py.export import DIALECTS
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.plan import plan_cell
+from robomax_py.publish import publish
+from robomax_py.verify import verify_program
+
+runner = CliRunner()
+MAIN = {"krl": ".src", "rapid": ".mod", "fanuc": ".ls", "urscript": ".script", "srcl": ".srcl"}
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> dict[str, Any]:  # type: ignore[no-untyped-def]
+    tmp = tmp_path_factory.mktemp("dialects")
+    path = write_small_cell(tmp)
+    cell = load_cell(path)
+    robot = load_cell_robot(cell)
+    result = plan_cell(cell, robot)
+    assert result.status == "planned", result.message
+    files, _ = publish(result, cell, robot, tuple(DIALECTS))
+    for name, text in files.items():
+        (tmp / name).write_text(text)
+    return {"tmp": tmp, "cell_path": path, "cell": cell, "robot": robot, "files": files}
+
+
+def _verify(written: dict[str, Any], fmt: str, edit: Callable[[str], str], *, ext: str | None = None) -> Any:
+    """Verify the program with one of its files edited (the main file, or `ext`)."""
+    ext = ext or MAIN[fmt]
+    folder = written["tmp"] / f"edited_{fmt}_{abs(hash(edit)) % 10**6}"
+    folder.mkdir()
+    for name, text in written["files"].items():
+        if name.endswith(tuple(DIALECTS[fmt].extensions)):
+            mine = name == f"small_cell{ext}"
+            new = edit(text) if mine else text
+            if mine:
+                assert new != text, "the edit changed nothing"
+            (folder / name).write_text(new)
+    return verify_program(written["cell"], written["robot"], folder / f"small_cell{MAIN[fmt]}")
+
+
+def _first(pattern: str, text: str, replace: Callable[[re.Match[str]], str]) -> str:
+    return re.sub(pattern, replace, text, count=1, flags=re.M)
+
+
+@pytest.mark.parametrize("fmt", sorted(DIALECTS))
+def test_written_programs_verify_clean_from_the_cli(written: dict[str, Any], fmt: str) -> None:
+    result = runner.invoke(app, ["verify", str(written["cell_path"]), str(written["tmp"] / f"small_cell{MAIN[fmt]}")])
+    assert result.exit_code == EXIT_OK, result.output
+    assert "clean" in result.output
+
+
+def test_krl_dat_alone_is_read_with_its_src(written: dict[str, Any]) -> None:
+    report = verify_program(written["cell"], written["robot"], written["tmp"] / "small_cell.dat")
+    assert report.clean, report.violations
+
+
+# ------------------------------------------------------------------ a target 1 mm off
+
+def _plus_1mm(value: str) -> str:
+    return f"{float(value) + 1.0:.3f}"
+
+
+MOVED: dict[str, tuple[str | None, Callable[[str], str]]] = {
+    "krl": (".dat", lambda t: _first(r"(E6POS XP\d+=\{X )(-?[\d.]+)", t, lambda m: m[1] + _plus_1mm(m[2]))),
+    "rapid": (None, lambda t: _first(r"(robtarget p\d+ := \[\[)(-?[\d.]+)", t, lambda m: m[1] + _plus_1mm(m[2]))),
+    "fanuc": (None, lambda t: _first(r"(X = )(-?[\d.]+)", t, lambda m: m[1] + _plus_1mm(m[2]))),
+    "urscript": (None, lambda t: _first(r"(movel\(p\[)(-?[\d.]+)", t, lambda m: m[1] + f"{float(m[2]) + 0.001:.6f}")),
+    "srcl": (None, lambda t: _first(r"(MOVE LIN POS\()(-?[\d.]+)", t, lambda m: m[1] + _plus_1mm(m[2]))),
+}
+
+
+@pytest.mark.parametrize("fmt", sorted(MOVED))
+def test_a_target_1mm_off_is_rejected_with_its_line(written: dict[str, Any], fmt: str) -> None:
+    ext, edit = MOVED[fmt]
+    report = _verify(written, fmt, edit, ext=ext)
+    spot = [v for v in report.violations if v.kind == "spot" and "mm from the spot" in v.detail]
+    assert spot, report.violations
+    assert spot[0].line is not None
+
+
+# ------------------------------------------------------------------ another configuration
+
+FLIPPED: dict[str, tuple[str | None, Callable[[str], str]]] = {
+    "krl": (".dat", lambda t: _first(r"(E6POS XP\d+=\{[^}]*S )(\d)", t, lambda m: m[1] + str(int(m[2]) ^ 1))),
+    "rapid": (None, lambda t: _first(r"(robtarget p\d+ := \[\[[^\]]*\], \[[^\]]*\], \[[^\]]*, )(-?\d)\]",
+                                      t, lambda m: m[1] + str(int(m[2]) ^ 4) + "]")),
+    "fanuc": (None, lambda t: _first(r"CONFIG : '([FN])", t, lambda m: "CONFIG : '" + ("N" if m[1] == "F" else "F"))),
+    "srcl": (None, lambda t: _first(r"CONFIG 'S(\d)", t, lambda m: f"CONFIG 'S{int(m[1]) ^ 1}")),
+}
+
+
+@pytest.mark.parametrize("fmt", sorted(FLIPPED))
+def test_another_configuration_is_rejected_with_its_line(written: dict[str, Any], fmt: str) -> None:
+    ext, edit = FLIPPED[fmt]
+    report = _verify(written, fmt, edit, ext=ext)
+    config = [v for v in report.violations if v.kind in ("config", "spot") and "onfiguration" in v.detail or v.kind == "config"]
+    assert config, report.violations
+    assert all(v.line is not None for v in config)
+
+
+# ------------------------------------------------------------------ a blended weld point
+
+BLENDED: dict[str, Callable[[str], str]] = {
+    "krl": lambda t: _first(r"^(LIN XP\d+)( ; approach)", t, lambda m: m[1] + " C_DIS" + m[2]),
+    "rapid": lambda t: _first(r"^(\s*MoveL p\d+, v_lin\d+, )fine", t, lambda m: m[1] + "z10"),
+    "fanuc": lambda t: _first(r"^(\s*\d+:\s+L P\[\d+\] \d+mm/sec )FINE", t, lambda m: m[1] + "CNT50"),
+    "urscript": lambda t: _first(r"^(\s*movel\(.*)r=0\.000000\)(  # approach)", t, lambda m: m[1] + "r=0.010000)" + m[2]),
+    "srcl": lambda t: _first(r"^(\s*MOVE LIN .* MM/S)( \{ approach \})", t, lambda m: m[1] + " FLYBY 1.0000" + m[2]),
+}
+
+
+@pytest.mark.parametrize("fmt", sorted(BLENDED))
+def test_a_blended_weld_point_is_rejected_with_its_line(written: dict[str, Any], fmt: str) -> None:
+    report = _verify(written, fmt, BLENDED[fmt])
+    flyby = [v for v in report.violations if v.kind == "flyby"]
+    assert flyby, report.violations
+    assert flyby[0].line is not None
+
+
+# ------------------------------------------------------------------ lengths in the wrong unit
+
+def _in_metres(pattern: str) -> Callable[[str], str]:
+    return lambda t: re.sub(pattern, lambda m: m[1] + f"{float(m[2]) / 1000:.6f}", t)
+
+
+SCALED: dict[str, tuple[str | None, Callable[[str], str]]] = {
+    "krl": (".dat", _in_metres(r"(\b[XYZ] )(-?\d+\.\d{3})(?=,)")),
+    "rapid": (None, _in_metres(r"(robtarget p\d+ := \[\[|, )(-?\d+\.\d{3})(?=[,\]])")),
+    "fanuc": (None, _in_metres(r"(\b[XYZ] = )(-?\d+\.\d{3})(?=  mm)")),
+    "urscript": (None, lambda t: re.sub(r"(movel\(p\[)(-?[\d.]+), (-?[\d.]+), (-?[\d.]+)",
+                                        lambda m: m[1] + ", ".join(f"{float(v) * 1000:.3f}" for v in m.groups()[1:]), t)),
+}
+
+
+@pytest.mark.parametrize("fmt", sorted(SCALED))
+def test_lengths_in_another_unit_are_rejected(written: dict[str, Any], fmt: str) -> None:
+    ext, edit = SCALED[fmt]
+    report = _verify(written, fmt, edit, ext=ext)
+    assert not report.clean
+    assert any(v.line is not None for v in report.violations), report.violations
+
+
+def test_a_quaternion_that_is_not_unit_is_bad_input_with_its_line(written: dict[str, Any]) -> None:
+    edit: Callable[[str], str] = lambda t: _first(r"(robtarget p\d+ := \[\[[^\]]*\], \[)(-?[\d.]+)", t,  # noqa: E731
+                                                  lambda m: m[1] + f"{float(m[2]) + 0.1:.9f}")
+    with pytest.raises(ProgramError, match=r"line \d+.*not unit"):
+        _verify(written, "rapid", edit)
+    folder = next(p for p in written["tmp"].iterdir() if p.is_dir() and p.name.startswith("edited_rapid"))
+    result = runner.invoke(app, ["verify", str(written["cell_path"]), str(next(folder.glob("*.mod")))])
+    assert result.exit_code in (EXIT_BAD_INPUT, EXIT_VIOLATIONS), result.output
+
+
+def test_violations_exit_one_from_the_cli(written: dict[str, Any]) -> None:
+    ext, edit = MOVED["fanuc"]
+    _verify(written, "fanuc", edit, ext=ext)
+    folder = next(p for p in written["tmp"].iterdir() if p.is_dir() and p.name.startswith("edited_fanuc"))
+    result = runner.invoke(app, ["verify", str(written["cell_path"]), str(folder / "small_cell.ls")])
+    assert result.exit_code == EXIT_VIOLATIONS, result.output
+    assert re.search(r"line \d+", result.output), result.output
+
+
+def test_an_unknown_extension_is_bad_input(written: dict[str, Any], tmp_path: Path) -> None:
+    other = tmp_path / "small_cell.txt"
+    other.write_text("PTP HOME\n")
+    result = runner.invoke(app, ["verify", str(written["cell_path"]), str(other)])
+    assert result.exit_code == EXIT_BAD_INPUT
+    assert ".src" in result.output and ".script" in result.output
