@@ -129,7 +129,7 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
             f"{TOL.rebuilt_time_s * 1000:.0f} ms){f', at line {line} of {main}' if line else ''}")
     report = None
     if not diff.identical:
-        report = verify_rebuilt(cell, robot, main, rebuilt)
+        report = verify_rebuilt(cell, robot, main, rebuilt, clearance=False)
         if not report.clean:
             v = report.violations[0]
             raise ExportError(f"{fmt}: the written program's motion is not clean: {v.kind}: {v.detail}"

@@ -30,7 +30,7 @@ from robomax_py.spec import CellSpec
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.transforms import rot_x, rot_y, rot_z
 from robomax_py.world.collision import CollisionWorld
-from robomax_py.world.motion import Violation, check_motion
+from robomax_py.world.motion import Clearance, Violation, check_motion, min_clearance
 from robomax_py.world.scene import build_scene
 
 HOME_TOL_RAD = TOL.home_tol_rad
@@ -44,16 +44,6 @@ PIN_TOL = 1e-5
 
 
 @dataclass(frozen=True, slots=True)
-class Clearance:
-    """The smallest distance between the robot (or tool) and an obstacle over a motion."""
-
-    distance_m: float
-    t: float
-    between: str
-    line: int | None = None
-
-
-@dataclass(frozen=True, slots=True)
 class VerifyReport:
     program: str
     samples: int
@@ -61,7 +51,8 @@ class VerifyReport:
     collision_checks: int
     violations: tuple[Violation, ...]
     ignored: tuple[tuple[int, str], ...] = ()     # (line, statement) read but without effect on motion
-    clearance: Clearance | None = None            # the smallest distance to an obstacle reached
+    clearance: Clearance | None = None            # the smallest distance reached (None: not measured)
+    clearance_line: int | None = None             # the program line moving the robot then
 
     @property
     def clean(self) -> bool:
@@ -106,18 +97,19 @@ def _is_motion(parsed: Any, line: int) -> bool:
                for ins, at in zip(parsed.program.instructions, parsed.lines))
 
 
-def verify_rebuilt(cell: CellSpec, robot: RobotModel, name: str, rebuilt: Any) -> VerifyReport:
+def verify_rebuilt(cell: CellSpec, robot: RobotModel, name: str, rebuilt: Any, clearance: bool = True) -> VerifyReport:
     """Check a rebuilt motion (`export.rebuild.Rebuilt`) like a trajectory, with the program line
-    of each violation."""
+    of each violation (and of the smallest clearance, unless `clearance` is False)."""
     out = [Violation(p.t, p.kind, p.detail, p.line) for p in rebuilt.problems]
     if rebuilt.trajectory is None:
         return VerifyReport(name, 0, float("nan"), 0, tuple(out))
     traj = rebuilt.trajectory
     data = {"t": np.asarray(traj.t), "q": np.asarray(traj.q), "spots": rebuilt.spots}
-    report = _verify_motion(cell, robot, name, data, out)
+    report = _verify_motion(cell, robot, name, data, out, clearance)
     lined = tuple(v if v.line is not None else dataclasses.replace(v, line=rebuilt.line_at(v.t))
                   for v in report.violations)
-    return dataclasses.replace(report, violations=lined)
+    line = rebuilt.line_at(report.clearance.t) if report.clearance is not None else None
+    return dataclasses.replace(report, violations=lined, clearance_line=line)
 
 
 def verify_trajectory_file(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
@@ -137,8 +129,10 @@ def verify_srcl_file(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRep
     return verify_program(cell, robot, path)
 
 
-def _verify_motion(cell: CellSpec, robot: RobotModel, name: str, data: dict[str, Any], out: list[Violation]) -> VerifyReport:
-    """Home at both ends, limits and swept collisions, spots: appended to `out`."""
+def _verify_motion(cell: CellSpec, robot: RobotModel, name: str, data: dict[str, Any], out: list[Violation],
+                   clearance: bool = True) -> VerifyReport:
+    """Home at both ends, limits and swept collisions, spots: appended to `out`; and the smallest
+    clearance reached (when asked)."""
     t, q = data["t"], data["q"]
     for end, idx in (("start", 0), ("end", -1)):
         if np.abs(q[idx] - cell.home).max() > HOME_TOL_RAD:
@@ -147,7 +141,8 @@ def _verify_motion(cell: CellSpec, robot: RobotModel, name: str, data: dict[str,
     motion = check_motion(world, robot, t, q)
     out.extend(motion.violations)
     out.extend(_check_spots(cell, robot, data))
-    return VerifyReport(name, len(t), float(t[-1] - t[0]), motion.checks, tuple(out))
+    closest = min_clearance(world, t, q) if clearance else None
+    return VerifyReport(name, len(t), float(t[-1] - t[0]), motion.checks, tuple(out), clearance=closest)
 
 
 

@@ -242,6 +242,10 @@ def verify(
             when = "" if v.t is None else (f"t = {v.t:.3f}-{v.t_end:.3f} s" if v.t_end is not None else f"t = {v.t:.3f} s")
             place = f"{where}{when}".rstrip(", ")
             out.print(f"  [red]{v.kind}[/]: {place + ': ' if place else ''}{v.detail}", soft_wrap=True)
+        if report.clearance is not None:
+            c = report.clearance
+            at = f"line {report.clearance_line}, " if report.clearance_line is not None else ""
+            out.print(f"  smallest clearance {c.distance_m * 1000:.1f} mm ({at}t = {c.t:.3f} s, {c.between})")
         if report.ignored:
             out.print(f"  {len(report.ignored)} statement(s) read but without effect on the motion (I/O, declarations ...)")
         if report.clean:

@@ -40,6 +40,9 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
     for phase in result.trajectory.phases:
         split[phase.kind] = split.get(phase.kind, 0.0) + float(phase.t_end - phase.t_start)
     report["cycle_time"] = round(result.cycle_time, 4)
+    if result.clearance is not None:
+        c = result.clearance
+        report["clearance"] = {"mm": round(c.distance_m * 1000, 3), "t": round(c.t, 4), "between": c.between}
     report["split"] = {k: round(v, 4) for k, v in split.items()}
     report["spots"] = [
         {"seam": s.seam, "spot": s.name, "t_arrive": round(s.t_arrive, 4),
@@ -70,6 +73,9 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
         head.add_row("cycle time", f"{report['cycle_time']:.2f} s  ({split})")
         detours = ", ".join(f"{d['between']} ({d['checks_to_find']} checks)" for d in report["detours"])
         head.add_row("detours", detours or "none")
+        if "clearance" in report:
+            c = report["clearance"]
+            head.add_row("clearance", f"{c['mm']:.1f} mm at t = {c['t']:.2f} s ({c['between']})")
     stages = report.get("stats", {}).get("stage_seconds", {})
     split = ", ".join(f"{k} {v:.2f}" for k, v in stages.items())
     head.add_row("planning", f"{report['planning_seconds']:.2f} s" + (f"  ({split})" if split else ""))

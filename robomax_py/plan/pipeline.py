@@ -38,7 +38,7 @@ from robomax_py.timing import (
 )
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision import CollisionWorld
-from robomax_py.world.motion import MotionCheck, check_motion
+from robomax_py.world.motion import MotionCheck, check_motion, min_clearance
 from robomax_py.world.scene import build_scene
 
 log = logging.getLogger(__name__)
@@ -129,6 +129,10 @@ def plan_cell(
         return PlanResult(cell.name, robot.name, "infeasible",
                           f"the timed program failed its own check: {v.kind}: {v.detail} at t = {v.t:.3f} s")
 
+    t0 = time.perf_counter()
+    clearance = min_clearance(full_world, trajectory.t, trajectory.q)
+    clock["clearance"] = time.perf_counter() - t0
+
     stats = PlanStats(
         candidates=sum(len(c) for c in spots), candidate_checks=candidate_checks,
         sequencing_checks=sequencer.checks, roadmap_checks=roadmap.sampling_checks + roadmap.edge_checks,
@@ -140,7 +144,7 @@ def plan_cell(
                       tool=cell.tool.name, T_flange_tcp=np.asarray(robot.T_flange_tcp),
                       T_world_base=np.asarray(cell.T_world_base),
                       T_root_controller=np.asarray(cell.robot.controller.T_root_base), home=np.asarray(cell.home), options=options,
-                      weld_time=cell.process.weld_time)
+                      weld_time=cell.process.weld_time, clearance=clearance)
 
 
 def verify_trajectory(world: CollisionWorld, robot: RobotModel, traj: Trajectory) -> MotionCheck:

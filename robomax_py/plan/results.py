@@ -11,6 +11,7 @@ from robomax_py.spec import CellSpec
 from robomax_py.timing import (
     Trajectory,
 )
+from robomax_py.world.motion import Clearance
 
 Progress = Callable[[str, int, int], None]
 """progress(stage, done, total): called as a long stage advances ("candidates", "sequencing",
@@ -116,6 +117,7 @@ class PlanResult:
     home: FloatArray | None = None
     options: PlanOptions = PlanOptions()
     weld_time: float = 0.0
+    clearance: Clearance | None = None       # the smallest distance the planned motion keeps, and where
 
     @property
     def cycle_time(self) -> float:

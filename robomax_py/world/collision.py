@@ -321,6 +321,11 @@ class CollisionWorld:
             return Proximity(distance=math.inf, pair=None)
         return Proximity(distance=float(self._gdata.distanceResults[idx].min_distance), pair=self._contact(idx))
 
+    @property
+    def has_dynamic(self) -> bool:
+        """Whether some obstacle comes and goes (present only in time windows)."""
+        return bool(self._s.dynamic_ids.size)
+
     def sweep_length(self, q0: FloatArray, q1: FloatArray) -> float:
         """Upper bound (m) on how far any robot or tool point moves along the joint-space line q0 -> q1.
 

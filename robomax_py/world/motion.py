@@ -18,7 +18,8 @@ from robomax_py.world.collision import CollisionWorld
 # sampled peak slightly, hence the larger slack.
 VELOCITY_RTOL = TOL.velocity_rtol
 ACCELERATION_RTOL = TOL.acceleration_rtol
-MAX_REPORTED_COLLISIONS = 20
+MAX_REPORTED_COLLISIONS = 20        # collision intervals reported at most
+MIN_CLEARANCE_SUBSTEPS = 10
 
 
 @dataclass(frozen=True, slots=True)
@@ -60,39 +61,117 @@ def check_motion(
     Returns
     -------
     MotionCheck
-        The violations (collisions in time order, at most `max_collisions`; with `stop_at_first`,
-        at most one violation and no collision check once a limit is broken) and the number of
-        collision checks spent.
+        The violations, one per interval: a run of consecutive samples (or swept steps) breaking
+        the same limit of the same joint, or colliding with the same pair, is one violation from
+        its first to its last time (`t`, `t_end`) with its worst value; at most `max_collisions`
+        collision intervals. With `stop_at_first`, at most one violation and no collision check
+        once a limit is broken.
     """
     lim = robot.limits
     out: list[Violation] = []
-    outside = ~lim.contains(q, 1e-9)
-    for i in np.flatnonzero(outside)[:5]:
-        j = int(np.flatnonzero((q[i] < lim.lower - 1e-9) | (q[i] > lim.upper + 1e-9))[0])
-        out.append(Violation(float(t[i]), "joint_limit", f"{robot.joint_names[j]} = {math.degrees(q[i, j]):.3f} deg"))
+    below = q < lim.lower - 1e-9
+    above = q > lim.upper + 1e-9
+    for j, i0, i1 in _runs(below | above):
+        worst = i0 + int(np.argmax(np.maximum(lim.lower[j] - q[i0:i1 + 1, j], q[i0:i1 + 1, j] - lim.upper[j])))
+        out.append(Violation(float(t[i0]), "joint_limit", f"{robot.joint_names[j]} = {math.degrees(q[worst, j]):.3f} deg "
+                                                          f"(limits {math.degrees(lim.lower[j]):.3f} .. {math.degrees(lim.upper[j]):.3f})",
+                             t_end=_end(t, i0, i1)))
     dt = np.diff(t)
     v = np.diff(q, axis=0) / dt[:, None]
-    for i, j in np.argwhere(np.abs(v) > lim.velocity * (1 + velocity_rtol))[:5]:
-        out.append(Violation(float(t[i]), "velocity", f"{robot.joint_names[j]} {abs(v[i, j]):.3f} rad/s > "
-                                                      f"{lim.velocity[j]:.3f}"))
+    for j, i0, i1 in _runs(np.abs(v) > lim.velocity * (1 + velocity_rtol)):
+        peak = float(np.abs(v[i0:i1 + 1, j]).max())
+        out.append(Violation(float(t[i0]), "velocity", f"{robot.joint_names[j]} up to {peak:.3f} rad/s > {lim.velocity[j]:.3f}",
+                             t_end=float(t[i1 + 1])))
     a = np.diff(v, axis=0) / ((dt[:-1] + dt[1:]) / 2)[:, None]
-    for i, j in np.argwhere(np.abs(a) > lim.acceleration * (1 + ACCELERATION_RTOL))[:5]:
-        out.append(Violation(float(t[i + 1]), "acceleration", f"{robot.joint_names[j]} {abs(a[i, j]):.3f} rad/s^2 > "
-                                                              f"{lim.acceleration[j]:.3f}"))
+    for j, i0, i1 in _runs(np.abs(a) > lim.acceleration * (1 + ACCELERATION_RTOL)):
+        peak = float(np.abs(a[i0:i1 + 1, j]).max())
+        out.append(Violation(float(t[i0 + 1]), "acceleration", f"{robot.joint_names[j]} up to {peak:.3f} rad/s^2 > "
+                                                               f"{lim.acceleration[j]:.3f}", t_end=float(t[i1 + 1])))
+    out.sort(key=lambda x: (x.t if x.t is not None else -1.0))
     if stop_at_first and out:
         return MotionCheck(tuple(out[:1]), 0)
     checks = 0
-    collisions = 0
     limit = 1 if stop_at_first else max_collisions
+    collisions: list[Violation] = []
     for i in range(len(t) - 1):
         res = world.check_segment(q[i], q[i + 1], float(t[i]), float(t[i + 1]))
         checks += res.checks
-        if not res.free:
-            s_hit = res.s_contact or 0.0
-            tc = float(t[i] + s_hit * (t[i + 1] - t[i]))
-            contact = world.first_contact(q[i] + s_hit * (q[i + 1] - q[i]), tc)
-            out.append(Violation(tc, "collision", contact.describe() if contact else "collision"))
-            collisions += 1
-            if collisions >= limit:
-                break
+        if res.free:
+            continue
+        s_hit = res.s_contact or 0.0
+        tc = float(t[i] + s_hit * (t[i + 1] - t[i]))
+        contact = world.first_contact(q[i] + s_hit * (q[i + 1] - q[i]), tc)
+        detail = contact.describe() if contact else "collision"
+        last = collisions[-1] if collisions else None
+        if last is not None and last.detail == detail and last.t_end is not None and last.t_end >= float(t[i]) - 1e-9:
+            collisions[-1] = Violation(last.t, "collision", detail, t_end=float(t[i + 1]))
+            continue
+        if len(collisions) >= limit:
+            break
+        collisions.append(Violation(tc, "collision", detail, t_end=float(t[i + 1])))
+        if stop_at_first:
+            break
+    out.extend(collisions)
     return MotionCheck(tuple(out), checks)
+
+
+def _runs(mask: np.ndarray) -> list[tuple[int, int, int]]:
+    """(column, first row, last row) of every run of True down the columns of a (k, n) mask."""
+    out = []
+    for j in range(mask.shape[1]):
+        rows = np.flatnonzero(mask[:, j])
+        if not len(rows):
+            continue
+        breaks = np.flatnonzero(np.diff(rows) > 1)
+        starts = np.concatenate([[rows[0]], rows[breaks + 1]])
+        ends = np.concatenate([rows[breaks], [rows[-1]]])
+        out.extend((j, int(a), int(b)) for a, b in zip(starts, ends))
+    return out
+
+
+def _end(t: FloatArray, i0: int, i1: int) -> float | None:
+    return float(t[i1]) if i1 > i0 else None
+
+
+@dataclass(frozen=True, slots=True)
+class Clearance:
+    """The smallest distance (m) between the robot or tool and anything it must not touch, the time
+    it is reached (s) and between which bodies."""
+
+    distance_m: float
+    t: float
+    between: str
+
+
+def min_clearance(world: CollisionWorld, t: FloatArray, q: FloatArray) -> Clearance | None:
+    """The smallest distance over the samples of a motion, refined on the steps either side of
+    the closest sample (10 sub-steps each); None when no pair is checked."""
+    best_i, best = 0, math.inf
+    # Samples the robot cannot have brought closer than the best so far are skipped: no point
+    # moves farther than `sweep_length` from sample i, and two robot bodies approach each other
+    # by at most twice that, so d_k >= d_i - 2 sweep(q_i, q_k) > best.
+    # Obstacles that come and go (dynamic objects) change distances without motion: no skipping.
+    skip = not world.has_dynamic
+    i = 0
+    while i < len(t):
+        d = world.closest(q[i], float(t[i])).distance
+        if d < best:
+            best_i, best = i, d
+        j = i + 1
+        while skip and j < len(t) and math.isfinite(d) and 2.0 * world.sweep_length(q[i], q[j]) < d - best:
+            j += 1
+        i = j
+    if not math.isfinite(best):
+        return None
+    best_t, best_q = float(t[best_i]), q[best_i]
+    for k in (best_i - 1, best_i):
+        if 0 <= k < len(t) - 1:
+            for s in np.linspace(0.0, 1.0, MIN_CLEARANCE_SUBSTEPS + 1)[1:-1]:
+                qs = q[k] + s * (q[k + 1] - q[k])
+                ts = float(t[k] + s * (t[k + 1] - t[k]))
+                d = world.closest(qs, ts).distance
+                if d < best:
+                    best, best_t, best_q = d, ts, qs
+    pair = world.closest(best_q, best_t).pair
+    between = f"{pair.body_a} and {pair.body_b}" if pair is not None else "?"
+    return Clearance(float(best), best_t, between)
