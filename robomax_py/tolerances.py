@@ -76,5 +76,8 @@ class Tolerances:
     # Configuration data names a branch as far as the joints are this far from where it changes
     # (SPEC §6: re-solving a target in its configuration gives the planned joints within 0.01 deg).
     config_tol_deg: float = 0.01
+    # Over the approach distance the TCP stays on the electrode axis within this (m): the LIN
+    # lines follow it to 1e-5 m (lin_path_tol_m); blends start beyond it.
+    straight_tol_m: float = 1e-4
 
 DEFAULT = Tolerances()

@@ -174,6 +174,7 @@ def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> lis
         qs = q[inside]
         if np.ptp(qs, axis=0).max() > REST_TOL_RAD:
             out.append(Violation(t0, "dwell", f"{label}: the robot moves while welding"))
+        out.extend(_approach_straight(cell, robot, t, q, spot, label, t0, t1))
         T_world = np.asarray(cell.T_world_base) @ fk_tcp(robot, qs)
         err = np.linalg.norm(T_world[:, :3, 3] - spot.xyz, axis=1).max()
         if err > TOL.spot_pos_m:
@@ -209,6 +210,35 @@ def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> lis
             times = [seen[(seam.name, s.name)] for s in seam.spots if (seam.name, s.name) in seen]
             if any(b < a for a, b in zip(times[:-1], times[1:])):
                 out.append(Violation(None, "order", f"seam {seam.name} is ordered but welded out of order"))
+    return out
+
+
+def _approach_straight(cell: CellSpec, robot: RobotModel, t: FloatArray, q: FloatArray, spot: Any, label: str,
+                       t0: float, t1: float) -> list[Violation]:
+    """Within `process.approach` of the spot, before and after the weld, the TCP moves only along
+    the electrode axis (the TCP z axis at the spot) on the approach side."""
+    approach = cell.process.approach
+    if approach <= 0:
+        return []
+    i0, i1 = int(np.searchsorted(t, t0 - TIME_TOL_S)), int(np.searchsorted(t, t1 + TIME_TOL_S, side="right")) - 1
+    T_spot = np.asarray(cell.T_world_base) @ fk_tcp(robot, q[i0])
+    origin, axis = T_spot[:3, 3], T_spot[:3, 2]
+    out: list[Violation] = []
+    for step, start in ((-1, i0 - 1), (1, i1 + 1)):
+        worst, at, i = 0.0, None, start
+        while 0 <= i < len(t):
+            rel = (np.asarray(cell.T_world_base) @ fk_tcp(robot, q[i]))[:3, 3] - origin
+            if np.linalg.norm(rel) > approach:
+                break
+            along = float(rel @ axis)
+            off = max(float(np.linalg.norm(rel - along * axis)), -along)
+            if off > worst:
+                worst, at = off, float(t[i])
+            i += step
+        if worst > TOL.straight_tol_m:
+            side = "approach" if step < 0 else "retract"
+            out.append(Violation(at, "approach", f"{label}: the {side} leaves the electrode axis by {worst * 1000:.2f} mm "
+                                                 f"within {approach * 1000:.0f} mm of the spot"))
     return out
 
 

@@ -97,6 +97,8 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
         approach_follows = k < len(result.spots)
         for w, q in enumerate(trans.waypoints[1:], start=1):
             last = w == len(trans.waypoints) - 1
+            if last and approach_follows and trans.approach_q is not None:
+                q = trans.approach_q             # the approach line continued for the fly-by
             note = f"{trans.label}, {start}" if w == 1 else ""
             note = note if last or trans.kind == "move" else (note + ", " if note else "") + f"detour point {w}"
             # Radii as planned: detour corners and the join into the approach (joint space, deg).
@@ -113,14 +115,16 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
         xyz, zyx = pose_mm_zyx(to_frame(C, spot.T_spot))
         emit(spot.q_spot, LinMove(xyz, zyx, spot.config, lin_mm_s, comment="approach"),
              Spot(identifier(spot.name), identifier(spot.seam), spot.weld_time, spot.gun, spot.schedule))
-        xyz, zyx = pose_mm_zyx(to_frame(C, spot.T_app))
+        after = transitions[k + 1] if k + 1 < len(transitions) else None
+        extended = after is not None and after.retract_T is not None and after.retract_q is not None
+        xyz, zyx = pose_mm_zyx(to_frame(C, after.retract_T if extended else spot.T_app))   # type: ignore[union-attr]
         if k + 1 < len(result.spots) and result.spots[k + 1].interlocks:
             emit(spot.q_spot, *_interlocks(result.spots[k + 1].interlocks))
         if k + 1 < len(transitions) and transitions[k + 1].wait is not None:
             emit(spot.q_spot, *_wait(transitions[k + 1].wait))
         retract_radius = transitions[k + 1].flyby_radius if k + 1 < len(transitions) else 0.0
-        emit(spot.q_app, LinMove(xyz, zyx, spot.config_app, lin_mm_s, flyby=math.degrees(retract_radius),
-                                 comment="retract"))
+        q_end = after.retract_q if extended else spot.q_app                                  # type: ignore[union-attr]
+        emit(q_end, LinMove(xyz, zyx, spot.config_app, lin_mm_s, flyby=math.degrees(retract_radius), comment="retract"))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
                     tuple(identifier(j) for j in result.joint_names), f"robomax_py {__version__}", cell_sha256, stamp)
     return PlannedProgram(Program(identifier(result.cell), header, frames, tuple(out)), tuple(joints))

@@ -5,6 +5,12 @@ from the last spot, PTP moves through the transition's waypoints, the LIN approa
 spot. Each variant states where the robot flies by (radii in whole or half degrees, so a program
 states them exactly); every variant but the exact-stop one leaves the checked polyline and lines,
 so it is used only when its geometric path checks collision-free and it is faster.
+
+The electrode tips may come near the part only on the electrode axis: over `process.approach`
+from the spot the TCP stays on the line (issue 17). A blend cuts into the lines it joins, so a
+variant that flies by a retract or an approach extends that line beyond the approach point, to
+`WeldEnd.T_ext`, by as much as its largest blend cuts in (`extension`); the blend then starts and
+ends beyond the approach distance, and `_straight` checks that it does.
 """
 
 from __future__ import annotations
@@ -15,7 +21,8 @@ from typing import Protocol
 import numpy as np
 
 from robomax_py._typing import FloatArray
-from robomax_py.robot import JointLimits, RobotModel
+from robomax_py.program import as_written_joints
+from robomax_py.robot import JointLimits, RobotModel, fk_tcp
 from robomax_py.timing import Segment, TimingError, ptp_time_estimate
 from robomax_py.timing.chain import (
     ChainPath,
@@ -23,9 +30,11 @@ from robomax_py.timing.chain import (
     PtpStep,
     Step,
     chain_path,
+    column_of,
     time_chain,
 )
-from robomax_py.timing.lin import LinPath
+from robomax_py.timing.lin import LinPath, lin_path
+from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision import SegmentCheck
 
 # Fly-by radii (deg, Euclidean over the joints) tried where a retract meets a move and a move meets
@@ -38,6 +47,8 @@ DETOUR_RADII_DEG = (12.0, 6.0, 3.0)
 EXACT_BOUND_SLACK = 1e-3
 # Spacing of the geometric path samples checked for collisions, rad (Euclidean, joint space).
 CHECK_STEP_RAD = 0.005
+# The TCP is on the electrode axis within this (m) over the approach distance.
+STRAIGHT_TOL_M = TOL.straight_tol_m
 
 
 class PathChecks(Protocol):
@@ -54,6 +65,18 @@ class WeldEnd:
     T_app: FloatArray
     column: int | None          # None: the column of the configuration the line starts from
     label: str
+    T_ext: FloatArray | None = None     # the line continued beyond T_app (None: no fly-by here)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Extension:
+    """Where a fly-by variant's lines end: the retract's target beyond the approach point of the
+    spot before (pose and configuration) and the configuration the approach to the next spot
+    starts from (None where the line stops at its approach point)."""
+
+    retract_T: FloatArray | None = None
+    retract_q: FloatArray | None = None
+    approach_q: FloatArray | None = None
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -64,6 +87,7 @@ class Junction:
     junction_radius: float
     corner_radius: float
     checks: int
+    extension: Extension = Extension()
 
 
 def time_junction(
@@ -92,9 +116,13 @@ def time_junction(
         approach point of `after` (or home).
     """
     lin_cache: dict[bytes, LinPath] = {}
+    extended = _extension(robot, np.asarray(q_start, dtype=float), waypoints, before, after) if flyby else None
 
     def timed(rj: float, rd: float) -> tuple[float, list[ChainPath], list[Segment]] | None:
-        steps = _steps(waypoints, kind, label, before, after, tcp_speed, speed, rj, rd)
+        ext = extended if rj > 0 else None
+        if rj > 0 and ext is None:
+            return None
+        steps = _steps(waypoints, kind, label, before, after, tcp_speed, speed, rj, rd, ext)
         try:
             return _time_steps(robot, limits, q_start, steps, jerk_limited, lin_cache)
         except TimingError:
@@ -136,13 +164,14 @@ def time_junction(
                 continue
             free, used = _path_free(world, trial[1])
             checks += used
-            if free:
+            if free and (rj == 0 or _straight(robot, trial[1], before, after)):
                 best, best_rj, best_rd = trial, rj, rd
                 if not corners:
                     break                  # smaller junction radii only pass the corner more slowly
     if best is None:
         best = exact_motion()
-    return Junction(best[2], best_rj, best_rd, checks)
+    used = extended if best_rj > 0 and extended is not None else Extension()
+    return Junction(best[2], best_rj, best_rd, checks, used)
 
 
 def _exact_lower_bound(q_start: FloatArray, steps: list[Step], paths: list[ChainPath], limits: JointLimits) -> float:
@@ -163,12 +192,15 @@ def _exact_lower_bound(q_start: FloatArray, steps: list[Step], paths: list[Chain
 
 def _steps(
     waypoints: FloatArray, kind: str, label: str, before: WeldEnd | None, after: WeldEnd | None,
-    tcp_speed: float, speed: float, rj: float, rd: float,
+    tcp_speed: float, speed: float, rj: float, rd: float, ext: Extension | None = None,
 ) -> list[Step]:
     steps: list[Step] = []
     if before is not None:
-        steps.append(LinStep(before.T_app, tcp_speed, before.column, flyby=rj, kind="retract", label=before.label))
+        T = ext.retract_T if ext is not None and ext.retract_T is not None else before.T_app
+        steps.append(LinStep(T, tcp_speed, before.column, flyby=rj, kind="retract", label=before.label))
     targets = np.asarray(waypoints, dtype=float)[1:]
+    if after is not None and ext is not None and ext.approach_q is not None:
+        targets = np.vstack([targets[:-1], ext.approach_q[None, :]])
     for w, q in enumerate(targets):
         last = w == len(targets) - 1
         fly = (rj if after is not None else 0.0) if last else rd
@@ -176,6 +208,52 @@ def _steps(
     if after is not None:
         steps.append(LinStep(after.T_spot, tcp_speed, after.column, kind="approach", label=after.label))
     return steps
+
+
+def _extension(robot: RobotModel, q_start: FloatArray, waypoints: FloatArray, before: WeldEnd | None,
+               after: WeldEnd | None) -> Extension | None:
+    """The lines continued to T_ext in their branches (the retract's end pose and configuration,
+    the approach's start configuration, as programs state them); None when a line cannot be."""
+    retract_T = retract_q = approach_q = None
+    if before is not None and before.T_ext is not None:
+        # The retract from the spot, as the chain will follow it (`chain_path`).
+        lp = lin_path(robot, fk_tcp(robot, q_start), before.T_ext, column_of(robot, q_start), q_start=q_start)
+        if not lp.ok:
+            return None
+        retract_T, retract_q = before.T_ext, np.asarray(lp.q[-1], dtype=float)
+    if after is not None and after.T_ext is not None:
+        q_app = np.asarray(waypoints[-1], dtype=float)
+        lp = lin_path(robot, after.T_app, after.T_ext, column_of(robot, q_app))
+        if not lp.ok:
+            return None
+        approach_q = as_written_joints(lp.q[-1])
+    return Extension(retract_T, retract_q, approach_q)
+
+
+def _straight(robot: RobotModel, paths: list[ChainPath], before: WeldEnd | None, after: WeldEnd | None) -> bool:
+    """Whether the TCP is on the electrode axis, on the approach side, wherever the path comes
+    within the approach distance of a spot it starts or ends at (within STRAIGHT_TOL_M)."""
+    ends = [e for e in (before, after) if e is not None]
+    if not ends:
+        return True
+    for chain in paths:
+        if not np.any(chain.radii > 0):
+            continue
+        tcp = fk_tcp(robot, chain.path.sample(CHECK_STEP_RAD))[:, :3, 3]
+        for end in ends:
+            origin = np.asarray(end.T_spot, dtype=float)[:3, 3]
+            axis = np.asarray(end.T_app, dtype=float)[:3, 3] - origin
+            approach = float(np.linalg.norm(axis))
+            if approach <= 0.0:
+                continue
+            axis /= approach
+            rel = tcp - origin
+            along = rel @ axis
+            near = np.linalg.norm(rel, axis=1) <= approach          # within the approach distance
+            off = np.linalg.norm(rel - along[:, None] * axis, axis=1)
+            if np.any(near & ((off > STRAIGHT_TOL_M) | (along < -STRAIGHT_TOL_M))):
+                return False
+    return True
 
 
 def split_chains(steps: list[Step]) -> list[list[Step]]:

@@ -82,6 +82,10 @@ class Transition:
     blend_radius: float = 0.0        # rad: detour corners passed on G2 blends of this radius; 0: stops at each
     flyby_radius: float = 0.0        # rad: the retract -> move and move -> approach joins flown by; 0: stops
     wait: WaitPlan | None = None     # a wait at rest before it, for a dynamic obstacle to clear
+    # Where a fly-by's lines end beyond the approach points (junction.Extension); None: there.
+    retract_T: FloatArray | None = None     # (4, 4) the retract's target, robot base frame
+    retract_q: FloatArray | None = None     # the configuration there
+    approach_q: FloatArray | None = None    # the configuration the approach line starts from
 
 
 @dataclass(frozen=True, slots=True)

@@ -9,7 +9,7 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.plan.candidates import SpotCandidates
-from robomax_py.plan.junction import WeldEnd, time_junction
+from robomax_py.plan.junction import JUNCTION_RADII_DEG, WeldEnd, time_junction
 from robomax_py.plan.poses import (
     OrientationGrid,
     approach_poses,
@@ -77,7 +77,9 @@ def time_tour(
             jerk_limited=options.jerk_limited, flyby=options.blend,
         )
         block = list(junction.segments)
-        timed.append(replace(trans, blend_radius=junction.corner_radius, flyby_radius=junction.junction_radius))
+        ext = junction.extension
+        timed.append(replace(trans, blend_radius=junction.corner_radius, flyby_radius=junction.junction_radius,
+                             retract_T=ext.retract_T, retract_q=ext.retract_q, approach_q=ext.approach_q))
         q_now = block[-1].q[-1]
         if after is not None:
             block.append(dwell(q_now, weld_times[k], kind="weld", label=after.label))
@@ -94,6 +96,8 @@ def time_tour(
     traj = resample(concatenate(segments))
     plans = []
     waits_for = interlocks(cell, [spots[i] for i in tour.order])
+    # The retract of spot k ends where transition k + 1's fly-by continued it (or at its approach point).
+    retract_q = [timed[k + 1].retract_q if k + 1 < len(timed) else None for k in range(len(welded))]
     for k, (i, a, T_spot, T_app) in enumerate(welded):
         c = spots[i]
         seam = cell.seams[c.seam_index]
@@ -104,9 +108,15 @@ def time_tour(
         # the spot and changes sign over the approach line (issue 14).
         plans.append(SpotPlan(seam.name, c.name, c.angles[a], config_text(robot, c.q_spot[a]), q_spot,
                               as_written_joints(c.q_app[a]), float(phase.t_start), float(phase.t_end), T_spot, T_app,
-                              config_text(robot, c.q_app[a]), weld_times[k], cell.process.gun,
+                              config_text(robot, retract_q[k] if retract_q[k] is not None else c.q_app[a]),
+                              weld_times[k], cell.process.gun,
                               cell.process.schedule_of(spec_of[k]), waits_for[k]))
     return traj, plans, timed
+
+
+# A line continued for a fly-by gets this much more than the blend cuts in, and at most this (m).
+EXTENSION_MARGIN = 1.25
+MAX_EXTENSION_M = 0.1
 
 
 def interlocks(cell: CellSpec, order: list[SpotCandidates]) -> list[tuple[str, ...]]:
@@ -135,7 +145,22 @@ def weld_end(cell: CellSpec, c: SpotCandidates, a: int, grids: list[OrientationG
     C = cell.robot.controller.T_root_base
     T_spot = as_written_pose_in(invert(np.asarray(cell.T_world_base)) @ T_world, C)
     T_app = as_written_pose_in(approach_poses(T_spot, cell.process.approach), C)
-    return WeldEnd(T_spot, T_app, None, f"{seam.name}/{c.name}")
+    ext = approach_extension(cell.process.approach, c.q_spot[a], c.q_app[a], T_spot, T_app)
+    T_ext = as_written_pose_in(approach_poses(T_spot, cell.process.approach + ext), C) if ext > 0 else None
+    return WeldEnd(T_spot, T_app, None, f"{seam.name}/{c.name}", T_ext)
+
+
+def approach_extension(approach: float, q_spot: FloatArray, q_app: FloatArray, T_spot: FloatArray,
+                       T_app: FloatArray) -> float:
+    """How far (m) a line is continued beyond its approach point for the junction's fly-by: the
+    TCP length the largest junction radius cuts into it (joint radius over the line's joint-to-TCP
+    chord ratio), with a margin; 0 without an approach line."""
+    tcp = float(np.linalg.norm(np.asarray(T_app)[:3, 3] - np.asarray(T_spot)[:3, 3]))
+    joint = float(np.linalg.norm(np.asarray(q_app) - np.asarray(q_spot)))
+    if approach <= 0.0 or tcp <= 0.0 or joint <= 0.0:
+        return 0.0
+    cut = np.deg2rad(max(JUNCTION_RADII_DEG)) * tcp / joint
+    return float(min(EXTENSION_MARGIN * cut, MAX_EXTENSION_M))
 
 
 def _waits(cell: CellSpec, robot: RobotModel, blocks: list[list[Segment]]) -> list[WaitPlan]:
