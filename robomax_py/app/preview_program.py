@@ -223,14 +223,20 @@ def infer_phases(
         if t[j] - t[i] >= MIN_WAIT_S:
             kinds[i:j] = "wait"
         i = j
-    p = fk_tcp(robot, q)[:, :3, 3]
+    T = fk_tcp(robot, q)
+    p = T[:, :3, 3]
     for s in spots:
         a = int(np.argmin(np.abs(t - s.t_arrive)))
         b = int(np.argmin(np.abs(t - s.t_leave)))
         label = f"{s.seam}/{s.name}"
         kinds[a:b] = "weld"
         labels[a:b] = label
-        near = np.linalg.norm(p - p[a], axis=1) <= approach + APPROACH_SLACK_M
+        # Approach and retract: within the approach distance, or on the electrode axis beyond it
+        # (the lines are continued there where a fly-by joins them).
+        rel = p - p[a]
+        along = rel @ T[a, :3, 2]
+        off = np.linalg.norm(rel - along[:, None] * T[a, :3, 2], axis=1)
+        near = (np.linalg.norm(rel, axis=1) <= approach + APPROACH_SLACK_M) | ((off <= APPROACH_SLACK_M) & (along >= 0))
         i = a
         while i > 0 and near[i - 1] and kinds[i - 1] in ("move", "wait"):
             i -= 1

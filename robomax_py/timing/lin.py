@@ -113,8 +113,9 @@ class LinPath:
         return LinMoveError(self.reason, self.index, self.fraction, self.detail)
 
 
-# Samples of one LIN move at most (1 mm steps: a 100 m line); no arm's line is near it.
-MAX_LIN_SAMPLES = 100_000
+# Samples of one LIN move at most (1 mm steps: a 20 m line; no arm reaches that far): a target in
+# the wrong unit (a program in m read as mm) fails here instead of sampling kilometres.
+MAX_LIN_SAMPLES = 20_000
 
 
 def lin_path(
@@ -173,11 +174,6 @@ def lin_path(
     if line.length <= 0.0:
         return LinPath(True, "", "", -1, 0.0, frozen_array([0.0]), frozen_array(q0[None]), line.tcp_length, line.tcp_angle)
 
-    # The end first: a target out of reach (lengths in the wrong unit, a typing slip) fails here,
-    # before a path is sampled towards it.
-    last = tracker.solve(np.ones(1))
-    if getattr(last, "reachable", None) is not None and not tracker.reachable(last, 0):
-        return _failed(line, "unreachable", "no IK solution at the end of the line", 1.0, [0.0], [q0])
     count = 1 + max(1, int(np.ceil(line.tcp_length / step)), int(np.ceil(line.tcp_angle / rot_step)))
     if count > MAX_LIN_SAMPLES:
         detail = f"the line is {line.tcp_length:.1f} m long, longer than any arm can follow in one move"

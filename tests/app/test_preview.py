@@ -197,7 +197,10 @@ def test_srcl_of_another_cell_exits_2(planned: tuple[Path, Path], tmp_path: Path
 
 def test_json_phases_match_the_rebuilt_programs(planned: tuple[Path, Path]) -> None:
     """Phases recovered from the .json agree with the .srcl's rebuilt phases on where the robot welds,
-    approaches and detours (within one 10 ms sample)."""
+    approaches and detours: welds within two 10 ms samples; detours and approaches within 60 ms,
+    since a join flown by from a move into an approach line is split by the program in its middle
+    and by the inference where the TCP reaches the electrode axis (about 25 ms per such join in
+    this cell)."""
     cell_path, out = planned
     cell = load_cell(cell_path)
     robot = load_cell_robot(cell)
@@ -206,7 +209,7 @@ def test_json_phases_match_the_rebuilt_programs(planned: tuple[Path, Path]) -> N
     for kind in ("weld", "detour", "approach"):
         a = sum(p.duration for p in from_json.phases if p.kind == kind)
         b = sum(p.duration for p in from_srcl.phases if p.kind == kind)
-        assert abs(a - b) <= 0.0101 * 2, (kind, a, b)
+        assert abs(a - b) <= (0.0101 * 2 if kind == "weld" else 0.06), (kind, a, b)
     covered = sum(p.duration for p in from_json.phases)
     assert abs(covered - from_json.duration) < TIME_TOL_S
 

@@ -38,10 +38,10 @@ def written(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> dict[
     return {"tmp": tmp, "cell_path": path, "cell": cell, "robot": robot, "files": files}
 
 
-def _verify(written: dict[str, Any], fmt: str, edit: Callable[[str], str], *, ext: str | None = None) -> Any:
-    """Verify the program with one of its files edited (the main file, or `ext`)."""
+def _edited(written: dict[str, Any], fmt: str, edit: Callable[[str], str], tag: str, *, ext: str | None = None) -> Path:
+    """A folder with the program, one of its files edited (the main file, or `ext`); its main file."""
     ext = ext or MAIN[fmt]
-    folder = written["tmp"] / f"edited_{fmt}_{abs(hash(edit)) % 10**6}"
+    folder = written["tmp"] / f"edited_{fmt}_{tag}"
     folder.mkdir()
     for name, text in written["files"].items():
         if name.endswith(tuple(DIALECTS[fmt].extensions)):
@@ -50,7 +50,11 @@ def _verify(written: dict[str, Any], fmt: str, edit: Callable[[str], str], *, ex
             if mine:
                 assert new != text, "the edit changed nothing"
             (folder / name).write_text(new)
-    return verify_program(written["cell"], written["robot"], folder / f"small_cell{MAIN[fmt]}")
+    return folder / f"small_cell{MAIN[fmt]}"
+
+
+def _verify(written: dict[str, Any], fmt: str, edit: Callable[[str], str], tag: str, *, ext: str | None = None) -> Any:
+    return verify_program(written["cell"], written["robot"], _edited(written, fmt, edit, tag, ext=ext))
 
 
 def _first(pattern: str, text: str, replace: Callable[[re.Match[str]], str]) -> str:
@@ -87,7 +91,7 @@ MOVED: dict[str, tuple[str | None, Callable[[str], str]]] = {
 @pytest.mark.parametrize("fmt", sorted(MOVED))
 def test_a_target_1mm_off_is_rejected_with_its_line(written: dict[str, Any], fmt: str) -> None:
     ext, edit = MOVED[fmt]
-    report = _verify(written, fmt, edit, ext=ext)
+    report = _verify(written, fmt, edit, "moved", ext=ext)
     spot = [v for v in report.violations if v.kind == "spot" and "mm from the spot" in v.detail]
     assert spot, report.violations
     assert spot[0].line is not None
@@ -107,7 +111,7 @@ FLIPPED: dict[str, tuple[str | None, Callable[[str], str]]] = {
 @pytest.mark.parametrize("fmt", sorted(FLIPPED))
 def test_another_configuration_is_rejected_with_its_line(written: dict[str, Any], fmt: str) -> None:
     ext, edit = FLIPPED[fmt]
-    report = _verify(written, fmt, edit, ext=ext)
+    report = _verify(written, fmt, edit, "flipped", ext=ext)
     config = [v for v in report.violations if v.kind in ("config", "spot") and "onfiguration" in v.detail or v.kind == "config"]
     assert config, report.violations
     assert all(v.line is not None for v in config)
@@ -126,7 +130,7 @@ BLENDED: dict[str, Callable[[str], str]] = {
 
 @pytest.mark.parametrize("fmt", sorted(BLENDED))
 def test_a_blended_weld_point_is_rejected_with_its_line(written: dict[str, Any], fmt: str) -> None:
-    report = _verify(written, fmt, BLENDED[fmt])
+    report = _verify(written, fmt, BLENDED[fmt], "blended")
     flyby = [v for v in report.violations if v.kind == "flyby"]
     assert flyby, report.violations
     assert flyby[0].line is not None
@@ -150,7 +154,7 @@ SCALED: dict[str, tuple[str | None, Callable[[str], str]]] = {
 @pytest.mark.parametrize("fmt", sorted(SCALED))
 def test_lengths_in_another_unit_are_rejected(written: dict[str, Any], fmt: str) -> None:
     ext, edit = SCALED[fmt]
-    report = _verify(written, fmt, edit, ext=ext)
+    report = _verify(written, fmt, edit, "scaled", ext=ext)
     assert not report.clean
     assert any(v.line is not None for v in report.violations), report.violations
 
@@ -158,18 +162,17 @@ def test_lengths_in_another_unit_are_rejected(written: dict[str, Any], fmt: str)
 def test_a_quaternion_that_is_not_unit_is_bad_input_with_its_line(written: dict[str, Any]) -> None:
     edit: Callable[[str], str] = lambda t: _first(r"(robtarget p\d+ := \[\[[^\]]*\], \[)(-?[\d.]+)", t,  # noqa: E731
                                                   lambda m: m[1] + f"{float(m[2]) + 0.1:.9f}")
+    program = _edited(written, "rapid", edit, "quaternion")
     with pytest.raises(ProgramError, match=r"line \d+.*not unit"):
-        _verify(written, "rapid", edit)
-    folder = next(p for p in written["tmp"].iterdir() if p.is_dir() and p.name.startswith("edited_rapid"))
-    result = runner.invoke(app, ["verify", str(written["cell_path"]), str(next(folder.glob("*.mod")))])
+        verify_program(written["cell"], written["robot"], program)
+    result = runner.invoke(app, ["verify", str(written["cell_path"]), str(program)])
     assert result.exit_code in (EXIT_BAD_INPUT, EXIT_VIOLATIONS), result.output
 
 
 def test_violations_exit_one_from_the_cli(written: dict[str, Any]) -> None:
     ext, edit = MOVED["fanuc"]
-    _verify(written, "fanuc", edit, ext=ext)
-    folder = next(p for p in written["tmp"].iterdir() if p.is_dir() and p.name.startswith("edited_fanuc"))
-    result = runner.invoke(app, ["verify", str(written["cell_path"]), str(folder / "small_cell.ls")])
+    program = _edited(written, "fanuc", edit, "cli", ext=ext)
+    result = runner.invoke(app, ["verify", str(written["cell_path"]), str(program)])
     assert result.exit_code == EXIT_VIOLATIONS, result.output
     assert re.search(r"line \d+", result.output), result.output
 

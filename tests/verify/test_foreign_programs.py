@@ -1,0 +1,116 @@
+"""Every dialect's reader on programs written by others (tests/data/programs, SOURCES.md): it reads
+their motion subset, and reports what it cannot simulate (a motion to a register or an
+expression, circles, moves inside loops and conditions, jumps, calls) instead of guessing; `verify`
+then says the program cannot be verified, never that it is clean."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from robomax_py.export import dialect_for_file
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.program import Comment, LinMove, PtpMove, Wait
+from robomax_py.robot import RobotModel
+from robomax_py.verify import verify_program
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "programs"
+REPO = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def kr125() -> tuple[object, RobotModel]:
+    cell = load_cell(REPO / "cells" / "cabin_flange.yaml")
+    return cell, load_cell_robot(cell)
+
+
+def _read(name: str, robot: RobotModel):  # type: ignore[no-untyped-def]
+    path = DATA / name
+    dialect = dialect_for_file(path.suffix)
+    assert dialect is not None
+    return dialect.parse({dialect.extensions[0]: path.read_text(encoding="utf-8", errors="replace")}, str(path), robot)
+
+
+def _unsimulated(parsed) -> list[tuple[int, str]]:  # type: ignore[no-untyped-def]
+    return [(line, ins.text) for ins, line in zip(parsed.program.instructions, parsed.lines)
+            if isinstance(ins, Comment) and ins.text.startswith("not simulated")]
+
+
+def _count(parsed, kind: type) -> int:  # type: ignore[no-untyped-def]
+    return sum(isinstance(i, kind) for i in parsed.program.instructions)
+
+
+def test_krl_rsi_program(kr125) -> None:  # type: ignore[no-untyped-def]
+    parsed = _read("ros_rsi.src", kr125[1])
+    assert parsed.program.name == "RSI_AxisCorr"
+    moves = [i for i in parsed.program.instructions if isinstance(i, PtpMove)]
+    assert moves[0].target_deg == (0.0, -90.0, 90.0, 0.0, 90.0, 0.0)   # PTP {A1 0, A2 -90, ...}
+    assert any("RSI_MOVECORR" in text for _, text in _unsimulated(parsed))   # sensor-guided motion
+    assert parsed.ignored                                                    # BAS, RSI calls, IF blocks
+
+
+def test_rapid_moveabsj_program(kr125) -> None:  # type: ignore[no-untyped-def]
+    parsed = _read("Grey_T_ROB1.mod", kr125[1])
+    assert parsed.program.name == "Grey_T_ROB1"
+    (first,) = [i for i in parsed.program.instructions if isinstance(i, PtpMove)]
+    assert first.target_deg == (82.467, -17.016, 48.414, 85.948, 96.306, -31.779)
+    assert first.flyby_mm == 0.0                                             # fine
+    assert len([t for _, t in _unsimulated(parsed) if "MoveJ" in t]) == 10    # MoveJ to robtargets
+    assert [f.name for f in parsed.program.frames] == ["DefaultGHTool", "DefaultFrame"]
+
+
+def test_rapid_program_with_conditions(kr125) -> None:  # type: ignore[no-untyped-def]
+    parsed = _read("test_4.mod", kr125[1])
+    lins = [i for i in parsed.program.instructions if isinstance(i, LinMove)]
+    assert lins[0].position_mm == (25.0, 540.0, 45.8)
+    assert lins[0].speed_mm_s == 100.0 and lins[0].flyby_mm == 1.0          # speeddata Work, zone z1
+    assert _count(parsed, Wait) == 4                                        # WaitTime 0.9 and 1, twice (after ENDIF)
+    lines = [line for line, text in _unsimulated(parsed)]
+    assert 11 in lines                                                      # WaitDI inside IF ... ENDIF
+    tool = parsed.program.frames[0]
+    assert tool.name == "custom_tool1" and tool.xyz_mm == (-144.18, -154.4, 34.77)
+
+
+def test_fanuc_streaming_program(kr125) -> None:  # type: ignore[no-untyped-def]
+    parsed = _read("ros_movesm.ls", kr125[1])
+    texts = [t for _, t in _unsimulated(parsed)]
+    assert any("PR[2" in t for t in texts)                                   # J to a position register
+    assert any(t.endswith("JMP LBL[10]") for t in texts)                     # a loop
+
+
+def test_fanuc_production_program(kr125) -> None:  # type: ignore[no-untyped-def]
+    parsed = _read("up222.ls", kr125[1])
+    assert parsed.program.name == "UP222"
+    lins = [i for i in parsed.program.instructions if isinstance(i, LinMove)]
+    assert lins[0].position_mm == (344.99, -1889.465, -357.235)              # P[12], GP1 only
+    assert lins[0].zyx_deg == (-132.732, 62.119, -86.967)                    # R, P, W
+    assert lins[0].speed_mm_s == 1500.0 and lins[0].config == "N U T, 0, 0, 0"
+    texts = [t for _, t in _unsimulated(parsed)]
+    assert any(t.startswith("not simulated: J P[1]") for t in texts)         # J to a Cartesian point
+    assert any("CALL MAKRO050" in t for t in texts)                          # calls may move
+
+
+def test_urscript_polyscope_program(kr125) -> None:  # type: ignore[no-untyped-def]
+    parsed = _read("timing_debug.script", kr125[1])
+    assert parsed.program.name == "timing_debug"
+    assert parsed.program.frames[0].xyz_mm == (0.0, 0.0, 0.0)               # set_tcp(p[0, ...])
+    texts = [t for _, t in _unsimulated(parsed)]
+    assert len([t for t in texts if "movej(get_inverse_kin" in t]) == 2       # inside while, to an expression
+
+
+@pytest.mark.parametrize("name", ["ros_rsi.src", "Grey_T_ROB1.mod", "test_4.mod", "ros_movesm.ls", "up222.ls",
+                                  "timing_debug.script"])
+def test_verify_never_calls_them_clean(kr125, name: str, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    cell, robot = kr125
+    program = tmp_path / name
+    program.write_bytes((DATA / name).read_bytes())
+    try:
+        report = verify_program(cell, robot, program)
+    except Exception as exc:                 # a ProgramError (bad input) is an acceptable answer too
+        from robomax_py.errors import ProgramError
+
+        assert isinstance(exc, ProgramError), exc
+        return
+    assert not report.clean
+    assert any(v.kind == "unsupported" and v.line is not None for v in report.violations)
