@@ -215,8 +215,9 @@ def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> lis
 
 def _approach_straight(cell: CellSpec, robot: RobotModel, t: FloatArray, q: FloatArray, spot: Any, label: str,
                        t0: float, t1: float) -> list[Violation]:
-    """Within `process.approach` of the spot, before and after the weld, the TCP moves only along
-    the electrode axis (the TCP z axis at the spot) on the approach side."""
+    """Over the approach distance, before and after the weld, the TCP moves only along the
+    electrode axis (the TCP z axis at the spot) on the approach side: from the weld outwards until
+    it is `process.approach` up the axis (or that far from the spot)."""
     approach = cell.process.approach
     if approach <= 0:
         return []
@@ -228,9 +229,10 @@ def _approach_straight(cell: CellSpec, robot: RobotModel, t: FloatArray, q: Floa
         worst, at, i = 0.0, None, start
         while 0 <= i < len(t):
             rel = (np.asarray(cell.T_world_base) @ fk_tcp(robot, q[i]))[:3, 3] - origin
-            if np.linalg.norm(rel) > approach:
-                break
             along = float(rel @ axis)
+            # The approach distance is covered once the TCP is that far up the axis, or that far away.
+            if along >= approach - TOL.straight_tol_m or np.linalg.norm(rel) > approach:
+                break
             off = max(float(np.linalg.norm(rel - along * axis)), -along)
             if off > worst:
                 worst, at = off, float(t[i])

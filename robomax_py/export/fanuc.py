@@ -10,7 +10,7 @@ position data, frame instructions):
 - the tool frame set by the program: `PR[1]` assigned element by element, `UTOOL[1]=PR[1]`,
   `UTOOL_NUM=1`; targets in the controller's world frame (`UFRAME_NUM=0`, `UF : 0`), which is the
   robot base: the program states no base frame;
-- mm and joint values with TP's 3 decimals, W, P, R with 4, speeds in whole % and mm/sec, waits in 0.01 s (rounded up);
+- mm with TP's 3 decimals, W, P, R and joint values with 4, speeds in whole % and mm/sec, waits in 0.01 s (rounded up);
 - blends as `CNTn`: robomax's model of CNT flies by with the joint-space radius n x 0.12 deg
   (CNT100 = 12 deg, the largest radius the planner uses), so the planner's radii are whole CNTs;
 - a weld as `L ... FINE`, then `CALL SPOT_WELD(n,weld_time)`, then the `! seam/name` remark line
@@ -56,8 +56,9 @@ from robomax_py.robot import RobotModel
 __all__ = ["CNT_DEG", "adapt", "parse", "write"]
 
 CNT_DEG = 0.12            # joint-space fly-by radius of CNT1, deg
-# W, P, R with 4 decimals (TP's listings show 3): a spot orientation the planner chose at the edge
-# of its tolerance window stays inside it.
+# Angles (W, P, R and joint values) with 4 decimals, as every robomax program states them (TP's
+# listings show 3): a spot orientation the planner chose at the edge of its tolerance window stays
+# inside it, and a 12 deg detour corner blends as planned.
 ANGLE_DECIMALS = 4
 WEAPON = "SPOT_WELD"
 
@@ -88,7 +89,7 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     out: list[Instruction] = []
     for ins in program.instructions:
         if isinstance(ins, PtpMove):
-            ctrl = tuple(_round(v, 3) for v in _to_controller(ins.target_deg, coupled))
+            ctrl = tuple(_round(v, ANGLE_DECIMALS) for v in _to_controller(ins.target_deg, coupled))
             ins = dataclasses.replace(ins, target_deg=_from_controller(ctrl, coupled),
                                       speed=_percent(ins.speed) / 100, accel=_percent(ins.accel) / 100,
                                       flyby=_cnt(ins.flyby) * CNT_DEG)
@@ -138,8 +139,8 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                 mn.append(f"J P[{k}] {_percent(ins.speed)}% {term}{acc} ;")
                 q = _to_controller(ins.target_deg, coupled)
                 pos.append(f"P[{k}]{{\n   GP1:\n\tUF : 0, UT : 1,\n"
-                           f"\tJ1= {q[0]:.3f} deg,\tJ2= {q[1]:.3f} deg,\tJ3= {q[2]:.3f} deg,\n"
-                           f"\tJ4= {q[3]:.3f} deg,\tJ5= {q[4]:.3f} deg,\tJ6= {q[5]:.3f} deg\n}};")
+                           f"\tJ1= {q[0]:.4f} deg,\tJ2= {q[1]:.4f} deg,\tJ3= {q[2]:.4f} deg,\n"
+                           f"\tJ4= {q[3]:.4f} deg,\tJ5= {q[4]:.4f} deg,\tJ6= {q[5]:.4f} deg\n}};")
             else:
                 mn.append(f"L P[{k}] {int(round(ins.speed_mm_s))}mm/sec {term} ;")
                 x, y, z = ins.position_mm

@@ -231,27 +231,25 @@ def _extension(robot: RobotModel, q_start: FloatArray, waypoints: FloatArray, be
 
 
 def _straight(robot: RobotModel, paths: list[ChainPath], before: WeldEnd | None, after: WeldEnd | None) -> bool:
-    """Whether the TCP is on the electrode axis, on the approach side, wherever the path comes
-    within the approach distance of a spot it starts or ends at (within STRAIGHT_TOL_M)."""
-    ends = [e for e in (before, after) if e is not None]
-    if not ends:
-        return True
-    for chain in paths:
-        if not np.any(chain.radii > 0):
+    """Whether the TCP stays on the electrode axis, on the approach side, over the approach
+    distance: from the spot the junction leaves (the start of its first chain) or reaches (the
+    end of its last) until it is the approach distance up the axis (within STRAIGHT_TOL_M)."""
+    for end, chain, reverse in ((before, paths[0] if paths else None, False), (after, paths[-1] if paths else None, True)):
+        if end is None or chain is None:
             continue
+        origin = np.asarray(end.T_spot, dtype=float)[:3, 3]
+        axis = np.asarray(end.T_app, dtype=float)[:3, 3] - origin
+        approach = float(np.linalg.norm(axis))
+        if approach <= 0.0:
+            continue
+        axis /= approach
         tcp = fk_tcp(robot, chain.path.sample(CHECK_STEP_RAD))[:, :3, 3]
-        for end in ends:
-            origin = np.asarray(end.T_spot, dtype=float)[:3, 3]
-            axis = np.asarray(end.T_app, dtype=float)[:3, 3] - origin
-            approach = float(np.linalg.norm(axis))
-            if approach <= 0.0:
-                continue
-            axis /= approach
-            rel = tcp - origin
-            along = rel @ axis
-            near = np.linalg.norm(rel, axis=1) <= approach          # within the approach distance
-            off = np.linalg.norm(rel - along[:, None] * axis, axis=1)
-            if np.any(near & ((off > STRAIGHT_TOL_M) | (along < -STRAIGHT_TOL_M))):
+        for p in (tcp[::-1] if reverse else tcp):
+            rel = p - origin
+            along = float(rel @ axis)
+            if along >= approach - STRAIGHT_TOL_M or float(np.linalg.norm(rel)) > approach:
+                break
+            if along < -STRAIGHT_TOL_M or float(np.linalg.norm(rel - along * axis)) > STRAIGHT_TOL_M:
                 return False
     return True
 

@@ -417,8 +417,8 @@ GOLDEN = REPO / "tests" / "golden"
 
 def _program_mutants(rng: np.random.Generator) -> list[tuple[str, str, bytes]]:
     """(name, suffix, content) of broken programs for `verify`, from the small cell's golden files."""
-    srcl = (GOLDEN / "small_cell.srcl").read_bytes()
-    js = (GOLDEN / "small_cell.json").read_bytes()
+    srcl = (GOLDEN / "small_cell" / "small_cell.srcl").read_bytes()
+    js = (GOLDEN / "small_cell" / "small_cell.json").read_bytes()
     out: list[tuple[str, str, bytes]] = []
     for text, suffix in ((srcl, ".srcl"), (js, ".json")):
         for k in range(8):
@@ -478,7 +478,7 @@ def test_broken_programs_are_refused_cleanly_by_verify(tmp_path: Path, write_sma
     cell = write_small_cell(tmp_path)
     for suffix in (".srcl", ".json"):
         golden = tmp_path / f"golden{suffix}"
-        golden.write_bytes((GOLDEN / f"small_cell{suffix}").read_bytes())
+        golden.write_bytes((GOLDEN / "small_cell" / f"small_cell{suffix}").read_bytes())
         code, output, _ = _run(["verify", str(cell), str(golden)], tmp_path)
         assert code == 0, output            # the unbroken program verifies
     codes: Counter[int] = Counter()
@@ -501,6 +501,71 @@ def test_broken_programs_are_refused_cleanly_by_verify(tmp_path: Path, write_sma
             failures.append(f"{name}{suffix}: the message names no file:\n{output[-500:]}")
         program.unlink()
     print(f"\nprogram mutants by exit code: {dict(codes)}")
+    assert not failures, f"{len(failures)} failures:\n" + "\n".join(failures[:20])
+
+
+DIALECT_FILES = {".src": ".dat", ".mod": None, ".ls": None, ".script": None}
+
+
+def _dialect_mutants(rng: np.random.Generator) -> list[tuple[str, str, bytes]]:
+    """(name, file suffix, content) of broken controller programs (issue 17), from the small cell's
+    golden files: truncated, lines dropped or doubled, numbers replaced, bytes that are not text."""
+    out: list[tuple[str, str, bytes]] = []
+    numbers = [b"1e999", b"nan", b"9" * 400, b"-", b"1.2.3", b"0x10"]
+    for suffix in (*DIALECT_FILES, ".dat"):
+        text = (GOLDEN / "small_cell" / f"small_cell{suffix}").read_bytes()
+        lines = text.split(b"\n")
+        for k in range(3):
+            out.append((f"truncated_{k}", suffix, text[: int(rng.integers(1, len(text)))]))
+        for k in range(3):
+            i = int(rng.integers(len(lines)))
+            out.append((f"drop_{k}", suffix, b"\n".join(lines[:i] + lines[i + 1:])))
+        i = int(rng.integers(len(lines)))
+        out.append(("double", suffix, b"\n".join(lines[:i] + [lines[i]] * 2 + lines[i + 1:])))
+        for k in range(4):
+            i = int(rng.integers(len(lines)))
+            digits = [m.span() for m in __import__("re").finditer(rb"-?[0-9]+\.[0-9]+", lines[i])]
+            if not digits:
+                continue
+            a, b = digits[int(rng.integers(len(digits)))]
+            mutated = list(lines)
+            mutated[i] = lines[i][:a] + numbers[k % len(numbers)] + lines[i][b:]
+            out.append((f"number_{k}", suffix, b"\n".join(mutated)))
+        out += [("latin1", suffix, text + b"\n\xe9\xff"), ("empty", suffix, b""),
+                ("nul", suffix, text.replace(b"\n", b"\x00\n", 1))]
+    return out
+
+
+@pytest.mark.slow
+def test_broken_controller_programs_are_refused_cleanly_by_verify(tmp_path: Path, write_small_cell: Any) -> None:
+    from robomax_py.errors import RobomaxError
+    from robomax_py.io.cell import load_cell, load_cell_robot
+    from robomax_py.verify import verify_program
+
+    cell = load_cell(write_small_cell(tmp_path))
+    robot = load_cell_robot(cell)
+    outcomes: Counter[str] = Counter()
+    failures = []
+    for k, (name, suffix, content) in enumerate(_dialect_mutants(np.random.default_rng(3))):
+        folder = tmp_path / f"m{k}"
+        folder.mkdir()
+        main = ".src" if suffix == ".dat" else suffix
+        for ext in (main, DIALECT_FILES.get(main)):
+            if ext:
+                (folder / f"small_cell{ext}").write_bytes((GOLDEN / "small_cell" / f"small_cell{ext}").read_bytes())
+        (folder / f"small_cell{suffix}").write_bytes(content)
+        try:
+            with _deadline(60):
+                report = verify_program(cell, robot, folder / f"small_cell{main}")
+            outcomes["clean" if report.clean else "violations"] += 1
+        except RobomaxError as exc:
+            outcomes["bad input"] += 1
+            if "small_cell" not in str(exc):
+                failures.append(f"{name}{suffix}: the message names no file: {exc}")
+        except Exception as exc:  # noqa: BLE001 - a traceback for a user's file is the failure
+            failures.append(f"{name}{suffix}: {type(exc).__name__}: {exc}")
+    print(f"\ncontroller program mutants: {dict(outcomes)}")
+    assert sum(outcomes.values()) >= 60
     assert not failures, f"{len(failures)} failures:\n" + "\n".join(failures[:20])
 
 

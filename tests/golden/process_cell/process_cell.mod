@@ -4,7 +4,7 @@
 %%%
 
 MODULE process_cell
-  ! robomax_py 0.1.0 | cell process_cell | cell file sha256 07f708353b0dad51ba9d46e96786d44c0ddddf6af2bade2bc086e21390f48d4c | planned cycle 6.698 s
+  ! robomax_py 0.1.0 | cell process_cell | cell file sha256 07f708353b0dad51ba9d46e96786d44c0ddddf6af2bade2bc086e21390f48d4c | planned cycle 6.890 s
   ! robot kr125 | tool spot_gun_c | axes joint_a1 joint_a2 joint_a3 joint_a4 joint_a5 joint_a6
   ! RAPID module: mm, deg, quaternions [w, x, y, z], speeddata mm/s, zonedata mm
   PERS tooldata spot_gun_c_tcp := [TRUE, [[200.000, 0.000, 270.000], [0.500000000, -0.500000000, 0.500000000, -0.500000000]], [1, [0, 0, 0.001], [1, 0, 0, 0], 0, 0, 0]];  ! load: replace with the gun's (LoadIdentify)
@@ -12,25 +12,24 @@ MODULE process_cell
   CONST jointtarget jt1 := [[0.0000, -90.0000, 90.0000, 0.0000, 0.0000, 0.0000], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
   CONST zonedata z_1 := [FALSE, 51.900, 77.850, 77.850, 7.7850, 77.850, 7.7850];
   CONST jointtarget jt2 := [[6.6170, -105.8301, 123.4674, -4.1696, 62.6530, -164.4578], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
-  CONST zonedata z_2 := [FALSE, 14.011, 21.017, 21.017, 2.1016, 21.017, 2.1016];
   CONST jointtarget jt3 := [[6.6170, -98.6987, 133.6861, -5.2077, 45.3595, -162.7116], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
   CONST speeddata v_lin1 := [500.000, 500, 5000, 1000];
   CONST robtarget p4 := [[1346.720, -84.790, 875.510], [0.501470274, 0.428743215, 0.475615273, 0.581804891], [0, -1, -2, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
-  CONST zonedata z_3 := [FALSE, 14.868, 22.302, 22.302, 2.2302, 22.302, 2.2302];
-  CONST robtarget p5 := [[1375.997, -81.087, 880.908], [0.501470274, 0.428743215, 0.475615273, 0.581804891], [0, -1, -2, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
-  CONST zonedata z_4 := [FALSE, 24.263, 36.395, 36.395, 3.6395, 36.395, 3.6395];
-  CONST jointtarget jt6 := [[2.7536, -99.0283, 133.6521, -4.8412, 45.6175, -164.4196], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+  CONST zonedata z_2 := [FALSE, 14.895, 22.343, 22.343, 2.2342, 22.343, 2.2342];
+  CONST robtarget p5 := [[1394.135, -78.793, 884.252], [0.501470274, 0.428743215, 0.475615273, 0.581804891], [0, -1, -2, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+  CONST zonedata z_3 := [FALSE, 24.670, 37.005, 37.005, 3.7005, 37.005, 3.7005];
+  CONST jointtarget jt6 := [[2.5533, -98.0214, 132.5956, -4.7901, 45.6532, -164.6553], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
   CONST robtarget p7 := [[1348.500, 0.000, 880.000], [0.489107198, 0.418651975, 0.484518125, 0.592238853], [0, -1, -2, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
-  CONST zonedata z_5 := [FALSE, 14.847, 22.270, 22.270, 2.2270, 22.270, 2.2270];
-  CONST robtarget p8 := [[1377.595, 4.931, 885.398], [0.489107198, 0.418651975, 0.484518125, 0.592238853], [0, -1, -2, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
-  CONST zonedata z_6 := [FALSE, 60.659, 90.989, 90.989, 9.0988, 90.989, 9.0988];
+  CONST zonedata z_4 := [FALSE, 14.874, 22.311, 22.311, 2.2311, 22.311, 2.2311];
+  CONST robtarget p8 := [[1395.594, 7.982, 888.738], [0.489107198, 0.418651975, 0.484518125, 0.592238853], [0, -1, -2, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
+  CONST zonedata z_5 := [FALSE, 58.282, 87.423, 87.423, 8.7423, 87.423, 8.7423];
   CONST jointtarget jt9 := [[6.6170, -98.6987, 133.6861, -5.2077, 45.3595, -162.7116], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
-  CONST zonedata z_7 := [FALSE, 35.027, 52.541, 52.541, 5.2541, 52.541, 5.2541];
+  CONST zonedata z_6 := [FALSE, 35.027, 52.541, 52.541, 5.2541, 52.541, 5.2541];
   CONST jointtarget jt10 := [[6.6170, -105.8301, 123.4674, -4.1696, 62.6530, -164.4578], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
   CONST jointtarget jt11 := [[0.0000, -90.0000, 90.0000, 0.0000, 0.0000, 0.0000], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
 
   PROC main()
-    ! start at home; 2 spots, planned cycle 6.698 s
+    ! start at home; 2 spots, planned cycle 6.890 s
     VelSet 100.0, 5000;
     AccSet 100.0, 100;
     MoveAbsJ jt1, vmax, fine, spot_gun_c_tcp \WObj:=robot_base;  ! home
@@ -39,18 +38,18 @@ MODULE process_cell
     ! wait 1.501 s for door to clear
     WaitDI door_clear, 1;
     MoveAbsJ jt2, vmax, z_1, spot_gun_c_tcp \WObj:=robot_base;  ! home -> s7, t 1.501 s, detour point 1
-    MoveAbsJ jt3, vmax, z_2, spot_gun_c_tcp \WObj:=robot_base;
-    ! flange/s7: arrive 3.079 s, leave 3.579 s, alpha -10.0 beta 10.0 gamma 0.0 deg
+    MoveAbsJ jt3, vmax, fine, spot_gun_c_tcp \WObj:=robot_base;
+    ! flange/s7: arrive 3.111 s, leave 3.611 s, alpha -10.0 beta 10.0 gamma 0.0 deg
     MoveL p4, v_lin1, fine, spot_gun_c_tcp \WObj:=robot_base;  ! approach
     spot_weld 1, 0.500;  ! flange/s7 gun 2 schedule 4
-    MoveL p5, v_lin1, z_3, spot_gun_c_tcp \WObj:=robot_base;  ! retract
-    MoveAbsJ jt6, vmax, z_4, spot_gun_c_tcp \WObj:=robot_base;  ! s7 -> s8, t 3.736 s
-    ! flange/s8: arrive 4.079 s, leave 4.879 s, alpha -10.0 beta 10.0 gamma 0.0 deg
+    MoveL p5, v_lin1, z_2, spot_gun_c_tcp \WObj:=robot_base;  ! retract
+    MoveAbsJ jt6, vmax, z_3, spot_gun_c_tcp \WObj:=robot_base;  ! s7 -> s8, t 3.818 s
+    ! flange/s8: arrive 4.212 s, leave 5.012 s, alpha -10.0 beta 10.0 gamma 0.0 deg
     MoveL p7, v_lin1, fine, spot_gun_c_tcp \WObj:=robot_base;  ! approach
     spot_weld 2, 0.800;  ! flange/s8 gun 2 schedule 7
-    MoveL p8, v_lin1, z_5, spot_gun_c_tcp \WObj:=robot_base;  ! retract
-    MoveAbsJ jt9, vmax, z_6, spot_gun_c_tcp \WObj:=robot_base;  ! s8 -> home, t 5.039 s, detour point 1
-    MoveAbsJ jt10, vmax, z_7, spot_gun_c_tcp \WObj:=robot_base;  ! detour point 2
+    MoveL p8, v_lin1, z_4, spot_gun_c_tcp \WObj:=robot_base;  ! retract
+    MoveAbsJ jt9, vmax, z_5, spot_gun_c_tcp \WObj:=robot_base;  ! s8 -> home, t 5.227 s, detour point 1
+    MoveAbsJ jt10, vmax, z_6, spot_gun_c_tcp \WObj:=robot_base;  ! detour point 2
     MoveAbsJ jt11, vmax, fine, spot_gun_c_tcp \WObj:=robot_base;
   ENDPROC
 

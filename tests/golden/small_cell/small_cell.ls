@@ -17,7 +17,7 @@ TCD:  STACK_SIZE	= 0,
 DEFAULT_GROUP	= 1,*,*,*,*;
 CONTROL_CODE	= 00000000 00000000;
 /MN
-   1:  ! robomax_py 0.1.0 | cell small_cell | cell file sha256 6bdd9e0710192b7603b20d63ba10c8d20d75769150c8bd427604ec09a0453a6e | planned cycle 4.897 s ;
+   1:  ! robomax_py 0.1.0 | cell small_cell | cell file sha256 6bdd9e0710192b7603b20d63ba10c8d20d75769150c8bd427604ec09a0453a6e | planned cycle 5.089 s ;
    2:  ! robot kr125 | tool spot_gun_c | axes joint_a1 joint_a2 joint_a3 joint_a4 joint_a5 joint_a6 ;
    3:  PR[1]=LPOS ;
    4:  PR[1]=PR[1]-PR[1] ;
@@ -32,7 +32,7 @@ CONTROL_CODE	= 00000000 00000000;
   13:  UFRAME_NUM=0 ;
   14:  J P[1] 100% FINE ;
   15:  J P[2] 100% CNT100 ;
-  16:  J P[3] 100% CNT10 ;
+  16:  J P[3] 100% FINE ;
   17:  L P[4] 500mm/sec FINE ;
   18:  CALL SPOT_WELD(1,0.500) ;
   19:  ! flange/s7 gun 1 schedule 1 ;
@@ -49,20 +49,20 @@ CONTROL_CODE	= 00000000 00000000;
 P[1]{
    GP1:
 	UF : 0, UT : 1,
-	J1= 0.000 deg,	J2= -90.000 deg,	J3= 90.000 deg,
-	J4= 0.000 deg,	J5= 0.000 deg,	J6= 0.000 deg
+	J1= 0.0000 deg,	J2= -90.0000 deg,	J3= 90.0000 deg,
+	J4= 0.0000 deg,	J5= 0.0000 deg,	J6= 0.0000 deg
 };
 P[2]{
    GP1:
 	UF : 0, UT : 1,
-	J1= 6.617 deg,	J2= -105.830 deg,	J3= 123.467 deg,
-	J4= -4.170 deg,	J5= 62.653 deg,	J6= -164.458 deg
+	J1= 6.6170 deg,	J2= -105.8301 deg,	J3= 123.4674 deg,
+	J4= -4.1696 deg,	J5= 62.6530 deg,	J6= -164.4578 deg
 };
 P[3]{
    GP1:
 	UF : 0, UT : 1,
-	J1= 6.617 deg,	J2= -98.699 deg,	J3= 133.686 deg,
-	J4= -5.208 deg,	J5= 45.359 deg,	J6= -162.712 deg
+	J1= 6.6170 deg,	J2= -98.6987 deg,	J3= 133.6861 deg,
+	J4= -5.2077 deg,	J5= 45.3595 deg,	J6= -162.7116 deg
 };
 P[4]{
    GP1:
@@ -73,14 +73,14 @@ P[4]{
 P[5]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'N U T, 0, 0, 0',
-	X = 1375.997  mm,	Y = -81.087  mm,	Z = 880.908  mm,
+	X = 1394.135  mm,	Y = -78.793  mm,	Z = 884.252  mm,
 	W = 79.6313 deg,	P = -1.2535 deg,	R = 97.4375 deg
 };
 P[6]{
    GP1:
 	UF : 0, UT : 1,
-	J1= 2.754 deg,	J2= -99.028 deg,	J3= 133.652 deg,
-	J4= -4.841 deg,	J5= 45.617 deg,	J6= -164.420 deg
+	J1= 2.5533 deg,	J2= -98.0214 deg,	J3= 132.5956 deg,
+	J4= -4.7901 deg,	J5= 45.6532 deg,	J6= -164.6553 deg
 };
 P[7]{
    GP1:
@@ -91,25 +91,25 @@ P[7]{
 P[8]{
    GP1:
 	UF : 0, UT : 1,		CONFIG : 'N U T, 0, 0, 0',
-	X = 1377.595  mm,	Y = 4.931  mm,	Z = 885.398  mm,
+	X = 1395.594  mm,	Y = 7.982  mm,	Z = 888.738  mm,
 	W = 79.6309 deg,	P = -1.2561 deg,	R = 99.8489 deg
 };
 P[9]{
    GP1:
 	UF : 0, UT : 1,
-	J1= 6.617 deg,	J2= -98.699 deg,	J3= 133.686 deg,
-	J4= -5.208 deg,	J5= 45.359 deg,	J6= -162.712 deg
+	J1= 6.6170 deg,	J2= -98.6987 deg,	J3= 133.6861 deg,
+	J4= -5.2077 deg,	J5= 45.3595 deg,	J6= -162.7116 deg
 };
 P[10]{
    GP1:
 	UF : 0, UT : 1,
-	J1= 6.617 deg,	J2= -105.830 deg,	J3= 123.467 deg,
-	J4= -4.170 deg,	J5= 62.653 deg,	J6= -164.458 deg
+	J1= 6.6170 deg,	J2= -105.8301 deg,	J3= 123.4674 deg,
+	J4= -4.1696 deg,	J5= 62.6530 deg,	J6= -164.4578 deg
 };
 P[11]{
    GP1:
 	UF : 0, UT : 1,
-	J1= 0.000 deg,	J2= -90.000 deg,	J3= 90.000 deg,
-	J4= 0.000 deg,	J5= 0.000 deg,	J6= 0.000 deg
+	J1= 0.0000 deg,	J2= -90.0000 deg,	J3= 90.0000 deg,
+	J4= 0.0000 deg,	J5= 0.0000 deg,	J6= 0.0000 deg
 };
 /END
