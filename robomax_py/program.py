@@ -72,6 +72,9 @@ MM_DECIMALS = 3      # mm
 ANGLE_DECIMALS = 4   # deg (ZYX orientation angles)
 SPEED_DECIMALS = 3   # PTP fractions and LIN mm/s
 TIME_DECIMALS = 3    # s
+# A fly-by stated as a TCP distance, mm: finer than positions, since a move that hardly displaces
+# the TCP states a joint-space radius of degrees in a fraction of a millimetre.
+FLYBY_MM_DECIMALS = 6
 
 FrameKind: TypeAlias = Literal["tool", "base"]
 
@@ -168,7 +171,7 @@ class PtpMove:
     comment : str
         Note carried with the move; surrounding whitespace is stripped; "" for none.
     flyby_mm : float
-        The fly-by stated as a TCP distance instead, mm (3 decimals), as KRL `C_DIS`, RAPID
+        The fly-by stated as a TCP distance instead, mm (6 decimals), as KRL `C_DIS`, RAPID
         zones and URScript `r` state it: the joint-space radius is this distance times the
         move's joint-to-TCP chord ratio (`timing.chain`). At most one of the two is non-zero.
     """
@@ -186,7 +189,7 @@ class PtpMove:
         _set(self, "accel", _fixed(self.accel, SPEED_DECIMALS))
         _set(self, "flyby", _fixed(self.flyby, ANGLE_DECIMALS))
         _set(self, "comment", str(self.comment).strip())
-        _set(self, "flyby_mm", _fixed(self.flyby_mm, MM_DECIMALS))
+        _set(self, "flyby_mm", _fixed(self.flyby_mm, FLYBY_MM_DECIMALS))
 
     @property
     def flies(self) -> bool:
@@ -230,7 +233,7 @@ class LinMove:
         _set(self, "speed_mm_s", _fixed(self.speed_mm_s, SPEED_DECIMALS))
         _set(self, "flyby", _fixed(self.flyby, ANGLE_DECIMALS))
         _set(self, "comment", str(self.comment).strip())
-        _set(self, "flyby_mm", _fixed(self.flyby_mm, MM_DECIMALS))
+        _set(self, "flyby_mm", _fixed(self.flyby_mm, FLYBY_MM_DECIMALS))
 
     @property
     def flies(self) -> bool:

@@ -38,6 +38,7 @@ __all__ = ["CheckedProgram", "MotionDifference", "file_names", "motion_differenc
 
 # Samples per interval between weld boundaries when comparing rebuilt and planned motion.
 COMPARE_SAMPLES = 40
+COMPARE_DT_S = 0.001
 
 
 @dataclass(frozen=True, slots=True)
@@ -191,8 +192,9 @@ def motion_difference(planned: Trajectory, rebuilt: Trajectory, robot: RobotMode
     u = np.linspace(0.0, 1.0, COMPARE_SAMPLES)
     worst_joint, worst_tcp, t_worst = 0.0, 0.0, float(b[0])
     for i in range(len(a) - 1):
-        inside = (planned.t >= a[i]) & (planned.t <= a[i + 1])
-        path = np.vstack([evaluate(planned, [a[i]]).q, planned.q[inside], evaluate(planned, [a[i + 1]]).q])
+        # The planned path densely (1 ms): chords between its 10 ms samples would sag off a blend.
+        dense = np.linspace(a[i], a[i + 1], max(2, int(np.ceil((a[i + 1] - a[i]) / COMPARE_DT_S)) + 1))
+        path = evaluate(planned, dense).q
         tb = b[i] + u * (b[i + 1] - b[i])
         points = evaluate(rebuilt, tb).q
         joint = _to_polyline(points, path)

@@ -126,7 +126,7 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                 dat.append(f"DECL E6POS {point}={_pose(ins)}")
             if ins.flyby_mm > 0 and ins.flyby_mm != apo:
                 apo = ins.flyby_mm
-                src.append(f"$APO.CDIS = {apo:.3f}")
+                src.append(f"$APO.CDIS = {apo:.6f}")
             motion = "PTP" if isinstance(ins, PtpMove) else "LIN"
             line = f"{motion} {point}" + (" C_DIS" if ins.flyby_mm > 0 else "")
             src.append(line + (f" ; {ins.comment}" if ins.comment else ""))

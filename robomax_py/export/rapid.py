@@ -90,7 +90,7 @@ def _xyz(xyz: tuple[float, ...]) -> str:
 
 def _zone(mm: float) -> str:
     # ABB's predefined zones keep pzone_ori = pzone_eout = 1.5 pzone_tcp, zone_ori = 0.15 pzone_tcp (deg).
-    return f"[FALSE, {mm:.3f}, {1.5 * mm:.3f}, {1.5 * mm:.3f}, {0.15 * mm:.4f}, {1.5 * mm:.3f}, {0.15 * mm:.4f}]"
+    return f"[FALSE, {mm:.6f}, {1.5 * mm:.6f}, {1.5 * mm:.6f}, {0.15 * mm:.6f}, {1.5 * mm:.6f}, {0.15 * mm:.6f}]"
 
 
 def write(program: Program, robot: RobotModel) -> dict[str, str]:

@@ -106,10 +106,10 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
             r = ins.flyby_mm / 1000.0
             if isinstance(ins, PtpMove):
                 q = ", ".join(f"{math.radians(v):.9f}" for v in ins.target_deg)
-                out.append(f"  movej([{q}], a={ins.accel * a_ref:.6f}, v={ins.speed * v_ref:.6f}, r={r:.6f}){note}")
+                out.append(f"  movej([{q}], a={ins.accel * a_ref:.6f}, v={ins.speed * v_ref:.6f}, r={r:.9f}){note}")
             else:
                 out.append(f"  movel({_pose(ins.position_mm, ins.zyx_deg)}, a={LIN_ACCEL_M_S2:.1f}, "
-                           f"v={ins.speed_mm_s / 1000:.6f}, r={r:.6f}){note}")
+                           f"v={ins.speed_mm_s / 1000:.6f}, r={r:.9f}){note}")
         elif isinstance(ins, Spot):
             n_weld += 1
             out.append(f"  spot_weld({n_weld}, {ins.time_s:.3f})  # {spot_label(ins)}")

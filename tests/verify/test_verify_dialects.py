@@ -123,7 +123,7 @@ BLENDED: dict[str, Callable[[str], str]] = {
     "krl": lambda t: _first(r"^(LIN XP\d+)( ; approach)", t, lambda m: m[1] + " C_DIS" + m[2]),
     "rapid": lambda t: _first(r"^(\s*MoveL p\d+, v_lin\d+, )fine", t, lambda m: m[1] + "z10"),
     "fanuc": lambda t: _first(r"^(\s*\d+:\s+L P\[\d+\] \d+mm/sec )FINE", t, lambda m: m[1] + "CNT50"),
-    "urscript": lambda t: _first(r"^(\s*movel\(.*)r=0\.000000\)(  # approach)", t, lambda m: m[1] + "r=0.010000)" + m[2]),
+    "urscript": lambda t: _first(r"^(\s*movel\(.*)r=0\.000000000\)(  # approach)", t, lambda m: m[1] + "r=0.010000000)" + m[2]),
     "srcl": lambda t: _first(r"^(\s*MOVE LIN .* MM/S)( \{ approach \})", t, lambda m: m[1] + " FLYBY 1.0000" + m[2]),
 }
 
