@@ -197,6 +197,11 @@ def without_comments(program: Program) -> Program:
     return dataclasses.replace(program, instructions=kept)
 
 
+def percent(fraction: float) -> int:
+    """A speed or acceleration fraction as the whole percentage KRL and TP state (1 to 100)."""
+    return max(1, min(100, int(round(fraction * 100))))
+
+
 def require_six_axes(robot: RobotModel, dialect: str) -> None:
     if robot.dof != 6:
         raise ExportError(f"{dialect} programs are for 6-axis arms; {robot.name} has {robot.dof} joints")

@@ -33,6 +33,7 @@ from robomax_py.export.dialect import (
     PlannedProgram,
     header_lines,
     is_header_comment,
+    percent,
     read_header,
     read_spot_label,
     require_six_axes,
@@ -91,7 +92,7 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
         if isinstance(ins, PtpMove):
             ctrl = tuple(_round(v, ANGLE_DECIMALS) for v in _to_controller(ins.target_deg, coupled))
             ins = dataclasses.replace(ins, target_deg=_from_controller(ctrl, coupled),
-                                      speed=_percent(ins.speed) / 100, accel=_percent(ins.accel) / 100,
+                                      speed=percent(ins.speed) / 100, accel=percent(ins.accel) / 100,
                                       flyby=_cnt(ins.flyby) * CNT_DEG)
         elif isinstance(ins, LinMove):
             ins = dataclasses.replace(ins, position_mm=tuple(_round(v, 3) for v in ins.position_mm),
@@ -104,10 +105,6 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
                                        zyx_deg=tuple(_round(v, ANGLE_DECIMALS) for v in f.zyx_deg))
                    for f in program.frames if f.kind == "tool")
     return dataclasses.replace(program, name=program.name.upper(), frames=frames, instructions=tuple(out))
-
-
-def _percent(fraction: float) -> int:
-    return max(1, min(100, int(round(fraction * 100))))
 
 
 def _cnt(radius_deg: float) -> int:
@@ -135,8 +132,8 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
             k = len(pos) + 1
             term = f"CNT{_cnt(ins.flyby)}" if ins.flyby > 0 else "FINE"
             if isinstance(ins, PtpMove):
-                acc = f" ACC{_percent(ins.accel)}" if _percent(ins.accel) != 100 else ""
-                mn.append(f"J P[{k}] {_percent(ins.speed)}% {term}{acc} ;")
+                acc = f" ACC{percent(ins.accel)}" if percent(ins.accel) != 100 else ""
+                mn.append(f"J P[{k}] {percent(ins.speed)}% {term}{acc} ;")
                 q = _to_controller(ins.target_deg, coupled)
                 pos.append(f"P[{k}]{{\n   GP1:\n\tUF : 0, UT : 1,\n"
                            f"\tJ1= {q[0]:.4f} deg,\tJ2= {q[1]:.4f} deg,\tJ3= {q[2]:.4f} deg,\n"

@@ -37,6 +37,7 @@ from robomax_py.export.dialect import (
     PlannedProgram,
     header_lines,
     is_header_comment,
+    percent,
     read_header,
     read_spot_label,
     require_six_axes,
@@ -74,13 +75,9 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     out: list[Instruction] = []
     for ins in program.instructions:
         if isinstance(ins, PtpMove):
-            ins = dataclasses.replace(ins, speed=_percent(ins.speed) / 100, accel=_percent(ins.accel) / 100)
+            ins = dataclasses.replace(ins, speed=percent(ins.speed) / 100, accel=percent(ins.accel) / 100)
         out.append(ins)
     return dataclasses.replace(program, instructions=tuple(out))
-
-
-def _percent(fraction: float) -> int:
-    return max(1, min(100, int(round(fraction * 100))))
 
 
 # ================================================================================== writing
@@ -113,10 +110,10 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
             if isinstance(ins, PtpMove):
                 if ins.speed != speed:
                     speed = ins.speed
-                    src += [f"$VEL_AXIS[{i}] = {_percent(speed)}" for i in range(1, 7)]
+                    src += [f"$VEL_AXIS[{i}] = {percent(speed)}" for i in range(1, 7)]
                 if ins.accel != accel:
                     accel = ins.accel
-                    src += [f"$ACC_AXIS[{i}] = {_percent(accel)}" for i in range(1, 7)]
+                    src += [f"$ACC_AXIS[{i}] = {percent(accel)}" for i in range(1, 7)]
                 values = ", ".join(f"{a} {v:.4f}" for a, v in zip(_AXES, ins.target_deg))
                 dat.append(f"DECL E6AXIS {point}={{{values}, {_EXTERNAL}}}")
             else:
