@@ -22,7 +22,8 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.program import as_written_joints
-from robomax_py.robot import JointLimits, RobotModel, fk_tcp
+from robomax_py.robot import JointLimits, RobotModel, fk_tcp, prismatic_mask
+from robomax_py.robot.ik.turns import wrap_to_pi
 from robomax_py.timing import Segment, TimingError, ptp_time_estimate
 from robomax_py.timing.chain import (
     ChainPath,
@@ -47,6 +48,8 @@ DETOUR_RADII_DEG = (12.0, 6.0, 3.0)
 EXACT_BOUND_SLACK = 1e-3
 # Spacing of the geometric path samples checked for collisions, rad (Euclidean, joint space).
 CHECK_STEP_RAD = 0.005
+# A continued line ending this far (rad, any joint) from its approach point changed branch: not used.
+MAX_EXTENSION_JOINT_RAD = 0.5
 # The TCP is on the electrode axis within this (m) over the approach distance.
 STRAIGHT_TOL_M = TOL.straight_tol_m
 
@@ -226,7 +229,13 @@ def _extension(robot: RobotModel, q_start: FloatArray, waypoints: FloatArray, be
         lp = lin_path(robot, after.T_app, after.T_ext, column_of(robot, q_app))
         if not lp.ok:
             return None
-        approach_q = as_written_joints(lp.q[-1])
+        # The same turn as the approach point (the column's solution may be 2 pi away on a joint).
+        q_ext = np.array(lp.q[-1], dtype=float)
+        revolute = ~prismatic_mask(robot.model)
+        q_ext[revolute] = q_app[revolute] + wrap_to_pi(q_ext[revolute] - q_app[revolute])
+        if float(np.abs(q_ext - q_app).max()) > MAX_EXTENSION_JOINT_RAD or not bool(robot.limits.contains(q_ext)):
+            return None
+        approach_q = as_written_joints(q_ext)
     return Extension(retract_T, retract_q, approach_q)
 
 

@@ -565,7 +565,7 @@ def test_broken_controller_programs_are_refused_cleanly_by_verify(tmp_path: Path
         except Exception as exc:  # noqa: BLE001 - a traceback for a user's file is the failure
             failures.append(f"{name}{suffix}: {type(exc).__name__}: {exc}")
     print(f"\ncontroller program mutants: {dict(outcomes)}")
-    assert sum(outcomes.values()) >= 60
+    assert sum(outcomes.values()) >= 50
     assert not failures, f"{len(failures)} failures:\n" + "\n".join(failures[:20])
 
 
