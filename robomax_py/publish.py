@@ -90,8 +90,9 @@ def publish(result: PlanResult, cell: CellSpec, robot: RobotModel, formats: tupl
     files = {f"{name}.json": render_trajectory(result)}
     planned = planned_program(result, cell.digest, stamp)
     checked = []
+    reference: list[PlannedPath] = []            # made once, by the first dialect that needs it
     for fmt in formats:
-        one = _checked(fmt, planned, result, cell, robot, name)
+        one = _checked(fmt, planned, result, cell, robot, name, reference)
         for file_name in one.files:
             if file_name in files and files[file_name] != one.files[file_name]:
                 raise ExportError(f"two formats write {file_name} with different contents")
@@ -101,7 +102,7 @@ def publish(result: PlanResult, cell: CellSpec, robot: RobotModel, formats: tupl
 
 
 def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSpec, robot: RobotModel,
-             name: str) -> CheckedProgram:
+             name: str, reference: list[PlannedPath]) -> CheckedProgram:
     dialect = DIALECTS[fmt]
     t0 = time.process_time()
     adapted = dialect.adapt(planned, robot)
@@ -121,7 +122,10 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
         where = f"line {p.line}: " if p and p.line else ""
         raise ExportError(f"{fmt}: the written program's motion cannot be rebuilt: {where}{p.detail if p else ''}")
     assert result.trajectory is not None
-    diff = motion_difference(result.trajectory, rebuilt.trajectory, robot)
+    traj = result.trajectory
+    if not _same_samples(traj, rebuilt.trajectory) and not reference:
+        reference.append(PlannedPath.of(traj, robot))
+    diff = motion_difference(traj, rebuilt.trajectory, robot, reference[0] if reference else None)
     if not diff.within():
         line = rebuilt.line_at(diff.t_worst)
         raise ExportError(
@@ -179,31 +183,58 @@ def _anchors(traj: Trajectory) -> FloatArray:
     return np.array(times)
 
 
-def motion_difference(planned: Trajectory, rebuilt: Trajectory, robot: RobotModel) -> MotionDifference:
+@dataclass(frozen=True, slots=True, eq=False)
+class PlannedPath:
+    """The planned motion as the comparison needs it, made once for all dialects: its weld
+    boundaries, and between each two the path sampled at COMPARE_DT_S (chords between its 10 ms
+    samples would sag off a blend), in joint space and as TCP positions."""
+
+    anchors: FloatArray
+    joints: tuple[FloatArray, ...]
+    tcp: tuple[FloatArray, ...]
+
+    @staticmethod
+    def of(planned: Trajectory, robot: RobotModel) -> PlannedPath:
+        a = _anchors(planned)
+        joints = []
+        for i in range(len(a) - 1):
+            dense = np.linspace(a[i], a[i + 1], max(2, int(np.ceil((a[i + 1] - a[i]) / COMPARE_DT_S)) + 1))
+            joints.append(evaluate(planned, dense).q)
+        return PlannedPath(a, tuple(joints), tuple(fk_tcp(robot, q)[:, :3, 3] for q in joints))
+
+
+def motion_difference(planned: Trajectory, rebuilt: Trajectory, robot: RobotModel,
+                      reference: PlannedPath | None = None) -> MotionDifference:
     """How far a rebuilt motion is from the planned one (`MotionDifference`): the path, as the
     largest distance of the rebuilt motion's points from the planned path between the same weld
     boundaries (joint space and TCP), and the time, as the largest shift of those boundaries. A
-    path compared at equal times would count a shift of a few ms as a joint difference."""
-    if len(planned.t) == len(rebuilt.t) and np.array_equal(planned.t, rebuilt.t) and np.array_equal(planned.q, rebuilt.q):
+    path compared at equal times would count a shift of a few ms as a joint difference.
+
+    reference : `PlannedPath.of(planned, robot)`, when several rebuilt motions are compared.
+    """
+    if _same_samples(planned, rebuilt):
         return MotionDifference(0.0, 0.0, 0.0)
-    a, b = _anchors(planned), _anchors(rebuilt)
+    ref = reference if reference is not None else PlannedPath.of(planned, robot)
+    a, b = ref.anchors, _anchors(rebuilt)
     if len(a) != len(b):
         return MotionDifference(math.inf, math.inf, math.inf, float(planned.t[0]))
     u = np.linspace(0.0, 1.0, COMPARE_SAMPLES)
     worst_joint, worst_tcp, t_worst = 0.0, 0.0, float(b[0])
     for i in range(len(a) - 1):
-        # The planned path densely (1 ms): chords between its 10 ms samples would sag off a blend.
-        dense = np.linspace(a[i], a[i + 1], max(2, int(np.ceil((a[i + 1] - a[i]) / COMPARE_DT_S)) + 1))
-        path = evaluate(planned, dense).q
         tb = b[i] + u * (b[i + 1] - b[i])
         points = evaluate(rebuilt, tb).q
-        joint = _to_polyline(points, path)
-        tcp = _to_polyline(fk_tcp(robot, points)[:, :3, 3], fk_tcp(robot, path)[:, :3, 3])
+        joint = _to_polyline(points, ref.joints[i])
+        tcp = _to_polyline(fk_tcp(robot, points)[:, :3, 3], ref.tcp[i])
         k = int(np.argmax(joint))
         if joint[k] > worst_joint:
             worst_joint, t_worst = float(joint[k]), float(tb[k])
         worst_tcp = max(worst_tcp, float(tcp.max()))
     return MotionDifference(math.degrees(worst_joint), worst_tcp * 1000.0, float(np.abs(a - b).max()), t_worst)
+
+
+def _same_samples(a: Trajectory, b: Trajectory) -> bool:
+    """The same motion sample for sample (np.array_equal also compares the shapes)."""
+    return bool(np.array_equal(a.t, b.t) and np.array_equal(a.q, b.q))
 
 
 def _to_polyline(points: FloatArray, path: FloatArray) -> FloatArray:

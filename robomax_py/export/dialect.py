@@ -5,7 +5,7 @@ data into the terms of a controller brand.
 A dialect module owns both directions for its files: `adapt` (the dialect-free `Program` as
 this dialect can state it: its decimals, its kind of blend, its brand's configuration data),
 `write` (that program -> file texts) and `parse` (file texts -> `Parsed`: the program and the line
-of each statement). `export.checked` proves, before anything is written, that parsing the written
+of each statement). `robomax_py.publish` proves, before anything is written, that parsing the written
 text gives back the adapted program and that its rebuilt motion is the planned one.
 """
 
@@ -17,7 +17,7 @@ import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-import numpy as np
+from lark import Token, Tree
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import ExportError, ProgramError
@@ -31,8 +31,7 @@ from robomax_py.program import (
     Spot,
 )
 from robomax_py.robot import RobotModel
-from robomax_py.robot.ik.config import brand_text
-from robomax_py.robot.solve import config_of
+from robomax_py.robot.solve import brand_text_of
 from robomax_py.timing import TimingError
 from robomax_py.timing.chain import flyby_tcp_distance
 
@@ -184,8 +183,7 @@ def with_brand_configs(program: Program, joints: Sequence[FloatArray], robot: Ro
     out: list[Instruction] = []
     for ins, q in zip(program.instructions, joints):
         if isinstance(ins, LinMove):
-            ind = config_of(robot, q)
-            ins = dataclasses.replace(ins, config=brand_text(brand, ind.status, ind.turn, np.asarray(q, dtype=float)))
+            ins = dataclasses.replace(ins, config=brand_text_of(robot, q, brand))
         out.append(ins)
     return dataclasses.replace(program, instructions=tuple(out))
 
@@ -195,6 +193,19 @@ def without_comments(program: Program) -> Program:
     kept = tuple(dataclasses.replace(i, comment="") if isinstance(i, (PtpMove, LinMove)) else i
                  for i in program.instructions if not isinstance(i, Comment))
     return dataclasses.replace(program, instructions=kept)
+
+
+def tree_numbers(node: object, file: str, line: int, lists: tuple[str, ...] = ("list",)) -> list[float]:
+    """The finite numbers of a parsed value: a NUMBER token, or a tree named one of `lists`
+    (nested) of them; ProgramError naming the line for anything else."""
+    if isinstance(node, Token) and node.type == "NUMBER":
+        value = float(node)
+        if not math.isfinite(value):
+            raise ProgramError(file, f"line {line}", f"number {node} is not finite")
+        return [value]
+    if isinstance(node, Tree) and node.data in lists:
+        return [v for c in node.children for v in tree_numbers(c, file, line, lists)]
+    raise ProgramError(file, f"line {line}", f"expected numbers, got {node}")
 
 
 def percent(fraction: float) -> int:

@@ -42,6 +42,7 @@ from robomax_py.export.dialect import (
     read_spot_label,
     require_six_axes,
     spot_label,
+    tree_numbers,
     with_brand_configs,
     with_tcp_blends,
 )
@@ -239,17 +240,6 @@ def _split_comment(raw: str) -> tuple[str, str | None]:
     return raw, None
 
 
-def _numbers(node: object, file: str, line: int) -> list[float]:
-    if isinstance(node, Token) and node.type == "NUMBER":
-        value = float(node)
-        if not math.isfinite(value):
-            raise ProgramError(file, f"line {line}", f"number {node} is not finite")
-        return [value]
-    if isinstance(node, Tree) and node.data == "list":
-        return [v for c in node.children for v in _numbers(c, file, line)]
-    raise ProgramError(file, f"line {line}", f"expected numbers, got {node}")
-
-
 class _Reader:
     def __init__(self, file: str) -> None:
         self.file = file
@@ -276,7 +266,7 @@ class _Reader:
             raise self.error(line, f"cannot read {text!r} (column {getattr(exc, 'column', '?')})") from None
 
     def quaternion(self, node: object, line: int) -> tuple[float, float, float]:
-        q = _numbers(node, self.file, line)
+        q = tree_numbers(node, self.file, line)
         if len(q) != 4:
             raise self.error(line, f"an orientation needs 4 quaternion values, got {len(q)}")
         norm = math.sqrt(sum(v * v for v in q))
@@ -287,7 +277,7 @@ class _Reader:
     def pose(self, node: object, line: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
         if not (isinstance(node, Tree) and node.data == "list" and len(node.children) >= 2):
             raise self.error(line, "a frame needs [[x, y, z], [q1, q2, q3, q4]]")
-        xyz = _numbers(node.children[0], self.file, line)
+        xyz = tree_numbers(node.children[0], self.file, line)
         if len(xyz) != 3:
             raise self.error(line, f"a position needs 3 values, got {len(xyz)}")
         return tuple(xyz), self.quaternion(node.children[1], line)
@@ -324,7 +314,7 @@ class _Reader:
             match = _PREDEFINED_SPEED.match(str(node))
             if match and str(node).lower() not in self.data:
                 return float(match.group(1))
-        values = _numbers(self.resolve(node, "speeddata", line), self.file, line)
+        values = tree_numbers(self.resolve(node, "speeddata", line), self.file, line)
         return values[0]
 
     def zone(self, node: object, line: int) -> float:
@@ -337,7 +327,7 @@ class _Reader:
         value = self.resolve(node, "zonedata", line)
         if isinstance(value, Tree) and len(value.children) >= 2:
             fine = str(value.children[0]).upper() == "TRUE"
-            return 0.0 if fine else _numbers(value.children[1], self.file, line)[0]
+            return 0.0 if fine else tree_numbers(value.children[1], self.file, line)[0]
         raise self.error(line, f"cannot read zone {node}")
 
     def move(self, tree: Tree[Token], comment: str, line: int) -> None:
@@ -352,7 +342,7 @@ class _Reader:
             value = self.resolve(target, "jointtarget", line)
             if not (isinstance(value, Tree) and value.children):
                 raise self.error(line, "a jointtarget needs [[j1, ..., j6], [external axes]]")
-            joints = _numbers(value.children[0], self.file, line)
+            joints = tree_numbers(value.children[0], self.file, line)
             self.add(PtpMove(tuple(joints), self.override / 100.0, self.accel / 100.0, comment=comment,
                              flyby_mm=flyby_mm), line)
             return
@@ -360,7 +350,7 @@ class _Reader:
         if not (isinstance(value, Tree) and len(value.children) >= 3):
             raise self.error(line, "a robtarget needs [[x, y, z], [q1, q2, q3, q4], [confdata], [external axes]]")
         xyz, zyx = self.pose(value, line)
-        conf = [int(round(c)) for c in _numbers(value.children[2], self.file, line)]
+        conf = [int(round(c)) for c in tree_numbers(value.children[2], self.file, line)]
         config = "[" + ",".join(str(c) for c in conf) + "]"
         v_tcp = VMAX_TCP_MM_S if v is None else v
         self.add(LinMove(xyz, zyx, config, v_tcp * self.override / 100.0, comment=comment, flyby_mm=flyby_mm), line)

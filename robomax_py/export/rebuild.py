@@ -39,8 +39,7 @@ from robomax_py.program import (
 )
 from robomax_py.robot import RobotModel
 from robomax_py.robot.ik import same_config
-from robomax_py.robot.ik.config import brand_text
-from robomax_py.robot.solve import config_of, config_texts_near
+from robomax_py.robot.solve import brand_text_of, config_texts_near
 from robomax_py.spec import CellSpec
 from robomax_py.timing import (
     LinMoveError,
@@ -53,7 +52,7 @@ from robomax_py.timing import (
 )
 from robomax_py.timing.chain import LinStep, PtpStep, Step, chain_path, time_chain
 from robomax_py.tolerances import DEFAULT as TOL
-from robomax_py.world.scene import distance_to_object
+from robomax_py.world.scene import clamps_near
 
 # Frame definitions must match the cell's tool and base within the program's decimals.
 FRAME_TOL_MM = TOL.frame_tol_mm
@@ -242,8 +241,7 @@ class _Builder:
 
     def config_text(self, q: FloatArray) -> str:
         """The configuration data, in the program's brand, of joint values q."""
-        ind = config_of(self.robot, q)
-        return brand_text(self.brand, ind.status, ind.turn, np.asarray(q, dtype=float))
+        return brand_text_of(self.robot, q, self.brand)
 
     def _hold(self, seconds: float, label: str) -> None:
         if seconds > 0:
@@ -259,12 +257,11 @@ class _Builder:
         spec = next((p for p in seam.spots if identifier(p.name) == spot.name), None) if seam else None
         if spec is None:
             return
-        for obj in self.cell.objects:
-            if obj.signal and identifier(obj.signal) not in self.waited and \
-                    distance_to_object(obj, spec.xyz) <= self.cell.process.interlock_distance:
+        for obj in clamps_near(self.cell, spec.xyz):
+            if identifier(str(obj.signal)) not in self.waited:
                 self.problems.append(Problem(self.t, "interlock", f"{label} is welded near clamp {obj.name} before "
                                                                   f"waiting for its input {obj.signal}", self.line))
-                self.waited.add(identifier(obj.signal))
+                self.waited.add(identifier(str(obj.signal)))
 
     def _wait_for(self, signal: str) -> None:
         from robomax_py.export.plan_program import identifier

@@ -26,7 +26,7 @@ import math
 import re
 from functools import lru_cache
 
-from lark import Lark, Token, Tree
+from lark import Lark, Tree
 from lark.exceptions import UnexpectedInput
 
 from robomax_py.errors import ExportError, ProgramError
@@ -39,6 +39,7 @@ from robomax_py.export.dialect import (
     read_spot_label,
     require_six_axes,
     spot_label,
+    tree_numbers,
     with_brand_configs,
     with_tcp_blends,
 )
@@ -131,8 +132,8 @@ start: NAME "(" [arg ("," arg)*] ")"
 ?arg: value | NAME "=" value -> keyword
 ?value: NUMBER | NAME | list | pose
 list: "[" [value ("," value)*] "]"
-pose: POSE_OPEN value ("," value)* "]"
-POSE_OPEN.2: /p\[/
+pose: _POSE_OPEN value ("," value)* "]"
+_POSE_OPEN.2: /p\[/
 NAME: /[A-Za-z_][A-Za-z0-9_]*/
 NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 %ignore /[ \t]+/
@@ -160,15 +161,7 @@ def _split(raw: str) -> tuple[str, str]:
 
 
 def _numbers(node: object, file: str, line: int) -> list[float]:
-    if isinstance(node, Token) and node.type == "NUMBER":
-        value = float(node)
-        if not math.isfinite(value):
-            raise ProgramError(file, f"line {line}", f"number {node} is not finite")
-        return [value]
-    if isinstance(node, Tree) and node.data in ("list", "pose"):
-        return [v for c in node.children if not (isinstance(c, Token) and c.type == "POSE_OPEN")
-                for v in _numbers(c, file, line)]
-    raise ProgramError(file, f"line {line}", f"expected numbers, got {node}")
+    return tree_numbers(node, file, line, ("list", "pose"))
 
 
 def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:

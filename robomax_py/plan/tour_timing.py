@@ -44,7 +44,7 @@ from robomax_py.timing import (
 )
 from robomax_py.transforms import invert
 from robomax_py.world.collision import CollisionWorld
-from robomax_py.world.scene import build_scene, distance_to_object
+from robomax_py.world.scene import build_scene, clamps_near
 
 
 def time_tour(
@@ -123,14 +123,14 @@ def interlocks(cell: CellSpec, order: list[SpotCandidates]) -> list[tuple[str, .
     """Per spot in weld order, the clamp signals to wait for before moving to it: each clamp
     (an object with `signal`) before the first weld within `process.interlock_distance` of it."""
     out: list[tuple[str, ...]] = [() for _ in order]
-    clamps = [o for o in cell.objects if o.signal]
-    if not clamps:
+    if not any(o.signal for o in cell.objects):
         return out
-    points = [np.asarray(cell.seams[c.seam_index].spots[c.spot_index].xyz, dtype=float) for c in order]
-    for obj in clamps:
-        near = [k for k, p in enumerate(points) if distance_to_object(obj, p) <= cell.process.interlock_distance]
-        if near:
-            out[near[0]] = (*out[near[0]], str(obj.signal))
+    waited: set[str] = set()
+    for k, c in enumerate(order):
+        for obj in clamps_near(cell, cell.seams[c.seam_index].spots[c.spot_index].xyz):
+            if obj.name not in waited:
+                waited.add(obj.name)
+                out[k] = (*out[k], str(obj.signal))
     return out
 
 

@@ -173,8 +173,7 @@ def config_of(robot: RobotModel, q: FloatArray) -> ConfigIndicator:
 
 def config_text(robot: RobotModel, q: FloatArray) -> str:
     """The configuration data the robot's controller brand writes for q (n,), rad (`config.brand_text`)."""
-    ind = config_of(robot, q)
-    return brand_text(robot.controller.brand, ind.status, ind.turn, np.asarray(q, dtype=float))
+    return brand_text_of(robot, q, robot.controller.brand)
 
 
 def brand_text_of(robot: RobotModel, q: FloatArray, brand: str) -> str:
@@ -198,6 +197,5 @@ def config_texts_near(robot: RobotModel, q: FloatArray, brand: str, tol_rad: flo
             for bit, j in enumerate(near):
                 if mask >> bit & 1:
                     p[j] = quarter * round(q[j] / quarter) + sign * 2.0 * tol_rad
-            ind = config_of(robot, p)
-            texts.add(brand_text(brand, ind.status, ind.turn, p))
+            texts.add(brand_text_of(robot, p, brand))
     return texts

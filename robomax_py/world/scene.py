@@ -280,3 +280,10 @@ def distance_to_object(obj: ObjectSpec, point: FloatArray) -> float:
         coal.distance(piece, T_obj, probe, T_probe, coal.DistanceRequest(), result)
         best = min(best, max(0.0, float(result.min_distance) + 1e-6))
     return float(best)
+
+
+def clamps_near(cell: CellSpec, point: FloatArray) -> list[ObjectSpec]:
+    """The clamps (objects with an interlock `signal`) within `process.interlock_distance` of a
+    world point: a weld there waits for their inputs first."""
+    return [o for o in cell.objects
+            if o.signal and distance_to_object(o, point) <= cell.process.interlock_distance]
