@@ -38,6 +38,8 @@ class PlanOptions:
     straight_tries: int = 12         # blocked straight moves between two spots before detours only
     max_rounds: int = 80             # sequencing rounds (optimise, verify, repair)
     max_evaluations: int = 400       # DP evaluations per sequencing round
+    order_candidates: int = 32       # candidates per spot the order search sees (exact DP then uses all)
+    probe_neighbours: int = 6        # nearest spots per spot whose straight move is probed up front
     jerk_limited: bool = True        # PTP moves and detour legs with ruckig; False: toppra (vel/acc only)
     blend: bool = True               # fly by detour corners and approach points on checked G2 blends where faster
 

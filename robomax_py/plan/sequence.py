@@ -27,6 +27,8 @@ HOME = -1  # the start/end configuration, a layer of one node
 OR_OPT_WINDOW = 6
 # Consecutive perturbations that found no unseen order before the search gives up.
 MAX_STALE_KICKS = 50
+# Up to this many admissible orders, `optimise` evaluates every one (exact).
+EXACT_ORDERS = 720
 
 # cost(i, j) -> (N_i, N_j) float: motion time from every candidate of spot i to every candidate of
 # spot j (HOME has one candidate). Must be deterministic; the optimiser caches what it asks for.
@@ -248,7 +250,7 @@ def optimise(
     rng: np.random.Generator | None = None,
     max_evaluations: int = 600,
     screen: int = 12,
-    exact_limit: int = 720,
+    exact_limit: int = EXACT_ORDERS,
     starts: Sequence[tuple[int, ...]] = (),
 ) -> tuple[Tour, SearchStats]:
     """Best tour: exact when few orders are admissible, else construction + iterated local search.
@@ -397,6 +399,11 @@ def _perturb(blocks: Blocks, ordered: Sequence[bool], rng: np.random.Generator) 
         a, c = rng.choice(len(out), size=2, replace=False)
         out[a], out[c] = out[c], out[a]
     return out
+
+
+def order_count(blocks: Sequence[SeamBlock]) -> int:
+    """How many orders the constraints admit (capped a little above 10^9)."""
+    return _count_orders(blocks)
 
 
 def _count_orders(blocks: Sequence[SeamBlock]) -> int:

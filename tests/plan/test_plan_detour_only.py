@@ -76,8 +76,7 @@ def _sequencer(cell: CellSpec, robot: Any, world: Any, spots: list[SpotCandidate
 def test_blocked_first_probe_with_free_alternative_plans_straight(tmp_path: Path, write_small_cell: SmallCell) -> None:
     cell, robot, world, spots = _setup(tmp_path, write_small_cell)
     probe = _sequencer(cell, robot, world, spots, 1)
-    est = probe.estimate(0, 1)
-    a, b = np.unravel_index(int(np.argmin(est)), est.shape)          # what `_probe_pairs` checks first
+    a, b = probe.probe_pair(0, 1)                                    # what `_probe_pairs` checks first
     clamped = _ClampedWorld(world, spots[0].q_app[a], spots[1].q_app[b])
     seq = _sequencer(cell, robot, clamped, spots, 80)
     outcome = seq.run()
