@@ -321,6 +321,21 @@ class CollisionWorld:
             return Proximity(distance=math.inf, pair=None)
         return Proximity(distance=float(self._gdata.distanceResults[idx].min_distance), pair=self._contact(idx))
 
+    def pair_distances(self, q: FloatArray, pairs: IntArray) -> FloatArray:
+        """Distances (m) of the enabled pairs `pairs` (indices into `geometry_model.collisionPairs`)
+        at q, every dynamic obstacle present; each as `closest` computes it."""
+        s = self._s
+        pin.updateGeometryPlacements(s.model, self._data, s.geom_model, self._gdata, np.asarray(q, dtype=np.float64))
+        gm, gd = s.geom_model, self._gdata
+        return np.array([pin.computeDistance(gm, gd, int(p)).min_distance for p in pairs], dtype=float)
+
+    def pair_approach_factors(self) -> FloatArray:
+        """(p,) how fast each enabled pair's distance can shrink, in units of `sweep_length`: 1 for
+        a robot or tool piece against a static obstacle (one side moves), 2 between two moving pieces."""
+        s = self._s
+        kinds = [(s.pieces[int(a)].kind, s.pieces[int(b)].kind) for a, b in zip(s.pair_a, s.pair_b)]
+        return np.array([1.0 if KIND_OBJECT in pair else 2.0 for pair in kinds])
+
     @property
     def has_dynamic(self) -> bool:
         """Whether some obstacle comes and goes (present only in time windows)."""

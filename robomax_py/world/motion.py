@@ -146,21 +146,13 @@ class Clearance:
 def min_clearance(world: CollisionWorld, t: FloatArray, q: FloatArray) -> Clearance | None:
     """The smallest distance over the samples of a motion, refined on the steps either side of
     the closest sample (10 sub-steps each); None when no pair is checked."""
-    best_i, best = 0, math.inf
-    # Samples the robot cannot have brought closer than the best so far are skipped: no point
-    # moves farther than `sweep_length` from sample i, and two robot bodies approach each other
-    # by at most twice that, so d_k >= d_i - 2 sweep(q_i, q_k) > best.
-    # Obstacles that come and go (dynamic objects) change distances without motion: no skipping.
-    skip = not world.has_dynamic
-    i = 0
-    while i < len(t):
-        d = world.closest(q[i], float(t[i])).distance
-        if d < best:
-            best_i, best = i, d
-        j = i + 1
-        while skip and j < len(t) and math.isfinite(d) and 2.0 * world.sweep_length(q[i], q[j]) < d - best:
-            j += 1
-        i = j
+    best_i, best = (0, math.inf) if world.has_dynamic else _closest_sample(world, q)
+    if world.has_dynamic:
+        # Obstacles that come and go change distances without motion: every sample, every pair.
+        for i in range(len(t)):
+            d = world.closest(q[i], float(t[i])).distance
+            if d < best:
+                best_i, best = i, d
     if not math.isfinite(best):
         return None
     best_t, best_q = float(t[best_i]), q[best_i]
@@ -175,3 +167,35 @@ def min_clearance(world: CollisionWorld, t: FloatArray, q: FloatArray) -> Cleara
     pair = world.closest(best_q, best_t).pair
     between = f"{pair.body_a} and {pair.body_b}" if pair is not None else "?"
     return Clearance(float(best), best_t, between)
+
+
+def _closest_sample(world: CollisionWorld, q: FloatArray) -> tuple[int, float]:
+    """The first sample of the least distance over every enabled pair, and that distance (static scene).
+
+    A pair is computed again only where the motion since it was last computed could have brought
+    it below the best so far: no point moves farther than `sweep_length`, so a pair's distance
+    shrinks by at most its approach factor times the sweep (1 against a static obstacle, 2 between
+    two moving bodies). The answer is the minimum over every pair and sample, exactly as computing
+    them all; the closest few pairs are computed at most samples, the rest rarely.
+    """
+    n_pairs = world.n_pairs
+    if n_pairs == 0 or len(q) == 0:
+        return 0, math.inf
+    lever = world.lever_arms
+    factor = world.pair_approach_factors()
+    everything = np.arange(n_pairs)
+    last = world.pair_distances(q[0], everything)              # distance of each pair where last computed
+    where = np.repeat(np.asarray(q[:1], dtype=float), n_pairs, axis=0)
+    best_i, best = 0, float(np.min(last))
+    for i in range(1, len(q)):
+        bound = last - factor * (np.abs(q[i] - where) @ lever)
+        due = np.flatnonzero(bound < best)
+        if not len(due):
+            continue
+        d = world.pair_distances(q[i], due)
+        last[due] = d
+        where[due] = q[i]
+        low = float(np.min(d))
+        if low < best:
+            best_i, best = i, low
+    return best_i, best
