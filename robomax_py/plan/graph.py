@@ -453,8 +453,10 @@ class Sequencer:
             return
         self.checks += det.checks
         self.detours.append((i, j, det))
-        # Every pair sharing an end spot with this detour may now use it.
-        self._matrices.clear()
+        # Every pair sharing an end spot with this detour may now use it (`vias_for`).
+        for table in (self._matrices, self._full):
+            for key in [key for key in table if not {i, j}.isdisjoint(key)]:
+                del table[key]
         self._record_leg(i, a, j, b, len(self.detours) - 1, True)   # its ends are this pair's configurations
 
     def _retry_straight(self, i: int, j: int) -> bool:

@@ -83,15 +83,38 @@ class _Costs:
             got = self._bounds[(i, j)] = float(np.min(self(i, j)))
         return got
 
-    def bound_matrix(self, spots: Sequence[int]) -> FloatArray:
-        """(S+1, S+1) min edge cost between spots, index S standing for HOME; spots are 0..S-1."""
-        ids = [*spots, HOME]
-        out = np.zeros((len(ids), len(ids)))
-        for a, i in enumerate(ids):
-            for b, j in enumerate(ids):
-                if i != j or i == HOME:
-                    out[a, b] = self.lower_bound(i, j)
-        return out
+
+
+class _BoundTable:
+    """Spot-level lower bounds (min edge cost between two spots) for spots 0..S-1, index S standing
+    for HOME, filled in as orders ask for them: a neighbourhood only joins spots of one seam and
+    seam ends, so most of the S^2 pairs of a large cell are never needed (and each costs a matrix)."""
+
+    def __init__(self, costs: _Costs, size: int) -> None:
+        self.costs, self.size = costs, size
+        self.table = np.full((size + 1, size + 1), np.nan)
+
+    def _id(self, k: int) -> int:
+        return HOME if k == self.size else k
+
+    def of_orders(self, orders: Sequence[tuple[int, ...]]) -> FloatArray:
+        """Sum of the bounds along each of many same-length orders (home at both ends).
+
+        Node minima are the same for every permutation of the same spots, so they are left out: the
+        result ranks orders correctly but is a bound only after adding them back.
+        """
+        arr = np.asarray(orders, dtype=np.int64)
+        home = np.full((len(arr), 1), self.size)
+        padded = np.concatenate([home, arr, home], axis=1)
+        a, b = padded[:, :-1], padded[:, 1:]
+        values = self.table[a, b]
+        missing = np.isnan(values)
+        if missing.any():
+            for code in np.unique(a[missing] * (self.size + 1) + b[missing]).tolist():
+                x, y = divmod(code, self.size + 1)
+                self.table[x, y] = self.costs.lower_bound(self._id(x), self._id(y))
+            values = self.table[a, b]
+        return values.sum(axis=1)
 
 
 def best_choice(order: Sequence[int], costs: _Costs) -> tuple[tuple[int, ...], float]:
@@ -232,17 +255,6 @@ def _bound(order: tuple[int, ...], costs: _Costs) -> float:
     return edges + sum(costs.node_min[s] for s in order)
 
 
-def _bounds(orders: Sequence[tuple[int, ...]], bound: FloatArray, home: int) -> FloatArray:
-    """`_bound` of many same-length orders at once; `bound` from `_Costs.bound_matrix`.
-
-    Node minima are the same for every permutation of the same spots, so they are left out: the
-    result ranks orders correctly but is a bound only after adding them back.
-    """
-    arr = np.asarray(orders, dtype=np.int64)
-    padded = np.concatenate([np.full((len(arr), 1), home), arr, np.full((len(arr), 1), home)], axis=1)
-    return bound[padded[:, :-1], padded[:, 1:]].sum(axis=1)
-
-
 def optimise(
     blocks: Sequence[SeamBlock],
     edge: EdgeCosts,
@@ -275,8 +287,7 @@ def optimise(
     all_spots = sorted(s for b in blocks for s in b.spots)
     if all_spots != list(range(len(all_spots))):
         raise ValueError("spot ids must be 0..S-1")  # an internal contract, not user input
-    bound = costs.bound_matrix(all_spots)
-    home_index = len(all_spots)
+    bounds_of = _BoundTable(costs, len(all_spots))
     node_total = sum(costs.node_min)
     counter = {"evaluations": 0, "screened": 0, "improvements": 0}
     seen: dict[tuple[int, ...], float] = {}
@@ -298,7 +309,7 @@ def optimise(
         got = screened.get(key)
         if got is None:
             options = _neighbours(current, ordered)
-            bounds = _bounds(options.flats, bound, home_index) + node_total if len(options) else np.zeros(0)
+            bounds = bounds_of.of_orders(options.flats) + node_total if len(options) else np.zeros(0)
             got = screened[key] = (options, bounds, np.argsort(bounds, kind="stable").tolist())
         return got
 
