@@ -14,6 +14,7 @@ blocked edges expensive, add detours, and ask again.
 from __future__ import annotations
 
 import itertools
+from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -27,6 +28,8 @@ HOME = -1  # the start/end configuration, a layer of one node
 OR_OPT_WINDOW = 6
 # Consecutive perturbations that found no unseen order before the search gives up.
 MAX_STALE_KICKS = 50
+# Neighbourhoods (all orders one move away) a search keeps for orders it may pass through again.
+KEPT_NEIGHBOURHOODS = 16
 # Up to this many admissible orders, `optimise` evaluates every one (exact).
 EXACT_ORDERS = 720
 
@@ -300,8 +303,9 @@ def optimise(
             seen[flat] = prefix(flat)
         return seen[flat]
 
-    # Descents from different starts and kicks pass through the same orders again and again.
-    screened: dict[tuple[tuple[int, tuple[int, ...]], ...], tuple[_Moves, FloatArray, list[int]]] = {}
+    # Descents from different starts and kicks pass through the same orders again and again; the
+    # most recent neighbourhoods are kept (each holds thousands of whole orders on a large cell).
+    screened: OrderedDict[tuple[tuple[int, tuple[int, ...]], ...], tuple[_Moves, FloatArray, list[int]]] = OrderedDict()
 
     def neighbours(current: Blocks) -> tuple[_Moves, FloatArray, list[int]]:
         """The moves from `current`, their bounds and their ranking (cached per order)."""
@@ -311,6 +315,10 @@ def optimise(
             options = _neighbours(current, ordered)
             bounds = bounds_of.of_orders(options.flats) + node_total if len(options) else np.zeros(0)
             got = screened[key] = (options, bounds, np.argsort(bounds, kind="stable").tolist())
+            if len(screened) > KEPT_NEIGHBOURHOODS:
+                screened.popitem(last=False)
+        else:
+            screened.move_to_end(key)
         return got
 
     def descend(start: Blocks) -> tuple[Blocks, float]:
