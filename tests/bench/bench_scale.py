@@ -6,7 +6,9 @@
 Cells come from `scale_cells.py` (seeded, one KR 125 with the C-gun, N spots on flange rows, three
 families). Each plan runs in a fresh process (so peak memory is the plan's own and nothing is
 warm), one thread. Per family and N it prints the median over the runs of: CPU seconds of the plan
-(imports and cell loading excluded) and its stage split, collision checks by stage, sequencing
+(imports and cell loading excluded) and its split into candidates, sequencing, timing and the
+rest (world, roadmap, verify, clearance), each stage's share of the process's wall clock
+applied to its CPU seconds; collision checks by stage, sequencing
 rounds, peak resident memory, the cycle time and its ratio to the published baseline (same
 timing layer, planned in the same process) and to the rest-to-rest lower bound
 (`robomax_py.app.bench.lower_bound`); then the growth exponent per family, fitted by least squares
@@ -86,6 +88,51 @@ def growth(points: list[tuple[int, float]]) -> float:
     return sum((x - mx) * (y - my) for x, y in pts) / sum((x - mx) ** 2 for x, _ in pts)
 
 
+HEADER = (f"{'family':12s} {'N':>4s} {'CPU s':>7s} {'cand':>6s} {'seq':>6s} {'time':>6s} {'other':>6s} "
+          f"{'checks k':>9s} {'seq k':>7s} {'rounds':>6s} {'MB':>6s} {'cycle s':>8s} {'/base':>6s} "
+          f"{'/bound':>6s} {'vs old':>7s}")
+
+
+def report_row(family: str, n: int, rows: list[dict], old: list[dict]) -> float:
+    """Print one table row; returns the median CPU seconds."""
+    ok = [r for r in rows if r["status"] == "planned"]
+    cpu = median_of(rows, "cpu")
+    if not ok:
+        print(f"{family:12s} {n:4d} {rows[0]['status']}: {rows[0].get('message', '')[:90]}", flush=True)
+        return cpu
+    # Stage clocks are wall seconds of one single-threaded process: each stage's share of the wall
+    # is its share of the CPU (other load on the machine stretches them alike).
+    stage = {k: statistics.median(r["stages"].get(k, 0.0) / sum(r["stages"].values()) * r["cpu"] for r in ok)
+             for k in ("candidates", "sequencing", "timing")}
+    other = max(cpu - sum(stage.values()), 0.0)
+    checks = statistics.median(sum(r["checks"].values()) for r in ok) / 1e3
+    seq = statistics.median(r["checks"]["sequencing"] + r["checks"]["roadmap"] for r in ok) / 1e3
+    base = ok[0].get("baseline")
+    cycle = median_of(ok, "cycle")
+    vs_old = ""
+    if old:
+        old_cpu = median_of(old, "cpu")
+        vs_old = f"{cpu / old_cpu:7.2f}" if math.isfinite(old_cpu) else f"{old[0]['status']:>7s}"
+    print(f"{family:12s} {n:4d} {cpu:7.1f} {stage['candidates']:6.1f} {stage['sequencing']:6.1f} "
+          f"{stage['timing']:6.1f} {other:6.1f} {checks:9.0f} {seq:7.0f} "
+          f"{median_of(ok, 'rounds'):6.0f} {median_of(rows, 'peak_mb'):6.0f} {cycle:8.3f} "
+          f"{(cycle / base if base else math.nan):6.3f} {cycle / median_of(ok, 'bound'):6.3f} {vs_old}", flush=True)
+    return cpu
+
+
+def print_saved(paths: list[Path]) -> None:
+    """The table of runs saved by --json (several files are merged in order)."""
+    print(HEADER)
+    by_family: dict[str, list[tuple[int, dict]]] = {}
+    for path in paths:
+        for key, runs in json.loads(path.read_text(encoding="utf-8")).items():
+            family, n = key.split("/")
+            by_family.setdefault(family, []).append((int(n), runs))
+    for family, entries in by_family.items():
+        points = [(n, report_row(family, n, runs["new"], runs["old"])) for n, runs in sorted(entries, key=lambda e: e[0])]
+        print(f"{family:12s} growth exponent (CPU ~ N^k, N >= 30): k = {growth(points):.2f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="8,15,30,60,120,240")
@@ -96,14 +143,16 @@ def main() -> None:
     ap.add_argument("--against-max", type=int, default=30, help="largest N planned with --against")
     ap.add_argument("--timeout", type=float, default=1800.0)
     ap.add_argument("--json", type=Path, default=None, help="also write every run's figures here")
+    ap.add_argument("--table", type=Path, nargs="+", default=None, help="print the table of saved --json files")
     args = ap.parse_args()
+    if args.table:
+        print_saved(args.table)
+        return
     sizes = [int(x) for x in args.sizes.split(",")]
     families = args.families.split(",")
     everything: dict[str, dict] = {}
     with tempfile.TemporaryDirectory() as tmp:
-        print(f"{'family':12s} {'N':>4s} {'CPU s':>7s} {'cand':>6s} {'seq':>6s} {'time':>6s} {'other':>6s} "
-              f"{'checks k':>9s} {'seq k':>7s} {'rounds':>6s} {'MB':>6s} {'cycle s':>8s} {'/base':>6s} "
-              f"{'/bound':>6s} {'vs old':>7s}", flush=True)
+        print(HEADER, flush=True)
         for family in families:
             points = []
             for n in sizes:
@@ -112,33 +161,10 @@ def main() -> None:
                 old = [run_child(cell, args.against, baseline=False, timeout=args.timeout)
                        for _ in range(args.runs)] if args.against and n <= args.against_max else []
                 everything[f"{family}/{n}"] = {"new": rows, "old": old}
-                ok = [r for r in rows if r["status"] == "planned"]
-                cpu = median_of(rows, "cpu")
-                points.append((n, cpu))
-                if not ok:
-                    print(f"{family:12s} {n:4d} {rows[0]['status']}: {rows[0].get('message', '')[:90]}", flush=True)
-                    continue
-                stage = {k: statistics.median(r["stages"].get(k, 0.0) for r in ok)
-                         for k in ("candidates", "sequencing", "timing")}
-                # stage clocks are wall seconds inside one single-threaded process: their share of the CPU
-                wall = statistics.median(sum(r["stages"].values()) for r in ok)
-                other = max(wall - sum(stage.values()), 0.0)
-                checks = statistics.median(sum(r["checks"].values()) for r in ok) / 1e3
-                seq = statistics.median(r["checks"]["sequencing"] + r["checks"]["roadmap"] for r in ok) / 1e3
-                base = ok[0].get("baseline")
-                cycle = median_of(ok, "cycle")
-                vs_old = ""
-                if old:
-                    old_cpu = median_of(old, "cpu")
-                    vs_old = f"{cpu / old_cpu:7.2f}" if math.isfinite(old_cpu) else f"{old[0]['status']:>7s}"
-                print(f"{family:12s} {n:4d} {cpu:7.1f} {stage['candidates']:6.1f} {stage['sequencing']:6.1f} "
-                      f"{stage['timing']:6.1f} {other:6.1f} {checks:9.0f} {seq:7.0f} "
-                      f"{median_of(ok, 'rounds'):6.0f} {median_of(rows, 'peak_mb'):6.0f} {cycle:8.3f} "
-                      f"{(cycle / base if base else math.nan):6.3f} {cycle / median_of(ok, 'bound'):6.3f} {vs_old}",
-                      flush=True)
+                points.append((n, report_row(family, n, rows, old)))
+                if args.json:      # after every cell, so a long run that is stopped keeps what it measured
+                    args.json.write_text(json.dumps(everything, indent=1), encoding="utf-8")
             print(f"{family:12s} growth exponent (CPU ~ N^k, N >= 30): k = {growth(points):.2f}", flush=True)
-    if args.json:
-        args.json.write_text(json.dumps(everything, indent=1), encoding="utf-8")
 
 
 if __name__ == "__main__":
