@@ -10,10 +10,11 @@ move). Every collision check is counted.
 
 from __future__ import annotations
 
-import heapq
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from robomax_py._typing import FloatArray
@@ -91,9 +92,14 @@ class Roadmap:
         # Edge weights (s, estimated) computed once, vectorised.
         self._weight: dict[tuple[int, int], float] = {}
         pairs = np.array([(u, v) for u, adj in enumerate(self._adjacent) for v in adj if u < v], dtype=np.int64)
+        self._pairs = pairs.reshape(-1, 2)
+        self._pair_weight = np.zeros(len(self._pairs))
         if len(pairs):
             w = ptp_time_estimate(self.nodes[pairs[:, 0]], self.nodes[pairs[:, 1]], limits)
+            self._pair_weight = np.asarray(w, dtype=float)
             self._weight = {(int(u), int(v)): float(x) for (u, v), x in zip(pairs, w)}
+        self._edge_index = {(int(u), int(v)): e for e, (u, v) in enumerate(self._pairs)}
+        self._edge_blocked = np.zeros(len(self._pairs), dtype=bool)
         self._edge_free: dict[tuple[int, int], bool] = {}
         self.edge_checks = 0
 
@@ -114,19 +120,11 @@ class Roadmap:
         def point(u: int) -> FloatArray:
             return q_start if u == S else (q_goal if u == G else self.nodes[u])
 
-        def neighbours(u: int) -> list[int]:
-            if u == S:
-                return start_links
-            if u == G:
-                return []
-            out = list(self._adjacent[u])
-            if u in goal_links:
-                out.append(G)
-            return out
-
         blocked = 0
+        start_w = ptp_time_estimate(q_start[None, :], self.nodes[start_links], self._limits)
+        goal_w = ptp_time_estimate(self.nodes[goal_links], q_goal[None, :], self._limits)
         while blocked < MAX_BLOCKED_PER_QUERY:
-            path = self._shortest(S, G, point, neighbours, extra_free)
+            path = self._shortest(start_links, start_w, goal_links, goal_w, extra_free)
             if path is None:
                 return None
             bad = None
@@ -138,6 +136,8 @@ class Roadmap:
                     res = self._world.check_segment(point(u), point(v))
                     checks += res.checks
                     known = table[key] = res.free
+                    if not known and table is self._edge_free:
+                        self._edge_blocked[self._edge_index[key]] = True
                 if not known:
                     bad = key
                     break
@@ -151,37 +151,36 @@ class Roadmap:
         self.edge_checks += checks
         return None
 
-    def _shortest(self, S: int, G: int, point, neighbours, extra_free) -> list[int] | None:  # type: ignore[no-untyped-def]
-        """Dijkstra on time estimates, skipping edges known to be blocked."""
-        dist: dict[int, float] = {S: 0.0}
-        prev: dict[int, int] = {}
-        heap = [(0.0, S)]
-        done: set[int] = set()
-        while heap:
-            d, u = heapq.heappop(heap)
-            if u in done:
-                continue
-            if u == G:
-                path = [G]
-                while path[-1] != S:
-                    path.append(prev[path[-1]])
-                return path[::-1]
-            done.add(u)
-            pu = point(u)
-            for v in neighbours(u):
-                key = (min(u, v), max(u, v))
-                table = extra_free if u < 0 or v < 0 else self._edge_free
-                if table.get(key) is False:
-                    continue
-                w = self._weight.get(key)
-                if w is None:
-                    w = float(ptp_time_estimate(pu, point(v), self._limits))
-                nd = d + w
-                if nd < dist.get(v, np.inf):
-                    dist[v] = nd
-                    prev[v] = u
-                    heapq.heappush(heap, (nd, v))
-        return None
+    def _shortest(self, start_links: list[int], start_w: FloatArray, goal_links: list[int], goal_w: FloatArray,
+                  extra_free: dict[tuple[int, int], bool]) -> list[int] | None:
+        """Dijkstra (scipy, in C) on time estimates from the start S = -1 through the roadmap to the
+        goal G = -2, skipping edges known to be blocked; the path as node indices, S and G included.
+
+        The roadmap holds every spot candidate as a node (tens of thousands on a large cell), which
+        a Python heap search walked one dict look-up at a time.
+        """
+        n = len(self.nodes)
+        S, G = n, n + 1
+        keep = ~self._edge_blocked
+        rows = [self._pairs[keep, 0]]
+        cols = [self._pairs[keep, 1]]
+        data = [self._pair_weight[keep]]
+        for links, weights, end in ((start_links, start_w, S), (goal_links, goal_w, G)):
+            label = -1 if end == S else -2
+            ok = np.array([extra_free.get((min(label, v), max(label, v))) is not False for v in links], dtype=bool)
+            rows.append(np.full(int(ok.sum()), end, dtype=np.int64))
+            cols.append(np.asarray(links, dtype=np.int64)[ok])
+            data.append(np.asarray(weights, dtype=float)[ok])
+        # csgraph reads a stored zero as no edge: coinciding configurations get the least positive weight.
+        weight = np.maximum(np.concatenate(data), np.finfo(float).tiny)
+        graph = csr_matrix((weight, (np.concatenate(rows), np.concatenate(cols))), shape=(n + 2, n + 2))
+        dist, pred = dijkstra(graph, directed=False, indices=S, return_predecessors=True)
+        if not np.isfinite(dist[G]):
+            return None
+        path = [G]
+        while path[-1] != S:
+            path.append(int(pred[path[-1]]))
+        return [-1 if u == S else (-2 if u == G else u) for u in reversed(path)]
 
     def _shortcut(self, waypoints: FloatArray) -> tuple[FloatArray, int]:
         """Greedy: from each kept waypoint jump to the farthest later one reachable straight."""

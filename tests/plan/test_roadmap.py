@@ -1,0 +1,98 @@
+"""plan.roadmap: lazy PRM queries on a joint space with a ball-shaped obstacle.
+
+The world is a stand-in: a configuration is blocked inside a ball of radius 0.5 rad about a point in
+joint space; a straight move is checked at 41 states. Every detour found must be free by that rule,
+and the first path the lazy search checks must be the shortest one (an independent heap Dijkstra
+over the same graph and weights).
+"""
+
+from __future__ import annotations
+
+import heapq
+
+import numpy as np
+import pytest
+
+from robomax_py.plan.roadmap import Roadmap
+from robomax_py.robot import JointLimits
+from robomax_py.timing import ptp_time_estimate
+from robomax_py.world.collision import SegmentCheck
+
+CENTRE = np.zeros(6)
+RADIUS = 0.5
+LIMITS = JointLimits(lower=np.full(6, -3.0), upper=np.full(6, 3.0), velocity=np.array([2.0, 2.0, 2.5, 4.0, 4.0, 5.0]),
+                     acceleration=np.full(6, 8.0), jerk=np.full(6, 80.0))
+
+
+class BallWorld:
+    def __init__(self) -> None:
+        self.segments = 0
+
+    def are_free(self, qs: np.ndarray, t: float | None = None) -> np.ndarray:
+        return np.linalg.norm(qs - CENTRE, axis=1) > RADIUS
+
+    def check_segment(self, q0: np.ndarray, q1: np.ndarray, *args: object, **kwargs: object) -> SegmentCheck:
+        self.segments += 1
+        states = q0 + np.linspace(0, 1, 41)[:, None] * (q1 - q0)
+        free = bool(self.are_free(states).all())
+        return SegmentCheck(free, 41, 41, 0, None if free else 0.5)
+
+
+def _path_free(path: np.ndarray) -> bool:
+    world = BallWorld()
+    return all(world.check_segment(a, b).free for a, b in zip(path[:-1], path[1:]))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_detours_avoid_the_ball(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    start, goal = np.full(6, -0.9), np.full(6, 0.9)
+    start[1:] = rng.uniform(-0.2, 0.2, 5)
+    goal[1:] = rng.uniform(-0.2, 0.2, 5)
+    start[0], goal[0] = -0.9, 0.9
+    world = BallWorld()
+    assert not world.check_segment(start, goal).free
+    roadmap = Roadmap(world, LIMITS, np.array([start, goal]), rng, n_nodes=400, k=10)  # type: ignore[arg-type]
+    det = roadmap.query(start, goal)
+    assert det is not None
+    assert np.array_equal(det.waypoints[0], start) and np.array_equal(det.waypoints[-1], goal)
+    assert _path_free(det.waypoints)
+
+
+def test_first_checked_path_is_the_shortest() -> None:
+    rng = np.random.default_rng(5)
+    start, goal = np.full(6, -1.5), np.full(6, 1.5)
+    world = BallWorld()
+    roadmap = Roadmap(world, LIMITS, np.array([start, goal]), rng, n_nodes=300, k=8)  # type: ignore[arg-type]
+    kk = min(8, len(roadmap.nodes))
+    start_links = [int(v) for v in roadmap._tree.query(start * roadmap._scale, k=kk)[1]]
+    goal_links = [int(v) for v in roadmap._tree.query(goal * roadmap._scale, k=kk)[1]]
+    start_w = ptp_time_estimate(start[None], roadmap.nodes[start_links], LIMITS)
+    goal_w = ptp_time_estimate(roadmap.nodes[goal_links], goal[None], LIMITS)
+    path = roadmap._shortest(start_links, start_w, goal_links, goal_w, {})
+    assert path is not None and path[0] == -1 and path[-1] == -2
+
+    def point(u: int) -> np.ndarray:
+        return start if u == -1 else (goal if u == -2 else roadmap.nodes[u])
+
+    def length(p: list[int]) -> float:
+        return float(sum(ptp_time_estimate(point(a), point(b), LIMITS) for a, b in zip(p[:-1], p[1:])))
+
+    # Reference: a plain heap Dijkstra over the same graph.
+    adj: dict[int, list[tuple[int, float]]] = {-1: [(v, float(w)) for v, w in zip(start_links, start_w)]}
+    for (u, v), w in roadmap._weight.items():
+        adj.setdefault(u, []).append((v, w))
+        adj.setdefault(v, []).append((u, w))
+    for v, w in zip(goal_links, goal_w):
+        adj.setdefault(v, []).append((-2, float(w)))
+    dist = {-1: 0.0}
+    heap = [(0.0, -1)]
+    while heap:
+        d, u = heapq.heappop(heap)
+        if d > dist.get(u, np.inf) or u == -2:
+            continue
+        for v, w in adj.get(u, []):
+            if d + w < dist.get(v, np.inf):
+                dist[v] = d + w
+                heapq.heappush(heap, (d + w, v))
+    assert length(path) == pytest.approx(dist[-2], rel=1e-12)
