@@ -48,6 +48,12 @@ MAX_BLOCKED_LEGS = 4
 # Placeholder keeping detour indices stable for pairs a detour cannot serve.
 _UNUSABLE = Detour(np.zeros((0, 0)), float("inf"), 0)
 _ONE = np.zeros(1, dtype=np.int64)   # home's only candidate
+# Blocked straight moves between two spots after which only straight moves known to be free are
+# offered between them (a `straight_tries` batch is checked after each blocked one).
+MAX_BLOCKED_STRAIGHT = 24
+# Failed detour searches between two spots after which they count as unconnected (but for
+# detours found at their ends).
+MAX_FAILED_DETOURS = 6
 # States of the coarse probe of a move between two stops that are not near neighbours.
 PROBE_STATES = 9
 
@@ -122,6 +128,8 @@ class Sequencer:
         self._matrices: dict[tuple[int, int], FloatArray] = {}   # representatives x representatives
         self._full: dict[tuple[int, int], FloatArray] = {}       # every candidate, pairs of the last order only
         self.unresolved: Counter[str] = Counter()                                 # move label -> rounds left open
+        self.failed_detours: Counter[tuple[int, int]] = Counter()                 # unordered spot pair -> searches
+        self.unconnected: set[tuple[int, int]] = set()                            # unordered spot pairs given up
 
     # ------------------------------------------------------------------ knowledge and costs
 
@@ -196,11 +204,22 @@ class Sequencer:
             # Until a detour is known, price one at a multiple of the straight move: optimistic
             # enough to be explored, costly enough not to be preferred.
             usable = any(d is not _UNUSABLE for d in vias)
-            est = np.full_like(est, np.inf) if usable else est * DETOUR_PRIOR
+            unconnected = (min(i, j), max(i, j)) in self.unconnected
+            est = np.full_like(est, np.inf) if usable or unconnected else est * DETOUR_PRIOR
         else:
-            for (a, b), free in self.straight.get(key, {}).items():
-                if not free and pi[a] >= 0 and pj[b] >= 0:
-                    est[pi[a], pj[b]] = np.inf
+            known = self.straight.get(key, {})
+            if sum(1 for free in known.values() if not free) >= MAX_BLOCKED_STRAIGHT:
+                # Mostly blocked between these spots: only straight moves known to be free are
+                # offered, or the DP picks a fresh unchecked pair of candidates every round.
+                verified = np.full_like(est, np.inf)
+                for (a, b), free in known.items():
+                    if free and pi[a] >= 0 and pj[b] >= 0:
+                        verified[pi[a], pj[b]] = est[pi[a], pj[b]]
+                est = verified
+            else:
+                for (a, b), free in known.items():
+                    if not free and pi[a] >= 0 and pj[b] >= 0:
+                        est[pi[a], pj[b]] = np.inf
         for v, det in enumerate(vias):
             if det is not _UNUSABLE:
                 est = np.minimum(est, self._via_costs(i, j, v, det, rows, cols))
@@ -324,8 +343,11 @@ class Sequencer:
                 choice, cost = choice_for_order(found.order, self.full_cost, self.node)
                 tour = Tour(found.order, choice, cost)
             if not np.isfinite(tour.cost):
+                given_up = ", ".join(f"{self._name(i)} - {self._name(j)}" for i, j in sorted(self.unconnected)[:6])
                 return SequencingOutcome("disconnected", message="no collision-free connection found between some "
-                                         "spots (roadmap exhausted)")
+                                         "spots (roadmap exhausted)"
+                                         + (f"; no detour found {MAX_FAILED_DETOURS} times between {given_up}"
+                                            if given_up else ""))
             verified = self._verify(tour)
             if verified.complete:
                 self.progress("sequencing", self.rounds, self.rounds)
@@ -400,45 +422,58 @@ class Sequencer:
         return False
 
     def _lift_detour(self, i: int, a: int, j: int, b: int) -> Detour | None:
-        """Up, across, down: the TCP raised by h at both ends in the same IK branch, for clamps.
+        """Up, across, down: the TCP moved away by h at both ends in the same IK branch, for clamps.
 
-        The cheapest kind of detour an operator would teach; tried for rising h before the roadmap.
+        The cheapest kind of detour an operator would teach, tried for rising h before the roadmap:
+        first straight up; then backed off along each spot's approach line (away from the part,
+        where the clamps of the row above block the way up on a stacked flange); then both at once.
         """
         qa, qb = self.q(i)[a], self.q(j)[b]
         up = invert(np.asarray(self.cell.T_world_base))[:3, :3] @ np.array([0.0, 0.0, 1.0])
         checks = 0
-        for h in LIFT_HEIGHTS_M:
-            ends = []
-            for q, idx, col in ((qa, i, a), (qb, j, b)):
-                if idx == HOME:
-                    ends.append(q)
+        ends_at = [(qa, i, a), (qb, j, b)]
+        back = {idx: self._back_direction(idx, col) for _, idx, col in ends_at if idx != HOME}
+        for kind in ("up", "back", "up_back"):
+            for h in LIFT_HEIGHTS_M:
+                ends = []
+                for q, idx, col in ends_at:
+                    if idx == HOME:
+                        ends.append(q)
+                        continue
+                    away = up if kind == "up" else back[idx] if kind == "back" else (up + back[idx]) / np.sqrt(2.0)
+                    T = fk_tcp(self.robot, q)
+                    T[:3, 3] += h * away
+                    table = solve_all(self.robot, T[None], q_hint=q)
+                    column = int(self.spots[idx].column[col])
+                    if not table.valid[0, column]:
+                        break
+                    lifted = table.q[0, column].copy()
+                    ends.append(q + wrap_to_pi(lifted - q))
+                if len(ends) < 2 or not self.limits.contains(np.array(ends)).all():
                     continue
-                T = fk_tcp(self.robot, q)
-                T[:3, 3] += h * up
-                table = solve_all(self.robot, T[None], q_hint=q)
-                column = int(self.spots[idx].column[col])
-                if not table.valid[0, column]:
-                    break
-                lifted = table.q[0, column].copy()
-                ends.append(q + wrap_to_pi(lifted - q))
-            if len(ends) < 2 or not self.limits.contains(np.array(ends)).all():
-                continue
-            path = np.array([qa, ends[0], ends[1], qb])
-            ok = True
-            for p0, p1 in zip(path[:-1], path[1:]):
-                if np.allclose(p0, p1):
-                    continue
-                res = self.world.check_segment(p0, p1)
-                checks += res.checks
-                if not res.free:
-                    ok = False
-                    break
-            if ok:
-                keep = [0] + [k for k in range(1, 4) if not np.allclose(path[k], path[k - 1])]
-                wp = path[keep]
-                return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits))), checks)
+                path = np.array([qa, ends[0], ends[1], qb])
+                ok = True
+                for p0, p1 in zip(path[:-1], path[1:]):
+                    if np.allclose(p0, p1):
+                        continue
+                    res = self.world.check_segment(p0, p1)
+                    checks += res.checks
+                    if not res.free:
+                        ok = False
+                        break
+                if ok:
+                    keep = [0] + [k for k in range(1, 4) if not np.allclose(path[k], path[k - 1])]
+                    wp = path[keep]
+                    return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits))), checks)
         self.checks += checks
         return None
+
+    def _back_direction(self, idx: int, col: int) -> FloatArray:
+        """Unit vector (base frame) from the spot to its approach point: away from the part."""
+        c = self.spots[idx]
+        d = fk_tcp(self.robot, c.q_app[col])[:3, 3] - fk_tcp(self.robot, c.q_spot[col])[:3, 3]
+        norm = float(np.linalg.norm(d))
+        return d / norm if norm > 0 else np.zeros(3)
 
     def _new_detour(self, i: int, a: int, j: int, b: int) -> None:
         # Lift first: on clamp cells it is found in ~1,000 checks; the roadmap is the general fallback.
@@ -447,6 +482,13 @@ class Sequencer:
             # No way found for this exact pair: make sure the optimiser stops choosing it.
             self.no_way.setdefault((i, j), set()).add((a, b))
             self.no_way.setdefault((j, i), set()).add((b, a))
+            pair = (min(i, j), max(i, j))
+            self.failed_detours[pair] += 1
+            if self.failed_detours[pair] >= MAX_FAILED_DETOURS:
+                # Two spots with hundreds of candidates each would otherwise cost a round per
+                # banned candidate pair: the spots are taken to be unconnected except through
+                # detours known at their ends.
+                self.unconnected.add(pair)
             self._forget(i, j)
             if (min(i, j), max(i, j)) in self.detour_only:
                 self._retry_straight(i, j)

@@ -113,3 +113,38 @@ class _BlockEverything:
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._world, name)
+
+
+def test_mostly_blocked_spot_pair_offers_only_verified_moves(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    """Past MAX_BLOCKED_STRAIGHT blocked straight moves between two spots, only the straight moves
+    known to be free are offered (else the DP would pick an unchecked pair every round)."""
+    from robomax_py.plan.graph import MAX_BLOCKED_STRAIGHT
+
+    cell, robot, world, spots = _setup(tmp_path, write_small_cell)
+    seq = _sequencer(cell, robot, world, spots, 1)
+    pairs = [(a, b) for a in range(len(spots[0])) for b in range(len(spots[1]))]
+    assert len(pairs) > MAX_BLOCKED_STRAIGHT + 1
+    for a, b in pairs[:MAX_BLOCKED_STRAIGHT - 1]:
+        seq._record_straight(0, a, 1, b, False)
+    free_a, free_b = pairs[MAX_BLOCKED_STRAIGHT]
+    seq._record_straight(0, free_a, 1, free_b, True)
+    before = seq.full_cost(0, 1)
+    assert np.isfinite(before).sum() == before.size - (MAX_BLOCKED_STRAIGHT - 1)     # unknown pairs still offered
+    a, b = pairs[MAX_BLOCKED_STRAIGHT - 1]
+    seq._record_straight(0, a, 1, b, False)
+    after = seq.full_cost(0, 1)
+    assert np.argwhere(np.isfinite(after)).tolist() == [[free_a, free_b]]
+    assert after[free_a, free_b] == before[free_a, free_b]
+
+
+def test_spot_pair_without_detours_is_given_up(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    """After MAX_FAILED_DETOURS failed detour searches a detour-only pair is unconnected: no
+    candidate pair is offered, and the outcome names it instead of running out of rounds."""
+    from robomax_py.plan.graph import MAX_FAILED_DETOURS
+
+    cell, robot, world, spots = _setup(tmp_path, write_small_cell)
+    seq = _sequencer(cell, robot, _BlockEverything(world), spots, 80)
+    outcome = seq.run()
+    assert outcome.status == "disconnected", outcome.message
+    assert f"no detour found {MAX_FAILED_DETOURS} times between" in outcome.message
+    assert seq.rounds < 80
