@@ -31,15 +31,18 @@ CLAMP_GAP_M = 0.2           # the extra room a clamp takes on the row (reference
 RADII_M = (1.35, 1.55)      # rows alternate between these flange radii from the robot axis
 ROW_Z_M = 0.78              # height of the lowest row
 ROW_DZ_M = 0.16             # height between rows
+ROWS_UP = 6                 # rows stacked upwards from ROW_Z_M; the rest go below it
 
 
-def _row_angles(n: int, clamps: bool, rng: np.random.Generator, radius: float) -> tuple[np.ndarray, list[float]]:
-    """Angles (rad) of n spots along an arc centred on the robot's x axis, and of the clamp gaps."""
+def _row_angles(n: int, clamps: bool, rng: np.random.Generator, radius: float,
+                offset: int = 0) -> tuple[np.ndarray, list[float]]:
+    """Angles (rad) of n spots along an arc centred on the robot's x axis, and of the clamp gaps
+    (after every CLAMP_EVERY spots, counted from `offset`)."""
     arc = []
     clamp_at = []
     s = 0.0
     for k in range(n):
-        if clamps and k and k % CLAMP_EVERY == 0:
+        if clamps and k and (k + offset) % CLAMP_EVERY == 0:
             clamp_at.append(s + CLAMP_GAP_M / 2 - PITCH_M / 2)
             s += CLAMP_GAP_M - PITCH_M
         arc.append(s + rng.uniform(-0.006, 0.006))
@@ -74,8 +77,13 @@ def scale_cell(family: str, n: int, seed: int = 0) -> dict:
     spot_id = 0
     for r, count in enumerate(rows):
         radius = RADII_M[r % 2]
-        z0 = ROW_Z_M + ROW_DZ_M * r
-        phis, clamp_phis = _row_angles(count, family == "clamped", rng, radius)
+        # Rows stack upwards; from the seventh on they go below the first (higher ones would be
+        # in the arm's way at home). Rows of one radius two apart have their clamps staggered by
+        # half the clamp pitch, as fixtures alternate them: clamps stacked 0.32 m apart leave no
+        # way over for a C-gun (planned, that cell ends "disconnected", naming the spots).
+        z0 = ROW_Z_M + ROW_DZ_M * r if r < ROWS_UP else ROW_Z_M - ROW_DZ_M * (r - ROWS_UP + 1)
+        offset = CLAMP_EVERY // 2 if (r // 2) % 2 else 0
+        phis, clamp_phis = _row_angles(count, family == "clamped", rng, radius, offset)
         for c, phi in enumerate(clamp_phis):
             objects += _clamp(f"clamp{r + 1}x{c + 1}", phi, radius, z0)
         spots = []
