@@ -4,8 +4,9 @@ One KR 125-class robot with the C-gun welds N spots on vertical flanges arranged
 it (rows one above the other, like the side frame of a cab or a body side). Three families:
 
 - ``open``: no clamps; each row is split into free seams of at most `SEAM_SPOTS` spots;
-- ``clamped``: as open, with a toggle clamp (jaw, arm and post, the reference cell's clamp shape)
-  on the flange every `CLAMP_EVERY` spots, in a gap between two spots;
+- ``clamped``: a toggle clamp (jaw, arm and post, the reference cell's clamp shape) on the flange
+  every `CLAMP_EVERY` spots, in a gap between two spots; pairs of rows 0.5 m
+  apart (room for the gun over a clamp);
 - ``interleaved``: two free seams per row whose spots alternate along it, so a good tour finishes
   one seam before the other crosses the same ground.
 
@@ -31,7 +32,8 @@ CLAMP_GAP_M = 0.2           # the extra room a clamp takes on the row (reference
 RADII_M = (1.35, 1.55)      # rows alternate between these flange radii from the robot axis
 ROW_Z_M = 0.78              # height of the lowest row
 ROW_DZ_M = 0.16             # height between rows
-ROWS_UP = 6                 # rows stacked upwards from ROW_Z_M; the rest go below it
+PAIR_DZ_M = 0.5             # clamped family: height between pairs of rows
+CLAMPED_ROW_SPOTS = 30      # clamped family: spots per row
 
 
 def _row_angles(n: int, clamps: bool, rng: np.random.Generator, radius: float,
@@ -71,19 +73,20 @@ def scale_cell(family: str, n: int, seed: int = 0) -> dict:
     if family not in FAMILIES:
         raise ValueError(f"family must be one of {FAMILIES}, got {family!r}")
     rng = np.random.default_rng([seed, n, FAMILIES.index(family)])
-    rows = [ROW_SPOTS] * (n // ROW_SPOTS) + ([n % ROW_SPOTS] if n % ROW_SPOTS else [])
+    per_row = CLAMPED_ROW_SPOTS if family == "clamped" else ROW_SPOTS
+    rows = [per_row] * (n // per_row) + ([n % per_row] if n % per_row else [])
     objects: list[dict] = [{"name": "floor_table", "box": [1.0, 3.4, 0.5], "pose": {"xyz": [2.3, 0, 0.25]}}]
     seams: list[dict] = []
     spot_id = 0
     for r, count in enumerate(rows):
         radius = RADII_M[r % 2]
-        # Rows stack upwards; from the seventh on they go below the first (higher ones would be
-        # in the arm's way at home). Rows of one radius two apart have their clamps staggered by
-        # half the clamp pitch, as fixtures alternate them: clamps stacked 0.32 m apart leave no
-        # way over for a C-gun (planned, that cell ends "disconnected", naming the spots).
-        z0 = ROW_Z_M + ROW_DZ_M * r if r < ROWS_UP else ROW_Z_M - ROW_DZ_M * (r - ROWS_UP + 1)
-        offset = CLAMP_EVERY // 2 if (r // 2) % 2 else 0
-        phis, clamp_phis = _row_angles(count, family == "clamped", rng, radius, offset)
+        if family == "clamped":
+            # Pairs of rows (one per radius) 0.5 m apart: a clamp 0.32 m above a row leaves the
+            # C-gun no way over it (planned, such a cell ends "disconnected", naming the spots).
+            z0 = ROW_Z_M + PAIR_DZ_M * (r // 2) + ROW_DZ_M * (r % 2)
+        else:
+            z0 = ROW_Z_M + ROW_DZ_M * r
+        phis, clamp_phis = _row_angles(count, family == "clamped", rng, radius)
         for c, phi in enumerate(clamp_phis):
             objects += _clamp(f"clamp{r + 1}x{c + 1}", phi, radius, z0)
         spots = []
