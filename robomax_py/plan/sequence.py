@@ -248,6 +248,13 @@ def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> _Moves:
         swapped[a], swapped[c] = swapped[c], swapped[a]
         out.flats.append(_flatten(swapped))
         out._how.append(swapped)
+    # 2-opt at the seam level: a run of seams visited backwards, each free seam in it reversed
+    # (rows of seams are then welded as a serpentine, which pairwise swaps reach only one by one).
+    for a, c in itertools.combinations(range(len(blocks)), 2):
+        run = [(seam, spots if ordered[seam] else spots[::-1]) for seam, spots in reversed(blocks[a:c + 1])]
+        turned = blocks[:a] + run + blocks[c + 1:]
+        out.flats.append(_flatten(turned))
+        out._how.append(turned)
     return out
 
 

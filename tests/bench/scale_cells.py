@@ -5,8 +5,8 @@ it (rows one above the other, like the side frame of a cab or a body side). Thre
 
 - ``open``: no clamps; each row is split into free seams of at most `SEAM_SPOTS` spots;
 - ``clamped``: a toggle clamp (jaw, arm and post, the reference cell's clamp shape) on the flange
-  every `CLAMP_EVERY` spots, in a gap between two spots; pairs of rows 0.5 m
-  apart (room for the gun over a clamp);
+  every `CLAMP_EVERY` spots, in a gap between two spots; rows of 60 spots (~190 deg) on one
+  flange radius, 0.3 m apart, clamps of neighbouring rows staggered;
 - ``interleaved``: two free seams per row whose spots alternate along it, so a good tour finishes
   one seam before the other crosses the same ground.
 
@@ -32,8 +32,9 @@ CLAMP_GAP_M = 0.2           # the extra room a clamp takes on the row (reference
 RADII_M = (1.35, 1.55)      # rows alternate between these flange radii from the robot axis
 ROW_Z_M = 0.78              # height of the lowest row
 ROW_DZ_M = 0.16             # height between rows
-PAIR_DZ_M = 0.5             # clamped family: height between pairs of rows
-CLAMPED_ROW_SPOTS = 30      # clamped family: spots per row
+CLAMPED_DZ_M = 0.3          # clamped family: height between rows
+CLAMPED_RADIUS_M = 1.4      # clamped family: one flange radius for every row
+CLAMPED_ROW_SPOTS = 60      # clamped family: spots per row (an arc of ~190 deg)
 
 
 def _row_angles(n: int, clamps: bool, rng: np.random.Generator, radius: float,
@@ -81,12 +82,17 @@ def scale_cell(family: str, n: int, seed: int = 0) -> dict:
     for r, count in enumerate(rows):
         radius = RADII_M[r % 2]
         if family == "clamped":
-            # Pairs of rows (one per radius) 0.5 m apart: a clamp 0.32 m above a row leaves the
-            # C-gun no way over it (planned, such a cell ends "disconnected", naming the spots).
-            z0 = ROW_Z_M + PAIR_DZ_M * (r // 2) + ROW_DZ_M * (r % 2)
+            # One flange radius, rows 0.3 m apart, clamps of neighbouring rows staggered by half
+            # the clamp pitch: each clamp's arm runs outwards behind its own row, none under
+            # another row's spots or straight above another clamp (with rows of two radii the
+            # arms ran under the outer row, and no detour was found round them).
+            radius = CLAMPED_RADIUS_M
+            z0 = ROW_Z_M + CLAMPED_DZ_M * r
+            offset = CLAMP_EVERY // 2 if r % 2 else 0
         else:
             z0 = ROW_Z_M + ROW_DZ_M * r
-        phis, clamp_phis = _row_angles(count, family == "clamped", rng, radius)
+            offset = 0
+        phis, clamp_phis = _row_angles(count, family == "clamped", rng, radius, offset)
         for c, phi in enumerate(clamp_phis):
             objects += _clamp(f"clamp{r + 1}x{c + 1}", phi, radius, z0)
         spots = []
