@@ -267,11 +267,13 @@ class Sequencer:
         return blocks
 
     def probe_pair(self, i: int, j: int) -> tuple[int, int]:
-        """The candidate pair whose straight move `_probe_pairs` checks: the cheapest between the
-        two spots' representatives."""
-        est = self.cost(i, j)
+        """The candidate pair whose straight move `_probe_pairs` checks: the cheapest straight move
+        between the two spots' representatives. Not cached: the probe asks for every pair once, and
+        the search later needs only a few of those matrices."""
+        ri, rj = self._rows(i), self._rows(j)
+        est = ptp_time_estimate(self.q(i)[ri][:, None, :], self.q(j)[rj][None, :, :], self.limits, self.options.speed)
         a, b = np.unravel_index(int(np.argmin(est)), est.shape)
-        return int(self._rows(i)[a]), int(self._rows(j)[b])
+        return int(ri[a]), int(rj[b])
 
     def _probe_pairs(self) -> None:
         """What is blocked, learnt before the first round: a straight move (the cheapest
@@ -339,7 +341,8 @@ class Sequencer:
                 self.dp_evaluations += stats.dp_evaluations
                 previous = (found.order,)
                 # Every candidate for the order found; full matrices only of this order's moves.
-                self._full = {key: m for key, m in self._full.items() if key in _moves_of(found.order)}
+                moves = _moves_of(found.order)
+                self._full = {key: m for key, m in self._full.items() if key in moves}
                 choice, cost = choice_for_order(found.order, self.full_cost, self.node)
                 tour = Tour(found.order, choice, cost)
             if not np.isfinite(tour.cost):
@@ -433,6 +436,7 @@ class Sequencer:
         checks = 0
         ends_at = [(qa, i, a), (qb, j, b)]
         back = {idx: self._back_direction(idx, col) for _, idx, col in ends_at if idx != HOME}
+        tcp = {idx: fk_tcp(self.robot, q) for q, idx, _ in ends_at if idx != HOME}
         for kind in ("up", "back", "up_back"):
             for h in LIFT_HEIGHTS_M:
                 ends = []
@@ -441,7 +445,7 @@ class Sequencer:
                         ends.append(q)
                         continue
                     away = up if kind == "up" else back[idx] if kind == "back" else (up + back[idx]) / np.sqrt(2.0)
-                    T = fk_tcp(self.robot, q)
+                    T = tcp[idx].copy()
                     T[:3, 3] += h * away
                     table = solve_all(self.robot, T[None], q_hint=q)
                     column = int(self.spots[idx].column[col])

@@ -90,14 +90,12 @@ class Roadmap:
                     self._adjacent[u].add(int(v))
                     self._adjacent[int(v)].add(u)
         # Edge weights (s, estimated) computed once, vectorised.
-        self._weight: dict[tuple[int, int], float] = {}
         pairs = np.array([(u, v) for u, adj in enumerate(self._adjacent) for v in adj if u < v], dtype=np.int64)
         self._pairs = pairs.reshape(-1, 2)
         self._pair_weight = np.zeros(len(self._pairs))
         if len(pairs):
-            w = ptp_time_estimate(self.nodes[pairs[:, 0]], self.nodes[pairs[:, 1]], limits)
-            self._pair_weight = np.asarray(w, dtype=float)
-            self._weight = {(int(u), int(v)): float(x) for (u, v), x in zip(pairs, w)}
+            self._pair_weight = np.asarray(ptp_time_estimate(self.nodes[pairs[:, 0]], self.nodes[pairs[:, 1]], limits),
+                                           dtype=float)
         self._edge_index = {(int(u), int(v)): e for e, (u, v) in enumerate(self._pairs)}
         self._edge_blocked = np.zeros(len(self._pairs), dtype=bool)
         self._edge_free: dict[tuple[int, int], bool] = {}

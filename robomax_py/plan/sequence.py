@@ -288,9 +288,9 @@ def optimise(
     """
     rng = rng if rng is not None else np.random.default_rng(0)
     costs = _Costs(edge, node)
-    if _count_orders(blocks) <= exact_limit:
+    if order_count(blocks) <= exact_limit:
         tour = _exact(blocks, costs)
-        n = _count_orders(blocks)
+        n = order_count(blocks)
         return tour, SearchStats(dp_evaluations=n, moves_screened=n, improvements=0)
 
     ordered = [b.ordered for b in blocks]   # by seam id (= index in `blocks`)
@@ -429,10 +429,6 @@ def _perturb(blocks: Blocks, ordered: Sequence[bool], rng: np.random.Generator) 
 
 def order_count(blocks: Sequence[SeamBlock]) -> int:
     """How many orders the constraints admit (capped a little above 10^9)."""
-    return _count_orders(blocks)
-
-
-def _count_orders(blocks: Sequence[SeamBlock]) -> int:
     count = 1
     for i, b in enumerate(blocks, start=1):
         count *= i * (1 if b.ordered else _factorial(len(b.spots)))

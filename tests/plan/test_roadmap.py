@@ -80,7 +80,7 @@ def test_first_checked_path_is_the_shortest() -> None:
 
     # Reference: a plain heap Dijkstra over the same graph.
     adj: dict[int, list[tuple[int, float]]] = {-1: [(v, float(w)) for v, w in zip(start_links, start_w)]}
-    for (u, v), w in roadmap._weight.items():
+    for (u, v), w in zip(roadmap._pairs.tolist(), roadmap._pair_weight.tolist()):
         adj.setdefault(u, []).append((v, w))
         adj.setdefault(v, []).append((u, w))
     for v, w in zip(goal_links, goal_w):
