@@ -40,6 +40,7 @@ import pinocchio as pin
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.robot import RobotModel
 from robomax_py.world.bounds import KinematicBounds, joint_path
+from robomax_py.world.prefilter import Prefilter
 from robomax_py.world.scene import Scene, SceneObject
 
 KIND_LINK = "link"
@@ -56,6 +57,7 @@ class CollisionOptions:
     """How a CollisionWorld is built (defaults are the production settings)."""
 
     broad_phase: bool = True
+    prefilter: bool = True            # bounding-volume pre-filter before coal (with the broad phase only)
     acm_samples: int = 2000           # seeded random configurations for the ACM rules
     acm_margin: float = 0.02          # m: a self pair closer than this in any sample stays checked
     acm_seed: int = 0
@@ -114,6 +116,7 @@ class SharedGeometry:
     options: CollisionOptions
     acm: AllowedCollisions
     layout_contacts: tuple[tuple[str, str], ...]
+    prefilter: Prefilter | None              # bounding-sphere broad phase (None: coal's for every query)
 
 
 @dataclass(slots=True)
@@ -276,6 +279,7 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
         options=options,
         acm=acm,
         layout_contacts=_layout_contacts(gm, pieces, base_obstacle),
+        prefilter=Prefilter.of(model, gm, [p.kind in OBSTACLE_KINDS for p in pieces], pair_a, pair_b, pair_margin),
     )
 
 

@@ -448,6 +448,7 @@ def _compare_with_brute_force(world: CollisionWorld, robot: RobotModel, qs: np.n
     assert (batch == brute).all(), np.flatnonzero(batch != brute)
     assert (np.array([world.is_free(q) for q in qs]) == brute).all()
     assert (world.copy(broad_phase=False).are_free(qs) == brute).all()
+    assert (world.copy(prefilter=False).are_free(qs) == brute).all()
     for q, free in zip(qs[:200], brute[:200]):
         assert (world.first_contact(q) is None) == free
     return brute

@@ -1,0 +1,137 @@
+"""robomax_py.world.prefilter: the bounding-volume pre-filter before coal's exact test.
+
+What must hold: its forward kinematics is Pinocchio's (to 1e-12, rounding of six 3x3 products); a
+pair it clears is farther apart than its margin by coal's own distance (it may never clear a pair
+coal would call colliding); and every query of a world gives the same answers with the filter as
+without it (verdicts, the state a segment stops at, the contact named).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from robomax_py.io.robot import load_robot_spec
+from robomax_py.robot import RobotModel, load_robot
+from robomax_py.spec import CellSpec
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.prefilter import SLACK_M, Prefilter
+from robomax_py.world.scene import build_scene
+
+REPO = Path(__file__).resolve().parents[2]
+REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
+FK_TOL = 1e-12                        # m and rotation-matrix entries: products of six rotations
+LIBRARY = ["kr125", "kr16", "ur10"]
+ROSI = REPO / "tests" / "data" / "rosi"
+
+
+def _robots() -> list[RobotModel]:
+    out = [load_robot(load_robot_spec(REPO / "robomax_py" / "robots" / name / "robot.yaml")) for name in LIBRARY]
+    for yaml in sorted(ROSI.glob("*/robot.yaml")):
+        out.append(load_robot(load_robot_spec(yaml)))
+    return out
+
+
+ROBOTS = _robots()
+
+
+@pytest.fixture(scope="module")
+def reference() -> tuple[CellSpec, RobotModel, CollisionWorld]:
+    if not REFERENCE_CELL.is_file():
+        pytest.skip("reference cell not available")
+    from robomax_py.io.cell import load_cell, load_cell_robot
+
+    cell = load_cell(REFERENCE_CELL)
+    robot = load_cell_robot(cell)
+    return cell, robot, CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+
+
+@pytest.mark.parametrize("robot", ROBOTS, ids=[r.name for r in ROBOTS])
+@settings(max_examples=60, deadline=None)
+@given(u=st.lists(st.floats(0.0, 1.0), min_size=6, max_size=6))
+def test_forward_kinematics_is_pinocchios(robot: RobotModel, u: list[float]) -> None:
+    model = robot.model
+    lo, hi = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
+    q = lo + np.asarray(u[: model.nq]) * (hi - lo)
+    filt = Prefilter.of(model, robot.collision_model, [False] * robot.collision_model.ngeoms,
+                        np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0))
+    assert filt is not None
+    rot, trans = filt.joint_placements(q)
+    data = model.createData()
+    pin.forwardKinematics(model, data, q)
+    for j in range(model.njoints):
+        np.testing.assert_allclose(rot[j], data.oMi[j].rotation, atol=FK_TOL, rtol=0)
+        np.testing.assert_allclose(trans[j], data.oMi[j].translation, atol=FK_TOL, rtol=0)
+
+
+def test_no_filter_for_a_joint_it_does_not_model() -> None:
+    model = pin.Model()
+    j = model.addJoint(0, pin.JointModelRUBZ(), pin.SE3.Identity(), "continuous")   # cos/sin pair
+    model.addJointFrame(j)
+    assert Prefilter.of(model, pin.GeometryModel(), [], np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
+                        np.zeros(0)) is None
+
+
+def _configs(world: CollisionWorld, robot: RobotModel, rng: np.random.Generator, n: int) -> np.ndarray:
+    """Uniform samples and samples a few mrad from a contact (bisected between free and colliding)."""
+    lo, hi = robot.limits.lower, robot.limits.upper
+    out = list(rng.uniform(lo, hi, size=(n, robot.dof)))
+    exact = world.copy(prefilter=False)
+    while len(out) < 2 * n:
+        a, b = rng.uniform(lo, hi, size=(2, robot.dof))
+        fa, fb = exact.is_free(a), exact.is_free(b)
+        if fa == fb:
+            continue
+        for _ in range(14):
+            mid = (a + b) / 2
+            a, b = (mid, b) if exact.is_free(mid) == fa else (a, mid)
+        out.extend([a, b])
+    return np.asarray(out)
+
+
+def test_a_cleared_pair_is_farther_than_its_margin(
+    reference: tuple[CellSpec, RobotModel, CollisionWorld], rng: np.random.Generator
+) -> None:
+    _, robot, world = reference
+    filt = world._s.prefilter
+    assert filt is not None
+    margins = world.pair_margins()
+    everything = np.arange(world.n_pairs)
+    active = np.ones(world.n_pairs, dtype=bool)
+    qs = _configs(world, robot, rng, 150)
+    counts, pairs = filt.uncleared(qs, active)
+    ends = np.cumsum(counts)
+    cleared_total = 0
+    for i, q in enumerate(qs):
+        left = pairs[ends[i] - counts[i]:ends[i]]
+        assert (np.diff(left) > 0).all()                      # in pair order, once each
+        cleared = np.setdiff1d(everything, left)
+        cleared_total += len(cleared)
+        d = world.pair_distances(q, cleared)
+        assert (d > margins[cleared] + SLACK_M - 1e-9).all(), (i, cleared[d <= margins[cleared] + SLACK_M])
+    assert cleared_total > 0.9 * len(qs) * world.n_pairs      # and it does clear most pairs
+
+
+def test_answers_are_the_same_with_and_without_the_filter(
+    reference: tuple[CellSpec, RobotModel, CollisionWorld], rng: np.random.Generator
+) -> None:
+    _, robot, world = reference
+    plain = world.copy(prefilter=False)
+    qs = _configs(world, robot, rng, 100)
+    assert (world.are_free(qs) == plain.are_free(qs)).all()
+    for q in qs[:80]:
+        assert world.is_free(q) == plain.is_free(q)
+        assert world.check(q).contact == plain.check(q).contact
+    for a, b in zip(qs[:-1:2], qs[1::2]):
+        mine, theirs = world.check_segment(a, b), plain.check_segment(a, b)
+        assert (mine.free, mine.checks, mine.states, mine.s_contact) == \
+            (theirs.free, theirs.checks, theirs.states, theirs.s_contact)
+    path = qs[:12]
+    mine, theirs = world.check_path(path), plain.check_path(path)
+    assert (mine.free, mine.checks, mine.states, mine.s_contact) == \
+        (theirs.free, theirs.checks, theirs.states, theirs.s_contact)
