@@ -29,6 +29,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import coal
 import numpy as np
 import pinocchio as pin
 from numba import njit
@@ -72,14 +73,21 @@ class Prefilter:
         obb_axes = np.tile(np.eye(3), (n_geom, 1, 1))
         obb_half = np.full((n_geom, 3), np.inf)
         points_of: list[FloatArray | None] = []
+        chunks: list[list[FloatArray]] = []                  # per piece: a tree of point sets covering an obstacle
+        skips: list[list[int]] = []
         for g, obj in enumerate(gm.geometryObjects):
             piece_joint[g] = int(obj.parentJoint)
             points = support_points(obj.geometry)
             placed = points @ np.asarray(obj.placement.rotation).T + np.asarray(obj.placement.translation)
             if not np.isfinite(placed).all():
                 points_of.append(None)
+                chunks.append([])
+                skips.append([])
                 continue                                      # unbounded shape: never cleared
             points_of.append(placed)
+            nodes, skip = _mesh_chunks(obj.geometry, placed, points) if obstacle[g] else ([], [])
+            chunks.append(nodes)
+            skips.append(skip)
             if obstacle[g]:
                 box_lo[g], box_hi[g] = placed.min(axis=0), placed.max(axis=0)
             centre[g], radius[g] = _enclosing_sphere(placed)
@@ -114,11 +122,28 @@ class Prefilter:
         block_pairs = np.array([k for key in keys for k in blocks[key]], dtype=np.int64)
         group_joint = np.array(joints, dtype=np.int64)
 
+        # Obstacle chunks: an unbounded obstacle has none, and is never cleared.
+        flat = [c for piece in chunks for c in piece]
+        ch_end = np.cumsum([len(c) for c in chunks]).astype(np.int64)
+        ch_start = ch_end - np.array([len(c) for c in chunks], dtype=np.int64)
+        ch_skip = np.array([int(start) + k for start, skip in zip(ch_start, skips) for k in skip], dtype=np.int64)
+        for g in range(n_geom):
+            if is_obs[g] and points_of[g] is None:
+                ch_start[g] = ch_end[g] = -1
+        spheres = [_enclosing_sphere(c) for c in flat]
+        boxes = [_enclosing_box(c) for c in flat]
+        ch_centre = np.array([c for c, _ in spheres]).reshape(-1, 3)
+        ch_radius = np.array([r for _, r in spheres], dtype=float)
+        ch_box_c = np.array([b[0] for b in boxes]).reshape(-1, 3)
+        ch_box_r = np.array([b[1] for b in boxes]).reshape(-1, 3, 3)
+        ch_half = np.array([b[2] for b in boxes]).reshape(-1, 3)
+
         floats, ints = _pack(
             [axis, rot, trans, centre, radius, box_lo, box_hi, margin, g_centre, g_radius, block_margin,
-             obb_centre, obb_axes, obb_half],
+             obb_centre, obb_axes, obb_half, ch_centre, ch_radius, ch_box_c, ch_box_r, ch_half],
             [parent, kind, qi, piece_joint, robot_side, other, is_obs[other].astype(np.int64), group_joint,
-             block_kind, block_a, block_b, block_end, block_pairs],
+             block_kind, block_a, block_b, block_end, block_pairs, ch_start, ch_end, ch_skip],
+            len(flat),
         )
         return Prefilter(floats=floats, ints=ints, n_pairs=len(pa))
 
@@ -157,17 +182,53 @@ def _enclosing_sphere(points: FloatArray) -> tuple[FloatArray, float]:
     return c, r * (1 + 1e-9) + 1e-9
 
 
-_N_FLOAT_TABLES, _N_INT_TABLES = 14, 13
+_N_HEADER, _N_FLOAT_TABLES, _N_INT_TABLES = 6, 19, 16
+CHUNK_SIZE_M = 0.12            # an obstacle mesh is covered by chunks about this size (each its own box)
+CHUNK_MIN_TRIANGLES = 64       # meshes with fewer triangles are one chunk
 
 
-def _pack(floats: list[FloatArray], ints: list[IntArray]) -> tuple[FloatArray, IntArray]:
-    """Every table in one float and one int buffer, so a call unboxes four arrays, not thirty.
+def _mesh_chunks(geom: Any, placed: FloatArray, local: FloatArray) -> tuple[list[FloatArray], list[int]]:
+    """A tree of point sets whose convex hulls cover an obstacle piece, in pre-order, and for each
+    node the index just past its subtree (where a traversal goes when the node is cleared).
 
-    ints starts with J (joints), G (pieces), P (pairs), NG (groups), NB (blocks), then the start of
-    each float table in `floats`, then the start of each int table in `ints`.
+    A mesh (coal BVH: a triangle surface, which is all coal collides with) is split by triangle
+    centroids at the median of the longest side, until a node is within CHUNK_SIZE_M or holds one
+    triangle; a node's points are its triangles' vertices, so its hull holds all its triangles and
+    a node's children together hold its triangles. Anything else (a convex piece, a box) is one
+    node: its own points.
+    """
+    if not isinstance(geom, coal.BVHModelBase) or geom.num_tris < CHUNK_MIN_TRIANGLES \
+            or len(local) != geom.num_vertices:
+        return [placed], [1]
+    tris = np.array([[t[0], t[1], t[2]] for t in (geom.tri_indices(i) for i in range(geom.num_tris))], dtype=np.int64)
+    centroid = placed[tris].mean(axis=1)
+    nodes: list[FloatArray] = []
+    skip: list[int] = []
+
+    def visit(idx: IntArray) -> None:
+        pts = placed[np.unique(tris[idx])]
+        me = len(nodes)
+        nodes.append(pts)
+        skip.append(-1)
+        span = pts.max(axis=0) - pts.min(axis=0)
+        if len(idx) > 1 and span.max() > CHUNK_SIZE_M:
+            order = idx[np.argsort(centroid[idx, int(np.argmax(span))], kind="stable")]
+            visit(order[: len(order) // 2])
+            visit(order[len(order) // 2:])
+        skip[me] = len(nodes)
+
+    visit(np.arange(len(tris)))
+    return nodes, skip
+
+
+def _pack(floats: list[FloatArray], ints: list[IntArray], n_chunks: int) -> tuple[FloatArray, IntArray]:
+    """Every table in one float and one int buffer, so a call unboxes four arrays, not forty.
+
+    ints starts with J (joints), G (pieces), P (pairs), NG (groups), NB (blocks), C (obstacle
+    chunks), then the start of each float table in `floats`, then the start of each int table.
     """
     parent, piece_joint, pair_a, group_joint, block_kind = ints[0], ints[3], ints[4], ints[7], ints[8]
-    header = [len(parent), len(piece_joint), len(pair_a), len(group_joint), len(block_kind)]
+    header = [len(parent), len(piece_joint), len(pair_a), len(group_joint), len(block_kind), n_chunks]
     f_starts = np.cumsum([0] + [a.size for a in floats])[:-1]
     n_head = len(header) + len(floats) + len(ints)
     i_starts = n_head + np.cumsum([0] + [a.size for a in ints])[:-1]
@@ -253,7 +314,8 @@ def _forward(q: Any, parent: Any, kind: Any, axis: Any, jrot: Any, jtrans: Any, 
 @njit(cache=True, nogil=True)
 def _placements(q: Any, F: Any, I: Any) -> Any:
     J = I[0]
-    fo, io = I[5:5 + _N_FLOAT_TABLES], I[5 + _N_FLOAT_TABLES:5 + _N_FLOAT_TABLES + _N_INT_TABLES]
+    fo = I[_N_HEADER:_N_HEADER + _N_FLOAT_TABLES]
+    io = I[_N_HEADER + _N_FLOAT_TABLES:_N_HEADER + _N_FLOAT_TABLES + _N_INT_TABLES]
     rot = np.empty((J, 3, 3))
     trans = np.empty((J, 3))
     _forward(q, I[io[0]:io[0] + J], I[io[1]:io[1] + J], F[fo[0]:fo[0] + 3 * J].reshape((J, 3)),
@@ -264,8 +326,9 @@ def _placements(q: Any, F: Any, I: Any) -> Any:
 
 @njit(cache=True, nogil=True)
 def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
-    J, G, P, NG, NB = I[0], I[1], I[2], I[3], I[4]
-    fo, io = I[5:5 + _N_FLOAT_TABLES], I[5 + _N_FLOAT_TABLES:5 + _N_FLOAT_TABLES + _N_INT_TABLES]
+    J, G, P, NG, NB, C = I[0], I[1], I[2], I[3], I[4], I[5]
+    fo = I[_N_HEADER:_N_HEADER + _N_FLOAT_TABLES]
+    io = I[_N_HEADER + _N_FLOAT_TABLES:_N_HEADER + _N_FLOAT_TABLES + _N_INT_TABLES]
     axis = F[fo[0]:fo[0] + 3 * J].reshape((J, 3))
     jrot = F[fo[1]:fo[1] + 9 * J].reshape((J, 3, 3))
     jtrans = F[fo[2]:fo[2] + 3 * J].reshape((J, 3))
@@ -280,12 +343,18 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
     obb_c = F[fo[11]:fo[11] + 3 * G].reshape((G, 3))
     obb_r = F[fo[12]:fo[12] + 9 * G].reshape((G, 3, 3))
     obb_h = F[fo[13]:fo[13] + 3 * G].reshape((G, 3))
+    ch_c = F[fo[14]:fo[14] + 3 * C].reshape((C, 3))
+    ch_rad = F[fo[15]:fo[15] + C]
+    ch_bc = F[fo[16]:fo[16] + 3 * C].reshape((C, 3))
+    ch_br = F[fo[17]:fo[17] + 9 * C].reshape((C, 3, 3))
+    ch_h = F[fo[18]:fo[18] + 3 * C].reshape((C, 3))
     parent, kind, jq = I[io[0]:io[0] + J], I[io[1]:io[1] + J], I[io[2]:io[2] + J]
     piece_joint = I[io[3]:io[3] + G]
     pair_a, pair_b, pair_obstacle = I[io[4]:io[4] + P], I[io[5]:io[5] + P], I[io[6]:io[6] + P]
     group_joint = I[io[7]:io[7] + NG]
     b_kind, b_a, b_b, b_end = I[io[8]:io[8] + NB], I[io[9]:io[9] + NB], I[io[10]:io[10] + NB], I[io[11]:io[11] + NB]
     b_pairs = I[io[12]:io[12] + P]
+    ch_start, ch_end, ch_skip = I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C]
 
     n_cfg = qs.shape[0]
     rot = np.empty((J, 3, 3))
@@ -295,10 +364,6 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
     box_c = np.empty((G, 3))
     box_r = np.empty((G, 3, 3))
     placed = np.zeros(G, dtype=np.bool_)     # world box of the piece computed for this configuration
-    # Obstacles are fixed to the base frame: their boxes are placed once.
-    for g in range(G):
-        if piece_joint[g] == 0:
-            _place_box(np.eye(3).reshape((1, 3, 3)), np.zeros((1, 3)), 0, obb_c, obb_r, g, box_c, box_r)
     counts = np.zeros(n_cfg, dtype=np.int64)
     out = np.empty(n_cfg * P, dtype=np.int64)
     filled = 0
@@ -308,8 +373,7 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
             _place(rot, trans, piece_joint[g], centre, g, world)
         for g in range(NG):
             _place(rot, trans, group_joint[g], g_centre, g, g_world)
-        for g in range(G):
-            placed[g] = piece_joint[g] == 0
+        placed[:] = False
         first = filled
         begin = 0
         for blk in range(NB):
@@ -327,14 +391,29 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
                     a, b = pair_a[k], pair_b[k]
                     if pair_obstacle[k]:
                         ok = _sphere_box(world, a, radius[a] + margin[k], box_lo, box_hi, b)
+                        if not ok and ch_start[b] >= 0:   # near the obstacle's box: chunk by chunk
+                            if not placed[a]:
+                                _place_box(rot, trans, piece_joint[a], obb_c, obb_r, a, box_c, box_r)
+                                placed[a] = True
+                            ok = True
+                            c = ch_start[b]
+                            while c < ch_end[b]:          # the chunk tree, pre-order, without a stack
+                                if _sphere_point(world, a, ch_c, c, radius[a] + ch_rad[c] + margin[k]) or \
+                                        _boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, margin[k]):
+                                    c = ch_skip[c]        # cleared: past its subtree
+                                elif ch_skip[c] == c + 1:
+                                    ok = False            # a leaf it cannot clear
+                                    break
+                                else:
+                                    c += 1                # into its first child
                     else:
                         ok = _sphere_sphere(world, a, b, radius[a] + radius[b] + margin[k])
-                    if not ok:                    # the spheres overlap: try the pieces' boxes
-                        for g in (a, b):
-                            if not placed[g]:
-                                _place_box(rot, trans, piece_joint[g], obb_c, obb_r, g, box_c, box_r)
-                                placed[g] = True
-                        ok = _boxes_apart(box_c, box_r, obb_h, a, b, margin[k])
+                        if not ok:                # the spheres overlap: try the pieces' boxes
+                            for g in (a, b):
+                                if not placed[g]:
+                                    _place_box(rot, trans, piece_joint[g], obb_c, obb_r, g, box_c, box_r)
+                                    placed[g] = True
+                            ok = _boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b, margin[k])
                     if not ok:
                         out[filled] = k
                         filled += 1
@@ -371,6 +450,15 @@ def _sphere_box(world: Any, a: int, reach: float, lo: Any, hi: Any, b: int) -> b
 
 
 @njit(cache=True, nogil=True)
+def _sphere_point(world: Any, a: int, points: Any, c: int, reach: float) -> bool:
+    d2 = 0.0
+    for r in range(3):
+        e = world[a, r] - points[c, r]
+        d2 += e * e
+    return d2 > reach * reach
+
+
+@njit(cache=True, nogil=True)
 def _sphere_sphere(world: Any, a: int, b: int, reach: float) -> bool:
     d2 = 0.0
     for r in range(3):
@@ -390,10 +478,11 @@ def _place_box(rot: Any, trans: Any, j: int, local_c: Any, local_r: Any, g: int,
 
 
 @njit(cache=True, nogil=True)
-def _boxes_apart(box_c: Any, box_r: Any, half: Any, a: int, b: int, gap: float) -> bool:
-    """Whether oriented boxes a and b are more than `gap` apart along one of the 15 separating axes
-    (Gottschalk's test; a cross-product axis's gap scaled by its length). False proves nothing."""
-    ea, eb = half[a], half[b]
+def _boxes_apart(ca: Any, ra: Any, ha: Any, a: int, cb: Any, rb: Any, hb: Any, b: int, gap: float) -> bool:
+    """Whether oriented box a (centre ca[a], axes the columns of ra[a], half extents ha[a]) and box b
+    are more than `gap` apart along one of the 15 separating axes (Gottschalk's test; a cross-product
+    axis's gap scaled by its length). False proves nothing."""
+    ea, eb = ha[a], hb[b]
     if not (np.isfinite(ea[0]) and np.isfinite(eb[0])):
         return False
     R = np.empty((3, 3))
@@ -402,11 +491,11 @@ def _boxes_apart(box_c: Any, box_r: Any, half: Any, a: int, b: int, gap: float) 
     for i in range(3):
         t[i] = 0.0
         for k in range(3):
-            t[i] += box_r[a, k, i] * (box_c[b, k] - box_c[a, k])
+            t[i] += ra[a, k, i] * (cb[b, k] - ca[a, k])
         for j in range(3):
             v = 0.0
             for k in range(3):
-                v += box_r[a, k, i] * box_r[b, k, j]
+                v += ra[a, k, i] * rb[b, k, j]
             R[i, j] = v
             AbsR[i, j] = abs(v) + 1e-9          # near-parallel edges: no false separation
     for i in range(3):
