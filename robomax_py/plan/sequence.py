@@ -100,8 +100,8 @@ class _BoundTable:
     def _id(self, k: int) -> int:
         return HOME if k == self.size else k
 
-    def of_orders(self, orders: Sequence[tuple[int, ...]]) -> FloatArray:
-        """Sum of the bounds along each of many same-length orders (home at both ends).
+    def of_orders(self, orders: np.ndarray) -> FloatArray:
+        """Sum of the bounds along each of many same-length orders (rows; home at both ends).
 
         Node minima are the same for every permutation of the same spots, so they are left out: the
         result ranks orders correctly but is a bound only after adding them back.
@@ -196,65 +196,101 @@ def _flatten(blocks: Blocks) -> tuple[int, ...]:
 
 
 class _Moves:
-    """The orders one move away from `origin`: their flat forms, and their seam blocks on demand
-    (only the few a descent moves to are ever needed as blocks)."""
+    """The orders one move away from `origin`, kept compactly: for a move within seam b the new
+    order of that seam's spots (a row of `local[b]`), else the whole new blocks (seam moves). Flat
+    orders and blocks are built on demand: a descent looks at a few of its thousands of moves."""
 
     def __init__(self, origin: Blocks) -> None:
         self.origin = origin
-        self.flats: list[tuple[int, ...]] = []
-        self._how: list[tuple[int, tuple[int, ...]] | Blocks] = []   # (block index, its new spots) or whole
+        self.parts: list[tuple[int, np.ndarray]] = []      # (block index, (M_b, n_b) new block orders)
+        self.whole: list[Blocks] = []                       # seam moves, after every block move
+        self.n_local = 0
 
     def __len__(self) -> int:
-        return len(self.flats)
+        return self.n_local + len(self.whole)
+
+    def _locate(self, k: int) -> tuple[int, np.ndarray] | Blocks:
+        if k >= self.n_local:
+            return self.whole[k - self.n_local]
+        for b, rows in self.parts:
+            if k < len(rows):
+                return b, rows[k]
+            k -= len(rows)
+        raise IndexError(k)  # pragma: no cover
 
     def blocks(self, k: int) -> Blocks:
-        how = self._how[k]
-        if isinstance(how, list):
-            return how
-        b, spots = how
-        return self.origin[:b] + [(self.origin[b][0], spots)] + self.origin[b + 1:]
+        where = self._locate(k)
+        if isinstance(where, list):
+            return where
+        b, row = where
+        return self.origin[:b] + [(self.origin[b][0], tuple(int(s) for s in row))] + self.origin[b + 1:]
+
+    def flat(self, k: int) -> tuple[int, ...]:
+        return _flatten(self.blocks(k))
+
+    def rows(self) -> np.ndarray:
+        """(len, S) every move's flat order, in move order (for the bounds; not kept)."""
+        flats = [block for _, block in self.origin]
+        out = []
+        for b, rows in self.parts:
+            prefix = np.array([s for f in flats[:b] for s in f], dtype=np.int64)
+            suffix = np.array([s for f in flats[b + 1:] for s in f], dtype=np.int64)
+            out.append(np.concatenate([np.broadcast_to(prefix, (len(rows), len(prefix))), rows,
+                                       np.broadcast_to(suffix, (len(rows), len(suffix)))], axis=1))
+        out.extend(np.array([_flatten(w)], dtype=np.int64) for w in self.whole)
+        return np.concatenate(out) if out else np.zeros((0, 0), dtype=np.int64)
+
+
+_MOVE_TABLES: dict[int, np.ndarray] = {}
+
+
+def _move_table(n: int) -> np.ndarray:
+    """(M, n) the new positions of every distinct move within a free seam of n spots: 2-opt
+    (reverse positions i..j-1), then Or-opt (a run of 1-3 spots moved at most OR_OPT_WINDOW places,
+    both ways round); each new order once, first occurrence first; the unchanged order is no move.
+    The same for every seam of n spots, so made once per n."""
+    got = _MOVE_TABLES.get(n)
+    if got is not None:
+        return got
+    pos = tuple(range(n))
+    made: list[tuple[int, ...]] = []
+    for i in range(n):
+        for j in range(i + 2, n + 1):
+            made.append(pos[:i] + pos[i:j][::-1] + pos[j:])
+    for length in (1, 2, 3):
+        for i in range(n - length + 1):
+            run = pos[i:i + length]
+            rest = pos[:i] + pos[i + length:]
+            for k in range(max(0, i - OR_OPT_WINDOW), min(len(rest), i + OR_OPT_WINDOW) + 1):
+                if k == i:
+                    continue
+                for piece in (run, run[::-1]) if length > 1 else (run,):
+                    made.append(rest[:k] + piece + rest[k:])
+    fresh = [new for new in dict.fromkeys(made) if new != pos]
+    table = np.array(fresh, dtype=np.int64).reshape(len(fresh), n)
+    _MOVE_TABLES[n] = table
+    return table
 
 
 def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> _Moves:
     """Every order one move away: within free seams Or-opt (1-3 spots, moved at most
-    OR_OPT_WINDOW places) and 2-opt; seam swaps. Flat orders join the unchanged prefix and suffix."""
+    OR_OPT_WINDOW places) and 2-opt; seam swaps; seam-level 2-opt."""
     out = _Moves(blocks)
-    flats = [block for _, block in blocks]
     for b, (seam, block) in enumerate(blocks):
         if ordered[seam] or len(block) < 2:
             continue
-        prefix = tuple(s for f in flats[:b] for s in f)
-        suffix = tuple(s for f in flats[b + 1:] for s in f)
-        n = len(block)
-        made: list[tuple[int, ...]] = []
-        for i in range(n):                                   # 2-opt: reverse block[i:j]
-            for j in range(i + 2, n + 1):
-                made.append(block[:i] + block[i:j][::-1] + block[j:])
-        for length in (1, 2, 3):                             # Or-opt: move a run elsewhere
-            for i in range(n - length + 1):
-                run = block[i:i + length]
-                rest = block[:i] + block[i + length:]
-                for k in range(max(0, i - OR_OPT_WINDOW), min(len(rest), i + OR_OPT_WINDOW) + 1):
-                    if k == i:
-                        continue
-                    for piece in (run, run[::-1]) if length > 1 else (run,):
-                        made.append(rest[:k] + piece + rest[k:])
-        # Each new order once, first occurrence first; the unchanged block is no move.
-        fresh = [new for new in dict.fromkeys(made) if new != block]
-        out.flats.extend([prefix + new + suffix for new in fresh] if prefix or suffix else fresh)
-        out._how.extend((b, new) for new in fresh)
+        rows = np.asarray(block, dtype=np.int64)[_move_table(len(block))]
+        out.parts.append((b, rows))
+        out.n_local += len(rows)
     for a, c in itertools.combinations(range(len(blocks)), 2):  # seam order
         swapped = list(blocks)
         swapped[a], swapped[c] = swapped[c], swapped[a]
-        out.flats.append(_flatten(swapped))
-        out._how.append(swapped)
+        out.whole.append(swapped)
     # 2-opt at the seam level: a run of seams visited backwards, each free seam in it reversed
     # (rows of seams are then welded as a serpentine, which pairwise swaps reach only one by one).
     for a, c in itertools.combinations(range(len(blocks)), 2):
         run = [(seam, spots if ordered[seam] else spots[::-1]) for seam, spots in reversed(blocks[a:c + 1])]
-        turned = blocks[:a] + run + blocks[c + 1:]
-        out.flats.append(_flatten(turned))
-        out._how.append(turned)
+        out.whole.append(blocks[:a] + run + blocks[c + 1:])
     return out
 
 
@@ -320,7 +356,7 @@ def optimise(
         got = screened.get(key)
         if got is None:
             options = _neighbours(current, ordered)
-            bounds = bounds_of.of_orders(options.flats) + node_total if len(options) else np.zeros(0)
+            bounds = bounds_of.of_orders(options.rows()) + node_total if len(options) else np.zeros(0)
             got = screened[key] = (options, bounds, np.argsort(bounds, kind="stable").tolist())
             if len(screened) > KEPT_NEIGHBOURHOODS:
                 screened.popitem(last=False)
@@ -344,7 +380,7 @@ def optimise(
                     rank >= screen and bounds[idx] >= current_cost - 1e-9
                 ):
                     break
-                value = evaluate(options.flats[idx])
+                value = evaluate(options.flat(idx))
                 if value < current_cost - 1e-9:
                     current, current_cost, improved = options.blocks(idx), value, True
                     counter["improvements"] += 1
