@@ -2,6 +2,7 @@
 
     python tests/bench/bench_scale.py [--sizes 8,15,30,60,120,240] [--families open,clamped,interleaved]
                                       [--runs 1] [--against DIR] [--against-max 30] [--timeout 1800]
+    python tests/bench/bench_scale.py --cells CELL... [--runs 3] [--against DIR]
 
 Cells come from `scale_cells.py` (seeded, one KR 125 with the C-gun, N spots on flange rows, three
 families). Each plan runs in a fresh process (so peak memory is the plan's own and nothing is
@@ -144,9 +145,25 @@ def main() -> None:
     ap.add_argument("--timeout", type=float, default=1800.0)
     ap.add_argument("--json", type=Path, default=None, help="also write every run's figures here")
     ap.add_argument("--table", type=Path, nargs="+", default=None, help="print the table of saved --json files")
+    ap.add_argument("--cells", type=Path, nargs="+", default=None,
+                    help="plan these cell files instead of generated ones (each --runs times, --against too)")
     args = ap.parse_args()
     if args.table:
         print_saved(args.table)
+        return
+    if args.cells:
+        print(HEADER, flush=True)
+        saved: dict[str, dict] = {}
+        for cell in args.cells:
+            cell = cell.resolve()
+            rows = [run_child(cell, REPO, baseline=(k == 0), timeout=args.timeout) for k in range(args.runs)]
+            old = [run_child(cell, args.against, baseline=False, timeout=args.timeout)
+                   for _ in range(args.runs)] if args.against else []
+            label = f"{cell.parent.name}/{cell.stem}"       # two folders may hold cells of one name
+            saved[f"{label}/0"] = {"new": rows, "old": old}
+            report_row(label, 0, rows, old)
+            if args.json:
+                args.json.write_text(json.dumps(saved, indent=1), encoding="utf-8")
         return
     sizes = [int(x) for x in args.sizes.split(",")]
     families = args.families.split(",")
