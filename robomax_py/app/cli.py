@@ -288,6 +288,46 @@ def bench(
 
 
 @app.command()
+def cspace(
+    cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
+    wrist: Annotated[str, typer.Option("--wrist", help="A4-A6 held at home, or at a spot's nominal-orientation IK (spot or seam/spot)")] = "home",
+    resolution: Annotated[int, typer.Option("--resolution", help="samples per axis of A1-A3 (4..400)")] = 50,
+    plot: Annotated[Path | None, typer.Option("--plot", help="write a PNG of the blocked cells here")] = None,
+    jobs: Annotated[int, typer.Option("-j", "--jobs", min=0, help="processes (0: the cores this process may use)")] = 0,
+    as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable summary")] = False,
+) -> None:
+    """The A1-A3 configuration-space map of a cell with the wrist fixed, every cell checked exactly."""
+
+    def run() -> None:
+        import json as _json
+
+        from robomax_py.app.cspace_view import map_png, map_summary, spot_wrist
+        from robomax_py.cspace import build_map, check_arm, default_workers
+        from robomax_py.io.cell import load_cell, load_cell_robot
+        from robomax_py.io.files import write_atomic_bytes
+
+        spec = load_cell(cell)
+        robot = load_cell_robot(spec)
+        check_arm(robot)
+        values = "home" if wrist == "home" else spot_wrist(spec, robot, wrist)
+        m = build_map(spec, robot, values, resolution, jobs or default_workers())
+        png = map_png(m, f"{spec.name} ({robot.name}): C-space, wrist {wrist}, {resolution}^3") if plot else None
+        summary = {"cell": spec.name, "robot": robot.name, "wrist": wrist, **map_summary(m)}
+        if png is not None and plot is not None:
+            write_atomic_bytes(plot, png)
+            summary["plot"] = str(plot)
+        if as_json:
+            out.print_json(_json.dumps(summary))
+            return
+        table = Table(show_header=False, box=None)
+        for key, value in summary.items():
+            table.add_row(key, f"{value:,}" if isinstance(value, int) else str(value))
+        out.print(table)
+
+    _guarded(run)
+
+
+@app.command()
 def preview(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
     program: Annotated[Path | None, typer.Argument(help="program written by plan (.json or .srcl); without it the robot stands at home")] = None,

@@ -174,7 +174,7 @@ class CollisionWorld:
     Not thread-safe: owns Pinocchio scratch. `copy()` gives an independent world cheaply.
     """
 
-    __slots__ = ("_s", "_data", "_gdata", "_manager", "_callback", "_present", "_active_before", "_pf", "_active")
+    __slots__ = ("_s", "_data", "_gdata", "_manager", "_callback", "_present", "_active_before", "_pf", "_active", "_allowed")
 
     def __init__(
         self, robot: RobotModel, scene: Scene, clearance: float = 0.0, options: CollisionOptions = CollisionOptions()
@@ -200,6 +200,7 @@ class CollisionWorld:
         self._present: tuple[bool, ...] = tuple(True for _ in shared.dynamic_ids)
         self._active_before = np.arange(len(shared.pair_a) + 1, dtype=np.int64)
         self._active = np.ones(len(shared.pair_a), dtype=bool)
+        self._allowed = np.ones(len(shared.pair_a), dtype=bool)     # pairs this world checks at all
         self._pf = shared.prefilter if shared.options.broad_phase and shared.options.prefilter else None
 
     def copy(self, broad_phase: bool | None = None, prefilter: bool | None = None) -> CollisionWorld:
@@ -218,7 +219,25 @@ class CollisionWorld:
             shared = dataclasses.replace(shared, options=options)
         other = CollisionWorld.__new__(CollisionWorld)
         other._attach(shared)
+        if not self._allowed.all():                      # a restricted world's copy stays restricted
+            other._restrict(self._allowed)
         return other
+
+    def restricted(self, obstacles: bool = True, self_pairs: bool = True) -> CollisionWorld:
+        """A copy that checks only the robot/tool pairs against obstacles, or only the robot/tool
+        pairs among themselves (e.g. a configuration-space map of the cell's objects alone)."""
+        s = self._s
+        other = self.copy()
+        kinds = [(s.pieces[int(a)].kind, s.pieces[int(b)].kind) for a, b in zip(s.pair_a, s.pair_b)]
+        with_obstacle = np.array([KIND_OBJECT in k or KIND_DYNAMIC in k for k in kinds], dtype=bool)
+        other._restrict(self._allowed & np.where(with_obstacle, obstacles, self_pairs))
+        return other
+
+    def _restrict(self, allowed: np.ndarray) -> None:
+        self._allowed = allowed.copy()
+        for p in np.flatnonzero(~allowed):
+            self._gdata.deactivateCollisionPair(int(p))
+        self._refresh_active()
 
     # ----------------------------------------------------------------------------- properties
 
@@ -573,12 +592,15 @@ class CollisionWorld:
             if on_now == on_before:
                 continue
             for p in pairs:
-                if on_now:
+                if on_now and self._allowed[p]:
                     self._gdata.activateCollisionPair(int(p))
                 else:
                     self._gdata.deactivateCollisionPair(int(p))
         self._present = present
-        active = np.fromiter(self._gdata.activeCollisionPairs, dtype=bool, count=len(s.pair_a))
+        self._refresh_active()
+
+    def _refresh_active(self) -> None:
+        active = np.fromiter(self._gdata.activeCollisionPairs, dtype=bool, count=len(self._s.pair_a))
         self._active = active
         self._active_before = np.concatenate([[0], np.cumsum(active)]).astype(np.int64)
 

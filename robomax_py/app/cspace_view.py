@@ -1,0 +1,86 @@
+"""The `robomax cspace` command's work: the wrist of a spot, the map's summary and its picture."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.cspace import CSpaceError, CSpaceMap
+from robomax_py.plan.poses import nominal_rotation
+from robomax_py.robot import RobotModel
+from robomax_py.robot.solve import solve_all
+from robomax_py.spec import CellSpec
+from robomax_py.transforms import invert
+
+DPI = 100
+MAX_POINTS = 60_000          # blocked cells drawn at most (an even subsample beyond)
+
+
+def spot_wrist(cell: CellSpec, robot: RobotModel, name: str) -> FloatArray:
+    """A4-A6 (rad) of the spot's first IK branch within the limits at its nominal orientation.
+
+    `name` is "seam/spot" or a spot name that only one seam has."""
+    matches = [(seam, spot) for seam in cell.seams for spot in seam.spots
+               if name in (spot.name, f"{seam.name}/{spot.name}")]
+    if not matches:
+        raise CSpaceError(f"{cell.source}: --wrist: no spot named {name!r} (use home, a spot name or seam/spot)")
+    if len(matches) > 1:
+        raise CSpaceError(f"{cell.source}: --wrist: {len(matches)} seams have a spot {name!r}; name it as seam/spot")
+    _, spot = matches[0]
+    T_world_tcp = np.eye(4)
+    T_world_tcp[:3, :3] = nominal_rotation(spot)
+    T_world_tcp[:3, 3] = spot.xyz
+    T_base_tcp = invert(np.asarray(cell.T_world_base)) @ T_world_tcp
+    table = solve_all(robot, T_base_tcp[None], q_hint=np.asarray(cell.home, dtype=float), expand_turns=False)
+    valid = np.flatnonzero(table.valid[0])
+    if not len(valid):
+        raise CSpaceError(f"{cell.source}: --wrist: spot {name} has no IK solution within {robot.name}'s limits at "
+                          "its nominal orientation")
+    return np.asarray(table.q[0, valid[0], 3:], dtype=float)
+
+
+def map_summary(m: CSpaceMap) -> dict[str, object]:
+    """What the map holds, in degrees and counts (for the report and --json)."""
+    r = m.grid.resolution
+    return {
+        "resolution": r,
+        "cells": m.grid.size,
+        "wrist_deg": [round(float(v), 3) for v in np.degrees(m.grid.wrist)],
+        "axes_deg": [[round(float(np.degrees(a[0])), 3), round(float(np.degrees(a[-1])), 3)] for a in m.grid.axes],
+        "blocked_by_objects": int(m.obstacle.sum()),
+        "blocked_by_itself": int(m.self_contact.sum()),
+        "free": int((~m.blocked).sum()),
+        "checks": m.checks,
+        "cpu_s": round(m.cpu_seconds, 3),
+        "wall_s": round(m.wall_seconds, 3),
+        "method": m.method,
+    }
+
+
+def map_png(m: CSpaceMap, title: str) -> bytes:
+    """A 3-D scatter of the blocked cells (objects red, the arm itself grey) over A1-A3 in degrees."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(8, 7), dpi=DPI)
+    ax = fig.add_subplot(projection="3d")
+    rng = np.random.default_rng(0)
+    for mask, colour, label in ((m.obstacle, "#d62728", "objects"), (m.self_contact & ~m.obstacle, "#7f7f7f", "itself")):
+        idx = np.argwhere(mask)
+        if len(idx) > MAX_POINTS:
+            idx = idx[np.sort(rng.choice(len(idx), MAX_POINTS, replace=False))]
+        q = [np.degrees(m.grid.axes[a][idx[:, a]]) for a in range(3)]
+        ax.scatter(q[0], q[1], q[2], s=2, c=colour, alpha=0.35, depthshade=False, label=f"{label} ({int(mask.sum()):,})")
+    ax.set_xlabel("A1 (deg)")
+    ax.set_ylabel("A2 (deg)")
+    ax.set_zlabel("A3 (deg)")
+    ax.set_title(title)
+    ax.legend(loc="upper left", fontsize="small")
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=DPI)
+    plt.close(fig)
+    return buf.getvalue()

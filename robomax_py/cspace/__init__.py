@@ -1,0 +1,44 @@
+"""Configuration-space maps of A1-A3 with the wrist fixed (the ROBOMAX C-space method, issue 19).
+
+`build_map(cell, robot, wrist, resolution)` checks every cell of the grid exactly with the cell's
+collision world. The learned (RBF) model of the method is not built yet.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.cspace.exact import CSpaceMap, default_workers, exact_map
+from robomax_py.cspace.grid import MAX_RESOLUTION, MIN_RESOLUTION, CSpaceError, CSpaceGrid, check_arm
+from robomax_py.robot import RobotModel
+from robomax_py.spec import CellSpec
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.scene import build_scene
+
+
+def build_map(
+    cell: CellSpec,
+    robot: RobotModel,
+    wrist: Literal["home"] | FloatArray = "home",
+    resolution: int = 50,
+    workers: int = 1,
+) -> CSpaceMap:
+    """The exact A1-A3 map of `cell` (its clearance applied) with the wrist at home or at the given
+    joint values (rad, joints 4..6). A cell without objects is a CSpaceError: there is nothing to map."""
+    check_arm(robot)
+    values = np.asarray(cell.home, dtype=float)[3:] if isinstance(wrist, str) and wrist == "home" else wrist
+    grid = CSpaceGrid.of(robot, resolution, np.asarray(values, dtype=float))
+    scene = build_scene(cell, robot)
+    if not (scene.obstacles or scene.dynamic):
+        raise CSpaceError(f"{cell.source}: objects: the cell has no objects, so its C-space map has no obstacles")
+    world = CollisionWorld(robot, scene, cell.process.clearance)
+    return exact_map(world, grid, workers)
+
+
+__all__ = [
+    "MAX_RESOLUTION", "MIN_RESOLUTION", "CSpaceError", "CSpaceGrid", "CSpaceMap", "build_map", "check_arm",
+    "default_workers", "exact_map",
+]

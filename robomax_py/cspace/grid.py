@@ -1,0 +1,80 @@
+"""The grid of a configuration-space map: the first three joints sampled, the wrist held fixed.
+
+The published ROBOMAX method plans detours in a discrete map of A1-A3 with the wrist (A4-A6)
+fixed; this is that grid. Each axis is sampled at `resolution` values evenly over the joint's
+limits, ends included, so cell (i, j, k) is the configuration (q1[i], q2[j], q3[k], wrist).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.errors import RobomaxError
+from robomax_py.robot import RobotModel
+from robomax_py.robot.ik._chain import joint_axes_at_zero
+
+MIN_RESOLUTION = 4
+MAX_RESOLUTION = 400
+VERTICAL_TOL = 1e-6          # |cos| of A1's axis to the base z axis must be within this of 1
+
+
+class CSpaceError(RobomaxError):
+    """A configuration-space map cannot be made for this robot, cell or request."""
+
+
+@dataclass(frozen=True, slots=True)
+class CSpaceGrid:
+    """Sample values of A1-A3 (rad) and the fixed wrist (rad, joints 4..n)."""
+
+    axes: tuple[FloatArray, FloatArray, FloatArray]
+    wrist: FloatArray
+
+    @property
+    def resolution(self) -> int:
+        return len(self.axes[0])
+
+    @property
+    def size(self) -> int:
+        return self.resolution ** 3
+
+    def configs(self, start: int, stop: int) -> FloatArray:
+        """(stop - start, n) configurations of the flat cells start..stop-1 (C order over i, j, k)."""
+        r = self.resolution
+        flat = np.arange(start, stop)
+        i, rest = np.divmod(flat, r * r)
+        j, k = np.divmod(rest, r)
+        q = np.empty((len(flat), 3 + len(self.wrist)))
+        q[:, 0], q[:, 1], q[:, 2] = self.axes[0][i], self.axes[1][j], self.axes[2][k]
+        q[:, 3:] = self.wrist
+        return q
+
+    def cell_of(self, q: FloatArray) -> tuple[int, int, int]:
+        """The cell whose sample values are nearest to q's first three joints."""
+        return tuple(int(np.argmin(np.abs(self.axes[a] - q[a]))) for a in range(3))  # type: ignore[return-value]
+
+    @staticmethod
+    def of(robot: RobotModel, resolution: int, wrist: FloatArray) -> CSpaceGrid:
+        """The grid over `robot`'s limits; a robot that is not a 6-axis arm with a vertical A1, or a
+        resolution outside MIN_RESOLUTION..MAX_RESOLUTION, is a CSpaceError."""
+        check_arm(robot)
+        if not MIN_RESOLUTION <= resolution <= MAX_RESOLUTION:
+            raise CSpaceError(f"resolution must be {MIN_RESOLUTION}..{MAX_RESOLUTION} samples per axis, got {resolution}")
+        wrist = np.asarray(wrist, dtype=float).reshape(-1)
+        if len(wrist) != robot.dof - 3 or not np.isfinite(wrist).all():
+            raise CSpaceError(f"the wrist needs {robot.dof - 3} finite joint values, got {wrist.tolist()}")
+        lo, hi = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
+        axes = tuple(np.linspace(lo[a], hi[a], resolution) for a in range(3))
+        return CSpaceGrid(axes=axes, wrist=wrist)  # type: ignore[arg-type]
+
+
+def check_arm(robot: RobotModel) -> None:
+    """The map's method needs a 6-axis arm whose A1 turns about the base's vertical axis."""
+    if robot.dof != 6:
+        raise CSpaceError(f"robot {robot.name} has {robot.dof} axes; the C-space map needs a 6-axis arm")
+    axes = joint_axes_at_zero(robot.model, robot.flange_frame_id)
+    if abs(abs(float(axes.u[0][2])) - 1.0) > VERTICAL_TOL:
+        raise CSpaceError(f"robot {robot.name}: A1 is not vertical (axis {np.round(axes.u[0], 6).tolist()} in the "
+                          "base frame); the C-space map needs a vertical A1")
