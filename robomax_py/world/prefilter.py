@@ -382,7 +382,7 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
             if b_kind[blk] == 0:
                 cleared = _sphere_box(g_world, ga, g_radius[ga] + b_margin[blk], box_lo, box_hi, gb)
             else:
-                cleared = _sphere_sphere(g_world, ga, gb, g_radius[ga] + g_radius[gb] + b_margin[blk])
+                cleared = _sphere_point(g_world, ga, g_world, gb, g_radius[ga] + g_radius[gb] + b_margin[blk])
             if not cleared:
                 for n in range(begin, stop):
                     k = b_pairs[n]
@@ -407,7 +407,7 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
                                 else:
                                     c += 1                # into its first child
                     else:
-                        ok = _sphere_sphere(world, a, b, radius[a] + radius[b] + margin[k])
+                        ok = _sphere_point(world, a, world, b, radius[a] + radius[b] + margin[k])
                         if not ok:                # the spheres overlap: try the pieces' boxes
                             for g in (a, b):
                                 if not placed[g]:
@@ -451,18 +451,10 @@ def _sphere_box(world: Any, a: int, reach: float, lo: Any, hi: Any, b: int) -> b
 
 @njit(cache=True, nogil=True)
 def _sphere_point(world: Any, a: int, points: Any, c: int, reach: float) -> bool:
+    """Whether point world[a] is farther than `reach` from point points[c]."""
     d2 = 0.0
     for r in range(3):
         e = world[a, r] - points[c, r]
-        d2 += e * e
-    return d2 > reach * reach
-
-
-@njit(cache=True, nogil=True)
-def _sphere_sphere(world: Any, a: int, b: int, reach: float) -> bool:
-    d2 = 0.0
-    for r in range(3):
-        e = world[a, r] - world[b, r]
         d2 += e * e
     return d2 > reach * reach
 
