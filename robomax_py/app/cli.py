@@ -295,8 +295,12 @@ def cspace(
     plot: Annotated[Path | None, typer.Option("--plot", help="write a PNG of the blocked cells here")] = None,
     jobs: Annotated[int, typer.Option("-j", "--jobs", min=0, help="processes (0: the cores this process may use)")] = 0,
     as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable summary")] = False,
+    learned: Annotated[bool, typer.Option("--learned", help="also the map of the learned point model (trained once per robot, tool and wrist, then cached), compared with the exact one cell by cell")] = False,
+    spacing: Annotated[float, typer.Option("--spacing", min=0.005, max=1.0, help="m between the object surface points of the learned map")] = 0.1,
+    inflation: Annotated[float, typer.Option("--inflation", min=0.0, max=1.0, help="m added to the learned model's sphere radius (safety)")] = 0.03,
 ) -> None:
-    """The A1-A3 configuration-space map of a cell with the wrist fixed, every cell checked exactly."""
+    """The A1-A3 configuration-space map of a cell with the wrist fixed, every cell checked exactly
+    (and with --learned, from the learned point model too)."""
 
     def run() -> None:
         import json as _json
@@ -313,6 +317,10 @@ def cspace(
         m = build_map(spec, robot, values, resolution, jobs or default_workers())
         png = map_png(m, f"{spec.name} ({robot.name}): C-space, wrist {wrist}, {resolution}^3") if plot else None
         summary = {"cell": spec.name, "robot": robot.name, "wrist": wrist, **map_summary(m)}
+        if learned:
+            from robomax_py.app.cspace_view import learned_summary
+
+            summary.update(learned_summary(spec, robot, m, spacing, inflation))
         if png is not None and plot is not None:
             write_atomic_bytes(plot, png)
             summary["plot"] = str(plot)

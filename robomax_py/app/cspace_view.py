@@ -7,12 +7,21 @@ import io
 import numpy as np
 
 from robomax_py._typing import FloatArray
-from robomax_py.cspace import CSpaceError, CSpaceMap
+from robomax_py.cspace import (
+    CSpaceError,
+    CSpaceMap,
+    TrainingSettings,
+    cover_radius,
+    learned_map,
+    learned_model,
+    surface_points,
+)
 from robomax_py.plan.poses import nominal_rotation
 from robomax_py.robot import RobotModel
 from robomax_py.robot.solve import solve_all
 from robomax_py.spec import CellSpec
 from robomax_py.transforms import invert
+from robomax_py.world.scene import build_scene
 
 DPI = 100
 MAX_POINTS = 60_000          # blocked cells drawn at most (an even subsample beyond)
@@ -56,6 +65,25 @@ def map_summary(m: CSpaceMap) -> dict[str, object]:
         "cpu_s": round(m.cpu_seconds, 3),
         "wall_s": round(m.wall_seconds, 3),
         "method": m.method,
+    }
+
+
+def learned_summary(cell: CellSpec, robot: RobotModel, exact: CSpaceMap, spacing: float,
+                    inflation: float) -> dict[str, object]:
+    """The learned map on the exact map's grid, and how it differs from it cell by cell."""
+    radius = cell.process.clearance + cover_radius(spacing) + inflation
+    model, cached = learned_model(cell, robot, exact.grid.wrist, radius, TrainingSettings())
+    points = surface_points(build_scene(cell, robot), spacing)
+    m = learned_map(model, points, exact.grid)
+    return {
+        "learned_blocked_by_objects": int(m.obstacle.sum()),
+        "learned_wrongly_free": int((exact.obstacle & ~m.obstacle).sum()),
+        "learned_wrongly_blocked": int((~exact.obstacle & m.obstacle).sum()),
+        "learned_points": int(len(points)),
+        "learned_sphere_radius_m": round(radius, 4),
+        "learned_cpu_s": round(m.cpu_seconds, 3),
+        "training": "cached" if cached else f"{model.train_cpu_seconds:.1f} s CPU, {model.train_checks:,} checks",
+        "training_neurons": int(len(model.centres)),
     }
 
 

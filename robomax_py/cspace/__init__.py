@@ -1,7 +1,8 @@
 """Configuration-space maps of A1-A3 with the wrist fixed (the ROBOMAX C-space method, issue 19).
 
 `build_map(cell, robot, wrist, resolution)` checks every cell of the grid exactly with the cell's
-collision world. The learned (RBF) model of the method is not built yet.
+collision world; `learned_model` (trained once, cached on disk) and `learned_map` give the same map
+from the method's learned point model (`cspace.learned`). Detours through a map are not built yet.
 """
 
 from __future__ import annotations
@@ -11,7 +12,10 @@ from typing import Literal
 import numpy as np
 
 from robomax_py._typing import FloatArray
+from robomax_py.cspace.cache import cache_dir, learned_model
 from robomax_py.cspace.exact import CSpaceMap, default_workers, exact_map
+from robomax_py.cspace.learned import LearnedModel, TrainingSettings, learned_map
+from robomax_py.cspace.points import cover_radius, surface_points
 from robomax_py.cspace.grid import MAX_RESOLUTION, MIN_RESOLUTION, CSpaceError, CSpaceGrid, check_arm
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
@@ -39,6 +43,7 @@ def build_map(
 
 
 __all__ = [
-    "MAX_RESOLUTION", "MIN_RESOLUTION", "CSpaceError", "CSpaceGrid", "CSpaceMap", "build_map", "check_arm",
-    "default_workers", "exact_map",
+    "MAX_RESOLUTION", "MIN_RESOLUTION", "CSpaceError", "CSpaceGrid", "CSpaceMap", "LearnedModel", "TrainingSettings",
+    "build_map", "cache_dir", "check_arm", "cover_radius", "default_workers", "exact_map", "learned_map",
+    "learned_model", "surface_points",
 ]

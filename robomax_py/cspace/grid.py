@@ -38,14 +38,14 @@ class CSpaceGrid:
 
     @property
     def size(self) -> int:
-        return self.resolution ** 3
+        return len(self.axes[0]) * len(self.axes[1]) * len(self.axes[2])
 
     def configs(self, start: int, stop: int) -> FloatArray:
         """(stop - start, n) configurations of the flat cells start..stop-1 (C order over i, j, k)."""
-        r = self.resolution
+        n2, n3 = len(self.axes[1]), len(self.axes[2])
         flat = np.arange(start, stop)
-        i, rest = np.divmod(flat, r * r)
-        j, k = np.divmod(rest, r)
+        i, rest = np.divmod(flat, n2 * n3)
+        j, k = np.divmod(rest, n3)
         q = np.empty((len(flat), 3 + len(self.wrist)))
         q[:, 0], q[:, 1], q[:, 2] = self.axes[0][i], self.axes[1][j], self.axes[2][k]
         q[:, 3:] = self.wrist
