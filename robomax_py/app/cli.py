@@ -297,7 +297,7 @@ def cspace(
     as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable summary")] = False,
     learned: Annotated[bool, typer.Option("--learned", help="also the map of the learned point model (trained once per robot, tool and wrist, then cached), compared with the exact one cell by cell")] = False,
     spacing: Annotated[float, typer.Option("--spacing", min=0.005, max=1.0, help="m between the object surface points of the learned map")] = 0.1,
-    inflation: Annotated[float, typer.Option("--inflation", min=0.0, max=1.0, help="m added to the learned model's sphere radius (safety)")] = 0.03,
+    inflation: Annotated[float, typer.Option("--inflation", min=0.0, max=1.0, help="m added to the learned model's sphere radius (safety; 0.06 gave no wrongly free cell on the reference cell)")] = 0.06,
 ) -> None:
     """The A1-A3 configuration-space map of a cell with the wrist fixed, every cell checked exactly
     (and with --learned, from the learned point model too)."""

@@ -34,10 +34,11 @@ Using it
 --------
 A cell's objects become surface points (`points.surface_points`); each point's profiles are read at
 d and at d +- d_step (their union: a point between two training distances is covered by both), its
-bands and columns are shifted by its azimuth and elevation and marked in the map (a matrix product
-per band over a chunk of points). The sphere radius rho is the cell's clearance plus the points'
-cover radius plus `inflation`: with that, the points' spheres contain every object surface, and the
-inflation absorbs the model's approximations. Accuracy is measured against the exact map, never assumed.
+bands and columns are shifted by its azimuth and elevation and marked in the map (per band, the
+union of the points' (q2, q3) sets at each q1 cell the band reaches, a chunk of points at a time).
+The sphere radius rho is the cell's clearance plus the points' cover radius plus `inflation`: with
+that, the points' spheres contain every object surface, and the inflation absorbs the model's
+approximations. Accuracy is measured against the exact map, never assumed.
 """
 
 from __future__ import annotations
@@ -60,8 +61,8 @@ from robomax_py.world.bounds import support_points
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.scene import Scene, build_scene
 
-MODEL_VERSION = 2
-CHUNK = 1024                 # points marked per matrix product
+MODEL_VERSION = 3
+CHUNK = 1024                 # points marked at a time
 # Training: no self pairs are needed (obstacle pairs only), so no ACM samples or proof.
 _TRAIN_OPTIONS = CollisionOptions(acm_samples=1, acm_proof_joints=0)
 
@@ -125,7 +126,16 @@ class LearnedModel:
 
     def profiles(self, d: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(m, B, C) Q3lo and Q3hi (rad) per q1 band and q2 column at distances d; lo > hi: empty."""
-        out = _basis(np.asarray(d, dtype=float), self.centres) @ self.weights
+        # At most two neighbouring basis functions are nonzero at any d: the network's output is the
+        # blend of their two weight rows (the same values as `_basis(d, centres) @ weights`).
+        d = np.atleast_1d(np.asarray(d, dtype=float))
+        c = self.centres
+        if len(c) == 1:
+            out = np.repeat(self.weights, len(d), axis=0)
+        else:
+            k = np.clip(np.searchsorted(c, d, side="right") - 1, 0, len(c) - 2)
+            t = np.clip((d - c[k]) / (c[k + 1] - c[k]), 0.0, 1.0)[:, None]
+            out = (1.0 - t) * self.weights[k] + t * self.weights[k + 1]
         B, C = len(self.bands) - 1, len(self.q2)
         return out[:, :B * C].reshape(-1, B, C), out[:, B * C:].reshape(-1, B, C)
 
@@ -160,7 +170,9 @@ def train(cell: CellSpec, robot: RobotModel, wrist: FloatArray, radius: float,
     lo, hi = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
     q1_step, q23_step = math.radians(settings.q1_step_deg), math.radians(settings.q23_step_deg)
     dq1 = np.arange(-math.pi, math.pi, q1_step)
-    q2 = _axis(lo[1], hi[1], q23_step)
+    # A point's elevation e in [-pi/2, pi/2] shifts its A2 profile by e: the columns must cover the
+    # limits widened by that much, or a point below or above V loses the columns past the limits.
+    q2 = _axis(lo[1] - math.pi / 2, hi[1] + math.pi / 2, q23_step)
     q3 = _axis(lo[2], hi[2], q23_step)
     scene0 = build_scene(replace(cell, objects=(), dynamic=()), robot)
     d_max = _reach_from(base, robot, scene0) + radius
@@ -198,7 +210,7 @@ def learned_map(model: LearnedModel, points: FloatArray, grid: CSpaceGrid) -> CS
     # Each point's profiles: the union at d and d +- d_step (inverted intervals stay empty).
     order = np.argsort(d, kind="stable")          # points of like distance share their bands in a chunk
     d, alpha, elev = d[order], alpha[order], elev[order]
-    counts = np.zeros((r, r * r), dtype=np.float32)
+    marked = np.zeros((r, r * r), dtype=bool)
     step2 = float(model.q2[1] - model.q2[0]) if C > 1 else 1.0
     step3 = float(model.q3[1] - model.q3[0]) if len(model.q3) > 1 else 0.0
     half1 = model.q1_step / 2
@@ -235,8 +247,13 @@ def learned_map(model: LearnedModel, points: FloatArray, grid: CSpaceGrid) -> CS
                 continue
             in_q23 = (q3g[None, None, :] >= lo3[keep][:, :, None] - step3 / 2) & \
                 (q3g[None, None, :] <= hi3[keep][:, :, None] + step3 / 2)
-            counts += in_q1[keep].T.astype(np.float32) @ in_q23.reshape(-1, r * r).astype(np.float32)
-    blocked = (counts > 0).reshape(r, r, r)
+            flat = in_q23.reshape(-1, r * r)
+            in_q1 = in_q1[keep]
+            # Each q1 cell the band reaches: the union of its points' (q2, q3) sets (a band covers a
+            # few q1 cells, so this is a few passes over the points rather than r).
+            for i in np.flatnonzero(in_q1.any(axis=0)):
+                marked[i] |= flat[in_q1[:, i]].any(axis=0)
+    blocked = marked.reshape(r, r, r)
     return CSpaceMap(grid=grid, obstacle=blocked, self_contact=np.zeros_like(blocked), method="learned",
                      cpu_seconds=time.process_time() - c0, wall_seconds=time.perf_counter() - w0, checks=0)
 

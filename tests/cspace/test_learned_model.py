@@ -51,6 +51,16 @@ def test_triangular_basis_is_a_partition_of_unity_exact_at_its_centres() -> None
     np.testing.assert_allclose(_basis(np.array([0.4]), centres)[0], [0, 0.5, 0.5, 0], atol=1e-12)
 
 
+def test_the_models_profiles_are_the_networks_output(small) -> None:  # type: ignore[no-untyped-def]
+    model = small[4]
+    d = np.concatenate([np.linspace(-0.2, model.d_max + 0.3, 257), model.centres])
+    lo, hi = model.profiles(d)
+    full = _basis(d, model.centres) @ model.weights
+    B, C = len(model.bands) - 1, len(model.q2)
+    np.testing.assert_allclose(lo.reshape(len(d), -1), full[:, :B * C], atol=1e-12)
+    np.testing.assert_allclose(hi.reshape(len(d), -1), full[:, B * C:], atol=1e-12)
+
+
 def test_network_grows_until_every_profile_fits() -> None:
     d = np.linspace(0.0, 3.0, 31)
     targets = np.stack([np.sin(3 * d), np.where(d > 1.5, 1.0, -1.0)], axis=1)    # smooth, and a jump
