@@ -9,7 +9,7 @@ from __future__ import annotations
 import hashlib
 import math
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import (
@@ -231,6 +231,7 @@ class PlannerFile(_Strict):
     speed: Annotated[float, Field(gt=0, le=1)] = 1.0
     tcp_speed: Annotated[float, Field(gt=0, le=2)] = 0.5
     detour_speed: Annotated[float, Field(gt=0, le=1)] = 1.0
+    detours: Literal["roadmap", "cspace", "both"] = "roadmap"
 
 
 class CellFile(_Strict):
@@ -292,7 +293,7 @@ def load_cell(path: str | Path) -> CellSpec:
             interlock_distance=parsed.process.interlock_distance,
         ),
         planner=PlannerSpec(seed=parsed.planner.seed, speed=parsed.planner.speed, tcp_speed=parsed.planner.tcp_speed,
-                            detour_speed=parsed.planner.detour_speed),
+                            detour_speed=parsed.planner.detour_speed, detours=parsed.planner.detours),
         dynamic=tuple(_object(o, path, f"dynamic[{i}]") for i, o in enumerate(parsed.dynamic)),
         digest=digest,
     )

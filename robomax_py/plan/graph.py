@@ -14,6 +14,7 @@ import numpy as np
 
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.plan.candidates import SpotCandidates
+from robomax_py.plan.cspace_detour import grid_detour
 from robomax_py.plan.results import PlanOptions, Progress, Transition, _no_progress
 from robomax_py.plan.roadmap import Detour, Roadmap
 from robomax_py.plan.sequence import (
@@ -472,6 +473,26 @@ class Sequencer:
         self.checks += checks
         return None
 
+    def _searched_detour(self, qa: FloatArray, qb: FloatArray) -> Detour | None:
+        """The roadmap's detour, the local C-space map's, or the faster of both (`planner.detours`)."""
+        kind = self.options.detours or "roadmap"
+        found: list[Detour] = []
+        if kind in ("roadmap", "both"):
+            det = self.roadmap.query(qa, qb)
+            if det is not None:
+                found.append(det)
+        if kind in ("cspace", "both"):
+            det, spent = grid_detour(self.world, self.limits, qa, qb)
+            if det is None:
+                self.checks += spent           # a found detour's checks are counted with it
+            else:
+                found.append(det)
+        if not found:
+            return None
+        best = min(found, key=lambda d: d.time_estimate)
+        self.checks += sum(d.checks for d in found if d is not best)
+        return best
+
     def _back_direction(self, idx: int, col: int) -> FloatArray:
         """Unit vector (base frame) from the spot to its approach point: away from the part."""
         c = self.spots[idx]
@@ -481,7 +502,7 @@ class Sequencer:
 
     def _new_detour(self, i: int, a: int, j: int, b: int) -> None:
         # Lift first: on clamp cells it is found in ~1,000 checks; the roadmap is the general fallback.
-        det = self._lift_detour(i, a, j, b) or self.roadmap.query(self.q(i)[a], self.q(j)[b])
+        det = self._lift_detour(i, a, j, b) or self._searched_detour(self.q(i)[a], self.q(j)[b])
         if det is None:
             # No way found for this exact pair: make sure the optimiser stops choosing it.
             self.no_way.setdefault((i, j), set()).add((a, b))

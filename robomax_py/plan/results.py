@@ -33,6 +33,7 @@ class PlanOptions:
     speed: float | None = None       # global override in (0, 1] of every programmed speed
     tcp_speed: float | None = None   # m/s on approach and retract lines (before the override)
     detour_speed: float | None = None  # speed fraction of detour moves (before the override)
+    detours: str | None = None       # "roadmap", "cspace" or "both"; None takes the cell's planner.detours
     roadmap_nodes: int = 600
     roadmap_k: int = 12
     straight_tries: int = 12         # blocked straight moves between two spots before detours only
@@ -138,6 +139,7 @@ def resolved_options(cell: CellSpec, options: PlanOptions) -> PlanOptions:
         speed=p.speed if options.speed is None else options.speed,
         tcp_speed=p.tcp_speed if options.tcp_speed is None else options.tcp_speed,
         detour_speed=p.detour_speed if options.detour_speed is None else options.detour_speed,
+        detours=p.detours if options.detours is None else options.detours,
     )
 
 
