@@ -160,7 +160,7 @@ class PlannerSpec:
     speed: float = 1.0            # override of every programmed speed, fraction in (0, 1]
     tcp_speed: float = 0.5        # m/s on the LIN approach and retract lines
     detour_speed: float = 1.0     # speed fraction of PTP moves through detours (near clamps)
-    detours: str = "roadmap"      # where detours are searched: "roadmap", "cspace" (local A1-A3 map) or "both"
+    detours: str = "both"         # where detours are searched: "roadmap", "cspace" (local A1-A3 map) or "both"
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -297,6 +297,7 @@ def cspace(
     as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable summary")] = False,
     learned: Annotated[bool, typer.Option("--learned", help="also the map of the learned point model (trained once per robot, tool and wrist, then cached), compared with the exact one cell by cell")] = False,
     spacing: Annotated[float, typer.Option("--spacing", min=0.005, max=1.0, help="m between the object surface points of the learned map")] = 0.1,
+    plot_model: Annotated[Path | None, typer.Option("--plot-model", help="with --learned: write a PNG of one point's C-obstacle at three distances")] = None,
     inflation: Annotated[float, typer.Option("--inflation", min=0.0, max=1.0, help="m added to the learned model's sphere radius (safety; 0.06 gave no wrongly free cell on the reference cell)")] = 0.06,
 ) -> None:
     """The A1-A3 configuration-space map of a cell with the wrist fixed, every cell checked exactly
@@ -320,7 +321,15 @@ def cspace(
         if learned:
             from robomax_py.app.cspace_view import learned_summary
 
-            summary.update(learned_summary(spec, robot, m, spacing, inflation))
+            figures, model = learned_summary(spec, robot, m, spacing, inflation)
+            summary.update(figures)
+            if plot_model is not None:
+                from robomax_py.app.cspace_view import model_png
+
+                reach = model.d_max
+                write_atomic_bytes(plot_model, model_png(model, (0.3 * reach, 0.5 * reach, 0.7 * reach),
+                                                         f"{robot.name} + {spec.tool.name}: a point's C-obstacle"))
+                summary["plot_model"] = str(plot_model)
         if png is not None and plot is not None:
             write_atomic_bytes(plot, png)
             summary["plot"] = str(plot)

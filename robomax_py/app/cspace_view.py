@@ -10,6 +10,7 @@ from robomax_py._typing import FloatArray
 from robomax_py.cspace import (
     CSpaceError,
     CSpaceMap,
+    LearnedModel,
     TrainingSettings,
     cover_radius,
     learned_map,
@@ -69,8 +70,8 @@ def map_summary(m: CSpaceMap) -> dict[str, object]:
 
 
 def learned_summary(cell: CellSpec, robot: RobotModel, exact: CSpaceMap, spacing: float,
-                    inflation: float) -> dict[str, object]:
-    """The learned map on the exact map's grid, and how it differs from it cell by cell."""
+                    inflation: float) -> tuple[dict[str, object], LearnedModel]:
+    """The learned map on the exact map's grid, how it differs from it cell by cell, and the model."""
     radius = cell.process.clearance + cover_radius(spacing) + inflation
     model, cached = learned_model(cell, robot, exact.grid.wrist, radius, TrainingSettings())
     points = surface_points(build_scene(cell, robot), spacing)
@@ -84,7 +85,7 @@ def learned_summary(cell: CellSpec, robot: RobotModel, exact: CSpaceMap, spacing
         "learned_cpu_s": round(m.cpu_seconds, 3),
         "training": "cached" if cached else f"{model.train_cpu_seconds:.1f} s CPU, {model.train_checks:,} checks",
         "training_neurons": int(len(model.centres)),
-    }
+    }, model
 
 
 def map_png(m: CSpaceMap, title: str) -> bytes:
@@ -105,6 +106,35 @@ def map_png(m: CSpaceMap, title: str) -> bytes:
         ax.scatter(q[0], q[1], q[2], s=2, c=colour, alpha=0.35, depthshade=False, label=f"{label} ({int(mask.sum()):,})")
     ax.set_xlabel("A1 (deg)")
     ax.set_ylabel("A2 (deg)")
+    ax.set_zlabel("A3 (deg)")
+    ax.set_title(title)
+    ax.legend(loc="upper left", fontsize="small")
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=DPI)
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def model_png(model: LearnedModel, distances: tuple[float, ...], title: str) -> bytes:
+    """The paper's picture of the learned model: a point obstacle's C-obstacle over (q1 - azimuth,
+    q2 - elevation, q3) in degrees at a few distances from the virtual base, one colour each."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(8, 7), dpi=DPI)
+    ax = fig.add_subplot(projection="3d")
+    lo, hi = model.profiles(np.asarray(distances, dtype=float))            # (m, B, C)
+    mids = np.degrees((model.bands[:-1] + model.bands[1:]) / 2)
+    q3 = model.q3
+    colours = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
+    for n, d in enumerate(distances):
+        b, c, k = np.nonzero((q3[None, None, :] >= lo[n][:, :, None]) & (q3[None, None, :] <= hi[n][:, :, None]))
+        ax.scatter(mids[b], np.degrees(model.q2[c]), np.degrees(q3[k]), s=2, alpha=0.4, depthshade=False,
+                   c=colours[n % len(colours)], label=f"d = {d:.2f} m ({len(b):,} cells)")
+    ax.set_xlabel("A1 - azimuth (deg, band centre)")
+    ax.set_ylabel("A2 - elevation (deg)")
     ax.set_zlabel("A3 (deg)")
     ax.set_title(title)
     ax.legend(loc="upper left", fontsize="small")

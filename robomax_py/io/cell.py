@@ -231,7 +231,7 @@ class PlannerFile(_Strict):
     speed: Annotated[float, Field(gt=0, le=1)] = 1.0
     tcp_speed: Annotated[float, Field(gt=0, le=2)] = 0.5
     detour_speed: Annotated[float, Field(gt=0, le=1)] = 1.0
-    detours: Literal["roadmap", "cspace", "both"] = "roadmap"
+    detours: Literal["roadmap", "cspace", "both"] = "both"
 
 
 class CellFile(_Strict):

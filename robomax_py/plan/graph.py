@@ -475,7 +475,7 @@ class Sequencer:
 
     def _searched_detour(self, qa: FloatArray, qb: FloatArray) -> Detour | None:
         """The roadmap's detour, the local C-space map's, or the faster of both (`planner.detours`)."""
-        kind = self.options.detours or "roadmap"
+        kind = self.options.detours or "both"
         found: list[Detour] = []
         if kind in ("roadmap", "both"):
             det = self.roadmap.query(qa, qb)
