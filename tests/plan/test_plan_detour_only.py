@@ -67,7 +67,9 @@ def _setup(tmp_path: Path, write_small_cell: SmallCell) -> tuple[CellSpec, Any, 
 
 
 def _sequencer(cell: CellSpec, robot: Any, world: Any, spots: list[SpotCandidates], rounds: int) -> _Sequencer:
-    seq = _Sequencer(cell, robot, world, _NoRoadmap(), spots, resolved_options(cell, PlanOptions(max_rounds=rounds)),  # type: ignore[arg-type]
+    # No detour of any kind: no roadmap, no local C-space map (detours: roadmap), no lift below.
+    options = resolved_options(cell, PlanOptions(max_rounds=rounds, detours="roadmap"))
+    seq = _Sequencer(cell, robot, world, _NoRoadmap(), spots, options,  # type: ignore[arg-type]
                      np.random.default_rng(0))
     seq._lift_detour = lambda i, a, j, b: None  # type: ignore[method-assign]   # no way over the "clamp"
     return seq
