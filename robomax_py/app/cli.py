@@ -297,6 +297,7 @@ def cspace(
     as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable summary")] = False,
     learned: Annotated[bool, typer.Option("--learned", help="also the map of the learned point model (trained once per robot, tool and wrist, then cached), compared with the exact one cell by cell")] = False,
     spacing: Annotated[float, typer.Option("--spacing", min=0.005, max=1.0, help="m between the object surface points of the learned map")] = 0.1,
+    program: Annotated[Path | None, typer.Option("--program", help="with --plot: draw this trajectory file's A1-A3 path (a .json from plan) over the map")] = None,
     plot_model: Annotated[Path | None, typer.Option("--plot-model", help="with --learned: write a PNG of one point's C-obstacle at three distances")] = None,
     inflation: Annotated[float, typer.Option("--inflation", min=0.0, max=1.0, help="m added to the learned model's sphere radius (safety; 0.06 gave no wrongly free cell on the reference cell)")] = 0.06,
 ) -> None:
@@ -305,6 +306,8 @@ def cspace(
 
     def run() -> None:
         import json as _json
+
+        import numpy as np
 
         from robomax_py.app.cspace_view import map_png, map_summary, spot_wrist
         from robomax_py.cspace import build_map, check_arm, default_workers
@@ -316,7 +319,12 @@ def cspace(
         check_arm(robot)
         values = "home" if wrist == "home" else spot_wrist(spec, robot, wrist)
         m = build_map(spec, robot, values, resolution, jobs or default_workers())
-        png = map_png(m, f"{spec.name} ({robot.name}): C-space, wrist {wrist}, {resolution}^3") if plot else None
+        path = None
+        if program is not None:
+            from robomax_py.export.trajectory_json import load_trajectory_file
+
+            path = np.asarray(load_trajectory_file(program, robot)["q"], dtype=float)
+        png = map_png(m, f"{spec.name} ({robot.name}): C-space, wrist {wrist}, {resolution}^3", path) if plot else None
         summary = {"cell": spec.name, "robot": robot.name, "wrist": wrist, **map_summary(m)}
         if learned:
             from robomax_py.app.cspace_view import learned_summary

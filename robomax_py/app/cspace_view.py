@@ -88,8 +88,10 @@ def learned_summary(cell: CellSpec, robot: RobotModel, exact: CSpaceMap, spacing
     }, model
 
 
-def map_png(m: CSpaceMap, title: str) -> bytes:
-    """A 3-D scatter of the blocked cells (objects red, the arm itself grey) over A1-A3 in degrees."""
+def map_png(m: CSpaceMap, title: str, path: FloatArray | None = None) -> bytes:
+    """A 3-D scatter of the blocked cells (objects red, the arm itself grey) over A1-A3 in degrees,
+    and a program's path (its A1-A3 samples, (k, 3) rad) as a line when given. The map holds for its
+    fixed wrist; the path's wrist moves, so the line is the path's shadow on the map, not a proof."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -104,6 +106,10 @@ def map_png(m: CSpaceMap, title: str) -> bytes:
             idx = idx[np.sort(rng.choice(len(idx), MAX_POINTS, replace=False))]
         q = [np.degrees(m.grid.axes[a][idx[:, a]]) for a in range(3)]
         ax.scatter(q[0], q[1], q[2], s=2, c=colour, alpha=0.35, depthshade=False, label=f"{label} ({int(mask.sum()):,})")
+    if path is not None and len(path):
+        deg = np.degrees(np.asarray(path, dtype=float)[:, :3])
+        ax.plot(deg[:, 0], deg[:, 1], deg[:, 2], color="#1f77b4", linewidth=1.5, label="program")
+        ax.scatter(deg[[0, -1], 0], deg[[0, -1], 1], deg[[0, -1], 2], color="#1f77b4", s=25)
     ax.set_xlabel("A1 (deg)")
     ax.set_ylabel("A2 (deg)")
     ax.set_zlabel("A3 (deg)")

@@ -104,8 +104,16 @@ def test_cli_writes_the_picture_and_refuses_bad_requests(small, tmp_path: Path) 
     assert '"cells": 1000' in result.output and '"method": "exact"' in result.output
     result = runner.invoke(app, ["cspace", str(path), "--wrist", "s7", "--resolution", "6", "-j", "1"])
     assert result.exit_code == EXIT_OK, result.output
+    planned = runner.invoke(app, ["plan", str(path), "-o", str(tmp_path / "prog")])
+    assert planned.exit_code == EXIT_OK, planned.output
+    with_path = tmp_path / "with_path.png"
+    result = runner.invoke(app, ["cspace", str(path), "--resolution", "8", "-j", "1", "--plot", str(with_path),
+                                 "--program", str(tmp_path / "prog" / "small.json")])
+    assert result.exit_code == EXIT_OK, result.output
+    assert with_path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     for args, message in ((["--resolution", "3"], "resolution must be 4..400"),
-                          (["--wrist", "nope"], "no spot named 'nope'")):
+                          (["--wrist", "nope"], "no spot named 'nope'"),
+                          (["--program", str(tmp_path / "missing.json")], "program file not found")):
         bad = tmp_path / "bad.png"
         result = runner.invoke(app, ["cspace", str(path), *args, "--plot", str(bad)])
         assert result.exit_code == EXIT_BAD_INPUT, result.output
