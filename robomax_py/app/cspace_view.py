@@ -22,6 +22,7 @@ from robomax_py.robot import RobotModel
 from robomax_py.robot.solve import solve_all
 from robomax_py.spec import CellSpec
 from robomax_py.transforms import invert
+from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.scene import build_scene
 
 DPI = 100
@@ -29,7 +30,8 @@ MAX_POINTS = 60_000          # blocked cells drawn at most (an even subsample be
 
 
 def spot_wrist(cell: CellSpec, robot: RobotModel, name: str) -> FloatArray:
-    """A4-A6 (rad) of the spot's first IK branch within the limits at its nominal orientation.
+    """A4-A6 (rad) of the spot's first collision-free IK branch within the limits at its nominal
+    orientation.
 
     `name` is "seam/spot" or a spot name that only one seam has."""
     matches = [(seam, spot) for seam in cell.seams for spot in seam.spots
@@ -48,7 +50,13 @@ def spot_wrist(cell: CellSpec, robot: RobotModel, name: str) -> FloatArray:
     if not len(valid):
         raise CSpaceError(f"{cell.source}: --wrist: spot {name} has no IK solution within {robot.name}'s limits at "
                           "its nominal orientation")
-    return np.asarray(table.q[0, valid[0], 3:], dtype=float)
+    # The first branch the arm can weld in: a wrist that folds the gun into the arm blocks every cell.
+    world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+    for column in valid:
+        q = np.asarray(table.q[0, column], dtype=float)
+        if world.is_free(q):
+            return q[3:]
+    raise CSpaceError(f"{cell.source}: --wrist: every IK branch of spot {name} at its nominal orientation collides")
 
 
 def map_summary(m: CSpaceMap) -> dict[str, object]:
