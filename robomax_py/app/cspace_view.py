@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+from typing import Any
 
 import numpy as np
 
@@ -100,13 +101,7 @@ def map_png(m: CSpaceMap, title: str, path: FloatArray | None = None) -> bytes:
     """A 3-D scatter of the blocked cells (objects red, the arm itself grey) over A1-A3 in degrees,
     and a program's path (its A1-A3 samples, (k, 3) rad) as a line when given. The map holds for its
     fixed wrist; the path's wrist moves, so the line is the path's shadow on the map, not a proof."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig = plt.figure(figsize=(8, 7), dpi=DPI)
-    ax = fig.add_subplot(projection="3d")
+    fig, ax = _axes3d()
     rng = np.random.default_rng(0)
     for mask, colour, label in ((m.obstacle, "#d62728", "objects"), (m.self_contact & ~m.obstacle, "#7f7f7f", "itself")):
         idx = np.argwhere(mask)
@@ -118,27 +113,13 @@ def map_png(m: CSpaceMap, title: str, path: FloatArray | None = None) -> bytes:
         deg = np.degrees(np.asarray(path, dtype=float)[:, :3])
         ax.plot(deg[:, 0], deg[:, 1], deg[:, 2], color="#1f77b4", linewidth=1.5, label="program")
         ax.scatter(deg[[0, -1], 0], deg[[0, -1], 1], deg[[0, -1], 2], color="#1f77b4", s=25)
-    ax.set_xlabel("A1 (deg)")
-    ax.set_ylabel("A2 (deg)")
-    ax.set_zlabel("A3 (deg)")
-    ax.set_title(title)
-    ax.legend(loc="upper left", fontsize="small")
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=DPI)
-    plt.close(fig)
-    return buf.getvalue()
+    return _png(fig, ax, ("A1 (deg)", "A2 (deg)", "A3 (deg)"), title)
 
 
 def model_png(model: LearnedModel, distances: tuple[float, ...], title: str) -> bytes:
     """The paper's picture of the learned model: a point obstacle's C-obstacle over (q1 - azimuth,
     q2 - elevation, q3) in degrees at a few distances from the virtual base, one colour each."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig = plt.figure(figsize=(8, 7), dpi=DPI)
-    ax = fig.add_subplot(projection="3d")
+    fig, ax = _axes3d()
     lo, hi = model.profiles(np.asarray(distances, dtype=float))            # (m, B, C)
     mids = np.degrees((model.bands[:-1] + model.bands[1:]) / 2)
     q3 = model.q3
@@ -147,9 +128,25 @@ def model_png(model: LearnedModel, distances: tuple[float, ...], title: str) -> 
         b, c, k = np.nonzero((q3[None, None, :] >= lo[n][:, :, None]) & (q3[None, None, :] <= hi[n][:, :, None]))
         ax.scatter(mids[b], np.degrees(model.q2[c]), np.degrees(q3[k]), s=2, alpha=0.4, depthshade=False,
                    c=colours[n % len(colours)], label=f"d = {d:.2f} m ({len(b):,} cells)")
-    ax.set_xlabel("A1 - azimuth (deg, band centre)")
-    ax.set_ylabel("A2 - elevation (deg)")
-    ax.set_zlabel("A3 (deg)")
+    return _png(fig, ax, ("A1 - azimuth (deg, band centre)", "A2 - elevation (deg)", "A3 (deg)"), title)
+
+
+def _axes3d() -> tuple[Any, Any]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(8, 7), dpi=DPI)
+    return fig, fig.add_subplot(projection="3d")
+
+
+def _png(fig: Any, ax: Any, labels: tuple[str, str, str], title: str) -> bytes:
+    import matplotlib.pyplot as plt
+
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])
+    ax.set_zlabel(labels[2])
     ax.set_title(title)
     ax.legend(loc="upper left", fontsize="small")
     buf = io.BytesIO()
