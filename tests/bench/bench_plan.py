@@ -42,7 +42,7 @@ def cpu() -> float:
 
 
 def grid_detour(world: CollisionWorld, q_start: np.ndarray, q_goal: np.ndarray, lower: np.ndarray,
-                upper: np.ndarray, r: int) -> tuple[int, float, bool, int]:
+                upper: np.ndarray, r: int, learned: object = None) -> tuple[int, float, bool, int, bool]:
     """The published method: test every cell of an r^3 grid over A1-A3, then search the free cells.
 
     The grid spans the start/goal box widened by 0.5 rad on A1-A3 (within limits); the wrist joints
@@ -59,9 +59,21 @@ def grid_detour(world: CollisionWorld, q_start: np.ndarray, q_goal: np.ndarray, 
     wrist = q_start[3:] + frac[:, None] * (q_goal[3:] - q_start[3:])
     qs = np.hstack([g, wrist])
     free = np.zeros(len(qs), dtype=bool)
-    for k in range(0, len(qs), 4096):
-        free[k:k + 4096] = world.are_free(qs[k:k + 4096])
-    tests = len(qs)
+    if learned is None:
+        for k in range(0, len(qs), 4096):
+            free[k:k + 4096] = world.are_free(qs[k:k + 4096])
+        tests = len(qs)
+    else:
+        # The learned model's map holds for one wrist (the start's): no check at all, then the
+        # path is swept-checked with the wrist interpolated, like the exact map's.
+        from robomax_py.cspace import CSpaceGrid, learned_map
+        model, points = learned
+        blocked = learned_map(model, points, CSpaceGrid(axes=tuple(axes), wrist=q_start[3:])).blocked  # type: ignore[arg-type]
+        free = ~blocked.reshape(-1)
+        world_self = world.restricted(obstacles=False, self_pairs=True)
+        for k in range(0, len(qs), 4096):          # self contact is not the model's: checked exactly
+            free[k:k + 4096] &= world_self.are_free(qs[k:k + 4096])
+        tests = len(qs)
 
     def cell_of(q: np.ndarray) -> tuple[int, int, int]:
         return tuple(int(np.argmin(np.abs(axes[k] - q[k]))) for k in range(3))  # type: ignore[return-value]
@@ -101,6 +113,7 @@ def main() -> None:
     parser.add_argument("cell", nargs="?", default=str(REFERENCE_CELL))
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--resolutions", default="20,50,100")
+    parser.add_argument("--learned", action="store_true", help="also the detour through the learned map (trains once)")
     args = parser.parse_args()
 
     cell = load_cell(args.cell)
@@ -136,6 +149,16 @@ def main() -> None:
     q5, q6 = by_name["s5"].q_app, by_name["s6"].q_app
     world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
     straight = world.check_segment(q5, q6)
+    learned = None
+    if args.learned:
+        from robomax_py.cspace import cover_radius, learned_model, surface_points
+
+        t0 = cpu()
+        radius = cell.process.clearance + cover_radius(0.1) + 0.06
+        model, cached = learned_model(cell, robot, q5[3:], radius)
+        learned = (model, surface_points(build_scene(cell, robot), 0.1))
+        print(f"\nlearned model for the wrist at s5: {'from the cache' if cached else 'trained'} in {cpu() - t0:.1f} s CPU "
+              f"({model.train_checks:,} training checks, {len(model.centres)} neurons)")
     print(f"\ndetour s5 -> s6 (straight move free: {straight.free}, {straight.checks} checks to find out)")
     print(f"{'method':34s} {'tests':>10s} {'seconds':>9s}  result")
     for r in (int(x) for x in args.resolutions.split(",")):
@@ -145,6 +168,12 @@ def main() -> None:
         print(f"{'C-space grid here, resolution ' + str(r):34s} {tests:>10,} {seconds:>9.2f}  "
               + (f"path of {length} steps; swept 2 mm check: {'free' if sweep_free else 'BLOCKED (grid too coarse)'}"
                  if found else "no path"))
+        if learned is not None:
+            tests, seconds, found, length, sweep_free = grid_detour(
+                world, q5, q6, robot.limits.lower, robot.limits.upper, r, learned)
+            print(f"{'learned map, resolution ' + str(r):34s} {tests:>10,} {seconds:>9.2f}  "
+                  + (f"path of {length} steps; swept 2 mm check: {'free' if sweep_free else 'BLOCKED'}"
+                     if found else "no path") + " (tests: self contact only; objects from the model)")
     rng = np.random.default_rng(cell.planner.seed)
     seq = _Sequencer.__new__(_Sequencer)  # only for its lift detour, on the same world
     seq.cell, seq.robot, seq.world, seq.limits, seq.checks = cell, robot, world, robot.limits, 0
@@ -166,6 +195,12 @@ def main() -> None:
     det = roadmap.query(q5, q6)
     print(f"{'lazy roadmap (600 nodes), ours':34s} {roadmap.sampling_checks + roadmap.edge_checks:>10,} "
           f"{cpu() - t0:>9.3f}  {'found, ' + str(len(det.waypoints)) + ' waypoints' if det else 'none'}")
+    from robomax_py.plan.cspace_detour import grid_detour as local_map_detour
+
+    t0 = cpu()
+    det, spent = local_map_detour(world, robot.limits, q5, q6)
+    print(f"{'local C-space map (24^3), ours':34s} {spent:>10,} {cpu() - t0:>9.3f}  "
+          f"{'found, ' + str(len(det.waypoints)) + ' waypoints' if det else 'none'}")
 
 
 if __name__ == "__main__":
