@@ -1,0 +1,133 @@
+"""Voxel free space of a cell's static objects, refined adaptively (an octree), for searches of the
+TCP's path in the work space (issue 20's first part; not used by the planner yet).
+
+The root is a cube over the given bounds. A node whose box is farther than `inflation` from every
+static object is a free leaf; a node within `inflation` of one is split into its eight octants
+until its edge would fall below `precision`, and is then a blocked leaf. So free space near the
+objects is resolved to `precision` and far from them in large boxes, and a free leaf is provably
+free: coal decides "within `inflation`" exactly (a box against each object piece with that
+security margin), after an AABB test in numpy that only skips pieces whose inflated AABB the node
+misses. A node inside a convex piece (a box, a convex part) is a blocked leaf at once, so the
+inside of a table is not refined. Blocked leaves are conservative: a leaf at the precision limit
+that touches the inflated object counts as blocked even where most of it is free. Dynamic objects are left out (their time
+windows are for the search to weigh).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import coal
+import numpy as np
+
+from scipy.spatial import ConvexHull
+
+from robomax_py._typing import BoolArray, FloatArray
+from robomax_py.world.bounds import support_points
+from robomax_py.world.scene import Scene
+
+
+@dataclass(frozen=True, slots=True)
+class VoxelMap:
+    """Leaves of the octree: lower corners (L, 3) m, edges (L,) m and whether each is free."""
+
+    corner: FloatArray
+    edge: FloatArray
+    free: BoolArray
+    precision: float
+    inflation: float
+    coal_tests: int
+
+    def leaf_of(self, points: FloatArray) -> np.ndarray:
+        """(P,) index of the leaf holding each point (base frame, m); -1 outside the root."""
+        p = np.asarray(points, dtype=float).reshape(-1, 3)
+        out = np.full(len(p), -1, dtype=np.int64)
+        for start in range(0, len(p), 4096):
+            chunk = p[start:start + 4096]
+            inside = np.all((chunk[:, None, :] >= self.corner[None]) &
+                            (chunk[:, None, :] < self.corner[None] + self.edge[None, :, None]), axis=2)
+            hit = inside.any(axis=1)
+            out[start:start + 4096][hit] = np.argmax(inside[hit], axis=1)
+        return out
+
+    def is_free(self, points: FloatArray) -> BoolArray:
+        """Whether each point lies in a free leaf (outside the root: not free)."""
+        leaf = self.leaf_of(points)
+        return np.where(leaf >= 0, self.free[np.maximum(leaf, 0)], False)
+
+
+def build_voxels(scene: Scene, lo: FloatArray, hi: FloatArray, precision: float, inflation: float = 0.0) -> VoxelMap:
+    """The octree over the cube that holds the box lo..hi (base frame, m)."""
+    if not (math.isfinite(precision) and precision > 0):
+        raise ValueError(f"precision must be a finite length > 0 m, got {precision}")
+    if not (math.isfinite(inflation) and inflation >= 0):
+        raise ValueError(f"inflation must be a finite length >= 0 m, got {inflation}")
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    if not (np.isfinite(lo).all() and np.isfinite(hi).all() and (hi > lo).all()):
+        raise ValueError("the bounds must be finite with hi > lo on every axis")
+    pieces = []
+    solids = []                                # (piece, plane normals (f, 3), offsets (f,)) of convex pieces
+    for obj in scene.obstacles:
+        T = np.asarray(obj.T_base_object, dtype=float)
+        for geom in obj.pieces:
+            pts = support_points(geom) @ T[:3, :3].T + T[:3, 3]
+            if isinstance(geom, (coal.Box, coal.ConvexBase)):
+                # The piece is exactly the hull of these points: a node inside it is blocked whole.
+                hull = ConvexHull(pts)
+                solids.append((len(pieces), hull.equations[:, :3], -hull.equations[:, 3]))
+            pieces.append((geom, coal.Transform3s(T[:3, :3], T[:3, 3]),
+                           pts.min(axis=0) - inflation, pts.max(axis=0) + inflation))
+    box_lo = np.array([p[2] for p in pieces]).reshape(-1, 3)
+    box_hi = np.array([p[3] for p in pieces]).reshape(-1, 3)
+    request = coal.CollisionRequest()
+    request.security_margin = float(inflation)
+    request.enable_contact = True          # coal 3.0.3 misses some overlaps without it (see acm.configure_requests)
+
+    size = float((hi - lo).max())
+    corners = lo[None, :].copy()
+    edges = np.array([size])
+    out_corner, out_edge, out_free = [], [], []
+    tests = 0
+    octants = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], dtype=float)
+    while len(corners):
+        # Pieces whose inflated AABB each node overlaps (numpy); coal for those only.
+        overlap = np.all((corners[:, None, :] <= box_hi[None]) &
+                         (corners[:, None, :] + edges[:, None, None] >= box_lo[None]), axis=2)
+        touching = np.zeros(len(corners), dtype=bool)
+        for n in np.flatnonzero(overlap.any(axis=1)):
+            half = edges[n] / 2
+            node = coal.Box(edges[n], edges[n], edges[n])
+            place = coal.Transform3s(np.eye(3), corners[n] + half)
+            for m in np.flatnonzero(overlap[n]):
+                geom, T, _, _ = pieces[m]
+                tests += 1
+                if coal.collide(node, place, geom, T, request, coal.CollisionResult()):
+                    touching[n] = True
+                    break
+        inside = _inside_a_solid(corners, edges, solids, octants)
+        split = touching & ~inside & (edges / 2 >= precision)
+        leaf = ~split
+        out_corner.append(corners[leaf])
+        out_edge.append(edges[leaf])
+        out_free.append(~touching[leaf])
+        corners = (corners[split][:, None, :] + octants[None] * (edges[split] / 2)[:, None, None]).reshape(-1, 3)
+        edges = np.repeat(edges[split] / 2, 8)
+    return VoxelMap(corner=np.concatenate(out_corner), edge=np.concatenate(out_edge), free=np.concatenate(out_free),
+                    precision=precision, inflation=inflation, coal_tests=tests)
+
+
+def _inside_a_solid(corners: FloatArray, edges: FloatArray, solids: list[tuple[int, FloatArray, FloatArray]],
+                    octants: FloatArray) -> BoolArray:
+    """Whether each node box lies inside one convex piece (all eight corners within its planes)."""
+    out = np.zeros(len(corners), dtype=bool)
+    if not solids or not len(corners):
+        return out
+    pts = corners[:, None, :] + octants[None] * edges[:, None, None]          # (N, 8, 3)
+    for _, normals, offsets in solids:
+        todo = ~out
+        if not todo.any():
+            break
+        side = pts[todo] @ normals.T                                         # (n, 8, f)
+        out[np.flatnonzero(todo)[np.all(side <= offsets - 1e-12, axis=(1, 2))]] = True
+    return out
