@@ -290,7 +290,7 @@ def _reach_from(base: VirtualBase, robot: RobotModel, scene: Scene) -> float:
     for j, placement, geom in pieces:
         if j == 0:
             continue
-        pts = support_points(geom) @ placement[:3, :3].T + placement[:3, 3]
+        pts = support_points(geom, placement)
         reach = max(reach, offsets[j] + float(np.linalg.norm(pts, axis=1).max()))
     return float(np.linalg.norm(o1 - base.origin)) + reach
 

@@ -18,7 +18,7 @@ import numpy as np
 import trimesh
 
 from robomax_py._typing import FloatArray
-from robomax_py.world.bounds import support_points
+from robomax_py.world.bounds import support_points, triangles
 from robomax_py.world.scene import Scene
 
 
@@ -48,9 +48,7 @@ def surface_points(scene: Scene, spacing: float) -> FloatArray:
 
 def _piece_mesh(geom: coal.CollisionGeometry) -> trimesh.Trimesh | None:
     if isinstance(geom, coal.BVHModelBase):
-        tris = np.array([[t[0], t[1], t[2]] for t in (geom.tri_indices(i) for i in range(geom.num_tris))],
-                        dtype=np.int64)
-        return trimesh.Trimesh(np.asarray(geom.vertices(), dtype=float), tris, process=False)
+        return trimesh.Trimesh(support_points(geom), triangles(geom), process=False)
     pts = support_points(geom)
     if not np.isfinite(pts).all():
         return None                       # an unbounded shape (a plane) has no surface to sample

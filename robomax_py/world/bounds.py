@@ -13,18 +13,30 @@ import pinocchio as pin
 from robomax_py._typing import BoolArray, FloatArray
 
 
-def support_points(geom: coal.CollisionGeometry) -> FloatArray:
-    """(m, 3) points in a piece's own frame whose convex hull contains the piece, metres.
+def support_points(geom: coal.CollisionGeometry, pose: FloatArray | None = None) -> FloatArray:
+    """(m, 3) points whose convex hull contains the piece, metres: in the piece's own frame, or in
+    the frame where the piece sits at `pose` (4, 4).
 
     Convex polytope: its vertices; BVH: its vertices; anything else: its local AABB corners.
     """
     if isinstance(geom, coal.ConvexBase):
-        return np.asarray(geom.points(), dtype=float).reshape(-1, 3)
-    if isinstance(geom, coal.BVHModelBase):
-        return np.asarray(geom.vertices(), dtype=float).reshape(-1, 3)
-    geom.computeLocalAABB()
-    lo, hi = np.asarray(geom.aabb_local.min_, dtype=float), np.asarray(geom.aabb_local.max_, dtype=float)
-    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        pts = np.asarray(geom.points(), dtype=float).reshape(-1, 3)
+    elif isinstance(geom, coal.BVHModelBase):
+        pts = np.asarray(geom.vertices(), dtype=float).reshape(-1, 3)
+    else:
+        geom.computeLocalAABB()
+        lo, hi = np.asarray(geom.aabb_local.min_, dtype=float), np.asarray(geom.aabb_local.max_, dtype=float)
+        pts = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    if pose is None:
+        return pts
+    T = np.asarray(pose, dtype=float)
+    return pts @ T[:3, :3].T + T[:3, 3]
+
+
+def triangles(geom: coal.BVHModelBase) -> np.ndarray:
+    """(t, 3) vertex indices of a mesh piece's triangles (into `support_points`' rows)."""
+    return np.array([[t[0], t[1], t[2]] for t in (geom.tri_indices(i) for i in range(geom.num_tris))],
+                    dtype=np.int64).reshape(-1, 3)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -66,8 +78,7 @@ class KinematicBounds:
         if self.prismatic[k]:
             return 1.0
         j = int(geometry_object.parentJoint)
-        placement = geometry_object.placement
-        pts = support_points(geometry_object.geometry) @ np.asarray(placement.rotation).T + np.asarray(placement.translation)
+        pts = support_points(geometry_object.geometry, geometry_object.placement.homogeneous)
         if j == k:
             radial = pts - np.outer(pts @ self.axis[k], self.axis[k])
             return float(np.max(np.linalg.norm(radial, axis=1)))

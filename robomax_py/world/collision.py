@@ -342,11 +342,11 @@ class CollisionWorld:
         out = np.empty(len(qs), dtype=bool)
         s = self._s
         if self._pf is not None:
-            counts, pairs = self._pf.uncleared(qs, self._active)
-            out[:] = counts == 0
-            ends = np.cumsum(counts)
-            for i in np.flatnonzero(counts):
-                out[i] = self._exact(qs[i], pairs[ends[i] - counts[i]:ends[i]])[0]
+            offsets, pairs = self._pf.uncleared(qs, self._active)
+            left = np.diff(offsets)
+            out[:] = left == 0
+            for i in np.flatnonzero(left):
+                out[i] = self._exact(qs[i], pairs[offsets[i]:offsets[i + 1]])[0]
         elif self._manager is not None:
             model, data, manager, callback = s.model, self._data, self._manager, self._callback
             for i in range(len(qs)):
@@ -543,10 +543,9 @@ class CollisionWorld:
         start, chunk = 0, _FIRST_CHUNK
         while start < len(states):
             block = states[start:start + chunk]
-            counts, pairs = self._pf.uncleared(block, self._active)
-            ends = np.cumsum(counts)
-            for i in np.flatnonzero(counts):
-                free, n = self._exact(block[i], pairs[ends[i] - counts[i]:ends[i]])
+            offsets, pairs = self._pf.uncleared(block, self._active)
+            for i in np.flatnonzero(np.diff(offsets)):
+                free, n = self._exact(block[i], pairs[offsets[i]:offsets[i + 1]])
                 tests += n
                 if not free:
                     k = start + int(i)

@@ -35,7 +35,7 @@ import pinocchio as pin
 from numba import njit
 
 from robomax_py._typing import BoolArray, FloatArray, IntArray
-from robomax_py.world.bounds import support_points
+from robomax_py.world.bounds import support_points, triangles
 
 SLACK_M = 1e-6                 # m: a cleared pair's bound exceeds its margin by this (GJK decides to ~1e-9 m)
 _REVOLUTE, _PRISMATIC = 0, 1
@@ -53,7 +53,6 @@ class Prefilter:
 
     floats: FloatArray           # every float table, packed (see `_pack`)
     ints: IntArray               # every integer table and the offsets of both, packed
-    n_pairs: int
 
     @staticmethod
     def of(model: pin.Model, gm: pin.GeometryModel, obstacle: list[bool], pair_a: IntArray, pair_b: IntArray,
@@ -77,15 +76,14 @@ class Prefilter:
         skips: list[list[int]] = []
         for g, obj in enumerate(gm.geometryObjects):
             piece_joint[g] = int(obj.parentJoint)
-            points = support_points(obj.geometry)
-            placed = points @ np.asarray(obj.placement.rotation).T + np.asarray(obj.placement.translation)
+            placed = support_points(obj.geometry, obj.placement.homogeneous)
             if not np.isfinite(placed).all():
                 points_of.append(None)
                 chunks.append([])
                 skips.append([])
                 continue                                      # unbounded shape: never cleared
             points_of.append(placed)
-            nodes, skip = _mesh_chunks(obj.geometry, placed, points) if obstacle[g] else ([], [])
+            nodes, skip = _mesh_chunks(obj.geometry, placed) if obstacle[g] else ([], [])
             chunks.append(nodes)
             skips.append(skip)
             if obstacle[g]:
@@ -145,15 +143,16 @@ class Prefilter:
              block_kind, block_a, block_b, block_end, block_pairs, ch_start, ch_end, ch_skip],
             len(flat),
         )
-        return Prefilter(floats=floats, ints=ints, n_pairs=len(pa))
+        return Prefilter(floats=floats, ints=ints)
 
     def uncleared(self, qs: FloatArray, active: BoolArray) -> tuple[IntArray, IntArray]:
         """For each configuration of qs (k, n), the active pairs it does not clear.
 
-        Returns (counts (k,), pairs): configuration i's pairs are pairs[offsets[i]:offsets[i + 1]]
-        with offsets the running sum of counts, each run in pair order.
+        Returns (offsets (k + 1,), pairs): configuration i's pairs are pairs[offsets[i]:offsets[i + 1]],
+        in pair order.
         """
-        return _uncleared(np.ascontiguousarray(qs, dtype=np.float64), self.floats, self.ints, active)  # type: ignore[no-any-return]
+        counts, pairs = _uncleared(np.ascontiguousarray(qs, dtype=np.float64), self.floats, self.ints, active)
+        return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), pairs
 
     def joint_placements(self, q: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(J, 3, 3) rotations and (J, 3) translations of every joint frame at q (as Pinocchio's oMi)."""
@@ -187,7 +186,7 @@ CHUNK_SIZE_M = 0.12            # an obstacle mesh is covered by chunks about thi
 CHUNK_MIN_TRIANGLES = 64       # meshes with fewer triangles are one chunk
 
 
-def _mesh_chunks(geom: Any, placed: FloatArray, local: FloatArray) -> tuple[list[FloatArray], list[int]]:
+def _mesh_chunks(geom: Any, placed: FloatArray) -> tuple[list[FloatArray], list[int]]:
     """A tree of point sets whose convex hulls cover an obstacle piece, in pre-order, and for each
     node the index just past its subtree (where a traversal goes when the node is cleared).
 
@@ -197,10 +196,9 @@ def _mesh_chunks(geom: Any, placed: FloatArray, local: FloatArray) -> tuple[list
     a node's children together hold its triangles. Anything else (a convex piece, a box) is one
     node: its own points.
     """
-    if not isinstance(geom, coal.BVHModelBase) or geom.num_tris < CHUNK_MIN_TRIANGLES \
-            or len(local) != geom.num_vertices:
+    if not isinstance(geom, coal.BVHModelBase) or geom.num_tris < CHUNK_MIN_TRIANGLES:
         return [placed], [1]
-    tris = np.array([[t[0], t[1], t[2]] for t in (geom.tri_indices(i) for i in range(geom.num_tris))], dtype=np.int64)
+    tris = triangles(geom)
     centroid = placed[tris].mean(axis=1)
     nodes: list[FloatArray] = []
     skip: list[int] = []
@@ -312,26 +310,37 @@ def _forward(q: Any, parent: Any, kind: Any, axis: Any, jrot: Any, jtrans: Any, 
 
 
 @njit(cache=True, nogil=True)
-def _placements(q: Any, F: Any, I: Any) -> Any:
-    J = I[0]
+def _offsets(I: Any) -> Any:
+    """Where each float and each int table starts in the packed buffers (see `_pack`)."""
     fo = I[_N_HEADER:_N_HEADER + _N_FLOAT_TABLES]
     io = I[_N_HEADER + _N_FLOAT_TABLES:_N_HEADER + _N_FLOAT_TABLES + _N_INT_TABLES]
+    return fo, io
+
+
+@njit(cache=True, nogil=True)
+def _chain_tables(F: Any, I: Any) -> Any:
+    """The chain's tables in `_forward`'s argument order: parent, kind, axis, rotation, translation, q index."""
+    J = I[0]
+    fo, io = _offsets(I)
+    return (I[io[0]:io[0] + J], I[io[1]:io[1] + J], F[fo[0]:fo[0] + 3 * J].reshape((J, 3)),
+            F[fo[1]:fo[1] + 9 * J].reshape((J, 3, 3)), F[fo[2]:fo[2] + 3 * J].reshape((J, 3)), I[io[2]:io[2] + J])
+
+
+@njit(cache=True, nogil=True)
+def _placements(q: Any, F: Any, I: Any) -> Any:
+    J = I[0]
+    parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
     rot = np.empty((J, 3, 3))
     trans = np.empty((J, 3))
-    _forward(q, I[io[0]:io[0] + J], I[io[1]:io[1] + J], F[fo[0]:fo[0] + 3 * J].reshape((J, 3)),
-             F[fo[1]:fo[1] + 9 * J].reshape((J, 3, 3)), F[fo[2]:fo[2] + 3 * J].reshape((J, 3)), I[io[2]:io[2] + J],
-             rot, trans)
+    _forward(q, parent, kind, axis, jrot, jtrans, jq, rot, trans)
     return rot, trans
 
 
 @njit(cache=True, nogil=True)
 def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
     J, G, P, NG, NB, C = I[0], I[1], I[2], I[3], I[4], I[5]
-    fo = I[_N_HEADER:_N_HEADER + _N_FLOAT_TABLES]
-    io = I[_N_HEADER + _N_FLOAT_TABLES:_N_HEADER + _N_FLOAT_TABLES + _N_INT_TABLES]
-    axis = F[fo[0]:fo[0] + 3 * J].reshape((J, 3))
-    jrot = F[fo[1]:fo[1] + 9 * J].reshape((J, 3, 3))
-    jtrans = F[fo[2]:fo[2] + 3 * J].reshape((J, 3))
+    fo, io = _offsets(I)
+    parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
     centre = F[fo[3]:fo[3] + 3 * G].reshape((G, 3))
     radius = F[fo[4]:fo[4] + G]
     box_lo = F[fo[5]:fo[5] + 3 * G].reshape((G, 3))
@@ -348,7 +357,6 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
     ch_bc = F[fo[16]:fo[16] + 3 * C].reshape((C, 3))
     ch_br = F[fo[17]:fo[17] + 9 * C].reshape((C, 3, 3))
     ch_h = F[fo[18]:fo[18] + 3 * C].reshape((C, 3))
-    parent, kind, jq = I[io[0]:io[0] + J], I[io[1]:io[1] + J], I[io[2]:io[2] + J]
     piece_joint = I[io[3]:io[3] + G]
     pair_a, pair_b, pair_obstacle = I[io[4]:io[4] + P], I[io[5]:io[5] + P], I[io[6]:io[6] + P]
     group_joint = I[io[7]:io[7] + NG]

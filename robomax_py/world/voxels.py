@@ -71,7 +71,7 @@ def build_voxels(scene: Scene, lo: FloatArray, hi: FloatArray, precision: float,
     for obj in scene.obstacles:
         T = np.asarray(obj.T_base_object, dtype=float)
         for geom in obj.pieces:
-            pts = support_points(geom) @ T[:3, :3].T + T[:3, 3]
+            pts = support_points(geom, T)
             if isinstance(geom, (coal.Box, coal.ConvexBase)):
                 # The piece is exactly the hull of these points: a node inside it is blocked whole.
                 hull = ConvexHull(pts)
