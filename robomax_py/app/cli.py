@@ -311,14 +311,18 @@ def cspace(
 
         from robomax_py.app.cspace_view import map_png, map_summary, spot_wrist
         from robomax_py.cspace import build_map, check_arm, default_workers
+        from robomax_py.world.collision import CollisionWorld
+        from robomax_py.world.scene import build_scene
         from robomax_py.io.cell import load_cell, load_cell_robot
         from robomax_py.io.files import write_atomic_bytes
 
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
         check_arm(robot)
-        values = "home" if wrist == "home" else spot_wrist(spec, robot, wrist)
-        m = build_map(spec, robot, values, resolution, jobs or default_workers())
+        scene = build_scene(spec, robot)             # one world for the wrist's IK check and the map
+        world = CollisionWorld(robot, scene, spec.process.clearance)
+        values = "home" if wrist == "home" else spot_wrist(spec, robot, wrist, world)
+        m = build_map(spec, robot, values, resolution, jobs or default_workers(), world)
         path = None
         if program is not None:
             from robomax_py.export.trajectory_json import load_trajectory_file
@@ -329,7 +333,7 @@ def cspace(
         if learned:
             from robomax_py.app.cspace_view import learned_summary
 
-            figures, model = learned_summary(spec, robot, m, spacing, inflation)
+            figures, model = learned_summary(spec, robot, scene, m, spacing, inflation)
             summary.update(figures)
             if plot_model is not None:
                 from robomax_py.app.cspace_view import model_png

@@ -24,17 +24,17 @@ from robomax_py.robot.solve import solve_all
 from robomax_py.spec import CellSpec
 from robomax_py.transforms import invert
 from robomax_py.world.collision import CollisionWorld
-from robomax_py.world.scene import build_scene
+from robomax_py.world.scene import Scene
 
 DPI = 100
 MAX_POINTS = 60_000          # blocked cells drawn at most (an even subsample beyond)
 
 
-def spot_wrist(cell: CellSpec, robot: RobotModel, name: str) -> FloatArray:
+def spot_wrist(cell: CellSpec, robot: RobotModel, name: str, world: CollisionWorld) -> FloatArray:
     """A4-A6 (rad) of the spot's first collision-free IK branch within the limits at its nominal
     orientation.
 
-    `name` is "seam/spot" or a spot name that only one seam has."""
+    `name` is "seam/spot" or a spot name that only one seam has; `world` is the cell's."""
     matches = [(seam, spot) for seam in cell.seams for spot in seam.spots
                if name in (spot.name, f"{seam.name}/{spot.name}")]
     if not matches:
@@ -52,7 +52,6 @@ def spot_wrist(cell: CellSpec, robot: RobotModel, name: str) -> FloatArray:
         raise CSpaceError(f"{cell.source}: --wrist: spot {name} has no IK solution within {robot.name}'s limits at "
                           "its nominal orientation")
     # The first branch the arm can weld in: a wrist that folds the gun into the arm blocks every cell.
-    world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
     for column in valid:
         q = np.asarray(table.q[0, column], dtype=float)
         if world.is_free(q):
@@ -78,12 +77,12 @@ def map_summary(m: CSpaceMap) -> dict[str, object]:
     }
 
 
-def learned_summary(cell: CellSpec, robot: RobotModel, exact: CSpaceMap, spacing: float,
+def learned_summary(cell: CellSpec, robot: RobotModel, scene: Scene, exact: CSpaceMap, spacing: float,
                     inflation: float) -> tuple[dict[str, object], LearnedModel]:
     """The learned map on the exact map's grid, how it differs from it cell by cell, and the model."""
     radius = cell.process.clearance + cover_radius(spacing) + inflation
     model, cached = learned_model(cell, robot, exact.grid.wrist, radius, TrainingSettings())
-    points = surface_points(build_scene(cell, robot), spacing)
+    points = surface_points(scene, spacing)
     m = learned_map(model, points, exact.grid)
     return {
         "learned_blocked_by_objects": int(m.obstacle.sum()),

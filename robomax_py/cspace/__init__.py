@@ -29,16 +29,18 @@ def build_map(
     wrist: Literal["home"] | FloatArray = "home",
     resolution: int = 50,
     workers: int = 1,
+    world: CollisionWorld | None = None,
 ) -> CSpaceMap:
     """The exact A1-A3 map of `cell` (its clearance applied) with the wrist at home or at the given
-    joint values (rad, joints 4..6). A cell without objects is a CSpaceError: there is nothing to map."""
+    joint values (rad, joints 4..6), in `world` when the caller has built the cell's world already.
+    A cell without objects is a CSpaceError: there is nothing to map."""
     check_arm(robot)
     values = np.asarray(cell.home, dtype=float)[3:] if isinstance(wrist, str) and wrist == "home" else wrist
     grid = CSpaceGrid.of(robot, resolution, np.asarray(values, dtype=float))
-    scene = build_scene(cell, robot)
-    if not (scene.obstacles or scene.dynamic):
+    if not (cell.objects or cell.dynamic):
         raise CSpaceError(f"{cell.source}: objects: the cell has no objects, so its C-space map has no obstacles")
-    world = CollisionWorld(robot, scene, cell.process.clearance)
+    if world is None:
+        world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
     return exact_map(world, grid, workers)
 
 

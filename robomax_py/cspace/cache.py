@@ -13,16 +13,22 @@ import io
 import os
 import tempfile
 import zipfile
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from robomax_py._typing import FloatArray
-from robomax_py.cspace.learned import LearnedModel, TrainingSettings, from_arrays, model_key, to_arrays, train
+from robomax_py.cspace.learned import (
+    LearnedModel,
+    TrainingSettings,
+    from_arrays,
+    model_key,
+    to_arrays,
+    tool_scene,
+    train,
+)
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
-from robomax_py.world.scene import build_scene
 
 CACHE_ENV = "ROBOMAX_CACHE"
 
@@ -41,7 +47,7 @@ def learned_model(
     """The model for the cell's robot and tool with this wrist and sphere radius: from the cache when
     there, else trained and stored. Returns (model, whether it came from the cache)."""
     folder = cache_dir() if folder is None else folder
-    scene0 = build_scene(replace(cell, objects=(), dynamic=()), robot)
+    scene0 = tool_scene(cell, robot)
     key = model_key(robot, scene0, np.asarray(wrist, dtype=float), radius, settings)
     path = folder / f"{key}.npz"
     if path.is_file():
@@ -52,7 +58,7 @@ def learned_model(
             model = None
         if model is not None:
             return model, True
-    model = train(cell, robot, wrist, radius, settings)
+    model = train(scene0, robot, wrist, radius, settings)
     _store(path, model)
     return model, False
 

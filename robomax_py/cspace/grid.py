@@ -53,7 +53,7 @@ class CSpaceGrid:
 
     def cell_of(self, q: FloatArray) -> tuple[int, int, int]:
         """The cell whose sample values are nearest to q's first three joints."""
-        return tuple(int(np.argmin(np.abs(self.axes[a] - q[a]))) for a in range(3))  # type: ignore[return-value]
+        return nearest_cell(self.axes, q)
 
     @staticmethod
     def of(robot: RobotModel, resolution: int, wrist: FloatArray) -> CSpaceGrid:
@@ -68,6 +68,11 @@ class CSpaceGrid:
         lo, hi = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
         axes = tuple(np.linspace(lo[a], hi[a], resolution) for a in range(3))
         return CSpaceGrid(axes=axes, wrist=wrist)  # type: ignore[arg-type]
+
+
+def nearest_cell(axes: tuple[FloatArray, ...] | list[FloatArray], q: FloatArray) -> tuple[int, int, int]:
+    """Indices of the samples of three axes nearest to q's first three values."""
+    return tuple(int(np.argmin(np.abs(axes[a] - q[a]))) for a in range(3))  # type: ignore[return-value]
 
 
 def check_arm(robot: RobotModel) -> None:

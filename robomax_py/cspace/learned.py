@@ -48,6 +48,7 @@ import math
 import time
 from dataclasses import dataclass, replace
 
+import coal
 import numpy as np
 
 from robomax_py._typing import FloatArray
@@ -55,11 +56,11 @@ from robomax_py.cspace.exact import BLOCK, CSpaceMap
 from robomax_py.cspace.grid import CSpaceError, CSpaceGrid, check_arm
 from robomax_py.robot import RobotModel
 from robomax_py.robot.ik._chain import joint_axes_at_zero
-from robomax_py.spec import CellSpec, ObjectSpec, Sphere
+from robomax_py.spec import CellSpec, frozen_array
 from robomax_py.world.acm import CollisionOptions
 from robomax_py.world.bounds import support_points
 from robomax_py.world.collision import CollisionWorld
-from robomax_py.world.scene import Scene, build_scene
+from robomax_py.world.scene import Scene, SceneObject, build_scene
 
 MODEL_VERSION = 3
 CHUNK = 1024                 # points marked at a time
@@ -160,9 +161,15 @@ def model_key(robot: RobotModel, scene: Scene, wrist: FloatArray, radius: float,
     return h.hexdigest()
 
 
-def train(cell: CellSpec, robot: RobotModel, wrist: FloatArray, radius: float,
+def tool_scene(cell: CellSpec, robot: RobotModel) -> Scene:
+    """The cell's scene without its objects: the robot's tool, which is all a model depends on."""
+    return build_scene(replace(cell, objects=(), dynamic=()), robot)
+
+
+def train(scene0: Scene, robot: RobotModel, wrist: FloatArray, radius: float,
           settings: TrainingSettings = TrainingSettings()) -> LearnedModel:
-    """Train the model of `robot` with `cell`'s tool and the wrist fixed (see the module docstring)."""
+    """Train the model of `robot` with the tool of `scene0` (`tool_scene`) and the wrist fixed (see
+    the module docstring)."""
     check_arm(robot)
     c0 = time.process_time()
     wrist = np.asarray(wrist, dtype=float)
@@ -174,7 +181,6 @@ def train(cell: CellSpec, robot: RobotModel, wrist: FloatArray, radius: float,
     # limits widened by that much, or a point below or above V loses the columns past the limits.
     q2 = _axis(lo[1] - math.pi / 2, hi[1] + math.pi / 2, q23_step)
     q3 = _axis(lo[2], hi[2], q23_step)
-    scene0 = build_scene(replace(cell, objects=(), dynamic=()), robot)
     d_max = _reach_from(base, robot, scene0) + radius
     distances = np.arange(0.0, d_max + settings.d_step, settings.d_step)
     grid = CSpaceGrid(axes=(base.q1_sign * dq1, q2, q3), wrist=wrist)   # q1 values in the arm's own sense
@@ -183,7 +189,7 @@ def train(cell: CellSpec, robot: RobotModel, wrist: FloatArray, radius: float,
     band_of = np.minimum(np.searchsorted(bands, dq1, side="right") - 1, n_bands - 1)
     rows, checks = [], 0
     for d in distances:
-        occupied = _occupancy(cell, robot, base, grid, float(d), radius)
+        occupied = _occupancy(scene0, robot, base, grid, float(d), radius)
         checks += occupied.size
         rows.append(_profile(occupied, band_of, n_bands, q3))
     targets = np.array(rows)
@@ -295,15 +301,14 @@ def _reach_from(base: VirtualBase, robot: RobotModel, scene: Scene) -> float:
     return float(np.linalg.norm(o1 - base.origin)) + reach
 
 
-def _occupancy(cell: CellSpec, robot: RobotModel, base: VirtualBase, grid: CSpaceGrid, d: float,
+def _occupancy(scene0: Scene, robot: RobotModel, base: VirtualBase, grid: CSpaceGrid, d: float,
                radius: float) -> np.ndarray:
     """(n1, C, T) bool: the arm touches the sphere of `radius` at (d, 0, 0) from the virtual base."""
-    centre_base = base.origin + np.array([d, 0.0, 0.0])
-    T_world_base = np.asarray(cell.T_world_base, dtype=float)
     pose = np.eye(4)
-    pose[:3, 3] = T_world_base[:3, :3] @ centre_base + T_world_base[:3, 3]
-    probe = ObjectSpec("cspace_probe", Sphere(radius), pose)
-    world = CollisionWorld(robot, build_scene(replace(cell, objects=(probe,), dynamic=()), robot), 0.0,
+    pose[:3, 3] = base.origin + np.array([d, 0.0, 0.0])
+    probe = SceneObject(name="cspace_probe", pieces=(coal.Sphere(radius),), T_base_object=frozen_array(pose),
+                        workpiece=False, representation="primitive")
+    world = CollisionWorld(robot, replace(scene0, obstacles=(probe,), dynamic=()), 0.0,
                            _TRAIN_OPTIONS).restricted(obstacles=True, self_pairs=False)
     out = np.zeros(grid.size, dtype=bool)
     for a in range(0, grid.size, BLOCK):

@@ -20,6 +20,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from robomax_py._typing import FloatArray
+from robomax_py.cspace.grid import nearest_cell
 from robomax_py.plan.roadmap import Detour
 from robomax_py.robot import JointLimits
 from robomax_py.timing import ptp_time_estimate
@@ -35,17 +36,10 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
     """A swept-checked detour from qa to qb through the local A1-A3 map (None when the map has no
     free way or its path does not survive the swept check), and the collision checks spent."""
     qa, qb = np.asarray(qa, dtype=float), np.asarray(qb, dtype=float)
-    lo = np.maximum(np.minimum(qa[:3], qb[:3]) - margin, np.asarray(limits.lower)[:3])
-    hi = np.minimum(np.maximum(qa[:3], qb[:3]) + margin, np.asarray(limits.upper)[:3])
-    axes = [np.linspace(lo[k], hi[k], resolution) for k in range(3)]
-    cells = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    span = qb[:3] - qa[:3]
-    denom = float(span @ span)
-    frac = np.clip((cells - qa[:3]) @ span / denom, 0.0, 1.0) if denom > 1e-12 else np.zeros(len(cells))
-    configs = np.hstack([cells, qa[3:] + frac[:, None] * (qb[3:] - qa[3:])])
+    axes, configs = local_grid(qa, qb, limits.lower, limits.upper, resolution, margin)
     free = world.are_free(configs)
     checks = len(configs)
-    start, goal = (_nearest(axes, q) for q in (qa, qb))
+    start, goal = (nearest_cell(axes, q) for q in (qa, qb))
     r = resolution
     flat = lambda ijk: (ijk[0] * r + ijk[1]) * r + ijk[2]  # noqa: E731 - index arithmetic, used twice
     if not (free[flat(start)] and free[flat(goal)]):
@@ -76,8 +70,19 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
     return Detour(short, float(np.sum(ptp_time_estimate(short[:-1], short[1:], limits))), checks), checks
 
 
-def _nearest(axes: list[FloatArray], q: FloatArray) -> tuple[int, int, int]:
-    return tuple(int(np.argmin(np.abs(axes[k] - q[k]))) for k in range(3))  # type: ignore[return-value]
+def local_grid(qa: FloatArray, qb: FloatArray, lower: FloatArray, upper: FloatArray, resolution: int,
+               margin: float) -> tuple[list[FloatArray], FloatArray]:
+    """The A1-A3 sample values over the box qa and qb span, widened by `margin` within the limits,
+    and every cell's configuration (C order) with the wrist at the cell's projection onto the
+    straight A1-A3 line from qa to qb."""
+    lo = np.maximum(np.minimum(qa[:3], qb[:3]) - margin, np.asarray(lower)[:3])
+    hi = np.minimum(np.maximum(qa[:3], qb[:3]) + margin, np.asarray(upper)[:3])
+    axes = [np.linspace(lo[k], hi[k], resolution) for k in range(3)]
+    cells = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    span = qb[:3] - qa[:3]
+    denom = float(span @ span)
+    frac = np.clip((cells - qa[:3]) @ span / denom, 0.0, 1.0) if denom > 1e-12 else np.zeros(len(cells))
+    return axes, np.hstack([cells, qa[3:] + frac[:, None] * (qb[3:] - qa[3:])])
 
 
 def _shortcut(world: CollisionWorld, waypoints: FloatArray) -> tuple[FloatArray | None, int]:

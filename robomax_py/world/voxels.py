@@ -35,20 +35,34 @@ class VoxelMap:
     corner: FloatArray
     edge: FloatArray
     free: BoolArray
+    level: np.ndarray            # (L,) depth of each leaf: its edge is the root's / 2**level
+    root_corner: FloatArray      # (3,) m
+    root_edge: float             # m
     precision: float
     inflation: float
     coal_tests: int
 
     def leaf_of(self, points: FloatArray) -> np.ndarray:
-        """(P,) index of the leaf holding each point (base frame, m); -1 outside the root."""
+        """(P,) index of the leaf holding each point (base frame, m); -1 outside the root.
+
+        Per depth, the point's cell at that depth is looked up among that depth's leaves (sorted
+        integer keys): a few binary searches a point, not a scan of every leaf."""
         p = np.asarray(points, dtype=float).reshape(-1, 3)
         out = np.full(len(p), -1, dtype=np.int64)
-        for start in range(0, len(p), 4096):
-            chunk = p[start:start + 4096]
-            inside = np.all((chunk[:, None, :] >= self.corner[None]) &
-                            (chunk[:, None, :] < self.corner[None] + self.edge[None, :, None]), axis=2)
-            hit = inside.any(axis=1)
-            out[start:start + 4096][hit] = np.argmax(inside[hit], axis=1)
+        rel = (p - self.root_corner) / self.root_edge                    # in [0, 1) inside the root
+        inside = np.all((rel >= 0.0) & (rel < 1.0), axis=1)
+        for depth in np.unique(self.level):
+            n = 1 << int(depth)
+            leaves = np.flatnonzero(self.level == depth)
+            cells = np.round((self.corner[leaves] - self.root_corner) / self.root_edge * n).astype(np.int64)
+            keys = (cells[:, 0] * n + cells[:, 1]) * n + cells[:, 2]
+            order = np.argsort(keys)
+            keys = keys[order]
+            at = np.minimum((rel * n).astype(np.int64), n - 1)
+            want = (at[:, 0] * n + at[:, 1]) * n + at[:, 2]
+            pos = np.clip(np.searchsorted(keys, want), 0, len(keys) - 1)
+            hit = inside & (out < 0) & (keys[pos] == want)
+            out[hit] = leaves[order[pos[hit]]]
         return out
 
     def is_free(self, points: FloatArray) -> BoolArray:
@@ -87,8 +101,9 @@ def build_voxels(scene: Scene, lo: FloatArray, hi: FloatArray, precision: float,
     size = float((hi - lo).max())
     corners = lo[None, :].copy()
     edges = np.array([size])
-    out_corner, out_edge, out_free = [], [], []
+    out_corner, out_edge, out_free, out_level = [], [], [], []
     tests = 0
+    depth = 0
     octants = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], dtype=float)
     while len(corners):
         # Pieces whose inflated AABB each node overlaps (numpy); coal for those only.
@@ -111,10 +126,13 @@ def build_voxels(scene: Scene, lo: FloatArray, hi: FloatArray, precision: float,
         out_corner.append(corners[leaf])
         out_edge.append(edges[leaf])
         out_free.append(~touching[leaf])
+        out_level.append(np.full(int(leaf.sum()), depth, dtype=np.int64))
+        depth += 1
         corners = (corners[split][:, None, :] + octants[None] * (edges[split] / 2)[:, None, None]).reshape(-1, 3)
         edges = np.repeat(edges[split] / 2, 8)
     return VoxelMap(corner=np.concatenate(out_corner), edge=np.concatenate(out_edge), free=np.concatenate(out_free),
-                    precision=precision, inflation=inflation, coal_tests=tests)
+                    level=np.concatenate(out_level), root_corner=lo, root_edge=size, precision=precision,
+                    inflation=inflation, coal_tests=tests)
 
 
 def _inside_a_solid(corners: FloatArray, edges: FloatArray, solids: list[tuple[int, FloatArray, FloatArray]],

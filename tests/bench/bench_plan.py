@@ -28,6 +28,8 @@ import numpy as np  # noqa: E402
 from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
 from robomax_py.plan import PlanOptions, plan_cell  # noqa: E402
 from robomax_py.plan.graph import Sequencer as _Sequencer
+from robomax_py.cspace.grid import nearest_cell  # noqa: E402
+from robomax_py.plan.cspace_detour import local_grid  # noqa: E402
 from robomax_py.plan.roadmap import Roadmap  # noqa: E402
 from robomax_py.world.collision import CollisionWorld  # noqa: E402
 from robomax_py.world.scene import build_scene  # noqa: E402
@@ -45,19 +47,12 @@ def grid_detour(world: CollisionWorld, q_start: np.ndarray, q_goal: np.ndarray, 
                 upper: np.ndarray, r: int, learned: object = None) -> tuple[int, float, bool, int, bool]:
     """The published method: test every cell of an r^3 grid over A1-A3, then search the free cells.
 
-    The grid spans the start/goal box widened by 0.5 rad on A1-A3 (within limits); the wrist joints
-    follow the straight line from start to goal along the A1 coordinate. Returns (tests, seconds,
-    path found, waypoints).
+    The grid is the planner's local map grid (`plan.cspace_detour.local_grid`): the start/goal box
+    widened by 0.5 rad on A1-A3 (within limits), the wrist interpolated along the straight A1-A3
+    line from start to goal. Returns (tests, seconds, path found, waypoints, swept check free).
     """
     t0 = cpu()
-    lo = np.maximum(np.minimum(q_start[:3], q_goal[:3]) - 0.5, lower[:3])
-    hi = np.minimum(np.maximum(q_start[:3], q_goal[:3]) + 0.5, upper[:3])
-    axes = [np.linspace(lo[k], hi[k], r) for k in range(3)]
-    g = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    span = q_goal[0] - q_start[0]
-    frac = np.clip((g[:, 0] - q_start[0]) / span, 0.0, 1.0) if abs(span) > 1e-9 else np.zeros(len(g))
-    wrist = q_start[3:] + frac[:, None] * (q_goal[3:] - q_start[3:])
-    qs = np.hstack([g, wrist])
+    axes, qs = local_grid(q_start, q_goal, lower, upper, r, 0.5)
     free = np.zeros(len(qs), dtype=bool)
     if learned is None:
         for k in range(0, len(qs), 4096):
@@ -75,11 +70,8 @@ def grid_detour(world: CollisionWorld, q_start: np.ndarray, q_goal: np.ndarray, 
             free[k:k + 4096] &= world_self.are_free(qs[k:k + 4096])
         tests = len(qs)
 
-    def cell_of(q: np.ndarray) -> tuple[int, int, int]:
-        return tuple(int(np.argmin(np.abs(axes[k] - q[k]))) for k in range(3))  # type: ignore[return-value]
-
     free3 = free.reshape(r, r, r)
-    start, goal = cell_of(q_start), cell_of(q_goal)
+    start, goal = nearest_cell(axes, q_start), nearest_cell(axes, q_goal)
     prev = {start: start}
     queue = collections.deque([start])
     steps = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) != (0, 0, 0)]

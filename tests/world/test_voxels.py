@@ -73,3 +73,15 @@ def test_bad_arguments_are_refused(small) -> None:  # type: ignore[no-untyped-de
             build_voxels(scene, LO, HI, **kwargs)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="hi > lo"):
         build_voxels(scene, HI, LO, 0.1)
+
+
+def test_leaf_lookup_equals_a_scan_of_every_leaf(small, rng: np.random.Generator) -> None:  # type: ignore[no-untyped-def]
+    _, v = small
+    root = float((HI - LO).max())
+    points = rng.uniform(LO - 0.3, LO + root + 0.3, size=(2000, 3))       # some outside the root
+    inside = np.all((points[:, None, :] >= v.corner[None]) & (points[:, None, :] < v.corner[None] + v.edge[None, :, None]),
+                    axis=2)
+    assert (inside.sum(axis=1) <= 1).all()                                 # leaves do not overlap
+    scan = np.where(inside.any(axis=1), np.argmax(inside, axis=1), -1)
+    np.testing.assert_array_equal(v.leaf_of(points), scan)
+    assert (scan >= 0).any() and (scan < 0).any()
