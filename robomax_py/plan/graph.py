@@ -475,7 +475,9 @@ class Sequencer:
 
     def _searched_detour(self, qa: FloatArray, qb: FloatArray) -> Detour | None:
         """The roadmap's detour, the local C-space map's, or the faster of both (`planner.detours`)."""
-        kind = self.options.detours or "both"
+        kind = self.options.detours                   # resolved from the cell (`resolved_options`)
+        if kind not in ("roadmap", "cspace", "both"):
+            raise ValueError(f"planner.detours must be roadmap, cspace or both, got {kind!r}")
         found: list[Detour] = []
         if kind in ("roadmap", "both"):
             det = self.roadmap.query(qa, qb)
