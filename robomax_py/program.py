@@ -62,6 +62,7 @@ __all__ = [
     "Program",
     "PtpMove",
     "Spot",
+    "Gripper",
     "Wait",
     "WaitFor",
     "find_problem",
@@ -257,6 +258,20 @@ class Spot:
 
 
 @dataclass(frozen=True, slots=True)
+class Gripper:
+    """The gripper's action at rest at station `name` of job `seam` (tending cells): close ("grip")
+    or open ("release"), taking `time_s` s (3 decimals)."""
+
+    action: Literal["grip", "release"]
+    name: str
+    seam: str
+    time_s: float
+
+    def __post_init__(self) -> None:
+        _set(self, "time_s", _fixed(self.time_s, TIME_DECIMALS))
+
+
+@dataclass(frozen=True, slots=True)
 class Wait:
     """Dwell for `seconds` s (3 decimals), >= 0."""
 
@@ -283,7 +298,7 @@ class Comment:
         _set(self, "text", str(self.text).strip())
 
 
-Instruction: TypeAlias = PtpMove | LinMove | Spot | Wait | WaitFor | Comment
+Instruction: TypeAlias = PtpMove | LinMove | Spot | Gripper | Wait | WaitFor | Comment
 
 
 @dataclass(frozen=True, slots=True)
@@ -374,6 +389,11 @@ def find_problem(item: Header | FrameDef | Instruction, n_joints: int) -> str | 
     if isinstance(item, Spot):
         problem = _finite("weld time", (item.time_s,))
         return problem or (f"weld time {item.time_s:.3f} s is negative" if item.time_s < 0 else None)
+    if isinstance(item, Gripper):
+        problem = _finite("gripper time", (item.time_s,))
+        if item.action not in ("grip", "release"):
+            return f"gripper action {item.action!r} is neither grip nor release"
+        return problem or (f"gripper time {item.time_s:.3f} s is negative" if item.time_s < 0 else None)
     if isinstance(item, Wait):
         problem = _finite("wait time", (item.seconds,))
         return problem or (f"wait time {item.seconds:.3f} s is negative" if item.seconds < 0 else None)

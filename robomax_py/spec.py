@@ -111,6 +111,8 @@ class ObjectSpec:
     present: tuple[tuple[float, float], ...] | None = None
     # Clamp interlock: the input the program waits for before the first weld near this object.
     signal: str | None = None
+    # A machine's door (tending cells): present while closed; the program waits for `<name>_open`.
+    door: bool = False
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -124,6 +126,10 @@ class SpotSpec:
     schedule: int | None = None               # weld schedule number
     angles: tuple[float, float, float] | None = None   # pinned alpha, beta, gamma, rad
     config: str | None = None                 # pinned configuration data (the controller brand's)
+    # Tending stations (cell-file `tending`): the gripper action at rest here instead of a weld,
+    # and the machine whose door the station lies behind.
+    action: Literal["grip", "release"] | None = None
+    machine: str | None = None
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -161,6 +167,19 @@ class PlannerSpec:
     tcp_speed: float = 0.5        # m/s on the LIN approach and retract lines
     detour_speed: float = 1.0     # speed fraction of PTP moves through detours (near clamps)
     detours: str = "both"         # where detours are searched: "roadmap", "cspace" (local A1-A3 map) or "both"
+    # Dynamic obstacles: "timed" searches the roadmap with their windows (waiting where it pays,
+    # or going round); "rest" plans them as absent and waits at rest before the blocked move.
+    dynamic: str = "timed"
+    max_wait: float = 600.0       # s: a search that would wait longer at one place has no solution
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class MachineSpec:
+    """A machine of a tending cell: its door (a dynamic object) closed while it machines."""
+
+    name: str
+    door: str                                 # the dynamic object's name
+    windows: tuple[tuple[float, float], ...]  # s from program start: door closed (machining)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -177,3 +196,4 @@ class CellSpec:
     planner: PlannerSpec = field(default_factory=PlannerSpec)
     dynamic: tuple[ObjectSpec, ...] = ()
     digest: str = ""                          # SHA-256 (hex) of the cell file's bytes
+    machines: tuple[MachineSpec, ...] = ()    # tending cells: machines and their door schedules

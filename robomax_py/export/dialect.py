@@ -29,6 +29,7 @@ from robomax_py.program import (
     Program,
     PtpMove,
     Spot,
+    Gripper,
 )
 from robomax_py.robot import RobotModel
 from robomax_py.robot.solve import brand_text_of
@@ -154,6 +155,25 @@ def read_spot_label(text: str, n: int, time_s: float, file: str, line: int) -> S
                                                  f"(optionally 'gun G schedule S'), got {text!r}")
     gun, schedule = int(match["gun"] or 1), int(match["schedule"] or 1)
     return Spot(match["name"], match["seam"], time_s, gun, schedule)
+
+
+def gripper_label(ins: Gripper) -> str:
+    """`seam/name`, the comment a gripper call carries."""
+    return f"{ins.seam}/{ins.name}"
+
+
+def read_gripper(action: str, text: str, n: int, time_s: float, file: str, line: int) -> Gripper:
+    """A gripper call (`grip` / `release`) and its comment -> Gripper; without one, station n of an
+    unnamed job."""
+    text = text.strip()
+    if action not in ("grip", "release"):
+        raise ProgramError(file, f"line {line}", f"unknown gripper action {action!r}")
+    if not text:
+        return Gripper(action, f"station{n}", "unnamed", time_s)      # type: ignore[arg-type]
+    match = _LABEL.match(text)
+    if match is None or match["gun"] is not None:
+        raise ProgramError(file, f"line {line}", f"the {action} call's comment must be 'job/station', got {text!r}")
+    return Gripper(action, match["name"], match["seam"], time_s)      # type: ignore[arg-type]
 
 
 def with_tcp_blends(planned: PlannedProgram, robot: RobotModel) -> Program:

@@ -35,8 +35,10 @@ from robomax_py.export.dialect import (
     is_header_comment,
     percent,
     read_header,
+    read_gripper,
     read_spot_label,
     require_six_axes,
+    gripper_label,
     spot_label,
     with_brand_configs,
     without_comments,
@@ -49,6 +51,7 @@ from robomax_py.program import (
     Program,
     PtpMove,
     Spot,
+    Gripper,
     Wait,
     WaitFor,
 )
@@ -127,6 +130,7 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     pos: list[str] = []
     signals: dict[str, int] = {}
     n_weld = 0
+    grips: dict[str, int] = {}
     for ins in program.instructions:
         if isinstance(ins, (PtpMove, LinMove)):
             k = len(pos) + 1
@@ -148,6 +152,9 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
         elif isinstance(ins, Spot):
             n_weld += 1
             mn += [f"CALL {WEAPON}({n_weld},{ins.time_s:.3f}) ;", f"! {spot_label(ins)} ;"]
+        elif isinstance(ins, Gripper):
+            grips[ins.action] = grips.get(ins.action, 0) + 1
+            mn += [f"CALL {ins.action.upper()}({grips[ins.action]},{ins.time_s:.3f}) ;", f"! {gripper_label(ins)} ;"]
         elif isinstance(ins, Wait):
             mn.append(f"WAIT {ins.seconds:.2f}(sec) ;")
         elif isinstance(ins, WaitFor):
@@ -156,9 +163,16 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
         elif not isinstance(ins, Comment):
             raise ExportError(f"FANUC TP cannot write {type(ins).__name__}")
     main = _ls(program.name, "robomax_py", mn, pos)
-    weld = _ls(WEAPON, "default weld", ["! default weld: rest AR[2] s ;", "! replace with the gun's package ;",
-                                          "R[1:weld_time]=AR[2] ;", "WAIT R[1] ;"], [])
-    return {".ls": main, "spot_weld.ls": weld}
+    out = {".ls": main}
+    if n_weld or not grips:
+        out["spot_weld.ls"] = _ls(WEAPON, "default weld", ["! default weld: rest AR[2] s ;",
+                                                             "! replace with the gun's package ;",
+                                                             "R[1:weld_time]=AR[2] ;", "WAIT R[1] ;"], [])
+    for action in sorted(grips):
+        out[f"{action}.ls"] = _ls(action.upper(), f"default {action}", [
+            f"! default {action}: rest AR[2] s ;", "! replace with the gripper's DO and sensors ;",
+            f"R[1:{action}_time]=AR[2] ;", "WAIT R[1] ;"], [])
+    return out
 
 
 def _ls(name: str, comment: str, mn: list[str], pos: list[str]) -> str:
@@ -179,7 +193,7 @@ def _ls(name: str, comment: str, mn: list[str], pos: list[str]) -> str:
 _MN_LINE = re.compile(r"^\s*([0-9]+):\s*(.*?)\s*;?\s*$")
 _MOVE = re.compile(r"^(J|L)\s+P\[([0-9]+)(?::[^\]]*)?\]\s+([0-9.]+)\s*(%|mm/sec|cm/min|inch/min|deg/sec|sec|msec)\s+"
                    r"(FINE|CNT\s*([0-9]+))(.*)$", re.I)
-_CALL = re.compile(r"^CALL\s+SPOT_WELD\s*\(\s*([0-9]+)\s*,\s*([0-9.]+)\s*\)$", re.I)
+_CALL = re.compile(r"^CALL\s+(SPOT_WELD|GRIP|RELEASE)\s*\(\s*([0-9]+)\s*,\s*([0-9.]+)\s*\)$", re.I)
 _WAIT = re.compile(r"^WAIT\s+([0-9]*\.?[0-9]+)\s*\(sec\)$", re.I)
 _WAIT_DI = re.compile(r"^WAIT\s+DI\[([0-9]+)(?::([^\]]*))?\]\s*=\s*ON$", re.I)
 _PR_ELEMENT = re.compile(r"^PR\[([0-9]+),([1-6])\]\s*=\s*([+-]?[0-9]*\.?[0-9]+)$", re.I)
@@ -189,7 +203,7 @@ _FIELD = re.compile(r"\b(X|Y|Z|W|P|R|J[1-6])\s*=\s*([+-]?[0-9]*\.?[0-9]+)\s*(mm|
 _CONFIG = re.compile(r"CONFIG\s*:\s*'([^']*)'", re.I)
 # Motions this reader does not simulate, and control flow (jumps, conditions): the program's
 # motion then depends on what the reader cannot follow.
-_UNSIMULATED = re.compile(r"^(C|A)\s+P\[|^(J|L)\s+PR\[|^JMP\b|^IF\b|^SELECT\b|^FOR\b|^CALL\s+(?!SPOT_WELD\b)", re.I)
+_UNSIMULATED = re.compile(r"^(C|A)\s+P\[|^(J|L)\s+PR\[|^JMP\b|^IF\b|^SELECT\b|^FOR\b|^CALL\s+(?!(SPOT_WELD|GRIP|RELEASE)\b)", re.I)
 
 
 def _positions(text: str, file: str, start_line: int) -> dict[int, tuple[dict[str, float], str, int]]:
@@ -244,6 +258,10 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             elif instructions and isinstance(instructions[-1], Spot) and where[-1] == number - 1:
                 n = int(instructions[-1].name[4:]) if instructions[-1].seam == "unnamed" else 0
                 instructions[-1] = read_spot_label(remark, n, instructions[-1].time_s, file, number)
+            elif instructions and isinstance(instructions[-1], Gripper) and where[-1] == number - 1:
+                last = instructions[-1]
+                n = int(last.name[7:]) if last.seam == "unnamed" else 0
+                instructions[-1] = read_gripper(last.action, remark, n, last.time_s, file, number)
             continue
         move = _MOVE.match(stmt)
         # Offsets and incremental moves change the target; TB/TA/DB triggers and ACC do not.
@@ -278,7 +296,9 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             continue
         call = _CALL.match(stmt)
         if call:
-            instructions.append(read_spot_label("", int(call.group(1)), float(call.group(2)), file, number))
+            routine, n, seconds = call.group(1).upper(), int(call.group(2)), float(call.group(3))
+            instructions.append(read_spot_label("", n, seconds, file, number) if routine == "SPOT_WELD"
+                                else read_gripper(routine.lower(), "", n, seconds, file, number))
             where.append(number)
             continue
         wait = _WAIT.match(stmt)

@@ -39,8 +39,10 @@ from robomax_py.export.dialect import (
     is_header_comment,
     percent,
     read_header,
+    read_gripper,
     read_spot_label,
     require_six_axes,
+    gripper_label,
     spot_label,
     with_brand_configs,
     with_tcp_blends,
@@ -53,6 +55,7 @@ from robomax_py.program import (
     Program,
     PtpMove,
     Spot,
+    Gripper,
     Wait,
     WaitFor,
 )
@@ -100,6 +103,7 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     cp_speed = None
     apo = None
     n_point = n_weld = 0
+    grips: dict[str, int] = {}
     for ins in program.instructions:
         if isinstance(ins, Comment):
             src.append(f"; {ins.text}" if ins.text else ";")
@@ -130,15 +134,25 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
         elif isinstance(ins, Spot):
             n_weld += 1
             src.append(f"spot_weld({n_weld}, {ins.time_s:.3f}) ; {spot_label(ins)}")
+        elif isinstance(ins, Gripper):
+            grips[ins.action] = grips.get(ins.action, 0) + 1
+            src.append(f"{ins.action}({grips[ins.action]}, {ins.time_s:.3f}) ; {gripper_label(ins)}")
         elif isinstance(ins, Wait):
             src.append(f"WAIT SEC {ins.seconds:.3f}")
         elif isinstance(ins, WaitFor):
             src.append(f"WAIT FOR {ins.signal}")
         else:
             raise ExportError(f"KRL cannot write {type(ins).__name__}")
-    src += ["END", "", "DEF spot_weld(n:IN, weld_time:IN)", "  INT n", "  REAL weld_time",
-            "  ; default weld: rest for weld_time s; replace with the gun's technology package",
-            "  WAIT SEC weld_time", "END"]
+    if n_weld or not grips:
+        src += ["END", "", "DEF spot_weld(n:IN, weld_time:IN)", "  INT n", "  REAL weld_time",
+                "  ; default weld: rest for weld_time s; replace with the gun's technology package",
+                "  WAIT SEC weld_time", "END"]
+    else:
+        src.append("END")
+    for action in sorted(grips):
+        src += ["", f"DEF {action}(n:IN, {action}_time:IN)", "  INT n", f"  REAL {action}_time",
+                f"  ; default {action}: rest for {action}_time s; replace with the gripper's outputs and sensors",
+                f"  WAIT SEC {action}_time", "END"]
     dat.append("ENDDAT")
     return {".src": "\n".join(src) + "\n", ".dat": "\n".join(dat) + "\n"}
 
@@ -168,7 +182,7 @@ def _pose(move: LinMove) -> str:
 # ================================================================================== reading
 
 _GRAMMAR = r"""
-?start: motion | assign | weld | wait_sec | wait_for | signal | decl
+?start: motion | assign | weld | gripper | wait_sec | wait_for | signal | decl
 motion: MOTION target APPROX?
 target: NAME | aggregate
 aggregate: "{" (NAME ":")? [field ("," field)*] "}"
@@ -176,12 +190,14 @@ field: NAME value
 ?value: NUMBER | BITS | NAME
 assign: SYSVAR ("." NAME)? ("[" NUMBER "]")? "=" (NUMBER | aggregate | SYSVAR)
 weld: "spot_weld"i "(" NUMBER "," NUMBER ")"
+gripper: GRIPPER "(" NUMBER "," NUMBER ")"
 wait_sec: "WAIT"i "SEC"i NUMBER
 wait_for: "WAIT"i "FOR"i NAME
 signal: "SIGNAL"i NAME SYSVAR "[" NUMBER "]"
 decl: "DECL"i NAME NAME "=" aggregate
 
 MOTION.2: /(PTP|LIN)\b/i
+GRIPPER.2: /(grip|release)\b/i
 APPROX.2: /C_(DIS|PTP|VEL|ORI)\b/i
 SYSVAR: /\$[A-Za-z_][A-Za-z0-9_]*/
 NAME: /[A-Za-z_][A-Za-z0-9_]*/
@@ -193,7 +209,7 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 # Motions KRL has that this reader does not simulate: a program with one is not verified clean.
 _UNSIMULATED = re.compile(r"^(CIRC|SPTP|SLIN|SCIRC|PTP_REL|LIN_REL|CIRC_REL|SPTP_REL|SLIN_REL|SPLINE|PTP_SPLINE|RSI_MOVECORR)\b",
                           re.I)
-_KNOWN = re.compile(r"^(PTP|LIN|\$|spot_weld\s*\(|WAIT\s+(SEC|FOR)\b|SIGNAL\b|DECL\s+(E6AXIS|AXIS|E6POS|POS|FRAME)\b)", re.I)
+_KNOWN = re.compile(r"^(PTP|LIN|\$|spot_weld\s*\(|(grip|release)\s*\(|WAIT\s+(SEC|FOR)\b|SIGNAL\b|DECL\s+(E6AXIS|AXIS|E6POS|POS|FRAME)\b)", re.I)
 
 
 _BLOCK_START = re.compile(r"^(IF\b.*\bTHEN|LOOP|WHILE\b.*|FOR\b.*|REPEAT|SWITCH\b.*)$", re.I)
@@ -362,6 +378,10 @@ class _Reader:
     def on_weld(self, tree: Tree[Token], comment: str, line: int) -> None:
         n, seconds = (float(t) for t in tree.children)
         self.add(read_spot_label(comment, int(n), seconds, self.file, line), line)
+
+    def on_gripper(self, tree: Tree[Token], comment: str, line: int) -> None:
+        action, n, seconds = tree.children
+        self.add(read_gripper(str(action).lower(), comment, int(float(n)), float(seconds), self.file, line), line)
 
     def on_wait_sec(self, tree: Tree[Token], comment: str, line: int) -> None:
         self.add(Wait(float(tree.children[0])), line)

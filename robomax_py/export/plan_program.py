@@ -20,10 +20,11 @@ from robomax_py._version import __version__
 from robomax_py.errors import ExportError
 from robomax_py.export.dialect import PlannedProgram
 from robomax_py.plan import PlanResult
-from robomax_py.plan.waiting import CLEAR_SUFFIX, WaitPlan
+from robomax_py.plan.waiting import WaitPlan, signal_of
 from robomax_py.program import (
     Comment,
     FrameDef,
+    Gripper,
     Header,
     Instruction,
     LinMove,
@@ -105,6 +106,9 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
             radius = (trans.flyby_radius if approach_follows else 0.0) if last else trans.blend_radius
             speed = opts.speed * (opts.detour_speed if trans.kind == "detour" else 1.0)
             emit(q, PtpMove(tuple(np.degrees(q)), speed, 1.0, flyby=math.degrees(radius), comment=note.strip(", ")))
+            for stage in trans.stages:
+                if stage.index == w:
+                    emit(q, *_wait(stage.wait))
         if not approach_follows:
             break
         spot = result.spots[k]
@@ -113,8 +117,9 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
         emit(q_before, Comment(f"{spot.seam}/{spot.name}: arrive {spot.t_arrive - t0:.3f} s, leave "
                                f"{spot.t_leave - t0:.3f} s, alpha {alpha:.1f} beta {beta:.1f} gamma {gamma:.1f} deg"))
         xyz, zyx = pose_mm_zyx(to_frame(C, spot.T_spot))
-        emit(spot.q_spot, LinMove(xyz, zyx, spot.config, lin_mm_s, comment="approach"),
-             Spot(identifier(spot.name), identifier(spot.seam), spot.weld_time, spot.gun, spot.schedule))
+        act: Instruction = Spot(identifier(spot.name), identifier(spot.seam), spot.weld_time, spot.gun, spot.schedule) \
+            if spot.action is None else Gripper(spot.action, identifier(spot.name), identifier(spot.seam), spot.weld_time)
+        emit(spot.q_spot, LinMove(xyz, zyx, spot.config, lin_mm_s, comment="approach"), act)
         after = transitions[k + 1] if k + 1 < len(transitions) else None
         extended = after is not None and after.retract_T is not None and after.retract_q is not None
         xyz, zyx = pose_mm_zyx(to_frame(C, after.retract_T if extended else spot.T_app))   # type: ignore[union-attr]
@@ -140,9 +145,9 @@ def _interlocks(signals: tuple[str, ...]) -> list[Instruction]:
 
 def _wait(w: WaitPlan) -> list[Instruction]:
     """A wait for a dynamic obstacle: for its clear signal when it is there as the wait begins."""
-    note = Comment(f"wait {w.seconds:.3f} s for {w.obstacle} to clear")
+    note = Comment(f"wait {w.seconds:.3f} s for {w.obstacle} to {'open' if w.door else 'clear'}")
     if w.for_signal:
-        return [note, WaitFor(identifier(w.obstacle) + CLEAR_SUFFIX)]
+        return [note, WaitFor(signal_of(identifier(w.obstacle), w.door))]
     return [note, Wait(w.seconds)]
 
 

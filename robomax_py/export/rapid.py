@@ -39,8 +39,10 @@ from robomax_py.export.dialect import (
     header_lines,
     is_header_comment,
     read_header,
+    read_gripper,
     read_spot_label,
     require_six_axes,
+    gripper_label,
     spot_label,
     tree_numbers,
     with_brand_configs,
@@ -55,6 +57,7 @@ from robomax_py.program import (
     Program,
     PtpMove,
     Spot,
+    Gripper,
     Wait,
     WaitFor,
 )
@@ -112,6 +115,7 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     zones: dict[float, str] = {}
     override = accel = None
     n_point = n_weld = 0
+    grips: dict[str, int] = {}
     for ins in program.instructions:
         if isinstance(ins, Comment):
             body.append(f"    ! {ins.text}" if ins.text else "    !")
@@ -148,6 +152,9 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
         elif isinstance(ins, Spot):
             n_weld += 1
             body.append(f"    spot_weld {n_weld}, {ins.time_s:.3f};  ! {spot_label(ins)}")
+        elif isinstance(ins, Gripper):
+            grips[ins.action] = grips.get(ins.action, 0) + 1
+            body.append(f"    {ins.action} {grips[ins.action]}, {ins.time_s:.3f};  ! {gripper_label(ins)}")
         elif isinstance(ins, Wait):
             body.append(f"    WaitTime {ins.seconds:.3f};")
         elif isinstance(ins, WaitFor):
@@ -158,17 +165,23 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     lines += [f"  ! {text}" for text in header_lines(program.header)]
     lines.append(f"  ! {_NOTE}: mm, deg, quaternions [w, x, y, z], speeddata mm/s, zonedata mm")
     lines += decl
-    lines += ["", "  PROC main()", *body, "  ENDPROC", "",
-              "  PROC spot_weld(num n, num weld_time)",
-              "    ! default weld: rest for weld_time s; replace with the gun's technology package",
-              "    WaitTime \\InPos, weld_time;", "  ENDPROC", "ENDMODULE"]
+    lines += ["", "  PROC main()", *body, "  ENDPROC"]
+    if n_weld or not grips:
+        lines += ["", "  PROC spot_weld(num n, num weld_time)",
+                  "    ! default weld: rest for weld_time s; replace with the gun's technology package",
+                  "    WaitTime \\InPos, weld_time;", "  ENDPROC"]
+    for action in sorted(grips):
+        lines += ["", f"  PROC {action}(num n, num {action}_time)",
+                  f"    ! default {action}: rest for {action}_time s; replace with the gripper's SetDO and sensor checks",
+                  f"    WaitTime \\InPos, {action}_time;", "  ENDPROC"]
+    lines.append("ENDMODULE")
     return {".mod": "\n".join(lines) + "\n"}
 
 
 # ================================================================================== reading
 
 _GRAMMAR = r"""
-?start: decl | move | velset | accset | waittime | waitdi | weld
+?start: decl | move | velset | accset | waittime | waitdi | weld | gripper
 decl: ("CONST"i | "PERS"i | "VAR"i) NAME NAME (":=" value)?
 move: MOVE arg ("," arg | opt)*
 velset: "VelSet"i NUMBER "," NUMBER
@@ -176,11 +189,13 @@ accset: "AccSet"i NUMBER "," NUMBER ("\\" NAME ":=" NUMBER)?
 waittime: "WaitTime"i ("\\" NAME ",")? NUMBER
 waitdi: "WaitDI"i NAME "," NUMBER ("\\" NAME (":=" value)?)*
 weld: "spot_weld"i NUMBER "," NUMBER
+gripper: GRIPPER NUMBER "," NUMBER
 ?arg: value | opt
 opt: "\\" NAME (":=" value)?
 ?value: NUMBER | NAME | STRING | list | BOOL
 list: "[" [value ("," value)*] "]"
 MOVE.2: /(MoveAbsJ|MoveL)\b/i
+GRIPPER.2: /(grip|release)\b/i
 BOOL.2: /(TRUE|FALSE)\b/i
 NAME: /[A-Za-z_][A-Za-z0-9_]*/
 STRING: /"[^"]*"/
@@ -190,7 +205,7 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 
 _UNSIMULATED = re.compile(r"^(MoveJ|MoveC|MoveLDO|MoveJDO|MoveLSync|MoveJSync|MoveCSync|MoveExtJ|SearchL|SearchC|"
                           r"TriggL|TriggJ|TriggC|MoveLRel|MoveAbsJDO|MoveAbsJSync|SpotL|SpotJ)\b", re.I)
-_KNOWN = re.compile(r"^(MoveAbsJ|MoveL|VelSet|AccSet|WaitTime|WaitDI|spot_weld)\b", re.I)
+_KNOWN = re.compile(r"^(MoveAbsJ|MoveL|VelSet|AccSet|WaitTime|WaitDI|spot_weld|grip|release)\b", re.I)
 # Lines that end a statement without ';': routine heads and ends, and control-flow lines.
 _HEADLINE = re.compile(r"^(MODULE|ENDMODULE|(LOCAL\s+)?PROC|ENDPROC|(LOCAL\s+)?FUNC|ENDFUNC|(LOCAL\s+)?TRAP|ENDTRAP)\b", re.I)
 _OPENS = re.compile(r"\b(THEN|DO)\s*$|^(TEST\b.*|ELSE|DEFAULT\s*:|CASE\b.*:)\s*$", re.I)
@@ -393,6 +408,9 @@ class _Reader:
         elif tree.data == "weld":
             n, seconds = (float(t) for t in tree.children)
             self.add(read_spot_label(comment, int(n), seconds, self.file, line), line)
+        elif tree.data == "gripper":
+            action, n, seconds = tree.children
+            self.add(read_gripper(str(action).lower(), comment, int(float(n)), float(seconds), self.file, line), line)
 
 
 def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
@@ -423,7 +441,8 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             header_comments.append(comment)
     if not module:
         raise ProgramError(file, None, "no MODULE line: not a RAPID module")
-    main = procs.get("main") or next((body for name, body in procs.items() if name != "spot_weld"), None)
+    main = procs.get("main") or next((body for name, body in procs.items()
+                                      if name not in ("spot_weld", "grip", "release")), None)
     if main is None:
         raise ProgramError(file, None, "the module has no PROC main()")
     for line, stmt, comment in main:

@@ -21,7 +21,7 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
-from robomax_py.plan.waiting import CLEAR_SUFFIX, clear_wait
+from robomax_py.plan.waiting import clear_wait, signal_of
 from robomax_py.program import (
     Comment,
     FrameDef,
@@ -29,6 +29,7 @@ from robomax_py.program import (
     Program,
     PtpMove,
     Spot,
+    Gripper,
     Wait,
     WaitFor,
     frame_in_world,
@@ -176,14 +177,16 @@ class _Builder:
                 self.configs.append((len(self.pending) - 1, ins.config))
             return True if ins.flies else self.flush()
         if self.pending:
-            what = "weld" if isinstance(ins, Spot) else "wait"
+            what = "weld" if isinstance(ins, Spot) else ("gripper action" if isinstance(ins, Gripper) else "wait")
             self.problems.append(Problem(self.t, "flyby", f"a {what} after a move that flies by (blended): the robot "
                                                           "is not at rest", self.line))
             if not self.flush():
                 return False
-        if isinstance(ins, Spot):
+        if isinstance(ins, (Spot, Gripper)):
             label = f"{ins.seam}/{ins.name}"
-            self._check_interlocks(ins, label)
+            if isinstance(ins, Spot):
+                self._check_interlocks(ins, label)
+            self._check_action(ins, label)
             self.segments.append(dwell(self.q, ins.time_s, kind="weld", label=label))
             config = self.last_config or self.config_text(self.q)
             self.spots.append({"seam": ins.seam, "name": ins.name, "t_arrive": self.t,
@@ -203,7 +206,7 @@ class _Builder:
             return PtpStep(ptp_target(ins), speed=ins.speed, accel=ins.accel,
                            flyby=math.radians(ins.flyby), kind="move", label=label, flyby_tcp=ins.flyby_mm / 1000.0)
         T = from_frame(self.robot.controller.T_root_base, lin_pose(ins))   # stated in the controller's base
-        kind = "approach" if isinstance(following, Spot) else "retract"
+        kind = "approach" if isinstance(following, (Spot, Gripper)) else "retract"
         return LinStep(T, ins.speed_mm_s / 1000.0, None, flyby=math.radians(ins.flyby), kind=kind, label=label,
                        flyby_tcp=ins.flyby_mm / 1000.0)
 
@@ -249,6 +252,21 @@ class _Builder:
             self.spans.append(Span(self.t, self.t + seconds, self.line))
             self.t += seconds
 
+    def _check_action(self, ins: Spot | Gripper, label: str) -> None:
+        """A tending station gets its gripper action, a weld spot a weld."""
+        from robomax_py.export.plan_program import identifier
+
+        seam = next((s for s in self.cell.seams if identifier(s.name) == ins.seam), None)
+        spec = next((p for p in seam.spots if identifier(p.name) == ins.name), None) if seam else None
+        if spec is None:
+            return
+        said = ins.action if isinstance(ins, Gripper) else None
+        if said != spec.action:
+            want = f"a {spec.action}" if spec.action else "a weld"
+            got = f"a {said}" if said else "a weld"
+            self.problems.append(Problem(self.t, "action", f"{label}: the program does {got}, the cell asks for {want}",
+                                         self.line))
+
     def _check_interlocks(self, spot: Spot, label: str) -> None:
         """A weld near a clamp with an input comes after waiting for that input."""
         from robomax_py.export.plan_program import identifier
@@ -269,9 +287,9 @@ class _Builder:
         if any(obj.signal and identifier(obj.signal) == signal for obj in self.cell.objects):
             self.waited.add(signal)           # a clamp input: set once the clamp is closed, no time planned
             return
-        obstacle = next((d for d in self.cell.dynamic if identifier(d.name) + CLEAR_SUFFIX == signal), None)
+        obstacle = next((d for d in self.cell.dynamic if signal_of(identifier(d.name), d.door) == signal), None)
         if obstacle is None:
-            known = ", ".join([*(identifier(d.name) + CLEAR_SUFFIX for d in self.cell.dynamic),
+            known = ", ".join([*(signal_of(identifier(d.name), d.door) for d in self.cell.dynamic),
                                *(identifier(str(o.signal)) for o in self.cell.objects if o.signal)]) or "none in this cell"
             self.problems.append(Problem(self.t, "signal", f"WAIT FOR {signal}: unknown signal (known: {known})",
                                          self.line))

@@ -43,6 +43,7 @@ from robomax_py.program import (
     Program,
     PtpMove,
     Spot,
+    Gripper,
     Wait,
     WaitFor,
     find_problem,
@@ -57,7 +58,7 @@ DIALECT = "robomax SRCL/1"
 # Upper-case keywords; they cannot be used as names (names are case-sensitive, so `spot` is a name).
 RESERVED: frozenset[str] = frozenset(
     "PROGRAM CELL ROBOT AXES TOOL CYCLE SEC VAR FRAME BASE POS ORI BEGIN ENDPROGRAM "
-    "MOVE PTP LIN AXIS SPEED ACCEL FLYBY CONFIG SPOT SEAM TIME WAIT FOR GUN SCHEDULE".split()
+    "MOVE PTP LIN AXIS SPEED ACCEL FLYBY CONFIG SPOT SEAM TIME WAIT FOR GUN SCHEDULE GRIP RELEASE".split()
 )
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -155,6 +156,8 @@ def _statement(ins: Instruction) -> str:
     if isinstance(ins, Spot):
         return (f"SPOT {ins.name} SEAM {ins.seam} TIME {_num(ins.time_s, TIME_DECIMALS)} SEC "
                 f"GUN {ins.gun} SCHEDULE {ins.schedule};")
+    if isinstance(ins, Gripper):
+        return f"{ins.action.upper()} {ins.name} SEAM {ins.seam} TIME {_num(ins.time_s, TIME_DECIMALS)} SEC;"
     if isinstance(ins, Wait):
         return f"WAIT {_num(ins.seconds, TIME_DECIMALS)} SEC;"
     if isinstance(ins, WaitFor):
@@ -179,7 +182,8 @@ def _check_text(where: str, text: str, forbidden: str) -> None:
 
 def _kind(ins: Instruction) -> str:
     return {
-        PtpMove: "MOVE PTP", LinMove: "MOVE LIN", Spot: "SPOT", Wait: "WAIT", WaitFor: "WAIT FOR", Comment: "comment"
+        PtpMove: "MOVE PTP", LinMove: "MOVE LIN", Spot: "SPOT", Gripper: "GRIP/RELEASE", Wait: "WAIT",
+        WaitFor: "WAIT FOR", Comment: "comment"
     }.get(type(ins), type(ins).__name__)
 
 
@@ -212,7 +216,7 @@ def _check_program(program: Program) -> None:
             _check_text(where + " comment", ins.comment, "{}")
         if isinstance(ins, LinMove):
             _check_text(where + " config", ins.config, "'")
-        elif isinstance(ins, Spot):
+        elif isinstance(ins, (Spot, Gripper)):
             _check_name(where + " spot name", ins.name)
             _check_name(where + " seam name", ins.seam)
         elif isinstance(ins, WaitFor):
@@ -245,16 +249,19 @@ kind: "TOOL" -> tool_kind
 pos: "POS" "(" NUMBER "," NUMBER "," NUMBER ")"
 ori: "ORI" "(" NUMBER "," NUMBER "," NUMBER ")"
 
-_stmt: ptp | lin | spot | wait | wait_for | note
+_stmt: ptp | lin | spot | gripper | wait | wait_for | note
 ptp: "MOVE" "PTP" "AXIS" "(" NUMBER ("," NUMBER)* ")" "SPEED" NUMBER "ACCEL" NUMBER flyby? COMMENT? ";"
 lin: "MOVE" "LIN" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S flyby? COMMENT? ";"
 flyby: FLYBY NUMBER
 spot: "SPOT" IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ("GUN" NUMBER "SCHEDULE" NUMBER)? ";"
+gripper: (GRIP | RELEASE) IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ";"
 wait: "WAIT" NUMBER "SEC" ";"
 wait_for: "WAIT" "FOR" IDENT ";"
 note: COMMENT
 
 FLYBY: "FLYBY"
+GRIP: "GRIP"
+RELEASE: "RELEASE"
 _MM_S.2: "MM/S"
 IDENT: /[A-Za-z_][A-Za-z0-9_]*/
 NUMBER: /[+-]?\.?[0-9][A-Za-z0-9_.]*/
@@ -269,7 +276,7 @@ _PLAIN_NUMBER = re.compile(r"[+-]?[0-9]+(\.[0-9]+)?")
 _CONTEXT = {
     "PROGRAM": "PROGRAM heading", "CELL": "CELL line", "ROBOT": "ROBOT line", "TOOL": "TOOL line",
     "CYCLE": "CYCLE line", "MOVE": "MOVE statement", "SPOT": "SPOT statement", "WAIT": "WAIT statement",
-    "ENDPROGRAM": "ENDPROGRAM",
+    "GRIP": "GRIP statement", "RELEASE": "RELEASE statement", "ENDPROGRAM": "ENDPROGRAM",
 }
 _NAMED = {
     "IDENT": "a name", "NUMBER": "a number", "STRING": "a quoted string", "COMMENT": "a comment",
@@ -402,7 +409,7 @@ def _describe(parser: Lark, text: str, exc: UnexpectedInput) -> tuple[int, int, 
     if "MOVE" in expected and "ENDPROGRAM" in expected and token.type != "SEMICOLON":
         hint = " (keywords are upper case)" if str(token).upper() in RESERVED else ""
         return line, column, (
-            f"unknown statement {got}{hint}; expected MOVE, SPOT, WAIT, a {{ comment }} or ENDPROGRAM"
+            f"unknown statement {got}{hint}; expected MOVE, SPOT, GRIP, RELEASE, WAIT, a {{ comment }} or ENDPROGRAM"
         )
     where, closed = _context(parser, text, pos)
     if where and not closed:
@@ -525,6 +532,11 @@ class _Builder:
             numbers = self.tokens(tree, "NUMBER")
             gun, schedule = (self.whole(t) for t in numbers[1:]) if len(numbers) == 3 else (1, 1)
             return Spot(str(name), str(seam), self.number(numbers[0]), gun, schedule)
+        if tree.data == "gripper":
+            name, seam = self.tokens(tree, "IDENT")
+            (seconds,) = self.tokens(tree, "NUMBER")
+            action = "grip" if self.tokens(tree, "GRIP") else "release"
+            return Gripper(action, str(name), str(seam), self.number(seconds))
         if tree.data == "wait":
             (seconds,) = self.tokens(tree, "NUMBER")
             return Wait(self.number(seconds))

@@ -36,8 +36,10 @@ from robomax_py.export.dialect import (
     header_lines,
     is_header_comment,
     read_header,
+    read_gripper,
     read_spot_label,
     require_six_axes,
+    gripper_label,
     spot_label,
     tree_numbers,
     with_brand_configs,
@@ -52,6 +54,7 @@ from robomax_py.program import (
     Program,
     PtpMove,
     Spot,
+    Gripper,
     Wait,
     WaitFor,
 )
@@ -96,7 +99,12 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
             "    # default weld: rest for weld_time s; replace with the gun's technology package",
             "    sleep(weld_time)", "  end",
             "  def wait_for_signal(n):", "    while not get_standard_digital_in(n):", "      sync()", "    end", "  end"]
+    for action in sorted({ins.action for ins in program.instructions if isinstance(ins, Gripper)}):
+        out += [f"  def {action}(n, {action}_time):",
+                f"    # default {action}: rest for {action}_time s; replace with the gripper's outputs and sensors",
+                f"    sleep({action}_time)", "  end"]
     signals: dict[str, int] = {}
+    grips: dict[str, int] = {}
     n_weld = 0
     for ins in program.instructions:
         if isinstance(ins, Comment):
@@ -114,6 +122,9 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
         elif isinstance(ins, Spot):
             n_weld += 1
             out.append(f"  spot_weld({n_weld}, {ins.time_s:.3f})  # {spot_label(ins)}")
+        elif isinstance(ins, Gripper):
+            grips[ins.action] = grips.get(ins.action, 0) + 1
+            out.append(f"  {ins.action}({grips[ins.action]}, {ins.time_s:.3f})  # {gripper_label(ins)}")
         elif isinstance(ins, Wait):
             out.append(f"  sleep({ins.seconds:.3f})")
         elif isinstance(ins, WaitFor):
@@ -139,7 +150,7 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 %ignore /[ \t]+/
 """
 
-_CALLS = ("movej", "movel", "set_tcp", "sleep", "spot_weld", "wait_for_signal")
+_CALLS = ("movej", "movel", "set_tcp", "sleep", "spot_weld", "grip", "release", "wait_for_signal")
 _UNSIMULATED = ("movep", "movec", "servoj", "servoc", "speedj", "speedl", "move_path", "movej_pose")
 _BLOCK = re.compile(r"^(def|thread|while|if|for)\b.*:\s*$")
 # elif / else continue a block rather than open one.
@@ -202,7 +213,7 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             continue
         if "def" in blocks:             # a function's body runs when it is called: not here
             continue
-        if blocks and re.match(r"^(move\w*|servo\w*|speed\w*|sleep|spot_weld|wait_for_signal)\s*\(", stmt):
+        if blocks and re.match(r"^(move\w*|servo\w*|speed\w*|sleep|spot_weld|grip|release|wait_for_signal)\s*\(", stmt):
             # Inside while / if / for / thread: the reader does not follow control flow.
             ignored.append((number, stmt))
             add(Comment(f"not simulated: {stmt}"), number)
@@ -265,6 +276,9 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         elif func == "spot_weld":
             n, seconds = (_numbers(a, file, number)[0] for a in args[:2])
             add(read_spot_label(comment, int(n), seconds, file, number), number)
+        elif func in ("grip", "release"):
+            n, seconds = (_numbers(a, file, number)[0] for a in args[:2])
+            add(read_gripper(func, comment, int(n), seconds, file, number), number)
         elif func == "wait_for_signal":
             k = int(_numbers(target, file, number)[0])
             add(WaitFor(comment or f"digital_in_{k}"), number)

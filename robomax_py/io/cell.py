@@ -37,6 +37,7 @@ from robomax_py.spec import (
     Capsule,
     CellSpec,
     Cylinder,
+    MachineSpec,
     MeshShape,
     ObjectSpec,
     PlannerSpec,
@@ -63,6 +64,8 @@ Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
 # bounded length; a cell name is also a file stem, so no path separators and at most 100 characters.
 MAX_NAME_CHARS = 200
 MAX_CELL_NAME_CHARS = 100
+# The seam a tending job becomes (one ordered seam: the cycles' station visits).
+TENDING_SEAM = "tending"
 # Dynamic windows beyond a day of program time are a typo, and would overflow the time grid.
 MAX_WINDOW_S = 86_400.0
 
@@ -232,6 +235,54 @@ class PlannerFile(_Strict):
     tcp_speed: Annotated[float, Field(gt=0, le=2)] = 0.5
     detour_speed: Annotated[float, Field(gt=0, le=1)] = 1.0
     detours: Literal["roadmap", "cspace", "both"] = "both"
+    dynamic: Literal["timed", "rest"] = "timed"
+    max_wait: Annotated[float, Field(gt=0, le=MAX_WINDOW_S, allow_inf_nan=False)] = 600.0
+
+
+# Tending cells (README, "Machine tending"): stations visited in a fixed order per cycle, machines
+# whose doors are closed while they machine, on a fixed schedule.
+
+
+class StationFile(_Strict):
+    name: Name
+    xyz: Vec3                                 # m, the TCP at the station
+    rpy: Vec3 = [0.0, 0.0, 0.0]               # deg: the TCP frame there; the tool arrives and leaves along +z
+    action: Literal["grip", "release"]
+    machine: Name | None = None               # the machine whose door the station lies behind
+    config: Annotated[str, Field(min_length=1, max_length=64)] | None = None
+
+
+class ScheduleFile(_Strict):
+    start: WindowTime = 0.0                   # s: the first machining starts (door closes)
+    machining: Positive                       # s the door stays closed per part
+    period: Positive                          # s from one machining start to the next
+    count: Annotated[int, Field(ge=1, le=10_000)] | None = None   # machinings; default: the cycles
+
+    @model_validator(mode="after")
+    def _door_opens(self) -> ScheduleFile:
+        if self.machining >= self.period:
+            raise ValueError(f"machining {self.machining:g} s fills the period {self.period:g} s: the door never "
+                             "opens, so the schedule can never be met")
+        return self
+
+
+class MachineFile(_Strict):
+    name: Name
+    door: ObjectFile                          # the door's shape and pose when closed
+    schedule: ScheduleFile
+
+
+class GripperFile(_Strict):
+    grip: NonNegative = 0.5                   # s the gripper takes to close, at rest
+    release: NonNegative = 0.5                # s to open
+
+
+class TendingFile(_Strict):
+    cycles: Annotated[int, Field(ge=1, le=1000)] = 1
+    gripper: GripperFile = GripperFile()
+    machines: list[MachineFile] = []
+    stations: Annotated[list[StationFile], Field(min_length=1)]
+    sequence: Annotated[list[Name], Field(min_length=1)] | None = None   # one cycle; default: the stations
 
 
 class CellFile(_Strict):
@@ -240,10 +291,11 @@ class CellFile(_Strict):
     robot: RobotRefFile
     tool: Reference
     objects: list[ObjectFile] = []
-    seams: Annotated[list[SeamFile], Field(min_length=1)]
+    seams: list[SeamFile] = []                # required unless the cell tends machines
     process: ProcessFile = ProcessFile()
     planner: PlannerFile = PlannerFile()
     dynamic: list[DynamicObjectFile] = []
+    tending: TendingFile | None = None
 
 
 def load_cell(path: str | Path) -> CellSpec:
@@ -265,6 +317,7 @@ def load_cell(path: str | Path) -> CellSpec:
     except ValidationError as exc:
         raise validation_error(exc, CellFile, path, CellFileError) from None
     _check_unique_names(parsed, path)
+    machines, doors = _machines(parsed, path)
 
     robot_file = checked_file(resolve_robot_file(parsed.robot.model, path), LIMITS.description,
                               named_by(CellFileError, path, "robot.model"), f"unknown robot '{parsed.robot.model}':")
@@ -283,7 +336,7 @@ def load_cell(path: str | Path) -> CellSpec:
         home=frozen_array(_home(parsed, robot_spec, path)),
         tool=tool_spec,
         objects=tuple(_object(o, path, f"objects[{i}]") for i, o in enumerate(parsed.objects)),
-        seams=_seams(parsed, path),
+        seams=_tending_seams(parsed, path) if parsed.tending is not None else _seams(parsed, path),
         process=ProcessSpec(
             weld_time=parsed.process.weld_time,
             approach=parsed.process.approach,
@@ -293,9 +346,11 @@ def load_cell(path: str | Path) -> CellSpec:
             interlock_distance=parsed.process.interlock_distance,
         ),
         planner=PlannerSpec(seed=parsed.planner.seed, speed=parsed.planner.speed, tcp_speed=parsed.planner.tcp_speed,
-                            detour_speed=parsed.planner.detour_speed, detours=parsed.planner.detours),
-        dynamic=tuple(_object(o, path, f"dynamic[{i}]") for i, o in enumerate(parsed.dynamic)),
+                            detour_speed=parsed.planner.detour_speed, detours=parsed.planner.detours,
+                            dynamic=parsed.planner.dynamic, max_wait=parsed.planner.max_wait),
+        dynamic=tuple(_object(o, path, f"dynamic[{i}]") for i, o in enumerate(parsed.dynamic)) + doors,
         digest=digest,
+        machines=machines,
     )
 
 
@@ -332,11 +387,18 @@ def _home(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray:
 
 def _check_unique_names(parsed: CellFile, path: Path) -> None:
     seen: dict[str, str] = {}
-    for group, items in (("objects", parsed.objects), ("dynamic", parsed.dynamic)):
-        for i, obj in enumerate(items):
-            if obj.name in seen:
-                raise CellFileError(path, f"{group}[{i}].name", f"duplicate name '{obj.name}' (also {seen[obj.name]})")
-            seen[obj.name] = f"{group}[{i}]"
+    doors = [(f"tending.machines[{i}].door", m.door) for i, m in enumerate(parsed.tending.machines)] \
+        if parsed.tending else []
+    named = [(f"{group}[{i}]", obj) for group, items in (("objects", parsed.objects), ("dynamic", parsed.dynamic))
+             for i, obj in enumerate(items)]
+    for key, obj in named + doors:
+        if obj.name in seen:
+            raise CellFileError(path, f"{key}.name", f"duplicate name '{obj.name}' (also {seen[obj.name]})")
+        seen[obj.name] = key
+    if parsed.tending is not None and parsed.seams:
+        raise CellFileError(path, "tending", "a cell welds seams or tends machines, not both: remove seams or tending")
+    if parsed.tending is None and not parsed.seams:
+        raise CellFileError(path, "seams", "required: at least one seam (or a tending section)")
     seams: dict[str, int] = {}
     for i, seam in enumerate(parsed.seams):
         if seam.name in seams:
@@ -409,6 +471,63 @@ def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError) -> 
         load_mesh(mesh)
     except Exception as exc:  # trimesh raises many kinds for unreadable files
         raise type(error)(error.file, error.key, f"{error.problem}: {exc}") from None
+
+
+def _machines(parsed: CellFile, path: Path) -> tuple[tuple[MachineSpec, ...], tuple[ObjectSpec, ...]]:
+    """Each machine and its door, a dynamic object closed in the schedule's windows."""
+    if parsed.tending is None:
+        return (), ()
+    machines, doors = [], []
+    for i, m in enumerate(parsed.tending.machines):
+        sched = m.schedule
+        count = sched.count or parsed.tending.cycles
+        windows = tuple((sched.start + k * sched.period, sched.start + k * sched.period + sched.machining)
+                        for k in range(count))
+        if windows[-1][1] > MAX_WINDOW_S:
+            raise CellFileError(path, f"tending.machines[{i}].schedule", f"the last machining ends at "
+                                f"{windows[-1][1]:g} s, beyond a day ({MAX_WINDOW_S:g} s) of program time")
+        door = _object(m.door, path, f"tending.machines[{i}].door")
+        doors.append(ObjectSpec(name=door.name, shape=door.shape, T_world_object=door.T_world_object,
+                                present=windows, door=True))
+        machines.append(MachineSpec(m.name, door.name, windows))
+    return tuple(machines), tuple(doors)
+
+
+def _tending_seams(parsed: CellFile, path: Path) -> tuple[SeamSpec, ...]:
+    """The tending job as one ordered seam: every cycle's station visits in order, each a stop at
+    the station's TCP pose (pinned, orientation as given) with the gripper's action as its dwell."""
+    tending = parsed.tending
+    assert tending is not None
+    stations: dict[str, int] = {}
+    machines = {m.name for m in tending.machines}
+    for i, st in enumerate(tending.stations):
+        if st.name in stations:
+            raise CellFileError(path, f"tending.stations[{i}].name",
+                                f"duplicate station name '{st.name}' (also stations[{stations[st.name]}])")
+        stations[st.name] = i
+        if st.machine is not None and st.machine not in machines:
+            known = ", ".join(sorted(machines)) or "none"
+            raise CellFileError(path, f"tending.stations[{i}].machine", f"unknown machine '{st.machine}' (machines: {known})")
+    sequence = tending.sequence or [st.name for st in tending.stations]
+    for j, name in enumerate(sequence):
+        if name not in stations:
+            raise CellFileError(path, f"tending.sequence[{j}]", f"unknown station '{name}' (stations: "
+                                f"{', '.join(stations)})")
+    spots = []
+    for cycle in range(1, tending.cycles + 1):
+        seen: dict[str, int] = {}
+        for name in sequence:
+            seen[name] = seen.get(name, 0) + 1
+            st = tending.stations[stations[name]]
+            R = pose_matrix([0.0, 0.0, 0.0], [deg_to_rad(a) for a in st.rpy])[:3, :3]
+            visit = f"c{cycle}_{name}" + (f"_{seen[name]}" if seen[name] > 1 else "")
+            spots.append(SpotSpec(
+                name=visit, xyz=frozen_array(st.xyz), normal=frozen_array(-R[:, 2]), direction=frozen_array(R[:, 0]),
+                weld_time=tending.gripper.grip if st.action == "grip" else tending.gripper.release,
+                angles=(0.0, 0.0, 0.0), config=st.config, action=st.action, machine=st.machine,
+            ))
+    return (SeamSpec(name=TENDING_SEAM, ordered=True, alpha_max=0.0, beta_max=0.0, gamma_range=(0.0, 0.0), grid=1,
+                     spots=tuple(spots)),)
 
 
 def _seams(parsed: CellFile, path: Path) -> tuple[SeamSpec, ...]:

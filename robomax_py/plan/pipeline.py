@@ -109,7 +109,8 @@ def plan_cell(
 
     t0 = time.perf_counter()
     try:
-        trajectory, plans, transitions = time_tour(cell, robot, world, spots, tour, transitions, options, progress)
+        trajectory, plans, transitions = time_tour(cell, robot, world, spots, tour, transitions, options, progress,
+                                                   roadmap)
     except TimingError as exc:
         return PlanResult(cell.name, robot.name, "infeasible", f"timing failed: {exc}")
     except WaitingError as exc:

@@ -34,6 +34,7 @@ class PlanOptions:
     tcp_speed: float | None = None   # m/s on approach and retract lines (before the override)
     detour_speed: float | None = None  # speed fraction of detour moves (before the override)
     detours: str | None = None       # "roadmap", "cspace" or "both"; None takes the cell's planner.detours
+    dynamic: str | None = None       # "timed" or "rest"; None takes the cell's planner.dynamic
     roadmap_nodes: int = 600
     roadmap_k: int = 12
     straight_tries: int = 12         # blocked straight moves between two spots before detours only
@@ -64,6 +65,7 @@ class SpotPlan:
     gun: int = 1
     schedule: int = 1
     interlocks: tuple[str, ...] = ()  # clamp signals the program waits for before moving to this spot
+    action: str | None = None        # tending stations: "grip" or "release" instead of a weld
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,6 +74,14 @@ class SpotFailure:
     name: str
     reason: str                      # unreachable | joint_limit | collision | approach_blocked
     detail: str
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Stage:
+    """A stop inside a transition: the robot halts at waypoint `index` and waits there."""
+
+    index: int
+    wait: WaitPlan
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -85,6 +95,7 @@ class Transition:
     blend_radius: float = 0.0        # rad: detour corners passed on G2 blends of this radius; 0: stops at each
     flyby_radius: float = 0.0        # rad: the retract -> move and move -> approach joins flown by; 0: stops
     wait: WaitPlan | None = None     # a wait at rest before it, for a dynamic obstacle to clear
+    stages: tuple[Stage, ...] = ()   # stops inside it where the robot waits (time-aware planning)
     # Where a fly-by's lines end beyond the approach points (junction.Extension); None: there.
     retract_T: FloatArray | None = None     # (4, 4) the retract's target, robot base frame
     retract_q: FloatArray | None = None     # the configuration there
@@ -140,6 +151,7 @@ def resolved_options(cell: CellSpec, options: PlanOptions) -> PlanOptions:
         tcp_speed=p.tcp_speed if options.tcp_speed is None else options.tcp_speed,
         detour_speed=p.detour_speed if options.detour_speed is None else options.detour_speed,
         detours=p.detours if options.detours is None else options.detours,
+        dynamic=p.dynamic if options.dynamic is None else options.dynamic,
     )
 
 

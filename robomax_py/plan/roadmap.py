@@ -104,6 +104,30 @@ class Roadmap:
     def __len__(self) -> int:
         return len(self.nodes)
 
+    def neighbours(self, u: int) -> list[tuple[int, float]]:
+        """(v, estimated move time s) of node u's edges, blocked ones included (`edge_free` says)."""
+        return [(v, float(self._pair_weight[self._edge_index[(min(u, v), max(u, v))]])) for v in sorted(self._adjacent[u])
+                if v != u]
+
+    def edge_free(self, u: int, v: int) -> bool:
+        """Is the straight move between nodes u and v free? Checked once, shared with `query`."""
+        key = (min(u, v), max(u, v))
+        known = self._edge_free.get(key)
+        if known is None:
+            res = self._world.check_segment(self.nodes[u], self.nodes[v])
+            self.edge_checks += res.checks
+            known = self._edge_free[key] = res.free
+            if not known:
+                self._edge_blocked[self._edge_index[key]] = True
+        return known
+
+    def nearest(self, q: FloatArray, k: int | None = None) -> list[int]:
+        """The k (default: the roadmap's k) nodes nearest q in the time-scaled metric."""
+        if self._tree is None:
+            return []
+        kk = min(k or self._k, len(self.nodes))
+        return [int(v) for v in np.atleast_1d(self._tree.query(np.asarray(q) * self._scale, k=kk)[1])]
+
     def query(self, q_start: FloatArray, q_goal: FloatArray) -> Detour | None:
         """A free path from q_start to q_goal through the roadmap, shortcut; None if none is found."""
         checks = 0

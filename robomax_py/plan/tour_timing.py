@@ -3,6 +3,7 @@ waits for dynamic obstacles; the spot plans as the program states them."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -24,7 +25,9 @@ from robomax_py.plan.results import (
     _no_progress,
 )
 from robomax_py.plan.sequence import Tour
-from robomax_py.plan.waiting import WaitPlan, schedule_waits
+from robomax_py.plan.roadmap import Roadmap
+from robomax_py.plan.timed_moves import DynamicConflicts, JunctionContext, StagedJunction, staged_junction
+from robomax_py.plan.waiting import WaitingError, schedule_waits, wait_at_rest
 from robomax_py.program import (
     as_written_joints,
     as_written_pose_in,
@@ -50,6 +53,7 @@ from robomax_py.world.scene import build_scene, clamps_near
 def time_tour(
     cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots: list[SpotCandidates], tour: Tour,
     transitions: list[Transition], options: PlanOptions, progress: Progress = _no_progress,
+    roadmap: Roadmap | None = None,
 ) -> tuple[Trajectory, list[SpotPlan], list[Transition]]:
     """Junction by junction (retract, move or detour, approach; `junction.time_junction`) and dwells."""
     grids = [orientation_grid(seam) for seam in cell.seams]
@@ -84,14 +88,9 @@ def time_tour(
         if after is not None:
             block.append(dwell(q_now, weld_times[k], kind="weld", label=after.label))
         blocks.append(block)
-    segments: list[Segment] = []
-    waits = {w.index: w for w in _waits(cell, robot, blocks)}
-    for k, block in enumerate(blocks):
-        if k in waits:
-            w = waits[k]
-            segments.append(dwell(block[0].q[0], w.seconds, kind="wait", label=f"wait for {w.obstacle}"))
-            timed[k] = replace(timed[k], wait=w)
-        segments.extend(block)
+    if cell.dynamic:
+        blocks, timed = _with_dynamic(cell, robot, world, roadmap, blocks, timed, ends, weld_times, options)
+    segments = [s for block in blocks for s in block]
     progress("timing", len(transitions), len(transitions))
     traj = resample(concatenate(segments))
     plans = []
@@ -110,7 +109,7 @@ def time_tour(
                               as_written_joints(c.q_app[a]), float(phase.t_start), float(phase.t_end), T_spot, T_app,
                               config_text(robot, retract_q[k] if retract_q[k] is not None else c.q_app[a]),
                               weld_times[k], cell.process.gun,
-                              cell.process.schedule_of(spec_of[k]), waits_for[k]))
+                              cell.process.schedule_of(spec_of[k]), waits_for[k], spec_of[k].action))
     return traj, plans, timed
 
 
@@ -163,10 +162,59 @@ def approach_extension(approach: float, q_spot: FloatArray, q_app: FloatArray, T
     return float(min(EXTENSION_MARGIN * cut, MAX_EXTENSION_M))
 
 
-def _waits(cell: CellSpec, robot: RobotModel, blocks: list[list[Segment]]) -> list[WaitPlan]:
-    """Where the robot waits for dynamic obstacles (`waiting`), checked against them alone."""
-    if not cell.dynamic:
-        return []
-    world = CollisionWorld(robot, build_scene(replace(cell, objects=()), robot), cell.process.clearance)
+def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, roadmap: Roadmap | None,
+                  blocks: list[list[Segment]], timed: list[Transition], ends: list[WeldEnd], weld_times: list[float],
+                  options: PlanOptions) -> tuple[list[list[Segment]], list[Transition]]:
+    """The blocks in time order with their waits for the dynamic obstacles: at rest before a blocked
+    junction (`planner.dynamic: rest`), or also the time-aware junction (`timed_moves`) where it
+    finishes sooner (`timed`, the default)."""
+    dynamic_world = CollisionWorld(robot, build_scene(replace(cell, objects=()), robot), cell.process.clearance)
     windows = {d.name: d.present if d.present is not None else ((0.0, float("inf")),) for d in cell.dynamic}
-    return schedule_waits(world, blocks, windows)
+    doors = frozenset(d.name for d in cell.dynamic if d.door)
+    if options.dynamic == "rest":
+        waits = {w.index: w for w in schedule_waits(dynamic_world, blocks, windows, doors)}
+        out = [([dwell(b[0].q[0], waits[k].seconds, kind="wait", label=f"wait for {waits[k].obstacle}")]
+                if k in waits else []) + b for k, b in enumerate(blocks)]
+        return out, [replace(tr, wait=waits[k]) if k in waits else tr for k, tr in enumerate(timed)]
+    ctx = JunctionContext(robot, world, dynamic_world, DynamicConflicts(cell, robot), roadmap, windows, doors,
+                          tcp_speed=written_tcp_speed(options.tcp_speed * options.speed),
+                          speed=written_speed(options.speed), jerk_limited=options.jerk_limited,
+                          max_wait=cell.planner.max_wait)
+    out_blocks: list[list[Segment]] = []
+    out_timed: list[Transition] = []
+    t = 0.0
+    for k, block in enumerate(blocks):
+        trans = timed[k]
+        try:
+            rest = wait_at_rest(dynamic_world, block, t, windows, k, doors)
+            rest_error = None
+        except WaitingError as exc:
+            rest, rest_error = None, exc
+        if rest is None and rest_error is None:
+            out_blocks.append(block)
+            out_timed.append(trans)
+            t += sum(s.duration for s in block)
+            continue
+        has_action = k < len(ends)
+        moves = block[:-1] if has_action else block
+        speed = options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)
+        staged = staged_junction(
+            replace(ctx, speed=written_speed(speed)), k, t, np.asarray(block[0].q[0]), trans.waypoints, trans.kind, trans.label, ends[k - 1] if k else None,
+            ends[k] if has_action else None, moves, weld_times[k] if has_action else 0.0,
+            np.asarray(block[-1].q[0]) if has_action else None)
+        rest_end = math.inf if rest is None else t + rest.seconds + sum(s.duration for s in block)
+        if isinstance(staged, StagedJunction):
+            new_block = staged.segments + block[-1:] if has_action else staged.segments
+            if t + sum(s.duration for s in new_block) < rest_end - 1e-9:
+                out_blocks.append(new_block)
+                out_timed.append(replace(trans, waypoints=staged.waypoints, stages=staged.stages, blend_radius=0.0,
+                                         flyby_radius=0.0, retract_T=None, retract_q=None, approach_q=None))
+                t += sum(s.duration for s in new_block)
+                continue
+        if rest is None:
+            assert rest_error is not None
+            raise rest_error
+        out_blocks.append([dwell(block[0].q[0], rest.seconds, kind="wait", label=f"wait for {rest.obstacle}"), *block])
+        out_timed.append(replace(trans, wait=rest))
+        t += rest.seconds + sum(s.duration for s in block)
+    return out_blocks, out_timed

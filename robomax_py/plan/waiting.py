@@ -3,8 +3,9 @@
 The planner plans the cell as if its dynamic obstacles were absent, then walks the timed program
 in time order: where a junction (retract, move or detour, approach, and the weld after it) would
 meet a dynamic obstacle inside one of its windows, the robot waits at rest where it is until that
-window is over, and the program says so (`WAIT FOR <name>_clear` when the obstacle is there when
-the wait begins, else `WAIT n SEC`). A robot that would itself be hit while waiting, or a window
+window is over, and the program says so (`WAIT FOR <name>_clear`, or `<name>_open` for a
+machine's door, when the obstacle is there when the wait begins, else `WAIT n SEC`). The time-aware
+alternative (`timed_moves`) waits nearer the goal or goes round. A robot that would itself be hit while waiting, or a window
 that never ends, makes the cell infeasible with a message naming the obstacle.
 
 `WAIT FOR <name>_clear` holds for `clear_wait`: until the window's end rounded up to the
@@ -29,6 +30,7 @@ TIME_STEP_S = 0.001
 # Waits inserted per program before the planner gives up.
 MAX_WAITS = 50
 CLEAR_SUFFIX = "_clear"
+OPEN_SUFFIX = "_open"
 
 
 @dataclass(frozen=True, slots=True)
@@ -39,6 +41,11 @@ class WaitPlan:
     seconds: float
     obstacle: str
     for_signal: bool
+    door: bool = False               # the obstacle is a machine's door: the signal is <name>_open
+
+    @property
+    def signal(self) -> str:
+        return signal_of(self.obstacle, self.door)
 
 
 class WaitingError(RobomaxError):
@@ -57,53 +64,65 @@ def _ceil_ms(seconds: float) -> float:
     return round(math.ceil(round(seconds / TIME_STEP_S, 6)) * TIME_STEP_S, 3)
 
 
+def signal_of(obstacle: str, door: bool) -> str:
+    """The input a program waits for: `<name>_open` for a machine's door, else `<name>_clear`."""
+    return obstacle + (OPEN_SUFFIX if door else CLEAR_SUFFIX)
+
+
 def schedule_waits(world: CollisionWorld, blocks: Sequence[Sequence[Segment]],
-                   windows: dict[str, tuple[tuple[float, float], ...]]) -> list[WaitPlan]:
+                   windows: dict[str, tuple[tuple[float, float], ...]], doors: frozenset[str] = frozenset()) -> list[WaitPlan]:
     """Waits (at most one per block, before it) that keep every block clear of dynamic obstacles.
 
     blocks : the program's motion in order, each a list of segments starting at rest (a
         junction and the weld after it). Times add up as the program's clock.
-    windows : each dynamic obstacle's presence windows, by name.
+    windows : each dynamic obstacle's presence windows, by name; doors : which of them are doors.
     """
-    waits: dict[int, WaitPlan] = {}
-    starts = [0.0] * len(blocks)
-    k = 0
+    waits: list[WaitPlan] = []
     t = 0.0
-    for _ in range(MAX_WAITS + len(blocks)):
-        if k >= len(blocks):
-            return [waits[i] for i in sorted(waits)]
-        starts[k] = t
-        wait = waits[k].seconds if k in waits else 0.0
-        q_rest = np.asarray(blocks[k][0].q[0], dtype=float)
-        if wait > 0:
+    for k, block in enumerate(blocks):
+        w = wait_at_rest(world, block, t, windows, k, doors)
+        if w is not None:
+            waits.append(w)
+            if len(waits) > MAX_WAITS:
+                raise WaitingError(f"more than {MAX_WAITS} waits would be needed for the dynamic obstacles")
+        t += (w.seconds if w else 0.0) + sum(s.duration for s in block)
+    return waits
+
+
+def wait_at_rest(world: CollisionWorld, block: Sequence[Segment], t: float,
+                 windows: dict[str, tuple[tuple[float, float], ...]], index: int,
+                 doors: frozenset[str] = frozenset()) -> WaitPlan | None:
+    """The shortest wait at rest before `block` (starting at t) that keeps it clear of the dynamic
+    obstacles, None when it needs none; WaitingError when waiting cannot help."""
+    wait: WaitPlan | None = None
+    q_rest = np.asarray(block[0].q[0], dtype=float)
+    for _ in range(MAX_WAITS):
+        seconds = wait.seconds if wait else 0.0
+        if seconds > 0:
             for spans in windows.values():
                 for w0, w1 in spans:
-                    if w0 <= t + wait and w1 >= t:
+                    if w0 <= t + seconds and w1 >= t:
                         t_in = max(w0, t)
                         contact = world.first_contact(q_rest, t_in)
                         if contact is not None and contact.kind_b == KIND_DYNAMIC:
                             raise WaitingError(f"the robot would be hit while waiting at rest ({contact.describe()}) "
                                                f"at t = {t_in:.3f} s")
-        hit = _first_dynamic_hit(world, blocks[k], t + wait)
+        hit = first_dynamic_hit(world, block, t + seconds)
         if hit is None:
-            t += wait + sum(s.duration for s in blocks[k])
-            k += 1
-            continue
+            return wait
         name, t_hit = hit
         ends = [w1 for w0, w1 in windows[name] if w0 <= t_hit <= w1]
         if not ends or not math.isfinite(ends[0]):
             raise WaitingError(f"{name} is in the way at t = {t_hit:.3f} s and its window does not end")
         needed = _ceil_ms(ends[0] - t) + TIME_STEP_S
-        if needed <= wait:
-            raise WaitingError(f"{name} is in the way at t = {t_hit:.3f} s even after waiting {wait:.3f} s")
+        if needed <= seconds:
+            raise WaitingError(f"{name} is in the way at t = {t_hit:.3f} s even after waiting {seconds:.3f} s")
         for_signal = clear_wait(t, windows[name]) == needed
-        waits[k] = WaitPlan(k, needed, name, for_signal)
-        if len(waits) > MAX_WAITS:
-            break
-    raise WaitingError(f"more than {MAX_WAITS} waits would be needed for the dynamic obstacles")
+        wait = WaitPlan(index, needed, name, for_signal, name in doors)
+    raise WaitingError(f"more than {MAX_WAITS} windows in the way of one move")
 
 
-def _first_dynamic_hit(world: CollisionWorld, block: Sequence[Segment], t0: float) -> tuple[str, float] | None:
+def first_dynamic_hit(world: CollisionWorld, block: Sequence[Segment], t0: float) -> tuple[str, float] | None:
     """(obstacle name, time) of the block's first contact with a dynamic obstacle, or None."""
     t = t0
     for seg in block:

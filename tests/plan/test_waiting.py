@@ -58,7 +58,7 @@ def door_cell(tmp_path_factory: pytest.TempPathFactory, write_small_cell: SmallC
 def test_robot_waits_for_the_door_and_the_program_says_so(door_cell: dict[str, Any]) -> None:
     cell = load_cell(door_cell["path"])
     robot = door_cell["robot"]
-    result = plan_cell(cell, robot, PlanOptions())
+    result = plan_cell(cell, robot, PlanOptions(dynamic="rest"))
     assert result.status == "planned", result.message
     wait = result.transitions[0].wait
     assert wait is not None and wait.obstacle == "door" and wait.for_signal
@@ -75,8 +75,28 @@ def test_robot_waits_for_the_door_and_the_program_says_so(door_cell: dict[str, A
     np.testing.assert_array_equal(rebuilt.trajectory.t, result.trajectory.t)
 
 
+def test_time_aware_planning_is_never_slower_and_verifies(door_cell: dict[str, Any]) -> None:
+    """The default (`planner.dynamic: timed`) against waiting at rest on the same cell: never a
+    longer cycle, the dynamic obstacle never met, the program rebuilt exactly."""
+    cell = load_cell(door_cell["path"])
+    robot = door_cell["robot"]
+    rest = plan_cell(cell, robot, PlanOptions(dynamic="rest"))
+    timed = plan_cell(cell, robot, PlanOptions())
+    assert timed.status == "planned", timed.message
+    assert timed.cycle_time <= rest.cycle_time + 1e-9
+    program = parse_program(write_program(program_from_plan(timed)))
+    rebuilt = rebuild(program, cell, robot, "door.srcl")
+    assert rebuilt.problems == []
+    np.testing.assert_array_equal(rebuilt.trajectory.q, timed.trajectory.q)
+    np.testing.assert_array_equal(rebuilt.trajectory.t, timed.trajectory.t)
+
+
 def test_plan_and_verify_a_door_cell_from_the_command_line(door_cell: dict[str, Any]) -> None:
     out = door_cell["tmp"] / "out"
+    data = dict(door_cell["data"], planner={"dynamic": "rest"})
+    path = door_cell["tmp"] / "door_rest.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    door_cell = dict(door_cell, path=path)
     result = runner.invoke(app, ["plan", str(door_cell["path"]), "-o", str(out)])
     assert result.exit_code == EXIT_OK, result.output
     for program in ("small_cell.srcl", "small_cell.json"):

@@ -5,7 +5,7 @@ COMMENT		= "robomax_py";
 PROG_SIZE	= 0;
 FILE_NAME	= PROCESS_CELL;
 VERSION		= 0;
-LINE_COUNT	= 30;
+LINE_COUNT	= 29;
 MEMORY_SIZE	= 0;
 PROTECT		= READ_WRITE;
 TCD:  STACK_SIZE	= 0,
@@ -17,7 +17,7 @@ TCD:  STACK_SIZE	= 0,
 DEFAULT_GROUP	= 1,*,*,*,*;
 CONTROL_CODE	= 00000000 00000000;
 /MN
-   1:  ! robomax_py 0.1.0 | cell process_cell | cell file sha256 07f708353b0dad51ba9d46e96786d44c0ddddf6af2bade2bc086e21390f48d4c | planned cycle 6.890 s ;
+   1:  ! robomax_py 0.1.0 | cell process_cell | cell file sha256 07f708353b0dad51ba9d46e96786d44c0ddddf6af2bade2bc086e21390f48d4c | planned cycle 5.706 s ;
    2:  ! robot kr125 | tool spot_gun_c | axes joint_a1 joint_a2 joint_a3 joint_a4 joint_a5 joint_a6 ;
    3:  PR[1]=LPOS ;
    4:  PR[1]=PR[1]-PR[1] ;
@@ -32,21 +32,20 @@ CONTROL_CODE	= 00000000 00000000;
   13:  UFRAME_NUM=0 ;
   14:  J P[1] 100% FINE ;
   15:  WAIT DI[1:clamp1_closed]=ON ;
-  16:  WAIT DI[2:door_clear]=ON ;
-  17:  J P[2] 100% CNT100 ;
-  18:  J P[3] 100% FINE ;
-  19:  L P[4] 500mm/sec FINE ;
-  20:  CALL SPOT_WELD(1,0.500) ;
-  21:  ! flange/s7 gun 2 schedule 4 ;
-  22:  L P[5] 500mm/sec CNT10 ;
-  23:  J P[6] 100% CNT10 ;
-  24:  L P[7] 500mm/sec FINE ;
-  25:  CALL SPOT_WELD(2,0.800) ;
-  26:  ! flange/s8 gun 2 schedule 7 ;
-  27:  L P[8] 500mm/sec CNT10 ;
-  28:  J P[9] 100% CNT25 ;
-  29:  J P[10] 100% CNT25 ;
-  30:  J P[11] 100% FINE ;
+  16:  J P[2] 100% FINE ;
+  17:  J P[3] 100% FINE ;
+  18:  L P[4] 500mm/sec FINE ;
+  19:  CALL SPOT_WELD(1,0.500) ;
+  20:  ! flange/s7 gun 2 schedule 4 ;
+  21:  L P[5] 500mm/sec CNT10 ;
+  22:  J P[6] 100% CNT10 ;
+  23:  L P[7] 500mm/sec FINE ;
+  24:  CALL SPOT_WELD(2,0.800) ;
+  25:  ! flange/s8 gun 2 schedule 7 ;
+  26:  L P[8] 500mm/sec CNT10 ;
+  27:  J P[9] 100% CNT25 ;
+  28:  J P[10] 100% CNT25 ;
+  29:  J P[11] 100% FINE ;
 /POS
 P[1]{
    GP1:
@@ -57,8 +56,8 @@ P[1]{
 P[2]{
    GP1:
 	UF : 0, UT : 1,
-	J1= 6.6170 deg,	J2= -105.8301 deg,	J3= 123.4674 deg,
-	J4= -4.1696 deg,	J5= 62.6530 deg,	J6= -164.4578 deg
+	J1= 14.6863 deg,	J2= -112.3308 deg,	J3= 130.6160 deg,
+	J4= 9.5876 deg,	J5= 47.0343 deg,	J6= -154.0441 deg
 };
 P[3]{
    GP1:

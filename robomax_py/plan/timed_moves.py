@@ -1,0 +1,274 @@
+"""Moves past dynamic obstacles that know their windows: wait nearer the goal, or go round.
+
+Today's way (`waiting`) plans the cell as if its dynamic obstacles were absent and holds the robot
+at rest before a move that would meet one, until its window ends. Here a blocked junction is
+searched again in time (`timed_search`, the time-windowed A* of Kholopov et al.) over the cell's
+roadmap, the junction's own planned path and a direct move: each node and edge is blocked in the
+windows of the dynamic obstacles its configuration or straight move touches (checked once per
+obstacle, since an obstacle does not move while it is there), the goal for as long as the approach,
+the action and the retract stay there. The route found may wait at a node near the door, so the
+robot is in front of it when it opens, or go round.
+
+The route is then timed for real: exact stops at its waits, each wait the shortest at rest that
+keeps the rest of the junction clear (`waiting.wait_at_rest`, so `WAIT FOR <door>_open` holds as
+planned), every piece checked against the dynamic obstacles at its times. The caller keeps it only
+when it finishes before waiting at rest would; otherwise, or when anything fails, today's way stays.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.errors import RobomaxError
+from robomax_py.plan.junction import WeldEnd, time_junction
+from robomax_py.plan.results import Stage
+from robomax_py.plan.roadmap import Roadmap
+from robomax_py.plan.timed_search import (
+    NoRoute,
+    TimedGraph,
+    TimedRoute,
+    Windows,
+    merge_windows,
+    timed_astar,
+)
+from robomax_py.plan.waiting import first_dynamic_hit, wait_at_rest
+from robomax_py.program import as_written_joints
+from robomax_py.robot import RobotModel
+from robomax_py.spec import CellSpec, ObjectSpec
+from robomax_py.timing import Segment, TimingError, dwell, ptp_time_estimate
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.scene import build_scene
+
+
+class DynamicConflicts:
+    """Which dynamic obstacles a configuration or a straight joint move touches (any time), and the
+    windows in which that matters. One collision world per obstacle, robot-against-obstacle pairs only."""
+
+    def __init__(self, cell: CellSpec, robot: RobotModel) -> None:
+        self.names = tuple(d.name for d in cell.dynamic)
+        self.windows = tuple(d.present if d.present is not None else ((0.0, math.inf),) for d in cell.dynamic)
+        def world(objects: tuple[ObjectSpec, ...]) -> CollisionWorld:
+            return CollisionWorld(robot, build_scene(replace(cell, objects=(), dynamic=objects), robot),
+                                  cell.process.clearance).restricted(obstacles=True, self_pairs=False)
+
+        # All of them first: most moves touch none, and then one check answers.
+        self._all = world(cell.dynamic)
+        self._worlds = [world((d,)) for d in cell.dynamic] if len(cell.dynamic) > 1 else [self._all]
+        self.checks = 0
+
+    def point(self, q: FloatArray) -> frozenset[int]:
+        self.checks += 1
+        if self._all.is_free(q):
+            return frozenset()
+        out = set()
+        for i, w in enumerate(self._worlds):
+            self.checks += 1
+            if not w.is_free(q):
+                out.add(i)
+        return frozenset(out)
+
+    def segment(self, qa: FloatArray, qb: FloatArray) -> frozenset[int]:
+        res = self._all.check_segment(qa, qb)
+        self.checks += res.checks
+        if res.free:
+            return frozenset()
+        out = set()
+        for i, w in enumerate(self._worlds):
+            res = w.check_segment(qa, qb)
+            self.checks += res.checks
+            if not res.free:
+                out.add(i)
+        return frozenset(out)
+
+    def windows_of(self, objects: frozenset[int]) -> Windows:
+        return merge_windows([w for i in sorted(objects) for w in self.windows[i]])
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class StagedJunction:
+    """A junction timed with stops where the robot waits, ready to replace the one waiting at rest."""
+
+    segments: list[Segment]          # retract ... approach with the waits (not the action after it)
+    waypoints: FloatArray            # (m, n): where the retract ends, ..., the approach point
+    stages: tuple[Stage, ...]
+    route: TimedRoute
+
+
+@dataclass(frozen=True, slots=True)
+class JunctionContext:
+    """What a junction's time-aware search needs besides the junction itself."""
+
+    robot: RobotModel
+    world: CollisionWorld            # the static obstacles (the plan's world)
+    dynamic_world: CollisionWorld    # the dynamic obstacles alone, at their times
+    conflicts: DynamicConflicts
+    roadmap: Roadmap | None
+    windows: dict[str, tuple[tuple[float, float], ...]]
+    doors: frozenset[str]
+    tcp_speed: float
+    speed: float
+    jerk_limited: bool
+    max_wait: float
+
+
+class _StageFailed(RobomaxError):
+    pass
+
+
+def staged_junction(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray, waypoints: FloatArray,
+                    kind: str, label: str, before: WeldEnd | None, after: WeldEnd | None, baseline: Sequence[Segment],
+                    action_s: float, q_action: FloatArray | None) -> StagedJunction | NoRoute:
+    """Junction `index` searched and timed with its dynamic obstacles' windows, starting at rest at
+    q_rest at t_block; `baseline` is its timing without them (for the retract and approach times).
+    q_action: the configuration of the action after it (None: the way home)."""
+    retract_s = sum(s.duration for s in baseline if s.kind == "retract")
+    approach_s = sum(s.duration for s in baseline if s.kind == "approach")
+    # The goal is held for the approach, the action and the retract after it.
+    tail_s = 2.0 * approach_s + action_s if q_action is not None else 0.0
+    graph, points = _graph(ctx, waypoints, q_action, tail_s)
+    start, goal = len(points) - 2, len(points) - 1
+    found = timed_astar(graph, start, goal, t_block + retract_s, ctx.max_wait)
+    if isinstance(found, NoRoute):
+        return found
+    if found.steps[0].depart - found.steps[0].arrive > 1e-6:
+        return NoRoute("no_gain", "the route waits where the retract ends: no better than waiting at rest", 0)
+    try:
+        return _timed(ctx, index, t_block, q_rest, found, points, kind, label, before, after, action_s, q_action)
+    except (_StageFailed, TimingError, RobomaxError) as exc:
+        return NoRoute("timing", str(exc), found.expansions)
+
+
+def _graph(ctx: JunctionContext, waypoints: FloatArray, q_action: FloatArray | None,
+           tail_s: float) -> tuple[TimedGraph, FloatArray]:
+    """Roadmap nodes, then the junction's inner waypoints, then start and goal."""
+    roadmap = ctx.roadmap
+    nodes = roadmap.nodes if roadmap is not None else np.zeros((0, waypoints.shape[1]))
+    n_road = len(nodes)
+    inner = waypoints[1:-1]
+    points = np.vstack([nodes, inner, waypoints[:1], waypoints[-1:]])
+    start, goal = len(points) - 2, len(points) - 1
+    chain = [start, *range(n_road, n_road + len(inner)), goal]
+    limits = ctx.robot.limits
+    links: dict[int, set[int]] = {u: set() for u in (start, goal, *chain)}
+    for a, b in zip(chain[:-1], chain[1:]):
+        links[a].add(b)
+        links[b].add(a)
+    links[start].add(goal)
+    links[goal].add(start)
+    ends: dict[int, list[int]] = {}
+    if roadmap is not None:
+        for end in (start, goal):
+            for v in roadmap.nearest(points[end]):
+                links[end].add(v)
+                ends.setdefault(v, []).append(end)
+    known_free = {(min(a, b), max(a, b)) for a, b in zip(chain[:-1], chain[1:])}   # the planned path
+    static: dict[tuple[int, int], bool] = {}
+    dynamic: dict[tuple[int, int], frozenset[int]] = {}
+    node_objs: dict[int, frozenset[int]] = {}
+
+    def duration(u: int, v: int) -> float:
+        return float(ptp_time_estimate(points[u], points[v], limits, ctx.speed))
+
+    def neighbours(u: int) -> list[tuple[int, float]]:
+        out = [(v, w / ctx.speed) for v, w in roadmap.neighbours(u)] if roadmap is not None and u < n_road else []
+        return out + [(v, duration(u, v)) for v in sorted(links.get(u, ())) + ends.get(u, [])]
+
+    def edge_windows(u: int, v: int) -> Windows | None:
+        key = (min(u, v), max(u, v))
+        if key not in static:
+            if key in known_free:
+                static[key] = True
+            elif roadmap is not None and max(u, v) < n_road:
+                static[key] = roadmap.edge_free(u, v)
+            else:
+                static[key] = ctx.world.check_segment(points[u], points[v]).free
+        if not static[key]:
+            return None
+        if key not in dynamic:
+            dynamic[key] = ctx.conflicts.segment(points[u], points[v])
+        return ctx.conflicts.windows_of(dynamic[key])
+
+    def node_windows(u: int) -> Windows:
+        if u == goal and q_action is not None:
+            objs = ctx.conflicts.segment(points[goal], q_action)
+            # Arriving at t holds the goal until t + tail: blocked from a window's start - tail.
+            return merge_windows([(max(0.0, a - tail_s), b) for a, b in ctx.conflicts.windows_of(objs)])
+        if u not in node_objs:
+            node_objs[u] = ctx.conflicts.point(points[u])
+        return ctx.conflicts.windows_of(node_objs[u])
+
+    def heuristic(u: int) -> float:
+        return float(ptp_time_estimate(points[u], points[goal], limits, ctx.speed, straight=False))
+
+    return TimedGraph(neighbours, node_windows, edge_windows, heuristic), points
+
+
+def _timed(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray, route: TimedRoute, points: FloatArray,
+           kind: str, label: str, before: WeldEnd | None, after: WeldEnd | None, action_s: float,
+           q_action: FloatArray | None) -> StagedJunction:
+    """The route timed piece by piece, split where it waits; each wait the shortest at rest."""
+    nodes = [s.node for s in route.steps]
+    cuts = [i for i, s in enumerate(route.steps) if 0 < i < len(nodes) - 1 and s.depart - s.arrive > 1e-6]
+    bounds = [0, *cuts, len(nodes) - 1]
+    # Rounded as the program states them, so the written program is exactly the motion timed.
+    pieces = [as_written_joints(_shortcut(ctx, points[nodes[a:b + 1]])) for a, b in zip(bounds[:-1], bounds[1:])]
+    segments: list[Segment] = []
+    stages: list[Stage] = []
+    waypoints: list[FloatArray] = [pieces[0][0]]
+    t = t_block
+    q_now = np.asarray(q_rest, dtype=float)
+    for p, piece in enumerate(pieces):
+        last = p == len(pieces) - 1
+        junction = time_junction(
+            ctx.robot, ctx.world, ctx.robot.limits, q_now, piece, kind, label,
+            before if p == 0 else None, after if last else None,
+            tcp_speed=ctx.tcp_speed, speed=ctx.speed, jerk_limited=ctx.jerk_limited, flyby=False,
+        )
+        block = list(junction.segments)
+        check = block + ([dwell(block[-1].q[-1], action_s, kind="weld", label="")] if last and q_action is not None
+                         else [])
+        if p > 0:
+            w = wait_at_rest(ctx.dynamic_world, check, t, ctx.windows, index, ctx.doors)
+            if w is not None:
+                segments.append(dwell(q_now, w.seconds, kind="wait", label=f"wait for {w.obstacle}"))
+                stages.append(Stage(len(waypoints) - 1, w))
+                t += w.seconds
+        elif first_dynamic_hit(ctx.dynamic_world, check, t) is not None:
+            raise _StageFailed("the first piece meets a dynamic obstacle as timed")
+        segments.extend(block)
+        t += sum(s.duration for s in block)
+        q_now = np.asarray(block[-1].q[-1], dtype=float)
+        waypoints.extend(piece[1:])
+    if q_action is not None:
+        # The retract after the action leaves along the approach line: nothing may close on it then.
+        t_out = t + action_s
+        retract_s = sum(s.duration for s in segments if s.kind == "approach")
+        objs = ctx.conflicts.segment(np.asarray(waypoints[-1]), np.asarray(q_action))
+        if any(w0 <= t_out + retract_s and w1 >= t_out for w0, w1 in ctx.conflicts.windows_of(objs)):
+            raise _StageFailed("a dynamic obstacle would close on the retract after the action")
+    return StagedJunction(segments, np.array(waypoints), tuple(stages), route)
+
+
+def _shortcut(ctx: JunctionContext, piece: FloatArray) -> FloatArray:
+    """Greedy: from each kept point to the farthest later one reachable by a straight move that is
+    statically free and touches no dynamic obstacle the skipped edges did not touch already."""
+    if len(piece) <= 2:
+        return piece
+    touched = [ctx.conflicts.segment(piece[i], piece[i + 1]) for i in range(len(piece) - 1)]
+    kept = [0]
+    i = 0
+    while i < len(piece) - 1:
+        j = len(piece) - 1
+        while j > i + 1:
+            allowed = frozenset().union(*touched[i:j])
+            if ctx.world.check_segment(piece[i], piece[j]).free and ctx.conflicts.segment(piece[i], piece[j]) <= allowed:
+                break
+            j -= 1
+        kept.append(j)
+        i = j
+    return piece[kept]
