@@ -59,6 +59,11 @@ def test_shipped_cell_plans_and_verifies(cell: Path, tmp_path: Path, update_gold
     for file, digest in digests.items():
         assert digest == sums.get(file), f"{file} differs from tests/golden/shipped/SHA256SUMS"
     spec = yaml.safe_load(cell.read_text())
+    if "tending" in spec:                   # the job as one ordered seam of station visits per cycle
+        job = spec["tending"]
+        visits = job.get("sequence") or [st["name"] for st in job["stations"]]
+        spec["seams"] = [{"name": "tending", "ordered": True, "spots": [
+            {"name": f"c{c}_{v}"} for c in range(1, job.get("cycles", 1) + 1) for v in visits]}]
     wanted = {(s["name"], p["name"]) for s in spec["seams"] for p in s["spots"]}
     welded = [(s["seam"], s["name"]) for s in data["spots"]]  # type: ignore[union-attr]
     assert sorted(welded) == sorted(wanted)                      # every spot of every seam, once

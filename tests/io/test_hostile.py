@@ -136,9 +136,13 @@ def _tree_mutants(rng: np.random.Generator, base: dict[str, Any], cell: str, n: 
             _get(data, p[:-1])[p[-1]] = copy.deepcopy(v)
             label = f"{'.'.join(map(str, p))}={v!r}"[:60]
         else:
-            lists = [("objects", "name"), ("seams", "name")] + [(("seams", i, "spots"), "name") for i in range(len(data["seams"]))]
+            lists: list[tuple[Any, str]] = [(("objects",), "name")]
+            if "seams" in data:
+                lists += [(("seams",), "name")] + [(("seams", i, "spots"), "name") for i in range(len(data["seams"]))]
+            if "tending" in data:
+                lists += [(("tending", "stations"), "name"), (("tending", "machines"), "name")]
             where, key = lists[int(rng.integers(len(lists)))]
-            items = _get(data, where if isinstance(where, tuple) else (where,))
+            items = _get(data, where)
             if len(items) >= 2:
                 items[1][key] = items[0][key]
             label = f"{where}"
@@ -247,9 +251,15 @@ def _name_mutants(base: dict[str, Any], cell: str) -> list[Mutant]:
         data = copy.deepcopy(base)
         data["objects"][0]["name"] = v if k == "long_object" else data["objects"][0]["name"]
         if k == "nul_seam":
-            data["seams"][0]["name"] = v
+            if "seams" in data:
+                data["seams"][0]["name"] = v
+            else:
+                data["tending"]["machines"][0]["name"] = v
         if k == "unicode_spot":
-            data["seams"][0]["spots"][0]["name"] = v
+            if "seams" in data:
+                data["seams"][0]["spots"][0]["name"] = v
+            else:
+                data["tending"]["stations"][0]["name"] = v
         out.append(Mutant("odd_name", f"{cell}:{k}", lambda folder, d=data: _write(folder, d)))
     data = copy.deepcopy(base)
     data.setdefault("dynamic", []).append({"name": "door", "box": [0.1, 0.1, 0.1], "pose": {"xyz": [3, 3, 3]},
