@@ -361,6 +361,9 @@ def preview(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
     program: Annotated[Path | None, typer.Argument(help="program written by plan (.json or .srcl); without it the robot stands at home")] = None,
     html: Annotated[Path | None, typer.Option("--html", help="write one self-contained HTML page instead of serving")] = None,
+    voxels: Annotated[float | None, typer.Option("--voxels", min=0.005, max=0.5, metavar="PRECISION",
+                                                 help="also draw the voxel map of the static objects (blocked leaves) "
+                                                      "at this precision limit, m")] = None,
 ) -> None:
     """Show the cell in meshcat, animated along a program (serves until Ctrl-C, or writes --html)."""
 
@@ -372,11 +375,24 @@ def preview(
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
         shown = home_program(spec) if program is None else load_program(program, spec, robot)
+        vmap = None
+        if voxels is not None:
+            from dataclasses import replace
+
+            import numpy as np
+
+            from robomax_py.plan.tcp_route import HALF_WIDTH_M
+            from robomax_py.world.scene import build_scene
+            from robomax_py.world.voxels import build_voxels
+
+            lo = np.array([-HALF_WIDTH_M, -HALF_WIDTH_M, -0.5])
+            vmap = build_voxels(build_scene(replace(spec, dynamic=()), robot), lo, lo + 2 * HALF_WIDTH_M, voxels)
         if html is not None:
-            content = write_html(html, spec, robot, shown)
-            out.print(f"wrote {html} ({content.frames} animation frames, cycle {content.duration:.3f} s)")
+            content = write_html(html, spec, robot, shown, voxels=vmap)
+            drawn = f", {content.voxels} blocked voxels" if vmap is not None else ""
+            out.print(f"wrote {html} ({content.frames} animation frames, cycle {content.duration:.3f} s{drawn})")
             return
-        serve(spec, robot, shown, lambda url: out.print(f"meshcat preview at {url}  (Ctrl-C to stop)"))
+        serve(spec, robot, shown, lambda url: out.print(f"meshcat preview at {url}  (Ctrl-C to stop)"), voxels=vmap)
         out.print("preview stopped")
 
     _guarded(run)

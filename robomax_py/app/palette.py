@@ -27,6 +27,9 @@ FLOOR = 0xD9DCE1
 # Spot markers.
 SPOT = 0xFFD400
 
+# Voxel map (`preview --voxels`): the blocked leaves' centres.
+VOXEL = 0x17BECF
+
 # Trajectory phase kinds (timing.trajectory.SEGMENT_KINDS) for the TCP path and the Gantt bars.
 PHASE_COLOURS: dict[str, int] = {
     "weld": 0xE41A1C,
@@ -73,6 +76,7 @@ __all__ = [
     "SPOT",
     "TOOL_BODY",
     "TOOL_TIPS",
+    "VOXEL",
     "hex_colour",
     "object_role",
     "phase_colour",

@@ -42,6 +42,7 @@ from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.robot.geometry import load_mesh, shape_trimesh
 from robomax_py.spec import Box, Capsule, CellSpec, Cylinder, Shape, Sphere
 from robomax_py.world.scene import build_scene
+from robomax_py.world.voxels import VoxelMap
 
 DEFAULT_FPS = 30
 ROOT = "robomax"
@@ -78,6 +79,7 @@ class PreviewContent:
     frames: int
     fps: int
     duration: float
+    voxels: int = 0                  # blocked voxel leaves drawn (`--voxels`)
 
 
 def frame_times(duration: float, fps: int) -> FloatArray:
@@ -97,7 +99,8 @@ def frame_times(duration: float, fps: int) -> FloatArray:
     return frames
 
 
-def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram, fps: int = DEFAULT_FPS) -> PreviewContent:
+def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram, fps: int = DEFAULT_FPS,
+             voxels: VoxelMap | None = None) -> PreviewContent:
     """Draw the cell, robot, tool, spots and TCP path into a meshcat visualizer and animate it.
 
     Parameters
@@ -110,6 +113,8 @@ def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram,
         The motion; a single sample shows the robot standing still (no animation).
     fps : int
         Animation frames per second of program time.
+    voxels : VoxelMap, optional
+        Drawn as the centres of its blocked leaves (base frame), each point the precision limit wide.
 
     Raises
     ------
@@ -136,6 +141,7 @@ def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram,
 
     spots = _draw_spots(root, cell, robot, program)
     lines = _draw_path(root, robot, program, T_world_base)
+    n_voxels = _draw_voxels(root, voxels, T_world_base) if voxels is not None else 0
 
     frames = frame_times(program.duration, fps)
     if len(frames):
@@ -159,10 +165,12 @@ def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram,
         frames=len(frames),
         fps=fps,
         duration=program.duration,
+        voxels=n_voxels,
     )
 
 
-def write_html(path: Path, cell: CellSpec, robot: RobotModel, program: ShownProgram, fps: int = DEFAULT_FPS) -> PreviewContent:
+def write_html(path: Path, cell: CellSpec, robot: RobotModel, program: ShownProgram, fps: int = DEFAULT_FPS,
+               voxels: VoxelMap | None = None) -> PreviewContent:
     """Write the preview as one self-contained HTML page (atomically); works offline.
 
     A meshcat server runs only while the page is made (meshcat builds the page from its scene).
@@ -171,7 +179,7 @@ def write_html(path: Path, cell: CellSpec, robot: RobotModel, program: ShownProg
 
     vis = _visualizer()
     try:
-        content = populate(vis, cell, robot, program, fps)
+        content = populate(vis, cell, robot, program, fps, voxels)
         html = vis.static_html()
     finally:
         _close(vis)
@@ -179,13 +187,14 @@ def write_html(path: Path, cell: CellSpec, robot: RobotModel, program: ShownProg
     return content
 
 
-def serve(cell: CellSpec, robot: RobotModel, program: ShownProgram, announce: Callable[[str], None], fps: int = DEFAULT_FPS) -> None:
+def serve(cell: CellSpec, robot: RobotModel, program: ShownProgram, announce: Callable[[str], None], fps: int = DEFAULT_FPS,
+          voxels: VoxelMap | None = None) -> None:
     """Start a meshcat server with the preview, announce its URL, and serve until Ctrl-C (then return)."""
     import time
 
     vis = _visualizer()
     try:
-        populate(vis, cell, robot, program, fps)
+        populate(vis, cell, robot, program, fps, voxels)
         announce(vis.url())
         while True:
             time.sleep(3600)
@@ -364,6 +373,19 @@ def _draw_path(root: Any, robot: RobotModel, program: ShownProgram, T_world_base
         root[path].set_object(g.Line(g.PointsGeometry(points), g.LineBasicMaterial(color=colour)))
         drawn.append((path, phase.kind, colour))
     return drawn
+
+
+def _draw_voxels(root: Any, voxels: VoxelMap, T_world_base: FloatArray) -> int:
+    """The blocked leaves' centres as one point cloud (world frame); how many."""
+    import meshcat.geometry as g
+
+    blocked = ~voxels.free
+    centres = voxels.corner[blocked] + voxels.edge[blocked, None] / 2
+    points = centres @ T_world_base[:3, :3].T + T_world_base[:3, 3]
+    colour = np.tile(np.array([(palette.VOXEL >> s & 0xFF) / 255.0 for s in (16, 8, 0)], dtype=np.float32)[:, None],
+                     (1, len(points)))
+    root["voxels"].set_object(g.PointCloud(np.asarray(points.T, dtype=np.float32), colour, size=float(voxels.precision)))
+    return len(points)
 
 
 def _place_camera(vis: Any, cell: CellSpec, robot: RobotModel) -> None:

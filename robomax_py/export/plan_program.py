@@ -104,6 +104,8 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
             note = note if last or trans.kind == "move" else (note + ", " if note else "") + f"detour point {w}"
             # Radii as planned: detour corners and the join into the approach (joint space, deg).
             radius = (trans.flyby_radius if approach_follows else 0.0) if last else trans.blend_radius
+            if any(stage.index == w for stage in trans.stages):
+                radius = 0.0                     # the robot stops there to wait
             speed = opts.speed * (opts.detour_speed if trans.kind == "detour" else 1.0)
             emit(q, PtpMove(tuple(np.degrees(q)), speed, 1.0, flyby=math.degrees(radius), comment=note.strip(", ")))
             for stage in trans.stages:

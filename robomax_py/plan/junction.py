@@ -177,6 +177,29 @@ def time_junction(
     return Junction(best[2], best_rj, best_rd, checks, used)
 
 
+def time_junction_at(
+    robot: RobotModel, world: PathChecks, limits: JointLimits, q_start: FloatArray, waypoints: FloatArray,
+    kind: str, label: str, before: WeldEnd | None, after: WeldEnd | None, junction_radius: float,
+    corner_radius: float, *, tcp_speed: float, speed: float = 1.0, jerk_limited: bool = True,
+) -> Junction | None:
+    """The junction flown by with exactly these radii (rad; 0: stop), or None when that motion
+    cannot be timed or leaves free space (several pieces of one transition share their radii)."""
+    ext = None
+    if junction_radius > 0:
+        ext = _extension(robot, np.asarray(q_start, dtype=float), waypoints, before, after)
+        if ext is None:
+            return None
+    steps = _steps(waypoints, kind, label, before, after, tcp_speed, speed, junction_radius, corner_radius, ext)
+    try:
+        _, paths, segments = _time_steps(robot, limits, q_start, steps, jerk_limited, {})
+    except TimingError:
+        return None
+    free, used = _path_free(world, paths)
+    if not free or (junction_radius > 0 and not _straight(robot, paths, before, after)):
+        return None
+    return Junction(segments, junction_radius, corner_radius, used, ext or Extension())
+
+
 def _exact_lower_bound(q_start: FloatArray, steps: list[Step], paths: list[ChainPath], limits: JointLimits) -> float:
     """A lower bound (s) of the time of `steps` stopping at every target: each move takes at least
     its slowest joint's rest-to-rest time under the velocity and acceleration limits it may use.

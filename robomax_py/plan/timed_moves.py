@@ -25,9 +25,16 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import RobomaxError
-from robomax_py.plan.junction import WeldEnd, time_junction
+from robomax_py.plan.junction import (
+    DETOUR_RADII_DEG,
+    JUNCTION_RADII_DEG,
+    Extension,
+    WeldEnd,
+    time_junction_at,
+)
 from robomax_py.plan.results import Stage
 from robomax_py.plan.roadmap import Roadmap
+from robomax_py.plan.tcp_route import TcpSpace, follow, tcp_route
 from robomax_py.plan.timed_search import (
     NoRoute,
     TimedGraph,
@@ -36,9 +43,9 @@ from robomax_py.plan.timed_search import (
     merge_windows,
     timed_astar,
 )
-from robomax_py.plan.waiting import first_dynamic_hit, wait_at_rest
+from robomax_py.plan.waiting import WaitingError, first_dynamic_hit, wait_at_rest
 from robomax_py.program import as_written_joints
-from robomax_py.robot import RobotModel
+from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.spec import CellSpec, ObjectSpec
 from robomax_py.timing import Segment, TimingError, dwell, ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
@@ -89,6 +96,11 @@ class DynamicConflicts:
         return merge_windows([w for i in sorted(objects) for w in self.windows[i]])
 
 
+# (junction, corner) radii tried for a staged junction's pieces, deg: the largest first, then stops.
+STAGED_RADII_DEG = ((JUNCTION_RADII_DEG[0], DETOUR_RADII_DEG[0]), (JUNCTION_RADII_DEG[0], DETOUR_RADII_DEG[-1]),
+                    (JUNCTION_RADII_DEG[-1], 0.0), (0.0, 0.0))
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class StagedJunction:
     """A junction timed with stops where the robot waits, ready to replace the one waiting at rest."""
@@ -97,6 +109,9 @@ class StagedJunction:
     waypoints: FloatArray            # (m, n): where the retract ends, ..., the approach point
     stages: tuple[Stage, ...]
     route: TimedRoute
+    junction_radius: float           # rad, as `Junction`
+    corner_radius: float
+    extension: Extension
 
 
 @dataclass(frozen=True, slots=True)
@@ -114,6 +129,7 @@ class JunctionContext:
     speed: float
     jerk_limited: bool
     max_wait: float
+    tcp: TcpSpace | None = None      # the TCP's free voxels: a route through them is one more way
 
 
 class _StageFailed(RobomaxError):
@@ -130,7 +146,15 @@ def staged_junction(ctx: JunctionContext, index: int, t_block: float, q_rest: Fl
     approach_s = sum(s.duration for s in baseline if s.kind == "approach")
     # The goal is held for the approach, the action and the retract after it.
     tail_s = 2.0 * approach_s + action_s if q_action is not None else 0.0
-    graph, points = _graph(ctx, waypoints, q_action, tail_s)
+    chains = [waypoints[1:-1]]
+    if ctx.tcp is not None:
+        p = fk_tcp(ctx.robot, waypoints[[0, -1]])[:, :3, 3]
+        route = tcp_route(ctx.tcp, p[0], p[1], t_block + retract_s, ctx.max_wait)
+        if not isinstance(route, NoRoute):
+            followed = follow(ctx.robot, ctx.world, route, waypoints[0], waypoints[-1])
+            if followed is not None:
+                chains.append(followed[1:-1])
+    graph, points = _graph(ctx, waypoints, q_action, tail_s, chains)
     start, goal = len(points) - 2, len(points) - 1
     found = timed_astar(graph, start, goal, t_block + retract_s, ctx.max_wait)
     if isinstance(found, NoRoute):
@@ -144,20 +168,26 @@ def staged_junction(ctx: JunctionContext, index: int, t_block: float, q_rest: Fl
 
 
 def _graph(ctx: JunctionContext, waypoints: FloatArray, q_action: FloatArray | None,
-           tail_s: float) -> tuple[TimedGraph, FloatArray]:
-    """Roadmap nodes, then the junction's inner waypoints, then start and goal."""
+           tail_s: float, chains: list[FloatArray]) -> tuple[TimedGraph, FloatArray]:
+    """Roadmap nodes, then the inner points of each chain (joint paths from start to goal whose
+    straight moves are known to be statically free: the junction's own, the TCP route's), then
+    start and goal."""
     roadmap = ctx.roadmap
     nodes = roadmap.nodes if roadmap is not None else np.zeros((0, waypoints.shape[1]))
     n_road = len(nodes)
-    inner = waypoints[1:-1]
-    points = np.vstack([nodes, inner, waypoints[:1], waypoints[-1:]])
+    points = np.vstack([nodes, *chains, waypoints[:1], waypoints[-1:]])
     start, goal = len(points) - 2, len(points) - 1
-    chain = [start, *range(n_road, n_road + len(inner)), goal]
     limits = ctx.robot.limits
-    links: dict[int, set[int]] = {u: set() for u in (start, goal, *chain)}
-    for a, b in zip(chain[:-1], chain[1:]):
-        links[a].add(b)
-        links[b].add(a)
+    links: dict[int, set[int]] = {u: set() for u in (start, goal)}
+    known_free: set[tuple[int, int]] = set()
+    at = n_road
+    for inner in chains:
+        chain = [start, *range(at, at + len(inner)), goal]
+        at += len(inner)
+        for a, b in zip(chain[:-1], chain[1:]):
+            links.setdefault(a, set()).add(b)
+            links.setdefault(b, set()).add(a)
+            known_free.add((min(a, b), max(a, b)))
     links[start].add(goal)
     links[goal].add(start)
     ends: dict[int, list[int]] = {}
@@ -166,7 +196,6 @@ def _graph(ctx: JunctionContext, waypoints: FloatArray, q_action: FloatArray | N
             for v in roadmap.nearest(points[end]):
                 links[end].add(v)
                 ends.setdefault(v, []).append(end)
-    known_free = {(min(a, b), max(a, b)) for a, b in zip(chain[:-1], chain[1:])}   # the planned path
     static: dict[tuple[int, int], bool] = {}
     dynamic: dict[tuple[int, int], frozenset[int]] = {}
     node_objs: dict[int, frozenset[int]] = {}
@@ -217,33 +246,17 @@ def _timed(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray,
     bounds = [0, *cuts, len(nodes) - 1]
     # Rounded as the program states them, so the written program is exactly the motion timed.
     pieces = [as_written_joints(_shortcut(ctx, points[nodes[a:b + 1]])) for a, b in zip(bounds[:-1], bounds[1:])]
-    segments: list[Segment] = []
-    stages: list[Stage] = []
-    waypoints: list[FloatArray] = [pieces[0][0]]
-    t = t_block
-    q_now = np.asarray(q_rest, dtype=float)
-    for p, piece in enumerate(pieces):
-        last = p == len(pieces) - 1
-        junction = time_junction(
-            ctx.robot, ctx.world, ctx.robot.limits, q_now, piece, kind, label,
-            before if p == 0 else None, after if last else None,
-            tcp_speed=ctx.tcp_speed, speed=ctx.speed, jerk_limited=ctx.jerk_limited, flyby=False,
-        )
-        block = list(junction.segments)
-        check = block + ([dwell(block[-1].q[-1], action_s, kind="weld", label="")] if last and q_action is not None
-                         else [])
-        if p > 0:
-            w = wait_at_rest(ctx.dynamic_world, check, t, ctx.windows, index, ctx.doors)
-            if w is not None:
-                segments.append(dwell(q_now, w.seconds, kind="wait", label=f"wait for {w.obstacle}"))
-                stages.append(Stage(len(waypoints) - 1, w))
-                t += w.seconds
-        elif first_dynamic_hit(ctx.dynamic_world, check, t) is not None:
-            raise _StageFailed("the first piece meets a dynamic obstacle as timed")
-        segments.extend(block)
-        t += sum(s.duration for s in block)
-        q_now = np.asarray(block[-1].q[-1], dtype=float)
-        waypoints.extend(piece[1:])
+    # One corner and one junction radius for every piece (the program states one per transition),
+    # the largest that times and stays free in every piece; the pieces stop where they wait.
+    for rj_deg, rd_deg in STAGED_RADII_DEG:
+        timed = _pieces(ctx, index, t_block, q_rest, pieces, kind, label, before, after, action_s, q_action,
+                        math.radians(rj_deg), math.radians(rd_deg))
+        if timed is not None:
+            break
+    if timed is None:
+        raise _StageFailed("the pieces cannot be timed")
+    segments, stages, t, extension = timed
+    waypoints = [pieces[0][0], *(q for piece in pieces for q in piece[1:])]
     if q_action is not None:
         # The retract after the action leaves along the approach line: nothing may close on it then.
         t_out = t + action_s
@@ -251,7 +264,51 @@ def _timed(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray,
         objs = ctx.conflicts.segment(np.asarray(waypoints[-1]), np.asarray(q_action))
         if any(w0 <= t_out + retract_s and w1 >= t_out for w0, w1 in ctx.conflicts.windows_of(objs)):
             raise _StageFailed("a dynamic obstacle would close on the retract after the action")
-    return StagedJunction(segments, np.array(waypoints), tuple(stages), route)
+    return StagedJunction(segments, np.array(waypoints), tuple(stages), route, math.radians(rj_deg),
+                          math.radians(rd_deg), extension)
+
+
+def _pieces(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray, pieces: list[FloatArray], kind: str,
+            label: str, before: WeldEnd | None, after: WeldEnd | None, action_s: float, q_action: FloatArray | None,
+            rj: float, rd: float) -> tuple[list[Segment], list[Stage], float, Extension] | None:
+    """The pieces timed with radii rj, rd, each wait the shortest at rest; None where one cannot be."""
+    segments: list[Segment] = []
+    stages: list[Stage] = []
+    t = t_block
+    q_now = np.asarray(q_rest, dtype=float)
+    at = 0
+    retract = Extension()
+    for p, piece in enumerate(pieces):
+        last = p == len(pieces) - 1
+        junction = time_junction_at(ctx.robot, ctx.world, ctx.robot.limits, q_now, piece, kind, label,
+                                    before if p == 0 else None, after if last else None, rj, rd,
+                                    tcp_speed=ctx.tcp_speed, speed=ctx.speed, jerk_limited=ctx.jerk_limited)
+        if junction is None:
+            return None
+        block = list(junction.segments)
+        check = block + ([dwell(block[-1].q[-1], action_s, kind="weld", label="")] if last and q_action is not None
+                         else [])
+        if p > 0:
+            try:
+                w = wait_at_rest(ctx.dynamic_world, check, t, ctx.windows, index, ctx.doors)
+            except WaitingError:
+                return None
+            if w is not None:
+                segments.append(dwell(q_now, w.seconds, kind="wait", label=f"wait for {w.obstacle}"))
+                stages.append(Stage(at, w))
+                t += w.seconds
+        elif first_dynamic_hit(ctx.dynamic_world, check, t) is not None:
+            return None                       # the first piece meets a dynamic obstacle as timed
+        segments.extend(block)
+        t += sum(s.duration for s in block)
+        q_now = np.asarray(block[-1].q[-1], dtype=float)
+        at += len(piece) - 1
+        ext = junction.extension
+        if p == 0:
+            retract = Extension(ext.retract_T, ext.retract_q, None)
+        if last:
+            retract = Extension(retract.retract_T, retract.retract_q, ext.approach_q)
+    return segments, stages, t, retract
 
 
 def _shortcut(ctx: JunctionContext, piece: FloatArray) -> FloatArray:

@@ -4,6 +4,7 @@ waits for dynamic obstacles; the spot plans as the program states them."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -26,6 +27,7 @@ from robomax_py.plan.results import (
 )
 from robomax_py.plan.sequence import Tour
 from robomax_py.plan.roadmap import Roadmap
+from robomax_py.plan.tcp_route import TcpSpace, dynamic_boxes, tcp_space
 from robomax_py.plan.timed_moves import DynamicConflicts, JunctionContext, StagedJunction, staged_junction
 from robomax_py.plan.waiting import WaitingError, schedule_waits, wait_at_rest
 from robomax_py.program import (
@@ -68,28 +70,34 @@ def time_tour(
     q_now = as_written_joints(cell.home)
     spec_of = [cell.seams[spots[i].seam_index].spots[spots[i].spot_index] for i in tour.order]
     weld_times = [written_seconds(cell.process.weld_time_of(spot)) for spot in spec_of]
-    for k, trans in enumerate(transitions):
-        progress("timing", k, len(transitions))
+    def junction_block(k: int, q_start: FloatArray) -> tuple[list[Segment], Transition]:
+        """Junction k timed from q_start, and the action after it."""
         before = ends[k - 1] if k > 0 else None
         after = ends[k] if k < len(ends) else None
-        waypoints = as_written_joints(trans.waypoints)      # the first row: where the retract ends
-        trans = replace(trans, waypoints=waypoints)
+        waypoints = as_written_joints(transitions[k].waypoints)      # the first row: where the retract ends
+        trans = replace(transitions[k], waypoints=waypoints)
         junction = time_junction(
-            robot, world, robot.limits, q_now, waypoints, trans.kind, trans.label, before, after,
+            robot, world, robot.limits, q_start, waypoints, trans.kind, trans.label, before, after,
             tcp_speed=written_tcp_speed(options.tcp_speed * options.speed),
             speed=written_speed(options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)),
             jerk_limited=options.jerk_limited, flyby=options.blend,
         )
         block = list(junction.segments)
         ext = junction.extension
-        timed.append(replace(trans, blend_radius=junction.corner_radius, flyby_radius=junction.junction_radius,
-                             retract_T=ext.retract_T, retract_q=ext.retract_q, approach_q=ext.approach_q))
-        q_now = block[-1].q[-1]
         if after is not None:
-            block.append(dwell(q_now, weld_times[k], kind="weld", label=after.label))
+            block.append(dwell(block[-1].q[-1], weld_times[k], kind="weld", label=after.label))
+        return block, replace(trans, blend_radius=junction.corner_radius, flyby_radius=junction.junction_radius,
+                              retract_T=ext.retract_T, retract_q=ext.retract_q, approach_q=ext.approach_q)
+
+    for k in range(len(transitions)):
+        progress("timing", k, len(transitions))
+        block, trans = junction_block(k, q_now)
+        timed.append(trans)
         blocks.append(block)
+        q_now = block[-1].q[-1]
     if cell.dynamic:
-        blocks, timed = _with_dynamic(cell, robot, world, roadmap, blocks, timed, ends, weld_times, options)
+        blocks, timed = _with_dynamic(cell, robot, world, roadmap, blocks, timed, ends, weld_times, options,
+                                      junction_block)
     segments = [s for block in blocks for s in block]
     progress("timing", len(transitions), len(transitions))
     traj = resample(concatenate(segments))
@@ -162,9 +170,16 @@ def approach_extension(approach: float, q_spot: FloatArray, q_app: FloatArray, T
     return float(min(EXTENSION_MARGIN * cut, MAX_EXTENSION_M))
 
 
+def _tcp_space(cell: CellSpec, robot: RobotModel) -> TcpSpace:
+    """The TCP's free voxels of the static cell, the dynamic objects' boxes marked with their windows."""
+    static = build_scene(replace(cell, dynamic=()), robot)
+    return tcp_space(static, robot, cell.process.clearance, dynamic_boxes(build_scene(cell, robot)))
+
+
 def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, roadmap: Roadmap | None,
                   blocks: list[list[Segment]], timed: list[Transition], ends: list[WeldEnd], weld_times: list[float],
-                  options: PlanOptions) -> tuple[list[list[Segment]], list[Transition]]:
+                  options: PlanOptions, retime: Callable[[int, FloatArray], tuple[list[Segment], Transition]],
+                  ) -> tuple[list[list[Segment]], list[Transition]]:
     """The blocks in time order with their waits for the dynamic obstacles: at rest before a blocked
     junction (`planner.dynamic: rest`), or also the time-aware junction (`timed_moves`) where it
     finishes sooner (`timed`, the default)."""
@@ -179,12 +194,16 @@ def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, road
     ctx = JunctionContext(robot, world, dynamic_world, DynamicConflicts(cell, robot), roadmap, windows, doors,
                           tcp_speed=written_tcp_speed(options.tcp_speed * options.speed),
                           speed=written_speed(options.speed), jerk_limited=options.jerk_limited,
-                          max_wait=cell.planner.max_wait)
+                          max_wait=cell.planner.max_wait, tcp=_tcp_space(cell, robot))
     out_blocks: list[list[Segment]] = []
     out_timed: list[Transition] = []
     t = 0.0
     for k, block in enumerate(blocks):
         trans = timed[k]
+        if out_blocks and not np.array_equal(out_blocks[-1][-1].q[-1], block[0].q[0]):
+            # A time-aware junction before ended its line at the spot a hair away (its own LIN
+            # solution): this one is timed again from there, so the program states what was timed.
+            block, trans = retime(k, np.asarray(out_blocks[-1][-1].q[-1]))
         try:
             rest = wait_at_rest(dynamic_world, block, t, windows, k, doors)
             rest_error = None
@@ -204,11 +223,15 @@ def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, road
             np.asarray(block[-1].q[0]) if has_action else None)
         rest_end = math.inf if rest is None else t + rest.seconds + sum(s.duration for s in block)
         if isinstance(staged, StagedJunction):
-            new_block = staged.segments + block[-1:] if has_action else staged.segments
+            action = block[-1]
+            new_block = staged.segments + ([dwell(staged.segments[-1].q[-1], action.duration, kind=action.kind,
+                                                   label=action.label)] if has_action else [])
             if t + sum(s.duration for s in new_block) < rest_end - 1e-9:
                 out_blocks.append(new_block)
-                out_timed.append(replace(trans, waypoints=staged.waypoints, stages=staged.stages, blend_radius=0.0,
-                                         flyby_radius=0.0, retract_T=None, retract_q=None, approach_q=None))
+                ext = staged.extension
+                out_timed.append(replace(trans, waypoints=staged.waypoints, stages=staged.stages,
+                                         blend_radius=staged.corner_radius, flyby_radius=staged.junction_radius,
+                                         retract_T=ext.retract_T, retract_q=ext.retract_q, approach_q=ext.approach_q))
                 t += sum(s.duration for s in new_block)
                 continue
         if rest is None:

@@ -16,7 +16,7 @@ windows are for the search to weigh).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import coal
 import numpy as np
@@ -41,6 +41,8 @@ class VoxelMap:
     precision: float
     inflation: float
     coal_tests: int
+    # Per depth: (cells per axis, sorted integer keys, leaf index of each key); built on first use.
+    _index: list[tuple[int, np.ndarray, np.ndarray]] = field(default_factory=list, repr=False, compare=False)
 
     def leaf_of(self, points: FloatArray) -> np.ndarray:
         """(P,) index of the leaf holding each point (base frame, m); -1 outside the root.
@@ -51,18 +53,20 @@ class VoxelMap:
         out = np.full(len(p), -1, dtype=np.int64)
         rel = (p - self.root_corner) / self.root_edge                    # in [0, 1) inside the root
         inside = np.all((rel >= 0.0) & (rel < 1.0), axis=1)
-        for depth in np.unique(self.level):
-            n = 1 << int(depth)
-            leaves = np.flatnonzero(self.level == depth)
-            cells = np.round((self.corner[leaves] - self.root_corner) / self.root_edge * n).astype(np.int64)
-            keys = (cells[:, 0] * n + cells[:, 1]) * n + cells[:, 2]
-            order = np.argsort(keys)
-            keys = keys[order]
+        if not self._index:
+            for depth in np.unique(self.level):
+                n = 1 << int(depth)
+                leaves = np.flatnonzero(self.level == depth)
+                cells = np.round((self.corner[leaves] - self.root_corner) / self.root_edge * n).astype(np.int64)
+                keys = (cells[:, 0] * n + cells[:, 1]) * n + cells[:, 2]
+                order = np.argsort(keys)
+                self._index.append((n, keys[order], leaves[order]))
+        for n, keys, leaves in self._index:
             at = np.minimum((rel * n).astype(np.int64), n - 1)
             want = (at[:, 0] * n + at[:, 1]) * n + at[:, 2]
             pos = np.clip(np.searchsorted(keys, want), 0, len(keys) - 1)
             hit = inside & (out < 0) & (keys[pos] == want)
-            out[hit] = leaves[order[pos[hit]]]
+            out[hit] = leaves[pos[hit]]
         return out
 
     def is_free(self, points: FloatArray) -> BoolArray:

@@ -263,3 +263,28 @@ def test_dynamic_objects_are_visible_only_in_their_windows(planned: tuple[Path, 
     shown_at = {round(k["time"] / 10, 6): k["value"] for k in track["keys"]}
     assert len(shown_at) == content.frames == 21
     assert [s for s, v in sorted(shown_at.items()) if v] == [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 1.5, 1.6, 1.7, 1.8, 1.9, 2.0]
+
+
+def test_voxels_are_drawn_as_the_blocked_leaves(planned: tuple[Path, Path], tmp_path: Path) -> None:
+    """`preview --voxels`: one point cloud of the blocked leaves' centres (world frame), sized to
+    the precision limit; a precision out of range is refused."""
+    from dataclasses import replace
+
+    from robomax_py.world.scene import build_scene
+    from robomax_py.world.voxels import build_voxels
+
+    cell_path, _ = planned
+    cell = load_cell(cell_path)
+    robot = load_cell_robot(cell)
+    vmap = build_voxels(build_scene(replace(cell, dynamic=()), robot), np.array([-2.0, -2.0, -0.5]),
+                        np.array([2.0, 2.0, 3.5]), 0.08)
+    rec = Recorder()
+    content = populate(meshcat.Visualizer(window=rec), cell, robot, home_program(cell), voxels=vmap)
+    assert content.voxels == int((~vmap.free).sum()) > 0
+    (cloud,) = [c for c in rec.commands if c["type"] == "set_object" and c["path"] == "/meshcat/robomax/voxels"]
+    assert cloud["object"]["materials"][0]["size"] == pytest.approx(0.08)
+    result = runner.invoke(app, ["preview", str(cell_path), "--voxels", "0.04", "--html", str(tmp_path / "v.html")])
+    assert result.exit_code == EXIT_OK, result.output
+    assert "blocked voxels" in result.output and (tmp_path / "v.html").is_file()
+    refused = runner.invoke(app, ["preview", str(cell_path), "--voxels", "0", "--html", str(tmp_path / "w.html")])
+    assert refused.exit_code == 2 and not (tmp_path / "w.html").exists()

@@ -126,18 +126,24 @@ def main() -> None:
     if args.variants:
         rng = np.random.default_rng(args.seed)
         gains = []
+        outcomes: list[tuple[bool, bool]] = []
         print(f"\n{args.variants} seeded schedules (seed {args.seed}):")
         for i in range(args.variants):
             v = variant(cell, rng)
             (timed, _), (rest, _) = plan(v, robot, "timed"), plan(v, robot, "rest")
             if timed.status != "planned" or rest.status != "planned":
-                print(f"  {i}: timed {timed.status}, rest {rest.status}: {(timed.message or rest.message)[:90]}")
+                failed = rest if rest.status != "planned" else timed
+                print(f"  {i}: timed {timed.status}, rest {rest.status}: {failed.message[:100]}")
+                outcomes.append((timed.status == "planned", rest.status == "planned"))
                 continue
+            outcomes.append((True, True))
             gain = 100 * (1 - timed.cycle_time / rest.cycle_time)
             gains.append(gain)
             print(f"  {i}: rest {rest.cycle_time:7.3f} s, timed {timed.cycle_time:7.3f} s, shorter by {gain:5.2f} %")
+        print(f"planned: timed {sum(t for t, _ in outcomes)}, rest {sum(r for _, r in outcomes)} of {len(outcomes)}")
         if gains:
-            print(f"gain: min {min(gains):.2f} %, median {statistics.median(gains):.2f} %, max {max(gains):.2f} %")
+            print(f"gain where both planned: min {min(gains):.2f} %, median {statistics.median(gains):.2f} %, "
+                  f"max {max(gains):.2f} %")
 
 
 if __name__ == "__main__":

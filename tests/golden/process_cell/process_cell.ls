@@ -17,7 +17,7 @@ TCD:  STACK_SIZE	= 0,
 DEFAULT_GROUP	= 1,*,*,*,*;
 CONTROL_CODE	= 00000000 00000000;
 /MN
-   1:  ! robomax_py 0.1.0 | cell process_cell | cell file sha256 07f708353b0dad51ba9d46e96786d44c0ddddf6af2bade2bc086e21390f48d4c | planned cycle 5.706 s ;
+   1:  ! robomax_py 0.1.0 | cell process_cell | cell file sha256 07f708353b0dad51ba9d46e96786d44c0ddddf6af2bade2bc086e21390f48d4c | planned cycle 5.460 s ;
    2:  ! robot kr125 | tool spot_gun_c | axes joint_a1 joint_a2 joint_a3 joint_a4 joint_a5 joint_a6 ;
    3:  PR[1]=LPOS ;
    4:  PR[1]=PR[1]-PR[1] ;
@@ -32,8 +32,8 @@ CONTROL_CODE	= 00000000 00000000;
   13:  UFRAME_NUM=0 ;
   14:  J P[1] 100% FINE ;
   15:  WAIT DI[1:clamp1_closed]=ON ;
-  16:  J P[2] 100% FINE ;
-  17:  J P[3] 100% FINE ;
+  16:  J P[2] 100% CNT100 ;
+  17:  J P[3] 100% CNT10 ;
   18:  L P[4] 500mm/sec FINE ;
   19:  CALL SPOT_WELD(1,0.500) ;
   20:  ! flange/s7 gun 2 schedule 4 ;
@@ -62,8 +62,8 @@ P[2]{
 P[3]{
    GP1:
 	UF : 0, UT : 1,
-	J1= 6.6170 deg,	J2= -98.6987 deg,	J3= 133.6861 deg,
-	J4= -5.2077 deg,	J5= 45.3595 deg,	J6= -162.7116 deg
+	J1= 6.3938 deg,	J2= -97.7023 deg,	J3= 132.6311 deg,
+	J4= -5.1505 deg,	J5= 45.4012 deg,	J6= -162.9750 deg
 };
 P[4]{
    GP1:
