@@ -1,16 +1,17 @@
-"""Voxel free space of a cell's static objects, refined adaptively (an octree), for searches of the
-TCP's path in the work space (issue 20's first part; not used by the planner yet).
+"""Voxel free space of a cell's static objects, refined adaptively (an octree), for the TCP's
+route through the work space (`plan.tcp_route`) and the preview (`preview --voxels`).
 
-The root is a cube over the given bounds. A node whose box is farther than `inflation` from every
-static object is a free leaf; a node within `inflation` of one is split into its eight octants
-until its edge would fall below `precision`, and is then a blocked leaf. So free space near the
-objects is resolved to `precision` and far from them in large boxes, and a free leaf is provably
-free: coal decides "within `inflation`" exactly (a box against each object piece with that
-security margin), after an AABB test in numpy that only skips pieces whose inflated AABB the node
-misses. A node inside a convex piece (a box, a convex part) is a blocked leaf at once, so the
-inside of a table is not refined. Blocked leaves are conservative: a leaf at the precision limit
-that touches the inflated object counts as blocked even where most of it is free. Dynamic objects are left out (their time
-windows are for the search to weigh).
+The root is a cube over the given bounds. A node whose cube, grown by `inflation` on every side,
+meets no object is a free leaf; any other node is split into its eight octants until its edge
+would fall below `precision`, and is then a blocked leaf. So free space near the objects is
+resolved to `precision` and far from them in large boxes. The test is compiled
+(`voxel_kernels`: the grown cube against the objects' triangles, separating axes): a grown cube
+holds every point within `inflation` of the cube, so a free leaf is provably farther than
+`inflation` from every object (tested against coal's distance). A node inside a convex piece (a
+box, a convex part) is a blocked leaf at once, so the inside of a table is not refined; cylinders,
+spheres and capsules count as their bounding boxes. Blocked leaves are conservative: a leaf at the
+precision limit that touches the grown object counts as blocked even where most of it is free.
+Dynamic objects are left out (their time windows are for the search to weigh).
 """
 
 from __future__ import annotations
@@ -24,8 +25,9 @@ import numpy as np
 from scipy.spatial import ConvexHull
 
 from robomax_py._typing import BoolArray, FloatArray
-from robomax_py.world.bounds import support_points
+from robomax_py.world.bounds import support_points, triangles
 from robomax_py.world.scene import Scene
+from robomax_py.world.voxel_kernels import TriangleGrid
 
 
 @dataclass(frozen=True, slots=True)
@@ -40,7 +42,7 @@ class VoxelMap:
     root_edge: float             # m
     precision: float
     inflation: float
-    coal_tests: int
+    tests: int                   # triangle-cube tests made
     # Per depth: (cells per axis, sorted integer keys, leaf index of each key); built on first use.
     _index: list[tuple[int, np.ndarray, np.ndarray]] = field(default_factory=list, repr=False, compare=False)
 
@@ -84,23 +86,21 @@ def build_voxels(scene: Scene, lo: FloatArray, hi: FloatArray, precision: float,
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
     if not (np.isfinite(lo).all() and np.isfinite(hi).all() and (hi > lo).all()):
         raise ValueError("the bounds must be finite with hi > lo on every axis")
-    pieces = []
+    tris = []
     solids = []                                # (piece, plane normals (f, 3), offsets (f,)) of convex pieces
     for obj in scene.obstacles:
         T = np.asarray(obj.T_base_object, dtype=float)
         for geom in obj.pieces:
             pts = support_points(geom, T)
-            if isinstance(geom, (coal.Box, coal.ConvexBase)):
-                # The piece is exactly the hull of these points: a node inside it is blocked whole.
-                hull = ConvexHull(pts)
-                solids.append((len(pieces), hull.equations[:, :3], -hull.equations[:, 3]))
-            pieces.append((geom, coal.Transform3s(T[:3, :3], T[:3, 3]),
-                           pts.min(axis=0) - inflation, pts.max(axis=0) + inflation))
-    box_lo = np.array([p[2] for p in pieces]).reshape(-1, 3)
-    box_hi = np.array([p[3] for p in pieces]).reshape(-1, 3)
-    request = coal.CollisionRequest()
-    request.security_margin = float(inflation)
-    request.enable_contact = True          # coal 3.0.3 misses some overlaps without it (see acm.configure_requests)
+            if isinstance(geom, coal.BVHModelBase):
+                tris.append(pts[triangles(geom)])
+                continue
+            # A convex piece is exactly the hull of these points (any other primitive lies inside
+            # the hull of its bounding box): a node inside it is blocked whole.
+            hull = ConvexHull(pts)
+            tris.append(pts[hull.simplices])
+            solids.append((len(solids), hull.equations[:, :3], -hull.equations[:, 3]))
+    grid = TriangleGrid(np.concatenate(tris) if tris else np.zeros((0, 3, 3)), precision)
 
     size = float((hi - lo).max())
     corners = lo[None, :].copy()
@@ -110,21 +110,11 @@ def build_voxels(scene: Scene, lo: FloatArray, hi: FloatArray, precision: float,
     depth = 0
     octants = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], dtype=float)
     while len(corners):
-        # Pieces whose inflated AABB each node overlaps (numpy); coal for those only.
-        overlap = np.all((corners[:, None, :] <= box_hi[None]) &
-                         (corners[:, None, :] + edges[:, None, None] >= box_lo[None]), axis=2)
-        touching = np.zeros(len(corners), dtype=bool)
-        for n in np.flatnonzero(overlap.any(axis=1)):
-            half = edges[n] / 2
-            node = coal.Box(edges[n], edges[n], edges[n])
-            place = coal.Transform3s(np.eye(3), corners[n] + half)
-            for m in np.flatnonzero(overlap[n]):
-                geom, T, _, _ = pieces[m]
-                tests += 1
-                if coal.collide(node, place, geom, T, request, coal.CollisionResult()):
-                    touching[n] = True
-                    break
+        # The cube grown by the inflation against the triangles (compiled), then the solids' insides.
+        touching, used = grid.touching(corners + edges[:, None] / 2, edges / 2 + inflation)
+        tests += used
         inside = _inside_a_solid(corners, edges, solids, octants)
+        touching |= inside
         split = touching & ~inside & (edges / 2 >= precision)
         leaf = ~split
         out_corner.append(corners[leaf])
@@ -136,7 +126,7 @@ def build_voxels(scene: Scene, lo: FloatArray, hi: FloatArray, precision: float,
         edges = np.repeat(edges[split] / 2, 8)
     return VoxelMap(corner=np.concatenate(out_corner), edge=np.concatenate(out_edge), free=np.concatenate(out_free),
                     level=np.concatenate(out_level), root_corner=lo, root_edge=size, precision=precision,
-                    inflation=inflation, coal_tests=tests)
+                    inflation=inflation, tests=tests)
 
 
 def _inside_a_solid(corners: FloatArray, edges: FloatArray, solids: list[tuple[int, FloatArray, FloatArray]],

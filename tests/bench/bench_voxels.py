@@ -30,7 +30,7 @@ LO, HI = np.array([-3.2, -3.2, -0.5]), np.array([3.2, 3.2, 2.9])
 
 def main() -> None:
     cells = [Path(a) for a in sys.argv[1:]] or CELLS
-    print(f"{'cell':28s} {'mm':>4s} {'leaves':>9s} {'free':>8s} {'coal tests':>11s} {'CPU s':>7s}")
+    print(f"{'cell':28s} {'mm':>4s} {'leaves':>9s} {'free':>8s} {'tests':>11s} {'CPU s':>7s}")
     for path in cells:
         cell = load_cell(path)
         scene = build_scene(cell, load_cell_robot(cell))
@@ -41,7 +41,7 @@ def main() -> None:
                 v = build_voxels(scene, LO, HI, precision)
                 seconds.append(time.process_time() - t0)
             print(f"{path.parent.name + '/' + path.stem:28s} {precision * 1000:4.0f} {len(v.edge):9,} "
-                  f"{int(v.free.sum()):8,} {v.coal_tests:11,} {statistics.median(seconds):7.2f}", flush=True)
+                  f"{int(v.free.sum()):8,} {v.tests:11,} {statistics.median(seconds):7.2f}", flush=True)
 
 
 if __name__ == "__main__":
