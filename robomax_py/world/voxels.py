@@ -87,7 +87,7 @@ def build_voxels(scene: Scene, lo: FloatArray, hi: FloatArray, precision: float,
     if not (np.isfinite(lo).all() and np.isfinite(hi).all() and (hi > lo).all()):
         raise ValueError("the bounds must be finite with hi > lo on every axis")
     tris = []
-    solids = []                                # (piece, plane normals (f, 3), offsets (f,)) of convex pieces
+    solids = []                                # (AABB lo, hi, plane normals (f, 3), offsets (f,)) of convex pieces
     for obj in scene.obstacles:
         T = np.asarray(obj.T_base_object, dtype=float)
         for geom in obj.pieces:
@@ -99,7 +99,7 @@ def build_voxels(scene: Scene, lo: FloatArray, hi: FloatArray, precision: float,
             # the hull of its bounding box): a node inside it is blocked whole.
             hull = ConvexHull(pts)
             tris.append(pts[hull.simplices])
-            solids.append((len(solids), hull.equations[:, :3], -hull.equations[:, 3]))
+            solids.append((pts.min(axis=0), pts.max(axis=0), hull.equations[:, :3], -hull.equations[:, 3]))
     grid = TriangleGrid(np.concatenate(tris) if tris else np.zeros((0, 3, 3)), precision)
 
     size = float((hi - lo).max())
@@ -129,17 +129,18 @@ def build_voxels(scene: Scene, lo: FloatArray, hi: FloatArray, precision: float,
                     inflation=inflation, tests=tests)
 
 
-def _inside_a_solid(corners: FloatArray, edges: FloatArray, solids: list[tuple[int, FloatArray, FloatArray]],
+def _inside_a_solid(corners: FloatArray, edges: FloatArray, solids: list[tuple[FloatArray, FloatArray, FloatArray, FloatArray]],
                     octants: FloatArray) -> BoolArray:
     """Whether each node box lies inside one convex piece (all eight corners within its planes)."""
     out = np.zeros(len(corners), dtype=bool)
     if not solids or not len(corners):
         return out
-    pts = corners[:, None, :] + octants[None] * edges[:, None, None]          # (N, 8, 3)
-    for _, normals, offsets in solids:
-        todo = ~out
-        if not todo.any():
-            break
-        side = pts[todo] @ normals.T                                         # (n, 8, f)
-        out[np.flatnonzero(todo)[np.all(side <= offsets - 1e-12, axis=(1, 2))]] = True
+    for lo, hi, normals, offsets in solids:
+        # Only a node inside the solid's bounding box can be inside the solid.
+        todo = np.flatnonzero(~out & np.all(corners >= lo, axis=1) & np.all(corners + edges[:, None] <= hi, axis=1))
+        if not len(todo):
+            continue
+        pts = corners[todo, None, :] + octants[None] * edges[todo, None, None]   # (n, 8, 3)
+        side = pts @ normals.T                                                    # (n, 8, f)
+        out[todo[np.all(side <= offsets - 1e-12, axis=(1, 2))]] = True
     return out
