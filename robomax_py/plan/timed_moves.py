@@ -153,7 +153,10 @@ def staged_junction(ctx: JunctionContext, index: int, t_block: float, q_rest: Fl
         if not isinstance(route, NoRoute):
             followed = follow(ctx.robot, ctx.world, route, waypoints[0], waypoints[-1])
             if followed is not None:
-                chains.append(followed[1:-1])
+                # Its points are close together (the arm follows the TCP's line); the search times
+                # each edge from rest to rest, so only the corners it needs are kept: the last
+                # point before a dynamic object, where it may wait, survives.
+                chains.append(_compress(ctx, followed)[1:-1])
     graph, points = _graph(ctx, waypoints, q_action, tail_s, chains)
     start, goal = len(points) - 2, len(points) - 1
     found = timed_astar(graph, start, goal, t_block + retract_s, ctx.max_wait)
@@ -309,6 +312,19 @@ def _pieces(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray
         if last:
             retract = Extension(retract.retract_T, retract.retract_q, ext.approach_q)
     return segments, stages, t, retract
+
+
+def _compress(ctx: JunctionContext, path: FloatArray) -> FloatArray:
+    """A dense joint path shortcut between the points where the set of dynamic objects it touches
+    changes: those points (the last one clear of a door, the first one in its way) are kept."""
+    touched = [ctx.conflicts.point(q) for q in path]
+    keep = [0, *(i for i in range(1, len(path) - 1) if touched[i] != touched[i - 1] or touched[i] != touched[i + 1]),
+            len(path) - 1]
+    keep = sorted(set(keep))
+    out = [path[:1]]
+    for a, b in zip(keep[:-1], keep[1:]):
+        out.append(_shortcut(ctx, path[a:b + 1])[1:])
+    return np.vstack(out)
 
 
 def _shortcut(ctx: JunctionContext, piece: FloatArray) -> FloatArray:
