@@ -130,6 +130,7 @@ class SpotSpec:
     # and the machine whose door the station lies behind.
     action: Literal["grip", "release"] | None = None
     machine: str | None = None
+    key: str | None = None                    # where the cell file states it, when not seams[i].spots[j]
 
 
 @dataclass(frozen=True, slots=True, eq=False)

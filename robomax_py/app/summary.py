@@ -67,4 +67,13 @@ def cell_summary(cell: CellSpec, robot: Any) -> Group:
             f"±{math.degrees(seam.alpha_max):g} / ±{math.degrees(seam.beta_max):g}",
             f"[{g0:g}, {g1:g}]", str(seam.grid), str(seam.grid ** 3),
         )
-    return Group(head, objects, seams)
+    if not cell.machines:
+        return Group(head, objects, seams)
+    machines = Table(title="machines", title_justify="left")
+    for col in ("machine", "door", "closed (machining)", "stations"):
+        machines.add_column(col)
+    for m in cell.machines:
+        windows = ", ".join(f"[{a:g}, {b:g}]" for a, b in m.windows[:3]) + (" ..." if len(m.windows) > 3 else "") + " s"
+        visits = sorted({s.name.split("_", 1)[1] for seam in cell.seams for s in seam.spots if s.machine == m.name})
+        machines.add_row(m.name, m.door, windows, ", ".join(visits))
+    return Group(head, objects, seams, machines)

@@ -525,6 +525,7 @@ def _tending_seams(parsed: CellFile, path: Path) -> tuple[SeamSpec, ...]:
                 name=visit, xyz=frozen_array(st.xyz), normal=frozen_array(-R[:, 2]), direction=frozen_array(R[:, 0]),
                 weld_time=tending.gripper.grip if st.action == "grip" else tending.gripper.release,
                 angles=(0.0, 0.0, 0.0), config=st.config, action=st.action, machine=st.machine,
+                key=f"tending.stations[{stations[name]}]",
             ))
     return (SeamSpec(name=TENDING_SEAM, ordered=True, alpha_max=0.0, beta_max=0.0, gamma_range=(0.0, 0.0), grid=1,
                      spots=tuple(spots)),)

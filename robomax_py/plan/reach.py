@@ -35,7 +35,7 @@ class SpotReach:
 
     seam: str
     name: str
-    key: str                 # seams[i].spots[j]
+    key: str                 # seams[i].spots[j], or where the cell file states the spot
     distance_m: float        # from the shoulder circle to the reference point, best orientation
     reach_m: float           # the longest that distance can be
 
@@ -93,7 +93,7 @@ def reach_report(cell: CellSpec, robot: RobotModel) -> list[SpotReach]:
         d = _distance_to_circle(ref, rm)                            # (s, o)
         best = d.min(axis=1)
         for j, spot in enumerate(seam.spots):
-            out.append(SpotReach(seam.name, spot.name, f"seams[{i}].spots[{j}]", float(best[j]), rm.reach))
+            out.append(SpotReach(seam.name, spot.name, spot.key or f"seams[{i}].spots[{j}]", float(best[j]), rm.reach))
     return out
 
 

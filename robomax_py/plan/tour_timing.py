@@ -28,6 +28,7 @@ from robomax_py.plan.results import (
 from robomax_py.plan.sequence import Tour
 from robomax_py.plan.roadmap import Roadmap
 from robomax_py.plan.tcp_route import TcpSpace, dynamic_boxes, tcp_space
+from robomax_py.plan.timed_search import NoRoute
 from robomax_py.plan.timed_moves import DynamicConflicts, JunctionContext, StagedJunction, staged_junction
 from robomax_py.plan.waiting import WaitingError, schedule_waits, wait_at_rest
 from robomax_py.program import (
@@ -236,7 +237,9 @@ def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, road
                 continue
         if rest is None:
             assert rest_error is not None
-            raise rest_error
+            why = staged.detail if isinstance(staged, NoRoute) else "its way finishes no sooner"
+            raise WaitingError(f"{trans.label}: waiting at rest fails ({rest_error}), and so does the time-aware "
+                               f"search ({why}): the schedule cannot be met")
         out_blocks.append([dwell(block[0].q[0], rest.seconds, kind="wait", label=f"wait for {rest.obstacle}"), *block])
         out_timed.append(replace(trans, wait=rest))
         t += rest.seconds + sum(s.duration for s in block)

@@ -30,7 +30,7 @@ from __future__ import annotations
 import argparse
 import math
 import struct
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -809,14 +809,32 @@ def generate(out: Path) -> list[Path]:
     return written
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
-    parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent,
+def write_tool(out: Path, name: str, body: Sequence[trimesh.Trimesh], tips: Sequence[trimesh.Trimesh],
+               tool_yaml: str) -> list[Path]:
+    """A tool's files under ``out`` (the ``robots/`` folder layout): body.stl, tips.stl, tool.yaml."""
+    root = out / "tools" / name
+    root.mkdir(parents=True, exist_ok=True)
+    files = {"body.stl": _stl_bytes(_shells_mesh(body)), "tips.stl": _stl_bytes(_shells_mesh(tips)),
+             "tool.yaml": tool_yaml.encode()}
+    for file, data in files.items():
+        (root / file).write_bytes(data)
+    return [root / file for file in files]
+
+
+def script_main(generate: Callable[[Path], list[Path]], doc: str | None, here: Path,
+                argv: Sequence[str] | None = None) -> int:
+    """A generator script's command line: ``--out DIR`` (default: the robots/ folder), the files printed."""
+    parser = argparse.ArgumentParser(description=doc.split("\n", 1)[0] if doc else None)
+    parser.add_argument("--out", type=Path, default=here,
                         help="output folder (default: the robots/ folder holding this script)")
     args = parser.parse_args(argv)
     for path in generate(args.out):
         print(path)
     return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    return script_main(generate, __doc__, Path(__file__).resolve().parent, argv)
 
 
 if __name__ == "__main__":

@@ -15,7 +15,6 @@ nothing else.
 
 from __future__ import annotations
 
-import argparse
 import importlib.util
 import sys
 from collections.abc import Sequence
@@ -93,28 +92,12 @@ def tool_yaml(g: Gripper) -> str:
 
 def generate(out: Path) -> list[Path]:
     """Write the gripper's files under ``out`` (the ``robots/`` folder layout); returns them in order."""
-    root = out / "tools" / NAME
-    root.mkdir(parents=True, exist_ok=True)
     body, tips = shells(GRIPPER)
-    files = {
-        "body.stl": G._stl_bytes(G._shells_mesh(body)),
-        "tips.stl": G._stl_bytes(G._shells_mesh(tips)),
-        "tool.yaml": tool_yaml(GRIPPER).encode(),
-    }
-    written = []
-    for name, data in files.items():
-        (root / name).write_bytes(data)
-        written.append(root / name)
-    return written
+    return G.write_tool(out, NAME, body, tips, tool_yaml(GRIPPER))
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0] if __doc__ else None)
-    parser.add_argument("--out", type=Path, default=HERE, help="output folder (default: robots/)")
-    args = parser.parse_args(argv)
-    for path in generate(args.out):
-        print(path)
-    return 0
+    return G.script_main(generate, __doc__, HERE, argv)
 
 
 if __name__ == "__main__":

@@ -110,3 +110,11 @@ def test_bad_tending_sections_are_refused_with_the_key(tmp_path: Path, tending: 
     result = runner.invoke(app, ["check", str(path)])
     assert result.exit_code == EXIT_BAD_INPUT
     assert where in result.output and "Traceback" not in result.output
+
+
+def test_a_station_out_of_reach_is_named_by_its_key(tmp_path: Path, tending: dict[str, Any]) -> None:
+    data = copy.deepcopy(tending)
+    data["tending"]["stations"][1]["xyz"] = [2.6, 0.0, 0.75]
+    result = runner.invoke(app, ["check", str(_write(tmp_path, data))])
+    assert result.exit_code == EXIT_BAD_INPUT
+    assert "tending.stations[1]" in result.output and "out of kr16's reach" in result.output
