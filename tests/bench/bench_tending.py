@@ -1,6 +1,6 @@
 """Machine tending with time windows, compared in one run (a script, not a test):
 
-    python tests/bench/bench_tending.py [CELL] [--variants N] [--seed S]
+    python tests/bench/bench_tending.py [CELL] [--variants N] [--seed S] [--cycles 1,2,4,8]
 
 Plans the tending cell (default `cells/tending.yaml`) three ways in the same process:
 - `timed`: the time-aware planner (`planner.dynamic: timed`, the default): time-windowed A* over
@@ -17,7 +17,8 @@ which the robot comes closer than `process.clearance` to a dynamic object while 
 present (dense samples, 10 ms apart). With --variants N it also plans N seeded schedules of the same
 cell (each machine's start, machining time and period drawn at random) both ways and prints the
 cycle-time gain of `timed` over `rest` per variant (never negative by construction: the planner
-keeps a time-aware move only where it finishes sooner).
+keeps a time-aware move only where it finishes sooner). With --cycles it plans the cell with each
+number of cycles instead, both ways, and prints how the CPU seconds grow with the job's size.
 """
 
 from __future__ import annotations
@@ -99,12 +100,44 @@ def variant(cell: CellSpec, rng: np.random.Generator) -> CellSpec:
     return replace(cell, machines=tuple(machines), dynamic=dynamic)
 
 
+def scale(path: Path, counts: list[int]) -> None:
+    """CPU seconds of planning against the number of cycles (station visits grow with it), both ways."""
+    import math
+    import tempfile
+
+    import yaml
+
+    data = yaml.safe_load(path.read_text())
+    rows = []
+    print(f"{'cycles':>6s} {'visits':>6s} {'timed s':>8s} {'rest s':>7s} {'timed cycle':>11s} {'rest cycle':>10s}")
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in counts:
+            data["tending"]["cycles"] = n
+            copy = Path(tmp) / f"tending_{n}.yaml"
+            copy.write_text(yaml.safe_dump(data, sort_keys=False))
+            cell = load_cell(copy)
+            robot = load_cell_robot(cell)
+            (timed, t_cpu), (rest, r_cpu) = plan(cell, robot, "timed"), plan(cell, robot, "rest")
+            rows.append((n, t_cpu, r_cpu))
+            print(f"{n:6d} {len(cell.seams[0].spots):6d} {t_cpu:8.1f} {r_cpu:7.1f} {timed.cycle_time:11.3f} "
+                  f"{rest.cycle_time:10.3f}", flush=True)
+    if len(rows) >= 2:
+        (n0, t0, r0), (n1, t1, r1) = rows[0], rows[-1]
+        print(f"growth from {n0} to {n1} cycles: timed N^{math.log(t1 / t0) / math.log(n1 / n0):.2f}, "
+              f"rest N^{math.log(r1 / r0) / math.log(n1 / n0):.2f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0] if __doc__ else None)
     parser.add_argument("cell", nargs="?", type=Path, default=REPO / "cells" / "tending.yaml")
     parser.add_argument("--variants", type=int, default=0)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--cycles", type=str, default="",
+                        help="comma-separated cycle counts: plan the cell with each, both ways, and print the CPU growth")
     args = parser.parse_args()
+    if args.cycles:
+        scale(args.cell, [int(c) for c in args.cycles.split(",")])
+        return
     cell = load_cell(args.cell)
     robot = load_cell_robot(cell)
     print(f"{cell.name}: {len(cell.seams[0].spots)} station visits, machines "

@@ -1,0 +1,184 @@
+"""Inverse kinematics as a table (Diane and Anikina's associative memory), for any arm.
+
+Every joint is sampled on its own grid, `q_i(j) = q_start + j (q_end - q_start) / (J_i - 1)`, forward
+kinematics fills the rows `Q -> X` of the table, and rows in collision are dropped (once without and
+once with the held part, which gives two tables). The inverse lookup returns the stored
+configuration whose point is nearest the target (`argmin |x - x*|`, a k-d tree), with the distance
+as the lookup's error. The stored points are also the nodes of a k-nearest-neighbour graph over
+which a route between two configurations is found by Dijkstra (edges checked only when a route
+uses them), and a route is followed by damped Jacobian interpolation, `q += J+ (p(t+dt) - p(t))`,
+which keeps the point on the straight line between two nodes within a stated error.
+
+The module knows nothing of the robot: forward kinematics, the Jacobian and the collision test are
+functions handed in, so the same table serves a 6-axis arm, a planar test arm or anything else.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import dijkstra
+from scipy.spatial import cKDTree
+
+from robomax_py._typing import BoolArray, FloatArray
+
+Forward = Callable[[FloatArray], FloatArray]          # (m, n) joint rows -> (m, d) points
+FreeTest = Callable[[FloatArray], BoolArray]          # (m, n) joint rows -> (m,) collision-free
+Jacobian = Callable[[FloatArray], FloatArray]         # (n,) joints -> (d, n) d point / d joints
+
+# Rows filled per call of the forward kinematics and the collision test.
+BATCH = 65_536
+
+
+@dataclass(frozen=True, slots=True)
+class JointGrid:
+    """Per joint: the first and last value (rad, or m) and the number of samples J_i >= 2."""
+
+    start: tuple[float, ...]
+    end: tuple[float, ...]
+    counts: tuple[int, ...]
+
+    def __post_init__(self) -> None:
+        if not (len(self.start) == len(self.end) == len(self.counts)) or not self.counts:
+            raise ValueError("start, end and counts need one entry per joint")
+        if any(c < 2 for c in self.counts):
+            raise ValueError(f"every joint needs at least 2 samples, got {self.counts}")
+
+    @staticmethod
+    def stepped(start: tuple[float, ...], end: tuple[float, ...], counts: int | tuple[int, ...]) -> JointGrid:
+        n = len(start)
+        return JointGrid(tuple(start), tuple(end), (counts,) * n if isinstance(counts, int) else tuple(counts))
+
+    def values(self, i: int) -> FloatArray:
+        j = np.arange(self.counts[i])
+        return self.start[i] + j * (self.end[i] - self.start[i]) / (self.counts[i] - 1)
+
+    @property
+    def size(self) -> int:
+        return int(np.prod(self.counts))
+
+    def rows(self, first: int, count: int) -> FloatArray:
+        """Configurations first .. first + count - 1 of the grid (the last joint fastest)."""
+        idx = np.unravel_index(np.arange(first, min(first + count, self.size)), self.counts)
+        return np.stack([self.values(i)[k] for i, k in enumerate(idx)], axis=1)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class TableIk:
+    """The collision-free rows of a joint grid: configurations q (K, n) and their points x (K, d)."""
+
+    q: FloatArray
+    x: FloatArray
+    grid_size: int                    # rows before collision filtering
+    tree: cKDTree = field(repr=False)
+
+    def __len__(self) -> int:
+        return len(self.q)
+
+    def lookup(self, targets: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """(configurations (m, n), errors (m,)) of the stored points nearest each target (m, d)."""
+        t = np.atleast_2d(np.asarray(targets, dtype=float))
+        dist, idx = self.tree.query(t, k=1)
+        return self.q[idx], np.asarray(dist, dtype=float)
+
+
+def build_table(grid: JointGrid, forward: Forward, free: FreeTest) -> TableIk:
+    """The table of a grid: forward kinematics of every row, the rows in collision dropped."""
+    qs, xs = [], []
+    for first in range(0, grid.size, BATCH):
+        rows = grid.rows(first, BATCH)
+        keep = np.asarray(free(rows), dtype=bool)
+        qs.append(rows[keep])
+        xs.append(np.asarray(forward(rows[keep]), dtype=float))
+    q = np.concatenate(qs) if qs else np.zeros((0, len(grid.counts)))
+    x = np.concatenate(xs) if xs else np.zeros((0, 0))
+    return TableIk(q, x, grid.size, cKDTree(x) if len(x) else cKDTree(np.zeros((1, max(1, x.shape[1] if x.ndim == 2 else 1)))))
+
+
+@dataclass(frozen=True, slots=True)
+class TableRoute:
+    """Stored rows from the start's to the goal's (indices into the table), and the checks spent."""
+
+    nodes: tuple[int, ...]
+    edge_checks: int
+
+
+def route(table: TableIk, start: int, goal: int, k: int, edge_free: Callable[[FloatArray, FloatArray], bool],
+          max_blocked: int = 200) -> TableRoute | None:
+    """Dijkstra over the k-nearest-neighbour graph of the stored points (k >= 3), lengths in the
+    point space; an edge is checked (`edge_free` of its two configurations) only when a shortest
+    route uses it, and a blocked one is dropped and the search repeated (lazily). None: no route."""
+    if k < 3:
+        raise ValueError(f"k must be at least 3, got {k}")
+    n = len(table)
+    kk = min(k + 1, n)
+    dist, idx = table.tree.query(table.x, k=kk)
+    rows = np.repeat(np.arange(n), kk - 1)
+    cols = idx[:, 1:].reshape(-1)
+    w = np.maximum(dist[:, 1:].reshape(-1), np.finfo(float).tiny)
+    pairs = {}
+    for r, c, wt in zip(rows, cols, w):
+        a, b = (int(r), int(c)) if r < c else (int(c), int(r))
+        if a != b:
+            pairs[(a, b)] = float(wt)
+    known: dict[tuple[int, int], bool] = {}
+    checks = 0
+    for _ in range(max_blocked):
+        keys = [e for e in pairs if known.get(e) is not False]
+        if not keys:
+            return None
+        a = np.array([e[0] for e in keys])
+        b = np.array([e[1] for e in keys])
+        graph = csr_matrix((np.array([pairs[e] for e in keys]), (a, b)), shape=(n, n))
+        d, pred = dijkstra(graph, directed=False, indices=start, return_predecessors=True)
+        if not math.isfinite(d[goal]):
+            return None
+        path = [goal]
+        while path[-1] != start:
+            path.append(int(pred[path[-1]]))
+        path.reverse()
+        blocked = False
+        for u, v in zip(path[:-1], path[1:]):
+            e = (min(u, v), max(u, v))
+            if e not in known:
+                checks += 1
+                known[e] = bool(edge_free(table.q[u], table.q[v]))
+            if not known[e]:
+                blocked = True
+                break
+        if not blocked:
+            return TableRoute(tuple(path), checks)
+    return None
+
+
+def jacobian_interpolation(q0: FloatArray, p1: FloatArray, forward: Forward, jacobian: Jacobian, step: float,
+                           damping: float = 1e-3) -> tuple[FloatArray, float]:
+    """Joint rows from q0 moving the point on the straight line to p1 in steps of at most `step`
+    (same unit as the point): q(t + dt) = q(t) + J+ (p(t + dt) - p(t)), J+ the damped least-squares
+    inverse. Returns the rows and the largest distance (point units) of the point from the line."""
+    q = np.asarray(q0, dtype=float).copy()
+    p0 = np.asarray(forward(q[None, :]), dtype=float)[0]
+    p1 = np.asarray(p1, dtype=float)
+    n_steps = max(1, int(math.ceil(float(np.linalg.norm(p1 - p0)) / step)))
+    rows = [q.copy()]
+    worst = 0.0
+    for s in range(1, n_steps + 1):
+        target = p0 + (p1 - p0) * (s / n_steps)
+        p = np.asarray(forward(q[None, :]), dtype=float)[0]
+        J = np.asarray(jacobian(q), dtype=float)
+        # Damped least squares: J^T (J J^T + lambda^2 I)^-1, steady near singular configurations.
+        dq = J.T @ np.linalg.solve(J @ J.T + damping ** 2 * np.eye(J.shape[0]), target - p)
+        q = q + dq
+        rows.append(q.copy())
+        worst = max(worst, _off_line(np.asarray(forward(q[None, :]), dtype=float)[0], p0, p1))
+    return np.array(rows), worst
+
+
+def _off_line(p: FloatArray, a: FloatArray, b: FloatArray) -> float:
+    ab = b - a
+    t = 0.0 if not ab.any() else float(np.clip((p - a) @ ab / (ab @ ab), 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + t * ab)))
