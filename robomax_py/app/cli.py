@@ -311,10 +311,10 @@ def cspace(
 
         from robomax_py.app.cspace_view import map_png, map_summary, spot_wrist
         from robomax_py.cspace import build_map, check_arm, default_workers
-        from robomax_py.world.collision import CollisionWorld
-        from robomax_py.world.scene import build_scene
         from robomax_py.io.cell import load_cell, load_cell_robot
         from robomax_py.io.files import write_atomic_bytes
+        from robomax_py.world.collision import CollisionWorld
+        from robomax_py.world.scene import build_scene
 
         spec = load_cell(cell)
         robot = load_cell_robot(spec)

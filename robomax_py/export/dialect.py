@@ -23,13 +23,13 @@ from robomax_py._typing import FloatArray
 from robomax_py.errors import ExportError, ProgramError
 from robomax_py.program import (
     Comment,
+    Gripper,
     Header,
     Instruction,
     LinMove,
     Program,
     PtpMove,
     Spot,
-    Gripper,
 )
 from robomax_py.robot import RobotModel
 from robomax_py.robot.solve import brand_text_of

@@ -25,11 +25,11 @@ from robomax_py.plan.waiting import clear_wait, signal_of
 from robomax_py.program import (
     Comment,
     FrameDef,
+    Gripper,
     LinMove,
     Program,
     PtpMove,
     Spot,
-    Gripper,
     Wait,
     WaitFor,
     frame_in_world,

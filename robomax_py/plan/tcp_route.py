@@ -25,7 +25,13 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation, Slerp
 
 from robomax_py._typing import FloatArray
-from robomax_py.plan.timed_search import NoRoute, TimedGraph, Windows, merge_windows, timed_astar
+from robomax_py.plan.timed_search import (
+    NoRoute,
+    TimedGraph,
+    Windows,
+    merge_windows,
+    timed_astar,
+)
 from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.robot.solve import solve_all
 from robomax_py.world.bounds import support_points

@@ -25,11 +25,16 @@ from robomax_py.plan.results import (
     Transition,
     _no_progress,
 )
-from robomax_py.plan.sequence import Tour
 from robomax_py.plan.roadmap import Roadmap
+from robomax_py.plan.sequence import Tour
 from robomax_py.plan.tcp_route import TcpSpace, dynamic_boxes, tcp_space
+from robomax_py.plan.timed_moves import (
+    DynamicConflicts,
+    JunctionContext,
+    StagedJunction,
+    staged_junction,
+)
 from robomax_py.plan.timed_search import NoRoute
-from robomax_py.plan.timed_moves import DynamicConflicts, JunctionContext, StagedJunction, staged_junction
 from robomax_py.plan.waiting import WaitingError, schedule_waits, wait_at_rest
 from robomax_py.program import (
     as_written_joints,

@@ -21,7 +21,6 @@ from dataclasses import dataclass, field
 
 import coal
 import numpy as np
-
 from scipy.spatial import ConvexHull
 
 from robomax_py._typing import BoolArray, FloatArray

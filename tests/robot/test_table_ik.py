@@ -9,7 +9,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robomax_py.robot.ik.table import JointGrid, build_table, jacobian_interpolation, route
+from robomax_py.robot.ik.table import (
+    JointGrid,
+    build_table,
+    jacobian_interpolation,
+    route,
+)
 from robomax_py.robot.planar import Container, PlanarArm
 
 HALF_PI = np.pi / 2
