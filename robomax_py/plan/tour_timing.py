@@ -35,7 +35,16 @@ from robomax_py.plan.timed_moves import (
     staged_junction,
 )
 from robomax_py.plan.timed_search import NoRoute
-from robomax_py.plan.waiting import WaitingError, schedule_waits, wait_at_rest
+from robomax_py.plan.waiting import (
+    MAX_WAITS,
+    TIME_STEP_S,
+    Trapped,
+    WaitingError,
+    WaitPlan,
+    ceil_ms,
+    first_dynamic_hit,
+    wait_at_rest,
+)
 from robomax_py.program import (
     as_written_joints,
     as_written_pose_in,
@@ -187,65 +196,104 @@ def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, road
                   options: PlanOptions, retime: Callable[[int, FloatArray], tuple[list[Segment], Transition]],
                   ) -> tuple[list[list[Segment]], list[Transition]]:
     """The blocks in time order with their waits for the dynamic obstacles: at rest before a blocked
-    junction (`planner.dynamic: rest`), or also the time-aware junction (`timed_moves`) where it
-    finishes sooner (`timed`, the default)."""
+    junction (`planner.dynamic: rest`), or the time-aware junction (`timed_moves`) where it
+    finishes sooner (`timed`, the default).
+
+    A robot that would be trapped where a junction starts (a door closing on it while it waits at
+    rest, in a machine it has just served) makes the junction before start later, after that
+    door's window: it then enters in the next opening (`Trapped`, at most MAX_WAITS times)."""
     dynamic_world = CollisionWorld(robot, build_scene(replace(cell, objects=()), robot), cell.process.clearance)
     windows = {d.name: d.present if d.present is not None else ((0.0, float("inf")),) for d in cell.dynamic}
     doors = frozenset(d.name for d in cell.dynamic if d.door)
-    if options.dynamic == "rest":
-        waits = {w.index: w for w in schedule_waits(dynamic_world, blocks, windows, doors)}
-        out = [([dwell(b[0].q[0], waits[k].seconds, kind="wait", label=f"wait for {waits[k].obstacle}")]
-                if k in waits else []) + b for k, b in enumerate(blocks)]
-        return out, [replace(tr, wait=waits[k]) if k in waits else tr for k, tr in enumerate(timed)]
-    ctx = JunctionContext(robot, world, dynamic_world, DynamicConflicts(cell, robot), roadmap, windows, doors,
-                          tcp_speed=written_tcp_speed(options.tcp_speed * options.speed),
-                          speed=written_speed(options.speed), jerk_limited=options.jerk_limited,
-                          max_wait=cell.planner.max_wait, tcp=_tcp_space(cell, robot))
+    ctx = None if options.dynamic == "rest" else JunctionContext(
+        robot, world, dynamic_world, DynamicConflicts(cell, robot), roadmap, windows, doors,
+        tcp_speed=written_tcp_speed(options.tcp_speed * options.speed), speed=written_speed(options.speed),
+        jerk_limited=options.jerk_limited, max_wait=cell.planner.max_wait, tcp=_tcp_space(cell, robot))
     out_blocks: list[list[Segment]] = []
     out_timed: list[Transition] = []
-    t = 0.0
-    for k, block in enumerate(blocks):
-        trans = timed[k]
+    starts: list[float] = []
+    holds: dict[int, Trapped] = {}          # block -> what trapped the robot after it: start after its window
+    k, t, backtracks = 0, 0.0, 0
+    while k < len(blocks):
+        block, trans = blocks[k], timed[k]
         if out_blocks and not np.array_equal(out_blocks[-1][-1].q[-1], block[0].q[0]):
             # A time-aware junction before ended its line at the spot a hair away (its own LIN
             # solution): this one is timed again from there, so the program states what was timed.
             block, trans = retime(k, np.asarray(out_blocks[-1][-1].q[-1]))
-        try:
-            rest = wait_at_rest(dynamic_world, block, t, windows, k, doors)
-            rest_error = None
-        except WaitingError as exc:
-            rest, rest_error = None, exc
-        if rest is None and rest_error is None:
-            out_blocks.append(block)
-            out_timed.append(trans)
-            t += sum(s.duration for s in block)
-            continue
+        hold = holds.get(k)
+        pre = ceil_ms(hold.window_end - t) + TIME_STEP_S if hold is not None and hold.window_end >= t else 0.0
+        hit = first_dynamic_hit(dynamic_world, [dwell(block[0].q[0], pre, kind="wait")], t) if pre > 0 else None
+        if hit is not None:
+            # Held back here, the robot would be hit while it waits: the block before starts later.
+            name, t_hit = hit
+            end = max((b for a, b in windows[name] if a <= t_hit <= b), default=t_hit)
+            chosen, error = None, Trapped(f"the robot would be hit while held back at rest by {name} at "
+                                          f"t = {t_hit:.3f} s", name, end, name in doors)
+        else:
+            chosen, error = _next_block(ctx, options, dynamic_world, windows, doors, k, t + pre, block, trans, ends,
+                                        weld_times)
+        if chosen is None:
+            if isinstance(error, Trapped) and k > 0 and backtracks < MAX_WAITS:
+                backtracks += 1
+                k -= 1
+                holds[k] = error
+                t = starts[k]
+                del out_blocks[k:], out_timed[k:], starts[k:]
+                continue
+            raise error
+        new_block, new_trans = chosen
+        if pre > 0:
+            assert hold is not None
+            waited = pre + (new_trans.wait.seconds if new_trans.wait is not None else 0.0)
+            new_block = [dwell(block[0].q[0], pre, kind="wait", label=f"wait for {hold.obstacle}"), *new_block]
+            new_trans = replace(new_trans, wait=WaitPlan(k, waited, hold.obstacle, False, hold.door))
+        starts.append(t)
+        out_blocks.append(new_block)
+        out_timed.append(new_trans)
+        t += sum(s.duration for s in new_block)
+        k += 1
+    return out_blocks, out_timed
+
+
+def _next_block(ctx: JunctionContext | None, options: PlanOptions, dynamic_world: CollisionWorld,
+                windows: dict[str, tuple[tuple[float, float], ...]], doors: frozenset[str], k: int, t: float,
+                block: list[Segment], trans: Transition, ends: list[WeldEnd], weld_times: list[float],
+                ) -> tuple[tuple[list[Segment], Transition] | None, WaitingError]:
+    """Block k started at t: as it is, after a wait at rest, or time-aware (ctx given), whichever
+    finishes first; None and the reason when none can."""
+    try:
+        rest = wait_at_rest(dynamic_world, block, t, windows, k, doors)
+        rest_error: WaitingError | None = None
+    except WaitingError as exc:
+        rest, rest_error = None, exc
+    if rest is None and rest_error is None:
+        return (block, trans), WaitingError("")
+    rest_end = math.inf if rest is None else t + rest.seconds + sum(s.duration for s in block)
+    staged: StagedJunction | NoRoute | None = None
+    if ctx is not None:
         has_action = k < len(ends)
-        moves = block[:-1] if has_action else block
         speed = options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)
         staged = staged_junction(
-            replace(ctx, speed=written_speed(speed)), k, t, np.asarray(block[0].q[0]), trans.waypoints, trans.kind, trans.label, ends[k - 1] if k else None,
-            ends[k] if has_action else None, moves, weld_times[k] if has_action else 0.0,
+            replace(ctx, speed=written_speed(speed)), k, t, np.asarray(block[0].q[0]), trans.waypoints, trans.kind,
+            trans.label, ends[k - 1] if k else None, ends[k] if has_action else None,
+            block[:-1] if has_action else block, weld_times[k] if has_action else 0.0,
             np.asarray(block[-1].q[0]) if has_action else None)
-        rest_end = math.inf if rest is None else t + rest.seconds + sum(s.duration for s in block)
         if isinstance(staged, StagedJunction):
             action = block[-1]
             new_block = staged.segments + ([dwell(staged.segments[-1].q[-1], action.duration, kind=action.kind,
                                                    label=action.label)] if has_action else [])
             if t + sum(s.duration for s in new_block) < rest_end - 1e-9:
-                out_blocks.append(new_block)
                 ext = staged.extension
-                out_timed.append(replace(trans, waypoints=staged.waypoints, stages=staged.stages,
-                                         blend_radius=staged.corner_radius, flyby_radius=staged.junction_radius,
-                                         retract_T=ext.retract_T, retract_q=ext.retract_q, approach_q=ext.approach_q))
-                t += sum(s.duration for s in new_block)
-                continue
-        if rest is None:
-            assert rest_error is not None
-            why = staged.detail if isinstance(staged, NoRoute) else "its way finishes no sooner"
-            raise WaitingError(f"{trans.label}: waiting at rest fails ({rest_error}), and so does the time-aware "
-                               f"search ({why}): the schedule cannot be met")
-        out_blocks.append([dwell(block[0].q[0], rest.seconds, kind="wait", label=f"wait for {rest.obstacle}"), *block])
-        out_timed.append(replace(trans, wait=rest))
-        t += rest.seconds + sum(s.duration for s in block)
-    return out_blocks, out_timed
+                return (new_block, replace(trans, waypoints=staged.waypoints, stages=staged.stages,
+                                           blend_radius=staged.corner_radius, flyby_radius=staged.junction_radius,
+                                           retract_T=ext.retract_T, retract_q=ext.retract_q,
+                                           approach_q=ext.approach_q)), WaitingError("")
+    if rest is not None:
+        return ([dwell(block[0].q[0], rest.seconds, kind="wait", label=f"wait for {rest.obstacle}"), *block],
+                replace(trans, wait=rest)), WaitingError("")
+    assert rest_error is not None
+    if staged is None or isinstance(rest_error, Trapped):
+        return None, rest_error
+    why = staged.detail if isinstance(staged, NoRoute) else "its way finishes no sooner"
+    return None, WaitingError(f"{trans.label}: waiting at rest fails ({rest_error}), and so does the time-aware "
+                              f"search ({why}): the schedule cannot be met")

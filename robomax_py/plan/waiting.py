@@ -27,7 +27,8 @@ from robomax_py.world.collision import KIND_DYNAMIC, CollisionWorld
 
 # Programs state times in milliseconds (TIME_DECIMALS = 3).
 TIME_STEP_S = 0.001
-# Waits inserted per program before the planner gives up.
+# Windows in the way of one move, and junctions started later so a trapped robot is not, before the
+# planner gives up.
 MAX_WAITS = 50
 CLEAR_SUFFIX = "_clear"
 OPEN_SUFFIX = "_open"
@@ -52,41 +53,30 @@ class WaitingError(RobomaxError):
     """The dynamic obstacles cannot be avoided by waiting; the message says which and when."""
 
 
+class Trapped(WaitingError):
+    """The robot, at rest where a move starts, would be hit by a dynamic obstacle while it waits:
+    the move before should have ended elsewhere, or later (after `window_end`)."""
+
+    def __init__(self, message: str, obstacle: str, window_end: float, door: bool) -> None:
+        super().__init__(message)
+        self.obstacle, self.window_end, self.door = obstacle, window_end, door
+
+
 def clear_wait(t: float, windows: Sequence[tuple[float, float]]) -> float:
     """Seconds `WAIT FOR <name>_clear` holds at time t: 0 when the obstacle is absent."""
     for w0, w1 in windows:
         if w0 <= t <= w1:
-            return _ceil_ms(w1 - t) + TIME_STEP_S
+            return ceil_ms(w1 - t) + TIME_STEP_S
     return 0.0
 
 
-def _ceil_ms(seconds: float) -> float:
+def ceil_ms(seconds: float) -> float:
     return round(math.ceil(round(seconds / TIME_STEP_S, 6)) * TIME_STEP_S, 3)
 
 
 def signal_of(obstacle: str, door: bool) -> str:
     """The input a program waits for: `<name>_open` for a machine's door, else `<name>_clear`."""
     return obstacle + (OPEN_SUFFIX if door else CLEAR_SUFFIX)
-
-
-def schedule_waits(world: CollisionWorld, blocks: Sequence[Sequence[Segment]],
-                   windows: dict[str, tuple[tuple[float, float], ...]], doors: frozenset[str] = frozenset()) -> list[WaitPlan]:
-    """Waits (at most one per block, before it) that keep every block clear of dynamic obstacles.
-
-    blocks : the program's motion in order, each a list of segments starting at rest (a
-        junction and the weld after it). Times add up as the program's clock.
-    windows : each dynamic obstacle's presence windows, by name; doors : which of them are doors.
-    """
-    waits: list[WaitPlan] = []
-    t = 0.0
-    for k, block in enumerate(blocks):
-        w = wait_at_rest(world, block, t, windows, k, doors)
-        if w is not None:
-            waits.append(w)
-            if len(waits) > MAX_WAITS:
-                raise WaitingError(f"more than {MAX_WAITS} waits would be needed for the dynamic obstacles")
-        t += (w.seconds if w else 0.0) + sum(s.duration for s in block)
-    return waits
 
 
 def wait_at_rest(world: CollisionWorld, block: Sequence[Segment], t: float,
@@ -105,8 +95,10 @@ def wait_at_rest(world: CollisionWorld, block: Sequence[Segment], t: float,
                         t_in = max(w0, t)
                         contact = world.first_contact(q_rest, t_in)
                         if contact is not None and contact.kind_b == KIND_DYNAMIC:
-                            raise WaitingError(f"the robot would be hit while waiting at rest ({contact.describe()}) "
-                                               f"at t = {t_in:.3f} s")
+                            name = contact.body_b
+                            end = max((b for a, b in windows.get(name, ()) if a <= t_in <= b), default=w1)
+                            raise Trapped(f"the robot would be hit while waiting at rest ({contact.describe()}) "
+                                          f"at t = {t_in:.3f} s", name, end, name in doors)
         hit = first_dynamic_hit(world, block, t + seconds)
         if hit is None:
             return wait
@@ -114,7 +106,7 @@ def wait_at_rest(world: CollisionWorld, block: Sequence[Segment], t: float,
         ends = [w1 for w0, w1 in windows[name] if w0 <= t_hit <= w1]
         if not ends or not math.isfinite(ends[0]):
             raise WaitingError(f"{name} is in the way at t = {t_hit:.3f} s and its window does not end")
-        needed = _ceil_ms(ends[0] - t) + TIME_STEP_S
+        needed = ceil_ms(ends[0] - t) + TIME_STEP_S
         if needed <= seconds:
             raise WaitingError(f"{name} is in the way at t = {t_hit:.3f} s even after waiting {seconds:.3f} s")
         for_signal = clear_wait(t, windows[name]) == needed
@@ -136,8 +128,10 @@ def first_dynamic_hit(world: CollisionWorld, block: Sequence[Segment], t0: float
                 continue
             s = res.s_contact or 0.0
             tc = float(ta + s * (tb - ta))
-            contact = world.first_contact(qa + s * (qb - qa), tc)
-            if contact is not None and contact.kind_b == KIND_DYNAMIC:
-                return contact.body_b, tc
+            # At rest, the obstacle that hits may only appear later in the span: look when each does.
+            for at in [tc, *(world.window_starts(float(ta), float(tb)) if np.array_equal(qa, qb) else [])]:
+                contact = world.first_contact(qa + s * (qb - qa), at)
+                if contact is not None and contact.kind_b == KIND_DYNAMIC:
+                    return contact.body_b, at
         t += seg.duration
     return None

@@ -390,6 +390,12 @@ class CollisionWorld:
         kinds = [(s.pieces[int(a)].kind, s.pieces[int(b)].kind) for a, b in zip(s.pair_a, s.pair_b)]
         return np.array([1.0 if KIND_OBJECT in pair else 2.0 for pair in kinds])
 
+    def window_starts(self, ta: float, tb: float) -> list[float]:
+        """Times in (ta, tb] at which a dynamic obstacle appears, in order."""
+        s = self._s
+        return sorted({float(w0) for i in s.dynamic_ids for w0, _ in (s.obstacles[int(i)].present or ())
+                       if ta < w0 <= tb})
+
     @property
     def has_dynamic(self) -> bool:
         """Whether some obstacle comes and goes (present only in time windows)."""

@@ -1,6 +1,6 @@
 """Machine tending with time windows, compared in one run (a script, not a test):
 
-    python tests/bench/bench_tending.py [CELL] [--variants N] [--seed S] [--cycles 1,2,4,8]
+    python tests/bench/bench_tending.py [CELL] [--variants N] [--seed S] [--cycles 1,2,4,8] [--generated DIR]
 
 Plans the tending cell (default `cells/tending.yaml`) three ways in the same process:
 - `timed`: the time-aware planner (`planner.dynamic: timed`, the default): time-windowed A* over
@@ -18,7 +18,8 @@ present (dense samples, 10 ms apart). With --variants N it also plans N seeded s
 cell (each machine's start, machining time and period drawn at random) both ways and prints the
 cycle-time gain of `timed` over `rest` per variant (never negative by construction: the planner
 keeps a time-aware move only where it finishes sooner). With --cycles it plans the cell with each
-number of cycles instead, both ways, and prints how the CPU seconds grow with the job's size.
+number of cycles instead, both ways, and prints how the CPU seconds grow with the job's size; with
+--generated DIR it plans the seeded cells of `tests/bench/tending_cells.py` in DIR both ways.
 """
 
 from __future__ import annotations
@@ -100,6 +101,35 @@ def variant(cell: CellSpec, rng: np.random.Generator) -> CellSpec:
     return replace(cell, machines=tuple(machines), dynamic=dynamic)
 
 
+def generated(paths: list[Path]) -> None:
+    """Each generated cell planned both ways: status, cycle, CPU, and the timed plan's verdict."""
+    print(f"{'cell':16s} {'robot':6s} {'visits':>6s} {'timed':>28s} {'rest':>28s}")
+    both, only_timed, only_rest, gains = 0, 0, 0, []
+    for path in paths:
+        cell = load_cell(path)
+        robot = load_cell_robot(cell)
+        (timed, t_cpu), (rest, r_cpu) = plan(cell, robot, "timed"), plan(cell, robot, "rest")
+
+        def shown(r: PlanResult, cpu: float) -> str:
+            return f"{r.cycle_time:8.3f} s {cpu:5.1f} CPU" if r.status == "planned" else f"{r.status} {cpu:5.1f} CPU"
+
+        print(f"{cell.name:16s} {cell.robot.name:6s} {len(cell.seams[0].spots):6d} {shown(timed, t_cpu):>28s} "
+              f"{shown(rest, r_cpu):>28s}")
+        for r in (timed, rest):
+            if r.status != "planned":
+                print(f"    {'timed' if r is timed else 'rest'}: {r.message[:150]}")
+        ok_t, ok_r = timed.status == "planned", rest.status == "planned"
+        both += ok_t and ok_r
+        only_timed += ok_t and not ok_r
+        only_rest += ok_r and not ok_t
+        if ok_t and ok_r:
+            gains.append(100 * (1 - timed.cycle_time / rest.cycle_time))
+    print(f"planned by both {both}, by timed only {only_timed}, by rest only {only_rest}, of {len(paths)}")
+    if gains:
+        print(f"cycle gain where both planned: min {min(gains):.2f} %, median {statistics.median(gains):.2f} %, "
+              f"max {max(gains):.2f} %")
+
+
 def scale(path: Path, counts: list[int]) -> None:
     """CPU seconds of planning against the number of cycles (station visits grow with it), both ways."""
     import math
@@ -134,7 +164,12 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--cycles", type=str, default="",
                         help="comma-separated cycle counts: plan the cell with each, both ways, and print the CPU growth")
+    parser.add_argument("--generated", type=Path, default=None,
+                        help="plan every cell in this folder (tests/bench/tending_cells.py) both ways")
     args = parser.parse_args()
+    if args.generated is not None:
+        generated(sorted(args.generated.glob("*.yaml")))
+        return
     if args.cycles:
         scale(args.cell, [int(c) for c in args.cycles.split(",")])
         return

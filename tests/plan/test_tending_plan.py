@@ -46,3 +46,29 @@ def test_time_aware_tending_against_waiting_at_rest() -> None:
     traj = timed.trajectory
     least = min(doors.closest(q, float(t)).distance for t, q in zip(traj.t, traj.q))
     assert least >= cell.process.clearance
+
+
+@pytest.mark.slow
+def test_a_generated_tending_cell_plans_both_ways(tmp_path: Path) -> None:
+    """A seeded cell from tests/bench/tending_cells.py (KR 16 class arm, its machines and schedules
+    drawn) that waiting at rest could only plan by entering a machine in a later opening (a door
+    would otherwise close on the robot inside): both ways plan, the time-aware plan is no longer."""
+    import importlib.util
+
+    import yaml
+
+    spec = importlib.util.spec_from_file_location("tending_cells", REPO / "tests" / "bench" / "tending_cells.py")
+    assert spec is not None and spec.loader is not None
+    generator = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(generator)
+    rng = np.random.default_rng(5)
+    data = [generator.cell(rng, i) for i in range(2)][1]
+    path = tmp_path / "generated.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    cell = load_cell(path)
+    robot = load_cell_robot(cell)
+    rest = plan_cell(cell, robot, PlanOptions(dynamic="rest"))
+    timed = plan_cell(cell, robot, PlanOptions())
+    assert rest.status == timed.status == "planned", (rest.message, timed.message)
+    assert timed.cycle_time <= rest.cycle_time
+    assert any(t.wait is not None and not t.wait.for_signal for t in rest.transitions)   # held back a window

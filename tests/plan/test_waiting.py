@@ -121,3 +121,25 @@ def test_a_door_that_would_hit_the_waiting_robot_is_infeasible(door_cell: dict[s
     result = plan_cell(cell, door_cell["robot"], PlanOptions())
     assert result.status == "infeasible"
     assert "door" in result.message and "waiting" in result.message
+
+
+def test_an_obstacle_appearing_while_the_robot_rests_is_found(door_cell: dict[str, Any]) -> None:
+    """At rest over [0, 10] s, an obstacle at the robot that appears at 5 s is a hit at 5 s (its
+    appearance, not the start of the rest, when it is not there yet)."""
+    import dataclasses
+
+    from robomax_py.plan.waiting import first_dynamic_hit
+    from robomax_py.spec import Box, ObjectSpec
+    from robomax_py.timing import dwell
+    from robomax_py.world.collision import CollisionWorld
+    from robomax_py.world.scene import build_scene
+
+    cell = load_cell(door_cell["path"])
+    robot = door_cell["robot"]
+    home_tcp = (np.asarray(cell.T_world_base) @ fk_tcp(robot, cell.home))[:3, 3]
+    T = np.eye(4)
+    T[:3, 3] = home_tcp
+    box = ObjectSpec("shutter", Box((0.3, 0.3, 0.3)), T, present=((5.0, 6.0),))
+    world = CollisionWorld(robot, build_scene(dataclasses.replace(cell, objects=(), dynamic=(box,)), robot), 0.0)
+    assert first_dynamic_hit(world, [dwell(cell.home, 10.0, kind="wait")], 0.0) == ("shutter", 5.0)
+    assert first_dynamic_hit(world, [dwell(cell.home, 4.0, kind="wait")], 0.0) is None
