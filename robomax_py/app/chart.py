@@ -44,6 +44,7 @@ class CycleChart:
     cycle_time: float
     rows: tuple[str, ...]
     bars: tuple[Bar, ...]
+    tending: bool = False            # the stops are gripper actions at stations, not welds
 
     def size_px(self) -> tuple[int, int]:
         """(width, height) of the rendered PNG, pixels."""
@@ -74,7 +75,8 @@ def cycle_chart(result: PlanResult) -> CycleChart:
             row += 1                     # the spot is done: what follows leads to the next one
     if any(b.row == len(rows) for b in bars):
         rows.append(RETURN_ROW)
-    return CycleChart(result.cell, result.robot, float(traj.duration), tuple(rows), tuple(bars))
+    return CycleChart(result.cell, result.robot, float(traj.duration), tuple(rows), tuple(bars),
+                      any(s.action is not None for s in result.spots))
 
 
 def chart_figure(chart: CycleChart) -> Any:
@@ -102,12 +104,18 @@ def chart_figure(chart: CycleChart) -> Any:
     ax.grid(axis="x", color="#dddddd", linewidth=0.6)
     ax.set_axisbelow(True)
     ax.set_title(f"{chart.cell} ({chart.robot}): cycle time {chart.cycle_time:.2f} s, "
-                 f"{sum(1 for r in chart.rows if r != RETURN_ROW)} spots")
+                 f"{sum(1 for r in chart.rows if r != RETURN_ROW)} {'stations' if chart.tending else 'spots'}")
     kinds = [k for k in LEGEND_ORDER if k in totals] + sorted(k for k in totals if k not in LEGEND_ORDER)
-    handles = [Patch(color=palette.hex_colour(palette.phase_colour(k)), label=f"{k} {totals[k]:.2f} s") for k in kinds]
+    handles = [Patch(color=palette.hex_colour(palette.phase_colour(k)), label=f"{_word(k, chart.tending)} {totals[k]:.2f} s")
+               for k in kinds]
     fig.legend(handles=handles, loc="lower center", ncol=len(handles), frameon=False, fontsize="small")
     fig.tight_layout(rect=(0.0, 40.0 / height, 1.0, 1.0))
     return fig
+
+
+def _word(kind: str, tending: bool) -> str:
+    """A phase kind as the chart names it: the stop at a tending station is the gripper's action."""
+    return "grip/release" if tending and kind == "weld" else kind
 
 
 def render_png(chart: CycleChart) -> bytes:

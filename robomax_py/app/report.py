@@ -44,6 +44,7 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
         c = result.clearance
         report["clearance"] = {"mm": round(c.distance_m * 1000, 3), "t": round(c.t, 4), "between": c.between}
     report["split"] = {k: round(v, 4) for k, v in split.items()}
+    report["tending"] = any(s.action is not None for s in result.spots)
     report["spots"] = [
         {"seam": s.seam, "spot": s.name, "t_arrive": round(s.t_arrive, 4),
          "alpha": round(math.degrees(s.angles[0]), 3), "beta": round(math.degrees(s.angles[1]), 3),
@@ -69,7 +70,9 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
     head.add_row("cell", f"{report['cell']} ({report['robot']}), {report['method']}")
     head.add_row("status", report["status"] if report["status"] == "planned" else f"{report['status']}: {report['message']}")
     if "cycle_time" in report:
-        split = ", ".join(f"{k} {v:.2f}" for k, v in report["split"].items() if v > 0)
+        # A tending cell's stops are the gripper's actions (the trajectory's "weld" phases).
+        word = {"weld": "grip/release"} if report.get("tending") else {}
+        split = ", ".join(f"{word.get(k, k)} {v:.2f}" for k, v in report["split"].items() if v > 0)
         head.add_row("cycle time", f"{report['cycle_time']:.2f} s  ({split})")
         detours = ", ".join(f"{d['between']} ({d['checks_to_find']} checks)" for d in report["detours"])
         head.add_row("detours", detours or "none")
@@ -93,8 +96,10 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
         head.add_row("wrote", f)
     out: list[Any] = [head]
     if report.get("spots"):
-        spots = Table(title="spots in weld order", title_justify="left")
-        for col in ("seam", "spot", "arrive (s)", "alpha", "beta", "gamma (deg)", "config"):
+        tending = bool(report.get("tending"))
+        spots = Table(title="stations in order" if tending else "spots in weld order", title_justify="left")
+        for col in ("job" if tending else "seam", "station" if tending else "spot", "arrive (s)", "alpha", "beta",
+                    "gamma (deg)", "config"):
             spots.add_column(col)
         for s in report["spots"]:
             spots.add_row(s["seam"], s["spot"], f"{s['t_arrive']:.2f}", f"{s['alpha']:g}", f"{s['beta']:g}",
