@@ -22,6 +22,7 @@ from scipy.sparse.csgraph import dijkstra
 from robomax_py._typing import FloatArray
 from robomax_py.cspace.grid import nearest_cell
 from robomax_py.plan.roadmap import Detour
+from robomax_py.plan.shortcut import greedy_shortcut
 from robomax_py.robot import JointLimits
 from robomax_py.timing import ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
@@ -89,16 +90,12 @@ def _shortcut(world: CollisionWorld, waypoints: FloatArray) -> tuple[FloatArray 
     """Greedy shortcutting (each kept waypoint joined to the farthest later one reachable by a free
     swept move); None when some consecutive pair is not free (the map only checked cell centres)."""
     checks = 0
-    keep = [0]
-    i, n = 0, len(waypoints)
-    while i < n - 1:
-        for j in range(n - 1, i, -1):
-            res = world.check_segment(waypoints[i], waypoints[j])
-            checks += res.checks
-            if res.free:
-                keep.append(j)
-                i = j
-                break
-        else:
-            return None, checks
-    return waypoints[keep], checks
+
+    def free(i: int, j: int) -> bool:
+        nonlocal checks
+        res = world.check_segment(waypoints[i], waypoints[j])
+        checks += res.checks
+        return res.free
+
+    keep = greedy_shortcut(len(waypoints), free, check_neighbours=True)
+    return (None if keep is None else waypoints[keep]), checks

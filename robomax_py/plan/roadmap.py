@@ -18,6 +18,7 @@ from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from robomax_py._typing import FloatArray
+from robomax_py.plan.shortcut import greedy_shortcut
 from robomax_py.robot import JointLimits
 from robomax_py.timing import ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
@@ -111,15 +112,22 @@ class Roadmap:
 
     def edge_free(self, u: int, v: int) -> bool:
         """Is the straight move between nodes u and v free? Checked once, shared with `query`."""
+        free, used = self._edge(u, v)
+        self.edge_checks += used
+        return free
+
+    def _edge(self, u: int, v: int) -> tuple[bool, int]:
+        """Whether the edge between nodes u and v is free (checked once, a blocked one dropped from
+        the graph), and the collision checks this call took."""
         key = (min(u, v), max(u, v))
         known = self._edge_free.get(key)
-        if known is None:
-            res = self._world.check_segment(self.nodes[u], self.nodes[v])
-            self.edge_checks += res.checks
-            known = self._edge_free[key] = res.free
-            if not known:
-                self._edge_blocked[self._edge_index[key]] = True
-        return known
+        if known is not None:
+            return known, 0
+        res = self._world.check_segment(self.nodes[u], self.nodes[v])
+        self._edge_free[key] = res.free
+        if not res.free:
+            self._edge_blocked[self._edge_index[key]] = True
+        return res.free, res.checks
 
     def nearest(self, q: FloatArray, k: int | None = None) -> list[int]:
         """The k (default: the roadmap's k) nodes nearest q in the time-scaled metric."""
@@ -152,14 +160,13 @@ class Roadmap:
             bad = None
             for u, v in zip(path[:-1], path[1:]):
                 key = (min(u, v), max(u, v))
-                table = extra_free if u < 0 or v < 0 else self._edge_free
-                known = table.get(key)
-                if known is None:
+                if u >= 0 and v >= 0:
+                    known, used = self._edge(u, v)
+                    checks += used
+                elif (known := extra_free.get(key)) is None:
                     res = self._world.check_segment(point(u), point(v))
                     checks += res.checks
-                    known = table[key] = res.free
-                    if not known and table is self._edge_free:
-                        self._edge_blocked[self._edge_index[key]] = True
+                    known = extra_free[key] = res.free
                 if not known:
                     bad = key
                     break
@@ -205,21 +212,18 @@ class Roadmap:
         return [-1 if u == S else (-2 if u == G else u) for u in reversed(path)]
 
     def _shortcut(self, waypoints: FloatArray) -> tuple[FloatArray, int]:
-        """Greedy: from each kept waypoint jump to the farthest later one reachable straight."""
+        """Greedy (`greedy_shortcut`): each kept waypoint joined to the farthest later one reachable
+        straight; the collision checks it took."""
         checks = 0
-        kept = [0]
-        i = 0
-        last = len(waypoints) - 1
-        while i < last:
-            j = last
-            while j > i + 1:
-                res = self._world.check_segment(waypoints[i], waypoints[j])
-                checks += res.checks
-                if res.free:
-                    break
-                j -= 1
-            kept.append(j)
-            i = j
+
+        def free(i: int, j: int) -> bool:
+            nonlocal checks
+            res = self._world.check_segment(waypoints[i], waypoints[j])
+            checks += res.checks
+            return res.free
+
+        kept = greedy_shortcut(len(waypoints), free)
+        assert kept is not None                       # neighbours are not checked: always a path
         return waypoints[kept], checks
 
 

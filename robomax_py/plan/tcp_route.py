@@ -25,6 +25,7 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation, Slerp
 
 from robomax_py._typing import FloatArray
+from robomax_py.plan.shortcut import greedy_shortcut
 from robomax_py.plan.timed_search import (
     NoRoute,
     TimedGraph,
@@ -57,11 +58,10 @@ HALF_WIDTH_M = 2.0
 
 @dataclass(frozen=True, slots=True, eq=False)
 class TcpSpace:
-    """The free leaves of the cell's work space (base frame) and their proximity graph."""
+    """The free leaves of the cell's work space (base frame), each with its dynamic objects' windows."""
 
     voxels: VoxelMap
     centres: FloatArray              # (N, 3) m, the free leaves' centres
-    tree: cKDTree
     door_windows: tuple[Windows, ...]  # per free leaf: windows in which a dynamic object is near it
 
 
@@ -83,7 +83,7 @@ def tcp_space(scene: Scene, robot: RobotModel, clearance: float,
             for dlo, dhi, _ in dynamic]
     door_windows = [merge_windows([w for m, (_, _, ws) in zip(near, dynamic) if m[i] for w in ws])
                     if any(m[i] for m in near) else () for i in range(len(free))]
-    return TcpSpace(voxels, centres, cKDTree(centres), tuple(door_windows))
+    return TcpSpace(voxels, centres, tuple(door_windows))
 
 
 def dynamic_boxes(scene: Scene) -> tuple[tuple[FloatArray, FloatArray, Windows], ...]:
@@ -151,13 +151,8 @@ def tcp_route(space: TcpSpace, p_start: FloatArray, p_goal: FloatArray, t0: floa
 
 
 def _shortcut(space: TcpSpace, route: FloatArray) -> FloatArray:
-    kept, i = [0], 0
-    while i < len(route) - 1:
-        j = len(route) - 1
-        while j > i + 1 and not _line_free(space, route[i], route[j]):
-            j -= 1
-        kept.append(j)
-        i = j
+    kept = greedy_shortcut(len(route), lambda i, j: _line_free(space, route[i], route[j]))
+    assert kept is not None                           # neighbours are not checked: always a path
     return route[kept]
 
 

@@ -34,6 +34,7 @@ from robomax_py.plan.junction import (
 )
 from robomax_py.plan.results import Stage
 from robomax_py.plan.roadmap import Roadmap
+from robomax_py.plan.shortcut import greedy_shortcut
 from robomax_py.plan.tcp_route import TcpSpace, follow, tcp_route
 from robomax_py.plan.timed_search import (
     NoRoute,
@@ -47,7 +48,7 @@ from robomax_py.plan.waiting import WaitingError, first_dynamic_hit, wait_at_res
 from robomax_py.program import as_written_joints
 from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.spec import CellSpec, ObjectSpec
-from robomax_py.timing import Segment, TimingError, dwell, ptp_time_estimate
+from robomax_py.timing import Segment, dwell, ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.scene import build_scene
 
@@ -57,7 +58,6 @@ class DynamicConflicts:
     windows in which that matters. One collision world per obstacle, robot-against-obstacle pairs only."""
 
     def __init__(self, cell: CellSpec, robot: RobotModel) -> None:
-        self.names = tuple(d.name for d in cell.dynamic)
         self.windows = tuple(d.present if d.present is not None else ((0.0, math.inf),) for d in cell.dynamic)
         def world(objects: tuple[ObjectSpec, ...]) -> CollisionWorld:
             return CollisionWorld(robot, build_scene(replace(cell, objects=(), dynamic=objects), robot),
@@ -66,31 +66,16 @@ class DynamicConflicts:
         # All of them first: most moves touch none, and then one check answers.
         self._all = world(cell.dynamic)
         self._worlds = [world((d,)) for d in cell.dynamic] if len(cell.dynamic) > 1 else [self._all]
-        self.checks = 0
 
     def point(self, q: FloatArray) -> frozenset[int]:
-        self.checks += 1
         if self._all.is_free(q):
             return frozenset()
-        out = set()
-        for i, w in enumerate(self._worlds):
-            self.checks += 1
-            if not w.is_free(q):
-                out.add(i)
-        return frozenset(out)
+        return frozenset(i for i, w in enumerate(self._worlds) if not w.is_free(q))
 
     def segment(self, qa: FloatArray, qb: FloatArray) -> frozenset[int]:
-        res = self._all.check_segment(qa, qb)
-        self.checks += res.checks
-        if res.free:
+        if self._all.check_segment(qa, qb).free:
             return frozenset()
-        out = set()
-        for i, w in enumerate(self._worlds):
-            res = w.check_segment(qa, qb)
-            self.checks += res.checks
-            if not res.free:
-                out.add(i)
-        return frozenset(out)
+        return frozenset(i for i, w in enumerate(self._worlds) if not w.check_segment(qa, qb).free)
 
     def windows_of(self, objects: frozenset[int]) -> Windows:
         return merge_windows([w for i in sorted(objects) for w in self.windows[i]])
@@ -108,7 +93,6 @@ class StagedJunction:
     segments: list[Segment]          # retract ... approach with the waits (not the action after it)
     waypoints: FloatArray            # (m, n): where the retract ends, ..., the approach point
     stages: tuple[Stage, ...]
-    route: TimedRoute
     junction_radius: float           # rad, as `Junction`
     corner_radius: float
     extension: Extension
@@ -166,7 +150,7 @@ def staged_junction(ctx: JunctionContext, index: int, t_block: float, q_rest: Fl
         return NoRoute("no_gain", "the route waits where the retract ends: no better than waiting at rest", 0)
     try:
         return _timed(ctx, index, t_block, q_rest, found, points, kind, label, before, after, action_s, q_action)
-    except (_StageFailed, TimingError, RobomaxError) as exc:
+    except RobomaxError as exc:             # a piece that cannot be timed (TimingError) or checked
         return NoRoute("timing", str(exc), found.expansions)
 
 
@@ -267,7 +251,7 @@ def _timed(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray,
         objs = ctx.conflicts.segment(np.asarray(waypoints[-1]), np.asarray(q_action))
         if any(w0 <= t_out + retract_s and w1 >= t_out for w0, w1 in ctx.conflicts.windows_of(objs)):
             raise _StageFailed("a dynamic obstacle would close on the retract after the action")
-    return StagedJunction(segments, np.array(waypoints), tuple(stages), route, math.radians(rj_deg),
+    return StagedJunction(segments, np.array(waypoints), tuple(stages), math.radians(rj_deg),
                           math.radians(rd_deg), extension)
 
 
@@ -333,15 +317,11 @@ def _shortcut(ctx: JunctionContext, piece: FloatArray) -> FloatArray:
     if len(piece) <= 2:
         return piece
     touched = [ctx.conflicts.segment(piece[i], piece[i + 1]) for i in range(len(piece) - 1)]
-    kept = [0]
-    i = 0
-    while i < len(piece) - 1:
-        j = len(piece) - 1
-        while j > i + 1:
-            allowed = frozenset().union(*touched[i:j])
-            if ctx.world.check_segment(piece[i], piece[j]).free and ctx.conflicts.segment(piece[i], piece[j]) <= allowed:
-                break
-            j -= 1
-        kept.append(j)
-        i = j
+
+    def reachable(i: int, j: int) -> bool:
+        return bool(ctx.world.check_segment(piece[i], piece[j]).free
+                    and ctx.conflicts.segment(piece[i], piece[j]) <= frozenset().union(*touched[i:j]))
+
+    kept = greedy_shortcut(len(piece), reachable)
+    assert kept is not None                           # neighbours are not checked: always a path
     return piece[kept]
