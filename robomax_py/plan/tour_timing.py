@@ -42,7 +42,7 @@ from robomax_py.plan.waiting import (
     WaitingError,
     WaitPlan,
     ceil_ms,
-    first_dynamic_hit,
+    trapped,
     wait_at_rest,
 )
 from robomax_py.program import (
@@ -222,25 +222,19 @@ def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, road
             block, trans = retime(k, np.asarray(out_blocks[-1][-1].q[-1]))
         hold = holds.get(k)
         pre = ceil_ms(hold.window_end - t) + TIME_STEP_S if hold is not None and hold.window_end >= t else 0.0
-        hit = first_dynamic_hit(dynamic_world, [dwell(block[0].q[0], pre, kind="wait")], t) if pre > 0 else None
-        if hit is not None:
-            # Held back here, the robot would be hit while it waits: the block before starts later.
-            name, t_hit = hit
-            end = max((b for a, b in windows[name] if a <= t_hit <= b), default=t_hit)
-            chosen, error = None, Trapped(f"the robot would be hit while held back at rest by {name} at "
-                                          f"t = {t_hit:.3f} s", name, end, name in doors)
-        else:
-            chosen, error = _next_block(ctx, options, dynamic_world, windows, doors, k, t + pre, block, trans, ends,
-                                        weld_times)
-        if chosen is None:
-            if isinstance(error, Trapped) and k > 0 and backtracks < MAX_WAITS:
+        # Held back here, the robot may itself be hit while it waits: then the block before starts later.
+        caught = trapped(dynamic_world, np.asarray(block[0].q[0]), t, pre, windows, doors) if pre > 0 else None
+        chosen = caught if caught is not None else _next_block(ctx, options, dynamic_world, windows, doors, k, t + pre,
+                                                               block, trans, ends, weld_times)
+        if isinstance(chosen, WaitingError):
+            if isinstance(chosen, Trapped) and k > 0 and backtracks < MAX_WAITS:
                 backtracks += 1
                 k -= 1
-                holds[k] = error
+                holds[k] = chosen
                 t = starts[k]
                 del out_blocks[k:], out_timed[k:], starts[k:]
                 continue
-            raise error
+            raise chosen
         new_block, new_trans = chosen
         if pre > 0:
             assert hold is not None
@@ -258,16 +252,16 @@ def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, road
 def _next_block(ctx: JunctionContext | None, options: PlanOptions, dynamic_world: CollisionWorld,
                 windows: dict[str, tuple[tuple[float, float], ...]], doors: frozenset[str], k: int, t: float,
                 block: list[Segment], trans: Transition, ends: list[WeldEnd], weld_times: list[float],
-                ) -> tuple[tuple[list[Segment], Transition] | None, WaitingError]:
+                ) -> tuple[list[Segment], Transition] | WaitingError:
     """Block k started at t: as it is, after a wait at rest, or time-aware (ctx given), whichever
-    finishes first; None and the reason when none can."""
+    finishes first; the reason when none can."""
     try:
         rest = wait_at_rest(dynamic_world, block, t, windows, k, doors)
         rest_error: WaitingError | None = None
     except WaitingError as exc:
         rest, rest_error = None, exc
     if rest is None and rest_error is None:
-        return (block, trans), WaitingError("")
+        return block, trans
     rest_end = math.inf if rest is None else t + rest.seconds + sum(s.duration for s in block)
     staged: StagedJunction | NoRoute | None = None
     if ctx is not None:
@@ -287,13 +281,13 @@ def _next_block(ctx: JunctionContext | None, options: PlanOptions, dynamic_world
                 return (new_block, replace(trans, waypoints=staged.waypoints, stages=staged.stages,
                                            blend_radius=staged.corner_radius, flyby_radius=staged.junction_radius,
                                            retract_T=ext.retract_T, retract_q=ext.retract_q,
-                                           approach_q=ext.approach_q)), WaitingError("")
+                                           approach_q=ext.approach_q))
     if rest is not None:
         return ([dwell(block[0].q[0], rest.seconds, kind="wait", label=f"wait for {rest.obstacle}"), *block],
-                replace(trans, wait=rest)), WaitingError("")
+                replace(trans, wait=rest))
     assert rest_error is not None
     if staged is None or isinstance(rest_error, Trapped):
-        return None, rest_error
+        return rest_error
     why = staged.detail if isinstance(staged, NoRoute) else "its way finishes no sooner"
-    return None, WaitingError(f"{trans.label}: waiting at rest fails ({rest_error}), and so does the time-aware "
+    return WaitingError(f"{trans.label}: waiting at rest fails ({rest_error}), and so does the time-aware "
                               f"search ({why}): the schedule cannot be met")

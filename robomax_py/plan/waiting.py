@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from robomax_py._typing import FloatArray
 from robomax_py.errors import RobomaxError
 from robomax_py.timing import Segment
 from robomax_py.world.collision import KIND_DYNAMIC, CollisionWorld
@@ -88,17 +89,9 @@ def wait_at_rest(world: CollisionWorld, block: Sequence[Segment], t: float,
     q_rest = np.asarray(block[0].q[0], dtype=float)
     for _ in range(MAX_WAITS):
         seconds = wait.seconds if wait else 0.0
-        if seconds > 0:
-            for spans in windows.values():
-                for w0, w1 in spans:
-                    if w0 <= t + seconds and w1 >= t:
-                        t_in = max(w0, t)
-                        contact = world.first_contact(q_rest, t_in)
-                        if contact is not None and contact.kind_b == KIND_DYNAMIC:
-                            name = contact.body_b
-                            end = max((b for a, b in windows.get(name, ()) if a <= t_in <= b), default=w1)
-                            raise Trapped(f"the robot would be hit while waiting at rest ({contact.describe()}) "
-                                          f"at t = {t_in:.3f} s", name, end, name in doors)
+        caught = trapped(world, q_rest, t, seconds, windows, doors) if seconds > 0 else None
+        if caught is not None:
+            raise caught
         hit = first_dynamic_hit(world, block, t + seconds)
         if hit is None:
             return wait
@@ -112,6 +105,24 @@ def wait_at_rest(world: CollisionWorld, block: Sequence[Segment], t: float,
         for_signal = clear_wait(t, windows[name]) == needed
         wait = WaitPlan(index, needed, name, for_signal, name in doors)
     raise WaitingError(f"more than {MAX_WAITS} windows in the way of one move")
+
+
+def trapped(world: CollisionWorld, q_rest: FloatArray, t: float, seconds: float,
+            windows: dict[str, tuple[tuple[float, float], ...]], doors: frozenset[str]) -> Trapped | None:
+    """Whether the robot at rest at q_rest over [t, t + seconds] is hit by a dynamic obstacle
+    (checked where each window that meets the span begins): the error saying which, and until
+    when its window lasts; None when it is not."""
+    for spans in windows.values():
+        for w0, w1 in spans:
+            if w0 <= t + seconds and w1 >= t:
+                t_in = max(w0, t)
+                contact = world.first_contact(q_rest, t_in)
+                if contact is not None and contact.kind_b == KIND_DYNAMIC:
+                    name = contact.body_b
+                    end = max((b for a, b in windows.get(name, ()) if a <= t_in <= b), default=w1)
+                    return Trapped(f"the robot would be hit while waiting at rest ({contact.describe()}) "
+                                   f"at t = {t_in:.3f} s", name, end, name in doors)
+    return None
 
 
 def first_dynamic_hit(world: CollisionWorld, block: Sequence[Segment], t0: float) -> tuple[str, float] | None:
