@@ -198,3 +198,8 @@ class CellSpec:
     dynamic: tuple[ObjectSpec, ...] = ()
     digest: str = ""                          # SHA-256 (hex) of the cell file's bytes
     machines: tuple[MachineSpec, ...] = ()    # tending cells: machines and their door schedules
+
+    @property
+    def tending(self) -> bool:
+        """Whether the cell tends machines (its stops are gripper actions at stations, not welds)."""
+        return any(spot.action is not None for seam in self.seams for spot in seam.spots)

@@ -75,8 +75,7 @@ def cycle_chart(result: PlanResult) -> CycleChart:
             row += 1                     # the spot is done: what follows leads to the next one
     if any(b.row == len(rows) for b in bars):
         rows.append(RETURN_ROW)
-    return CycleChart(result.cell, result.robot, float(traj.duration), tuple(rows), tuple(bars),
-                      any(s.action is not None for s in result.spots))
+    return CycleChart(result.cell, result.robot, float(traj.duration), tuple(rows), tuple(bars), result.tending)
 
 
 def chart_figure(chart: CycleChart) -> Any:

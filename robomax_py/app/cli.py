@@ -249,8 +249,8 @@ def verify(
         if report.ignored:
             out.print(f"  {len(report.ignored)} statement(s) read but without effect on the motion (I/O, declarations ...)")
         if report.clean:
-            done = ("every station's gripper action at rest on its pose" if spec.machines or
-                    any(p.action for seam in spec.seams for p in seam.spots) else "every spot welded within tolerance")
+            done = ("every station's gripper action at rest on its pose" if spec.tending
+                    else "every spot welded within tolerance")
             out.print(f"[green]clean[/]: no collisions, limits kept, {done}")
             return EXIT_OK
         out.print(f"[red]{len(report.violations)} violation(s)[/]")

@@ -44,7 +44,7 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
         c = result.clearance
         report["clearance"] = {"mm": round(c.distance_m * 1000, 3), "t": round(c.t, 4), "between": c.between}
     report["split"] = {k: round(v, 4) for k, v in split.items()}
-    report["tending"] = any(s.action is not None for s in result.spots)
+    report["tending"] = result.tending
     report["spots"] = [
         {"seam": s.seam, "spot": s.name, "t_arrive": round(s.t_arrive, 4),
          "alpha": round(math.degrees(s.angles[0]), 3), "beta": round(math.degrees(s.angles[1]), 3),

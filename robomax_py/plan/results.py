@@ -138,6 +138,11 @@ class PlanResult:
     clearance: Clearance | None = None       # the smallest distance the planned motion keeps, and where
 
     @property
+    def tending(self) -> bool:
+        """Whether the stops are gripper actions at tending stations rather than welds."""
+        return any(s.action is not None for s in self.spots)
+
+    @property
     def cycle_time(self) -> float:
         return float("nan") if self.trajectory is None else self.trajectory.duration
 
