@@ -87,16 +87,19 @@ class TableIk:
 
 
 def build_table(grid: JointGrid, forward: Forward, free: FreeTest) -> TableIk:
-    """The table of a grid: forward kinematics of every row, the rows in collision dropped."""
+    """The table of a grid: forward kinematics of every row, the rows in collision dropped;
+    ValueError when none is left."""
     qs, xs = [], []
     for first in range(0, grid.size, BATCH):
         rows = grid.rows(first, BATCH)
         keep = np.asarray(free(rows), dtype=bool)
         qs.append(rows[keep])
         xs.append(np.asarray(forward(rows[keep]), dtype=float))
-    q = np.concatenate(qs) if qs else np.zeros((0, len(grid.counts)))
-    x = np.concatenate(xs) if xs else np.zeros((0, 0))
-    return TableIk(q, x, grid.size, cKDTree(x) if len(x) else cKDTree(np.zeros((1, max(1, x.shape[1] if x.ndim == 2 else 1)))))
+    q, x = np.concatenate(qs), np.concatenate(xs)
+    if not len(q):
+        # A table without rows answers no lookup; say so here rather than on the first one.
+        raise ValueError(f"every one of the grid's {grid.size} rows is in collision")
+    return TableIk(q, x, grid.size, cKDTree(x))
 
 
 @dataclass(frozen=True, slots=True)
