@@ -109,3 +109,10 @@ def test_jacobian_interpolation_stays_on_the_line() -> None:
     assert worst <= LINE_TOL_M
     assert np.linalg.norm(arm.tip(rows[-1:])[0] - p1) <= LINE_TOL_M
     assert len(rows) == int(np.ceil(np.linalg.norm(p1 - p0) / STEP_M)) + 1
+
+
+def test_a_grid_wholly_in_collision_is_refused() -> None:
+    arm = PlanarArm()
+    grid = JointGrid.stepped((-HALF_PI,) * 3, (HALF_PI,) * 3, 3)
+    with pytest.raises(ValueError, match="every one of the grid's 27 rows is in collision"):
+        build_table(grid, arm.tip, lambda q: np.zeros(len(q), dtype=bool))
