@@ -56,6 +56,17 @@ class RobotSpec:
     disabled_links: tuple[tuple[str, str], ...] = ()        # robot.yaml collision.disable: never checked
     srdf_disabled_links: tuple[tuple[str, str], ...] = ()   # the SRDF's disable_collisions
     package_dirs: tuple[Path, ...] = ()   # folders P with P/NAME the package of the URDF's package://NAME meshes
+    loaded: JointLoadLimits | None = None    # joint limits carrying the rated payload (robot.yaml `loaded`)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class JointLoadLimits:
+    """Per joint, the limits with the rated payload at the flange: velocity (rad/s), acceleration
+    (rad/s^2), jerk (rad/s^3), each (n,). A lighter part gets limits interpolated by its mass."""
+
+    velocity: FloatArray
+    acceleration: FloatArray
+    jerk: FloatArray
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -131,6 +142,7 @@ class SpotSpec:
     action: Literal["grip", "release"] | None = None
     machine: str | None = None
     key: str | None = None                    # where the cell file states it, when not seams[i].spots[j]
+    part: str | None = None                   # pick and place: the part gripped or released here
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -183,6 +195,31 @@ class MachineSpec:
     windows: tuple[tuple[float, float], ...]  # s from program start: door closed (machining)
 
 
+@dataclass(frozen=True, slots=True)
+class TcpLimits:
+    """Limits on the TCP's path motion: speed v (m/s), tangential and radial acceleration a_T, a_R
+    (m/s^2) and the rates of change of those accelerations j_T, j_R (m/s^3)."""
+
+    v: float
+    a_T: float
+    a_R: float
+    j_T: float
+    j_R: float
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class PartSpec:
+    """A part of a pick-and-place cell: while held it moves with the TCP and collides with
+    everything but the gripper; it may touch (never enter) its `supports`."""
+
+    name: str
+    shape: Shape
+    mass: float                               # kg
+    T_tcp_part: FloatArray                    # (4, 4) the part's frame in the TCP frame while held
+    limits: TcpLimits | None                  # TCP limits while it is carried; None: the unloaded ones
+    supports: tuple[str, ...] = ()            # objects it rests on at its locations
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class CellSpec:
     name: str
@@ -198,6 +235,15 @@ class CellSpec:
     dynamic: tuple[ObjectSpec, ...] = ()
     digest: str = ""                          # SHA-256 (hex) of the cell file's bytes
     machines: tuple[MachineSpec, ...] = ()    # tending cells: machines and their door schedules
+    parts: tuple[PartSpec, ...] = ()          # pick-and-place cells: the parts moved
+    tcp_limits: TcpLimits | None = None       # pick-and-place cells: TCP limits without a part
+
+    def part(self, name: str) -> PartSpec:
+        """The part called `name` (KeyError when the cell has none of that name)."""
+        for p in self.parts:
+            if p.name == name:
+                return p
+        raise KeyError(name)
 
     @property
     def tending(self) -> bool:

@@ -21,6 +21,7 @@ import numpy as np
 from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
 from robomax_py.export.trajectory_json import load_trajectory_file
+from robomax_py.plan.loads import Loads, check_carried_motion
 from robomax_py.plan.poses import nominal_rotation
 from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.robot.ik import same_config
@@ -138,7 +139,12 @@ def _verify_motion(cell: CellSpec, robot: RobotModel, name: str, data: dict[str,
         if np.abs(q[idx] - cell.home).max() > HOME_TOL_RAD:
             out.append(Violation(float(t[idx]), "home", f"program does not {end} at robot.home"))
     world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
-    motion = check_motion(world, robot, t, q)
+    loads = Loads.of(cell, robot)
+    if loads is None:
+        motion = check_motion(world, robot, t, q)
+    else:
+        # While a part is held: checked with it in the gripper, under its limits (`plan.loads`).
+        motion = check_carried_motion(cell, robot, world, loads.worlds, t, q, data["spots"])
     out.extend(motion.violations)
     out.extend(_check_spots(cell, robot, data))
     closest = min_clearance(world, t, q) if clearance else None

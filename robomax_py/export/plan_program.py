@@ -20,6 +20,7 @@ from robomax_py._version import __version__
 from robomax_py.errors import ExportError
 from robomax_py.export.dialect import PlannedProgram
 from robomax_py.plan import PlanResult
+from robomax_py.plan.results import Transition
 from robomax_py.plan.waiting import WaitPlan, signal_of
 from robomax_py.program import (
     Comment,
@@ -106,8 +107,9 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
             radius = (trans.flyby_radius if approach_follows else 0.0) if last else trans.blend_radius
             if any(stage.index == w for stage in trans.stages):
                 radius = 0.0                     # the robot stops there to wait
-            speed = opts.speed * (opts.detour_speed if trans.kind == "detour" else 1.0)
-            emit(q, PtpMove(tuple(np.degrees(q)), speed, 1.0, flyby=math.degrees(radius), comment=note.strip(", ")))
+            speed = opts.speed * (opts.detour_speed if trans.kind == "detour" else 1.0) if trans.speed is None \
+                else trans.speed
+            emit(q, PtpMove(tuple(np.degrees(q)), speed, trans.accel, flyby=math.degrees(radius), comment=note.strip(", ")))
             for stage in trans.stages:
                 if stage.index == w:
                     emit(q, *_wait(stage.wait))
@@ -121,7 +123,7 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
         xyz, zyx = pose_mm_zyx(to_frame(C, spot.T_spot))
         act: Instruction = Spot(identifier(spot.name), identifier(spot.seam), spot.weld_time, spot.gun, spot.schedule) \
             if spot.action is None else Gripper(spot.action, identifier(spot.name), identifier(spot.seam), spot.weld_time)
-        emit(spot.q_spot, LinMove(xyz, zyx, spot.config, lin_mm_s, comment="approach"), act)
+        emit(spot.q_spot, LinMove(xyz, zyx, spot.config, _lin_mm_s(trans, lin_mm_s), comment="approach"), act)
         after = transitions[k + 1] if k + 1 < len(transitions) else None
         extended = after is not None and after.retract_T is not None and after.retract_q is not None
         xyz, zyx = pose_mm_zyx(to_frame(C, after.retract_T if extended else spot.T_app))   # type: ignore[union-attr]
@@ -131,10 +133,16 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
             emit(spot.q_spot, *_wait(transitions[k + 1].wait))
         retract_radius = transitions[k + 1].flyby_radius if k + 1 < len(transitions) else 0.0
         q_end = after.retract_q if extended else spot.q_app                                  # type: ignore[union-attr]
-        emit(q_end, LinMove(xyz, zyx, spot.config_app, lin_mm_s, flyby=math.degrees(retract_radius), comment="retract"))
+        emit(q_end, LinMove(xyz, zyx, spot.config_app, lin_mm_s if after is None else _lin_mm_s(after, lin_mm_s),
+                            flyby=math.degrees(retract_radius), comment="retract"))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
                     tuple(identifier(j) for j in result.joint_names), f"robomax_py {__version__}", cell_sha256, stamp)
     return PlannedProgram(Program(identifier(result.cell), header, frames, tuple(out)), tuple(joints))
+
+
+def _lin_mm_s(trans: Transition, default: float) -> float:
+    """The TCP speed of the lines a transition joins (its retract and approach), mm/s."""
+    return default if trans.tcp_speed is None else trans.tcp_speed * 1000.0
 
 
 def _interlocks(signals: tuple[str, ...]) -> list[Instruction]:

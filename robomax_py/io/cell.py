@@ -40,6 +40,7 @@ from robomax_py.spec import (
     MachineSpec,
     MeshShape,
     ObjectSpec,
+    PartSpec,
     PlannerSpec,
     ProcessSpec,
     RobotSpec,
@@ -47,6 +48,7 @@ from robomax_py.spec import (
     Shape,
     Sphere,
     SpotSpec,
+    TcpLimits,
     frozen_array,
 )
 from robomax_py.transforms import pose_matrix
@@ -66,6 +68,7 @@ MAX_NAME_CHARS = 200
 MAX_CELL_NAME_CHARS = 100
 # The seam a tending job becomes (one ordered seam: the cycles' station visits).
 TENDING_SEAM = "tending"
+PICK_PLACE_SEAM = "transfers"
 # Dynamic windows beyond a day of program time are a typo, and would overflow the time grid.
 MAX_WINDOW_S = 86_400.0
 
@@ -285,6 +288,50 @@ class TendingFile(_Strict):
     sequence: Annotated[list[Name], Field(min_length=1)] | None = None   # one cycle; default: the stations
 
 
+# Pick-and-place cells (README, "Pick and place"): parts carried from location to location, each
+# transfer a grip and a release; while held, a part moves with the TCP and is checked for collisions.
+
+
+class TcpLimitsFile(_Strict):
+    v: Positive                               # m/s, TCP speed
+    a_T: Positive                             # m/s^2, tangential (along the path) acceleration
+    a_R: Positive                             # m/s^2, radial (centripetal) acceleration
+    j_T: Positive                             # m/s^3, rate of change of a_T
+    j_R: Positive                             # m/s^3, rate of change of a_R
+
+
+class PartFile(ObjectFile):
+    mass: Annotated[float, Field(ge=0, allow_inf_nan=False)]          # kg
+    grasp: PoseFile = PoseFile()              # the TCP in the part's frame while held
+    limits: TcpLimitsFile | None = None       # TCP limits while this part is carried
+
+    @model_validator(mode="after")
+    def _no_placement(self) -> PartFile:
+        if self.pose != PoseFile() or self.workpiece or self.signal is not None:
+            raise ValueError("a part has no pose, workpiece or signal: its locations place it")
+        return self
+
+
+class LocationFile(_Strict):
+    name: Name
+    pose: PoseFile                            # the part's frame when it lies here
+    support: list[Name] = []                  # objects the part rests on here (it may touch them)
+
+
+class TransferFile(_Strict):
+    part: Name
+    from_: Annotated[Name, Field(alias="from")]
+    to: Name
+
+
+class PickPlaceFile(_Strict):
+    gripper: GripperFile = GripperFile()
+    unloaded: TcpLimitsFile | None = None     # TCP limits without a part
+    parts: Annotated[list[PartFile], Field(min_length=1)]
+    locations: Annotated[list[LocationFile], Field(min_length=2)]
+    transfers: Annotated[list[TransferFile], Field(min_length=1, max_length=10_000)]
+
+
 class CellFile(_Strict):
     robomax: int
     name: CellName | None = None
@@ -296,6 +343,7 @@ class CellFile(_Strict):
     planner: PlannerFile = PlannerFile()
     dynamic: list[DynamicObjectFile] = []
     tending: TendingFile | None = None
+    pick_place: PickPlaceFile | None = None
 
 
 def load_cell(path: str | Path) -> CellSpec:
@@ -336,7 +384,7 @@ def load_cell(path: str | Path) -> CellSpec:
         home=frozen_array(_home(parsed, robot_spec, path)),
         tool=tool_spec,
         objects=tuple(_object(o, path, f"objects[{i}]") for i, o in enumerate(parsed.objects)),
-        seams=_tending_seams(parsed, path) if parsed.tending is not None else _seams(parsed, path),
+        seams=_job_seams(parsed, path),
         process=ProcessSpec(
             weld_time=parsed.process.weld_time,
             approach=parsed.process.approach,
@@ -351,7 +399,84 @@ def load_cell(path: str | Path) -> CellSpec:
         dynamic=tuple(_object(o, path, f"dynamic[{i}]") for i, o in enumerate(parsed.dynamic)) + doors,
         digest=digest,
         machines=machines,
+        parts=_parts(parsed, path, robot_spec),
+        tcp_limits=_tcp_limits(parsed.pick_place.unloaded) if parsed.pick_place is not None else None,
     )
+
+
+def _job_seams(parsed: CellFile, path: Path) -> tuple[SeamSpec, ...]:
+    if parsed.tending is not None:
+        return _tending_seams(parsed, path)
+    if parsed.pick_place is not None:
+        return _pick_place_seams(parsed.pick_place, {o.name for o in parsed.objects}, path)
+    return _seams(parsed, path)
+
+
+def _tcp_limits(limits: TcpLimitsFile | None) -> TcpLimits | None:
+    return None if limits is None else TcpLimits(limits.v, limits.a_T, limits.a_R, limits.j_T, limits.j_R)
+
+
+def _parts(parsed: CellFile, path: Path, robot: RobotSpec) -> tuple[PartSpec, ...]:
+    """The parts with their held pose in the TCP frame and the supports of the locations they visit."""
+    job = parsed.pick_place
+    if job is None:
+        return ()
+    out = []
+    for i, part in enumerate(job.parts):
+        key = f"pick_place.parts[{i}]"
+        if robot.payload_kg is not None and part.mass > robot.payload_kg:
+            raise CellFileError(path, f"{key}.mass", f"{part.mass:g} kg is above the robot's rated payload "
+                                f"{robot.payload_kg:g} kg ({robot.source})")
+        shape = _object(part, path, key).shape
+        at = {t.from_ for t in job.transfers if t.part == part.name} | {t.to for t in job.transfers if t.part == part.name}
+        supports = sorted({name for loc in job.locations if loc.name in at for name in loc.support})
+        out.append(PartSpec(name=part.name, shape=shape, mass=part.mass,
+                            T_tcp_part=frozen_array(np.linalg.inv(_pose(part.grasp))),
+                            limits=_tcp_limits(part.limits), supports=tuple(supports)))
+    return tuple(out)
+
+
+def _pick_place_seams(job: PickPlaceFile, objects: set[str], path: Path) -> tuple[SeamSpec, ...]:
+    """The transfers as one ordered seam: per transfer a grip where the part lies and a release
+    where it goes, each at the TCP pose the part's grasp gives there."""
+    parts: dict[str, int] = {}
+    for i, part in enumerate(job.parts):
+        if part.name in parts:
+            raise CellFileError(path, f"pick_place.parts[{i}].name", f"duplicate part name '{part.name}' "
+                                f"(also parts[{parts[part.name]}])")
+        parts[part.name] = i
+    locations: dict[str, int] = {}
+    for i, loc in enumerate(job.locations):
+        if loc.name in locations:
+            raise CellFileError(path, f"pick_place.locations[{i}].name", f"duplicate location name '{loc.name}' "
+                                f"(also locations[{locations[loc.name]}])")
+        locations[loc.name] = i
+        for j, name in enumerate(loc.support):
+            if name not in objects:
+                raise CellFileError(path, f"pick_place.locations[{i}].support[{j}]",
+                                    f"unknown object '{name}' (a support is one of the cell's objects)")
+    spots = []
+    for k, tr in enumerate(job.transfers):
+        key = f"pick_place.transfers[{k}]"
+        if tr.part not in parts:
+            raise CellFileError(path, f"{key}.part", f"unknown part '{tr.part}' (parts: {', '.join(parts)})")
+        for field, name in (("from", tr.from_), ("to", tr.to)):
+            if name not in locations:
+                raise CellFileError(path, f"{key}.{field}", f"unknown location '{name}' (locations: {', '.join(locations)})")
+        if tr.from_ == tr.to:
+            raise CellFileError(path, f"{key}.to", f"the part goes back where it lies ('{tr.to}'): a transfer moves it")
+        T_tcp_in_part = _pose(job.parts[parts[tr.part]].grasp)
+        for action, name, visit in (("grip", tr.from_, "pick"), ("release", tr.to, "place")):
+            T = _pose(job.locations[locations[name]].pose) @ T_tcp_in_part
+            R = T[:3, :3]
+            spots.append(SpotSpec(
+                name=f"t{k + 1}_{visit}_{name}", xyz=frozen_array(T[:3, 3]), normal=frozen_array(-R[:, 2]),
+                direction=frozen_array(R[:, 0]),
+                weld_time=job.gripper.grip if action == "grip" else job.gripper.release,
+                angles=(0.0, 0.0, 0.0), action=action, key=key, part=tr.part,  # type: ignore[arg-type]
+            ))
+    return (SeamSpec(name=PICK_PLACE_SEAM, ordered=True, alpha_max=0.0, beta_max=0.0, gamma_range=(0.0, 0.0),
+                     grid=1, spots=tuple(spots)),)
 
 
 def load_cell_robot(cell: CellSpec) -> Any:
@@ -395,10 +520,14 @@ def _check_unique_names(parsed: CellFile, path: Path) -> None:
         if obj.name in seen:
             raise CellFileError(path, f"{key}.name", f"duplicate name '{obj.name}' (also {seen[obj.name]})")
         seen[obj.name] = key
-    if parsed.tending is not None and parsed.seams:
-        raise CellFileError(path, "tending", "a cell welds seams or tends machines, not both: remove seams or tending")
-    if parsed.tending is None and not parsed.seams:
-        raise CellFileError(path, "seams", "required: at least one seam (or a tending section)")
+    jobs = [key for key, given in (("seams", bool(parsed.seams)), ("tending", parsed.tending is not None),
+                                   ("pick_place", parsed.pick_place is not None)) if given]
+    if len(jobs) > 1:
+        raise CellFileError(path, jobs[1], f"a cell has one job: {' and '.join(jobs)} are both given; keep one")
+    if not jobs:
+        raise CellFileError(path, "seams", "required: at least one seam (or a tending or pick_place section)")
+    if parsed.pick_place is not None and parsed.dynamic:
+        raise CellFileError(path, "dynamic", "pick-and-place cells do not plan dynamic objects yet: remove them")
     seams: dict[str, int] = {}
     for i, seam in enumerate(parsed.seams):
         if seam.name in seams:

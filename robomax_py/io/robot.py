@@ -20,7 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from robomax_py.errors import RobotModelError
 from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
 from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
-from robomax_py.spec import ControllerSpec, RobotSpec, ToolSpec, frozen_array
+from robomax_py.spec import ControllerSpec, JointLoadLimits, RobotSpec, ToolSpec, frozen_array
 from robomax_py.transforms import pose_matrix
 from robomax_py.units import degs_to_rads
 
@@ -53,9 +53,25 @@ class IkFile(_Strict):
     params: dict[str, Any] | None = None
 
 
+class LoadedLimitsFile(_Strict):
+    """Joint limits carrying the rated payload (`payload`), deg/s, deg/s^2, deg/s^3."""
+
+    velocity: list[Finite]
+    acceleration: list[Finite]
+    jerk: list[Finite]
+
+    @field_validator("velocity", "acceleration", "jerk")
+    @classmethod
+    def _positive(cls, v: list[float]) -> list[float]:
+        if any(x <= 0 for x in v):
+            raise ValueError(f"every value must be > 0, got {v}")
+        return v
+
+
 class LimitsFile(_Strict):
     acceleration: list[Finite] | None = None  # deg/s^2 (m/s^2 for a prismatic joint)
     jerk: list[Finite] | None = None          # deg/s^3
+    loaded: LoadedLimitsFile | None = None    # extension: with the rated payload at the flange
 
     @field_validator("acceleration", "jerk")
     @classmethod
@@ -340,6 +356,8 @@ def load_robot_spec(path: Path) -> RobotSpec:
     srdf = () if parsed.srdf is None else tuple(srdf_disabled_pairs((path.parent / parsed.srdf).resolve(), path))
     ctrl = parsed.controller
     limits = parsed.limits
+    if limits.loaded is not None and parsed.payload is None:
+        raise RobotModelError(path, "limits.loaded", "needs `payload` (kg): the loaded limits hold for the rated payload")
     package_dirs = urdf_package_dirs(urdf, path)
     return RobotSpec(
         name=parsed.name,
@@ -359,6 +377,11 @@ def load_robot_spec(path: Path) -> RobotSpec:
         disabled_links=disabled,
         srdf_disabled_links=srdf,
         package_dirs=package_dirs,
+        loaded=None if limits.loaded is None else JointLoadLimits(
+            velocity=frozen_array(degs_to_rads(limits.loaded.velocity)),
+            acceleration=frozen_array(degs_to_rads(limits.loaded.acceleration)),
+            jerk=frozen_array(degs_to_rads(limits.loaded.jerk)),
+        ),
     )
 
 

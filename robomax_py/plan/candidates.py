@@ -98,10 +98,12 @@ class CandidateStats:
 def seam_candidates(
     cell: CellSpec, robot: RobotModel, world: CollisionWorld, seam_index: int,
     max_variants: int = MAX_TURN_VARIANTS, on_spot: Callable[[], None] | None = None,
+    line_world: Callable[[int], CollisionWorld] | None = None,
 ) -> tuple[list[SpotCandidates], CandidateStats]:
     """Candidates for every spot of one seam; at most `max_variants` turn variants per orientation
     and IK branch (those nearest home), the others counted as rejected `turn_variant`;
-    `on_spot()` is called as each spot is done."""
+    `on_spot()` is called as each spot is done; `line_world(s)`, when given, is the world spot s's
+    approach line is checked in (a pick-and-place stop's line carries the part)."""
     seam = cell.seams[seam_index]
     grid = orientation_grid(seam)
     T_base_world = invert(np.asarray(cell.T_world_base))
@@ -113,7 +115,8 @@ def seam_candidates(
     checks = 0
     out: list[SpotCandidates] = []
     for s in range(len(seam.spots)):
-        result, used = _spot_candidates(robot, world, seam, grid, s, table, seam_index)
+        result, used = _spot_candidates(robot, world if line_world is None else line_world(s), seam, grid, s, table,
+                                        seam_index)
         checks += used
         out.append(_nearest_variants(result, table.branch, np.asarray(cell.home), robot, max_variants))
         if on_spot is not None:

@@ -15,6 +15,7 @@ import numpy as np
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.plan.candidates import SpotCandidates
 from robomax_py.plan.cspace_detour import grid_detour
+from robomax_py.plan.loads import Loads
 from robomax_py.plan.results import PlanOptions, Progress, Transition, _no_progress
 from robomax_py.plan.roadmap import Detour, Roadmap
 from robomax_py.plan.sequence import (
@@ -103,9 +104,12 @@ class Sequencer:
     def __init__(
         self, cell: CellSpec, robot: RobotModel, world: CollisionWorld, roadmap: Roadmap,
         spots: list[SpotCandidates], options: PlanOptions, rng: np.random.Generator,
-        progress: Progress = _no_progress,
+        progress: Progress = _no_progress, loads: Loads | None = None,
     ) -> None:
         self.cell, self.robot, self.world, self.roadmap = cell, robot, world, roadmap
+        # Pick and place: the moves leaving a grip carry the part (their own world and roadmap).
+        self.loads = loads
+        self._roadmaps: dict[str | None, Roadmap] = {None: roadmap}
         self.progress = progress
         self.spots, self.options, self.rng = spots, options, rng
         self.limits = robot.limits
@@ -137,6 +141,24 @@ class Sequencer:
     def q(self, i: int) -> FloatArray:
         return self.home if i == HOME else self.spots[i].q_app
 
+    def _load(self, i: int) -> str | None:
+        return None if self.loads is None else self.loads.part_after(i)
+
+    def world_from(self, i: int) -> CollisionWorld:
+        """The collision world of the moves leaving stop i (with the part it grips, if any)."""
+        return self.world if self.loads is None else self.loads.world_after(i, self.world)
+
+    def roadmap_from(self, i: int) -> Roadmap:
+        """The roadmap of the moves leaving stop i, built for a held part when first needed."""
+        part = self._load(i)
+        if part not in self._roadmaps:
+            assert self.loads is not None and part is not None
+            rng = np.random.default_rng([self.cell.planner.seed, 1 + sorted(self.loads.worlds).index(part)])
+            anchors = np.vstack([self.home, *[c.q_app for c in self.spots]])
+            self._roadmaps[part] = Roadmap(self.world_from(i), self.limits, anchors, rng, self.options.roadmap_nodes,
+                                           self.options.roadmap_k, seeds=anchors)
+        return self._roadmaps[part]
+
     def _forget(self, i: int, j: int) -> None:
         for table in (self._matrices, self._full):
             table.pop((i, j), None)
@@ -163,7 +185,9 @@ class Sequencer:
         Indices are stable: new detours are only appended."""
         out: list[Detour] = []
         for di, dj, det in self.detours:
-            if di == i or dj == j:
+            if self._load(di) != self._load(i):
+                out.append(_UNUSABLE)            # found for another load: not checked for this one
+            elif di == i or dj == j:
                 out.append(det)
             elif dj == i or di == j:
                 out.append(Detour(det.waypoints[::-1].copy(), det.time_estimate, det.checks))
@@ -247,13 +271,15 @@ class Sequencer:
 
     def _record_straight(self, i: int, a: int, j: int, b: int, free: bool) -> None:
         self.straight.setdefault((i, j), {})[(a, b)] = free
-        self.straight.setdefault((j, i), {})[(b, a)] = free
+        if self._load(i) == self._load(j):       # else the way back is checked in another world
+            self.straight.setdefault((j, i), {})[(b, a)] = free
         self._forget(i, j)
 
     def _record_leg(self, i: int, a: int, j: int, b: int, v: int, ok: bool) -> None:
         table = self.legs_ok if ok else self.legs_bad
         table.setdefault((i, j), set()).add((a, b, v))
-        table.setdefault((j, i), set()).add((b, a, v))
+        if self._load(i) == self._load(j):
+            table.setdefault((j, i), set()).add((b, a, v))
         self._forget(i, j)
 
     # ------------------------------------------------------------------ the loop
@@ -302,7 +328,7 @@ class Sequencer:
                 a, b = self.probe_pair(i, j)
                 qa, qb = self.q(i)[a], self.q(j)[b]
                 if (i, j) in near:
-                    res = self.world.check_segment(qa, qb)
+                    res = self.world_from(i).check_segment(qa, qb)
                     self.checks += res.checks
                     free = res.free
                     self._record_straight(i, a, j, b, free)
@@ -310,7 +336,7 @@ class Sequencer:
                     free = True
                     for f in fractions:
                         self.checks += 1
-                        if not self.world.is_free(qa + f * (qb - qa)):
+                        if not self.world_from(i).is_free(qa + f * (qb - qa)):
                             free = False
                             break
                     if not free:
@@ -399,7 +425,7 @@ class Sequencer:
         known = self.straight.get((i, j), {}).get((a, b))
         if known is not None:
             return known
-        res = self.world.check_segment(self.q(i)[a], self.q(j)[b])
+        res = self.world_from(i).check_segment(self.q(i)[a], self.q(j)[b])
         self.checks += res.checks
         self._record_straight(i, a, j, b, res.free)
         if res.free:
@@ -414,7 +440,7 @@ class Sequencer:
             aa, bb = np.unravel_index(int(flat), est.shape)
             if (int(aa), int(bb)) in known_pairs:
                 continue
-            r = self.world.check_segment(self.q(i)[aa], self.q(j)[bb])
+            r = self.world_from(i).check_segment(self.q(i)[aa], self.q(j)[bb])
             self.checks += r.checks
             self._record_straight(i, int(aa), j, int(bb), r.free)
             if r.free:
@@ -461,7 +487,7 @@ class Sequencer:
                 for p0, p1 in zip(path[:-1], path[1:]):
                     if np.allclose(p0, p1):
                         continue
-                    res = self.world.check_segment(p0, p1)
+                    res = self.world_from(i).check_segment(p0, p1)
                     checks += res.checks
                     if not res.free:
                         ok = False
@@ -473,18 +499,18 @@ class Sequencer:
         self.checks += checks
         return None
 
-    def _searched_detour(self, qa: FloatArray, qb: FloatArray) -> Detour | None:
+    def _searched_detour(self, i: int, qa: FloatArray, qb: FloatArray) -> Detour | None:
         """The roadmap's detour, the local C-space map's, or the faster of both (`planner.detours`)."""
         kind = self.options.detours                   # resolved from the cell (`resolved_options`)
         if kind not in ("roadmap", "cspace", "both"):
             raise ValueError(f"planner.detours must be roadmap, cspace or both, got {kind!r}")
         found: list[Detour] = []
         if kind in ("roadmap", "both"):
-            det = self.roadmap.query(qa, qb)
+            det = self.roadmap_from(i).query(qa, qb)
             if det is not None:
                 found.append(det)
         if kind in ("cspace", "both"):
-            det, spent = grid_detour(self.world, self.limits, qa, qb)
+            det, spent = grid_detour(self.world_from(i), self.limits, qa, qb)
             if det is None:
                 self.checks += spent           # a found detour's checks are counted with it
             else:
@@ -504,7 +530,7 @@ class Sequencer:
 
     def _new_detour(self, i: int, a: int, j: int, b: int) -> None:
         # Lift first: on clamp cells it is found in ~1,000 checks; the roadmap is the general fallback.
-        det = self._lift_detour(i, a, j, b) or self._searched_detour(self.q(i)[a], self.q(j)[b])
+        det = self._lift_detour(i, a, j, b) or self._searched_detour(i, self.q(i)[a], self.q(j)[b])
         if det is None:
             # No way found for this exact pair: make sure the optimiser stops choosing it.
             self.no_way.setdefault((i, j), set()).add((a, b))
@@ -545,7 +571,7 @@ class Sequencer:
             a, b = (int(x) for x in np.unravel_index(int(flat), est.shape))
             if (a, b) in known or (a, b) in banned or not np.isfinite(est[a, b]):
                 continue
-            res = self.world.check_segment(self.q(i)[a], self.q(j)[b])
+            res = self.world_from(i).check_segment(self.q(i)[a], self.q(j)[b])
             self.checks += res.checks
             self._record_straight(i, a, j, b, res.free)
             tried += 1
@@ -562,7 +588,7 @@ class Sequencer:
             for p, r in ((qa, wp[0]), (wp[-1], qb)):
                 if np.allclose(p, r):
                     continue
-                res = self.world.check_segment(p, r)
+                res = self.world_from(i).check_segment(p, r)
                 self.checks += res.checks
                 if not res.free:
                     self._record_leg(i, a, j, b, v, False)

@@ -106,13 +106,14 @@ def time_junction(
     *,
     tcp_speed: float,
     speed: float = 1.0,
+    accel: float = 1.0,
     jerk_limited: bool = True,
     flyby: bool = True,
 ) -> Junction:
     """The fastest collision-free way through a junction.
 
     tcp_speed : the LIN lines' TCP speed, m/s (any override applied).
-    speed : the PTP moves' speed fraction.
+    speed, accel : the PTP moves' speed and acceleration fractions.
     q_start : the configuration at the start (at the spot when `before` is given, else home).
     waypoints : (m, n) the transition's joint path: first row where it starts (not used: the
         motion starts where the retract ends, or at q_start), then the PTP targets, the last the
@@ -125,7 +126,7 @@ def time_junction(
         ext = extended if rj > 0 else None
         if rj > 0 and ext is None:
             return None
-        steps = _steps(waypoints, kind, label, before, after, tcp_speed, speed, rj, rd, ext)
+        steps = _steps(waypoints, kind, label, before, after, tcp_speed, speed, rj, rd, ext, accel)
         try:
             return _time_steps(robot, limits, q_start, steps, jerk_limited, lin_cache)
         except TimingError:
@@ -151,7 +152,7 @@ def time_junction(
     def faster(trial: tuple[float, list[ChainPath], list[Segment]]) -> bool:
         if best is not None:
             return trial[0] < best[0]
-        stops = _steps(waypoints, kind, label, before, after, tcp_speed, speed, 0.0, 0.0)
+        stops = _steps(waypoints, kind, label, before, after, tcp_speed, speed, 0.0, 0.0, accel=accel)
         bound = _exact_lower_bound(q_start, stops, trial[1], limits)
         return trial[0] < bound or trial[0] < exact_motion()[0]
 
@@ -218,7 +219,7 @@ def _exact_lower_bound(q_start: FloatArray, steps: list[Step], paths: list[Chain
 
 def _steps(
     waypoints: FloatArray, kind: str, label: str, before: WeldEnd | None, after: WeldEnd | None,
-    tcp_speed: float, speed: float, rj: float, rd: float, ext: Extension | None = None,
+    tcp_speed: float, speed: float, rj: float, rd: float, ext: Extension | None = None, accel: float = 1.0,
 ) -> list[Step]:
     steps: list[Step] = []
     if before is not None:
@@ -230,7 +231,7 @@ def _steps(
     for w, q in enumerate(targets):
         last = w == len(targets) - 1
         fly = (rj if after is not None else 0.0) if last else rd
-        steps.append(PtpStep(q, speed=speed, flyby=fly, kind=kind, label=label))
+        steps.append(PtpStep(q, speed=speed, accel=accel, flyby=fly, kind=kind, label=label))
     if after is not None:
         steps.append(LinStep(after.T_spot, tcp_speed, after.column, kind="approach", label=after.label))
     return steps

@@ -18,6 +18,7 @@ import numpy as np
 
 from robomax_py.plan.candidates import SpotCandidates, seam_candidates
 from robomax_py.plan.graph import Sequencer
+from robomax_py.plan.loads import Loads, check_carried_motion
 from robomax_py.plan.results import (
     PlanOptions,
     PlanResult,
@@ -76,9 +77,13 @@ def plan_cell(
     n_spots = sum(len(seam.spots) for seam in cell.seams)
     done = iter(range(1, n_spots + 1))
     progress("candidates", 0, n_spots)
+    loads = Loads.of(cell, robot)
     for s in range(len(cell.seams)):
+        offset = sum(len(seam.spots) for seam in cell.seams[:s])
+        line_world = None if loads is None else (lambda j, offset=offset: loads.line_world(offset + j, world))
         found, stats = seam_candidates(cell, robot, world, s,
-                                       on_spot=lambda: progress("candidates", next(done), n_spots))
+                                       on_spot=lambda: progress("candidates", next(done), n_spots),
+                                       line_world=line_world)
         spots.extend(found)
         candidate_checks += stats.collision_checks
     clock["candidates"] = time.perf_counter() - t0
@@ -101,7 +106,7 @@ def plan_cell(
     log.debug("roadmap: %d nodes in %.2f s", len(roadmap.nodes), clock["roadmap"])
 
     t0 = time.perf_counter()
-    sequencer = Sequencer(cell, robot, world, roadmap, spots, options, rng, progress)
+    sequencer = Sequencer(cell, robot, world, roadmap, spots, options, rng, progress, loads=loads)
     outcome = sequencer.run()
     clock["sequencing"] = time.perf_counter() - t0
     log.debug("sequencing: %d rounds, %d DP evaluations, %d collision checks in %.2f s", sequencer.rounds,
@@ -112,7 +117,7 @@ def plan_cell(
 
     t0 = time.perf_counter()
     try:
-        timings = _timed_tours(cell, robot, world, spots, tour, transitions, options, progress, roadmap)
+        timings = _timed_tours(cell, robot, world, spots, tour, transitions, options, progress, roadmap, loads)
     except TimingError as exc:
         return PlanResult(cell.name, robot.name, "infeasible", f"timing failed: {exc}")
     except WaitingError as exc:
@@ -124,7 +129,7 @@ def plan_cell(
     verify_checks = 0
     # The first timing that passes its own check (the next is waiting at rest, where there is one).
     for trajectory, plans, transitions in timings:
-        check = verify_trajectory(full_world, robot, trajectory)
+        check = verify_trajectory(full_world, robot, trajectory, cell, loads, plans)
         verify_checks += check.checks
         if check.clean:
             break
@@ -139,6 +144,7 @@ def plan_cell(
                           f"the timed program failed its own check: {v.kind}: {v.detail} at t = {v.t:.3f} s")
 
     t0 = time.perf_counter()
+    # The robot's and tool's clearance; a carried part rests on its supports at its ends (0 mm).
     clearance = min_clearance(full_world, trajectory.t, trajectory.q)
     clock["clearance"] = time.perf_counter() - t0
 
@@ -158,12 +164,12 @@ def plan_cell(
 
 def _timed_tours(cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots: list[SpotCandidates], tour: Tour,
                  transitions: list[Transition], options: PlanOptions, progress: Progress,
-                 roadmap: Roadmap) -> list[tuple[Trajectory, list[SpotPlan], list[Transition]]]:
+                 roadmap: Roadmap, loads: Loads | None = None) -> list[tuple[Trajectory, list[SpotPlan], list[Transition]]]:
     """The tour timed, best first. With dynamic objects planned in time (`planner.dynamic: timed`)
     it is also timed waiting at rest, shorter first: the time-aware choice is made junction by
     junction, and an earlier arrival can meet a door that a later one would not."""
     if not cell.dynamic or options.dynamic != "timed":
-        return [time_tour(cell, robot, world, spots, tour, transitions, options, progress, roadmap)]
+        return [time_tour(cell, robot, world, spots, tour, transitions, options, progress, roadmap, loads)]
     out = []
     failure: WaitingError | None = None
     for mode in ("timed", "rest"):
@@ -178,9 +184,15 @@ def _timed_tours(cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots
     return sorted(out, key=lambda timing: timing[0].duration)
 
 
-def verify_trajectory(world: CollisionWorld, robot: RobotModel, traj: Trajectory) -> MotionCheck:
+def verify_trajectory(world: CollisionWorld, robot: RobotModel, traj: Trajectory, cell: CellSpec | None = None,
+                      loads: Loads | None = None, plans: list[SpotPlan] | None = None) -> MotionCheck:
     """Every sample within limits and every straight step between samples free? The same check
-    `robomax verify` runs (`world.motion.check_motion`), stopping at the first problem."""
+    `robomax verify` runs (`world.motion.check_motion`; with a part held, `loads.check_carried_motion`),
+    stopping at the first problem."""
+    if loads is not None and cell is not None and plans is not None:
+        spots = [{"seam": p.seam, "name": p.name, "t_arrive": p.t_arrive, "t_leave": p.t_leave} for p in plans]
+        return check_carried_motion(cell, robot, world, loads.worlds, traj.t, traj.q, spots, stop_at_first=True,
+                                    velocity_rtol=PLAN_VELOCITY_RTOL)
     return check_motion(world, robot, traj.t, traj.q, stop_at_first=True, velocity_rtol=PLAN_VELOCITY_RTOL)
 
 

@@ -100,6 +100,12 @@ class Transition:
     retract_T: FloatArray | None = None     # (4, 4) the retract's target, robot base frame
     retract_q: FloatArray | None = None     # the configuration there
     approach_q: FloatArray | None = None    # the configuration the approach line starts from
+    # What it carries (pick and place) and, where limits of the load slow it, the overrides it is
+    # timed and written with: PTP speed and acceleration fractions, its lines' TCP speed (m/s).
+    part: str | None = None
+    speed: float | None = None              # None: the plan's (`planner.speed`, `detour_speed`)
+    accel: float = 1.0
+    tcp_speed: float | None = None          # None: the plan's (`planner.tcp_speed`)
 
 
 @dataclass(frozen=True, slots=True)

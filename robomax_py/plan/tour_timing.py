@@ -11,7 +11,8 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.plan.candidates import SpotCandidates
-from robomax_py.plan.junction import JUNCTION_RADII_DEG, WeldEnd, time_junction
+from robomax_py.plan.junction import JUNCTION_RADII_DEG, Junction, WeldEnd, time_junction
+from robomax_py.plan.loads import MAX_TCP_RETIMES, LoadOverrides, Loads, tcp_block_peaks, tcp_limits_after
 from robomax_py.plan.poses import (
     OrientationGrid,
     approach_poses,
@@ -70,9 +71,10 @@ from robomax_py.world.scene import build_scene, clamps_near
 def time_tour(
     cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots: list[SpotCandidates], tour: Tour,
     transitions: list[Transition], options: PlanOptions, progress: Progress = _no_progress,
-    roadmap: Roadmap | None = None,
+    roadmap: Roadmap | None = None, loads: Loads | None = None,
 ) -> tuple[Trajectory, list[SpotPlan], list[Transition]]:
-    """Junction by junction (retract, move or detour, approach; `junction.time_junction`) and dwells."""
+    """Junction by junction (retract, move or detour, approach; `junction.time_junction`) and dwells.
+    A junction carrying a part (`loads`) is checked with it and slowed to its limits."""
     grids = [orientation_grid(seam) for seam in cell.seams]
     ends: list[WeldEnd] = []
     welded: list[tuple[int, int, FloatArray, FloatArray]] = []
@@ -91,12 +93,27 @@ def time_tour(
         after = ends[k] if k < len(ends) else None
         waypoints = as_written_joints(transitions[k].waypoints)      # the first row: where the retract ends
         trans = replace(transitions[k], waypoints=waypoints)
-        junction = time_junction(
-            robot, world, robot.limits, q_start, waypoints, trans.kind, trans.label, before, after,
-            tcp_speed=written_tcp_speed(options.tcp_speed * options.speed),
-            speed=written_speed(options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)),
-            jerk_limited=options.jerk_limited, flyby=options.blend,
-        )
+        part = loads.part_after(tour.order[k - 1]) if loads is not None and k > 0 else None
+        speed = options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)
+        load = LoadOverrides.of(cell, robot, part, speed, options.tcp_speed * options.speed)
+
+        def timed(load: LoadOverrides) -> Junction:
+            return time_junction(
+                robot, world if part is None or loads is None else loads.worlds[part], robot.limits, q_start, waypoints,
+                trans.kind, trans.label, before, after, tcp_speed=load.tcp_speed, speed=load.speed, accel=load.accel,
+                jerk_limited=options.jerk_limited, flyby=options.blend,
+            )
+
+        junction = timed(load)
+        tcp_limits = tcp_limits_after(cell, part)
+        for _ in range(MAX_TCP_RETIMES if tcp_limits is not None else 0):
+            slower = load.slowed(tcp_block_peaks(robot, junction.segments).scale_to(tcp_limits))
+            if slower is None:
+                break
+            load = slower
+            junction = timed(load)
+        if part is not None or tcp_limits is not None:
+            trans = replace(trans, part=part, speed=load.speed, accel=load.accel, tcp_speed=load.tcp_speed)
         block = list(junction.segments)
         ext = junction.extension
         if after is not None:

@@ -61,10 +61,23 @@ class RobotModel:
     disabled_links: frozenset[frozenset[str]] = frozenset()   # link pairs robot.yaml / SRDF exempt
     defaulted_limits: tuple[str, ...] = ()   # "acceleration", "jerk": derived, not given in robot.yaml
     warnings: tuple[str, ...] = ()           # what the user should know (fallbacks taken at load)
+    loaded_limits: JointLimits | None = None  # with the rated payload (robot.yaml `limits.loaded`)
+    payload_kg: float | None = None
 
     @property
     def dof(self) -> int:
         return int(self.model.nq)
+
+    def limits_carrying(self, mass: float) -> JointLimits:
+        """The joint limits carrying `mass` kg: linear in the mass from the unloaded limits to those
+        with the rated payload (our model: robot data sheets give the two ends only); the unloaded
+        limits when robot.yaml gives no loaded ones."""
+        if self.loaded_limits is None or self.payload_kg is None or mass <= 0:
+            return self.limits
+        f = min(mass / self.payload_kg, 1.0)
+        base, full = self.limits, self.loaded_limits
+        return dataclasses.replace(base, **{k: (1 - f) * getattr(base, k) + f * getattr(full, k)
+                                             for k in ("velocity", "acceleration", "jerk")})
 
 
 def kinematic_model(spec: RobotSpec) -> pin.Model:
@@ -119,6 +132,8 @@ def load_robot(spec: RobotSpec) -> RobotModel:
         # Visual meshes only serve the preview: plan with the collision meshes shown instead.
         warnings.append(f"{spec.urdf}: visual meshes not loaded ({exc.problem}); the preview shows the collision meshes")
         visual = collision.copy()
+    limits = JointLimits(lower, upper, velocity, np.asarray(acceleration, dtype=float), np.asarray(jerk, dtype=float))
+    loaded = _loaded_limits(spec, limits)
     defaulted = tuple(k for k, v in (("acceleration", spec.acceleration), ("jerk", spec.jerk)) if v is None)
     if defaulted:
         warnings.append(
@@ -141,6 +156,8 @@ def load_robot(spec: RobotSpec) -> RobotModel:
             acceleration=frozen_array(acceleration),
             jerk=frozen_array(jerk),
         ),
+        loaded_limits=loaded,
+        payload_kg=spec.payload_kg,
         ik_solver=spec.ik_solver,
         ik_params=ik_params,
         T_flange_tcp=frozen_array(np.eye(4)),
@@ -221,6 +238,26 @@ def reach(robot: RobotModel, samples: int = 4000, seed: int = 0) -> float:
     qs = rng.uniform(robot.limits.lower, robot.limits.upper, size=(samples, robot.dof))
     p = fk_flange(robot, qs)[:, :3, 3]
     return float(np.max(np.hypot(p[:, 0], p[:, 1])))
+
+
+def _loaded_limits(spec: RobotSpec, limits: JointLimits) -> JointLimits | None:
+    """robot.yaml's `limits.loaded`, checked: one value per joint, none above the unloaded limit."""
+    if spec.loaded is None:
+        return None
+    out = {}
+    for key in ("velocity", "acceleration", "jerk"):
+        given = np.asarray(getattr(spec.loaded, key), dtype=float)
+        unloaded = getattr(limits, key)
+        if len(given) != len(unloaded):
+            raise RobotModelError(spec.source, f"limits.loaded.{key}",
+                                  f"expected {len(unloaded)} values (one per joint), got {len(given)}")
+        above = np.flatnonzero(given > unloaded * (1 + 1e-9))
+        if above.size:
+            j = int(above[0])
+            raise RobotModelError(spec.source, f"limits.loaded.{key}", f"joint {j + 1}: {np.degrees(given[j]):g} is above "
+                                  f"the unloaded limit {np.degrees(unloaded[j]):g} (a payload never makes an arm faster)")
+        out[key] = given
+    return dataclasses.replace(limits, **out)
 
 
 def _limit_vector(spec: RobotSpec, key: str, given: FloatArray | None, default: FloatArray, n: int) -> FloatArray:

@@ -92,6 +92,8 @@ class ArmData:
     params_comment: str
     limits_comment: str
     urdf_comment: str
+    # Joint limits with the rated payload (robot.yaml `limits.loaded`); None: not given.
+    loaded_scale: tuple[float, float, float] | None = None    # velocity, acceleration, jerk fractions
 
 
 KUKA_OFFSETS_DEG = (0.0, -90.0, 0.0, 0.0, 0.0, 0.0)
@@ -204,6 +206,9 @@ KR16 = ArmData(
         "kr_16.csv. Masses (about 230 kg in all), inertias and efforts are estimated. "
         "Meshes are generated look-alikes, not KUKA CAD."
     ),
+    # Our estimate: KUKA publishes no payload-dependent limits (its controller derives them from
+    # the load data); full speed, 60 % of the acceleration and jerk with 16 kg at the flange.
+    loaded_scale=(1.0, 0.6, 0.6),
 )
 
 ARMS = (KR125, KR16)
@@ -731,6 +736,25 @@ def _robot_yaml(arm: ArmData) -> str:
         + arm.limits_comment
         + f"  acceleration: {lst(arm.acceleration_deg_s2)}   # deg/s^2, estimated\n"
         + f"  jerk: {lst(arm.jerk_deg_s3)}   # deg/s^3, estimated\n"
+        + _loaded_yaml(arm)
+    )
+
+
+def _deg_list(v: Sequence[float]) -> str:
+    return "[" + ", ".join(f"{x:g}" for x in v) + "]"
+
+
+def _loaded_yaml(arm: ArmData) -> str:
+    if arm.loaded_scale is None:
+        return ""
+    v, a, j = arm.loaded_scale
+    return (
+        f"  # estimated: with the rated {arm.payload_kg:g} kg payload, {v:.0%} of the speeds, {a:.0%} of the\n"
+        f"  # accelerations and {j:.0%} of the jerks (lighter parts: in proportion to their mass)\n"
+        + "  loaded:\n"
+        + f"    velocity: {_deg_list(tuple(v * x for x in arm.velocity_deg_s))}   # deg/s\n"
+        + f"    acceleration: {_deg_list(tuple(a * x for x in arm.acceleration_deg_s2))}   # deg/s^2\n"
+        + f"    jerk: {_deg_list(tuple(j * x for x in arm.jerk_deg_s3))}   # deg/s^3\n"
     )
 
 

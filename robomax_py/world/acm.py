@@ -48,7 +48,11 @@ KIND_TOOL_BODY = "tool_body"
 KIND_TOOL_TIPS = "tool_tips"
 KIND_OBJECT = "object"
 KIND_DYNAMIC = "dynamic"
-ROBOT_KINDS = (KIND_LINK, KIND_TOOL_BODY, KIND_TOOL_TIPS)
+KIND_HELD = "held"            # a part in the gripper: moves with the tool, collides like its body
+ROBOT_KINDS = (KIND_LINK, KIND_TOOL_BODY, KIND_TOOL_TIPS, KIND_HELD)
+# A held part may touch its supports (the objects it rests on where it is gripped or released)
+# but not sink into them by more than this (m): resting is a contact at distance 0.
+HELD_SUPPORT_PENETRATION_M = 1e-3
 OBSTACLE_KINDS = (KIND_OBJECT, KIND_DYNAMIC)
 
 
@@ -149,6 +153,12 @@ def _pieces(robot: RobotModel, scene: Scene) -> tuple[pin.GeometryModel, list[Pi
                 pin.GeometryObject(name, int(flange.parentJoint), int(scene.flange_frame_id), flange.placement, geom)
             )
             pieces.append(Piece(name, kind, kind, int(flange.parentJoint), -1))
+    if scene.held is not None:
+        placement = flange.placement * pin.SE3(np.asarray(scene.held.T_flange_part, dtype=float))
+        for i, geom in enumerate(scene.held.pieces):
+            name = f"{KIND_HELD}:{scene.held.name}[{i}]"
+            gm.addGeometryObject(pin.GeometryObject(name, int(flange.parentJoint), int(scene.flange_frame_id), placement, geom))
+            pieces.append(Piece(name, scene.held.name, KIND_HELD, int(flange.parentJoint), -1))
 
     obstacles = (*scene.obstacles, *scene.dynamic)
     for o, obj in enumerate(obstacles):
@@ -246,10 +256,18 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
         gm.addCollisionPair(pin.CollisionPair(a, b))
     pair_a = np.array([a for a, _ in ordered], dtype=np.int64)
     pair_b = np.array([b for _, b in ordered], dtype=np.int64)
-    pair_margin = np.array(
-        [clearance if (pieces[a].kind in OBSTACLE_KINDS or pieces[b].kind in OBSTACLE_KINDS) else 0.0 for a, b in ordered],
-        dtype=float,
-    )
+    supports = set(scene.held.supports) if scene.held is not None else set()
+
+    def margin(a: int, b: int) -> float:
+        pa, pb = pieces[a], pieces[b]
+        if pa.kind not in OBSTACLE_KINDS and pb.kind not in OBSTACLE_KINDS:
+            return 0.0
+        held, obstacle = (pa, pb) if pa.kind == KIND_HELD else (pb, pa)
+        if held.kind == KIND_HELD and obstacles[obstacle.obstacle].name in supports:
+            return -HELD_SUPPORT_PENETRATION_M
+        return clearance
+
+    pair_margin = np.array([margin(a, b) for a, b in ordered], dtype=float)
     dynamic_ids = np.array([o for o, obj in enumerate(obstacles) if obj.dynamic], dtype=np.int64)
     dynamic_pairs = tuple(
         np.array(

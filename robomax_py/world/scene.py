@@ -45,6 +45,7 @@ from robomax_py.spec import (
     Cylinder,
     MeshShape,
     ObjectSpec,
+    PartSpec,
     Shape,
     Sphere,
     frozen_array,
@@ -114,6 +115,17 @@ class ToolGeometry:
 
 
 @dataclass(frozen=True, slots=True, eq=False)
+class HeldPart:
+    """A part in the gripper: pieces in the part's frame, that frame in the flange frame. It may
+    touch (never enter) its supports, the objects it rests on where it is gripped and released."""
+
+    name: str
+    pieces: tuple[coal.CollisionGeometry, ...]
+    T_flange_part: FloatArray         # (4, 4)
+    supports: tuple[str, ...]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
 class Scene:
     """Everything the robot can hit, in the robot base frame.
 
@@ -135,6 +147,7 @@ class Scene:
     tool: ToolGeometry
     T_world_base: FloatArray
     flange_frame_id: int
+    held: HeldPart | None = None
 
     def object(self, name: str) -> SceneObject:
         """The static or dynamic obstacle called `name`; KeyError if there is none."""
@@ -144,7 +157,7 @@ class Scene:
         raise KeyError(name)
 
 
-def build_scene(cell: CellSpec, robot: RobotModel) -> Scene:
+def build_scene(cell: CellSpec, robot: RobotModel, held: PartSpec | None = None) -> Scene:
     """Collision geometry of a cell's objects and tool, posed for `robot`.
 
     Parameters
@@ -153,6 +166,8 @@ def build_scene(cell: CellSpec, robot: RobotModel) -> Scene:
         Objects in the world frame; the robot base at `cell.T_world_base`.
     robot : RobotModel
         The robot the tool is mounted on (its flange frame carries the tool pieces).
+    held : PartSpec, optional
+        A part of the cell in the gripper (carried with the tool).
 
     Returns
     -------
@@ -184,6 +199,11 @@ def build_scene(cell: CellSpec, robot: RobotModel) -> Scene:
         tips_representation=tips_repr,
         T_flange_tcp=frozen_array(cell.tool.T_flange_tcp),
     )
+    carried = None
+    if held is not None:
+        pieces, _ = shape_pieces(held.shape, cell.source, f"pick_place.parts[{cell.parts.index(held)}].mesh")
+        carried = HeldPart(held.name, pieces, frozen_array(np.asarray(cell.tool.T_flange_tcp) @ held.T_tcp_part),
+                           held.supports)
     return Scene(
         cell_name=cell.name,
         obstacles=obstacles,
@@ -191,6 +211,7 @@ def build_scene(cell: CellSpec, robot: RobotModel) -> Scene:
         tool=tool,
         T_world_base=frozen_array(cell.T_world_base),
         flange_frame_id=int(robot.flange_frame_id),
+        held=carried,
     )
 
 

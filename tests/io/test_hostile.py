@@ -141,6 +141,8 @@ def _tree_mutants(rng: np.random.Generator, base: dict[str, Any], cell: str, n: 
                 lists += [(("seams",), "name")] + [(("seams", i, "spots"), "name") for i in range(len(data["seams"]))]
             if "tending" in data:
                 lists += [(("tending", "stations"), "name"), (("tending", "machines"), "name")]
+            if "pick_place" in data:
+                lists += [(("pick_place", "parts"), "name"), (("pick_place", "locations"), "name")]
             where, key = lists[int(rng.integers(len(lists)))]
             items = _get(data, where)
             if len(items) >= 2:
@@ -253,13 +255,17 @@ def _name_mutants(base: dict[str, Any], cell: str) -> list[Mutant]:
         if k == "nul_seam":
             if "seams" in data:
                 data["seams"][0]["name"] = v
-            else:
+            elif "tending" in data:
                 data["tending"]["machines"][0]["name"] = v
+            else:
+                data["pick_place"]["parts"][0]["name"] = v
         if k == "unicode_spot":
             if "seams" in data:
                 data["seams"][0]["spots"][0]["name"] = v
-            else:
+            elif "tending" in data:
                 data["tending"]["stations"][0]["name"] = v
+            else:
+                data["pick_place"]["locations"][0]["name"] = v
         out.append(Mutant("odd_name", f"{cell}:{k}", lambda folder, d=data: _write(folder, d)))
     data = copy.deepcopy(base)
     data.setdefault("dynamic", []).append({"name": "door", "box": [0.1, 0.1, 0.1], "pose": {"xyz": [3, 3, 3]},

@@ -95,7 +95,7 @@ _DROP = object()
     ("tending.cycles", 0, "tending.cycles", "greater than or equal to 1"),
     ("tending.stations", [], "tending.stations", "at least 1"),
     ("seams", [{"name": "s", "spots": [{"name": "p", "xyz": [1, 0, 1], "normal": [0, 0, 1], "direction": [1, 0, 0]}]}],
-     "tending", "not both"),
+     "tending", "both given"),
     ("tending", _DROP, "seams", "at least one seam"),
 ])
 def test_bad_tending_sections_are_refused_with_the_key(tmp_path: Path, tending: dict[str, Any], key: str, value: Any,

@@ -82,10 +82,15 @@ def test_robot_yaml_has_exactly_the_spec_keys(name: str) -> None:
     assert set(data["ik"]["params"]) == {"a1", "a2", "b", "c1", "c2", "c3", "c4", "offsets", "sign_corrections"}
     assert data["ik"]["params"]["offsets"] == [0, -90, 0, 0, 0, 0]
     assert data["ik"]["params"]["sign_corrections"] == [-1, 1, 1, -1, 1, -1]
-    assert set(data["limits"]) == {"acceleration", "jerk"}
+    assert set(data["limits"]) <= {"acceleration", "jerk", "loaded"}
     for key in ("acceleration", "jerk"):
         values = data["limits"][key]
         assert len(values) == 6 and all(v > 0 for v in values)
+    # The extension: limits with the rated payload, never above the unloaded ones.
+    loaded = data["limits"].get("loaded")
+    if loaded is not None:
+        for key in ("acceleration", "jerk"):
+            assert all(0 < a <= b for a, b in zip(loaded[key], data["limits"][key], strict=True))
 
 
 @pytest.mark.parametrize("name", ARMS)

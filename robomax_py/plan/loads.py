@@ -1,0 +1,303 @@
+"""What the robot carries on each move of a pick-and-place job, and what that changes.
+
+From a grip until the matching release the gripper holds a part: every move in between is checked
+with the part attached to the tool (a collision world of its own, `world.scene.build_scene(held=)`)
+and timed under the part's limits (the joint limits for its mass, `RobotModel.limits_carrying`, and
+its TCP limits). Moves are named by the stop they leave: the load after stop i is the part gripped
+at i, until a release.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomax_py._typing import FloatArray
+from robomax_py.plan.poses import nominal_rotation
+from robomax_py.program import written_speed, written_tcp_speed
+from robomax_py.robot import JointLimits, RobotModel, fk_tcp
+from robomax_py.spec import CellSpec, PartSpec, SpotSpec, TcpLimits
+from robomax_py.timing import Segment
+from robomax_py.timing.tcp_motion import TcpPeaks, tcp_peaks, tcp_series
+from robomax_py.tolerances import DEFAULT as TOL
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.motion import MotionCheck, Violation, check_motion
+from robomax_py.world.scene import build_scene
+
+HOME = -1   # as `plan.sequence.HOME`: the start and end configuration carries nothing
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Loads:
+    """Per stop (the planner's spot index), the part held when the robot leaves it, and per part
+    the collision world with it in the gripper."""
+
+    held_after: tuple[str | None, ...]
+    worlds: dict[str, CollisionWorld]
+    parts: dict[str, PartSpec]
+
+    @classmethod
+    def of(cls, cell: CellSpec, robot: RobotModel) -> Loads | None:
+        """The loads of a pick-and-place cell's stops, numbered as the planner numbers them (every
+        seam's spots in order), or None for a cell that carries nothing."""
+        if not cell.parts:
+            return None
+        held: list[str | None] = []
+        now: str | None = None
+        for spot in (s for seam in cell.seams for s in seam.spots):
+            now = spot.part if spot.action == "grip" else None if spot.action == "release" else now
+            held.append(now)
+        worlds = {p.name: CollisionWorld(robot, build_scene(cell, robot, held=p), cell.process.clearance)
+                  for p in cell.parts}
+        return cls(tuple(held), worlds, {p.name: p for p in cell.parts})
+
+    def part_after(self, i: int) -> str | None:
+        """The part held on leaving stop i (HOME: none)."""
+        return None if i == HOME else self.held_after[i]
+
+    def world_after(self, i: int, empty: CollisionWorld) -> CollisionWorld:
+        part = self.part_after(i)
+        return empty if part is None else self.worlds[part]
+
+    def line_world(self, i: int, empty: CollisionWorld) -> CollisionWorld:
+        """The world of stop i's approach and retract line: with the part gripped or released there
+        (the part is held on one of the two, and the same line serves both)."""
+        return self.world_after(i, empty) if self.held_after[i] is not None else \
+            self.world_after(i - 1, empty) if i > 0 and self.held_after[i - 1] is not None else empty
+
+
+def tcp_limits_after(cell: CellSpec, part: str | None) -> TcpLimits | None:
+    """The TCP limits of a move carrying `part` (None: empty): the part's own, else the cell's
+    unloaded ones (None: no TCP limits)."""
+    if part is not None:
+        own = cell.part(part).limits
+        if own is not None:
+            return own
+    return cell.tcp_limits
+
+
+def joint_limits_after(cell: CellSpec, robot: RobotModel, part: str | None) -> JointLimits:
+    return robot.limits if part is None else robot.limits_carrying(cell.part(part).mass)
+
+
+# A junction over its TCP limits is slowed down and timed again at most this often; each time by the
+# factor that would bring its peaks within the limits, times RETIME_MARGIN.
+MAX_TCP_RETIMES = 6
+LINE_KINDS = ("approach", "retract", "weld")
+RETIME_MARGIN = 0.97
+
+
+def _floor_percent(fraction: float) -> float:
+    """A speed or acceleration fraction rounded down to the whole percent every dialect can state
+    (KRL and FANUC TP write whole percents: rounding up would exceed the part's limits)."""
+    return max(math.floor(fraction * 100.0 + 1e-9), 1) / 100.0
+
+
+@dataclass(frozen=True, slots=True)
+class LoadOverrides:
+    """The overrides a junction is timed and written with: PTP speed and acceleration fractions (of
+    the robot's unloaded limits; the acceleration fraction scales the jerk limit too) and the lines'
+    TCP speed (m/s)."""
+
+    speed: float
+    accel: float
+    tcp_speed: float
+
+    @classmethod
+    def of(cls, cell: CellSpec, robot: RobotModel, part: str | None, speed: float, tcp_speed: float) -> LoadOverrides:
+        """The overrides carrying `part` (None: nothing) from the plan's `speed` fraction and TCP
+        speed: the joint limits for its mass as fractions, the TCP speed capped by its limit."""
+        limits = joint_limits_after(cell, robot, part)
+        tcp = tcp_limits_after(cell, part)
+        v_ratio = float(np.min(limits.velocity / robot.limits.velocity))
+        a_ratio = float(min(np.min(limits.acceleration / robot.limits.acceleration),
+                            np.min(limits.jerk / robot.limits.jerk)))
+        if v_ratio < 1.0:
+            speed = _floor_percent(speed * v_ratio)
+        accel = _floor_percent(a_ratio) if a_ratio < 1.0 else 1.0
+        if tcp is not None and tcp.v < tcp_speed:
+            tcp_speed = math.floor(tcp.v * 1000.0) / 1000.0
+        return cls(written_speed(speed), accel, written_tcp_speed(tcp_speed))
+
+    def slowed(self, factor: float) -> LoadOverrides | None:
+        """The PTP overrides slowed by a time-scaling `factor` (speed x factor, acceleration x
+        factor^2), rounded down; None when `factor` is 1 or nothing can be slowed further. The
+        lines keep their TCP speed (their peaks are not what is slowed, `tcp_block_peaks`)."""
+        if factor >= 1.0:
+            return None
+        f = factor * RETIME_MARGIN
+        out = LoadOverrides(_floor_percent(self.speed * f), _floor_percent(self.accel * f * f), self.tcp_speed)
+        return None if out == self else out
+
+
+def tcp_block_peaks(robot: RobotModel, segments: list[Segment]) -> TcpPeaks:
+    """The TCP peaks of the joint moves of segments run end to end (not the straight lines at the
+    stops, which the overrides do not slow: see `check_carried_motion`)."""
+    runs: list[list[Segment]] = [[]]
+    for seg in segments:
+        if seg.kind in LINE_KINDS:
+            runs.append([])
+        elif len(seg.t) > 1:
+            runs[-1].append(seg)
+    peaks = [_run_peaks(robot, run) for run in runs if run]
+    if not peaks:
+        return tcp_peaks(np.zeros(1), np.zeros((1, 3)))
+    return TcpPeaks(*(max((getattr(pk, name) for pk in peaks), key=lambda x: x[0])
+                      for name in ("v", "a_T", "a_R", "j_T", "j_R")))
+
+
+def _run_peaks(robot: RobotModel, run: list[Segment]) -> TcpPeaks:
+    ts, qs, t0 = [], [], 0.0
+    for seg in run:
+        first = 0 if not ts else 1
+        ts.append(np.asarray(seg.t[first:]) + t0)
+        qs.append(np.asarray(seg.q[first:]))
+        t0 += float(seg.t[-1])
+    t, q = np.concatenate(ts), np.concatenate(qs)
+    keep = np.concatenate([[True], np.diff(t) > 0])
+    return tcp_peaks(t[keep], fk_tcp(robot, q[keep])[:, :3, 3])
+
+
+# Finite differences of 10 ms samples: speeds within 1 %, accelerations within 5 % (as the joints'
+# checks, `tolerances`). TCP jerk is reported, not enforced (see `check_carried_motion`).
+TCP_SPEED_RTOL = 0.01
+TCP_ACCEL_RTOL = 0.05
+# A sample is on a stop's straight line when its TCP is this close to the line's axis (m), up to the
+# approach distance plus the longest fly-by extension of a line (`tour_timing.MAX_EXTENSION_M`).
+ON_LINE_TOL_M = 1e-3
+LINE_EXTENSION_M = 0.1
+
+
+@dataclass(frozen=True, slots=True)
+class Hold:
+    """A part in the gripper from t_start to t_end, gripped and released at these TCP poses."""
+
+    t_start: float
+    t_end: float
+    part: str
+    T_grip: FloatArray          # (4, 4) world
+    T_release: FloatArray
+
+
+def holds(cell: CellSpec, spots: list[dict]) -> list[Hold]:
+    """Every hold of a written motion, from its spot entries (`seam`, `name`, `t_arrive`,
+    `t_leave`): from the arrival at a grip to the departure from the release that follows it. The
+    part is in the gripper while it closes: the checks take it as held."""
+    wanted = {(seam.name, s.name): s for seam in cell.seams for s in seam.spots}
+    entries = sorted((e for e in spots if (str(e["seam"]), str(e["name"])) in wanted), key=lambda e: float(e["t_arrive"]))
+    out: list[Hold] = []
+    start: tuple[float, str, FloatArray] | None = None
+    for e in entries:
+        spot = wanted[(str(e["seam"]), str(e["name"]))]
+        if spot.action == "grip" and spot.part is not None:
+            start = (float(e["t_arrive"]), spot.part, stop_pose(spot))
+        elif spot.action == "release" and start is not None:
+            out.append(Hold(start[0], float(e["t_leave"]), start[1], start[2], stop_pose(spot)))
+            start = None
+    if start is not None:
+        out.append(Hold(start[0], math.inf, start[1], start[2], start[2]))
+    return out
+
+
+def stop_pose(spot: SpotSpec) -> FloatArray:
+    """The TCP pose (world) of a pick-and-place stop: its lines run along the TCP z axis."""
+    T = np.eye(4)
+    T[:3, :3] = nominal_rotation(spot)
+    T[:3, 3] = spot.xyz
+    return T
+
+
+def on_lines(cell: CellSpec, hold: Hold, p_world: FloatArray) -> np.ndarray:
+    """(k,) whether each TCP position is on the grip's or the release's straight line."""
+    out = np.zeros(len(p_world), dtype=bool)
+    reach = cell.process.approach + LINE_EXTENSION_M + ON_LINE_TOL_M
+    for T in (hold.T_grip, hold.T_release):
+        rel = p_world - T[:3, 3]
+        along = rel @ T[:3, 2]
+        off = np.linalg.norm(rel - along[:, None] * T[:3, 2], axis=1)
+        out |= (off <= ON_LINE_TOL_M) & (along >= -ON_LINE_TOL_M) & (along <= reach)
+    return out
+
+
+def check_carried_motion(
+    cell: CellSpec, robot: RobotModel, empty: CollisionWorld, worlds: dict[str, CollisionWorld], t: FloatArray,
+    q: FloatArray, spots: list[dict], stop_at_first: bool = False, velocity_rtol: float = TOL.velocity_rtol,
+) -> MotionCheck:
+    """`world.motion.check_motion` hold by hold: while a part is held, with it in the gripper; off
+    the stops' straight lines, also the joint limits for its mass and the TCP limits of the part
+    (speed, tangential and radial acceleration; elsewhere the unloaded TCP limits). On the lines
+    only the TCP speed is the part's: a program states no acceleration for a LIN move (its joints
+    accelerate as the unloaded arm's). TCP jerk is not checked: blended moves are timed by toppra
+    without a jerk limit, so a program cannot promise it."""
+    t, q = np.asarray(t, dtype=float), np.asarray(q, dtype=float)
+    out: list[Violation] = []
+    checks = 0
+    p = (np.asarray(cell.T_world_base) @ fk_tcp(robot, q))[:, :3, 3]
+    for i0, i1, hold in _runs(t, holds(cell, spots)):
+        part = hold.part if hold is not None else None
+        res = check_motion(empty if part is None else worlds[part], robot, t[i0:i1 + 1], q[i0:i1 + 1],
+                           stop_at_first=stop_at_first, velocity_rtol=velocity_rtol)
+        checks += res.checks
+        out.extend(dataclasses.replace(v, detail=f"carrying {part}: {v.detail}") if part else v for v in res.violations)
+        line = on_lines(cell, hold, p[i0:i1 + 1]) if hold is not None else np.zeros(i1 - i0 + 1, dtype=bool)
+        out.extend(_load_limits(cell, robot, part, t[i0:i1 + 1], q[i0:i1 + 1], p[i0:i1 + 1], line, velocity_rtol))
+        if stop_at_first and out:
+            break
+    out.sort(key=lambda x: (x.t if x.t is not None else -1.0))
+    return MotionCheck(tuple(out[:1] if stop_at_first else out), checks)
+
+
+def _runs(t: FloatArray, spans: list[Hold]) -> list[tuple[int, int, Hold | None]]:
+    """(first, last, hold) sample runs of constant load; a run starts on the last sample of the one before."""
+    held: list[Hold | None] = [None] * len(t)
+    for h in spans:
+        for i in np.flatnonzero((t >= h.t_start - 1e-9) & (t <= h.t_end + 1e-9)):
+            held[int(i)] = h
+    runs: list[tuple[int, int, Hold | None]] = []
+    start = 0
+    for i in range(1, len(t) + 1):
+        if i == len(t) or held[i] is not held[start]:
+            runs.append((start - 1 if runs else start, i - 1, held[start]))
+            start = i
+    return runs
+
+
+def _load_limits(cell: CellSpec, robot: RobotModel, part: str | None, t: FloatArray, q: FloatArray, p: FloatArray,
+                 line: np.ndarray, velocity_rtol: float) -> list[Violation]:
+    """The joint limits for the part's mass and the TCP limits, off the lines; the TCP speed on them."""
+    out: list[Violation] = []
+    what = f"carrying {part}" if part else "empty"
+    if len(t) < 3:
+        return out
+    off = ~line
+    if part is not None:
+        limits = joint_limits_after(cell, robot, part)
+        dt = np.diff(t)
+        v = np.diff(q, axis=0) / dt[:, None]
+        a = np.diff(v, axis=0) / ((dt[:-1] + dt[1:]) / 2)[:, None]
+        v_off = off[:-1] & off[1:]
+        a_off = off[:-2] & off[1:-1] & off[2:]
+        for name, x, mask, lim, rtol in (("velocity", v, v_off, limits.velocity, velocity_rtol),
+                                         ("acceleration", a, a_off, limits.acceleration, TOL.acceleration_rtol)):
+            ratio = np.where(mask[:, None], np.abs(x) / lim, 0.0)
+            if ratio.max() > 1 + rtol:
+                i, j = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+                out.append(Violation(float(t[i]), name, f"{what}: {robot.joint_names[j]} {abs(x[i, j]):.3f} > "
+                                                        f"{lim[j]:.3f} (the limit for {cell.part(part).mass:g} kg)"))
+    tcp = tcp_limits_after(cell, part)
+    if tcp is None:
+        return out
+    v_tcp, a_t, a_r = tcp_series(t, p)
+    for name, x, mask, limit, rtol, unit in (
+        ("v", v_tcp, np.ones(len(t), dtype=bool), tcp.v, TCP_SPEED_RTOL, "m/s"),
+        ("a_T", a_t, off, tcp.a_T, TCP_ACCEL_RTOL, "m/s^2"),
+        ("a_R", a_r, off, tcp.a_R, TCP_ACCEL_RTOL, "m/s^2"),
+    ):
+        worst = np.where(mask, np.abs(x), 0.0)
+        if worst.max() > limit * (1 + rtol):
+            i = int(np.argmax(worst))
+            out.append(Violation(float(t[i]), "tcp_limit", f"{what}: TCP {name} {worst[i]:.3f} {unit} > {limit:g}"))
+    return out
