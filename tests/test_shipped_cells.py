@@ -64,6 +64,10 @@ def test_shipped_cell_plans_and_verifies(cell: Path, tmp_path: Path, update_gold
         visits = job.get("sequence") or [st["name"] for st in job["stations"]]
         spec["seams"] = [{"name": "tending", "ordered": True, "spots": [
             {"name": f"c{c}_{v}"} for c in range(1, job.get("cycles", 1) + 1) for v in visits]}]
+    if "pick_place" in spec:                # each transfer a pick where the part lies and a place
+        spec["seams"] = [{"name": "transfers", "ordered": True, "spots": [
+            {"name": f"t{k}_{visit}_{loc}"} for k, tr in enumerate(spec["pick_place"]["transfers"], start=1)
+            for visit, loc in (("pick", tr["from"]), ("place", tr["to"]))]}]
     wanted = {(s["name"], p["name"]) for s in spec["seams"] for p in s["spots"]}
     welded = [(s["seam"], s["name"]) for s in data["spots"]]  # type: ignore[union-attr]
     assert sorted(welded) == sorted(wanted)                      # every spot of every seam, once
