@@ -436,21 +436,22 @@ def _parts(parsed: CellFile, path: Path, robot: RobotSpec) -> tuple[PartSpec, ..
     return tuple(out)
 
 
+def _index_by_name(names: list[str], what: str, key: str, path: Path) -> dict[str, int]:
+    """name -> index in the list at `key`; a repeated name is refused with both places."""
+    out: dict[str, int] = {}
+    for i, name in enumerate(names):
+        if name in out:
+            raise CellFileError(path, f"{key}[{i}].name", f"duplicate {what} name '{name}' (also {key.split('.')[-1]}[{out[name]}])")
+        out[name] = i
+    return out
+
+
 def _pick_place_seams(job: PickPlaceFile, objects: set[str], path: Path) -> tuple[SeamSpec, ...]:
     """The transfers as one ordered seam: per transfer a grip where the part lies and a release
     where it goes, each at the TCP pose the part's grasp gives there."""
-    parts: dict[str, int] = {}
-    for i, part in enumerate(job.parts):
-        if part.name in parts:
-            raise CellFileError(path, f"pick_place.parts[{i}].name", f"duplicate part name '{part.name}' "
-                                f"(also parts[{parts[part.name]}])")
-        parts[part.name] = i
-    locations: dict[str, int] = {}
+    parts = _index_by_name([p.name for p in job.parts], "part", "pick_place.parts", path)
+    locations = _index_by_name([loc.name for loc in job.locations], "location", "pick_place.locations", path)
     for i, loc in enumerate(job.locations):
-        if loc.name in locations:
-            raise CellFileError(path, f"pick_place.locations[{i}].name", f"duplicate location name '{loc.name}' "
-                                f"(also locations[{locations[loc.name]}])")
-        locations[loc.name] = i
         for j, name in enumerate(loc.support):
             if name not in objects:
                 raise CellFileError(path, f"pick_place.locations[{i}].support[{j}]",
