@@ -217,6 +217,9 @@ class LinMove:
     comment : str
     flyby_mm : float
         As for `PtpMove` (mm of TCP distance).
+    accel : float
+        Fraction in (0, 1] of the joint acceleration (and jerk) limits the line may use, as a PTP
+        move's (3 decimals): a part in the gripper slows the lines that carry it too.
     """
 
     position_mm: tuple[float, ...]
@@ -226,6 +229,7 @@ class LinMove:
     flyby: float = 0.0
     comment: str = ""
     flyby_mm: float = 0.0
+    accel: float = 1.0
 
     def __post_init__(self) -> None:
         _set(self, "position_mm", _fixed_all(self.position_mm, MM_DECIMALS))
@@ -235,6 +239,7 @@ class LinMove:
         _set(self, "flyby", _fixed(self.flyby, ANGLE_DECIMALS))
         _set(self, "comment", str(self.comment).strip())
         _set(self, "flyby_mm", _fixed(self.flyby_mm, FLYBY_MM_DECIMALS))
+        _set(self, "accel", _fixed(self.accel, SPEED_DECIMALS))
 
     @property
     def flies(self) -> bool:
@@ -379,12 +384,14 @@ def find_problem(item: Header | FrameDef | Instruction, n_joints: int) -> str | 
         problem = (
             _triple("LIN position", item.position_mm)
             or _triple("LIN orientation", item.zyx_deg)
-            or _finite("LIN speed", (item.speed_mm_s,))
+            or _finite("LIN speed/accel", (item.speed_mm_s, item.accel))
         )
         if problem:
             return problem
         if item.speed_mm_s <= 0:
             return f"LIN speed {item.speed_mm_s:.3f} mm/s must be > 0"
+        if not 0.0 < item.accel <= 1.0:
+            return f"LIN accel {item.accel:.3f} is outside (0, 1] (a fraction of the maximum)"
         return _flyby_problem(item)
     if isinstance(item, Spot):
         problem = _finite("weld time", (item.time_s,))

@@ -100,7 +100,8 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
         elif isinstance(ins, LinMove):
             ins = dataclasses.replace(ins, position_mm=tuple(_round(v, 3) for v in ins.position_mm),
                                       zyx_deg=tuple(_round(v, ANGLE_DECIMALS) for v in ins.zyx_deg),
-                                      speed_mm_s=float(max(1, round(ins.speed_mm_s))), flyby=_cnt(ins.flyby) * CNT_DEG)
+                                      speed_mm_s=float(max(1, round(ins.speed_mm_s))), flyby=_cnt(ins.flyby) * CNT_DEG,
+                                      accel=percent(ins.accel) / 100)
         elif isinstance(ins, Wait):
             ins = Wait(math.ceil(round(ins.seconds * 100, 6)) / 100)
         out.append(ins)
@@ -143,7 +144,8 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                            f"\tJ1= {q[0]:.4f} deg,\tJ2= {q[1]:.4f} deg,\tJ3= {q[2]:.4f} deg,\n"
                            f"\tJ4= {q[3]:.4f} deg,\tJ5= {q[4]:.4f} deg,\tJ6= {q[5]:.4f} deg\n}};")
             else:
-                mn.append(f"L P[{k}] {int(round(ins.speed_mm_s))}mm/sec {term} ;")
+                acc = f" ACC{percent(ins.accel)}" if percent(ins.accel) != 100 else ""
+                mn.append(f"L P[{k}] {int(round(ins.speed_mm_s))}mm/sec {term}{acc} ;")
                 x, y, z = ins.position_mm
                 a, b, c = ins.zyx_deg
                 pos.append(f"P[{k}]{{\n   GP1:\n\tUF : 0, UT : 1,\t\tCONFIG : '{ins.config}',\n"
@@ -264,7 +266,7 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
                 instructions[-1] = read_gripper(last.action, remark, n, last.time_s, file, number)
             continue
         move = _MOVE.match(stmt)
-        # Offsets and incremental moves change the target; TB/TA/DB triggers and ACC do not.
+        # Offsets and incremental moves change the target; TB/TA/DB triggers do not (ACC is read).
         if _UNSIMULATED.match(stmt) or (move and re.search(r"\b(Offset|Tool_Offset|INC|VOFFSET|Skip)\b",
                                                            move.group(7) or "", re.I)):
             ignored.append((number, stmt))
@@ -288,7 +290,8 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
                 if unit != "mm/sec":
                     raise error(number, f"a linear move's speed must be in mm/sec here, got {unit}")
                 instructions.append(LinMove((fields["X"], fields["Y"], fields["Z"]), (fields["R"], fields["P"], fields["W"]),
-                                            config, speed, flyby=cnt * CNT_DEG))
+                                            config, speed, flyby=cnt * CNT_DEG,
+                                            accel=(float(acc.group(1)) if acc else 100.0) / 100))
             else:                          # a joint move to a Cartesian point, or the other way round
                 ignored.append((number, stmt))
                 instructions.append(Comment(f"not simulated: {stmt}"))

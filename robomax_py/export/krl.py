@@ -6,7 +6,8 @@ What a program states, in KRL's own terms:
 - `$TOOL` (TCP in the flange frame) and `$BASE` (the robot base in the cell's world, so that
   targets are relative to the robot base when `$ROBROOT` is placed as the cell places the robot)
   before the first motion;
-- `$VEL_AXIS[i]` / `$ACC_AXIS[i]` in whole percent for PTP, `$VEL.CP` in m/s for LIN;
+- `$VEL_AXIS[i]` / `$ACC_AXIS[i]` in whole percent for PTP, `$VEL.CP` in m/s for LIN (and
+  `$ACC_AXIS[i]`, which this subset applies to a LIN's axes too, as KSS does for spline CP motions);
 - blends as `C_DIS` with `$APO.CDIS` in mm, for PTP moves too, as KSS 8.2 and later write them
   from inline forms (`$APO.CPTP` is a whole percentage of half the move, too coarse to state the
   planned radius; `$APO.CDIS` is a REAL distance: KUKA.PLC mxAutomation manual, "APO" structure);
@@ -79,6 +80,8 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     for ins in program.instructions:
         if isinstance(ins, PtpMove):
             ins = dataclasses.replace(ins, speed=percent(ins.speed) / 100, accel=percent(ins.accel) / 100)
+        elif isinstance(ins, LinMove):
+            ins = dataclasses.replace(ins, accel=percent(ins.accel) / 100)
         out.append(ins)
     return dataclasses.replace(program, instructions=tuple(out))
 
@@ -124,6 +127,11 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                 if ins.speed_mm_s != cp_speed:
                     cp_speed = ins.speed_mm_s
                     src.append(f"$VEL.CP = {cp_speed / 1000:.6f}")
+                if ins.accel != (1.0 if accel is None else accel):
+                    # Our subset's convention (as KSS for spline CP motions): $ACC_AXIS bounds
+                    # the axes on a LIN too; a line carrying a part states its own.
+                    accel = ins.accel
+                    src += [f"$ACC_AXIS[{i}] = {percent(accel)}" for i in range(1, 7)]
                 dat.append(f"DECL E6POS {point}={_pose(ins)}")
             if ins.flyby_mm > 0 and ins.flyby_mm != apo:
                 apo = ins.flyby_mm
@@ -373,7 +381,8 @@ class _Reader:
             config = str(ConfigIndicator(int(self.last_pose["S"]), int(self.last_pose["T"])))
         xyz = tuple(self.last_pose[k] for k in "XYZ")
         zyx = tuple(self.last_pose[k] for k in "ABC")
-        self.add(LinMove(xyz, zyx, config, self.vel_cp * 1000.0, comment=comment, flyby_mm=flyby_mm), line)
+        self.add(LinMove(xyz, zyx, config, self.vel_cp * 1000.0, comment=comment, flyby_mm=flyby_mm,
+                         accel=min(self.acc_axis) / 100.0), line)
 
     def on_weld(self, tree: Tree[Token], comment: str, line: int) -> None:
         n, seconds = (float(t) for t in tree.children)

@@ -123,7 +123,8 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
         xyz, zyx = pose_mm_zyx(to_frame(C, spot.T_spot))
         act: Instruction = Spot(identifier(spot.name), identifier(spot.seam), spot.weld_time, spot.gun, spot.schedule) \
             if spot.action is None else Gripper(spot.action, identifier(spot.name), identifier(spot.seam), spot.weld_time)
-        emit(spot.q_spot, LinMove(xyz, zyx, spot.config, _lin_mm_s(trans, lin_mm_s), comment="approach"), act)
+        emit(spot.q_spot, LinMove(xyz, zyx, spot.config, _lin_mm_s(trans, lin_mm_s), comment="approach",
+                                  accel=trans.accel), act)
         after = transitions[k + 1] if k + 1 < len(transitions) else None
         extended = after is not None and after.retract_T is not None and after.retract_q is not None
         xyz, zyx = pose_mm_zyx(to_frame(C, after.retract_T if extended else spot.T_app))   # type: ignore[union-attr]
@@ -134,7 +135,8 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
         retract_radius = transitions[k + 1].flyby_radius if k + 1 < len(transitions) else 0.0
         q_end = after.retract_q if extended else spot.q_app                                  # type: ignore[union-attr]
         emit(q_end, LinMove(xyz, zyx, spot.config_app, lin_mm_s if after is None else _lin_mm_s(after, lin_mm_s),
-                            flyby=math.degrees(retract_radius), comment="retract"))
+                            flyby=math.degrees(retract_radius), comment="retract",
+                            accel=1.0 if after is None else after.accel))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
                     tuple(identifier(j) for j in result.joint_names), f"robomax_py {__version__}", cell_sha256, stamp)
     return PlannedProgram(Program(identifier(result.cell), header, frames, tuple(out)), tuple(joints))

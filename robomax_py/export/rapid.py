@@ -7,7 +7,8 @@ jointtarget, speeddata, zonedata, tooldata, wobjdata; instructions MoveAbsJ, Mov
   configuration (SPEC §6), external axes 9E9;
 - `tooldata` (TCP in the flange frame) and `wobjdata` (user frame = the robot base in the cell's
   world) declared in the module and named by every move;
-- PTP moves as `MoveAbsJ ... vmax` under `VelSet` (the speed fraction, %) and `AccSet`; LIN moves as
+- PTP moves as `MoveAbsJ ... vmax` under `VelSet` (the speed fraction, %) and `AccSet` (which holds
+  for the `MoveL`s after it too, as on the controller); LIN moves as
   `MoveL` with a `speeddata` whose v_tcp is the planned TCP speed (mm/s, at `VelSet 100`);
 - blends as `zonedata` with pzone_tcp the TCP distance (mm) of the planned radius (the other
   zone sizes in the proportions of ABB's predefined zones), `fine` at every stop and weld;
@@ -133,10 +134,11 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
             if want != override:
                 override = want
                 body.append(f"    VelSet {100 * want:.1f}, 5000;")
+            # AccSet holds for every later move, MoveL too (RAPID reference, "AccSet").
+            if ins.accel != accel and (isinstance(ins, PtpMove) or accel is not None or ins.accel != 1.0):
+                accel = ins.accel
+                body.append(f"    AccSet {100 * accel:.1f}, 100;")
             if isinstance(ins, PtpMove):
-                if ins.accel != accel:
-                    accel = ins.accel
-                    body.append(f"    AccSet {100 * accel:.1f}, 100;")
                 name = f"jt{n_point}"
                 joints = ", ".join(f"{v:.4f}" for v in ins.target_deg)
                 decl.append(f"  CONST jointtarget {name} := [[{joints}], {_EAX}];")
@@ -368,7 +370,8 @@ class _Reader:
         conf = [int(round(c)) for c in tree_numbers(value.children[2], self.file, line)]
         config = "[" + ",".join(str(c) for c in conf) + "]"
         v_tcp = VMAX_TCP_MM_S if v is None else v
-        self.add(LinMove(xyz, zyx, config, v_tcp * self.override / 100.0, comment=comment, flyby_mm=flyby_mm), line)
+        self.add(LinMove(xyz, zyx, config, v_tcp * self.override / 100.0, comment=comment, flyby_mm=flyby_mm,
+                         accel=self.accel / 100.0), line)
 
     def statement(self, text: str, comment: str, line: int) -> None:
         if _CLOSES.match(text) and not text.upper().startswith("ELSE"):

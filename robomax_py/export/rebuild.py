@@ -208,7 +208,7 @@ class _Builder:
         T = from_frame(self.robot.controller.T_root_base, lin_pose(ins))   # stated in the controller's base
         kind = "approach" if isinstance(following, (Spot, Gripper)) else "retract"
         return LinStep(T, ins.speed_mm_s / 1000.0, None, flyby=math.radians(ins.flyby), kind=kind, label=label,
-                       flyby_tcp=ins.flyby_mm / 1000.0)
+                       flyby_tcp=ins.flyby_mm / 1000.0, accel=ins.accel)
 
     def flush(self) -> bool:
         """Build and time the pending chain; False when it cannot be built (reported)."""

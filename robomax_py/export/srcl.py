@@ -151,7 +151,8 @@ def _statement(ins: Instruction) -> str:
     if isinstance(ins, LinMove):
         return (
             f"MOVE LIN {_pose(ins.position_mm, ins.zyx_deg)} CONFIG '{ins.config}' "
-            f"SPEED {_num(ins.speed_mm_s, SPEED_DECIMALS)} MM/S" + _tail(ins.flyby, ins.comment)
+            f"SPEED {_num(ins.speed_mm_s, SPEED_DECIMALS)} MM/S"
+            + (f" ACCEL {_num(ins.accel, SPEED_DECIMALS)}" if ins.accel < 1.0 else "") + _tail(ins.flyby, ins.comment)
         )
     if isinstance(ins, Spot):
         return (f"SPOT {ins.name} SEAM {ins.seam} TIME {_num(ins.time_s, TIME_DECIMALS)} SEC "
@@ -251,7 +252,7 @@ ori: "ORI" "(" NUMBER "," NUMBER "," NUMBER ")"
 
 _stmt: ptp | lin | spot | gripper | wait | wait_for | note
 ptp: "MOVE" "PTP" "AXIS" "(" NUMBER ("," NUMBER)* ")" "SPEED" NUMBER "ACCEL" NUMBER flyby? COMMENT? ";"
-lin: "MOVE" "LIN" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S flyby? COMMENT? ";"
+lin: "MOVE" "LIN" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S ("ACCEL" NUMBER)? flyby? COMMENT? ";"
 flyby: FLYBY NUMBER
 spot: "SPOT" IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ("GUN" NUMBER "SCHEDULE" NUMBER)? ";"
 gripper: (GRIP | RELEASE) IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ";"
@@ -522,10 +523,11 @@ class _Builder:
             return PtpMove(tuple(values[:-2]), values[-2], values[-1], flyby, self.note(tree))
         if tree.data == "lin":
             (config,) = self.tokens(tree, "STRING")
-            (speed,) = self.tokens(tree, "NUMBER")
+            speed, *accel = self.tokens(tree, "NUMBER")
             return LinMove(
                 self.triple(self.subtree(tree, "pos")), self.triple(self.subtree(tree, "ori")),
                 str(config)[1:-1], self.number(speed), flyby, self.note(tree),
+                accel=self.number(accel[0]) if accel else 1.0,
             )
         if tree.data == "spot":
             name, seam = self.tokens(tree, "IDENT")

@@ -5,8 +5,9 @@ Language", movej / movel / set_tcp / sleep / get_standard_digital_in):
 - `movej([q1, ..., q6], a, v, r)` with joint values in rad, `v` and `a` the leading joint's
   speed (rad/s) and acceleration (rad/s^2): the planned fractions of the robot's slowest joint
   limits; `movel(p[x, y, z, rx, ry, rz], a, v, r)` with the TCP pose in m and a rotation vector
-  (rad) in the UR controller's base frame, `v` the TCP speed in m/s (`a` = 1.2 m/s^2, UR's
-  default, not modelled by robomax's timing);
+  (rad) in the UR controller's base frame, `v` the TCP speed in m/s, `a` the line's acceleration
+  fraction times 1.2 m/s^2, UR's default (at 1.2 the line is timed under the full joint limits; a
+  line carrying a part states less, and a reader takes a/1.2 as the fraction, at most 1);
 - `set_tcp` (the TCP in the flange frame) before the first motion; the base is the controller's;
 - blends as `r`, the TCP distance (m) of the planned radius; 0 at every stop and weld;
 - no configuration data: the controller keeps the branch the arm is in, as robomax's LIN moves do;
@@ -117,7 +118,8 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                 q = ", ".join(f"{math.radians(v):.9f}" for v in ins.target_deg)
                 out.append(f"  movej([{q}], a={ins.accel * a_ref:.6f}, v={ins.speed * v_ref:.6f}, r={r:.9f}){note}")
             else:
-                out.append(f"  movel({_pose(ins.position_mm, ins.zyx_deg)}, a={LIN_ACCEL_M_S2:.1f}, "
+                a = f"{LIN_ACCEL_M_S2:.1f}" if ins.accel >= 1.0 else f"{ins.accel * LIN_ACCEL_M_S2:.6f}"
+                out.append(f"  movel({_pose(ins.position_mm, ins.zyx_deg)}, a={a}, "
                            f"v={ins.speed_mm_s / 1000:.6f}, r={r:.9f}){note}")
         elif isinstance(ins, Spot):
             n_weld += 1
@@ -266,7 +268,8 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             if len(values) != 6:
                 raise error(number, f"a pose has 6 values, got {len(values)}")
             add(LinMove(tuple(v * 1000.0 for v in values[:3]), zyx_from_rotvec(tuple(values[3:])), "",
-                        kw("v", 0.25) * 1000.0, comment=comment, flyby_mm=kw("r", 0.0) * 1000.0), number)
+                        kw("v", 0.25) * 1000.0, comment=comment, flyby_mm=kw("r", 0.0) * 1000.0,
+                        accel=max(min(kw("a", LIN_ACCEL_M_S2) / LIN_ACCEL_M_S2, 1.0), 0.001)), number)
         elif func == "set_tcp":
             values = _numbers(target, file, number)
             frame_name = comment.split()[-1] if comment.startswith("tool frame ") else "tcp"

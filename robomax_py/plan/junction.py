@@ -224,7 +224,7 @@ def _steps(
     steps: list[Step] = []
     if before is not None:
         T = ext.retract_T if ext is not None and ext.retract_T is not None else before.T_app
-        steps.append(LinStep(T, tcp_speed, before.column, flyby=rj, kind="retract", label=before.label))
+        steps.append(LinStep(T, tcp_speed, before.column, flyby=rj, kind="retract", label=before.label, accel=accel))
     targets = np.asarray(waypoints, dtype=float)[1:]
     if after is not None and ext is not None and ext.approach_q is not None:
         targets = np.vstack([targets[:-1], ext.approach_q[None, :]])
@@ -233,7 +233,7 @@ def _steps(
         fly = (rj if after is not None else 0.0) if last else rd
         steps.append(PtpStep(q, speed=speed, accel=accel, flyby=fly, kind=kind, label=label))
     if after is not None:
-        steps.append(LinStep(after.T_spot, tcp_speed, after.column, kind="approach", label=after.label))
+        steps.append(LinStep(after.T_spot, tcp_speed, after.column, kind="approach", label=after.label, accel=accel))
     return steps
 
 

@@ -16,10 +16,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomax_py._typing import FloatArray
-from robomax_py.plan.poses import nominal_rotation
 from robomax_py.program import written_speed, written_tcp_speed
 from robomax_py.robot import JointLimits, RobotModel, fk_tcp
-from robomax_py.spec import CellSpec, PartSpec, SpotSpec, TcpLimits
+from robomax_py.spec import CellSpec, PartSpec, TcpLimits
 from robomax_py.timing import Segment
 from robomax_py.timing.tcp_motion import TcpPeaks, tcp_peaks, tcp_series
 from robomax_py.tolerances import DEFAULT as TOL
@@ -86,7 +85,6 @@ def joint_limits_after(cell: CellSpec, robot: RobotModel, part: str | None) -> J
 # A junction over its TCP limits is slowed down and timed again at most this often; each time by the
 # factor that would bring its peaks within the limits, times RETIME_MARGIN.
 MAX_TCP_RETIMES = 6
-LINE_KINDS = ("approach", "retract", "weld")
 RETIME_MARGIN = 0.97
 
 
@@ -98,9 +96,9 @@ def _floor_percent(fraction: float) -> float:
 
 @dataclass(frozen=True, slots=True)
 class LoadOverrides:
-    """The overrides a junction is timed and written with: PTP speed and acceleration fractions (of
-    the robot's unloaded limits; the acceleration fraction scales the jerk limit too) and the lines'
-    TCP speed (m/s)."""
+    """The overrides a junction is timed and written with: the PTP speed fraction and the
+    acceleration fraction of all its moves, lines included (of the robot's unloaded limits; it
+    scales the jerk limit too), and the lines' TCP speed (m/s)."""
 
     speed: float
     accel: float
@@ -123,9 +121,9 @@ class LoadOverrides:
         return cls(written_speed(speed), accel, written_tcp_speed(tcp_speed))
 
     def slowed(self, factor: float) -> LoadOverrides | None:
-        """The PTP overrides slowed by a time-scaling `factor` (speed x factor, acceleration x
-        factor^2), rounded down; None when `factor` is 1 or nothing can be slowed further. The
-        lines keep their TCP speed (their peaks are not what is slowed, `tcp_block_peaks`)."""
+        """The overrides slowed by a time-scaling `factor` (PTP speed x factor, acceleration of
+        every move x factor^2), rounded down; None when `factor` is 1 or nothing can be slowed
+        further. The lines keep their TCP speed: their peaks come from accelerating to it."""
         if factor >= 1.0:
             return None
         f = factor * RETIME_MARGIN
@@ -134,19 +132,8 @@ class LoadOverrides:
 
 
 def tcp_block_peaks(robot: RobotModel, segments: list[Segment]) -> TcpPeaks:
-    """The TCP peaks of the joint moves of segments run end to end (not the straight lines at the
-    stops, which the overrides do not slow: see `check_carried_motion`)."""
-    runs: list[list[Segment]] = [[]]
-    for seg in segments:
-        if seg.kind in LINE_KINDS:
-            runs.append([])
-        elif len(seg.t) > 1:
-            runs[-1].append(seg)
-    peaks = [_run_peaks(robot, run) for run in runs if run]
-    if not peaks:
-        return tcp_peaks(np.zeros(1), np.zeros((1, 3)))
-    return TcpPeaks(*(max((getattr(pk, name) for pk in peaks), key=lambda x: x[0])
-                      for name in ("v", "a_T", "a_R", "j_T", "j_R")))
+    """The TCP peaks of segments run end to end."""
+    return _run_peaks(robot, [seg for seg in segments if len(seg.t) > 1])
 
 
 def _run_peaks(robot: RobotModel, run: list[Segment]) -> TcpPeaks:
@@ -165,21 +152,13 @@ def _run_peaks(robot: RobotModel, run: list[Segment]) -> TcpPeaks:
 # checks, `tolerances`). TCP jerk is reported, not enforced (see `check_carried_motion`).
 TCP_SPEED_RTOL = 0.01
 TCP_ACCEL_RTOL = 0.05
-# A sample is on a stop's straight line when its TCP is this close to the line's axis (m), up to the
-# approach distance plus the longest fly-by extension of a line (`tour_timing.MAX_EXTENSION_M`).
-ON_LINE_TOL_M = 1e-3
-LINE_EXTENSION_M = 0.1
-
-
 @dataclass(frozen=True, slots=True)
 class Hold:
-    """A part in the gripper from t_start to t_end, gripped and released at these TCP poses."""
+    """A part in the gripper from t_start to t_end."""
 
     t_start: float
     t_end: float
     part: str
-    T_grip: FloatArray          # (4, 4) world
-    T_release: FloatArray
 
 
 def holds(cell: CellSpec, spots: list[dict]) -> list[Hold]:
@@ -189,36 +168,16 @@ def holds(cell: CellSpec, spots: list[dict]) -> list[Hold]:
     wanted = {(seam.name, s.name): s for seam in cell.seams for s in seam.spots}
     entries = sorted((e for e in spots if (str(e["seam"]), str(e["name"])) in wanted), key=lambda e: float(e["t_arrive"]))
     out: list[Hold] = []
-    start: tuple[float, str, FloatArray] | None = None
+    start: tuple[float, str] | None = None
     for e in entries:
         spot = wanted[(str(e["seam"]), str(e["name"]))]
         if spot.action == "grip" and spot.part is not None:
-            start = (float(e["t_arrive"]), spot.part, stop_pose(spot))
+            start = (float(e["t_arrive"]), spot.part)
         elif spot.action == "release" and start is not None:
-            out.append(Hold(start[0], float(e["t_leave"]), start[1], start[2], stop_pose(spot)))
+            out.append(Hold(start[0], float(e["t_leave"]), start[1]))
             start = None
     if start is not None:
-        out.append(Hold(start[0], math.inf, start[1], start[2], start[2]))
-    return out
-
-
-def stop_pose(spot: SpotSpec) -> FloatArray:
-    """The TCP pose (world) of a pick-and-place stop: its lines run along the TCP z axis."""
-    T = np.eye(4)
-    T[:3, :3] = nominal_rotation(spot)
-    T[:3, 3] = spot.xyz
-    return T
-
-
-def on_lines(cell: CellSpec, hold: Hold, p_world: FloatArray) -> np.ndarray:
-    """(k,) whether each TCP position is on the grip's or the release's straight line."""
-    out = np.zeros(len(p_world), dtype=bool)
-    reach = cell.process.approach + LINE_EXTENSION_M + ON_LINE_TOL_M
-    for T in (hold.T_grip, hold.T_release):
-        rel = p_world - T[:3, 3]
-        along = rel @ T[:3, 2]
-        off = np.linalg.norm(rel - along[:, None] * T[:3, 2], axis=1)
-        out |= (off <= ON_LINE_TOL_M) & (along >= -ON_LINE_TOL_M) & (along <= reach)
+        out.append(Hold(start[0], math.inf, start[1]))
     return out
 
 
@@ -226,12 +185,10 @@ def check_carried_motion(
     cell: CellSpec, robot: RobotModel, empty: CollisionWorld, worlds: dict[str, CollisionWorld], t: FloatArray,
     q: FloatArray, spots: list[dict], stop_at_first: bool = False, velocity_rtol: float = TOL.velocity_rtol,
 ) -> MotionCheck:
-    """`world.motion.check_motion` hold by hold: while a part is held, with it in the gripper; off
-    the stops' straight lines, also the joint limits for its mass and the TCP limits of the part
-    (speed, tangential and radial acceleration; elsewhere the unloaded TCP limits). On the lines
-    only the TCP speed is the part's: a program states no acceleration for a LIN move (its joints
-    accelerate as the unloaded arm's). TCP jerk is not checked: blended moves are timed by toppra
-    without a jerk limit, so a program cannot promise it."""
+    """`world.motion.check_motion` hold by hold: while a part is held, with it in the gripper and
+    within the joint limits for its mass and the part's TCP limits (speed, tangential and radial
+    acceleration); elsewhere within the unloaded TCP limits, if any. TCP jerk is not checked:
+    blended moves are timed by toppra without a jerk limit, so a program cannot promise it."""
     t, q = np.asarray(t, dtype=float), np.asarray(q, dtype=float)
     out: list[Violation] = []
     checks = 0
@@ -242,8 +199,7 @@ def check_carried_motion(
                            stop_at_first=stop_at_first, velocity_rtol=velocity_rtol)
         checks += res.checks
         out.extend(dataclasses.replace(v, detail=f"carrying {part}: {v.detail}") if part else v for v in res.violations)
-        line = on_lines(cell, hold, p[i0:i1 + 1]) if hold is not None else np.zeros(i1 - i0 + 1, dtype=bool)
-        out.extend(_load_limits(cell, robot, part, t[i0:i1 + 1], q[i0:i1 + 1], p[i0:i1 + 1], line, velocity_rtol))
+        out.extend(_load_limits(cell, robot, part, t[i0:i1 + 1], q[i0:i1 + 1], p[i0:i1 + 1], velocity_rtol))
         if stop_at_first and out:
             break
     out.sort(key=lambda x: (x.t if x.t is not None else -1.0))
@@ -266,23 +222,20 @@ def _runs(t: FloatArray, spans: list[Hold]) -> list[tuple[int, int, Hold | None]
 
 
 def _load_limits(cell: CellSpec, robot: RobotModel, part: str | None, t: FloatArray, q: FloatArray, p: FloatArray,
-                 line: np.ndarray, velocity_rtol: float) -> list[Violation]:
-    """The joint limits for the part's mass and the TCP limits, off the lines; the TCP speed on them."""
+                 velocity_rtol: float) -> list[Violation]:
+    """The joint limits for the part's mass and the TCP limits of the load."""
     out: list[Violation] = []
     what = f"carrying {part}" if part else "empty"
     if len(t) < 3:
         return out
-    off = ~line
     if part is not None:
         limits = joint_limits_after(cell, robot, part)
         dt = np.diff(t)
         v = np.diff(q, axis=0) / dt[:, None]
         a = np.diff(v, axis=0) / ((dt[:-1] + dt[1:]) / 2)[:, None]
-        v_off = off[:-1] & off[1:]
-        a_off = off[:-2] & off[1:-1] & off[2:]
-        for name, x, mask, lim, rtol in (("velocity", v, v_off, limits.velocity, velocity_rtol),
-                                         ("acceleration", a, a_off, limits.acceleration, TOL.acceleration_rtol)):
-            ratio = np.where(mask[:, None], np.abs(x) / lim, 0.0)
+        for name, x, lim, rtol in (("velocity", v, limits.velocity, velocity_rtol),
+                                   ("acceleration", a, limits.acceleration, TOL.acceleration_rtol)):
+            ratio = np.abs(x) / lim
             if ratio.max() > 1 + rtol:
                 i, j = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
                 out.append(Violation(float(t[i]), name, f"{what}: {robot.joint_names[j]} {abs(x[i, j]):.3f} > "
@@ -291,12 +244,12 @@ def _load_limits(cell: CellSpec, robot: RobotModel, part: str | None, t: FloatAr
     if tcp is None:
         return out
     v_tcp, a_t, a_r = tcp_series(t, p)
-    for name, x, mask, limit, rtol, unit in (
-        ("v", v_tcp, np.ones(len(t), dtype=bool), tcp.v, TCP_SPEED_RTOL, "m/s"),
-        ("a_T", a_t, off, tcp.a_T, TCP_ACCEL_RTOL, "m/s^2"),
-        ("a_R", a_r, off, tcp.a_R, TCP_ACCEL_RTOL, "m/s^2"),
+    for name, x, limit, rtol, unit in (
+        ("v", v_tcp, tcp.v, TCP_SPEED_RTOL, "m/s"),
+        ("a_T", a_t, tcp.a_T, TCP_ACCEL_RTOL, "m/s^2"),
+        ("a_R", a_r, tcp.a_R, TCP_ACCEL_RTOL, "m/s^2"),
     ):
-        worst = np.where(mask, np.abs(x), 0.0)
+        worst = np.abs(x)
         if worst.max() > limit * (1 + rtol):
             i = int(np.argmax(worst))
             out.append(Violation(float(t[i]), "tcp_limit", f"{what}: TCP {name} {worst[i]:.3f} {unit} > {limit:g}"))

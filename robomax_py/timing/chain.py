@@ -10,7 +10,7 @@ last flies by; it starts and ends at rest.
   limiting is off (then toppra on the straight line).
 - Every other chain (a LIN move; fly-by through several moves) is timed time-optimally by toppra
   on the blended path under the joint velocity and acceleration limits (no jerk limit), moving at
-  the lowest `speed` and `accel` of its PTP moves; LIN moves, and the joins next to them, also
+  the lowest `speed` of its PTP moves and the lowest `accel` of all its moves; LIN moves, and the joins next to them, also
   keep their TCP speed.
 
 The planner and `robomax verify` both build motion with `chain_path` and `time_chain`, so a
@@ -73,6 +73,7 @@ class LinStep:
     kind: str = "approach"
     label: str = ""
     flyby_tcp: float = 0.0
+    accel: float = 1.0               # fraction of the joint acceleration and jerk limits, as a PTP's
 
 
 Step = PtpStep | LinStep
@@ -244,7 +245,7 @@ def time_chain(
         return [ptp_move(chain.path.start, chain.path.end, limits, speed * step.speed, accel=step.accel,
                          kind=step.kind, label=step.label, dt=dt)]
     chain_speed = speed * min((s.speed for s in ptp), default=1.0)
-    chain_accel = min((s.accel for s in ptp), default=1.0)
+    chain_accel = min((s.accel for s in steps), default=1.0)
     bounds = chain.tcp_limits
 
     def path_speed_limit(s: FloatArray) -> FloatArray:
