@@ -16,6 +16,10 @@ ur
 numeric
     seeds (int >= 1, default 32): random starts per pose; solutions (int >= 1, default 8): solution
     slots; max_iterations (int >= 1, default 50). All optional.
+table
+    step (deg, or m for a prismatic joint; one number or one per joint, required): the grid of the
+    associative memory; max_rows (int, default 1,000,000); neighbours (int, default 32): stored rows
+    seeding each pose; solutions (default 8); max_iterations (default 40).
 """
 
 from __future__ import annotations
@@ -27,18 +31,20 @@ from typing import Any
 from robomax_py.errors import RobotModelError
 from robomax_py.robot.ik.numeric import NumericIkParams
 from robomax_py.robot.ik.opw import OpwParams
+from robomax_py.robot.ik.pose_table import TableIkParams
 from robomax_py.robot.ik.ur import UrParams
 
 _OPW_LENGTHS = ("a1", "a2", "b", "c1", "c2", "c3", "c4")
 _UR_LENGTHS = ("d1", "a2", "a3", "d4", "d5", "d6")
 _UR_POSES = ("base_xyz", "base_rpy", "flange_xyz", "flange_rpy")
 _NUMERIC_INTS = ("seeds", "solutions", "max_iterations")
+_TABLE_INTS = ("max_rows", "neighbours", "solutions", "max_iterations")
 
 
-SOLVERS = ("opw", "ur", "numeric")
+SOLVERS = ("opw", "ur", "numeric", "table")
 
 
-def params_from_mapping(solver: str, params: Mapping[str, Any]) -> OpwParams | UrParams | NumericIkParams:
+def params_from_mapping(solver: str, params: Mapping[str, Any]) -> OpwParams | UrParams | NumericIkParams | TableIkParams:
     """robot.yaml `ik.params` (m, deg) -> typed solver parameters (m, rad).
 
     Raises
@@ -55,6 +61,8 @@ def params_from_mapping(solver: str, params: Mapping[str, Any]) -> OpwParams | U
         allowed: tuple[str, ...] = (*_OPW_LENGTHS, "offsets", "sign_corrections")
     elif solver == "ur":
         allowed = (*_UR_LENGTHS, *_UR_POSES)
+    elif solver == "table":
+        allowed = ("step", *_TABLE_INTS)
     else:
         allowed = _NUMERIC_INTS
     for key in params:
@@ -94,9 +102,31 @@ def params_from_mapping(solver: str, params: Mapping[str, Any]) -> OpwParams | U
             d1=d1, a2=a2, a3=a3, d4=d4, d5=d5, d6=d6,
             base_xyz=(bx, by, bz), base_rpy=(br, bp, bw), flange_xyz=(fx, fy, fz), flange_rpy=(fr, fp, fw),
         )
+    if solver == "table":
+        return _table_params(params)
     defaults = NumericIkParams()
     return NumericIkParams(
         seeds=_positive_int(params, "seeds", defaults.seeds),
+        solutions=_positive_int(params, "solutions", defaults.solutions),
+        max_iterations=_positive_int(params, "max_iterations", defaults.max_iterations),
+    )
+
+
+def _table_params(params: Mapping[str, Any]) -> TableIkParams:
+    """The table's steps stay a tuple of degrees here (the joint count is the URDF's): converted by
+    `robot.model.checked_ik_params` once the joints are known."""
+    if "step" not in params:
+        raise RobotModelError(None, "ik.params.step", "missing (required): the grid step, deg (one number or one per joint)")
+    step = params["step"]
+    values = step if isinstance(step, (list, tuple)) else [step]
+    for i, v in enumerate(values):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
+            raise RobotModelError(None, "ik.params.step", f"entry {i}: expected a number > 0, got {v!r}")
+    defaults = TableIkParams(step=())
+    return TableIkParams(
+        step=tuple(float(v) for v in values),
+        max_rows=_positive_int(params, "max_rows", defaults.max_rows),
+        neighbours=_positive_int(params, "neighbours", defaults.neighbours),
         solutions=_positive_int(params, "solutions", defaults.solutions),
         max_iterations=_positive_int(params, "max_iterations", defaults.max_iterations),
     )

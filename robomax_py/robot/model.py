@@ -174,6 +174,8 @@ def checked_ik_params(spec: RobotSpec, model: pin.Model) -> Any:
     """The robot's closed-form IK parameters, fitted when not given, and checked against the URDF."""
     from robomax_py.robot.ik.fit import FitError, fit_opw, fit_ur, fk_agreement
 
+    if spec.ik_solver == "table":
+        return _table_steps(spec, model)
     if spec.ik_solver not in ("opw", "ur"):
         return spec.ik_params
     frame_id = int(model.getFrameId(spec.flange))
@@ -195,6 +197,25 @@ def checked_ik_params(spec: RobotSpec, model: pin.Model) -> Any:
             f"{agreement.samples} random configurations (allowed {TOL.ik_fit_m:g} m); parameters {params}",
         )
     return params
+
+
+def _table_steps(spec: RobotSpec, model: pin.Model) -> Any:
+    """The table solver's steps in the joints' units (rad; m for a prismatic joint), one per joint."""
+    params = spec.ik_params
+    steps = params.step
+    n = int(model.nq)
+    if len(steps) not in (1, n):
+        raise RobotModelError(spec.source, "ik.params.step", f"expected one step or {n} (one per joint), got {len(steps)}")
+    steps = steps * n if len(steps) == 1 else steps
+    prismatic = prismatic_mask(model)
+    out = dataclasses.replace(params, step=tuple(s if prismatic[i] else float(np.radians(s)) for i, s in enumerate(steps)))
+    from robomax_py.robot.ik.pose_table import grid_of
+
+    grid = grid_of(np.array(model.lowerPositionLimit), np.array(model.upperPositionLimit), out.step)
+    if grid.size > out.max_rows:
+        raise RobotModelError(spec.source, "ik.params.step", f"the grid has {grid.size:,} rows (J = {list(grid.counts)}), "
+                              f"more than max_rows {out.max_rows:,}: take larger steps (the wrist's especially)")
+    return out
 
 
 def _disabled_links(spec: RobotSpec, model: pin.Model) -> frozenset[frozenset[str]]:

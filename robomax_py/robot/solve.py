@@ -27,12 +27,13 @@ from robomax_py.robot.ik.config import (
 )
 from robomax_py.robot.ik.numeric import NumericIkParams, numeric_ik
 from robomax_py.robot.ik.opw import OpwParams, opw_ik
+from robomax_py.robot.ik.pose_table import TableIkParams, table_ik
 from robomax_py.robot.ik.turns import expand, turn_shifts, wrap_to_pi
 from robomax_py.robot.ik.ur import UrParams, ur_ik
 from robomax_py.robot.model import RobotModel
 from robomax_py.transforms import invert
 
-SOLVERS = ("opw", "ur", "numeric")
+SOLVERS = ("opw", "ur", "numeric", "table")
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -121,6 +122,14 @@ def solve_all(
             np.random.default_rng(0) if rng is None else rng,
             params.seeds, q_hint, max_solutions=params.solutions, max_iterations=params.max_iterations,
         )
+        q = np.where(rev, wrap_to_pi(q), q)
+        status = status_generic(model, robot.flange_frame_id, q)
+        if _has_status(model, robot.flange_frame_id):
+            q, valid, status = _by_status(q, valid, status)
+    elif solver == "table":
+        if not isinstance(params, TableIkParams):
+            raise RobotModelError(robot.source, "ik.params", f"solver 'table' needs TableIkParams, got {type(params).__name__}")
+        q, valid = table_ik(model, robot.flange_frame_id, T_base_flange, lower, upper, params, q_hint, robot.source)
         q = np.where(rev, wrap_to_pi(q), q)
         status = status_generic(model, robot.flange_frame_id, q)
         if _has_status(model, robot.flange_frame_id):

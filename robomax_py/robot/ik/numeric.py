@@ -61,6 +61,7 @@ def numeric_ik(
     max_iterations: int = 50,
     pos_tol_m: float = 1e-6,
     rot_tol_rad: float = 1e-6,
+    seeds: FloatArray | None = None,
 ) -> tuple[FloatArray, BoolArray]:
     """The distinct solutions found from `n_seeds` random starts per pose.
 
@@ -84,6 +85,9 @@ def numeric_ik(
         K, the number of solution slots per pose.
     pos_tol_m, rot_tol_rad : float
         A converged seed is accepted when its flange position and rotation errors are within these.
+    seeds : (P, S, n) float, optional
+        Starting configurations per pose (P poses flattened) used after the hint and before
+        `n_seeds` random ones (the table solver's nearest stored rows).
 
     Returns
     -------
@@ -105,12 +109,15 @@ def numeric_ik(
 
     lo = np.where(np.isfinite(lower), lower, -np.pi)
     hi = np.where(np.isfinite(upper), upper, np.pi)
-    n_start = n_seeds + (q_hint is not None)
-    seeds = rng.uniform(lo, hi, size=(n_pose, n_start, nq))
+    given = np.zeros((n_pose, 0, nq)) if seeds is None else np.asarray(seeds, dtype=float).reshape(n_pose, -1, nq)
+    n_start = n_seeds + (q_hint is not None) + given.shape[1]
+    start = rng.uniform(lo, hi, size=(n_pose, n_start, nq))
+    first = int(q_hint is not None)
+    start[:, first:first + given.shape[1]] = given
     if q_hint is not None:
         hint = np.broadcast_to(np.asarray(q_hint, dtype=float), batch + (nq,)).reshape(-1, nq)
-        seeds[:, 0] = np.clip(hint, lower, upper)
-    q = seeds.reshape(-1, nq)
+        start[:, 0] = np.clip(hint, lower, upper)
+    q = start.reshape(-1, nq)
     pose_of = np.repeat(np.arange(n_pose), n_start)
     R_des = T[:, :3, :3].transpose(1, 2, 0)                            # (3, 3, n_pose)
     p_des = T[:, :3, 3].T                                              # (3, n_pose)
