@@ -199,7 +199,10 @@ def check_carried_motion(
                            stop_at_first=stop_at_first, velocity_rtol=velocity_rtol)
         checks += res.checks
         out.extend(dataclasses.replace(v, detail=f"carrying {part}: {v.detail}") if part else v for v in res.violations)
-        out.extend(_load_limits(cell, robot, part, t[i0:i1 + 1], q[i0:i1 + 1], p[i0:i1 + 1], velocity_rtol))
+        # The limits of the load apply to its own samples: the run's first sample is the last of the
+        # run before (where the robot arrived, decelerating under the limits of that load).
+        j0 = i0 + 1 if i0 > 0 and i1 > i0 else i0
+        out.extend(_load_limits(cell, robot, part, t[j0:i1 + 1], q[j0:i1 + 1], p[j0:i1 + 1], velocity_rtol))
         if stop_at_first and out:
             break
     out.sort(key=lambda x: (x.t if x.t is not None else -1.0))

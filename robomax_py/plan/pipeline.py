@@ -93,7 +93,8 @@ def plan_cell(
     failures = tuple(_failure(cell, c) for c in spots if len(c) == 0)
     if failures:
         names = ", ".join(f"{f.seam}/{f.name} ({f.reason})" for f in failures)
-        return PlanResult(cell.name, robot.name, "infeasible", f"{len(failures)} spot(s) cannot be welded: {names}",
+        what = "station(s) cannot be reached" if cell.tending else "spot(s) cannot be welded"
+        return PlanResult(cell.name, robot.name, "infeasible", f"{len(failures)} {what}: {names}",
                           failures=failures)
     if options.baseline:
         spots = [_baseline_candidate(c) for c in spots]

@@ -37,7 +37,12 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--sizes", default="2,5,10,20")
     ap.add_argument("--out", type=Path, default=Path("/tmp/bench_pick_place"))
+    ap.add_argument("--generated", type=Path, default=None,
+                    help="plan and verify every cell in this folder (tests/bench/pick_place_cells.py) instead")
     args = ap.parse_args()
+    if args.generated is not None:
+        generated(args.generated, args.out)
+        return
     args.out.mkdir(parents=True, exist_ok=True)
     cell = load_cell(CELL)
     robot = load_cell_robot(cell)
@@ -79,6 +84,42 @@ def main() -> None:
             times.append(time.process_time() - t0)
         assert res is not None
         print(f"| {n} | {statistics.median(times):.2f} s | {res.cycle_time:.3f} s ({res.status}) |")
+
+
+def generated(folder: Path, out: Path) -> None:
+    """Each cell planned in this process (CPU), then through the CLI in all six formats, each
+    verified by `robomax verify` (exit codes)."""
+    import subprocess
+    import sys
+
+    print("| cell | robot | transfers | status | planning CPU | cycle | carried detours | verify (6 formats) |")
+    print("|---|---|---|---|---|---|---|---|")
+    for path in sorted(folder.glob("*.yaml")):
+        cell = load_cell(path)
+        robot = load_cell_robot(cell)
+        t0 = time.process_time()
+        result = plan_cell(cell, robot, PlanOptions())
+        cpu = time.process_time() - t0
+        n = len(cell.seams[0].spots) // 2
+        if result.status != "planned":
+            print(f"| {cell.name} | {cell.robot.name} | {n} | {result.status}: {result.message[:90]} | {cpu:.2f} s | | | |")
+            continue
+        target = out / cell.name
+        run = subprocess.run([sys.executable, "-m", "robomax_py", "plan", str(path), "-o", str(target), "--format", "all"],
+                             capture_output=True, text=True)
+        verdicts = []
+        for ext in (".json", ".srcl", ".src", ".mod", ".ls", ".script"):
+            program = target / f"{cell.name}{ext}"
+            if run.returncode != 0 or not program.is_file():
+                verdicts.append(f"{ext}: not written")
+                continue
+            check = subprocess.run([sys.executable, "-m", "robomax_py", "verify", str(path), str(program)],
+                                   capture_output=True, text=True)
+            verdicts.append("ok" if check.returncode == 0 else f"{ext}: exit {check.returncode}")
+        detours = sum(1 for t in result.transitions if t.part and t.kind == "detour")
+        summary = "all clean" if all(v == "ok" for v in verdicts) else ", ".join(v for v in verdicts if v != "ok")
+        print(f"| {cell.name} | {cell.robot.name} | {n} | planned | {cpu:.2f} s | {result.cycle_time:.3f} s | "
+              f"{detours} | {summary} |", flush=True)
 
 
 if __name__ == "__main__":
