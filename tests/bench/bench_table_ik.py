@@ -54,7 +54,7 @@ def main() -> None:
         batch.append(len(targets) / (time.process_time() - t0))
         t0 = time.process_time()
         for t in targets[:20_000]:
-            table.lookup(t)
+            table.nearest(t)
         single.append(20_000 / (time.process_time() - t0))
     print(f"lookups/s (J = 18, K* = {len(table)}): batch of 100,000 {statistics.median(batch):,.0f}, "
           f"one per call {statistics.median(single):,.0f}")

@@ -71,6 +71,10 @@ def test_lookup_is_the_nearest_stored_point(targets: list[tuple[float, float]]) 
     brute = np.linalg.norm(table.x[None, :, :] - t[:, None, :], axis=2)
     np.testing.assert_allclose(err, brute.min(axis=1), atol=1e-12)
     np.testing.assert_allclose(np.linalg.norm(arm.tip(q) - t, axis=1), err, atol=1e-12)
+    # One target per call (the compiled scan) finds the same distance.
+    for target, e in zip(t, err):
+        q1, e1 = table.nearest(target)
+        assert abs(e1 - e) <= 1e-12 and abs(float(np.linalg.norm(arm.tip(q1[None])[0] - target)) - e) <= 1e-12
 
 
 def test_a_route_uses_only_free_edges(tables: dict[str, object]) -> None:

@@ -20,6 +20,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
@@ -32,6 +33,21 @@ Jacobian = Callable[[FloatArray], FloatArray]         # (n,) joints -> (d, n) d 
 
 # Rows filled per call of the forward kinematics and the collision test.
 BATCH = 65_536
+# `TableIk.nearest` scans tables of up to this many stored numbers (rows x point dimension).
+SCAN_MAX_VALUES = 50_000
+
+
+@njit(cache=True, nogil=True)
+def _scan_nearest(points: FloatArray, target: FloatArray) -> tuple[int, float]:
+    best, best_i = np.inf, 0
+    for i in range(points.shape[0]):
+        d = 0.0
+        for j in range(points.shape[1]):
+            e = points[i, j] - target[j]
+            d += e * e
+        if d < best:
+            best, best_i = d, i
+    return best_i, math.sqrt(best)
 
 
 @dataclass(frozen=True, slots=True)
@@ -84,6 +100,17 @@ class TableIk:
         t = np.atleast_2d(np.asarray(targets, dtype=float))
         dist, idx = self.tree.query(t, k=1)
         return self.q[idx], np.asarray(dist, dtype=float)
+
+    def nearest(self, target: FloatArray) -> tuple[FloatArray, float]:
+        """(configuration (n,), error) of the stored point nearest one target (d,): a compiled scan
+        of every stored point for tables up to SCAN_MAX_VALUES numbers (no per-call k-d tree set-up,
+        which costs more than the scan there), else the k-d tree."""
+        x = np.asarray(target, dtype=float)
+        if self.x.size <= SCAN_MAX_VALUES:
+            i, d = _scan_nearest(self.x, x)
+        else:
+            d, i = self.tree.query(x, k=1)
+        return self.q[int(i)], float(d)
 
 
 def build_table(grid: JointGrid, forward: Forward, free: FreeTest) -> TableIk:
