@@ -35,6 +35,7 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray
 from robomax_py.app import palette
+from robomax_py.app.preview_parts import CarriedPart, carried_parts
 from robomax_py.app.preview_program import ShownProgram
 from robomax_py.errors import RobotModelError
 from robomax_py.plan.poses import nominal_rotation
@@ -139,6 +140,9 @@ def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram,
     for path, T in poses0.items():
         root[path].set_transform(T)
 
+    carried = carried_parts(cell, [(s.name, s.t_arrive, s.t_leave) for s in program.spots])
+    parts = _draw_parts(root, carried)
+    _pose_parts(root, carried, parts, float(program.t[0]), T_world_base @ fk_tcp(robot, q0))
     spots = _draw_spots(root, cell, robot, program)
     lines = _draw_path(root, robot, program, T_world_base)
     n_voxels = _draw_voxels(root, voxels, T_world_base) if voxels is not None else 0
@@ -154,6 +158,7 @@ def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram,
                 at[path].set_transform(T)
             for path, obj in dynamic:
                 at[path].set_property("visible", "boolean", _present(obj.present, float(frame) / fps))
+            _pose_parts(at, carried, parts, float(frame) / fps, T_world_base @ fk_tcp(robot, q), animated=True)
         vis.set_animation(anim, play=True, repetitions=1)
     _place_camera(vis, cell, robot)
     return PreviewContent(
@@ -269,6 +274,32 @@ def _draw_objects(root: Any, cell: CellSpec, robot: RobotModel) -> list[tuple[st
             root[path].set_transform(T_world_base @ np.asarray(obj.T_base_object, dtype=float))
             drawn.append((path, role, colour))
     return drawn
+
+
+def _draw_parts(root: Any, carried: list[CarriedPart]) -> list[str]:
+    """The transfers' parts (pick and place), in the workpiece colour."""
+    import meshcat.geometry as g
+
+    drawn = []
+    for item in carried:
+        mesh = shape_trimesh(item.part.shape)
+        path = f"cell/carried/{_safe(item.name)}"
+        root[path].set_object(_mesh_geometry(mesh.vertices, mesh.faces), g.MeshLambertMaterial(color=palette.ROLE_COLOURS["part"]))
+        drawn.append(path)
+    return drawn
+
+
+def _pose_parts(at: Any, carried: list[CarriedPart], paths: list[str], t: float, T_world_tcp: FloatArray,
+                animated: bool = False) -> None:
+    """Each part where it is at program time t (an animation frame's properties are typed)."""
+    for item, path in zip(carried, paths):
+        T = item.pose(t, T_world_tcp)
+        if animated:
+            at[path].set_property("visible", "boolean", T is not None)
+        else:
+            at[path].set_property("visible", T is not None)
+        if T is not None:
+            at[path].set_transform(T)
 
 
 def _draw_tool(root: Any, cell: CellSpec) -> list[str]:
