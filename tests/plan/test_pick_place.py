@@ -177,6 +177,25 @@ def test_a_part_that_would_hit_the_fence_makes_the_planner_go_round(tmp_path: Pa
     assert any(v.kind == "collision" and "block" in v.detail and "fence" in v.detail for v in found.violations)
 
 
+@pytest.mark.slow
+def test_unloaded_tcp_limits_slow_the_empty_moves(tmp_path: Path) -> None:
+    """`pick_place.unloaded`: the moves without a part keep those TCP limits (here tight enough
+    to slow them), the carried move the part's."""
+    path = tmp_path / "fence.yaml"
+    path.write_text(FENCE_CELL.replace("pick_place:\n", "pick_place:\n  unloaded: {v: 1.0, a_T: 3, a_R: 3, j_T: 30, j_R: 30}\n"))
+    cell = load_cell(path)
+    assert cell.tcp_limits is not None and cell.tcp_limits.a_T == 3
+    robot = load_cell_robot(cell)
+    result = plan_cell(cell, robot, PlanOptions())
+    assert result.status == "planned", result.message
+    empty_moves = [t for t in result.transitions if t.part is None]
+    assert empty_moves and all(t.speed is not None and t.accel < 1.0 for t in empty_moves)
+    loads = Loads.of(cell, robot)
+    empty = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+    assert check_carried_motion(cell, robot, empty, loads.worlds, result.trajectory.t, result.trajectory.q,
+                                _spot_entries(result)).clean
+
+
 def _spot_entries(result: object) -> list[dict]:
     return [{"seam": p.seam, "name": p.name, "t_arrive": p.t_arrive, "t_leave": p.t_leave}
             for p in result.spots]  # type: ignore[attr-defined]
