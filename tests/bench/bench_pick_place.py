@@ -61,6 +61,17 @@ def main() -> None:
     print(f"shipped cell, 10 transfers: {result.status}, cycle {result.cycle_time:.3f} s, planning CPU median "
           f"{statistics.median(cpu):.2f} s ({', '.join(f'{c:.2f}' for c in cpu)}), carried moves {len(carried)} "
           f"({sum(t.kind == 'detour' for t in carried)} detours), carried check {'clean' if check.clean else check.violations}")
+    print("| limits applied | cycle |")
+    print("|---|---|")
+    for label, variant in (
+        ("none (massless parts, no TCP limits)", replace(cell, parts=tuple(replace(p, limits=None, mass=0.0) for p in cell.parts),
+                                                         tcp_limits=None)),
+        ("joint limits for the parts' masses only", replace(cell, parts=tuple(replace(p, limits=None) for p in cell.parts),
+                                                            tcp_limits=None)),
+        ("the parts' TCP limits only", replace(cell, parts=tuple(replace(p, mass=0.0) for p in cell.parts))),
+        ("all (the cell as written)", cell),
+    ):
+        print(f"| {label} | {plan_cell(variant, robot, PlanOptions()).cycle_time:.3f} s |")
     light = replace(cell, parts=tuple(replace(p, limits=None, mass=0.0) for p in cell.parts), tcp_limits=None)
     fast = plan_cell(light, robot, PlanOptions())
     broken = check_carried_motion(cell, robot, empty, loads.worlds, fast.trajectory.t, fast.trajectory.q, _spots(fast))
