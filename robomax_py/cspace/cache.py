@@ -9,15 +9,13 @@ never read half a model. A cache folder that cannot be written only costs the tr
 
 from __future__ import annotations
 
-import io
-import os
-import tempfile
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from robomax_py._typing import FloatArray
+from robomax_py.cache_files import cache_folder, store_arrays
 from robomax_py.cspace.learned import (
     LearnedModel,
     TrainingSettings,
@@ -30,14 +28,10 @@ from robomax_py.cspace.learned import (
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 
-CACHE_ENV = "ROBOMAX_CACHE"
-
 
 def cache_dir() -> Path:
     """The folder models are kept in (not created here)."""
-    root = os.environ.get(CACHE_ENV) or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "robomax_py")
-    return Path(root) / "cspace"
+    return cache_folder("cspace")
 
 
 def learned_model(
@@ -64,19 +58,4 @@ def learned_model(
 
 
 def _store(path: Path, model: LearnedModel) -> None:
-    buf = io.BytesIO()
-    np.savez(buf, **to_arrays(model))
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=".", suffix=".tmp", dir=path.parent)
-        try:
-            with os.fdopen(fd, "wb") as f:
-                f.write(buf.getvalue())
-                f.flush()
-                os.fsync(f.fileno())
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-    except OSError:
-        return          # an unwritable cache: the model is trained again next time
+    store_arrays(path, to_arrays(model))     # an unwritable cache: the model is trained again next time

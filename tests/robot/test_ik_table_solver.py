@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from robomax_py.cache_files import CACHE_ENV
 from robomax_py.errors import RobotModelError
 from robomax_py.io.robot import load_robot_spec
 from robomax_py.robot import fk_flange, load_robot
@@ -32,7 +33,7 @@ def _table_robot(tmp_path: Path, params: str = f"{{step: {STEPS}}}") -> Path:
 
 @pytest.fixture
 def cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    monkeypatch.setenv(pose_table.CACHE_ENV, str(tmp_path / "cache"))
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path / "cache"))
     monkeypatch.setattr(pose_table, "_MEMORY", {})
     return tmp_path / "cache"
 

@@ -12,9 +12,6 @@ named by the SHA-256 of the chain's kinematics, the flange and the grid.
 from __future__ import annotations
 
 import hashlib
-import io
-import os
-import tempfile
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +21,7 @@ import pinocchio as pin
 from scipy.spatial import cKDTree
 
 from robomax_py._typing import BoolArray, FloatArray
+from robomax_py.cache_files import cache_folder, store_arrays
 from robomax_py.errors import RobotModelError
 from robomax_py.robot.ik._chain import chain_to_frame, frame_pose
 from robomax_py.robot.ik.numeric import numeric_ik
@@ -31,7 +29,6 @@ from robomax_py.robot.ik.table import JointGrid, TableIk
 
 ROTATION_WEIGHT_M = 0.3
 TABLE_FORMAT = 1
-CACHE_ENV = "ROBOMAX_CACHE"
 
 
 @dataclass(frozen=True, slots=True)
@@ -78,7 +75,7 @@ def flange_table(model: pin.Model, frame_id: int, lower: FloatArray, upper: Floa
     key = _key(model, frame_id, grid)
     if key in _MEMORY:
         return _MEMORY[key]
-    path = _cache_dir() / f"{key}.npz"
+    path = cache_folder("ik_tables") / f"{key}.npz"
     table = _load(path)
     if table is None:
         chain = chain_to_frame(model, frame_id)
@@ -119,12 +116,6 @@ def _key(model: pin.Model, frame_id: int, grid: JointGrid) -> str:
     return h.hexdigest()
 
 
-def _cache_dir() -> Path:
-    root = os.environ.get(CACHE_ENV) or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "robomax_py")
-    return Path(root) / "ik_tables"
-
-
 def _load(path: Path) -> TableIk | None:
     if not path.is_file():
         return None
@@ -139,17 +130,5 @@ def _load(path: Path) -> TableIk | None:
 
 
 def _store(path: Path, table: TableIk) -> None:
-    buf = io.BytesIO()
-    np.savez(buf, q=table.q, x=table.x, grid_size=np.int64(table.grid_size))
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=".", suffix=".tmp", dir=path.parent)
-        try:
-            with os.fdopen(fd, "wb") as f:
-                f.write(buf.getvalue())
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-    except OSError:
-        return          # an unwritable cache: the table is built again next time
+    # An unwritable cache: the table is built again next time.
+    store_arrays(path, {"q": table.q, "x": table.x, "grid_size": np.int64(table.grid_size)})
