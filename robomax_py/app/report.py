@@ -55,6 +55,14 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
         {"between": t.label, "waypoints": len(t.waypoints), "checks_to_find": t.checks}
         for t in result.transitions if t.kind == "detour"
     ]
+    # Pick and place: each move's load and the overrides its limits asked for.
+    slowed = [t for t in result.transitions if t.part is not None or t.tcp_speed is not None]
+    if slowed:
+        report["carried"] = [
+            {"between": t.label, "part": t.part, "kind": t.kind, "speed": t.speed, "accel": t.accel,
+             "tcp_speed_mm_s": None if t.tcp_speed is None else round(t.tcp_speed * 1000.0, 3)}
+            for t in slowed
+        ]
     if result.stats is not None:
         st = result.stats
         report["stats"] = {
@@ -76,6 +84,11 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
         head.add_row("cycle time", f"{report['cycle_time']:.2f} s  ({split})")
         detours = ", ".join(f"{d['between']} ({d['checks_to_find']} checks)" for d in report["detours"])
         head.add_row("detours", detours or "none")
+        carried = [c for c in report.get("carried", []) if c["part"]]
+        if carried:
+            head.add_row("carried", ", ".join(
+                f"{c['part']} {c['between'].split(' -> ')[0]} ({'detour, ' if c['kind'] == 'detour' else ''}"
+                f"speed {c['speed']:.2f}, accel {c['accel']:.2f})" for c in carried))
         if "clearance" in report:
             c = report["clearance"]
             head.add_row("clearance", f"{c['mm']:.1f} mm at t = {c['t']:.2f} s ({c['between']})")

@@ -83,8 +83,8 @@ def joint_limits_after(cell: CellSpec, robot: RobotModel, part: str | None) -> J
 
 
 # A junction over its TCP limits is slowed down and timed again at most this often; each time by the
-# factor that would bring its peaks within the limits, times RETIME_MARGIN.
-MAX_TCP_RETIMES = 6
+# factors that would bring its peaks within the limits, times RETIME_MARGIN.
+MAX_TCP_RETIMES = 8
 RETIME_MARGIN = 0.97
 
 
@@ -120,14 +120,24 @@ class LoadOverrides:
             tcp_speed = math.floor(tcp.v * 1000.0) / 1000.0
         return cls(written_speed(speed), accel, written_tcp_speed(tcp_speed))
 
-    def slowed(self, factor: float) -> LoadOverrides | None:
-        """The overrides slowed by a time-scaling `factor` (PTP speed x factor, acceleration of
-        every move x factor^2), rounded down; None when `factor` is 1 or nothing can be slowed
-        further. The lines keep their TCP speed: their peaks come from accelerating to it."""
-        if factor >= 1.0:
+    def slowed(self, peaks: TcpPeaks, limits: TcpLimits) -> LoadOverrides | None:
+        """The overrides that bring a motion with these TCP peaks within the limits, rounded down;
+        None when it is within them or nothing can be slowed further. The speed override answers
+        the TCP speed, the acceleration override the tangential acceleration, and both the radial
+        acceleration (v^2 times the path's curvature, and the joints' acceleration where a straight
+        joint move bends the TCP's path); the lines keep their TCP speed (their peaks come from
+        accelerating to it)."""
+        def ratio(peak: float, limit: float) -> float:
+            return 1.0 if peak <= limit else limit / peak
+
+        radial = ratio(peaks.a_R[0], limits.a_R)
+        speed = min(ratio(peaks.v[0], limits.v), math.sqrt(radial))
+        accel = min(ratio(peaks.a_T[0], limits.a_T), radial)
+        if speed >= 1.0 and accel >= 1.0:
             return None
-        f = factor * RETIME_MARGIN
-        out = LoadOverrides(_floor_percent(self.speed * f), _floor_percent(self.accel * f * f), self.tcp_speed)
+        out = LoadOverrides(_floor_percent(self.speed * speed * RETIME_MARGIN) if speed < 1.0 else self.speed,
+                            _floor_percent(self.accel * accel * RETIME_MARGIN) if accel < 1.0 else self.accel,
+                            self.tcp_speed)
         return None if out == self else out
 
 

@@ -107,7 +107,7 @@ def time_tour(
         junction = timed(load)
         tcp_limits = tcp_limits_after(cell, part)
         for _ in range(MAX_TCP_RETIMES if tcp_limits is not None else 0):
-            slower = load.slowed(tcp_block_peaks(robot, junction.segments).scale_to(tcp_limits))
+            slower = load.slowed(tcp_block_peaks(robot, junction.segments), tcp_limits)
             if slower is None:
                 break
             load = slower

@@ -39,18 +39,6 @@ class TcpPeaks:
                 out[name] = (peak, limit, at)
         return out
 
-    def scale_to(self, limits: TcpLimits) -> float:
-        """The time-scaling factor (<= 1) that brings speed and accelerations within the limits:
-        slowing a motion down by s scales speeds by s and accelerations by s^2."""
-        s = 1.0
-        if self.v[0] > 0:
-            s = min(s, limits.v / self.v[0])
-        for name in ("a_T", "a_R"):
-            peak = getattr(self, name)[0]
-            if peak > 0:
-                s = min(s, float(np.sqrt(getattr(limits, name) / peak)))
-        return s
-
 
 def tcp_series(t: FloatArray, p: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Per sample: TCP speed (m/s), tangential and radial acceleration (m/s^2); t (k,) s, p (k, 3) m."""
