@@ -104,6 +104,7 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
         src.append(f"{var} = {_frame(f.xyz_mm, f.zyx_deg)} ; {f.kind} frame {f.name}")
     speed = accel = None
     cp_speed = None
+    lin_note = False
     apo = None
     n_point = n_weld = 0
     grips: dict[str, int] = {}
@@ -129,7 +130,11 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                     src.append(f"$VEL.CP = {cp_speed / 1000:.6f}")
                 if ins.accel != (1.0 if accel is None else accel):
                     # Our subset's convention (as KSS for spline CP motions): $ACC_AXIS bounds
-                    # the axes on a LIN too; a line carrying a part states its own.
+                    # the axes on a LIN too; a line carrying a part states its own. A classical
+                    # LIN on the controller is bounded by $ACC.CP instead: the comment says so.
+                    if ins.accel < 1.0 and not lin_note:
+                        lin_note = True
+                        dat.append("; LIN moves with $ACC_AXIS below 100 % carry a part: set $ACC.CP to its a_T too")
                     accel = ins.accel
                     src += [f"$ACC_AXIS[{i}] = {percent(accel)}" for i in range(1, 7)]
                 dat.append(f"DECL E6POS {point}={_pose(ins)}")
