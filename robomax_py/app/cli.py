@@ -114,15 +114,16 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")]) -> Non
         out.print(cell_summary(spec, robot))
         reach = reach_report(spec, robot)
         far = [r for r in reach if not r.reachable]
+        stop = "station" if spec.tending else "spot"          # gripper actions (tending, pick and place)
         if far:
             worst = max(far, key=lambda r: r.out_by_m)
-            others = f" ({len(far) - 1} more spot(s) out of reach)" if len(far) > 1 else ""
-            raise CellFileError(cell, worst.key, f"spot {worst.seam}/{worst.name} is out of {robot.name}'s reach by "
+            others = f" ({len(far) - 1} more {stop}(s) out of reach)" if len(far) > 1 else ""
+            raise CellFileError(cell, worst.key, f"{stop} {worst.seam}/{worst.name} is out of {robot.name}'s reach by "
                                 f"{worst.out_by_m:.3f} m at every allowed orientation (shoulder to wrist "
                                 f"{worst.distance_m:.3f} m, the arm reaches {worst.reach_m:.3f} m){others}")
         if reach:
             tight = min(reach, key=lambda r: -r.out_by_m)
-            out.print(f"reach: all {len(reach)} spots within reach (least margin {-tight.out_by_m * 1000:.0f} mm "
+            out.print(f"reach: all {len(reach)} {stop}s within reach (least margin {-tight.out_by_m * 1000:.0f} mm "
                       f"at {tight.seam}/{tight.name})")
         at_home, always = self_contacts(robot, spec.home)
         _warn([f"{robot.name}: links {a} and {b} touch at home; if they touch by design, add "
