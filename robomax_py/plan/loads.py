@@ -16,17 +16,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomax_py._typing import FloatArray
+from robomax_py.plan.sequence import HOME
 from robomax_py.program import written_speed, written_tcp_speed
 from robomax_py.robot import JointLimits, RobotModel, fk_tcp
-from robomax_py.spec import CellSpec, PartSpec, TcpLimits
+from robomax_py.spec import CellSpec, TcpLimits
 from robomax_py.timing import Segment
 from robomax_py.timing.tcp_motion import TcpPeaks, tcp_peaks, tcp_series
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision import CollisionWorld
-from robomax_py.world.motion import MotionCheck, Violation, check_motion
+from robomax_py.world.motion import (
+    MotionCheck,
+    Violation,
+    check_motion,
+    rate_violations,
+)
 from robomax_py.world.scene import build_scene
-
-HOME = -1   # as `plan.sequence.HOME`: the start and end configuration carries nothing
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -36,7 +40,6 @@ class Loads:
 
     held_after: tuple[str | None, ...]
     worlds: dict[str, CollisionWorld]
-    parts: dict[str, PartSpec]
 
     @classmethod
     def of(cls, cell: CellSpec, robot: RobotModel) -> Loads | None:
@@ -51,7 +54,7 @@ class Loads:
             held.append(now)
         worlds = {p.name: CollisionWorld(robot, build_scene(cell, robot, held=p), cell.process.clearance)
                   for p in cell.parts}
-        return cls(tuple(held), worlds, {p.name: p for p in cell.parts})
+        return cls(tuple(held), worlds)
 
     def part_after(self, i: int) -> str | None:
         """The part held on leaving stop i (HOME: none)."""
@@ -142,13 +145,9 @@ class LoadOverrides:
 
 
 def tcp_block_peaks(robot: RobotModel, segments: list[Segment]) -> TcpPeaks:
-    """The TCP peaks of segments run end to end."""
-    return _run_peaks(robot, [seg for seg in segments if len(seg.t) > 1])
-
-
-def _run_peaks(robot: RobotModel, run: list[Segment]) -> TcpPeaks:
+    """The TCP peaks of segments run end to end (each starts where the one before ends)."""
     ts, qs, t0 = [], [], 0.0
-    for seg in run:
+    for seg in (seg for seg in segments if len(seg.t) > 1):
         first = 0 if not ts else 1
         ts.append(np.asarray(seg.t[first:]) + t0)
         qs.append(np.asarray(seg.q[first:]))
@@ -162,6 +161,8 @@ def _run_peaks(robot: RobotModel, run: list[Segment]) -> TcpPeaks:
 # checks, `tolerances`). TCP jerk is reported, not enforced (see `check_carried_motion`).
 TCP_SPEED_RTOL = 0.01
 TCP_ACCEL_RTOL = 0.05
+
+
 @dataclass(frozen=True, slots=True)
 class Hold:
     """A part in the gripper from t_start to t_end."""
@@ -242,17 +243,9 @@ def _load_limits(cell: CellSpec, robot: RobotModel, part: str | None, t: FloatAr
     if len(t) < 3:
         return out
     if part is not None:
-        limits = joint_limits_after(cell, robot, part)
-        dt = np.diff(t)
-        v = np.diff(q, axis=0) / dt[:, None]
-        a = np.diff(v, axis=0) / ((dt[:-1] + dt[1:]) / 2)[:, None]
-        for name, x, lim, rtol in (("velocity", v, limits.velocity, velocity_rtol),
-                                   ("acceleration", a, limits.acceleration, TOL.acceleration_rtol)):
-            ratio = np.abs(x) / lim
-            if ratio.max() > 1 + rtol:
-                i, j = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
-                out.append(Violation(float(t[i]), name, f"{what}: {robot.joint_names[j]} {abs(x[i, j]):.3f} > "
-                                                        f"{lim[j]:.3f} (the limit for {cell.part(part).mass:g} kg)"))
+        mass = cell.part(part).mass
+        out.extend(dataclasses.replace(v, detail=f"{what}: {v.detail} (the limit for {mass:g} kg)")
+                   for v in rate_violations(joint_limits_after(cell, robot, part), robot.joint_names, t, q, velocity_rtol))
     tcp = tcp_limits_after(cell, part)
     if tcp is None:
         return out

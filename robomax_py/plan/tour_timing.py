@@ -11,8 +11,19 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.plan.candidates import SpotCandidates
-from robomax_py.plan.junction import JUNCTION_RADII_DEG, Junction, WeldEnd, time_junction
-from robomax_py.plan.loads import MAX_TCP_RETIMES, LoadOverrides, Loads, tcp_block_peaks, tcp_limits_after
+from robomax_py.plan.junction import (
+    JUNCTION_RADII_DEG,
+    Junction,
+    WeldEnd,
+    time_junction,
+)
+from robomax_py.plan.loads import (
+    MAX_TCP_RETIMES,
+    LoadOverrides,
+    Loads,
+    tcp_block_peaks,
+    tcp_limits_after,
+)
 from robomax_py.plan.poses import (
     OrientationGrid,
     approach_poses,
@@ -27,7 +38,7 @@ from robomax_py.plan.results import (
     _no_progress,
 )
 from robomax_py.plan.roadmap import Roadmap
-from robomax_py.plan.sequence import Tour
+from robomax_py.plan.sequence import HOME, Tour
 from robomax_py.plan.tcp_route import TcpSpace, dynamic_boxes, tcp_space
 from robomax_py.plan.timed_moves import (
     DynamicConflicts,
@@ -93,15 +104,17 @@ def time_tour(
         after = ends[k] if k < len(ends) else None
         waypoints = as_written_joints(transitions[k].waypoints)      # the first row: where the retract ends
         trans = replace(transitions[k], waypoints=waypoints)
-        part = loads.part_after(tour.order[k - 1]) if loads is not None and k > 0 else None
+        leaving = tour.order[k - 1] if k > 0 else HOME
+        part = loads.part_after(leaving) if loads is not None else None
+        checked = loads.world_after(leaving, world) if loads is not None else world
         speed = options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)
         load = LoadOverrides.of(cell, robot, part, speed, options.tcp_speed * options.speed)
 
         def timed(load: LoadOverrides) -> Junction:
             return time_junction(
-                robot, world if part is None or loads is None else loads.worlds[part], robot.limits, q_start, waypoints,
-                trans.kind, trans.label, before, after, tcp_speed=load.tcp_speed, speed=load.speed, accel=load.accel,
-                jerk_limited=options.jerk_limited, flyby=options.blend,
+                robot, checked, robot.limits, q_start, waypoints, trans.kind, trans.label, before, after,
+                tcp_speed=load.tcp_speed, speed=load.speed, accel=load.accel, jerk_limited=options.jerk_limited,
+                flyby=options.blend,
             )
 
         junction = timed(load)

@@ -114,22 +114,19 @@ def solve_all(
         else:
             q, valid = ur_ik(params, T_base_flange, q_hint)
             status = status_generic(model, robot.flange_frame_id, q)
-    elif solver == "numeric":
-        if not isinstance(params, NumericIkParams):
-            raise RobotModelError(robot.source, "ik.params", f"solver 'numeric' needs NumericIkParams, got {type(params).__name__}")
-        q, valid = numeric_ik(
-            model, robot.flange_frame_id, T_base_flange, lower, upper,
-            np.random.default_rng(0) if rng is None else rng,
-            params.seeds, q_hint, max_solutions=params.solutions, max_iterations=params.max_iterations,
-        )
-        q = np.where(rev, wrap_to_pi(q), q)
-        status = status_generic(model, robot.flange_frame_id, q)
-        if _has_status(model, robot.flange_frame_id):
-            q, valid, status = _by_status(q, valid, status)
-    elif solver == "table":
-        if not isinstance(params, TableIkParams):
-            raise RobotModelError(robot.source, "ik.params", f"solver 'table' needs TableIkParams, got {type(params).__name__}")
-        q, valid = table_ik(model, robot.flange_frame_id, T_base_flange, lower, upper, params, q_hint, robot.source)
+    elif solver in ("numeric", "table"):
+        expected_params = NumericIkParams if solver == "numeric" else TableIkParams
+        if not isinstance(params, expected_params):
+            raise RobotModelError(robot.source, "ik.params", f"solver '{solver}' needs {expected_params.__name__}, "
+                                  f"got {type(params).__name__}")
+        if isinstance(params, NumericIkParams):
+            q, valid = numeric_ik(
+                model, robot.flange_frame_id, T_base_flange, lower, upper,
+                np.random.default_rng(0) if rng is None else rng,
+                params.seeds, q_hint, max_solutions=params.solutions, max_iterations=params.max_iterations,
+            )
+        else:
+            q, valid = table_ik(model, robot.flange_frame_id, T_base_flange, lower, upper, params, q_hint, robot.source)
         q = np.where(rev, wrap_to_pi(q), q)
         status = status_generic(model, robot.flange_frame_id, q)
         if _has_status(model, robot.flange_frame_id):

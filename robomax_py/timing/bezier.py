@@ -72,22 +72,30 @@ class BezierPath:
         d2 = w**3 * dd[0] + 3 * u * w**2 * dd[1] + 3 * u**2 * w * dd[2] + u**3 * dd[3]
         return pos, d1, d2
 
+    def segment_table(self, i: int, samples: int = TABLE_SAMPLES) -> tuple[FloatArray, FloatArray]:
+        """Points (samples + 1, 2) of segment i evenly spaced in u, and the signed curvature there."""
+        p, d1, d2 = self.derivatives(i, np.linspace(0.0, 1.0, samples + 1))
+        speed = np.linalg.norm(d1, axis=1)
+        return p, (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) / np.maximum(speed, 1e-12) ** 3
+
     def table(self, per_segment: int = TABLE_SAMPLES) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Along the whole path: arclength s (k,), points (k, 2) and signed curvature (k,)."""
-        pts, kap, seg_len = [], [], []
+        pts, kap = [], []
         for i in range(self.segments):
-            u = np.linspace(0.0, 1.0, per_segment + 1)[(1 if i else 0):]
-            p, d1, d2 = self.derivatives(i, u)
-            speed = np.linalg.norm(d1, axis=1)
-            pts.append(p)
-            kap.append((d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) / np.maximum(speed, 1e-12) ** 3)
-            seg_len.append(p)
+            p, kappa = self.segment_table(i, per_segment)
+            first = 1 if i else 0                  # a segment's start is the end of the one before
+            pts.append(p[first:])
+            kap.append(kappa[first:])
         points = np.vstack(pts)
-        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
-        return s, points, np.concatenate(kap)
+        return arclength(points), points, np.concatenate(kap)
 
 
-def default_parameters(waypoints: FloatArray, start_heading: float, end_heading: float) -> FloatArray:
+def arclength(points: FloatArray) -> FloatArray:
+    """Cumulative length (k,) of a polyline (k, d), from 0."""
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+
+
+def default_parameters(waypoints: FloatArray) -> FloatArray:
     """Initial free parameters: interior headings along the neighbours' chord, tangent lengths the
     shorter adjacent chord, no normal second derivative. Layout: [d_0, (theta, d, c) per interior
     waypoint, d_m]."""
@@ -125,13 +133,18 @@ class Profile:
         return float(self.t[-1])
 
 
+def _curvature_table(path: BezierPath) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The path's dense table: arclength, points, curvature and its derivative in arclength."""
+    s_tab, p_tab, k_tab = path.table()
+    return s_tab, p_tab, k_tab, np.gradient(k_tab, s_tab)
+
+
 def _grid(path: BezierPath, n: int) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """n points evenly spaced in arclength, with the largest |kappa| and |d kappa/ds| of the dense
     table within half a spacing of each (a tight bend between points is not missed)."""
-    s_tab, p_tab, k_tab = path.table()
+    s_tab, p_tab, k_tab, dk_tab = _curvature_table(path)
     s = np.linspace(0.0, s_tab[-1], n)
     points = np.column_stack([np.interp(s, s_tab, p_tab[:, j]) for j in range(2)])
-    dk_tab = np.gradient(k_tab, s_tab)
     cell = np.clip(np.rint(s_tab / (s[1] - s[0])).astype(int), 0, n - 1)
     kappa = np.zeros(n)
     dkappa = np.zeros(n)
@@ -178,8 +191,7 @@ def _kinematics(s_grid: FloatArray, b_grid: FloatArray, s: FloatArray, kappa: Fl
 
 
 def _curvature_at(path: BezierPath, s: FloatArray) -> tuple[FloatArray, FloatArray]:
-    s_tab, _, k_tab = path.table()
-    dk_tab = np.gradient(k_tab, s_tab)
+    s_tab, _, k_tab, dk_tab = _curvature_table(path)
     return np.interp(s, s_tab, k_tab), np.interp(s, s_tab, dk_tab)
 
 
@@ -189,7 +201,6 @@ def jerk_limited(path: BezierPath, limits: TcpLimits, n: int = 100) -> Profile:
     s, points, kappa, _ = _grid(path, n)
     fine = np.linspace(0.0, s[-1], CONSTRAINT_REFINE * (n - 1) + 1)
     k_fine, dk_fine = _curvature_at(path, fine)
-    ds = float(s[1] - s[0])
     cap = np.minimum(limits.v**2, limits.a_R / np.maximum(kappa, 1e-12))
     # Start well inside the jerk limits: the acceleration-limited profile, slowed.
     b0 = (0.5 * acceleration_limited(path, limits, n).v) ** 2
@@ -199,8 +210,7 @@ def jerk_limited(path: BezierPath, limits: TcpLimits, n: int = 100) -> Profile:
         return np.concatenate([[0.0], x, [0.0]])
 
     def time(x: FloatArray) -> float:
-        v = np.sqrt(np.maximum(full(x), 0.0))
-        return float(np.sum(2.0 * ds / np.maximum(v[:-1] + v[1:], 1e-9)))
+        return float(_times(s, np.sqrt(np.maximum(full(x), 0.0)))[-1])
 
     def constraints(x: FloatArray) -> FloatArray:
         v, a_t, a_r, j_t, j_r = _kinematics(s, full(x), fine, k_fine, dk_fine)
@@ -241,7 +251,7 @@ def optimise_path(waypoints: FloatArray, start_heading: float, end_heading: floa
                   iterations: int = 400) -> tuple[FloatArray, BezierPath]:
     """The free parameters minimising the acceleration-limited travel time under `limits`
     (Nelder-Mead from `default_parameters`), and their path."""
-    x0 = default_parameters(waypoints, start_heading, end_heading)
+    x0 = default_parameters(waypoints)
 
     def cost(x: FloatArray) -> float:
         return acceleration_limited(path_of(waypoints, start_heading, end_heading, x), limits, 200).duration

@@ -13,7 +13,7 @@ import numpy as np
 
 from robomax_py.robot import JointLimits
 from robomax_py.spec import TcpLimits
-from robomax_py.timing.bezier import BezierPath
+from robomax_py.timing.bezier import BezierPath, arclength
 from robomax_py.timing.paths import spline_path
 from robomax_py.timing.ptp import _ruckig
 from robomax_py.timing.topp import time_path
@@ -40,11 +40,8 @@ def toppra_time(path: BezierPath, limits: TcpLimits, samples: int = 600) -> floa
 def ruckig_per_segment_time(path: BezierPath, limits: TcpLimits) -> float:
     total = 0.0
     for i in range(path.segments):
-        u = np.linspace(0.0, 1.0, 801)
-        p, d1, d2 = path.derivatives(i, u)
-        speed = np.linalg.norm(d1, axis=1)
-        kappa = (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]) / np.maximum(speed, 1e-12) ** 3
-        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+        p, kappa = path.segment_table(i, 800)
+        s = arclength(p)
         dkappa = np.gradient(kappa, s)
         v = min(limits.v, float(np.sqrt(limits.a_R / max(np.abs(kappa).max(), 1e-12))),
                 float(np.cbrt(limits.j_R / max(np.abs(dkappa).max(), 1e-12))))

@@ -1,9 +1,8 @@
-"""The TCP's path motion from sampled joint motion: speed, tangential and radial acceleration, and
-their rates of change, for the TCP limits of a carried part (`spec.TcpLimits`).
+"""The TCP's path motion from sampled joint motion: speed, tangential and radial acceleration, for
+the TCP limits of a carried part (`spec.TcpLimits`; its jerks are not checked on arm motions).
 
 Finite differences of the TCP positions on the samples' own clock (a trajectory file's samples are
-at most 10 ms apart): v = |p'|, a_T = p''·t̂ (t̂ = p'/|p'|), a_R = |p'' - a_T t̂|, j_T = d a_T/dt,
-j_R = d a_R/dt. Below `REST_SPEED_M_S` the direction of motion is undefined: all acceleration counts
+at most 10 ms apart): v = |p'|, a_T = p''·t̂ (t̂ = p'/|p'|), a_R = |p'' - a_T t̂|. Below `REST_SPEED_M_S` the direction of motion is undefined: all acceleration counts
 as tangential there.
 """
 
@@ -14,7 +13,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomax_py._typing import FloatArray
-from robomax_py.spec import TcpLimits
 
 REST_SPEED_M_S = 1e-3
 
@@ -26,18 +24,6 @@ class TcpPeaks:
     v: tuple[float, float]
     a_T: tuple[float, float]
     a_R: tuple[float, float]
-    j_T: tuple[float, float]
-    j_R: tuple[float, float]
-
-    def excess(self, limits: TcpLimits) -> dict[str, tuple[float, float, float]]:
-        """Per quantity over its limit: (peak, limit, time)."""
-        out = {}
-        for name in ("v", "a_T", "a_R", "j_T", "j_R"):
-            peak, at = getattr(self, name)
-            limit = float(getattr(limits, name))
-            if peak > limit:
-                out[name] = (peak, limit, at)
-        return out
 
 
 def tcp_series(t: FloatArray, p: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -61,13 +47,11 @@ def tcp_peaks(t: FloatArray, p: FloatArray) -> TcpPeaks:
     t = np.asarray(t, dtype=float)
     if len(t) < 3:
         zero = (0.0, float(t[0]) if len(t) else 0.0)
-        return TcpPeaks(zero, zero, zero, zero, zero)
-    speed, a_t, a_r = tcp_series(t, p)
-    j_t = np.gradient(a_t, t)
-    j_r = np.gradient(a_r, t)
+        return TcpPeaks(zero, zero, zero)
 
     def peak(x: FloatArray) -> tuple[float, float]:
         i = int(np.argmax(np.abs(x)))
         return float(np.abs(x[i])), float(t[i])
 
-    return TcpPeaks(peak(speed), peak(a_t), peak(a_r), peak(j_t), peak(j_r))
+    speed, a_t, a_r = tcp_series(t, p)
+    return TcpPeaks(peak(speed), peak(a_t), peak(a_r))

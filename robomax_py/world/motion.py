@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomax_py._typing import FloatArray
-from robomax_py.robot import RobotModel
+from robomax_py.robot import JointLimits, RobotModel
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision import CollisionWorld
 
@@ -76,17 +76,7 @@ def check_motion(
         out.append(Violation(float(t[i0]), "joint_limit", f"{robot.joint_names[j]} = {math.degrees(q[worst, j]):.3f} deg "
                                                           f"(limits {math.degrees(lim.lower[j]):.3f} .. {math.degrees(lim.upper[j]):.3f})",
                              t_end=_end(t, i0, i1)))
-    dt = np.diff(t)
-    v = np.diff(q, axis=0) / dt[:, None]
-    for j, i0, i1 in _runs(np.abs(v) > lim.velocity * (1 + velocity_rtol)):
-        peak = float(np.abs(v[i0:i1 + 1, j]).max())
-        out.append(Violation(float(t[i0]), "velocity", f"{robot.joint_names[j]} up to {peak:.3f} rad/s > {lim.velocity[j]:.3f}",
-                             t_end=float(t[i1 + 1])))
-    a = np.diff(v, axis=0) / ((dt[:-1] + dt[1:]) / 2)[:, None]
-    for j, i0, i1 in _runs(np.abs(a) > lim.acceleration * (1 + ACCELERATION_RTOL)):
-        peak = float(np.abs(a[i0:i1 + 1, j]).max())
-        out.append(Violation(float(t[i0 + 1]), "acceleration", f"{robot.joint_names[j]} up to {peak:.3f} rad/s^2 > "
-                                                               f"{lim.acceleration[j]:.3f}", t_end=float(t[i1 + 1])))
+    out.extend(rate_violations(lim, robot.joint_names, t, q, velocity_rtol))
     out.sort(key=lambda x: (x.t if x.t is not None else -1.0))
     if stop_at_first and out:
         return MotionCheck(tuple(out[:1]), 0)
@@ -113,6 +103,25 @@ def check_motion(
             break
     out.extend(collisions)
     return MotionCheck(tuple(out), checks)
+
+
+def rate_violations(lim: JointLimits, names: tuple[str, ...], t: FloatArray, q: FloatArray,
+                    velocity_rtol: float = VELOCITY_RTOL) -> list[Violation]:
+    """Joint velocity and acceleration over their limits (finite differences of the samples), one
+    violation per run of samples breaking the same limit of the same joint, with its peak."""
+    out: list[Violation] = []
+    dt = np.diff(t)
+    v = np.diff(q, axis=0) / dt[:, None]
+    for j, i0, i1 in _runs(np.abs(v) > lim.velocity * (1 + velocity_rtol)):
+        peak = float(np.abs(v[i0:i1 + 1, j]).max())
+        out.append(Violation(float(t[i0]), "velocity", f"{names[j]} up to {peak:.3f} rad/s > {lim.velocity[j]:.3f}",
+                             t_end=float(t[i1 + 1])))
+    a = np.diff(v, axis=0) / ((dt[:-1] + dt[1:]) / 2)[:, None]
+    for j, i0, i1 in _runs(np.abs(a) > lim.acceleration * (1 + ACCELERATION_RTOL)):
+        peak = float(np.abs(a[i0:i1 + 1, j]).max())
+        out.append(Violation(float(t[i0 + 1]), "acceleration", f"{names[j]} up to {peak:.3f} rad/s^2 > "
+                                                               f"{lim.acceleration[j]:.3f}", t_end=float(t[i1 + 1])))
+    return out
 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int, int]]:

@@ -26,7 +26,7 @@ def test_a_path_is_followed_exactly_and_checked(waypoints: np.ndarray, z: float,
     robot = load_cell_robot(cell)
     housing = cell.part("housing")
     world = CollisionWorld(robot, build_scene(cell, robot, held=housing), cell.process.clearance)
-    path = path_of(waypoints, np.pi / 2, np.pi / 2, default_parameters(waypoints, np.pi / 2, np.pi / 2))
+    path = path_of(waypoints, np.pi / 2, np.pi / 2, default_parameters(waypoints))
     profile = jerk_limited(path, housing.limits, n=60)
     T0 = np.eye(4)
     T0[:2, 3], T0[2, 3] = waypoints[0], z

@@ -42,7 +42,7 @@ def test_joins_are_g2_to_1e_9(headings: list[float], lengths: list[float], norma
 
 
 def test_the_path_passes_its_waypoints_with_the_given_end_headings() -> None:
-    path = path_of(WAYPOINTS, 0.3, -0.2, default_parameters(WAYPOINTS, 0.3, -0.2))
+    path = path_of(WAYPOINTS, 0.3, -0.2, default_parameters(WAYPOINTS))
     _, d_start, _ = path.derivatives(0, np.array([0.0]))
     _, d_end, _ = path.derivatives(path.segments - 1, np.array([1.0]))
     assert abs(np.arctan2(d_start[0, 1], d_start[0, 0]) - 0.3) < 1e-12
@@ -53,7 +53,7 @@ def test_the_path_passes_its_waypoints_with_the_given_end_headings() -> None:
 
 
 def test_the_jerk_limited_profile_keeps_every_limit_and_starts_and_ends_at_rest() -> None:
-    path = path_of(WAYPOINTS, 0.0, 0.0, default_parameters(WAYPOINTS, 0.0, 0.0))
+    path = path_of(WAYPOINTS, 0.0, 0.0, default_parameters(WAYPOINTS))
     profile = jerk_limited(path, LIMITS)
     assert profile.v[0] == 0.0 and profile.v[-1] == 0.0
     peaks = profile_peaks(profile, path)
