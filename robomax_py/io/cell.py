@@ -51,7 +51,7 @@ from robomax_py.spec import (
     TcpLimits,
     frozen_array,
 )
-from robomax_py.transforms import pose_matrix
+from robomax_py.transforms import invert, pose_matrix
 from robomax_py.units import deg_to_rad
 
 SUPPORTED_VERSIONS = (1,)
@@ -431,7 +431,7 @@ def _parts(parsed: CellFile, path: Path, robot: RobotSpec) -> tuple[PartSpec, ..
         at = {t.from_ for t in job.transfers if t.part == part.name} | {t.to for t in job.transfers if t.part == part.name}
         supports = sorted({name for loc in job.locations if loc.name in at for name in loc.support})
         out.append(PartSpec(name=part.name, shape=shape, mass=part.mass,
-                            T_tcp_part=frozen_array(np.linalg.inv(_pose(part.grasp))),
+                            T_tcp_part=frozen_array(invert(_pose(part.grasp))),
                             limits=_tcp_limits(part.limits), supports=tuple(supports)))
     return tuple(out)
 
@@ -628,13 +628,9 @@ def _tending_seams(parsed: CellFile, path: Path) -> tuple[SeamSpec, ...]:
     the station's TCP pose (pinned, orientation as given) with the gripper's action as its dwell."""
     tending = parsed.tending
     assert tending is not None
-    stations: dict[str, int] = {}
+    stations = _index_by_name([st.name for st in tending.stations], "station", "tending.stations", path)
     machines = {m.name for m in tending.machines}
     for i, st in enumerate(tending.stations):
-        if st.name in stations:
-            raise CellFileError(path, f"tending.stations[{i}].name",
-                                f"duplicate station name '{st.name}' (also stations[{stations[st.name]}])")
-        stations[st.name] = i
         if st.machine is not None and st.machine not in machines:
             known = ", ".join(sorted(machines)) or "none"
             raise CellFileError(path, f"tending.stations[{i}].machine", f"unknown machine '{st.machine}' (machines: {known})")
