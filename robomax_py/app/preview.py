@@ -140,7 +140,8 @@ def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram,
     for path, T in poses0.items():
         root[path].set_transform(T)
 
-    carried = carried_parts(cell, [(s.name, s.t_arrive, s.t_leave) for s in program.spots])
+    carried = carried_parts(cell, [{"seam": s.seam, "name": s.name, "t_arrive": s.t_arrive, "t_leave": s.t_leave}
+                                   for s in program.spots])
     parts = _draw_parts(root, carried)
     _pose_parts(root, carried, parts, float(program.t[0]), T_world_base @ fk_tcp(robot, q0))
     spots = _draw_spots(root, cell, robot, program)

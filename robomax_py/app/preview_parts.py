@@ -3,7 +3,7 @@
 One drawn object per transfer: it lies at its pick location from when it is there (the start, or
 when an earlier transfer released a part there) until the gripper arrives, moves with the TCP until
 the release is done, then lies at the place location until a later transfer picks it up there (that
-transfer's object takes over). Times come from the program's own stops (`ShownSpot`).
+transfer's object takes over). The holds are those the carried check uses (`plan.loads.holds`).
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomax_py._typing import FloatArray
+from robomax_py.plan.loads import holds
 from robomax_py.plan.poses import nominal_rotation
 from robomax_py.spec import CellSpec, PartSpec, SpotSpec
 
@@ -42,22 +43,16 @@ class CarriedPart:
         return self.T_place
 
 
-def carried_parts(cell: CellSpec, stops: list[tuple[str, float, float]]) -> list[CarriedPart]:
-    """The transfers' parts of a pick-and-place cell, from its stops (name, t_arrive, t_leave) in
-    program order; empty for other cells or a program without its stops."""
-    if not cell.parts:
-        return []
-    spec = {s.name: s for seam in cell.seams for s in seam.spots}
-    times = {name: (a, b) for name, a, b in stops if name in spec}
+def carried_parts(cell: CellSpec, spots: list[dict]) -> list[CarriedPart]:
+    """The transfers' parts of a pick-and-place program, from its stops (`plan.loads.holds`: the
+    entries `seam`, `name`, `t_arrive`, `t_leave`); empty for other cells."""
     out: list[CarriedPart] = []
-    spots = [s for seam in cell.seams for s in seam.spots]
-    for grip, release in zip(spots[::2], spots[1::2]):
-        if grip.name not in times or release.name not in times or grip.part is None:
+    for hold in holds(cell, spots):
+        if hold.release is None:
             continue
-        part = cell.part(grip.part)
-        out.append(CarriedPart(f"{grip.name.split('_')[0]}_{part.name}", part, _at(grip) @ part.T_tcp_part,
-                               _at(release) @ part.T_tcp_part, 0.0, times[grip.name][0], times[release.name][1],
-                               math.inf))
+        part = cell.part(hold.part)
+        out.append(CarriedPart(f"{hold.grip.name.split('_')[0]}_{part.name}", part, _at(hold.grip) @ part.T_tcp_part,
+                               _at(hold.release) @ part.T_tcp_part, 0.0, hold.t_start, hold.t_end, math.inf))
     # A location emptied by a pick and filled by a place: hand the object over at those times.
     for k, item in enumerate(out):
         before = [o for o in out[:k] if np.allclose(o.T_place[:3, 3], item.T_pick[:3, 3], atol=1e-6)]

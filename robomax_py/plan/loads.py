@@ -19,7 +19,7 @@ from robomax_py._typing import FloatArray
 from robomax_py.plan.sequence import HOME
 from robomax_py.program import written_speed, written_tcp_speed
 from robomax_py.robot import JointLimits, RobotModel, fk_tcp
-from robomax_py.spec import CellSpec, TcpLimits
+from robomax_py.spec import CellSpec, SpotSpec, TcpLimits
 from robomax_py.timing import Segment
 from robomax_py.timing.tcp_motion import TcpPeaks, tcp_peaks, tcp_series
 from robomax_py.tolerances import DEFAULT as TOL
@@ -163,32 +163,36 @@ TCP_SPEED_RTOL = 0.01
 TCP_ACCEL_RTOL = 0.05
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, eq=False)
 class Hold:
-    """A part in the gripper from t_start to t_end."""
+    """A part in the gripper from t_start (the arrival at its grip) to t_end (the departure from
+    its release; inf when the motion ends holding it)."""
 
     t_start: float
     t_end: float
     part: str
+    grip: SpotSpec
+    release: SpotSpec | None
 
 
 def holds(cell: CellSpec, spots: list[dict]) -> list[Hold]:
     """Every hold of a written motion, from its spot entries (`seam`, `name`, `t_arrive`,
-    `t_leave`): from the arrival at a grip to the departure from the release that follows it. The
-    part is in the gripper while it closes: the checks take it as held."""
+    `t_leave`, as a trajectory file gives them): from the arrival at a grip to the departure from
+    the release that follows it. The part is in the gripper while it closes: the checks take it as
+    held."""
     wanted = {(seam.name, s.name): s for seam in cell.seams for s in seam.spots}
     entries = sorted((e for e in spots if (str(e["seam"]), str(e["name"])) in wanted), key=lambda e: float(e["t_arrive"]))
     out: list[Hold] = []
-    start: tuple[float, str] | None = None
+    start: tuple[float, SpotSpec] | None = None
     for e in entries:
         spot = wanted[(str(e["seam"]), str(e["name"]))]
         if spot.action == "grip" and spot.part is not None:
-            start = (float(e["t_arrive"]), spot.part)
+            start = (float(e["t_arrive"]), spot)
         elif spot.action == "release" and start is not None:
-            out.append(Hold(start[0], float(e["t_leave"]), start[1]))
+            out.append(Hold(start[0], float(e["t_leave"]), str(start[1].part), start[1], spot))
             start = None
     if start is not None:
-        out.append(Hold(start[0], math.inf, start[1]))
+        out.append(Hold(start[0], math.inf, str(start[1].part), start[1], None))
     return out
 
 

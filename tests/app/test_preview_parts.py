@@ -15,7 +15,8 @@ REPO = Path(__file__).resolve().parents[2]
 def test_a_part_lies_is_carried_and_is_handed_over() -> None:
     cell = load_cell(REPO / "cells" / "pick_place.yaml")
     spots = [s for seam in cell.seams for s in seam.spots]
-    stops = [(s.name, 10.0 * k + 1.0, 10.0 * k + 2.0) for k, s in enumerate(spots)]
+    stops = [{"seam": "transfers", "name": s.name, "t_arrive": 10.0 * k + 1.0, "t_leave": 10.0 * k + 2.0}
+             for k, s in enumerate(spots)]
     parts = carried_parts(cell, stops)
     assert len(parts) == 10
     first = parts[0]                                  # t1: housing low_1 -> a_1, gripped at 1 s, released at 12 s
@@ -35,4 +36,4 @@ def test_a_part_lies_is_carried_and_is_handed_over() -> None:
 
 def test_cells_without_parts_carry_nothing() -> None:
     cell = load_cell(REPO / "cells" / "tending.yaml")
-    assert carried_parts(cell, [("c1_conveyor_pick", 1.0, 2.0)]) == []
+    assert carried_parts(cell, [{"seam": "tending", "name": "c1_conveyor_pick", "t_arrive": 1.0, "t_leave": 2.0}]) == []
