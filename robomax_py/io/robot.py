@@ -20,7 +20,13 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from robomax_py.errors import RobotModelError
 from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
 from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
-from robomax_py.spec import ControllerSpec, JointLoadLimits, RobotSpec, ToolSpec, frozen_array
+from robomax_py.spec import (
+    ControllerSpec,
+    JointLoadLimits,
+    RobotSpec,
+    ToolSpec,
+    frozen_array,
+)
 from robomax_py.transforms import pose_matrix
 from robomax_py.units import degs_to_rads
 
@@ -53,6 +59,12 @@ class IkFile(_Strict):
     params: dict[str, Any] | None = None
 
 
+def _all_positive(v: list[float]) -> list[float]:
+    if any(x <= 0 for x in v):
+        raise ValueError(f"every value must be > 0, got {v}")
+    return v
+
+
 class LoadedLimitsFile(_Strict):
     """Joint limits carrying the rated payload (`payload`), deg/s, deg/s^2, deg/s^3."""
 
@@ -63,9 +75,7 @@ class LoadedLimitsFile(_Strict):
     @field_validator("velocity", "acceleration", "jerk")
     @classmethod
     def _positive(cls, v: list[float]) -> list[float]:
-        if any(x <= 0 for x in v):
-            raise ValueError(f"every value must be > 0, got {v}")
-        return v
+        return _all_positive(v)
 
 
 class LimitsFile(_Strict):
@@ -76,9 +86,7 @@ class LimitsFile(_Strict):
     @field_validator("acceleration", "jerk")
     @classmethod
     def _positive(cls, v: list[float] | None) -> list[float] | None:
-        if v is not None and any(x <= 0 for x in v):
-            raise ValueError(f"every value must be > 0, got {v}")
-        return v
+        return None if v is None else _all_positive(v)
 
 
 class ControllerFile(_Strict):

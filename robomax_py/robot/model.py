@@ -132,7 +132,8 @@ def load_robot(spec: RobotSpec) -> RobotModel:
         # Visual meshes only serve the preview: plan with the collision meshes shown instead.
         warnings.append(f"{spec.urdf}: visual meshes not loaded ({exc.problem}); the preview shows the collision meshes")
         visual = collision.copy()
-    limits = JointLimits(lower, upper, velocity, np.asarray(acceleration, dtype=float), np.asarray(jerk, dtype=float))
+    limits = JointLimits(lower=frozen_array(lower), upper=frozen_array(upper), velocity=frozen_array(velocity),
+                         acceleration=frozen_array(acceleration), jerk=frozen_array(jerk))
     loaded = _loaded_limits(spec, limits)
     defaulted = tuple(k for k, v in (("acceleration", spec.acceleration), ("jerk", spec.jerk)) if v is None)
     if defaulted:
@@ -149,13 +150,7 @@ def load_robot(spec: RobotSpec) -> RobotModel:
         visual_model=visual,
         joint_names=names,
         flange_frame_id=int(model.getFrameId(spec.flange)),
-        limits=JointLimits(
-            lower=frozen_array(lower),
-            upper=frozen_array(upper),
-            velocity=frozen_array(velocity),
-            acceleration=frozen_array(acceleration),
-            jerk=frozen_array(jerk),
-        ),
+        limits=limits,
         loaded_limits=loaded,
         payload_kg=spec.payload_kg,
         ik_solver=spec.ik_solver,

@@ -714,9 +714,6 @@ def _urdf(arm: ArmData, n_collision: dict[str, int], hulls: dict[str, trimesh.Tr
 
 
 def _robot_yaml(arm: ArmData) -> str:
-    def lst(v: Sequence[float]) -> str:
-        return "[" + ", ".join(f"{x:g}" for x in v) + "]"
-
     return (
         arm.yaml_header
         + f"name: {arm.name}\n"
@@ -730,17 +727,17 @@ def _robot_yaml(arm: ArmData) -> str:
         + arm.params_comment
         + f"    a1: {arm.a1:g}\n    a2: {arm.a2:g}\n    b: {arm.b:g}\n"
         + f"    c1: {arm.c1:g}\n    c2: {arm.c2:g}\n    c3: {arm.c3:g}\n    c4: {arm.c4:g}\n"
-        + f"    offsets: {lst(arm.offsets_deg)}\n"
-        + f"    sign_corrections: {lst(arm.sign_corrections)}\n"
+        + f"    offsets: {_yaml_list(arm.offsets_deg)}\n"
+        + f"    sign_corrections: {_yaml_list(arm.sign_corrections)}\n"
         + "limits:\n"
         + arm.limits_comment
-        + f"  acceleration: {lst(arm.acceleration_deg_s2)}   # deg/s^2, estimated\n"
-        + f"  jerk: {lst(arm.jerk_deg_s3)}   # deg/s^3, estimated\n"
+        + f"  acceleration: {_yaml_list(arm.acceleration_deg_s2)}   # deg/s^2, estimated\n"
+        + f"  jerk: {_yaml_list(arm.jerk_deg_s3)}   # deg/s^3, estimated\n"
         + _loaded_yaml(arm)
     )
 
 
-def _deg_list(v: Sequence[float]) -> str:
+def _yaml_list(v: Sequence[float]) -> str:
     return "[" + ", ".join(f"{x:g}" for x in v) + "]"
 
 
@@ -752,9 +749,9 @@ def _loaded_yaml(arm: ArmData) -> str:
         f"  # estimated: with the rated {arm.payload_kg:g} kg payload, {v:.0%} of the speeds, {a:.0%} of the\n"
         f"  # accelerations and {j:.0%} of the jerks (lighter parts: in proportion to their mass)\n"
         + "  loaded:\n"
-        + f"    velocity: {_deg_list(tuple(v * x for x in arm.velocity_deg_s))}   # deg/s\n"
-        + f"    acceleration: {_deg_list(tuple(a * x for x in arm.acceleration_deg_s2))}   # deg/s^2\n"
-        + f"    jerk: {_deg_list(tuple(j * x for x in arm.jerk_deg_s3))}   # deg/s^3\n"
+        + f"    velocity: {_yaml_list(tuple(v * x for x in arm.velocity_deg_s))}   # deg/s\n"
+        + f"    acceleration: {_yaml_list(tuple(a * x for x in arm.acceleration_deg_s2))}   # deg/s^2\n"
+        + f"    jerk: {_yaml_list(tuple(j * x for x in arm.jerk_deg_s3))}   # deg/s^3\n"
     )
 
 
