@@ -38,3 +38,14 @@ class ProgramError(_LocatedError):
 
 class ExportError(RobomaxError):
     """A plan cannot be written in the requested format."""
+
+
+class ControllerSetupError(ExportError):
+    """The cell's `robot.controller` numbers do not fit a dialect (a tool number beyond the
+    controller's slots, a signal without the input number the dialect waits on): `key` is the
+    cell key, `problem` what is wrong; the caller names the cell file."""
+
+    def __init__(self, key: str, problem: str) -> None:
+        self.key = key
+        self.problem = problem
+        super().__init__(f"{key}: {problem}")

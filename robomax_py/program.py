@@ -39,7 +39,6 @@ from robomax_py.transforms import invert, pose_matrix, rpy_from_matrix
 __all__ = [
     "as_written_joints",
     "as_written_pose",
-    "as_written_pose_in",
     "frame_in_world",
     "from_frame",
     "to_frame",
@@ -56,10 +55,13 @@ __all__ = [
     "TIME_DECIMALS",
     "Comment",
     "FrameDef",
+    "NULL_FRAME",
+    "UNSET_FRAME",
     "Header",
     "Instruction",
     "LinMove",
     "Program",
+    "ProgramSetup",
     "PtpMove",
     "Spot",
     "Gripper",
@@ -78,6 +80,9 @@ TIME_DECIMALS = 3    # s
 FLYBY_MM_DECIMALS = 6
 
 FrameKind: TypeAlias = Literal["tool", "base"]
+# A LIN's tool or base: the controller's null frame (flange / robot base frame), or none selected.
+NULL_FRAME = ""
+UNSET_FRAME = "?"
 
 
 def _fixed(value: float, decimals: int) -> float:
@@ -132,27 +137,38 @@ class Header:
 
 @dataclass(frozen=True, slots=True)
 class FrameDef:
-    """A named tool or base frame.
+    """A tool or user frame whose value the program's files state (SPEC §6).
 
     Attributes
     ----------
     name : str
+        How the program refers to it (a LIN's `tool` / `base`): a RAPID data name, a KRL
+        `TOOL_DATA[n]`, a FANUC `UTOOL[n]` ...; each dialect names them its own way.
     kind : {"tool", "base"}
-        "tool": TCP in the flange frame; "base": robot base in the world frame.
+        "tool": the TCP in the flange frame; "base": a user frame (KUKA base, ABB work object,
+        FANUC user frame) in the controller's robot base frame. Targets relative to it.
     xyz_mm : (3,) tuple of float
         Origin, mm (3 decimals).
     zyx_deg : (3,) tuple of float
         Orientation as ZYX angles (A, B, C), deg (4 decimals).
+    number : int
+        The controller's slot for it (KUKA TOOL_DATA / BASE_DATA, FANUC UTOOL / UFRAME); 0: none.
     """
 
     name: str
     kind: FrameKind
     xyz_mm: tuple[float, ...]
     zyx_deg: tuple[float, ...]
+    number: int = 0
 
     def __post_init__(self) -> None:
         _set(self, "xyz_mm", _fixed_all(self.xyz_mm, MM_DECIMALS))
         _set(self, "zyx_deg", _fixed_all(self.zyx_deg, ANGLE_DECIMALS))
+
+    @property
+    def pose(self) -> FloatArray:
+        """The frame as a (4, 4) pose, m."""
+        return lin_pose(LinMove(self.xyz_mm, self.zyx_deg))
 
 
 @dataclass(frozen=True, slots=True)
@@ -220,6 +236,11 @@ class LinMove:
     accel : float
         Fraction in (0, 1] of the joint acceleration (and jerk) limits the line may use, as a PTP
         move's (3 decimals): a part in the gripper slows the lines that carry it too.
+    tool, base : str
+        The tool and the user frame in force for this target, as the controller has them when it
+        executes the move: names of `FrameDef`s (of the program, or stored on the controller).
+        `NULL_FRAME` is the controller's null frame (the flange; the robot base frame itself);
+        `UNSET_FRAME`: the program did not select one (the controller keeps whatever was active).
     """
 
     position_mm: tuple[float, ...]
@@ -230,6 +251,8 @@ class LinMove:
     comment: str = ""
     flyby_mm: float = 0.0
     accel: float = 1.0
+    tool: str = NULL_FRAME
+    base: str = NULL_FRAME
 
     def __post_init__(self) -> None:
         _set(self, "position_mm", _fixed_all(self.position_mm, MM_DECIMALS))
@@ -288,9 +311,12 @@ class Wait:
 
 @dataclass(frozen=True, slots=True)
 class WaitFor:
-    """Block until the named input signal is set."""
+    """Block until an input is set: the cell's signal `signal`, on the controller's input `number`
+    (KUKA $IN, FANUC DI, UR standard digital input); None where the program names the signal only
+    (SRCL, RAPID's named signals)."""
 
     signal: str
+    number: int | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -307,13 +333,29 @@ Instruction: TypeAlias = PtpMove | LinMove | Spot | Gripper | Wait | WaitFor | C
 
 
 @dataclass(frozen=True, slots=True)
+class ProgramSetup:
+    """What the controller's integrator hands a program (the cell's `robot.controller`), for the
+    writers: the position and numeric registers it may use (FANUC), whether a weld calls the
+    program's own `spot_weld` routine ("call") or the controller's process package ("package"), and
+    frames a setup file lists for the integrator to enter by hand (`listed`: FANUC without position
+    registers to set them from). Nothing of it is read back: the statements say what they use."""
+
+    position_registers: tuple[int, ...] = ()
+    numeric_registers: tuple[int, ...] = ()
+    weld: Literal["call", "package"] = "call"
+    listed: tuple[FrameDef, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
 class Program:
-    """A complete program: header, frame definitions and the instruction list, in order."""
+    """A complete program: header, frame definitions and the instruction list, in order, and
+    what its writer may use on the controller (`setup`, not part of the text's meaning)."""
 
     name: str
     header: Header
     frames: tuple[FrameDef, ...] = ()
     instructions: tuple[Instruction, ...] = ()
+    setup: ProgramSetup = ProgramSetup()
 
     def __post_init__(self) -> None:
         _set(self, "frames", tuple(self.frames))
@@ -473,11 +515,6 @@ def frame_in_world(T_world_root: FloatArray, T_root_frame: FloatArray) -> FloatA
         return np.asarray(T_world_root, dtype=float)
     out: FloatArray = np.asarray(T_world_root, dtype=float) @ np.asarray(T_root_frame, dtype=float)
     return out
-
-
-def as_written_pose_in(T: FloatArray, T_root_frame: FloatArray) -> FloatArray:
-    """A root-frame TCP pose as a LIN statement in `T_root_frame` gives it back (root frame)."""
-    return from_frame(T_root_frame, as_written_pose(to_frame(T_root_frame, T)))
 
 
 def written_speed(fraction: float) -> float:

@@ -20,8 +20,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomax_py._typing import FloatArray
-from robomax_py.errors import ExportError, ProgramError
-from robomax_py.export import DIALECTS, render_trajectory
+from robomax_py.errors import (
+    CellFileError,
+    ControllerSetupError,
+    ExportError,
+    ProgramError,
+)
+from robomax_py.export import DIALECTS, controller_frames, render_trajectory
 from robomax_py.export.dialect import Parsed, PlannedProgram
 from robomax_py.export.plan_program import planned_program
 from robomax_py.export.rebuild import rebuild
@@ -74,8 +79,9 @@ class CheckedProgram:
 
 
 def file_names(name: str, files: dict[str, str]) -> dict[str, str]:
-    """Dialect keys (".src", or a whole file name such as "spot_weld.ls") -> file names."""
-    return {(f"{name}{key}" if key.startswith(".") else key): text for key, text in files.items()}
+    """Dialect keys (".src" or "_frames.src", after the program's name, or a whole file name such as
+    "spot_weld.ls") -> file names."""
+    return {(f"{name}{key}" if key.startswith((".", "_")) else key): text for key, text in files.items()}
 
 
 def publish(result: PlanResult, cell: CellSpec, robot: RobotModel, formats: tuple[str, ...], *,
@@ -105,7 +111,10 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
              name: str, reference: list[PlannedPath]) -> CheckedProgram:
     dialect = DIALECTS[fmt]
     t0 = time.process_time()
-    adapted = dialect.adapt(planned, robot)
+    try:
+        adapted = dialect.adapt(planned, robot)
+    except ControllerSetupError as exc:
+        raise CellFileError(cell.source, exc.key, f"{exc.problem} (--format {fmt})") from None
     if name != result.cell:
         adapted = dataclasses.replace(adapted, name=adapted.name + ("_BASELINE" if adapted.name.isupper() else "_baseline"))
     texts = dialect.write(adapted, robot)
@@ -116,7 +125,7 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
     except ProgramError as exc:
         raise ExportError(f"{fmt}: the written program does not read back: {exc}") from None
     _same_program(fmt, main, adapted, parsed)
-    rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand)
+    rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
     if rebuilt.problems or rebuilt.trajectory is None:
         p = rebuilt.problems[0] if rebuilt.problems else None
         where = f"line {p.line}: " if p and p.line else ""

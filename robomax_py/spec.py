@@ -25,6 +25,17 @@ def frozen_array(values: Any) -> FloatArray:
 Brand = Literal["kuka", "abb", "fanuc", "ur"]
 
 
+# The input a program waits for before moving through a dynamic object's space: `<name>_open` for a
+# machine's door, `<name>_clear` for any other dynamic object (cell keys `dynamic`, `tending`).
+CLEAR_SUFFIX = "_clear"
+OPEN_SUFFIX = "_open"
+
+
+def dynamic_signal(obstacle: str, door: bool) -> str:
+    """The input a program waits for: `<name>_open` for a machine's door, else `<name>_clear`."""
+    return obstacle + (OPEN_SUFFIX if door else CLEAR_SUFFIX)
+
+
 def _identity() -> FloatArray:
     return frozen_array(np.eye(4))
 
@@ -57,6 +68,66 @@ class RobotSpec:
     srdf_disabled_links: tuple[tuple[str, str], ...] = ()   # the SRDF's disable_collisions
     package_dirs: tuple[Path, ...] = ()   # folders P with P/NAME the package of the URDF's package://NAME meshes
     loaded: JointLoadLimits | None = None    # joint limits carrying the rated payload (robot.yaml `loaded`)
+
+
+@dataclass(frozen=True, slots=True)
+class ControllerFrame:
+    """A frame as the robot's controller stores it (SPEC §6, cell key `robot.controller`).
+
+    number : int
+        Its slot: KUKA TOOL_DATA[n] / BASE_DATA[n], FANUC UTOOL[n] / UFRAME[n].
+    name : str
+        Its name: ABB RAPID tooldata / wobjdata, UR variable, KUKA TOOL_NAME / BASE_NAME.
+    existing : bool
+        The cell named it, so it exists on the controller: RAPID refers to it without declaring it.
+    """
+
+    number: int
+    name: str
+    existing: bool = False
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class UserFrame:
+    """The user frame programs state their Cartesian targets in (KUKA base, ABB work object,
+    FANUC user frame), where the cell puts it: T_world_frame (4, 4) in the cell's world, m."""
+
+    frame: ControllerFrame
+    T_world_frame: FloatArray
+
+
+@dataclass(frozen=True, slots=True)
+class ControllerInput:
+    """A cell signal as the controller reads it: input `number` (KUKA $IN, FANUC DI, UR standard
+    digital input), and for RAPID the signal's `name` in the controller's I/O configuration."""
+
+    signal: str
+    number: int
+    name: str | None = None
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ControllerSetup:
+    """The integrator's numbers on the robot's controller (cell key `robot.controller`): which tool
+    and user frame programs select, the registers a program may use, the inputs each cell signal
+    arrives on, and whether welds call the default routine or the controller's process package.
+
+    tool : ControllerFrame | None
+        None: tool 1, named after the tool (`<tool>_tcp`), declared by the programs.
+    frame : UserFrame | None
+        None: targets in the robot base frame itself (KRL base 0, RAPID wobj0, FANUC UF 0).
+    """
+
+    tool: ControllerFrame | None = None
+    frame: UserFrame | None = None
+    position_registers: tuple[int, ...] = ()
+    numeric_registers: tuple[int, ...] = ()
+    inputs: tuple[ControllerInput, ...] = ()
+    weld: Literal["call", "package"] = "call"
+
+    def input_of(self, signal: str) -> ControllerInput | None:
+        """The input a cell signal is mapped to; None when the cell maps none."""
+        return next((i for i in self.inputs if i.signal == signal), None)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -237,6 +308,14 @@ class CellSpec:
     machines: tuple[MachineSpec, ...] = ()    # tending cells: machines and their door schedules
     parts: tuple[PartSpec, ...] = ()          # pick-and-place cells: the parts moved
     tcp_limits: TcpLimits | None = None       # pick-and-place cells: TCP limits without a part
+    controller: ControllerSetup = field(default_factory=ControllerSetup)   # the integrator's numbers
+
+    @property
+    def signals(self) -> tuple[str, ...]:
+        """Every input a program of this cell may wait for: clamp signals, then the dynamic
+        objects' `<name>_clear` / `<name>_open`, in cell order."""
+        clamps = [o.signal for o in self.objects if o.signal]
+        return tuple(dict.fromkeys([*clamps, *(dynamic_signal(d.name, d.door) for d in self.dynamic)]))
 
     def part(self, name: str) -> PartSpec:
         """The part called `name` (KeyError when the cell has none of that name)."""

@@ -63,7 +63,7 @@ class VerifyReport:
 def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
     """Verify a trajectory file (.json) or a program of any dialect robomax writes (its motion
     rebuilt from its statements alone)."""
-    from robomax_py.export import DIALECTS, dialect_for_file
+    from robomax_py.export import DIALECTS, controller_frames, dialect_for_file
 
     suffix = path.suffix.lower()
     if suffix == ".json":
@@ -80,10 +80,16 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
     main = path.with_suffix(dialect.extensions[0])
     if dialect.extensions[0] not in texts:
         raise ProgramError(main, None, f"{path.name} needs its main file {main.name} beside it")
+    for key in dialect.companions:
+        # A setup file beside the program (its frames) is what the controller was loaded with;
+        # without one, the controller holds the cell's calibrated frames (`controller_frames`).
+        companion = main.with_name(main.stem + key)
+        if companion.exists():
+            texts[key] = read_text(companion, LIMITS.program, ProgramError, "program file")
     from robomax_py.export.rebuild import rebuild
 
     parsed = dialect.parse(texts, str(main), robot)
-    rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand)
+    rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
     report = verify_rebuilt(cell, robot, str(path), rebuilt)
     unsimulated = tuple(Violation(None, "unsupported", f"{text} is not simulated: the program cannot be verified", line)
                         for line, text in parsed.ignored if _is_motion(parsed, line))

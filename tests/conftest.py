@@ -35,6 +35,36 @@ def _write_small_cell(folder: Path, name: str = "small_cell", extra_spots: list[
     return path
 
 
+def place_cell(data: dict[str, Any], xyz: tuple[float, float, float], yaw_deg: float, roll_deg: float = 0.0) -> None:
+    """Move a whole cell (its data as read from YAML) by one rigid transform, in place: the robot,
+    every object and dynamic object, every spot with its normal and direction, as a station puts a
+    cell wherever it stands. The cell plans the same motion: only the world moved."""
+    from scipy.spatial.transform import Rotation
+
+    R = Rotation.from_euler("xz", [roll_deg, yaw_deg], degrees=True)
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R.as_matrix(), xyz
+
+    def pose(p: dict[str, Any] | None) -> dict[str, Any]:
+        p = p or {}
+        M = np.eye(4)
+        M[:3, :3] = Rotation.from_euler("xyz", p.get("rpy", [0, 0, 0]), degrees=True).as_matrix()
+        M[:3, 3] = p.get("xyz", [0, 0, 0])
+        N = T @ M
+        rpy = Rotation.from_matrix(N[:3, :3]).as_euler("xyz", degrees=True)
+        return {"xyz": [round(float(v), 9) for v in N[:3, 3]], "rpy": [round(float(v), 9) for v in rpy]}
+
+    data["robot"]["base"] = pose(data["robot"].get("base"))
+    for key in ("objects", "dynamic"):
+        for obj in data.get(key, []):
+            obj["pose"] = pose(obj.get("pose"))
+    for seam in data.get("seams", []):
+        for spot in seam["spots"]:
+            spot["xyz"] = [round(float(v), 9) for v in (T @ np.r_[spot["xyz"], 1.0])[:3]]
+            for k in ("normal", "direction"):
+                spot[k] = [round(float(v), 12) for v in T[:3, :3] @ np.asarray(spot[k], dtype=float)]
+
+
 @pytest.fixture(scope="session")
 def write_small_cell() -> SmallCell:
     """Writes the small test cell into a folder: write_small_cell(folder, name=..., extra_spots=...)."""

@@ -9,21 +9,36 @@ module owns its adapter, writer and reader (`srcl`, `krl`, `rapid`, `fanuc`, `ur
 
 from __future__ import annotations
 
+import dataclasses
+
 from robomax_py.errors import ExportError
 from robomax_py.export import fanuc, krl, rapid, srcl, trajectory_json, urscript
 from robomax_py.export.dialect import Dialect
+from robomax_py.export.plan_program import frame_defs
 from robomax_py.plan import PlanResult
+from robomax_py.plan.program_frames import cell_program_frames
+from robomax_py.program import FrameDef
+from robomax_py.spec import CellSpec
 
-__all__ = ["DIALECTS", "Dialect", "dialect_for_file", "format_names", "render_trajectory"]
+__all__ = ["DIALECTS", "Dialect", "controller_frames", "dialect_for_file", "format_names", "render_trajectory"]
 
 # Registry order is the order files are written in (after the trajectory file).
 DIALECTS: dict[str, Dialect] = {
     "srcl": Dialect("srcl", (".srcl",), "", srcl.adapt, srcl.write, srcl.parse),
-    "krl": Dialect("krl", (".src", ".dat"), "kuka", krl.adapt, krl.write, krl.parse),
-    "rapid": Dialect("rapid", (".mod",), "abb", rapid.adapt, rapid.write, rapid.parse),
-    "fanuc": Dialect("fanuc", (".ls",), "fanuc", fanuc.adapt, fanuc.write, fanuc.parse),
+    "krl": Dialect("krl", (".src", ".dat"), "kuka", krl.adapt, krl.write, krl.parse, krl.frame_name,
+                   (krl.FRAMES_FILE,)),
+    "rapid": Dialect("rapid", (".mod",), "abb", rapid.adapt, rapid.write, rapid.parse, companions=(rapid.FRAMES_FILE,)),
+    "fanuc": Dialect("fanuc", (".ls",), "fanuc", fanuc.adapt, fanuc.write, fanuc.parse, fanuc.frame_name,
+                     (fanuc.FRAMES_FILE,)),
     "urscript": Dialect("urscript", (".script",), "ur", urscript.adapt, urscript.write, urscript.parse),
 }
+
+
+def controller_frames(dialect: Dialect, cell: CellSpec) -> tuple[FrameDef, ...]:
+    """The frames a controller set up for the cell holds (the integrator has calibrated the cell's
+    tool and user frame into it), named as `dialect` refers to them: what a program that selects
+    them without stating their values runs with."""
+    return tuple(dataclasses.replace(f, name=dialect.frame_name(f)) for f in frame_defs(cell_program_frames(cell)))
 NATIVE = {"kuka": "krl", "abb": "rapid", "fanuc": "fanuc", "ur": "urscript"}
 
 

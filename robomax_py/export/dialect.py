@@ -15,14 +15,15 @@ import dataclasses
 import math
 import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from lark import Token, Tree
 
 from robomax_py._typing import FloatArray
-from robomax_py.errors import ExportError, ProgramError
+from robomax_py.errors import ControllerSetupError, ExportError, ProgramError
 from robomax_py.program import (
     Comment,
+    FrameDef,
     Gripper,
     Header,
     Instruction,
@@ -30,9 +31,11 @@ from robomax_py.program import (
     Program,
     PtpMove,
     Spot,
+    WaitFor,
 )
 from robomax_py.robot import RobotModel
 from robomax_py.robot.solve import brand_text_of
+from robomax_py.spec import ControllerSetup
 from robomax_py.timing import TimingError
 from robomax_py.timing.chain import flyby_tcp_distance
 
@@ -61,6 +64,7 @@ class PlannedProgram:
 
     program: Program
     joints: tuple[FloatArray, ...]
+    controller: ControllerSetup = field(default_factory=ControllerSetup)     # the cell's `robot.controller`
 
 
 @dataclass(frozen=True, slots=True)
@@ -78,9 +82,16 @@ class Parsed:
     ignored: tuple[tuple[int, str], ...] = ()
 
 
+def own_name(frame: FrameDef) -> str:
+    """A frame's name as the program states it, for dialects that refer to frames by name."""
+    return frame.name
+
+
 @dataclass(frozen=True, slots=True)
 class Dialect:
-    """A controller dialect: its files (the first is the main one), its brand, both directions."""
+    """A controller dialect: its files (the first is the main one; keys starting with "_" are
+    companions named `<program>_...`, such as a frames setup file), its brand, both directions,
+    and how it refers to a numbered frame (`frame_name`: e.g. KRL "TOOL_DATA[1]")."""
 
     name: str
     extensions: tuple[str, ...]
@@ -88,6 +99,45 @@ class Dialect:
     adapt: Callable[[PlannedProgram, RobotModel], Program]
     write: Callable[[Program, RobotModel], dict[str, str]]
     parse: Callable[[dict[str, str], str, RobotModel], Parsed]
+    frame_name: Callable[[FrameDef], str] = own_name
+    companions: tuple[str, ...] = ()
+
+
+def with_frame_names(program: Program, name_of: Callable[[FrameDef], str]) -> Program:
+    """The program with its frames named as a dialect names them, and every LIN's tool and base
+    renamed alike."""
+    renamed = {(f.kind, f.name): name_of(f) for f in program.frames}
+    frames = tuple(dataclasses.replace(f, name=renamed[(f.kind, f.name)]) for f in program.frames)
+    out: list[Instruction] = []
+    for ins in program.instructions:
+        if isinstance(ins, LinMove):
+            ins = dataclasses.replace(ins, tool=renamed.get(("tool", ins.tool), ins.tool),
+                                      base=renamed.get(("base", ins.base), ins.base))
+        out.append(ins)
+    return dataclasses.replace(program, frames=frames, instructions=tuple(out))
+
+
+def numbered_inputs(program: Program, dialect: str, low: int, high: int) -> None:
+    """Every wait names a controller input in [low, high]: ControllerSetupError otherwise (a
+    dialect that waits on input numbers cannot guess one)."""
+    for ins in program.instructions:
+        if not isinstance(ins, WaitFor):
+            continue
+        key = f"robot.controller.inputs.{ins.signal}"
+        if ins.number is None:
+            raise ControllerSetupError(key, f"the program waits for signal {ins.signal}; {dialect} waits on an input "
+                                            "number: map the signal to the controller's input")
+        if not low <= ins.number <= high:
+            raise ControllerSetupError(key, f"input {ins.number} is outside {dialect}'s inputs {low}..{high}")
+
+
+def numbered_frames(program: Program, dialect: str, tools: int, bases: int) -> None:
+    """Every frame's number within the controller's slots (1..tools, 1..bases)."""
+    for f in program.frames:
+        high = tools if f.kind == "tool" else bases
+        if not 1 <= f.number <= high:
+            key = "robot.controller." + ("tool" if f.kind == "tool" else "frame") + ".number"
+            raise ControllerSetupError(key, f"{dialect} has {f.kind} slots 1..{high}, got {f.number}")
 
 
 # ------------------------------------------------------------------ the header

@@ -3,9 +3,14 @@
 What a program states, in KRL's own terms:
 - joint targets as E6AXIS (deg), Cartesian targets as E6POS: X, Y, Z mm; A, B, C deg with
   R = Rz(A)·Ry(B)·Rx(C); S and T the KUKA Status and Turn of the planned configuration (SPEC §6);
-- `$TOOL` (TCP in the flange frame) and `$BASE` (the robot base in the cell's world, so that
-  targets are relative to the robot base when `$ROBROOT` is placed as the cell places the robot)
-  before the first motion;
+- frames selected by number before the first Cartesian motion, as the controller stores them:
+  `$TOOL = TOOL_DATA[t]` and `$BASE = BASE_DATA[b]`, or `$BASE = $NULLFRAME` when the targets are
+  in the robot base frame itself. With factory settings `$ROBROOT` = `$WORLD` (the controller knows
+  nothing of the cell), so `$BASE` is the user frame in the robot base frame and a target's TCP
+  pose in the robot base frame is `$BASE` · target; the robot's placement in the cell is never
+  written. The frames' values go into a setup program `<name>_frames.src` (`TOOL_DATA[t] = {...}`,
+  `BASE_DATA[b] = {...}`) that the integrator runs once or compares with the calibrated values;
+  KSS declares TOOL_DATA[16] and BASE_DATA[32] in $config.dat;
 - `$VEL_AXIS[i]` / `$ACC_AXIS[i]` in whole percent for PTP, `$VEL.CP` in m/s for LIN (and
   `$ACC_AXIS[i]`, which this subset applies to a LIN's axes too, as KSS does for spline CP motions);
 - blends as `C_DIS` with `$APO.CDIS` in mm, for PTP moves too, as KSS 8.2 and later write them
@@ -13,13 +18,16 @@ What a program states, in KRL's own terms:
   planned radius; `$APO.CDIS` is a REAL distance: KUKA.PLC mxAutomation manual, "APO" structure);
 - a weld as an exact LIN to the spot followed by `spot_weld(n, weld_time) ; seam/name`, and
   `spot_weld` defined after the main program (rest for `weld_time`; the integrator replaces it);
-- `WAIT SEC t`, and `WAIT FOR <signal>` with `SIGNAL <signal> $IN[k]` declared (k in order of use).
+- `WAIT SEC t`, and `WAIT FOR <signal>` with `SIGNAL <signal> $IN[k]` declared, k the input the
+  cell maps the signal to (`robot.controller.inputs`).
 
 The reader takes the motion subset of any KRL program: PTP and LIN to points declared in the
 .dat or the .src, or written in place (E6AXIS/AXIS, E6POS/POS/FRAME aggregates, missing
 components keeping their last value), `$VEL`, `$ACC`, `$APO` assignments, `C_DIS`/`C_PTP`,
-`WAIT SEC`, `WAIT FOR` and calls of `spot_weld`; other motions (CIRC, SPTP, *_REL ...) are
-reported as not simulated, everything else as ignored.
+`WAIT SEC`, `WAIT FOR` and calls of `spot_weld`, the frames in force at each motion (`$TOOL` /
+`$BASE` set to literals, to `TOOL_DATA[n]` / `BASE_DATA[n]` or to `$NULLFRAME`; the values of
+`TOOL_DATA` / `BASE_DATA` from a setup program when given); other motions (CIRC, SPTP, *_REL ...)
+are reported as not simulated, everything else as ignored.
 """
 
 from __future__ import annotations
@@ -39,6 +47,8 @@ from robomax_py.export.dialect import (
     gripper_label,
     header_lines,
     is_header_comment,
+    numbered_frames,
+    numbered_inputs,
     percent,
     read_gripper,
     read_header,
@@ -46,9 +56,12 @@ from robomax_py.export.dialect import (
     require_six_axes,
     spot_label,
     with_brand_configs,
+    with_frame_names,
     with_tcp_blends,
 )
 from robomax_py.program import (
+    NULL_FRAME,
+    UNSET_FRAME,
     Comment,
     FrameDef,
     Gripper,
@@ -63,18 +76,31 @@ from robomax_py.program import (
 from robomax_py.robot import RobotModel
 from robomax_py.robot.ik.config import ConfigIndicator
 
-__all__ = ["adapt", "parse", "write"]
+__all__ = ["FRAMES_FILE", "adapt", "frame_name", "parse", "write"]
+
+# The setup program holding the frames' values (a companion of `<name>.src`).
+FRAMES_FILE = "_frames.src"
+# KSS 8.x declares TOOL_DATA[16] and BASE_DATA[32] ($config.dat), and 4096 digital inputs.
+TOOL_SLOTS, BASE_SLOTS, INPUTS = 16, 32, 4096
 
 _NOTE = "KRL of KSS 8.x"
 _AXES = ("A1", "A2", "A3", "A4", "A5", "A6")
 _EXTERNAL = ", ".join(f"E{i} 0.0" for i in range(1, 7))
 
 
+def frame_name(frame: FrameDef) -> str:
+    """How KRL refers to a stored frame: `TOOL_DATA[n]` or `BASE_DATA[n]`."""
+    return f"{'TOOL' if frame.kind == 'tool' else 'BASE'}_DATA[{frame.number}]"
+
+
 def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
-    """The program as KRL states it: KUKA configuration data, TCP-distance blends, whole-percent
-    PTP speeds and accelerations."""
+    """The program as KRL states it: frames by number, KUKA configuration data, TCP-distance
+    blends, whole-percent PTP speeds and accelerations, waits on input numbers."""
     require_six_axes(robot, "KRL")
-    program = with_brand_configs(planned.program, planned.joints, robot, "kuka")
+    numbered_frames(planned.program, "KRL", TOOL_SLOTS, BASE_SLOTS)
+    numbered_inputs(planned.program, "KRL", 1, INPUTS)
+    program = with_frame_names(planned.program, frame_name)
+    program = with_brand_configs(program, planned.joints, robot, "kuka")
     program = with_tcp_blends(dataclasses.replace(planned, program=program), robot)
     out: list[Instruction] = []
     for ins in program.instructions:
@@ -99,9 +125,11 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     src += [f"SIGNAL {sig} $IN[{k}]" for sig, k in signals.items()]
     dat: list[str] = [f"DEFDAT {name}", *(f"; {text}" for text in header_lines(program.header)),
                       f"; points of {name}.src"]
-    for f in program.frames:
-        var = "$TOOL" if f.kind == "tool" else "$BASE"
-        src.append(f"{var} = {_frame(f.xyz_mm, f.zyx_deg)} ; {f.kind} frame {f.name}")
+    # The frames are selected before the first motion (a PTP's C_DIS is a distance of the TCP too).
+    first = next((i for i in program.instructions if isinstance(i, LinMove)), None)
+    tool, base = (UNSET_FRAME, UNSET_FRAME) if first is None else (first.tool, first.base)
+    if first is not None:
+        src += [f"$TOOL = {tool or '$NULLFRAME'}", f"$BASE = {base or '$NULLFRAME'}"]
     speed = accel = None
     cp_speed = None
     lin_note = False
@@ -125,6 +153,12 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                 values = ", ".join(f"{a} {v:.4f}" for a, v in zip(_AXES, ins.target_deg))
                 dat.append(f"DECL E6AXIS {point}={{{values}, {_EXTERNAL}}}")
             else:
+                if ins.tool != tool:
+                    tool = ins.tool
+                    src.append(f"$TOOL = {tool or '$NULLFRAME'}")
+                if ins.base != base:
+                    base = ins.base
+                    src.append(f"$BASE = {base or '$NULLFRAME'}")
                 if ins.speed_mm_s != cp_speed:
                     cp_speed = ins.speed_mm_s
                     src.append(f"$VEL.CP = {cp_speed / 1000:.6f}")
@@ -167,14 +201,27 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                 f"  ; default {action}: rest for {action}_time s; replace with the gripper's outputs and sensors",
                 f"  WAIT SEC {action}_time", "END"]
     dat.append("ENDDAT")
-    return {".src": "\n".join(src) + "\n", ".dat": "\n".join(dat) + "\n"}
+    return {".src": "\n".join(src) + "\n", ".dat": "\n".join(dat) + "\n", FRAMES_FILE: _frames_program(program)}
+
+
+def _frames_program(program: Program) -> str:
+    """The setup program: the frames' values in the controller's TOOL_DATA / BASE_DATA."""
+    lines = ["&ACCESS RVP", "&REL 1", f"DEF {program.name}_frames( )", *(f"; {t}" for t in header_lines(program.header)),
+             f"; the frames {program.name}.src selects: run once to store them, or compare them with the calibrated ones",
+             "; (mm, deg; BASE_DATA in the robot base frame, $ROBROOT = $WORLD)"]
+    for f in program.frames:
+        what = "tool (TCP in the flange frame)" if f.kind == "tool" else "user frame in the robot base frame"
+        lines.append(f"{f.name} = {_frame(f.xyz_mm, f.zyx_deg)} ; {what}")
+    lines.append("END")
+    return "\n".join(lines) + "\n"
 
 
 def _signals(program: Program) -> dict[str, int]:
+    """Each waited-for signal and its input number (`numbered_inputs` has checked there is one)."""
     out: dict[str, int] = {}
     for ins in program.instructions:
         if isinstance(ins, WaitFor) and ins.signal not in out:
-            out[ins.signal] = len(out) + 1
+            out[ins.signal] = int(ins.number or 0)
     return out
 
 
@@ -195,17 +242,19 @@ def _pose(move: LinMove) -> str:
 # ================================================================================== reading
 
 _GRAMMAR = r"""
-?start: motion | assign | weld | gripper | wait_sec | wait_for | signal | decl
+?start: motion | assign | frame_data | weld | gripper | wait_sec | wait_for | signal | decl
 motion: MOTION target APPROX?
 target: NAME | aggregate
 aggregate: "{" (NAME ":")? [field ("," field)*] "}"
 field: NAME value
 ?value: NUMBER | BITS | NAME
-assign: SYSVAR ("." NAME)? ("[" NUMBER "]")? "=" (NUMBER | aggregate | SYSVAR)
+assign: SYSVAR ("." NAME)? ("[" NUMBER "]")? "=" (NUMBER | aggregate | SYSVAR | indexed)
+indexed: NAME "[" NUMBER "]"
+frame_data: NAME "[" NUMBER "]" "=" aggregate
 weld: "spot_weld"i "(" NUMBER "," NUMBER ")"
 gripper: GRIPPER "(" NUMBER "," NUMBER ")"
 wait_sec: "WAIT"i "SEC"i NUMBER
-wait_for: "WAIT"i "FOR"i NAME
+wait_for: "WAIT"i "FOR"i (NAME | SYSVAR "[" NUMBER "]")
 signal: "SIGNAL"i NAME SYSVAR "[" NUMBER "]"
 decl: "DECL"i NAME NAME "=" aggregate
 
@@ -222,7 +271,8 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 # Motions KRL has that this reader does not simulate: a program with one is not verified clean.
 _UNSIMULATED = re.compile(r"^(CIRC|SPTP|SLIN|SCIRC|PTP_REL|LIN_REL|CIRC_REL|SPTP_REL|SLIN_REL|SPLINE|PTP_SPLINE|RSI_MOVECORR)\b",
                           re.I)
-_KNOWN = re.compile(r"^(PTP|LIN|\$|spot_weld\s*\(|(grip|release)\s*\(|WAIT\s+(SEC|FOR)\b|SIGNAL\b|DECL\s+(E6AXIS|AXIS|E6POS|POS|FRAME)\b)", re.I)
+_KNOWN = re.compile(r"^(PTP|LIN|\$|spot_weld\s*\(|(grip|release)\s*\(|WAIT\s+(SEC|FOR)\b|SIGNAL\b|"
+                    r"DECL\s+(E6AXIS|AXIS|E6POS|POS|FRAME)\b|(TOOL|BASE)_DATA\s*\[)", re.I)
 
 
 _BLOCK_START = re.compile(r"^(IF\b.*\bTHEN|LOOP|WHILE\b.*|FOR\b.*|REPEAT|SWITCH\b.*)$", re.I)
@@ -252,7 +302,9 @@ class _Reader:
         self.instructions: list[Instruction] = []
         self.lines: list[int] = []
         self.ignored: list[tuple[int, str]] = []
-        self.frames: list[FrameDef] = []
+        self.frames: list[FrameDef] = []       # whose values the program's texts state
+        self.tool, self.base = UNSET_FRAME, UNSET_FRAME    # in force: names of frames
+        self.inputs: dict[str, int] = {}       # SIGNAL name -> $IN number
         self.vel_axis = [100.0] * 6
         self.acc_axis = [100.0] * 6
         self.vel_cp = 2.0                      # m/s, KSS default $VEL.CP
@@ -325,7 +377,27 @@ class _Reader:
         getattr(self, "on_" + tree.data)(tree, comment, line)
 
     def on_signal(self, tree: Tree[Token], comment: str, line: int) -> None:
-        return None
+        name, var, number = tree.children
+        if str(var).upper() == "$IN":
+            self.inputs[str(name).upper()] = int(float(str(number)))
+
+    def declare_frame(self, name: str, kind: str, node: Tree[Token], line: int, number: int = 0) -> None:
+        """A frame's value as the program states it (missing components are 0, as in $NULLFRAME)."""
+        agg = self.aggregate(node, line)
+        xyz = tuple(float(agg.get(k, 0.0)) for k in "XYZ")       # type: ignore[arg-type]
+        zyx = tuple(float(agg.get(k, 0.0)) for k in "ABC")       # type: ignore[arg-type]
+        self.frames = [f for f in self.frames if (f.kind, f.name) != (kind, name)]
+        self.frames.append(FrameDef(name, kind, xyz, zyx, number))      # type: ignore[arg-type]
+
+    def on_frame_data(self, tree: Tree[Token], comment: str, line: int) -> None:
+        """`TOOL_DATA[n] = {...}` / `BASE_DATA[n] = {...}`: the controller's stored frame n."""
+        array, index, value = tree.children
+        kind = {"TOOL_DATA": "tool", "BASE_DATA": "base"}.get(str(array).upper())
+        if kind is None:
+            self.ignored.append((line, f"{array}[{index}] = ..."))
+            return
+        n = int(float(str(index)))
+        self.declare_frame(f"{str(array).upper()}[{n}]", kind, value, line, n)      # type: ignore[arg-type]
 
     def on_assign(self, tree: Tree[Token], comment: str, line: int) -> None:
         toks = [c for c in tree.children if isinstance(c, Token)]
@@ -334,13 +406,22 @@ class _Reader:
         index = next((int(float(t)) for t in toks[1:-1] if t.type == "NUMBER"), None)
         rhs = tree.children[-1]
         number = float(rhs) if isinstance(rhs, Token) and rhs.type == "NUMBER" else None
-        if var in ("$TOOL", "$BASE") and isinstance(rhs, Tree):
-            agg = self.aggregate(rhs, line)
-            xyz = tuple(float(agg.get(k, 0.0)) for k in "XYZ")       # type: ignore[arg-type]
-            zyx = tuple(float(agg.get(k, 0.0)) for k in "ABC")       # type: ignore[arg-type]
+        if var in ("$TOOL", "$BASE"):
             kind = "tool" if var == "$TOOL" else "base"
-            name = comment.split()[-1] if comment.startswith(f"{kind} frame ") else kind
-            self.frames = [f for f in self.frames if f.kind != kind] + [FrameDef(name, kind, xyz, zyx)]
+            if isinstance(rhs, Tree) and rhs.data == "aggregate":
+                name = f"{var} of line {line}"
+                self.declare_frame(name, kind, rhs, line)
+            elif isinstance(rhs, Tree):                  # TOOL_DATA[n] / BASE_DATA[n]
+                array, n = rhs.children
+                name = f"{str(array).upper()}[{int(float(str(n)))}]"
+            elif str(rhs).upper() == "$NULLFRAME":
+                name = NULL_FRAME
+            else:
+                name = str(rhs).upper()                  # another variable: its value is not known here
+            if kind == "tool":
+                self.tool = name
+            else:
+                self.base = name
         elif number is None:
             return
         elif var in ("$VEL_AXIS", "$ACC_AXIS") and index is not None and 1 <= index <= 6:
@@ -387,7 +468,7 @@ class _Reader:
         xyz = tuple(self.last_pose[k] for k in "XYZ")
         zyx = tuple(self.last_pose[k] for k in "ABC")
         self.add(LinMove(xyz, zyx, config, self.vel_cp * 1000.0, comment=comment, flyby_mm=flyby_mm,
-                         accel=min(self.acc_axis) / 100.0), line)
+                         accel=min(self.acc_axis) / 100.0, tool=self.tool, base=self.base), line)
 
     def on_weld(self, tree: Tree[Token], comment: str, line: int) -> None:
         n, seconds = (float(t) for t in tree.children)
@@ -401,12 +482,28 @@ class _Reader:
         self.add(Wait(float(tree.children[0])), line)
 
     def on_wait_for(self, tree: Tree[Token], comment: str, line: int) -> None:
-        self.add(WaitFor(str(tree.children[0])), line)
+        """`WAIT FOR <signal>` (its SIGNAL declaration gives the input) or `WAIT FOR $IN[k]`."""
+        if len(tree.children) == 1:
+            name = str(tree.children[0])
+            self.add(WaitFor(name, self.inputs.get(name.upper())), line)
+            return
+        var, number = tree.children
+        if str(var).upper() != "$IN":
+            self.ignored.append((line, f"WAIT FOR {var}[{number}]"))
+            self.add(Comment(f"not simulated: WAIT FOR {var}[{number}]"), line)
+            return
+        k = int(float(str(number)))
+        name = next((n for n, i in self.inputs.items() if i == k), f"IN_{k}")
+        self.add(WaitFor(name, k), line)
 
 
 def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
     """A KRL program from its `.src` (and `.dat`, when given) texts."""
     reader = _Reader(file, robot)
+    for number, raw in enumerate(texts.get(FRAMES_FILE, "").splitlines(), start=1):
+        stmt, _ = _statement(raw)
+        if re.match(r"^(TOOL|BASE)_DATA\s*\[", stmt, re.I):
+            reader.statement(stmt, "", number)
     for raw in texts.get(".dat", "").splitlines():
         stmt, _ = _statement(raw)
         if re.match(r"^DECL\s+(E6AXIS|AXIS|E6POS|POS|FRAME)\b", stmt, re.I):
@@ -435,8 +532,6 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
                 else:
                     reader.add(Comment(comment), number)
             continue
-        if stmt.upper().startswith(("$TOOL", "$BASE")):
-            comment = comment if " frame " in comment else ""
         reader.statement(stmt, comment, number)
     if not main_name:
         raise ProgramError(file, None, "no DEF line: not a KRL program")

@@ -4,14 +4,17 @@ PTP moves to every stop, FLYBY with the radius the planner chose and checked (de
 joins retract -> move -> approach), LIN approach and retract along the electrode axis, each with the configuration data of its own
 target (the controller brand's), a SPOT
 statement per spot, and comments carrying the planned times and orientation angles. Cartesian
-targets are TCP poses in the robot base frame (mm, ZYX degrees); the tool and base frames are
-declared. Names are made into identifiers where a cell uses other characters.
+targets are TCP poses in the program's user frame (mm, ZYX degrees; by default the controller's
+robot base frame itself), each naming the tool and user frame it is stated with; their values are
+the program's frames. Waits name the cell's signal and the controller input the cell maps it to. Names are made into identifiers where a cell uses other characters.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
+from typing import Any
 
 import numpy as np
 
@@ -20,9 +23,11 @@ from robomax_py._version import __version__
 from robomax_py.errors import ExportError
 from robomax_py.export.dialect import PlannedProgram
 from robomax_py.plan import PlanResult
+from robomax_py.plan.program_frames import ProgramFrames, program_frames
 from robomax_py.plan.results import Transition
 from robomax_py.plan.waiting import WaitPlan, signal_of
 from robomax_py.program import (
+    NULL_FRAME,
     Comment,
     FrameDef,
     Gripper,
@@ -30,14 +35,13 @@ from robomax_py.program import (
     Instruction,
     LinMove,
     Program,
+    ProgramSetup,
     PtpMove,
     Spot,
     Wait,
     WaitFor,
-    frame_in_world,
-    pose_mm_zyx,
-    to_frame,
 )
+from robomax_py.spec import ControllerSetup
 
 _NOT_IDENT = re.compile(r"[^A-Za-z0-9_]")
 
@@ -68,14 +72,19 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
     if traj is None or result.T_flange_tcp is None or result.T_world_base is None or result.home is None:
         raise ExportError(f"cell {result.cell} has no complete plan to export")
     opts = result.options
-    tool_xyz, tool_zyx = pose_mm_zyx(result.T_flange_tcp)
-    # Cartesian targets are stated in the controller's base frame (SPEC §6), declared as the base.
+    setup = result.controller
+    # Cartesian targets are stated in the program's user frame (SPEC §6): by default the
+    # controller's robot base frame itself; never the robot's placement in the cell.
     C = np.eye(4) if result.T_root_controller is None else result.T_root_controller
-    base_xyz, base_zyx = pose_mm_zyx(frame_in_world(result.T_world_base, C))
-    frames = (
-        FrameDef(identifier(result.tool) + "_tcp", "tool", tool_xyz, tool_zyx),
-        FrameDef("robot_base", "base", base_xyz, base_zyx),
-    )
+    given = program_frames(result.tool, result.T_flange_tcp, result.T_world_base, C, setup)
+    frames = frame_defs(given)
+    tool = frames[0]
+    base_name = frames[1].name if len(frames) > 1 else NULL_FRAME
+
+    def lin(T_root_tcp: FloatArray, config: str, speed_mm_s: float, **kw: Any) -> LinMove:
+        xyz, zyx = given.stated(T_root_tcp)
+        return LinMove(xyz, zyx, config, speed_mm_s, tool=tool.name, base=base_name, **kw)
+
     t0 = float(traj.t[0])
     out: list[Instruction] = []
     joints: list[FloatArray] = []
@@ -89,9 +98,9 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
          PtpMove(tuple(np.degrees(home)), opts.speed, 1.0, comment="home"))
     transitions = result.transitions
     if result.spots and result.spots[0].interlocks:
-        emit(home, *_interlocks(result.spots[0].interlocks))
+        emit(home, *_interlocks(result.spots[0].interlocks, setup))
     if transitions and transitions[0].wait is not None:
-        emit(home, *_wait(transitions[0].wait))
+        emit(home, *_wait(transitions[0].wait, setup))
     lin_mm_s = opts.tcp_speed * opts.speed * 1000.0     # the override scales LIN speeds too
     for k, trans in enumerate(transitions):
         phases = traj.phases_of(trans.kind, trans.label)
@@ -112,7 +121,7 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
             emit(q, PtpMove(tuple(np.degrees(q)), speed, trans.accel, flyby=math.degrees(radius), comment=note.strip(", ")))
             for stage in trans.stages:
                 if stage.index == w:
-                    emit(q, *_wait(stage.wait))
+                    emit(q, *_wait(stage.wait, setup))
         if not approach_follows:
             break
         spot = result.spots[k]
@@ -120,26 +129,33 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
         q_before = joints[-1]
         emit(q_before, Comment(f"{spot.seam}/{spot.name}: arrive {spot.t_arrive - t0:.3f} s, leave "
                                f"{spot.t_leave - t0:.3f} s, alpha {alpha:.1f} beta {beta:.1f} gamma {gamma:.1f} deg"))
-        xyz, zyx = pose_mm_zyx(to_frame(C, spot.T_spot))
         act: Instruction = Spot(identifier(spot.name), identifier(spot.seam), spot.weld_time, spot.gun, spot.schedule) \
             if spot.action is None else Gripper(spot.action, identifier(spot.name), identifier(spot.seam), spot.weld_time)
-        emit(spot.q_spot, LinMove(xyz, zyx, spot.config, _lin_mm_s(trans, lin_mm_s), comment="approach",
-                                  accel=trans.accel), act)
+        emit(spot.q_spot, lin(spot.T_spot, spot.config, _lin_mm_s(trans, lin_mm_s), comment="approach",
+                              accel=trans.accel), act)
         after = transitions[k + 1] if k + 1 < len(transitions) else None
         extended = after is not None and after.retract_T is not None and after.retract_q is not None
-        xyz, zyx = pose_mm_zyx(to_frame(C, after.retract_T if extended else spot.T_app))   # type: ignore[union-attr]
+        T_retract = after.retract_T if extended else spot.T_app                              # type: ignore[union-attr]
         if k + 1 < len(result.spots) and result.spots[k + 1].interlocks:
-            emit(spot.q_spot, *_interlocks(result.spots[k + 1].interlocks))
+            emit(spot.q_spot, *_interlocks(result.spots[k + 1].interlocks, setup))
         if k + 1 < len(transitions) and transitions[k + 1].wait is not None:
-            emit(spot.q_spot, *_wait(transitions[k + 1].wait))
+            emit(spot.q_spot, *_wait(transitions[k + 1].wait, setup))
         retract_radius = transitions[k + 1].flyby_radius if k + 1 < len(transitions) else 0.0
         q_end = after.retract_q if extended else spot.q_app                                  # type: ignore[union-attr]
-        emit(q_end, LinMove(xyz, zyx, spot.config_app, lin_mm_s if after is None else _lin_mm_s(after, lin_mm_s),
-                            flyby=math.degrees(retract_radius), comment="retract",
-                            accel=1.0 if after is None else after.accel))
+        emit(q_end, lin(T_retract, spot.config_app, lin_mm_s if after is None else _lin_mm_s(after, lin_mm_s),
+                        flyby=math.degrees(retract_radius), comment="retract", accel=1.0 if after is None else after.accel))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
                     tuple(identifier(j) for j in result.joint_names), f"robomax_py {__version__}", cell_sha256, stamp)
-    return PlannedProgram(Program(identifier(result.cell), header, frames, tuple(out)), tuple(joints))
+    handed = ProgramSetup(setup.position_registers, setup.numeric_registers, setup.weld)
+    return PlannedProgram(Program(identifier(result.cell), header, frames, tuple(out), handed), tuple(joints), setup)
+
+
+def frame_defs(frames: ProgramFrames) -> tuple[FrameDef, ...]:
+    """The tool and (when the cell names one) user frame of a program, named as identifiers."""
+    out = [dataclasses.replace(frames.tool, name=identifier(frames.tool.name))]
+    if frames.base is not None:
+        out.append(dataclasses.replace(frames.base, name=identifier(frames.base.name)))
+    return tuple(out)
 
 
 def _lin_mm_s(trans: Transition, default: float) -> float:
@@ -147,19 +163,25 @@ def _lin_mm_s(trans: Transition, default: float) -> float:
     return default if trans.tcp_speed is None else trans.tcp_speed * 1000.0
 
 
-def _interlocks(signals: tuple[str, ...]) -> list[Instruction]:
+def _wait_for(signal: str, setup: ControllerSetup) -> WaitFor:
+    """A wait for a cell signal, on the input the cell maps it to (none: named only)."""
+    mapped = setup.input_of(signal)
+    return WaitFor(identifier(signal), None if mapped is None else mapped.number)
+
+
+def _interlocks(signals: tuple[str, ...], setup: ControllerSetup) -> list[Instruction]:
     """Waits for clamp inputs before moving to the first weld near each clamp (at rest)."""
     out: list[Instruction] = []
     for signal in signals:
-        out += [Comment(f"wait for clamp input {signal}"), WaitFor(identifier(signal))]
+        out += [Comment(f"wait for clamp input {signal}"), _wait_for(signal, setup)]
     return out
 
 
-def _wait(w: WaitPlan) -> list[Instruction]:
+def _wait(w: WaitPlan, setup: ControllerSetup) -> list[Instruction]:
     """A wait for a dynamic obstacle: for its clear signal when it is there as the wait begins."""
     note = Comment(f"wait {w.seconds:.3f} s for {w.obstacle} to {'open' if w.door else 'clear'}")
     if w.for_signal:
-        return [note, WaitFor(signal_of(identifier(w.obstacle), w.door))]
+        return [note, _wait_for(signal_of(w.obstacle, w.door), setup)]
     return [note, Wait(w.seconds)]
 
 

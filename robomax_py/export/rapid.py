@@ -1,12 +1,17 @@
-"""ABB RAPID, both directions: one module `<name>.mod`.
+r"""ABB RAPID, both directions: one module `<name>.mod`.
 
 What a program states, in RAPID's terms (RAPID Reference Manual, data types robtarget,
 jointtarget, speeddata, zonedata, tooldata, wobjdata; instructions MoveAbsJ, MoveL, VelSet, AccSet):
 - joint targets as `jointtarget` (deg), Cartesian targets as `robtarget`: [x, y, z] mm, a unit
   quaternion [q1, q2, q3, q4] with q1 = w, confdata [cf1, cf4, cf6, cfx] of the planned
   configuration (SPEC §6), external axes 9E9;
-- `tooldata` (TCP in the flange frame) and `wobjdata` (user frame = the robot base in the cell's
-  world) declared in the module and named by every move;
+- every MoveL names its `tooldata` and, when the targets are in a user frame, its `wobjdata`
+  (`\WObj:=`; without it RAPID uses wobj0). With factory settings the robot base frame is the
+  world (the controller knows nothing of the cell), so a robtarget's TCP pose in the robot base
+  frame is the work object's uframe · oframe · target; the robot's placement in the cell is never
+  written. The frames' values are declared in a data module `<name>_frames.mod` (PERS tooldata,
+  PERS wobjdata with oframe identity) that the integrator loads with the program; a tool or work
+  object the cell names (`robot.controller`) exists on the controller and is not declared again;
 - PTP moves as `MoveAbsJ ... vmax` under `VelSet` (the speed fraction, %) and `AccSet` (which holds
   for the `MoveL`s after it too, as on the controller); LIN moves as
   `MoveL` with a `speeddata` whose v_tcp is the planned TCP speed (mm/s, at `VelSet 100`);
@@ -14,7 +19,8 @@ jointtarget, speeddata, zonedata, tooldata, wobjdata; instructions MoveAbsJ, Mov
   zone sizes in the proportions of ABB's predefined zones), `fine` at every stop and weld;
 - a weld as `MoveL ... fine` followed by `spot_weld n, weld_time;  ! seam/name`, with `PROC
   spot_weld` defined in the module (rest for weld_time; the integrator replaces it);
-- `WaitTime t;` and `WaitDI <signal>, 1;`.
+- `WaitTime t;` and `WaitDI <signal>, 1;`, the signal named as the controller's I/O configuration
+  names it (`robot.controller.inputs`, else the cell's signal name).
 
 The tool's load is not known to robomax: tooldata carries a 1 kg load at the TCP that the
 integrator must replace with the gun's (LoadIdentify). The reader takes the motion subset of any
@@ -33,7 +39,7 @@ from functools import lru_cache
 from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedInput
 
-from robomax_py.errors import ExportError, ProgramError
+from robomax_py.errors import ControllerSetupError, ExportError, ProgramError
 from robomax_py.export.dialect import (
     Parsed,
     PlannedProgram,
@@ -49,8 +55,11 @@ from robomax_py.export.dialect import (
     with_brand_configs,
     with_tcp_blends,
 )
+from robomax_py.export.plan_program import identifier
 from robomax_py.export.quaternions import quaternion_from_zyx, zyx_from_quaternion
 from robomax_py.program import (
+    NULL_FRAME,
+    UNSET_FRAME,
     Comment,
     FrameDef,
     Gripper,
@@ -61,10 +70,14 @@ from robomax_py.program import (
     Spot,
     Wait,
     WaitFor,
+    pose_mm_zyx,
 )
 from robomax_py.robot import RobotModel
 
-__all__ = ["adapt", "parse", "write"]
+__all__ = ["FRAMES_FILE", "adapt", "parse", "write"]
+
+# The data module declaring the program's tooldata and wobjdata (a companion of `<name>.mod`).
+FRAMES_FILE = "_frames.mod"
 
 _NOTE = "RAPID module"
 _EAX = "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]"
@@ -76,9 +89,31 @@ VMAX_TCP_MM_S = 7000.0
 
 
 def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
-    """The program as RAPID states it: ABB confdata and TCP-distance zones."""
+    """The program as RAPID states it: ABB confdata, TCP-distance zones, frames by name (those the
+    cell names exist on the controller and are not declared), inputs by signal name."""
     require_six_axes(robot, "RAPID")
-    program = with_brand_configs(planned.program, planned.joints, robot, "abb")
+    setup = planned.controller
+    existing = set()
+    if setup.tool is not None and setup.tool.existing:
+        existing.add(("tool", identifier(setup.tool.name)))
+    if setup.frame is not None and setup.frame.frame.existing:
+        existing.add(("base", identifier(setup.frame.frame.name)))
+    program = planned.program
+    for f in program.frames:
+        if f.name.lower() in ("tool0", "wobj0"):
+            raise ControllerSetupError("robot.controller." + ("tool" if f.kind == "tool" else "frame") + ".name",
+                                       f"{f.name} is RAPID's predefined null frame; name the calibrated one")
+    out: list[Instruction] = []
+    for ins in program.instructions:
+        if isinstance(ins, WaitFor):
+            mapped = setup.input_of(ins.signal) or next((i for i in setup.inputs if identifier(i.signal) == ins.signal),
+                                                        None)
+            ins = WaitFor(mapped.name if mapped is not None and mapped.name else ins.signal)
+        out.append(ins)
+    # RAPID refers to data by name: the frames carry no slot number.
+    frames = tuple(dataclasses.replace(f, number=0) for f in program.frames if (f.kind, f.name) not in existing)
+    program = dataclasses.replace(program, frames=frames, instructions=tuple(out))
+    program = with_brand_configs(program, planned.joints, robot, "abb")
     return with_tcp_blends(dataclasses.replace(planned, program=program), robot)
 
 
@@ -98,20 +133,35 @@ def _zone(mm: float) -> str:
     return f"[FALSE, {mm:.6f}, {1.5 * mm:.6f}, {1.5 * mm:.6f}, {0.15 * mm:.6f}, {1.5 * mm:.6f}, {0.15 * mm:.6f}]"
 
 
+def _tail(tool: str, base: str) -> str:
+    """A move's tool and work object arguments (the null frames are RAPID's tool0 and wobj0)."""
+    if UNSET_FRAME in (tool, base):
+        raise ExportError("a RAPID move names its tool and work object: the program selects none")
+    return f", {tool or 'tool0'}" + (f" \\WObj:={base}" if base else "") + ";"
+
+
+def _frames_module(program: Program) -> str:
+    """The data module declaring the frames the program uses and does not find on the controller."""
+    lines = ["%%%", "  VERSION:1", "  LANGUAGE:ENGLISH", "%%%", "", f"MODULE {program.name}_frames"]
+    lines += [f"  ! {text}" for text in header_lines(program.header)]
+    lines.append(f"  ! the frames {program.name} uses: load with it, or compare with the calibrated ones "
+                 "(mm, quaternions [w, x, y, z]; work objects in the robot base frame, which is the world)")
+    for f in program.frames:
+        if f.kind == "tool":
+            lines.append(f"  PERS tooldata {f.name} := [TRUE, [{_xyz(f.xyz_mm)}, {_q(f.zyx_deg)}], "
+                         "[1, [0, 0, 0.001], [1, 0, 0, 0], 0, 0, 0]];  ! load: replace with the gun's (LoadIdentify)")
+        else:
+            lines.append(f"  PERS wobjdata {f.name} := [FALSE, TRUE, \"\", [{_xyz(f.xyz_mm)}, {_q(f.zyx_deg)}], "
+                         "[[0, 0, 0], [1, 0, 0, 0]]];")
+    lines.append("ENDMODULE")
+    return "\n".join(lines) + "\n"
+
+
 def write(program: Program, robot: RobotModel) -> dict[str, str]:
-    tool = next((f for f in program.frames if f.kind == "tool"), None)
-    base = next((f for f in program.frames if f.kind == "base"), None)
-    tool_name = tool.name if tool else "tool0"
-    wobj_name = base.name if base else "wobj0"
     decl: list[str] = []
     body: list[str] = []
-    if tool:
-        decl.append(f"  PERS tooldata {tool.name} := [TRUE, [{_xyz(tool.xyz_mm)}, {_q(tool.zyx_deg)}], "
-                    "[1, [0, 0, 0.001], [1, 0, 0, 0], 0, 0, 0]];  ! load: replace with the gun's (LoadIdentify)")
-    if base:
-        decl.append(f"  PERS wobjdata {base.name} := [FALSE, TRUE, \"\", [{_xyz(base.xyz_mm)}, {_q(base.zyx_deg)}], "
-                    "[[0, 0, 0], [1, 0, 0, 0]]];")
-    tail = f", {tool_name} \\WObj:={wobj_name};"
+    first = next((i for i in program.instructions if isinstance(i, LinMove)), None)
+    joint_tail = _tail(first.tool, "") if first is not None else ", tool0;"
     speeds: dict[float, str] = {}
     zones: dict[float, str] = {}
     override = accel = None
@@ -142,7 +192,7 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                 name = f"jt{n_point}"
                 joints = ", ".join(f"{v:.4f}" for v in ins.target_deg)
                 decl.append(f"  CONST jointtarget {name} := [[{joints}], {_EAX}];")
-                body.append(f"    MoveAbsJ {name}, vmax, {zone}{tail}{note}")
+                body.append(f"    MoveAbsJ {name}, vmax, {zone}{joint_tail}{note}")
             else:
                 if ins.speed_mm_s not in speeds:
                     speeds[ins.speed_mm_s] = f"v_lin{len(speeds) + 1}"
@@ -150,7 +200,7 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                 name = f"p{n_point}"
                 decl.append(f"  CONST robtarget {name} := [{_xyz(ins.position_mm)}, {_q(ins.zyx_deg)}, "
                             f"{ins.config.replace(',', ', ')}, {_EAX}];")
-                body.append(f"    MoveL {name}, {speeds[ins.speed_mm_s]}, {zone}{tail}{note}")
+                body.append(f"    MoveL {name}, {speeds[ins.speed_mm_s]}, {zone}{_tail(ins.tool, ins.base)}{note}")
         elif isinstance(ins, Spot):
             n_weld += 1
             body.append(f"    spot_weld {n_weld}, {ins.time_s:.3f};  ! {spot_label(ins)}")
@@ -177,7 +227,7 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                   f"    ! default {action}: rest for {action}_time s; replace with the gripper's SetDO and sensor checks",
                   f"    WaitTime \\InPos, {action}_time;", "  ENDPROC"]
     lines.append("ENDMODULE")
-    return {".mod": "\n".join(lines) + "\n"}
+    return {".mod": "\n".join(lines) + "\n", FRAMES_FILE: _frames_module(program)}
 
 
 # ================================================================================== reading
@@ -306,10 +356,22 @@ class _Reader:
         self.data[str(name).lower()] = (kind_l, value, line)
         if kind_l == "tooldata" and isinstance(value, Tree) and len(value.children) >= 2:
             xyz, zyx = self.pose(value.children[1], line)
-            self.frames = [f for f in self.frames if f.kind != "tool"] + [FrameDef(str(name), "tool", xyz, zyx)]
-        elif kind_l == "wobjdata" and isinstance(value, Tree) and len(value.children) >= 4:
-            xyz, zyx = self.pose(value.children[3], line)
-            self.frames = [f for f in self.frames if f.kind != "base"] + [FrameDef(str(name), "base", xyz, zyx)]
+            self.declare_frame(FrameDef(str(name), "tool", xyz, zyx))
+        elif kind_l == "wobjdata" and isinstance(value, Tree) and len(value.children) >= 5:
+            robhold, ufprog, ufmec = (str(v).strip('"').upper() for v in value.children[:3])
+            if robhold == "TRUE" or ufprog == "FALSE" or ufmec:
+                # Held by the robot or moved by a mechanical unit: not a fixed frame this reader places.
+                self.ignored.append((line, f"wobjdata {name}: a moving work object (robhold, ufprog, ufmec)"))
+                return
+            # The work object's frame in the world (= the robot base): uframe · oframe.
+            uframe = FrameDef("", "base", *self.pose(value.children[3], line)).pose
+            oframe = FrameDef("", "base", *self.pose(value.children[4], line)).pose
+            xyz, zyx = pose_mm_zyx(uframe @ oframe)
+            self.declare_frame(FrameDef(str(name), "base", xyz, zyx))
+
+    def declare_frame(self, frame: FrameDef) -> None:
+        self.frames = [f for f in self.frames if (f.kind, f.name.lower()) != (frame.kind, frame.name.lower())]
+        self.frames.append(frame)
 
     def resolve(self, node: object, kind: str, line: int) -> object:
         if isinstance(node, Token) and node.type == "NAME":
@@ -363,6 +425,15 @@ class _Reader:
             self.add(PtpMove(tuple(joints), self.override / 100.0, self.accel / 100.0, comment=comment,
                              flyby_mm=flyby_mm), line)
             return
+        tool = args[3] if len(args) > 3 else None
+        if not (isinstance(tool, Token) and tool.type == "NAME"):
+            raise self.error(line, "a MoveL names its tooldata after the zone")
+        wobj = next((o.children[1] for o in tree.children[1:] if isinstance(o, Tree) and o.data == "opt"
+                     and str(o.children[0]).lower() == "wobj" and len(o.children) > 1), None)
+        if wobj is not None and not (isinstance(wobj, Token) and wobj.type == "NAME"):
+            raise self.error(line, "\\WObj names a wobjdata")
+        tool_name = NULL_FRAME if str(tool).lower() == "tool0" else self.frame_ref("tool", str(tool))
+        base_name = NULL_FRAME if wobj is None or str(wobj).lower() == "wobj0" else self.frame_ref("base", str(wobj))
         value = self.resolve(target, "robtarget", line)
         if not (isinstance(value, Tree) and len(value.children) >= 3):
             raise self.error(line, "a robtarget needs [[x, y, z], [q1, q2, q3, q4], [confdata], [external axes]]")
@@ -371,7 +442,11 @@ class _Reader:
         config = "[" + ",".join(str(c) for c in conf) + "]"
         v_tcp = VMAX_TCP_MM_S if v is None else v
         self.add(LinMove(xyz, zyx, config, v_tcp * self.override / 100.0, comment=comment, flyby_mm=flyby_mm,
-                         accel=self.accel / 100.0), line)
+                         accel=self.accel / 100.0, tool=tool_name, base=base_name), line)
+
+    def frame_ref(self, kind: str, name: str) -> str:
+        """A frame named by a move, spelt as declared (RAPID names are case-insensitive)."""
+        return next((f.name for f in self.frames if f.kind == kind and f.name.lower() == name.lower()), name)
 
     def statement(self, text: str, comment: str, line: int) -> None:
         if _CLOSES.match(text) and not text.upper().startswith("ELSE"):
@@ -419,6 +494,9 @@ class _Reader:
 def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
     """A RAPID module's motion (the `main` procedure, else the first one)."""
     reader = _Reader(file)
+    for line, stmt, comment in _statements(texts.get(FRAMES_FILE, "")):
+        if _MOTION_DATA.match(stmt):
+            reader.statement(stmt, comment, line)
     module = ""
     header_comments: list[str] = []
     procs: dict[str, list[tuple[int, str, str]]] = {}

@@ -23,6 +23,8 @@ from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
 from robomax_py.plan.waiting import clear_wait, signal_of
 from robomax_py.program import (
+    NULL_FRAME,
+    UNSET_FRAME,
     Comment,
     FrameDef,
     Gripper,
@@ -32,13 +34,11 @@ from robomax_py.program import (
     Spot,
     Wait,
     WaitFor,
-    frame_in_world,
     from_frame,
     lin_pose,
-    pose_mm_zyx,
     ptp_target,
 )
-from robomax_py.robot import RobotModel
+from robomax_py.robot import RobotModel, mount_tool
 from robomax_py.robot.ik import same_config
 from robomax_py.robot.solve import brand_text_of, config_texts_near
 from robomax_py.spec import CellSpec
@@ -100,12 +100,18 @@ class Rebuilt:
 
 
 def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | str,
-            lines: tuple[int, ...] | None = None, brand: str | None = None) -> Rebuilt:
+            lines: tuple[int, ...] | None = None, brand: str | None = None,
+            stored: tuple[FrameDef, ...] = ()) -> Rebuilt:
     """Rebuild the motion; ProgramError when the program is not for this cell's robot.
 
     lines : the program line of each instruction (as the parser read them), for messages.
     brand : whose configuration data the program's Cartesian targets carry (SPEC §6);
         None: the robot's controller brand.
+    stored : the frames the controller holds without the program stating them (the cell's tool
+        and user frame, calibrated on the controller under the dialect's names). A LIN's target
+        is composed as the controller composes it: the controller's base, the user frame in force,
+        the target; the arm follows it with the tool in force (the program's, which the cell's
+        gun then carries wherever that puts it).
     A program that does not name its robot (a header with robot "" and no joints, as
     programs written by others) is taken to be for the cell's robot, joints in URDF order.
     """
@@ -114,8 +120,7 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
         raise ProgramError(file, "ROBOT", f"program is for robot {header.robot!r}, the cell uses {robot.name!r}")
     if header.joints and tuple(header.joints) != tuple(robot.joint_names):
         raise ProgramError(file, "AXES", f"expected {list(robot.joint_names)}, got {list(header.joints)}")
-    builder = _Builder(cell, robot, brand or robot.controller.brand)
-    builder.problems.extend(_frame_problems(program.frames, cell, robot))
+    builder = _Builder(cell, robot, brand or robot.controller.brand, {**_by_name(stored), **_by_name(program.frames)})
     numbered = [(ins, None if lines is None else lines[i]) for i, ins in enumerate(program.instructions)]
     moves = [(ins, line) for ins, line in numbered if not isinstance(ins, Comment)]
     if not moves or not isinstance(moves[0][0], PtpMove):
@@ -149,9 +154,17 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
     return Rebuilt(traj, builder.spots, builder.problems, builder.spans)
 
 
+def _by_name(frames: tuple[FrameDef, ...]) -> dict[tuple[str, str], FrameDef]:
+    return {(f.kind, f.name): f for f in frames}
+
+
 class _Builder:
-    def __init__(self, cell: CellSpec, robot: RobotModel, brand: str) -> None:
+    def __init__(self, cell: CellSpec, robot: RobotModel, brand: str,
+                 frames: dict[tuple[str, str], FrameDef]) -> None:
         self.cell, self.robot, self.brand = cell, robot, brand
+        self.frames = frames
+        self.reported: set[tuple[str, str]] = set()        # frames whose difference is reported
+        self.tools: list[FloatArray | None] = []           # of the pending steps: the tool of each LIN
         self.segments: list[Segment] = []
         self.spots: list[dict[str, Any]] = []
         self.problems: list[Problem] = []
@@ -171,7 +184,17 @@ class _Builder:
 
     def add(self, ins: Any, following: Any, index: int) -> bool:
         if isinstance(ins, (PtpMove, LinMove)):
-            self.pending.append(self._step(ins, following, index))
+            tool = None
+            if isinstance(ins, LinMove):
+                resolved = self._frames_of(ins)
+                if resolved is None:
+                    return False
+                tool, base = resolved
+                step: Step = self._lin_step(ins, base, following, index)
+            else:
+                step = self._step(ins, following, index)
+            self.pending.append(step)
+            self.tools.append(tool)
             self.step_lines.append(self.line)
             if isinstance(ins, LinMove):
                 self.configs.append((len(self.pending) - 1, ins.config))
@@ -197,26 +220,64 @@ class _Builder:
         elif isinstance(ins, Wait):
             self._hold(ins.seconds, "WAIT")
         elif isinstance(ins, WaitFor):
-            self._wait_for(ins.signal)
+            self._wait_for(ins)
         return True
 
-    def _step(self, ins: PtpMove | LinMove, following: Any, index: int) -> Step:
-        label = ins.comment or f"statement {index + 1}"
-        if isinstance(ins, PtpMove):
-            return PtpStep(ptp_target(ins), speed=ins.speed, accel=ins.accel,
-                           flyby=math.radians(ins.flyby), kind="move", label=label, flyby_tcp=ins.flyby_mm / 1000.0)
-        T = from_frame(self.robot.controller.T_root_base, lin_pose(ins))   # stated in the controller's base
+    def _step(self, ins: PtpMove, following: Any, index: int) -> Step:
+        return PtpStep(ptp_target(ins), speed=ins.speed, accel=ins.accel, flyby=math.radians(ins.flyby),
+                       kind="move", label=ins.comment or f"statement {index + 1}", flyby_tcp=ins.flyby_mm / 1000.0)
+
+    def _lin_step(self, ins: LinMove, T_ctrl_frame: FloatArray, following: Any, index: int) -> Step:
+        # The controller's composition: its robot base (in the URDF root), the user frame, the target.
+        T = from_frame(self.robot.controller.T_root_base, T_ctrl_frame @ lin_pose(ins))
         kind = "approach" if isinstance(following, (Spot, Gripper)) else "retract"
-        return LinStep(T, ins.speed_mm_s / 1000.0, None, flyby=math.radians(ins.flyby), kind=kind, label=label,
-                       flyby_tcp=ins.flyby_mm / 1000.0, accel=ins.accel)
+        return LinStep(T, ins.speed_mm_s / 1000.0, None, flyby=math.radians(ins.flyby), kind=kind,
+                       label=ins.comment or f"statement {index + 1}", flyby_tcp=ins.flyby_mm / 1000.0, accel=ins.accel)
+
+    def _frames_of(self, ins: LinMove) -> tuple[FloatArray, FloatArray] | None:
+        """The tool (flange -> TCP) and the user frame (in the controller's robot base) a LIN is
+        executed with; None when the program leaves one unknown (reported)."""
+        out = []
+        for kind, name in (("tool", ins.tool), ("base", ins.base)):
+            what = "tool" if kind == "tool" else "user frame (base)"
+            if name == NULL_FRAME:
+                out.append(np.eye(4))
+                continue
+            if name == UNSET_FRAME:
+                self.problems.append(Problem(self.t, "frame", f"the program selects no {what} before this move: the "
+                                                              f"controller would use whichever was left active", self.line))
+                return None
+            frame = self.frames.get((kind, name))
+            if frame is None:
+                known = ", ".join(sorted(n for k, n in self.frames if k == kind)) or "none"
+                self.problems.append(Problem(self.t, "frame", f"the move uses {what} {name}, whose value neither the "
+                                                              f"program nor the cell gives (known: {known})", self.line))
+                return None
+            out.append(frame.pose)
+        tool, base = out
+        self._check_tool(ins.tool, tool)
+        return tool, base
+
+    def _check_tool(self, name: str, T_flange_tcp: FloatArray) -> None:
+        """A tool unlike the cell's gun is reported once: the arm follows the program's tool, and
+        the gun's real TCP lands elsewhere."""
+        if ("tool", name) in self.reported:
+            return
+        self.reported.add(("tool", name))
+        d_mm, d_deg = _frame_difference(T_flange_tcp, np.asarray(self.robot.T_flange_tcp))
+        if d_mm > FRAME_TOL_MM or d_deg > FRAME_TOL_DEG:
+            self.problems.append(Problem(self.t, "frame", f"tool {name or 'flange (null frame)'} is not the cell's tool "
+                                                          f"({d_mm:.3f} mm, {d_deg:.4f} deg off): the arm follows the "
+                                                          "program's tool", self.line))
 
     def flush(self) -> bool:
         """Build and time the pending chain; False when it cannot be built (reported)."""
-        steps, configs, lines = self.pending, self.configs, self.step_lines
-        self.pending, self.configs, self.step_lines = [], [], []
+        steps, configs, lines, tools = self.pending, self.configs, self.step_lines, self.tools
+        self.pending, self.configs, self.step_lines, self.tools = [], [], [], []
+        robot = self._chain_robot([t for t in tools if t is not None], lines)
         try:
-            path = chain_path(self.robot, self.q, steps)
-            segments = time_chain(path, steps, self.robot.limits)
+            path = chain_path(robot, self.q, steps)
+            segments = time_chain(path, steps, robot.limits)
         except LinMoveError as exc:
             self.problems.append(Problem(self.t, "lin", f"a LIN move cannot be followed: {exc}", lines[-1]))
             return False
@@ -241,6 +302,16 @@ class _Builder:
         self.t = t_end
         self.q = np.asarray(segments[-1].q[-1], dtype=float)
         return True
+
+    def _chain_robot(self, tools: list[FloatArray], lines: list[int | None]) -> RobotModel:
+        """The arm with the tool the chain's lines are stated with mounted (the controller follows
+        its own TCP); the cell's when they state the cell's exactly."""
+        if not tools or np.array_equal(tools[0], self.robot.T_flange_tcp):
+            return self.robot
+        if any(not np.array_equal(t, tools[0]) for t in tools[1:]):
+            self.problems.append(Problem(self.t, "frame", "the tool changes between blended moves: the chain is "
+                                                          "followed with the first line's tool", lines[-1]))
+        return mount_tool(self.robot, tools[0])
 
     def config_text(self, q: FloatArray) -> str:
         """The configuration data, in the program's brand, of joint values q."""
@@ -281,9 +352,21 @@ class _Builder:
                                                                   f"waiting for its input {obj.signal}", self.line))
                 self.waited.add(identifier(str(obj.signal)))
 
-    def _wait_for(self, signal: str) -> None:
+    def _wait_for(self, ins: WaitFor) -> None:
+        """A wait on an input number means the cell signal mapped to that number (the controller
+        knows numbers, not names); a wait by name, the cell signal of that name."""
         from robomax_py.export.plan_program import identifier
 
+        signal = ins.signal
+        if ins.number is not None:
+            mapped = next((i for i in self.cell.controller.inputs if i.number == ins.number), None)
+            if mapped is None:
+                known = ", ".join(f"{i.number} ({i.signal})" for i in self.cell.controller.inputs) or "none mapped"
+                self.problems.append(Problem(self.t, "signal", f"the program waits for input {ins.number}, which the "
+                                                               f"cell maps to no signal (robot.controller.inputs: {known})",
+                                             self.line))
+                return
+            signal = identifier(mapped.signal)
         if any(obj.signal and identifier(obj.signal) == signal for obj in self.cell.objects):
             self.waited.add(signal)           # a clamp input: set once the clamp is closed, no time planned
             return
@@ -297,19 +380,8 @@ class _Builder:
         self._hold(clear_wait(self.t, obstacle.present or ()), f"WAIT FOR {signal}")
 
 
-def _frame_problems(frames: tuple[FrameDef, ...], cell: CellSpec, robot: RobotModel) -> list[Problem]:
-    out = []
-    wanted = {"tool": np.asarray(robot.T_flange_tcp),
-              "base": frame_in_world(np.asarray(cell.T_world_base), robot.controller.T_root_base)}
-    for kind, T in wanted.items():
-        stated = [f for f in frames if f.kind == kind]
-        if not stated:
-            continue                       # not stated: the cell's frame is meant
-        xyz, zyx = pose_mm_zyx(T)
-        f = stated[0]
-        d_mm = max(abs(a - b) for a, b in zip(f.xyz_mm, xyz))
-        d_deg = max(abs((a - b + 180.0) % 360.0 - 180.0) for a, b in zip(f.zyx_deg, zyx))
-        if d_mm > FRAME_TOL_MM or d_deg > FRAME_TOL_DEG:
-            out.append(Problem(None, "frame", f"{kind} frame {f.name} differs from the cell's ({d_mm:.3f} mm, "
-                                              f"{d_deg:.4f} deg); the motion is rebuilt with the cell's"))
-    return out
+def _frame_difference(A: FloatArray, B: FloatArray) -> tuple[float, float]:
+    """Distance between two frames' origins (mm) and the angle of the rotation between them (deg)."""
+    d_mm = 1000.0 * float(np.linalg.norm(A[:3, 3] - B[:3, 3]))
+    cos = (float(np.trace(A[:3, :3].T @ B[:3, :3])) - 1.0) / 2.0
+    return d_mm, math.degrees(math.acos(max(-1.0, min(1.0, cos))))

@@ -33,8 +33,10 @@ from robomax_py.program import (
     ANGLE_DECIMALS,
     JOINT_DECIMALS,
     MM_DECIMALS,
+    NULL_FRAME,
     SPEED_DECIMALS,
     TIME_DECIMALS,
+    UNSET_FRAME,
     Comment,
     FrameDef,
     Gripper,
@@ -58,7 +60,7 @@ DIALECT = "robomax SRCL/1"
 # Upper-case keywords; they cannot be used as names (names are case-sensitive, so `spot` is a name).
 RESERVED: frozenset[str] = frozenset(
     "PROGRAM CELL ROBOT AXES TOOL CYCLE SEC VAR FRAME BASE POS ORI BEGIN ENDPROGRAM "
-    "MOVE PTP LIN AXIS SPEED ACCEL FLYBY CONFIG SPOT SEAM TIME WAIT FOR GUN SCHEDULE GRIP RELEASE".split()
+    "MOVE PTP LIN AXIS SPEED ACCEL FLYBY CONFIG SPOT SEAM TIME WAIT FOR GUN SCHEDULE GRIP RELEASE INPUT".split()
 )
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -133,7 +135,8 @@ def _pose(xyz_mm: tuple[float, ...], zyx_deg: tuple[float, ...]) -> str:
 def _frame(f: FrameDef) -> str:
     pos = f"POS({_nums(f.xyz_mm, MM_DECIMALS)})"
     ori = f"ORI({_nums(f.zyx_deg, ANGLE_DECIMALS)})"
-    return f"{f.name}: {f.kind.upper()} FRAME := ({pos}, {ori});"
+    number = f" {f.number}" if f.number else ""
+    return f"{f.name}: {f.kind.upper()} FRAME{number} := ({pos}, {ori});"
 
 
 def _tail(flyby: float, comment: str) -> str:
@@ -162,7 +165,7 @@ def _statement(ins: Instruction) -> str:
     if isinstance(ins, Wait):
         return f"WAIT {_num(ins.seconds, TIME_DECIMALS)} SEC;"
     if isinstance(ins, WaitFor):
-        return f"WAIT FOR {ins.signal};"
+        return f"WAIT FOR {ins.signal}" + ("" if ins.number is None else f" INPUT {ins.number}") + ";"
     if isinstance(ins, Comment):
         return f"{{ {ins.text} }}" if ins.text else "{ }"
     raise ExportError(f"SRCL cannot write instruction {ins!r}")
@@ -211,6 +214,9 @@ def _check_program(program: Program) -> None:
         problem = find_problem(f, len(h.joints))
         if problem:
             raise ExportError(f"{where}: {problem}")
+        if f.number < 0:
+            raise ExportError(f"{where}: frame number {f.number} is negative")
+    tool, base = lin_frames(program.frames)
     for i, ins in enumerate(program.instructions):
         where = f"instruction {i} ({_kind(ins)})"
         if isinstance(ins, (PtpMove, LinMove)):
@@ -222,6 +228,8 @@ def _check_program(program: Program) -> None:
             _check_name(where + " seam name", ins.seam)
         elif isinstance(ins, WaitFor):
             _check_name(where + " signal", ins.signal)
+            if ins.number is not None and ins.number < 0:
+                raise ExportError(f"{where}: input number {ins.number} is negative")
         elif isinstance(ins, Comment):
             _check_text(where, ins.text, "{}")
         elif not isinstance(ins, (PtpMove, Wait)):
@@ -231,6 +239,22 @@ def _check_program(program: Program) -> None:
         problem = find_problem(ins, len(h.joints))
         if problem:
             raise ExportError(f"{where}: {problem}")
+        if isinstance(ins, LinMove) and (ins.tool, ins.base) != (tool, base):
+            raise ExportError(f"{where}: SRCL states every LIN in its one TOOL and BASE frame ({tool or 'none'}, "
+                              f"{base or 'the robot base'}); this one names {ins.tool or 'none'}, "
+                              f"{ins.base or 'the robot base'}")
+
+
+def lin_frames(frames: tuple[FrameDef, ...]) -> tuple[str, str]:
+    """The tool and base every SRCL LIN is stated in: the program's one TOOL FRAME (none declared:
+    `UNSET_FRAME`, the program selects no tool) and its one BASE FRAME (none: the robot base frame)."""
+    out = []
+    for kind, absent in (("tool", UNSET_FRAME), ("base", NULL_FRAME)):
+        named = [f.name for f in frames if f.kind == kind]
+        if len(named) > 1:
+            raise ExportError(f"SRCL declares at most one {kind.upper()} FRAME, got {len(named)}: {', '.join(named)}")
+        out.append(named[0] if named else absent)
+    return out[0], out[1]
 
 
 # ================================================================================== reading
@@ -244,7 +268,7 @@ header: "CELL" IDENT ";" COMMENT* \
         "CYCLE" NUMBER "SEC" ";" COMMENT*
 
 frames: ("VAR" COMMENT* frame*)?
-frame: IDENT ":" kind "FRAME" ":=" "(" pos "," ori ")" ";" COMMENT*
+frame: IDENT ":" kind "FRAME" NUMBER? ":=" "(" pos "," ori ")" ";" COMMENT*
 kind: "TOOL" -> tool_kind
     | "BASE" -> base_kind
 pos: "POS" "(" NUMBER "," NUMBER "," NUMBER ")"
@@ -257,7 +281,7 @@ flyby: FLYBY NUMBER
 spot: "SPOT" IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ("GUN" NUMBER "SCHEDULE" NUMBER)? ";"
 gripper: (GRIP | RELEASE) IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ";"
 wait: "WAIT" NUMBER "SEC" ";"
-wait_for: "WAIT" "FOR" IDENT ";"
+wait_for: "WAIT" "FOR" IDENT ("INPUT" NUMBER)? ";"
 note: COMMENT
 
 FLYBY: "FLYBY"
@@ -440,9 +464,9 @@ class _Builder:
             )
         return float(token)
 
-    def whole(self, token: Token) -> int:
-        if not re.fullmatch(r"[0-9]+", str(token)) or int(str(token)) < 1:
-            raise self.error(token.line, token.column, f"expected a whole number from 1, got '{token}'")
+    def whole(self, token: Token, low: int = 1) -> int:
+        if not re.fullmatch(r"[0-9]+", str(token)) or int(str(token)) < low:
+            raise self.error(token.line, token.column, f"expected a whole number from {low}, got '{token}'")
         return int(str(token))
 
     def tokens(self, tree: Tree[Token], kind: str) -> list[Token]:
@@ -473,10 +497,16 @@ class _Builder:
                 header = dataclasses.replace(header, stamp=match["stamp"])
         n_joints = len(header.joints)
         frames = self.frames(self.subtree(tree, "frames"), n_joints)
+        try:
+            tool, base = lin_frames(tuple(frames))
+        except ExportError as exc:
+            raise self.error(tree.meta.line, tree.meta.column, str(exc)) from None
         instructions: list[Instruction] = []
         for child in tree.children:
             if isinstance(child, Tree) and child.data not in ("header", "frames"):
                 ins = self.statement(child)
+                if isinstance(ins, LinMove):
+                    ins = dataclasses.replace(ins, tool=tool, base=base)
                 self.check(child, ins, n_joints)
                 instructions.append(ins)
                 self.lines.append(child.meta.line)
@@ -504,8 +534,10 @@ class _Builder:
             if any(f.name == str(name) for f in frames):
                 raise self.error(name.line, name.column, f"frame {str(name)!r} is already defined")
             kind = "tool" if any(isinstance(c, Tree) and c.data == "tool_kind" for c in node.children) else "base"
+            number = [t for t in node.children if isinstance(t, Token) and t.type == "NUMBER"]
             frame = FrameDef(
-                str(name), kind, self.triple(self.subtree(node, "pos")), self.triple(self.subtree(node, "ori"))
+                str(name), kind, self.triple(self.subtree(node, "pos")), self.triple(self.subtree(node, "ori")),
+                self.whole(number[0], 0) if number else 0,
             )
             self.check(node, frame, n_joints)
             frames.append(frame)
@@ -544,7 +576,8 @@ class _Builder:
             return Wait(self.number(seconds))
         if tree.data == "wait_for":
             (signal,) = self.tokens(tree, "IDENT")
-            return WaitFor(str(signal))
+            number = self.tokens(tree, "NUMBER")
+            return WaitFor(str(signal), self.whole(number[0], 0) if number else None)
         return Comment(self.note(tree))
 
 

@@ -8,15 +8,20 @@ Language", movej / movel / set_tcp / sleep / get_standard_digital_in):
   (rad) in the UR controller's base frame, `v` the TCP speed in m/s, `a` the line's acceleration
   fraction times 1.2 m/s^2, UR's default (at 1.2 the line is timed under the full joint limits; a
   line carrying a part states less, and a reader takes a/1.2 as the fraction, at most 1);
-- `set_tcp` (the TCP in the flange frame) before the first motion; the base is the controller's;
+- the frames as global pose variables, as PolyScope writes them: the TCP `global <tool> = p[...]`
+  (in the flange frame) set with `set_tcp(<tool>)` before the first motion; targets relative to
+  the robot base as the UR controller defines it (ROS-Industrial's `base` link: robot.yaml
+  `controller.base`), the robot's placement in the cell never written; in a user frame (a feature)
+  `movel(pose_trans(<frame>, p[...]), ...)` with `global <frame> = p[...]` its pose in the base;
 - blends as `r`, the TCP distance (m) of the planned radius; 0 at every stop and weld;
 - no configuration data: the controller keeps the branch the arm is in, as robomax's LIN moves do;
 - a weld as `movel(..., r=0)` followed by `spot_weld(n, weld_time)  # seam/name`, `spot_weld`
   defined in the program (sleep weld_time; the integrator replaces it);
-- `sleep(t)`, and `wait_for_signal(k)  # <signal>` waiting for standard digital input k.
+- `sleep(t)`, and `wait_for_signal(k)  # <signal>` waiting for standard digital input k (0..7), the
+  input the cell maps the signal to (`robot.controller.inputs`).
 
-The reader takes movej with a joint vector, movel with a pose, set_tcp, sleep and the calls
-above from any script; other motions (movep, movec, servoj, movej to a pose ...) are reported as
+The reader takes movej with a joint vector, movel with a pose or a pose_trans of a pose variable
+and a pose, pose variables, set_tcp, sleep and the calls above from any script; other motions (movep, movec, servoj, movej to a pose ...) are reported as
 not simulated, everything else as ignored.
 """
 
@@ -27,7 +32,7 @@ import math
 import re
 from functools import lru_cache
 
-from lark import Lark, Tree
+from lark import Lark, Token, Tree
 from lark.exceptions import UnexpectedInput
 
 from robomax_py.errors import ExportError, ProgramError
@@ -37,6 +42,7 @@ from robomax_py.export.dialect import (
     gripper_label,
     header_lines,
     is_header_comment,
+    numbered_inputs,
     read_gripper,
     read_header,
     read_spot_label,
@@ -48,6 +54,8 @@ from robomax_py.export.dialect import (
 )
 from robomax_py.export.quaternions import rotvec_from_zyx, zyx_from_rotvec
 from robomax_py.program import (
+    NULL_FRAME,
+    UNSET_FRAME,
     Comment,
     FrameDef,
     Gripper,
@@ -72,12 +80,19 @@ def reference_limits(robot: RobotModel) -> tuple[float, float]:
     return float(min(robot.limits.velocity)), float(min(robot.limits.acceleration))
 
 
+# The controller's standard digital inputs, get_standard_digital_in(0..7).
+INPUTS = 7
+
+
 def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
-    """The program as URScript states it: no configuration data, TCP-distance blends, no base frame."""
+    """The program as URScript states it: no configuration data, TCP-distance blends, frames as
+    pose variables, waits on standard digital inputs."""
     require_six_axes(robot, "URScript")
+    numbered_inputs(planned.program, "URScript", 0, INPUTS)
     program = with_brand_configs(planned.program, planned.joints, robot, "ur")
-    program = with_tcp_blends(dataclasses.replace(planned, program=program), robot)
-    return dataclasses.replace(program, frames=tuple(f for f in program.frames if f.kind == "tool"))
+    # URScript refers to poses by variable name: the frames carry no slot number.
+    program = dataclasses.replace(program, frames=tuple(dataclasses.replace(f, number=0) for f in program.frames))
+    return with_tcp_blends(dataclasses.replace(planned, program=program), robot)
 
 
 # ================================================================================== writing
@@ -89,13 +104,24 @@ def _pose(xyz_mm: tuple[float, ...], zyx: tuple[float, ...]) -> str:
     return f"p[{x:.6f}, {y:.6f}, {z:.6f}, {rx:.9f}, {ry:.9f}, {rz:.9f}]"
 
 
+def _tcp(name: str) -> str:
+    if name == UNSET_FRAME:
+        raise ExportError("a URScript program sets its TCP before a movel: the program selects none")
+    return name or "p[0, 0, 0, 0, 0, 0]"
+
+
 def write(program: Program, robot: RobotModel) -> dict[str, str]:
     v_ref, a_ref = reference_limits(robot)
     out = [f"def {program.name}():"]
     out += [f"  # {text}" for text in header_lines(program.header)]
     out.append(f"  # {_NOTE}: m, rad, rotation vectors; movej v rad/s, a rad/s^2; movel v m/s; blend r m")
-    for f in program.frames:
-        out.append(f"  set_tcp({_pose(f.xyz_mm, f.zyx_deg)})  # tool frame {f.name}")
+    what = {"tool": "TCP in the flange frame", "base": "user frame in the robot base frame"}
+    out += [f"  global {f.name} = {_pose(f.xyz_mm, f.zyx_deg)}  # {what[f.kind]}" for f in program.frames]
+    first = next((i for i in program.instructions if isinstance(i, LinMove)), None)
+    tool = UNSET_FRAME
+    if first is not None:
+        tool = first.tool
+        out.append(f"  set_tcp({_tcp(tool)})")
     out += ["  def spot_weld(n, weld_time):",
             "    # default weld: rest for weld_time s; replace with the gun's technology package",
             "    sleep(weld_time)", "  end",
@@ -104,7 +130,6 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
         out += [f"  def {action}(n, {action}_time):",
                 f"    # default {action}: rest for {action}_time s; replace with the gripper's outputs and sensors",
                 f"    sleep({action}_time)", "  end"]
-    signals: dict[str, int] = {}
     grips: dict[str, int] = {}
     n_weld = 0
     for ins in program.instructions:
@@ -118,9 +143,15 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                 q = ", ".join(f"{math.radians(v):.9f}" for v in ins.target_deg)
                 out.append(f"  movej([{q}], a={ins.accel * a_ref:.6f}, v={ins.speed * v_ref:.6f}, r={r:.9f}){note}")
             else:
+                if ins.tool != tool:
+                    tool = ins.tool
+                    out.append(f"  set_tcp({_tcp(tool)})")
+                if ins.base == UNSET_FRAME:
+                    raise ExportError("a URScript movel is relative to the base or a pose: the program selects none")
                 a = f"{LIN_ACCEL_M_S2:.1f}" if ins.accel >= 1.0 else f"{ins.accel * LIN_ACCEL_M_S2:.6f}"
-                out.append(f"  movel({_pose(ins.position_mm, ins.zyx_deg)}, a={a}, "
-                           f"v={ins.speed_mm_s / 1000:.6f}, r={r:.9f}){note}")
+                target = _pose(ins.position_mm, ins.zyx_deg)
+                target = f"pose_trans({ins.base}, {target})" if ins.base else target
+                out.append(f"  movel({target}, a={a}, v={ins.speed_mm_s / 1000:.6f}, r={r:.9f}){note}")
         elif isinstance(ins, Spot):
             n_weld += 1
             out.append(f"  spot_weld({n_weld}, {ins.time_s:.3f})  # {spot_label(ins)}")
@@ -130,8 +161,7 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
         elif isinstance(ins, Wait):
             out.append(f"  sleep({ins.seconds:.3f})")
         elif isinstance(ins, WaitFor):
-            k = signals.setdefault(ins.signal, len(signals))
-            out.append(f"  wait_for_signal({k})  # {ins.signal}")
+            out.append(f"  wait_for_signal({ins.number})  # {ins.signal}")
         else:
             raise ExportError(f"URScript cannot write {type(ins).__name__}")
     out.append("end")
@@ -143,8 +173,9 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
 _GRAMMAR = r"""
 start: NAME "(" [arg ("," arg)*] ")"
 ?arg: value | NAME "=" value -> keyword
-?value: NUMBER | NAME | list | pose
+?value: NUMBER | NAME | list | pose | call
 list: "[" [value ("," value)*] "]"
+call: NAME "(" [value ("," value)*] ")"
 pose: _POSE_OPEN value ("," value)* "]"
 _POSE_OPEN.2: /p\[/
 NAME: /[A-Za-z_][A-Za-z0-9_]*/
@@ -187,10 +218,26 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
     where: list[int] = []
     ignored: list[tuple[int, str]] = []
     header_comments: list[str] = []
-    frames: list[FrameDef] = []
+    frames: list[FrameDef] = []               # pose variables the program sets: tools and frames alike
+    poses: dict[str, tuple[tuple[float, ...], tuple[float, ...]]] = {}
+    tool = UNSET_FRAME                        # the TCP in force: the installation's until set_tcp
 
     def error(line: int, problem: str) -> ProgramError:
         return ProgramError(file, f"line {line}", problem)
+
+    def pose_of(node: object, line: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        values = _numbers(node, file, line)
+        if len(values) != 6:
+            raise error(line, f"a pose has 6 values, got {len(values)}")
+        return tuple(v * 1000.0 for v in values[:3]), zyx_from_rotvec(tuple(values[3:]))
+
+    def use(kind: str, name: str, line: int) -> str:
+        """A pose variable used as a tool or a frame: declared once per kind it serves."""
+        if name not in poses:
+            raise error(line, f"{name} is not a pose this program sets")
+        if not any(f.kind == kind and f.name == name for f in frames):
+            frames.append(FrameDef(name, kind, *poses[name]))      # type: ignore[arg-type]
+        return name
 
     def add(ins: Instruction, line: int) -> None:
         instructions.append(ins)
@@ -229,6 +276,16 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
                 else:
                     add(Comment(comment), number)
             continue
+        assign = re.match(r"^(?:global\s+)?([A-Za-z_][A-Za-z0-9_]*)\s*=\s*(p\[.*\])$", stmt)
+        if assign:
+            try:
+                pose = _parser().parse(f"f({assign.group(2)})").children[1]
+            except UnexpectedInput:
+                raise error(number, f"cannot read {stmt!r}") from None
+            if any(f.name == assign.group(1) for f in frames):
+                raise error(number, f"{assign.group(1)} is set again after a move used it: not simulated here")
+            poses[assign.group(1)] = pose_of(pose, number)
+            continue
         call = re.match(r"^([A-Za-z_][A-Za-z0-9_]*)\s*\(", stmt)
         func = call.group(1) if call else ""
         if func in _UNSIMULATED:
@@ -262,18 +319,23 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             add(PtpMove(tuple(math.degrees(v) for v in q), kw("v", 1.05) / v_ref, kw("a", 1.4) / a_ref,
                         comment=comment, flyby_mm=kw("r", 0.0) * 1000.0), number)
         elif func == "movel":
+            base = NULL_FRAME
+            if isinstance(target, Tree) and target.data == "call" and str(target.children[0]) == "pose_trans" \
+                    and len(target.children) == 3 and isinstance(target.children[1], Token):
+                base = use("base", str(target.children[1]), number)
+                target = target.children[2]
             if not (isinstance(target, Tree) and target.data == "pose"):
-                raise error(number, "movel needs a pose p[x, y, z, rx, ry, rz]")
-            values = _numbers(target, file, number)
-            if len(values) != 6:
-                raise error(number, f"a pose has 6 values, got {len(values)}")
-            add(LinMove(tuple(v * 1000.0 for v in values[:3]), zyx_from_rotvec(tuple(values[3:])), "",
-                        kw("v", 0.25) * 1000.0, comment=comment, flyby_mm=kw("r", 0.0) * 1000.0,
-                        accel=max(min(kw("a", LIN_ACCEL_M_S2) / LIN_ACCEL_M_S2, 1.0), 0.001)), number)
+                raise error(number, "movel needs a pose p[x, y, z, rx, ry, rz] or pose_trans(<pose variable>, p[...])")
+            xyz, zyx = pose_of(target, number)
+            add(LinMove(xyz, zyx, "", kw("v", 0.25) * 1000.0, comment=comment, flyby_mm=kw("r", 0.0) * 1000.0,
+                        accel=max(min(kw("a", LIN_ACCEL_M_S2) / LIN_ACCEL_M_S2, 1.0), 0.001), tool=tool, base=base),
+                number)
         elif func == "set_tcp":
-            values = _numbers(target, file, number)
-            frame_name = comment.split()[-1] if comment.startswith("tool frame ") else "tcp"
-            frames = [FrameDef(frame_name, "tool", tuple(v * 1000.0 for v in values[:3]), zyx_from_rotvec(tuple(values[3:])))]
+            if isinstance(target, Token) and target.type == "NAME":
+                tool = use("tool", str(target), number)
+            else:
+                tool = f"set_tcp of line {number}"
+                frames.append(FrameDef(tool, "tool", *pose_of(target, number)))
         elif func == "sleep":
             add(Wait(_numbers(target, file, number)[0]), number)
         elif func == "spot_weld":
@@ -284,7 +346,7 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             add(read_gripper(func, comment, int(n), seconds, file, number), number)
         elif func == "wait_for_signal":
             k = int(_numbers(target, file, number)[0])
-            add(WaitFor(comment or f"digital_in_{k}"), number)
+            add(WaitFor(comment or f"digital_in_{k}", k), number)
     if not name:
         raise ProgramError(file, None, "no 'def NAME():' line: not a URScript program")
     header = read_header(header_comments)

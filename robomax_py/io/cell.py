@@ -6,8 +6,10 @@ file, the key path (e.g. `seams[0].spots[3].normal`) and the problem; nothing he
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import math
+import re
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -36,6 +38,9 @@ from robomax_py.spec import (
     Box,
     Capsule,
     CellSpec,
+    ControllerFrame,
+    ControllerInput,
+    ControllerSetup,
     Cylinder,
     MachineSpec,
     MeshShape,
@@ -49,6 +54,7 @@ from robomax_py.spec import (
     Sphere,
     SpotSpec,
     TcpLimits,
+    UserFrame,
     frozen_array,
 )
 from robomax_py.transforms import invert, pose_matrix
@@ -112,10 +118,60 @@ class PoseFile(_Strict):
     rpy: Vec3 = [0.0, 0.0, 0.0]      # deg
 
 
+# Names a controller holds (RAPID data and signals, UR variables): identifiers of at most 32
+# characters starting with a letter, the RAPID rule (RAPID reference, "Identifiers").
+ControllerName = Annotated[str, Field(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,31}$")]
+
+
+class ControllerFrameFile(_Strict):
+    number: Annotated[int, Field(ge=1, le=999)] | None = None
+    name: ControllerName | None = None
+
+
+class UserFrameFile(ControllerFrameFile):
+    pose: PoseFile | None = None     # in the cell's world
+    object: Name | None = None       # or at this object's pose
+
+    @model_validator(mode="after")
+    def _one_place(self) -> UserFrameFile:
+        if (self.pose is None) == (self.object is None):
+            raise ValueError("give exactly one of pose (in the cell's world) or object (at that object's pose)")
+        return self
+
+
+class InputFile(_Strict):
+    number: Annotated[int, Field(ge=0, le=65535)]
+    name: ControllerName | None = None
+
+
+class RegistersFile(_Strict):
+    position: list[Annotated[int, Field(ge=1, le=9999)]] = []
+    numeric: list[Annotated[int, Field(ge=1, le=9999)]] = []
+
+    @field_validator("position", "numeric")
+    @classmethod
+    def _unique(cls, v: list[int]) -> list[int]:
+        repeated = sorted({r for r in v if v.count(r) > 1})
+        if repeated:
+            raise ValueError(f"register {repeated[0]} is listed twice")
+        return v
+
+
+class RobotControllerFile(_Strict):
+    """The integrator's numbers on the robot's controller (README, "Controller programs")."""
+
+    tool: ControllerFrameFile | None = None
+    frame: UserFrameFile | None = None
+    registers: RegistersFile = RegistersFile()
+    inputs: dict[Name, Annotated[int, Field(ge=0, le=65535)] | InputFile] = {}
+    weld: Literal["call", "package"] = "call"
+
+
 class RobotRefFile(_Strict):
     model: Reference
     base: PoseFile = PoseFile()
     home: list[Finite]               # deg (m for a prismatic joint)
+    controller: RobotControllerFile = RobotControllerFile()
 
 
 class CylinderFile(_Strict):
@@ -376,7 +432,7 @@ def load_cell(path: str | Path) -> CellSpec:
     for key, mesh in (("body", tool_spec.body), ("tips", tool_spec.tips)):
         _check_mesh_readable(mesh, RobotModelError(tool_file, key, f"cannot read mesh {mesh}"))
 
-    return CellSpec(
+    cell = CellSpec(
         name=parsed.name or _stem_name(path),
         source=path.resolve(),
         robot=robot_spec,
@@ -402,6 +458,44 @@ def load_cell(path: str | Path) -> CellSpec:
         parts=_parts(parsed, path, robot_spec),
         tcp_limits=_tcp_limits(parsed.pick_place.unloaded) if parsed.pick_place is not None else None,
     )
+    return dataclasses.replace(cell, controller=_controller(parsed.robot.controller, cell, path))
+
+
+def _controller(ctrl: RobotControllerFile, cell: CellSpec, path: Path) -> ControllerSetup:
+    """`robot.controller`: the tool and user frame programs select, registers, inputs, weld style."""
+    key = "robot.controller"
+    tool = None
+    if ctrl.tool is not None:
+        tool = ControllerFrame(ctrl.tool.number or 1, ctrl.tool.name or f"{cell.tool.name}_tcp", ctrl.tool.name is not None)
+    frame = None
+    if ctrl.frame is not None:
+        f = ctrl.frame
+        if f.object is not None:
+            obj = next((o for o in cell.objects if o.name == f.object), None)
+            if obj is None:
+                known = ", ".join(o.name for o in cell.objects) or "none"
+                raise CellFileError(path, f"{key}.frame.object", f"no object '{f.object}' in the cell (objects: {known})")
+            T = np.asarray(obj.T_world_object)
+        else:
+            assert f.pose is not None  # guaranteed by UserFrameFile._one_place
+            T = _pose(f.pose)
+        name = f.name or (f.object if f.object and re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,31}", f.object) else "user_frame")
+        frame = UserFrame(ControllerFrame(f.number or 1, name, f.name is not None), frozen_array(T))
+    signals = cell.signals
+    inputs: list[ControllerInput] = []
+    for signal, given in ctrl.inputs.items():
+        if signal not in signals:
+            raise CellFileError(path, f"{key}.inputs.{signal}", f"the cell has no signal '{signal}' (its signals: "
+                                f"{', '.join(signals) or 'none'}; clamps name theirs, dynamic objects wait for "
+                                "<name>_clear, machine doors for <machine>_open)")
+        entry = ControllerInput(signal, given, None) if isinstance(given, int) else \
+            ControllerInput(signal, given.number, given.name)
+        twin = next((i for i in inputs if i.number == entry.number), None)
+        if twin is not None:
+            raise CellFileError(path, f"{key}.inputs.{signal}", f"input {entry.number} is also {twin.signal}'s")
+        inputs.append(entry)
+    return ControllerSetup(tool=tool, frame=frame, position_registers=tuple(ctrl.registers.position),
+                           numeric_registers=tuple(ctrl.registers.numeric), inputs=tuple(inputs), weld=ctrl.weld)
 
 
 def _job_seams(parsed: CellFile, path: Path) -> tuple[SeamSpec, ...]:

@@ -159,7 +159,8 @@ def plan_cell(
                       trajectory=trajectory, stats=stats, baseline=options.baseline, joint_names=robot.joint_names,
                       tool=cell.tool.name, T_flange_tcp=np.asarray(robot.T_flange_tcp),
                       T_world_base=np.asarray(cell.T_world_base),
-                      T_root_controller=np.asarray(cell.robot.controller.T_root_base), home=np.asarray(cell.home), options=options,
+                      T_root_controller=np.asarray(cell.robot.controller.T_root_base), controller=cell.controller,
+                      home=np.asarray(cell.home), options=options,
                       weld_time=cell.process.weld_time, clearance=clearance)
 
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field, replace
 
 from robomax_py._typing import FloatArray
 from robomax_py.plan.waiting import WaitPlan
-from robomax_py.spec import CellSpec
+from robomax_py.spec import CellSpec, ControllerSetup
 from robomax_py.timing import (
     Trajectory,
 )
@@ -138,6 +138,7 @@ class PlanResult:
     T_flange_tcp: FloatArray | None = None   # (4, 4)
     T_world_base: FloatArray | None = None   # (4, 4)
     T_root_controller: FloatArray | None = None   # (4, 4) the controller's base in the URDF root frame
+    controller: ControllerSetup = field(default_factory=ControllerSetup)   # the cell's `robot.controller`: frames, inputs, weld style
     home: FloatArray | None = None
     options: PlanOptions = PlanOptions()
     weld_time: float = 0.0

@@ -30,6 +30,7 @@ from robomax_py.plan.poses import (
     orientation_grid,
     spot_poses,
 )
+from robomax_py.plan.program_frames import cell_program_frames
 from robomax_py.plan.results import (
     PlanOptions,
     Progress,
@@ -59,7 +60,6 @@ from robomax_py.plan.waiting import (
 )
 from robomax_py.program import (
     as_written_joints,
-    as_written_pose_in,
     written_seconds,
     written_speed,
     written_tcp_speed,
@@ -193,12 +193,12 @@ def weld_end(cell: CellSpec, c: SpotCandidates, a: int, grids: list[OrientationG
     grids: `orientation_grid` of every seam of the cell."""
     seam = cell.seams[c.seam_index]
     T_world = spot_poses((seam.spots[c.spot_index],), grids[c.seam_index])[0, c.orient[a]]
-    # Rounded as the program states them: in the controller's base frame (SPEC §6).
-    C = cell.robot.controller.T_root_base
-    T_spot = as_written_pose_in(invert(np.asarray(cell.T_world_base)) @ T_world, C)
-    T_app = as_written_pose_in(approach_poses(T_spot, cell.process.approach), C)
+    # Rounded as the program states them: in its user frame (SPEC §6).
+    frames = cell_program_frames(cell)
+    T_spot = frames.written(invert(np.asarray(cell.T_world_base)) @ T_world)
+    T_app = frames.written(approach_poses(T_spot, cell.process.approach))
     ext = approach_extension(cell.process.approach, c.q_spot[a], c.q_app[a], T_spot, T_app)
-    T_ext = as_written_pose_in(approach_poses(T_spot, cell.process.approach + ext), C) if ext > 0 else None
+    T_ext = frames.written(approach_poses(T_spot, cell.process.approach + ext)) if ext > 0 else None
     return WeldEnd(T_spot, T_app, None, f"{seam.name}/{c.name}", T_ext)
 
 

@@ -23,6 +23,7 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import RobomaxError
+from robomax_py.spec import dynamic_signal
 from robomax_py.timing import Segment
 from robomax_py.world.collision import KIND_DYNAMIC, CollisionWorld
 
@@ -31,8 +32,6 @@ TIME_STEP_S = 0.001
 # Windows in the way of one move, and junctions started later so a trapped robot is not, before the
 # planner gives up.
 MAX_WAITS = 50
-CLEAR_SUFFIX = "_clear"
-OPEN_SUFFIX = "_open"
 
 
 @dataclass(frozen=True, slots=True)
@@ -75,9 +74,7 @@ def ceil_ms(seconds: float) -> float:
     return round(math.ceil(round(seconds / TIME_STEP_S, 6)) * TIME_STEP_S, 3)
 
 
-def signal_of(obstacle: str, door: bool) -> str:
-    """The input a program waits for: `<name>_open` for a machine's door, else `<name>_clear`."""
-    return obstacle + (OPEN_SUFFIX if door else CLEAR_SUFFIX)
+signal_of = dynamic_signal
 
 
 def wait_at_rest(world: CollisionWorld, block: Sequence[Segment], t: float,

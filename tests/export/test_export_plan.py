@@ -9,6 +9,7 @@ from typing import Any
 
 import pytest
 import yaml
+from conftest import place_cell
 
 from robomax_py.export import DIALECTS
 from robomax_py.export.plan_program import identifier, program_from_plan
@@ -43,7 +44,9 @@ def small(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> dict[st
 @pytest.fixture(scope="module")
 def process_cell(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> dict[str, Any]:  # type: ignore[no-untyped-def]
     """The small cell with a door to wait for, clamp 1 behind an input, gun 2 and s8 welded longer
-    with its own schedule."""
+    with its own schedule; placed as a station places it (1.6 m off the origin, turned 30 deg, on a
+    0.45 m riser tilted 2 deg), with the integrator's numbers: tool 2, user frame 3 on the fixture
+    plate, position registers 40 and 41 for the frames, the clamp on input 12."""
     tmp = tmp_path_factory.mktemp("process")
     path = write_small_cell(tmp, name="process_cell")
     data = yaml.safe_load(path.read_text())
@@ -56,6 +59,13 @@ def process_cell(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> 
     for spot in data["seams"][0]["spots"]:
         if spot["name"] == "s8":
             spot.update(weld_time=0.8, schedule=7)
+    place_cell(data, (1.2, -1.05, 0.45), 30.0, roll_deg=2.0)
+    data["robot"]["controller"] = {
+        "tool": {"number": 2, "name": "gun2"},
+        "frame": {"number": 3, "object": "fixture_plate"},
+        "registers": {"position": [40, 41]},
+        "inputs": {"clamp1_closed": {"number": 12, "name": "diClamp1Closed"}, "door_clear": 13},
+    }
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     return _planned(path)
 
@@ -130,7 +140,7 @@ def test_stamp_only_when_asked(small: dict[str, Any]) -> None:
 def test_baseline_files_are_named_apart(small: dict[str, Any]) -> None:
     files, _ = publish(small["result"], small["cell"], small["robot"], ("srcl", "krl"), baseline=True)
     assert sorted(files) == ["small_cell_baseline.dat", "small_cell_baseline.json", "small_cell_baseline.src",
-                             "small_cell_baseline.srcl"]
+                             "small_cell_baseline.srcl", "small_cell_baseline_frames.src"]
 
 
 @pytest.mark.parametrize(("name", "ident"), [("door-L 2", "door_L_2"), ("7up", "_7up"), ("s1", "s1")])

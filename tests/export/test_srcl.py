@@ -11,7 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from robomax_py.errors import ExportError, ProgramError
-from robomax_py.export.srcl import RESERVED, parse_program, write_program
+from robomax_py.export.srcl import RESERVED, lin_frames, parse_program, write_program
 from robomax_py.program import (
     Comment,
     FrameDef,
@@ -35,7 +35,7 @@ def example_program() -> Program:
         name="cabin_flange",
         header=Header(cell="cabin_flange", robot="kr125", tool="spot_gun_c", cycle_time_s=23.71449, joints=JOINTS),
         frames=(
-            FrameDef("gun_tcp", "tool", (200.0, 0.0, 270.0), (0.0, -90.0, 0.0)),
+            FrameDef("gun_tcp", "tool", (200.0, 0.0, 270.0), (0.0, -90.0, 0.0), 1),
             FrameDef("robot_base", "base", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),
         ),
         instructions=(
@@ -43,11 +43,14 @@ def example_program() -> Program:
             PtpMove((0.0, -90.0, 90.0, 0.0, 0.0, 0.0), speed=1.0, accel=1.0, comment="home"),
             PtpMove((-29.53125, -71.2, 101.33333333, -0.000001, 55.5, 179.99999), speed=0.8, accel=0.5, flyby=11.999999),
             LinMove((1224.88, -693.91, 893.2), (90.0, 0.0, 180.0), "S010 T101010", 500.0, flyby=1.2,
-                    comment="approach s1"),
-            LinMove((1224.88, -693.91, 843.2), (90.0, 0.0, 180.0), "S010 T101010", 150.0),
+                    comment="approach s1", tool="gun_tcp", base="robot_base"),
+            LinMove((1224.88, -693.91, 843.2), (90.0, 0.0, 180.0), "S010 T101010", 150.0, tool="gun_tcp",
+                    base="robot_base"),
             Spot("s1", "flange", 0.5),
-            LinMove((1224.88, -693.91, 893.2), (90.0, 0.0, 180.0), "S010 T101010", 500.0, flyby=0.6),
+            LinMove((1224.88, -693.91, 893.2), (90.0, 0.0, 180.0), "S010 T101010", 500.0, flyby=0.6, tool="gun_tcp",
+                    base="robot_base"),
             WaitFor("door_clear"),
+            WaitFor("clamp_1", 17),
             Wait(2.0),
             Comment("back home"),
             PtpMove((0.0, -90.0, 90.0, 0.0, 0.0, 0.0), speed=1.0, accel=1.0),
@@ -131,19 +134,22 @@ def programs(draw: st.DrawFn) -> Program:
     joints = tuple(draw(st.lists(NAMES, min_size=1, max_size=8, unique=True)))
     n = len(joints)
     header = Header(draw(NAMES), draw(NAMES), draw(NAMES), draw(SECONDS), joints)
-    frame_names = draw(st.lists(NAMES, max_size=3, unique=True))
+    # SRCL declares at most one frame of each kind; every LIN is stated in them.
+    kinds = draw(st.lists(st.sampled_from(["tool", "base"]), max_size=2, unique=True))
+    frame_names = draw(st.lists(NAMES, min_size=len(kinds), max_size=len(kinds), unique=True))
     frames = tuple(
-        FrameDef(name, draw(st.sampled_from(["tool", "base"])), draw(st.tuples(MM, MM, MM)),
-                 draw(st.tuples(ANGLE, ANGLE, ANGLE)))
-        for name in frame_names
+        FrameDef(name, kind, draw(st.tuples(MM, MM, MM)), draw(st.tuples(ANGLE, ANGLE, ANGLE)),  # type: ignore[arg-type]
+                 draw(st.integers(0, 99)))
+        for name, kind in zip(frame_names, kinds)
     )
+    tool, base = lin_frames(frames)
     instruction: st.SearchStrategy[Instruction] = st.one_of(
         st.builds(PtpMove, st.tuples(*[_floats(-720.0, 720.0)] * n), FRACTION, FRACTION, RADIUS, TEXT),
         st.builds(LinMove, st.tuples(MM, MM, MM), st.tuples(ANGLE, ANGLE, ANGLE), CONFIG, _floats(0.001, 10000.0),
-                  RADIUS, TEXT),
+                  RADIUS, TEXT, tool=st.just(tool), base=st.just(base)),
         st.builds(Spot, NAMES, NAMES, SECONDS),
         st.builds(Wait, SECONDS),
-        st.builds(WaitFor, NAMES),
+        st.builds(WaitFor, NAMES, st.one_of(st.none(), st.integers(0, 4096))),
         st.builds(Comment, TEXT),
     )
     return Program(draw(NAMES), header, frames, tuple(draw(st.lists(instruction, max_size=12))))
