@@ -298,6 +298,23 @@ def test_flange_in_the_controller_base_is_where_the_vendor_frame_has_it(arms: di
         assert fk_flange(robot, home)[2, 3] == pytest.approx(1.565, abs=BASE_TOL_M)
 
 
+def test_ur_base_link_is_the_shipped_ur10_base(tmp_path: Path) -> None:
+    """The UR10 URDF of example-robot-data has a `base` link turned -180 deg about z from base_link
+    (joint base_link-base_fixed_joint): imported, it is the half turn the shipped ur10 states."""
+    from robomax_py.io.robot import shipped_robots_dir
+
+    shipped = load_robot_spec(shipped_robots_dir() / "ur10" / "robot.yaml")
+    folder = import_urdf(shipped.urdf, tmp_path / "ur10x").folder
+    text = (folder / "robot.yaml").read_text()
+    assert "  base: {xyz: [0, 0, 0], rpy: [0, 0, 180]}  # ROS-Industrial's `base` link" in text
+    np.testing.assert_allclose(load_robot_spec(folder / "robot.yaml").controller.T_root_base,
+                               shipped.controller.T_root_base, atol=BASE_TOL_M)
+    # Without the key the URDF's link gives the same frame (to the URDF's 11 decimals of pi).
+    (folder / "robot.yaml").write_text(text.replace(text[text.index("  base: "):text.index("\n", text.index("  base: ")) + 1], ""))
+    np.testing.assert_allclose(load_robot_spec(folder / "robot.yaml").controller.T_root_base,
+                               shipped.controller.T_root_base, atol=BASE_TOL_M)
+
+
 @pytest.mark.slow
 def test_fanuc_targets_are_measured_from_the_world_frame_at_j2_height(arms: dict[str, Path], tmp_path: Path) -> None:
     """SPEC §6 on the FANUC arm: `UF : 0` targets are in FANUC's world frame, 525 mm above base_link,
