@@ -2,8 +2,10 @@
 
 The folder holds the expanded URDF with relative mesh paths, the meshes it names (copied), an SRDF
 when one is given, and a robot.yaml with IK parameters fitted from the URDF and checked against its
-forward kinematics. It is built in a temporary folder beside the target, loaded back as any robot
-folder is (`robot.load_robot`), and only then moved into place: a failure leaves nothing behind.
+forward kinematics; when the URDF has a ROS-Industrial `base` link (the vendor's base frame), the
+robot.yaml states its pose as `controller.base`, so the folder says which frame Cartesian targets are
+in. It is built in a temporary folder beside the target, loaded back as any robot folder is
+(`robot.load_robot`), and only then moved into place: a failure leaves nothing behind.
 """
 
 from __future__ import annotations
@@ -23,8 +25,10 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+from robomax_py._typing import FloatArray
 from robomax_py.errors import RobotModelError
-from robomax_py.io.robot import mesh_candidates, package_dirs_for
+from robomax_py.io.robot import mesh_candidates, package_dirs_for, urdf_base_link
+from robomax_py.transforms import rpy_from_matrix
 
 MESH_SUFFIXES = (".stl", ".dae", ".obj", ".ply", ".off", ".glb", ".gltf")
 _BRAND_PATTERNS = (
@@ -128,8 +132,20 @@ def _number(v: float) -> str:
     return "0" if text in ("-0", "") else text
 
 
+def _base_yaml(T_root_base: FloatArray) -> str:
+    """robot.yaml's `controller.base` for a pose (4, 4), metres: xyz in m, rpy in deg (a half turn
+    written as 180, not -180)."""
+    xyz = ", ".join(_number(v) for v in T_root_base[:3, 3])
+    angles = [_number(math.degrees(a)) for a in rpy_from_matrix(T_root_base[:3, :3])]
+    rpy = ", ".join("180" if a == "-180" else a for a in angles)
+    return f"{{xyz: [{xyz}], rpy: [{rpy}]}}"
+
+
 def _robot_yaml(name: str, urdf: str, flange: str, solver: str, params: object, brand: str, srdf: str | None,
-                source: Path) -> str:
+                source: Path, T_root_base: FloatArray | None) -> str:
+    """The robot.yaml text. `T_root_base` (4, 4), metres: the URDF's ROS-Industrial `base` link in
+    its root frame (`io.robot.urdf_base_link`), written as `controller.base`; None when the URDF has
+    none (a UR arm then gets the UR controller's base, `base_link` turned 180 deg about z)."""
     from robomax_py.robot.ik.opw import OpwParams
     from robomax_py.robot.ik.ur import UrParams
 
@@ -161,7 +177,9 @@ def _robot_yaml(name: str, urdf: str, flange: str, solver: str, params: object, 
     lines.append(f"  brand: {brand}")
     if brand == "fanuc":
         lines.append("  j23_coupling: true        # FANUC counts J3 from the horizontal")
-    if brand == "ur":
+    if T_root_base is not None:
+        lines.append(f"  base: {_base_yaml(T_root_base)}  # ROS-Industrial's `base` link: the vendor's base frame")
+    elif brand == "ur":
         lines.append("  base: {rpy: [0, 0, 180]}  # the UR controller's base: base_link turned 180 deg about z")
     if srdf is not None:
         lines.append(f"srdf: {srdf}")
@@ -223,6 +241,7 @@ def import_urdf(
         raise RobotModelError(source, None, f"not a valid URDF (XML): {exc}") from None
     if root.tag != "robot":
         raise RobotModelError(source, None, f"not a URDF: the root element is <{root.tag}>, not <robot>")
+    T_root_base = urdf_base_link(root, source)
 
     warnings: list[str] = []
     files: dict[str, bytes] = {}
@@ -272,7 +291,8 @@ def import_urdf(
             (stage / srdf_name).write_bytes(Path(srdf).read_bytes())
         brand = brand or guess_brand(name, source.name, str(root.get("name", "")))
         (stage / "robot.yaml").write_text(
-            _robot_yaml(name, urdf_name, flange, solver_name, params, brand, srdf_name, source), encoding="utf-8")
+            _robot_yaml(name, urdf_name, flange, solver_name, params, brand, srdf_name, source, T_root_base),
+            encoding="utf-8")
         spec = load_robot_spec(stage / "robot.yaml")
         robot = load_robot(spec)       # the whole folder loads: meshes, pairs, IK checked against the URDF
         warnings.extend(w.replace(str(stage), str(out)) for w in robot.warnings if "limits." in w)

@@ -15,8 +15,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
+from robomax_py._typing import FloatArray
 from robomax_py.errors import RobotModelError
 from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
 from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
@@ -90,11 +92,16 @@ class LimitsFile(_Strict):
 
 
 class ControllerFile(_Strict):
-    """SPEC §6: the controller's brand (its configuration data and native dialect) and base frame."""
+    """SPEC §6: the controller's brand (its configuration data and native dialect) and base frame.
+
+    `base` is the controller's base frame in the URDF root frame. Absent, it is the pose of the
+    URDF's ROS-Industrial `base` link when fixed joints alone attach that link to the root
+    (`urdf_base_link`), else the identity; given (an identity too), it is used as written.
+    """
 
     brand: Literal["kuka", "abb", "fanuc", "ur"] = "kuka"
     j23_coupling: bool = False                # FANUC: J3 counted from the horizontal
-    base: PoseFile = PoseFile()               # controller base frame in the URDF root frame
+    base: PoseFile | None = None              # None: the URDF's `base` link, else identity
 
 
 class CollisionFile(_Strict):
@@ -277,12 +284,14 @@ def urdf_package_names(urdf_text: str) -> list[str]:
     return names
 
 
-def urdf_package_dirs(urdf: Path, file: Path) -> tuple[Path, ...]:
+def urdf_package_dirs(urdf: Path, file: Path, text: str | None = None) -> tuple[Path, ...]:
     """Package folders for the `package://NAME/...` meshes a URDF names (searched near the URDF).
 
     Every mesh file the URDF names that exists is checked by the guard here (a regular file within
-    the mesh size limit), so Pinocchio never opens a device, a pipe or a symlink loop."""
-    text = read_text(urdf, LIMITS.urdf, named_by(RobotModelError, file, "urdf"), f"URDF {urdf}")
+    the mesh size limit), so Pinocchio never opens a device, a pipe or a symlink loop. `text` is the
+    URDF's text when the caller has read it already."""
+    if text is None:
+        text = read_text(urdf, LIMITS.urdf, named_by(RobotModelError, file, "urdf"), f"URDF {urdf}")
     dirs: list[Path] = []
     for name in urdf_package_names(text):
         for d in package_dirs_for(name, urdf.parent):
@@ -312,6 +321,92 @@ def mesh_candidates(uri: str, urdf: Path, dirs: Sequence[Path]) -> list[Path]:
     return [urdf.parent / uri]
 
 
+# ------------------------------------------------------------------------------ the `base` link
+
+# The link ROS-Industrial support packages put at the vendor's own base frame, the origin of the
+# controller's robot Cartesian coordinates: REP-199 (draft, "Coordinate Frames for Serial Industrial
+# Manipulators", frame `base`), attached to `base_link` by the fixed joint `base_link-base`. At J2
+# height on FANUC arms (fanuc_m20ia_support/urdf/m20ia_macro.xacro: "base_link to Fanuc World
+# Coordinates transform", xyz 0 0 0.525), at `base_link` on ABB and KUKA arms, `base_link` turned
+# 180 deg about z on UR arms (Universal Robots' ur_description, doc/robot_frames.rst).
+ROS_INDUSTRIAL_BASE_LINK = "base"
+
+
+def parse_urdf(text: str, urdf: Path) -> ET.Element:
+    """The root element of a URDF's text; RobotModelError naming the file when it is not XML."""
+    try:
+        return ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise RobotModelError(urdf, None, f"cannot parse URDF: {exc}") from None
+
+
+def urdf_base_link(root: ET.Element, urdf: Path) -> FloatArray | None:
+    """The pose of the URDF's link named `base` in its root link's frame, when only fixed joints
+    lie between the two (ROS-Industrial's `base` link, the vendor's base frame).
+
+    Parameters
+    ----------
+    root : Element
+        The URDF's `<robot>` element.
+    urdf : Path
+        The URDF file, named in errors.
+
+    Returns
+    -------
+    (4, 4) float or None
+        The link's pose, metres, composed from the joints' `<origin>` (R = Rz(yaw) Ry(pitch) Rx(roll),
+        the URDF convention); exactly the identity when every origin on the way is zero. None when
+        the URDF has no link `base`, when a movable joint lies between it and the root (such a link
+        moves with that joint, so it is no fixed frame of the controller), or when the link is not
+        below the URDF's single root link (Pinocchio refuses such a URDF).
+
+    Raises
+    ------
+    RobotModelError
+        An `<origin>` on the way from the root is not three finite numbers for `xyz` or `rpy`.
+    """
+    links = {name for el in root.findall("link") if (name := el.get("name"))}
+    if ROS_INDUSTRIAL_BASE_LINK not in links:
+        return None
+    parent_joint: dict[str, ET.Element] = {}
+    for joint in root.findall("joint"):
+        child = joint.find("child")
+        name = None if child is None else child.get("link")
+        if name:
+            parent_joint.setdefault(name, joint)
+    chain: list[ET.Element] = []
+    link: str | None = ROS_INDUSTRIAL_BASE_LINK
+    while link in parent_joint:
+        joint = parent_joint[link]
+        parent = joint.find("parent")
+        if joint.get("type") != "fixed" or parent is None or len(chain) >= len(parent_joint):
+            return None          # movable, malformed, or a loop
+        chain.append(joint)
+        link = parent.get("link")
+    if links - set(parent_joint) != {link}:
+        return None              # not below the single root link
+    T: FloatArray = np.eye(4)
+    for joint in reversed(chain):
+        T = T @ _joint_origin(joint, urdf)
+    return T
+
+
+def _joint_origin(joint: ET.Element, urdf: Path) -> FloatArray:
+    """A URDF joint's `<origin>`: the child link's frame in the parent link's, (4, 4), metres."""
+    origin = joint.find("origin")
+    values = []
+    for key in ("xyz", "rpy"):
+        text = "0 0 0" if origin is None else origin.get(key, "0 0 0")
+        try:
+            v = [float(x) for x in text.split()]
+        except ValueError:
+            v = []
+        if len(v) != 3 or not all(math.isfinite(x) for x in v):
+            raise RobotModelError(urdf, f"joint {joint.get('name')}: origin {key}", f"expected 3 finite numbers, got {text!r}")
+        values.append(v)
+    return pose_matrix(values[0], values[1])
+
+
 # ------------------------------------------------------------------------------ SRDF
 
 
@@ -338,7 +433,11 @@ def srdf_disabled_pairs(path: Path, file: Path) -> list[tuple[str, str]]:
 
 def load_robot_spec(path: Path) -> RobotSpec:
     """Read and check a robot.yaml. What needs the URDF (limits' length, link names, fitted IK
-    parameters and their agreement with the URDF) is checked by `robot.load_robot`."""
+    parameters and their agreement with the URDF) is checked by `robot.load_robot`.
+
+    Without `controller.base` the controller's base frame is the URDF's ROS-Industrial `base` link
+    (`urdf_base_link`), or the URDF root frame when there is none; a given `controller.base` wins.
+    """
     from robomax_py.io.ik_params import params_from_mapping
 
     data = read_yaml_mapping(path, RobotModelError, "robot description", LIMITS.description)
@@ -366,7 +465,13 @@ def load_robot_spec(path: Path) -> RobotSpec:
     limits = parsed.limits
     if limits.loaded is not None and parsed.payload is None:
         raise RobotModelError(path, "limits.loaded", "needs `payload` (kg): the loaded limits hold for the rated payload")
-    package_dirs = urdf_package_dirs(urdf, path)
+    urdf_text = read_text(urdf, LIMITS.urdf, named_by(RobotModelError, path, "urdf"), f"URDF {urdf}")
+    package_dirs = urdf_package_dirs(urdf, path, urdf_text)
+    if ctrl.base is not None:
+        T_root_base = pose_matrix(ctrl.base.xyz, [math.radians(a) for a in ctrl.base.rpy])
+    else:
+        from_urdf = urdf_base_link(parse_urdf(urdf_text, urdf), urdf)
+        T_root_base = np.eye(4) if from_urdf is None else from_urdf
     return RobotSpec(
         name=parsed.name,
         source=path.resolve(),
@@ -380,7 +485,7 @@ def load_robot_spec(path: Path) -> RobotSpec:
         description=parsed.description,
         controller=ControllerSpec(
             brand=ctrl.brand, j23_coupling=ctrl.j23_coupling,
-            T_root_base=frozen_array(pose_matrix(ctrl.base.xyz, [math.radians(a) for a in ctrl.base.rpy])),
+            T_root_base=frozen_array(T_root_base),
         ),
         disabled_links=disabled,
         srdf_disabled_links=srdf,

@@ -191,6 +191,156 @@ def test_configuration_data_is_geometric_on_a_fanuc_arm(arms: dict[str, Path]) -
     assert config_text(abb, np.radians([100.0, 0.0, 0.0, -10.0, -30.0, 200.0])) == "[1,-1,2,1]"
 
 
+# ---------------------------------------------------------------------- the ROS-Industrial `base` link
+
+# Each arm's xacro macro, where its `base` link is attached (the fixed joint `${prefix}base_link-base`).
+MACROS = {
+    "irb2400": ROSI / "abb_irb2400_support/urdf/irb2400_macro.xacro",
+    "m20ia": ROSI / "fanuc_m20ia_support/urdf/m20ia_macro.xacro",
+    "kr120r2500pro": ROSI / "kuka_kr120_support/urdf/kr120r2500pro_macro.xacro",
+}
+BASE_TOL_M = 1e-9       # robot.yaml states the base in m and deg with 9 decimals
+
+
+def _rpy_pose(xyz: list[float], rpy: list[float]) -> np.ndarray:
+    """URDF <origin>: x' = Rz(yaw) Ry(pitch) Rx(roll) x + xyz (rad), written out here."""
+    (cr, sr), (cp, sp), (cy, sy) = ((math.cos(a), math.sin(a)) for a in rpy)
+    T = np.eye(4)
+    T[:3, :3] = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]]) @ np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]]) \
+        @ np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    T[:3, 3] = xyz
+    return T
+
+
+def _base_joint_in_xacro(name: str) -> np.ndarray:
+    """The `base` link's pose in `base_link`, read from the xacro text, and `base_link` checked to be
+    the macro's root link (no joint has it as child)."""
+    import xml.etree.ElementTree as ET
+
+    def end(joint: ET.Element, tag: str) -> str | None:
+        el = joint.find(tag)
+        return None if el is None else el.get("link")
+
+    macro = ET.parse(MACROS[name]).getroot()
+    joints = list(macro.iter("joint"))
+    (joint,) = [j for j in joints if j.get("name") == "${prefix}base_link-base"]
+    assert joint.get("type") == "fixed"
+    assert (end(joint, "parent"), end(joint, "child")) == ("${prefix}base_link", "${prefix}base")
+    assert all(end(j, "child") != "${prefix}base_link" for j in joints)
+    origin = joint.find("origin")
+    assert origin is not None
+    xyz, rpy = ([float(v) for v in origin.get(k, "0 0 0").split()] for k in ("xyz", "rpy"))
+    return _rpy_pose(xyz, rpy)
+
+
+def _stated_base(folder: Path) -> np.ndarray:
+    base = yaml.safe_load((folder / "robot.yaml").read_text())["controller"]["base"]
+    return _rpy_pose(base.get("xyz", [0, 0, 0]), [math.radians(a) for a in base.get("rpy", [0, 0, 0])])
+
+
+@pytest.mark.parametrize("name", list(ARMS))
+def test_import_states_the_base_link_as_controller_base(arms: dict[str, Path], name: str, tmp_path: Path) -> None:
+    want = _base_joint_in_xacro(name)
+    text = (arms[name] / "robot.yaml").read_text()
+    assert "  base: {xyz: [" in text and "# ROS-Industrial's `base` link: the vendor's base frame" in text
+    np.testing.assert_allclose(_stated_base(arms[name]), want, atol=BASE_TOL_M)
+    np.testing.assert_allclose(load_robot_spec(arms[name] / "robot.yaml").controller.T_root_base, want, atol=BASE_TOL_M)
+    # Without the key, loading finds the same frame in the URDF.
+    import shutil
+
+    folder = tmp_path / name
+    shutil.copytree(arms[name], folder)
+    (folder / "robot.yaml").write_text("".join(line for line in text.splitlines(keepends=True)
+                                               if not line.startswith("  base: ")))
+    np.testing.assert_allclose(load_robot_spec(folder / "robot.yaml").controller.T_root_base, want, atol=BASE_TOL_M)
+
+
+def test_fanuc_base_is_at_j2_height(arms: dict[str, Path]) -> None:
+    # fanuc_m20ia_support/urdf/m20ia_macro.xacro:160, the joint base_link-base: <origin xyz="0 0 0.525"/>;
+    # J2's axis: joint_1 at xyz 0 0 0.525 (line 115), joint_2 at xyz 0.150 0 0 from it (line 122).
+    import pinocchio as pin
+
+    base = _base_joint_in_xacro("m20ia")
+    np.testing.assert_allclose(base[:3, 3], [0.0, 0.0, 0.525], atol=BASE_TOL_M)
+    robot = load_robot(load_robot_spec(arms["m20ia"] / "robot.yaml"))
+    data = robot.model.createData()
+    pin.forwardKinematics(robot.model, data, np.zeros(robot.dof))
+    j2 = data.oMi[robot.model.getJointId("joint_2")].translation
+    assert robot.controller.T_root_base[2, 3] == pytest.approx(j2[2], abs=BASE_TOL_M)
+    # The ABB and KUKA arms' `base` is their base_link (ABB base frame, KUKA $ROBROOT at the foot).
+    for name in ("irb2400", "kr120r2500pro"):
+        assert np.array_equal(load_robot_spec(arms[name] / "robot.yaml").controller.T_root_base, np.eye(4))
+
+
+@pytest.mark.parametrize("name", list(ARMS))
+def test_flange_in_the_controller_base_is_where_the_vendor_frame_has_it(arms: dict[str, Path], name: str) -> None:
+    """FK in the URDF root frame, expressed in the controller's base: the flange relative to the
+    URDF's `base` link (Pinocchio's frames), and on the FANUC arm the height its world frame gives."""
+    import pinocchio as pin
+
+    from robomax_py.program import to_frame
+
+    robot = load_robot(load_robot_spec(arms[name] / "robot.yaml"))
+    home = np.zeros(robot.dof)
+    got = to_frame(robot.controller.T_root_base, fk_flange(robot, home))
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, home)
+    base, flange = (data.oMf[robot.model.getFrameId(f)] for f in ("base", "tool0"))
+    np.testing.assert_allclose(got, (base.inverse() * flange).homogeneous, atol=BASE_TOL_M)
+    if name == "m20ia":
+        # FANUC's world frame is at J2 height: at home the upper arm stands c2 above J2 and the
+        # wrist centre |a2| above J3 (fanuc_m20ia_support/config/opw_parameters_m20ia.yaml: c2 0.79,
+        # a2 -0.25), so the flange is 1.040 m above the world origin and 1.565 m above base_link.
+        opw = yaml.safe_load((ROSI / "fanuc_m20ia_support/config/opw_parameters_m20ia.yaml").read_text()
+                             .replace("deg(-90.0)", "-90").replace("deg(180.0)", "180"))["opw_kinematics_geometric_parameters"]
+        assert got[2, 3] == pytest.approx(opw["c2"] - opw["a2"], abs=BASE_TOL_M)
+        assert got[2, 3] == pytest.approx(1.040, abs=BASE_TOL_M)
+        assert fk_flange(robot, home)[2, 3] == pytest.approx(1.565, abs=BASE_TOL_M)
+
+
+def test_ur_base_link_is_the_shipped_ur10_base(tmp_path: Path) -> None:
+    """The UR10 URDF of example-robot-data has a `base` link turned -180 deg about z from base_link
+    (joint base_link-base_fixed_joint): imported, it is the half turn the shipped ur10 states."""
+    from robomax_py.io.robot import shipped_robots_dir
+
+    shipped = load_robot_spec(shipped_robots_dir() / "ur10" / "robot.yaml")
+    folder = import_urdf(shipped.urdf, tmp_path / "ur10x").folder
+    text = (folder / "robot.yaml").read_text()
+    assert "  base: {xyz: [0, 0, 0], rpy: [0, 0, 180]}  # ROS-Industrial's `base` link" in text
+    np.testing.assert_allclose(load_robot_spec(folder / "robot.yaml").controller.T_root_base,
+                               shipped.controller.T_root_base, atol=BASE_TOL_M)
+    # Without the key the URDF's link gives the same frame (to the URDF's 11 decimals of pi).
+    (folder / "robot.yaml").write_text(text.replace(text[text.index("  base: "):text.index("\n", text.index("  base: ")) + 1], ""))
+    np.testing.assert_allclose(load_robot_spec(folder / "robot.yaml").controller.T_root_base,
+                               shipped.controller.T_root_base, atol=BASE_TOL_M)
+
+
+@pytest.mark.slow
+def test_fanuc_targets_are_measured_from_the_world_frame_at_j2_height(arms: dict[str, Path], tmp_path: Path) -> None:
+    """SPEC §6 on the FANUC arm: `UF : 0` targets are in FANUC's world frame, 525 mm above base_link,
+    so a spot 0.95 m above base_link is written at Z = 425 mm; verify reads the program back."""
+    import re
+
+    cell = tmp_path / "m20ia_flange.yaml"
+    cell.write_text(_flange_cell(arms["m20ia"] / "robot.yaml", "spot_gun_light", 1.05, 0.95))
+    out = tmp_path / "programs"
+    result = runner.invoke(app, ["plan", str(cell), "-o", str(out), "--format", "fanuc"])
+    assert result.exit_code == 0, result.output
+    program = out / "m20ia_flange.ls"
+    verified = runner.invoke(app, ["verify", str(cell), str(program)])
+    assert verified.exit_code == 0, verified.output
+    text = program.read_text()
+    # The LIN target right before each weld call is the spot's TCP pose.
+    welds = re.findall(r"L P\[(\d+)\][^\n]*FINE ;\n\s*\d+:\s*CALL SPOT_WELD", text)
+    assert len(welds) == 4
+    for k in welds:
+        block = re.search(rf"P\[{k}\]\{{.*?X = (\S+)  mm,\tY = (\S+)  mm,\tZ = (\S+)  mm", text, re.DOTALL)
+        assert block is not None
+        x, y, z = (float(v) for v in block.groups())
+        assert x == pytest.approx(1050.0, abs=1e-3) and z == pytest.approx(425.0, abs=1e-3)
+        assert min(abs(y - yy) for yy in (-300.0, -100.0, 100.0, 300.0)) < 1e-3
+
+
 def test_brand_guess() -> None:
     assert guess_brand("kr120r2500pro") == "kuka"
     assert guess_brand("abb_irb4600") == "abb"
@@ -300,8 +450,10 @@ def test_cartesian_targets_are_stated_in_the_controller_base(arms: dict[str, Pat
 
     folder = tmp_path / "kr120r2500pro"
     shutil.copytree(arms["kr120r2500pro"], folder)
-    text = (folder / "robot.yaml").read_text().replace(
-        "controller:\n  brand: kuka\n", "controller:\n  brand: kuka\n  base: {xyz: [0.1, -0.2, 0.3], rpy: [0, 0, 90]}\n")
+    text = (folder / "robot.yaml").read_text()
+    stated = re.search(r"^  base: .*$", text, re.MULTILINE)      # the imported `base` link (identity here)
+    assert stated is not None
+    text = text.replace(stated.group(0), "  base: {xyz: [0.1, -0.2, 0.3], rpy: [0, 0, 90]}")
     (folder / "robot.yaml").write_text(text)
     cell = tmp_path / "based.yaml"
     cell.write_text(_flange_cell(folder / "robot.yaml", "spot_gun_c", 1.6, 1.2, "[0, -90, 90, 0, 30, 0]"))

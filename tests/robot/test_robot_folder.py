@@ -85,3 +85,88 @@ def test_broken_params_name_the_key(tmp_path: Path, key: str) -> None:
 
     with pytest.raises(RobotModelError, match=rf"robot\.yaml: ik\.params\.{key}"):
         load_robot_spec(path)
+
+
+# ---------------------------------------------------------------------------- controller.base default
+
+def _with_base_link(path: Path, joints: str, controller: str | None = None) -> Path:
+    """The test arm with extra URDF links and joints (`joints`, XML) and, optionally, a `controller`
+    section for robot.yaml (YAML text under `controller:`)."""
+    urdf = path.parent / "testarm.urdf"
+    urdf.write_text(urdf.read_text().replace("</robot>", joints + "</robot>"))
+    if controller is not None:
+        path.write_text(path.read_text() + "controller:\n" + controller)
+    return path
+
+
+def _link_pose(urdf: Path, link: str) -> np.ndarray:
+    """The link's pose in the URDF root frame at q = 0, from Pinocchio (not robomax_py's URDF reading)."""
+    import pinocchio as pin
+
+    model = pin.buildModelFromUrdf(str(urdf))
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, pin.neutral(model))
+    return np.asarray(data.oMf[model.getFrameId(link)].homogeneous)
+
+
+ROS_I_BASE = ('<link name="base"/><joint name="base_link-base" type="fixed"><parent link="base_link"/>'
+              '<child link="base"/><origin xyz="0.1 -0.2 0.45" rpy="0.1 -0.2 1.2"/></joint>')
+
+
+def test_without_a_base_link_the_controller_base_is_the_root(tmp_path: Path) -> None:
+    spec = load_robot_spec(write_arm(tmp_path / "testarm"))
+    assert np.array_equal(spec.controller.T_root_base, np.eye(4))
+
+
+def test_the_base_link_is_the_default_controller_base(tmp_path: Path) -> None:
+    path = _with_base_link(write_arm(tmp_path / "testarm"), ROS_I_BASE)
+    robot = load_robot(load_robot_spec(path))
+    want = _link_pose(path.parent / "testarm.urdf", "base")
+    np.testing.assert_allclose(want[:3, 3], [0.1, -0.2, 0.45], atol=POS_TOL_M)
+    np.testing.assert_allclose(robot.controller.T_root_base, want, atol=POS_TOL_M)
+
+
+def test_fixed_joints_in_a_row_compose(tmp_path: Path) -> None:
+    # base_link -> mount -> base, both fixed: the base link's pose is the product of the two origins.
+    joints = ('<link name="mount"/><joint name="base_link-mount" type="fixed"><parent link="base_link"/>'
+              '<child link="mount"/><origin xyz="0 0 0.2" rpy="0 0 1.5707963267948966"/></joint>'
+              '<link name="base"/><joint name="mount-base" type="fixed"><parent link="mount"/>'
+              '<child link="base"/><origin xyz="0.3 0 0.1" rpy="0 0.4 0"/></joint>')
+    path = _with_base_link(write_arm(tmp_path / "testarm"), joints)
+    got = load_robot_spec(path).controller.T_root_base
+    want = _link_pose(path.parent / "testarm.urdf", "base")
+    np.testing.assert_allclose(want[:3, 3], [0.0, 0.3, 0.3], atol=POS_TOL_M)   # the mount turned 90 deg
+    np.testing.assert_allclose(got, want, atol=POS_TOL_M)
+
+
+def test_a_given_controller_base_wins_identity_included(tmp_path: Path) -> None:
+    path = _with_base_link(write_arm(tmp_path / "a" / "testarm"), ROS_I_BASE,
+                           "  base: {xyz: [0, 0, 0], rpy: [0, 0, 0]}\n")
+    assert np.array_equal(load_robot_spec(path).controller.T_root_base, np.eye(4))
+    path = _with_base_link(write_arm(tmp_path / "b" / "testarm"), ROS_I_BASE, "  base: {xyz: [0, 0, 0.3]}\n")
+    want = np.eye(4)
+    want[2, 3] = 0.3
+    assert np.array_equal(load_robot_spec(path).controller.T_root_base, want)
+    # Another controller key alone leaves the default to the URDF.
+    path = _with_base_link(write_arm(tmp_path / "c" / "testarm"), ROS_I_BASE, "  brand: fanuc\n")
+    np.testing.assert_allclose(load_robot_spec(path).controller.T_root_base,
+                               _link_pose(path.parent / "testarm.urdf", "base"), atol=POS_TOL_M)
+
+
+def test_a_base_link_behind_a_movable_joint_is_not_the_controller_base(tmp_path: Path) -> None:
+    # A link named `base` carried by joint 1 moves with it: no fixed frame of the controller, so the
+    # default stays the URDF root frame (and loading says nothing about it).
+    joints = ('<link name="base"/><joint name="link_1-base" type="fixed"><parent link="link_1"/>'
+              '<child link="base"/><origin xyz="0 0 0.45"/></joint>')
+    path = _with_base_link(write_arm(tmp_path / "testarm"), joints)
+    robot = load_robot(load_robot_spec(path))
+    assert np.array_equal(robot.controller.T_root_base, np.eye(4))
+    assert not any("base" in w and "controller" in w for w in robot.warnings)
+
+
+def test_a_bad_origin_on_the_way_to_the_base_link_names_the_joint(tmp_path: Path) -> None:
+    from robomax_py.errors import RobotModelError
+
+    path = _with_base_link(write_arm(tmp_path / "testarm"), ROS_I_BASE.replace('xyz="0.1 -0.2 0.45"', 'xyz="0.1 nan"'))
+    with pytest.raises(RobotModelError, match=r"testarm\.urdf: joint base_link-base: origin xyz: expected 3 finite numbers"):
+        load_robot_spec(path)
