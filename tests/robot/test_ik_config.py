@@ -132,10 +132,15 @@ def test_abb_confdata() -> None:
 
 
 def test_fanuc_config() -> None:
+    """F when J5 >= 0 (FANUC's flip, not KUKA's A5 < 0 bit) and the turn numbers of J4, J5, J6, as
+    SPEC §6 states; this test once held F for J5 < 0 and the turns of J1, J4, J6, a convention the
+    writer and this test shared but no FANUC controller does."""
     q = np.array([0, 0, 0, 0, 30, -200]) * DEG
-    assert ConfigIndicator(0b010, 0).to_fanuc(q) == "N U T, 0, 0, -1"
-    assert ConfigIndicator(0b101, 0).to_fanuc(np.array([181, 0, 0, 540, 0, 180]) * DEG) == "F D B, 1, 1, 0"
-    assert ConfigIndicator(0, 0).to_fanuc(np.array([-180, 0, 0, 0, 0, 0]) * DEG).endswith("-1, 0, 0")
+    assert ConfigIndicator(0b010, 0).to_fanuc(q) == "F U T, 0, 0, -1"
+    assert ConfigIndicator(0b110, 0).to_fanuc(np.array([0, 0, 0, 0, -30, 0]) * DEG) == "N U T, 0, 0, 0"
+    assert ConfigIndicator(0b101, 0).to_fanuc(np.array([181, 0, 0, 540, 0, 180]) * DEG) == "F D B, 1, 0, 0"
+    assert ConfigIndicator(0b100, 0).to_fanuc(np.array([0, 0, 0, 0, 200, 0]) * DEG) == "N D T, 0, 1, 0"
+    assert ConfigIndicator(0, 0).to_fanuc(np.array([0, 0, 0, -180, 0, 0]) * DEG).endswith("-1, 0, 0")
 
 
 @pytest.mark.parametrize("params", [KR6_R700, LATERAL], ids=["kr6", "lateral"])

@@ -2,15 +2,18 @@
 
 These strings go into robot programs, so the definitions are spelled out here.
 
-KUKA Status (S, 3 bits) and Turn (T, one bit per axis), after the KUKA System Software manuals:
+KUKA Status (S, 3 bits) and Turn (T, one bit per axis), after the KUKA System Software 8.x
+operating and programming instructions for system integrators ("Status", "Turn"):
 
 - S bit 0 (overhead): the wrist point has x < 0 in the A1 coordinate system (the base frame turned
   with axis 1). 0 = basic area, 1 = overhead area.
-- S bit 1 (elbow): A3 >= phi, where phi is the A3 value of the stretched arm (forearm in line with
-  the upper arm, measured at the wrist point). 1 for the usual elbow-up working postures of KUKA arms
-  (e.g. A2 = -90 deg, A3 = +90 deg), 0 below phi. Taken modulo 360 deg: 1 iff A3 - phi lies in [0, 180).
-- S bit 2 (wrist): 1 iff A5 modulo 360 deg lies in [180, 360), i.e. -180 <= A5 < 0 for A5 in
-  [-180, 180); A5 = 0 gives 0, as in the KUKA manual.
+- S bit 1 (elbow): the wrist point lies in front of the line through the A2 and A3 axes (SPEC §6,
+  the KUKA-compatible definition of Beckhoff's TF5200 manual), seen in the arm plane turned with
+  A1, whichever way the URDF turns A3. On KUKA arms this is KUKA's A3 >= phi, phi the A3 value of
+  the stretched arm (forearm in line with the upper arm, measured at the wrist point), taken
+  modulo 360 deg: 1 for the usual elbow-up postures (e.g. A2 = -90 deg, A3 = +90 deg).
+- S bit 2 (wrist): the manual's table: 1 for -180 <= A5 < 0 deg and A5 >= 180 deg, 0 for
+  0 <= A5 < 180 deg and A5 < -180 deg; i.e. 1 iff A5 modulo 360 deg lies in [180, 360).
 - T bit i: 1 iff joint i+1 < 0 (the raw joint value, turns included).
 
 The wrist point is the KUKA "wrist root point", the intersection of the wrist axes (for a URDF whose
@@ -21,22 +24,31 @@ that the bits split the eight IK branches as they do for spherical wrists; see `
 String form `S110 T010011`: three status bits then six turn bits, each written most significant
 first, like KRL's 'B110' binary literals (leftmost = bit 2 resp. bit 5 = A6).
 
-ABB robtarget `confdata [cf1, cf4, cf6, cfx]`:
+ABB robtarget `confdata [cf1, cf4, cf6, cfx]` (Technical reference manual RAPID Instructions,
+Functions and Data types, data type confdata, robot configuration data for 6-axis robots):
 
 - cf1, cf4, cf6: quadrant of axis 1, 4, 6: floor(q / 90 deg) (0 for [0, 90), 1 for [90, 180),
   -1 for [-90, 0), -2 for [-180, -90), and onwards beyond +-180 deg).
 - cfx = 4 * (wrist point behind axis 1 = S bit 0) + 2 * (wrist point behind the lower arm =
-  not S bit 1) + (axis 5 negative = S bit 2): ABB's 0..7 table for six-axis arms.
+  not S bit 1; ABB's lower arm is the link from axis 2 to axis 3) + (axis 5 negative = S bit 2):
+  the manual's 0..7 table.
 
-Fanuc configuration string `F/N U/D T/B, t1, t4, t6`:
+FANUC configuration string `F|N U|D T|B, t4, t5, t6` (SPEC §6):
 
-- F (flip) iff S bit 2, else N; U (up) iff S bit 1, else D; T (front, "toward") iff not S bit 0, else
-  B (back).
-- t1, t4, t6: turn number of joints 1, 4, 6: the integer t with q - 360 deg * t in (-180, 180] deg.
-
-The elbow bit follows the robot's own A3 direction; for arms whose A3 increases as the forearm folds
-forward (KUKA, ABB, Fanuc conventions) it coincides with the vendor's "elbow up" / "in front of the
-lower arm" for front-area postures.
+- F (flip) when J5 >= 0, N when J5 < 0, J5 as the controller counts it, within its turn (the
+  turn number t5 holds whole turns). FANUC's flip is not KUKA's 'A5 < 0' bit: the RoboDK FANUC
+  post processor (ros-industrial-attic/robodk_postprocessors@d7e6c1c07758d67d2906cfd638049bdff88cca72,
+  Fanuc_R30iA.py line 616: "F means axis 5 >= 0, N means axis 5 < 0") and Tesseract's robot
+  configuration (tesseract-robotics/tesseract@f079ff409b733aeef78610d50f87fbacfb1385fe,
+  tesseract/tesseract_planning/tesseract_motion_planners/include/tesseract_motion_planners/robot_config.h,
+  lines 87-97: FUT for J5 >= 0, NUT for J5 < 0) agree.
+- U (up) when the elbow is above the shoulder-wrist line, D below: the same fact as S bit 1
+  (elbow above the line from the A2 axis to the wrist point = wrist point in front of the line
+  through the A2 and A3 axes), measured in the arm plane turned with J1, so a posture keeps its
+  letter when J2 alone swings the arm over the top (Tesseract's rule there: U for J3 < 90 deg).
+- T (front) when the wrist point is in front of J1 (not S bit 0), B (back) when behind.
+- t4, t5, t6: turn numbers of J4, J5, J6: the integer t with q - 360 deg * t in (-180, 180] deg.
+  A J2/J3 coupling (J3 counted from the horizontal) changes none of these.
 """
 
 from __future__ import annotations
@@ -107,11 +119,19 @@ class ConfigIndicator:
         return quadrant[0], quadrant[1], quadrant[2], int(cfx)
 
     def to_fanuc(self, q: FloatArray) -> str:
-        """Fanuc configuration string, e.g. `N U T, 0, 0, -1`, for joint values q (6,), rad."""
+        """FANUC configuration string, e.g. `N U T, 0, 0, -1`, for joint values q (6,), rad, that this
+        indicator describes (J4, J5, J6 as the controller counts them; see the module docstring)."""
         q = np.asarray(q, dtype=float)
-        letters = ("F" if self.wrist else "N", "U" if self.elbow else "D", "B" if self.overhead else "T")
-        turns = [int(np.ceil((q[i] - np.pi) / TWO_PI)) for i in (0, 3, 5)]
+        turns = [fanuc_turn(float(q[i])) for i in (3, 4, 5)]
+        # FANUC's flip is J5 >= 0 within its turn, not KUKA's wrist bit (A5 < 0).
+        flip = float(q[4]) - TWO_PI * turns[1] >= 0.0
+        letters = ("F" if flip else "N", "U" if self.elbow else "D", "B" if self.overhead else "T")
         return f"{' '.join(letters)}, {turns[0]}, {turns[1]}, {turns[2]}"
+
+
+def fanuc_turn(angle: float) -> int:
+    """FANUC turn number of a joint value, rad: the integer t with angle - 2 pi t in (-pi, pi]."""
+    return int(np.ceil((angle - np.pi) / TWO_PI))
 
 
 def turn_bits(q: FloatArray) -> IntArray:
@@ -215,8 +235,6 @@ def status_generic(model: pin.Model, frame_id: int, q: FloatArray) -> IntArray:
     return np.where(nan_rows, -1, status).astype(np.int64).reshape(batch)
 
 
-
-
 # ------------------------------------------------------------------ the controllers' own words
 
 def brand_text(brand: str, status: int, turn: int, q: FloatArray) -> str:
@@ -226,11 +244,10 @@ def brand_text(brand: str, status: int, turn: int, q: FloatArray) -> str:
     abb: robtarget confdata `[cf1,cf4,cf6,cfx]`: quadrants floor(q / 90 deg) of axes 1, 4, 6 and
     cfx = 4 (wrist centre behind axis 1) + 2 (behind the lower arm) + (axis 5 negative), the
     configuration table of the RAPID reference manual (data type confdata, 6-axis robots).
-    fanuc: `F|N U|D T|B, t4, t5, t6`: flip when J5 < 0, up when the elbow is above the
-    shoulder-wrist line (the same turn from upper arm to forearm as KUKA's elbow bit), T when the
-    wrist point is in front of J1, and the
-    turn numbers of J4, J5, J6 (0 for -180 < q <= 180 deg), as in the FANUC R-30iB operator's
-    manual ("Configuration"). ur: no configuration data ("").
+    fanuc: `F|N U|D T|B, t4, t5, t6`: flip when J5 >= 0 (within its turn), up when the elbow is
+    above the shoulder-wrist line (the same fact as KUKA's S bit 1), T when the wrist point is in
+    front of J1, and the turn numbers of J4, J5, J6 (0 for -180 < q <= 180 deg); the module
+    docstring gives the sources. ur: no configuration data ("").
     """
     ind = ConfigIndicator(status, turn)
     if brand == "kuka":
@@ -239,10 +256,7 @@ def brand_text(brand: str, status: int, turn: int, q: FloatArray) -> str:
         cf1, cf4, cf6, cfx = ind.to_abb(q)
         return f"[{cf1},{cf4},{cf6},{cfx}]"
     if brand == "fanuc":
-        qq = np.asarray(q, dtype=float)
-        letters = ("F" if ind.wrist else "N", "U" if ind.elbow else "D", "B" if ind.overhead else "T")
-        turns = [int(np.ceil((qq[i] - np.pi) / TWO_PI)) for i in (3, 4, 5)]
-        return f"{' '.join(letters)}, {turns[0]}, {turns[1]}, {turns[2]}"
+        return ind.to_fanuc(q)
     if brand == "ur":
         return ""
     raise ValueError(f"unknown controller brand {brand!r}")
