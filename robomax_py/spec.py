@@ -45,7 +45,7 @@ class ControllerSpec:
     """The robot's controller (SPEC §6): whose configuration data programs carry, and its frames."""
 
     brand: Brand = "kuka"
-    j23_coupling: bool = False        # FANUC: J3 as the controller counts it = J3 + J2 of the URDF
+    j23_coupling: bool = False        # FANUC: J3 as the controller counts it = J3 - J2 of the URDF
     T_root_base: FloatArray = field(default_factory=_identity)   # (4, 4) controller base in the URDF root
 
 

@@ -367,6 +367,11 @@ class _Builder:
                                              self.line))
                 return
             signal = identifier(mapped.signal)
+        else:
+            # A name of the controller's I/O configuration the cell maps to one of its signals.
+            named = next((i for i in self.cell.controller.inputs if i.name and i.name.lower() == signal.lower()), None)
+            if named is not None:
+                signal = identifier(named.signal)
         if any(obj.signal and identifier(obj.signal) == signal for obj in self.cell.objects):
             self.waited.add(signal)           # a clamp input: set once the clamp is closed, no time planned
             return

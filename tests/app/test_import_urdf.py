@@ -164,10 +164,11 @@ def test_srdf_pairs_are_not_checked(arms: dict[str, Path]) -> None:
 
 def test_configuration_data_is_geometric_on_a_fanuc_arm(arms: dict[str, Path]) -> None:
     # ROS-I FANUC arms turn J3 about -y. J2 = J3 = 0: upper arm vertical, forearm forward: the
-    # elbow is above the shoulder-wrist line (U), the wrist in front of J1 (T); J5 = -30 deg: flip.
+    # elbow is above the shoulder-wrist line (U), the wrist in front of J1 (T); J5 = -30 deg: no
+    # flip (FANUC's F is J5 >= 0, SPEC §6).
     robot = load_robot(load_robot_spec(arms["m20ia"] / "robot.yaml"))
     q = np.radians([0.0, 0.0, 0.0, 0.0, -30.0, 0.0])
-    assert config_text(robot, q) == "F U T, 0, 0, 0"
+    assert config_text(robot, q) == "N U T, 0, 0, 0"
     # Independently of the solver: the elbow letter from the joint origins (A2, A3 and the wrist
     # centre = the joint-5 origin of these URDFs) for J1 = 0, over the J3 range.
     import pinocchio as pin
@@ -180,7 +181,7 @@ def test_configuration_data_is_geometric_on_a_fanuc_arm(arms: dict[str, Path]) -
         a2, a3, w = (data.oMi[robot.model.getJointId(f"joint_{k}")].translation for k in (2, 3, 5))
         up = np.cross(a3 - a2, w - a3)[1] > 0
         front = w[0] > 0
-        want = f"N {'U' if up else 'D'} {'T' if front else 'B'}, 0, 0, 1"
+        want = f"F {'U' if up else 'D'} {'T' if front else 'B'}, 0, 0, 1"      # J5 = 0.5 rad: flip
         assert config_text(robot, q) == want
         letters.add(want[2])
     assert letters == {"U", "D"}

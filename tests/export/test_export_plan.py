@@ -46,7 +46,7 @@ def process_cell(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> 
     """The small cell with a door to wait for, clamp 1 behind an input, gun 2 and s8 welded longer
     with its own schedule; placed as a station places it (1.6 m off the origin, turned 30 deg, on a
     0.45 m riser tilted 2 deg), with the integrator's numbers: tool 2, user frame 3 on the fixture
-    plate, position registers 40 and 41 for the frames, the clamp on input 12."""
+    plate, position registers 40 and 41 for the frames, the clamp on input 5."""
     tmp = tmp_path_factory.mktemp("process")
     path = write_small_cell(tmp, name="process_cell")
     data = yaml.safe_load(path.read_text())
@@ -64,7 +64,7 @@ def process_cell(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> 
         "tool": {"number": 2, "name": "gun2"},
         "frame": {"number": 3, "object": "fixture_plate"},
         "registers": {"position": [40, 41]},
-        "inputs": {"clamp1_closed": {"number": 12, "name": "diClamp1Closed"}, "door_clear": 13},
+        "inputs": {"clamp1_closed": {"number": 5, "name": "diClamp1Closed"}, "door_clear": 6},
     }
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     return _planned(path)

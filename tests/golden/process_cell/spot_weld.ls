@@ -5,7 +5,7 @@ COMMENT		= "default weld";
 PROG_SIZE	= 0;
 FILE_NAME	= SPOT_WELD;
 VERSION		= 0;
-LINE_COUNT	= 4;
+LINE_COUNT	= 3;
 MEMORY_SIZE	= 0;
 PROTECT		= READ_WRITE;
 TCD:  STACK_SIZE	= 0,
@@ -19,7 +19,6 @@ CONTROL_CODE	= 00000000 00000000;
 /MN
    1:  ! default weld: rest AR[2] s ;
    2:  ! replace with the gun's package ;
-   3:  R[1:weld_time]=AR[2] ;
-   4:  WAIT R[1] ;
+   3:  WAIT AR[2] ;
 /POS
 /END

@@ -5,7 +5,7 @@ COMMENT		= "robomax_py";
 PROG_SIZE	= 0;
 FILE_NAME	= SMALL_CELL;
 VERSION		= 0;
-LINE_COUNT	= 28;
+LINE_COUNT	= 19;
 MEMORY_SIZE	= 0;
 PROTECT		= READ_WRITE;
 TCD:  STACK_SIZE	= 0,
@@ -19,32 +19,23 @@ CONTROL_CODE	= 00000000 00000000;
 /MN
    1:  ! robomax_py 0.1.0 | cell small_cell | cell file sha256 6bdd9e0710192b7603b20d63ba10c8d20d75769150c8bd427604ec09a0453a6e | planned cycle 5.089 s ;
    2:  ! robot kr125 | tool spot_gun_c | axes joint_a1 joint_a2 joint_a3 joint_a4 joint_a5 joint_a6 ;
-   3:  PR[1]=LPOS ;
-   4:  PR[1]=PR[1]-PR[1] ;
-   5:  PR[1,1]=200.000 ;
-   6:  PR[1,2]=0.000 ;
-   7:  PR[1,3]=270.000 ;
-   8:  PR[1,4]=-90.0000 ;
-   9:  PR[1,5]=0.0000 ;
-  10:  PR[1,6]=-90.0000 ;
-  11:  UTOOL[1]=PR[1] ;
-  12:  UTOOL_NUM=1 ;
-  13:  UFRAME_NUM=0 ;
-  14:  J P[1] 100% FINE ;
-  15:  J P[2] 100% CNT100 ;
-  16:  J P[3] 100% FINE ;
-  17:  L P[4] 500mm/sec FINE ;
-  18:  CALL SPOT_WELD(1,0.500) ;
-  19:  ! flange/s7 gun 1 schedule 1 ;
-  20:  L P[5] 500mm/sec CNT10 ;
-  21:  J P[6] 100% CNT10 ;
-  22:  L P[7] 500mm/sec FINE ;
-  23:  CALL SPOT_WELD(2,0.500) ;
-  24:  ! flange/s8 gun 1 schedule 1 ;
-  25:  L P[8] 500mm/sec CNT10 ;
-  26:  J P[9] 100% CNT25 ;
-  27:  J P[10] 100% CNT25 ;
-  28:  J P[11] 100% FINE ;
+   3:  UFRAME_NUM=0 ;
+   4:  UTOOL_NUM=1 ;
+   5:  J P[1] 100% FINE ;
+   6:  J P[2] 100% CNT100 ;
+   7:  J P[3] 100% FINE ;
+   8:  L P[4] 500mm/sec FINE ;
+   9:  CALL SPOT_WELD(1,0.500) ;
+  10:  ! flange/s7 gun 1 schedule 1 ;
+  11:  L P[5] 500mm/sec CNT10 ;
+  12:  J P[6] 100% CNT10 ;
+  13:  L P[7] 500mm/sec FINE ;
+  14:  CALL SPOT_WELD(2,0.500) ;
+  15:  ! flange/s8 gun 1 schedule 1 ;
+  16:  L P[8] 500mm/sec CNT10 ;
+  17:  J P[9] 100% CNT25 ;
+  18:  J P[10] 100% CNT25 ;
+  19:  J P[11] 100% FINE ;
 /POS
 P[1]{
    GP1:
@@ -66,13 +57,13 @@ P[3]{
 };
 P[4]{
    GP1:
-	UF : 0, UT : 1,		CONFIG : 'N U T, 0, 0, 0',
+	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 0',
 	X = 1346.720  mm,	Y = -84.790  mm,	Z = 875.510  mm,
 	W = 79.6313 deg,	P = -1.2535 deg,	R = 97.4375 deg
 };
 P[5]{
    GP1:
-	UF : 0, UT : 1,		CONFIG : 'N U T, 0, 0, 0',
+	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 0',
 	X = 1394.135  mm,	Y = -78.793  mm,	Z = 884.252  mm,
 	W = 79.6313 deg,	P = -1.2535 deg,	R = 97.4375 deg
 };
@@ -84,13 +75,13 @@ P[6]{
 };
 P[7]{
    GP1:
-	UF : 0, UT : 1,		CONFIG : 'N U T, 0, 0, 0',
+	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 0',
 	X = 1348.500  mm,	Y = 0.000  mm,	Z = 880.000  mm,
 	W = 79.6309 deg,	P = -1.2561 deg,	R = 99.8489 deg
 };
 P[8]{
    GP1:
-	UF : 0, UT : 1,		CONFIG : 'N U T, 0, 0, 0',
+	UF : 0, UT : 1,		CONFIG : 'F U T, 0, 0, 0',
 	X = 1395.594  mm,	Y = 7.982  mm,	Z = 888.738  mm,
 	W = 79.6309 deg,	P = -1.2561 deg,	R = 99.8489 deg
 };

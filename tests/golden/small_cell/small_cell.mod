@@ -7,8 +7,6 @@ MODULE small_cell
   ! robomax_py 0.1.0 | cell small_cell | cell file sha256 6bdd9e0710192b7603b20d63ba10c8d20d75769150c8bd427604ec09a0453a6e | planned cycle 5.089 s
   ! robot kr125 | tool spot_gun_c | axes joint_a1 joint_a2 joint_a3 joint_a4 joint_a5 joint_a6
   ! RAPID module: mm, deg, quaternions [w, x, y, z], speeddata mm/s, zonedata mm
-  PERS tooldata spot_gun_c_tcp := [TRUE, [[200.000, 0.000, 270.000], [0.500000000, -0.500000000, 0.500000000, -0.500000000]], [1, [0, 0, 0.001], [1, 0, 0, 0], 0, 0, 0]];  ! load: replace with the gun's (LoadIdentify)
-  PERS wobjdata robot_base := [FALSE, TRUE, "", [[0.000, 0.000, 0.000], [1.000000000, 0.000000000, 0.000000000, 0.000000000]], [[0, 0, 0], [1, 0, 0, 0]]];
   CONST jointtarget jt1 := [[0.0000, -90.0000, 90.0000, 0.0000, 0.0000, 0.0000], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
   CONST zonedata z_1 := [FALSE, 51.899617, 77.849425, 77.849425, 7.784943, 77.849425, 7.784943];
   CONST jointtarget jt2 := [[6.6170, -105.8301, 123.4674, -4.1696, 62.6530, -164.4578], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
@@ -32,21 +30,21 @@ MODULE small_cell
     ! start at home; 2 spots, planned cycle 5.089 s
     VelSet 100.0, 5000;
     AccSet 100.0, 100;
-    MoveAbsJ jt1, vmax, fine, spot_gun_c_tcp \WObj:=robot_base;  ! home
-    MoveAbsJ jt2, vmax, z_1, spot_gun_c_tcp \WObj:=robot_base;  ! home -> s7, t 0.000 s, detour point 1
-    MoveAbsJ jt3, vmax, fine, spot_gun_c_tcp \WObj:=robot_base;
+    MoveAbsJ jt1, vmax, fine, spot_gun_c_tcp;  ! home
+    MoveAbsJ jt2, vmax, z_1, spot_gun_c_tcp;  ! home -> s7, t 0.000 s, detour point 1
+    MoveAbsJ jt3, vmax, fine, spot_gun_c_tcp;
     ! flange/s7: arrive 1.610 s, leave 2.110 s, alpha -10.0 beta 10.0 gamma 0.0 deg
-    MoveL p4, v_lin1, fine, spot_gun_c_tcp \WObj:=robot_base;  ! approach
+    MoveL p4, v_lin1, fine, spot_gun_c_tcp;  ! approach
     spot_weld 1, 0.500;  ! flange/s7 gun 1 schedule 1
-    MoveL p5, v_lin1, z_2, spot_gun_c_tcp \WObj:=robot_base;  ! retract
-    MoveAbsJ jt6, vmax, z_3, spot_gun_c_tcp \WObj:=robot_base;  ! s7 -> s8, t 2.317 s
+    MoveL p5, v_lin1, z_2, spot_gun_c_tcp;  ! retract
+    MoveAbsJ jt6, vmax, z_3, spot_gun_c_tcp;  ! s7 -> s8, t 2.317 s
     ! flange/s8: arrive 2.711 s, leave 3.211 s, alpha -10.0 beta 10.0 gamma 0.0 deg
-    MoveL p7, v_lin1, fine, spot_gun_c_tcp \WObj:=robot_base;  ! approach
+    MoveL p7, v_lin1, fine, spot_gun_c_tcp;  ! approach
     spot_weld 2, 0.500;  ! flange/s8 gun 1 schedule 1
-    MoveL p8, v_lin1, z_4, spot_gun_c_tcp \WObj:=robot_base;  ! retract
-    MoveAbsJ jt9, vmax, z_5, spot_gun_c_tcp \WObj:=robot_base;  ! s8 -> home, t 3.426 s, detour point 1
-    MoveAbsJ jt10, vmax, z_6, spot_gun_c_tcp \WObj:=robot_base;  ! detour point 2
-    MoveAbsJ jt11, vmax, fine, spot_gun_c_tcp \WObj:=robot_base;
+    MoveL p8, v_lin1, z_4, spot_gun_c_tcp;  ! retract
+    MoveAbsJ jt9, vmax, z_5, spot_gun_c_tcp;  ! s8 -> home, t 3.426 s, detour point 1
+    MoveAbsJ jt10, vmax, z_6, spot_gun_c_tcp;  ! detour point 2
+    MoveAbsJ jt11, vmax, fine, spot_gun_c_tcp;
   ENDPROC
 
   PROC spot_weld(num n, num weld_time)
