@@ -363,7 +363,7 @@ def _register(line: _Line, code: str, state: _State) -> None:
                 reg.values[index - 1] = math.nan
             return
         if reg is None:
-            state.issue(line, "alarm", f"PR[{element.group(1)}] is uninitialised: its elements cannot be set")
+            state.issue(line, "undefined", f"PR[{element.group(1)}] is neither set by the program nor given")
             return
         if not 1 <= index <= len(reg.values):
             state.issue(line, "alarm", f"PR element {index} does not exist")
@@ -389,7 +389,7 @@ def _register(line: _Line, code: str, state: _State) -> None:
     a = state.registers.get(int(terms.group(1)))
     b = state.registers.get(int(terms.group(3))) if terms.group(3) else None
     if a is None or (terms.group(3) and b is None):
-        state.issue(line, "alarm", "arithmetic on an uninitialised position register")
+        state.issue(line, "undefined", "a position register neither set by the program nor given")
         state.registers.pop(target, None)
         return
     if b is None:
