@@ -35,8 +35,8 @@ fanuc_joint_streamer_node.cpp 73-74, launch files ``J23_factor`` = 1).
   (`controller_joints_deg`, `urdf_joints_deg`). The model returns joint values as written.
 
 Outside this subset (control flow, position registers as targets, Offset / Tool_Offset / INC /
-RTCP, circular and arc motions, TB / TA / DB and point logic, other motion groups, register
-waits) a statement is an ``unsupported`` issue.
+RTCP, circular and arc motions, TB / TA / DB and point logic, other motion groups and extended
+axes E1.. not at 0, register waits) a statement is an ``unsupported`` issue.
 """
 
 from __future__ import annotations
@@ -90,7 +90,7 @@ class _Position:
     config: FanucConfig | None
     cartesian: tuple[float, ...] | None    # X, Y, Z mm, W, P, R deg
     joints: tuple[float, ...] | None       # J1.. deg
-    other_groups: bool
+    other_groups: bool                     # other motion groups, or extended axes (E1..) not at 0
     problem: str | None                    # why the position cannot be used
 
 
@@ -235,13 +235,14 @@ def _position(text: str, where: Where) -> _Position:
         if m:
             values[key] = float(m.group(1))
     joints = {int(m.group(1)): float(m.group(2)) for m in re.finditer(rf"\bJ(\d)\s*=\s*{_FIELD}\s*deg", body)}
+    external = any(float(m.group(2)) != 0.0 for m in re.finditer(rf"\bE(\d)\s*=\s*{_FIELD}", body))
     cartesian = tuple(values[k] for k in "XYZWPR") if len(values) == 6 else None
     joint_values = tuple(joints[i] for i in range(1, 7)) if all(i in joints for i in range(1, 7)) else None
     if cartesian is None and joint_values is None:
         problem = problem or "neither X, Y, Z, W, P, R nor J1..J6"
     if cartesian is not None and config is None:
         problem = problem or "Cartesian position without CONFIG"
-    return _Position(where, uf_num, ut_num, config, cartesian, joint_values, len(bodies) > 1, problem)
+    return _Position(where, uf_num, ut_num, config, cartesian, joint_values, len(bodies) > 1 or external, problem)
 
 
 def _config(text: str) -> FanucConfig | None:
@@ -438,7 +439,8 @@ def _motion(line: _Line, statement: str, rest: str, positions: dict[int, _Positi
         state.issue(line, "unsupported", f"P[{index}]: {position.problem}")
         return
     if position.other_groups:
-        state.issue(line, "unsupported", f"P[{index}] moves other motion groups too (only GP1 is modelled)")
+        state.issue(line, "unsupported", f"P[{index}] moves other motion groups or extended axes too (only GP1's "
+                                         "six axes are modelled)")
     tool = state.utools.get(position.ut)
     user = state.uframes.get(position.uf)
     blend = None if termination == "FINE" else termination

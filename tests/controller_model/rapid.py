@@ -10,7 +10,8 @@ abb_rapid_msgs/msg/RobTarget.msg, WObjData.msg, ToolData.msg, ConfData.msg).
   object coordinate system ... If no work object is specified then this is the world coordinate
   system"; rot a quaternion [q1, q2, q3, q4], q1 the scalar part, which must be normalised (the
   model reports a norm off by more than `QUATERNION_NORM_TOL`; ABB states no tolerance); robconf
-  confdata [cf1, cf4, cf6, cfx] kept as written; extax ignored (no external axes modelled).
+  confdata [cf1, cf4, cf6, cfx] kept as written; extax: a value other than 9E9 (an external
+  axis that moves) is reported, external axes are not modelled.
 - jointtarget ``[robax, extax]``: robax in degrees as the controller counts them.
 - tooldata ``[robhold, tframe, tload]``: robhold TRUE = the robot holds the tool; tframe is the
   TCP "in mm, expressed in the wrist coordinate system (tool0)".
@@ -165,7 +166,7 @@ def _statements(text: str, name: str) -> list[_Statement]:
             start = number
         buffer = f"{buffer} {code}".strip()
         raw = f"{raw} {line.strip()}".strip()
-        if buffer.endswith(";") or (_BLOCK.match(buffer) and not buffer.upper().startswith(("LOCAL PERS",))):
+        if buffer.endswith(";") or _BLOCK.match(buffer):
             out.append(_Statement(Where(name, start), buffer.rstrip(";").strip(), raw))
             buffer, raw = "", ""
     if buffer:
@@ -356,8 +357,8 @@ def _motion(st: _Statement, name: str, args: _Args, state: _State) -> None:
             return
         target, _, zone, tool_name = args.positional
     blend = None if _stops(zone, state) else zone
-    tool = _frame_data(st, tool_name, "tooldata", state)
-    wobj = _frame_data(st, args.optional.get("WOBJ") or "wobj0", "wobjdata", state)
+    tool = _literal_or_data(st, tool_name, "tooldata", state)
+    wobj = _literal_or_data(st, args.optional.get("WOBJ") or "wobj0", "wobjdata", state)
     T_flange_tcp = _tool_frame(st, tool, state) if tool is not None else None
     T_base_user = _user_frame(st, wobj, state) if wobj is not None else None
     if upper == "MOVEABSJ":
@@ -384,6 +385,9 @@ def _motion(st: _Statement, name: str, args: _Args, state: _State) -> None:
         return
     if not _quaternion_ok([value[0], value[1]]):
         state.issue(st, "alarm", "robtarget orientation is not a normalised quaternion")
+    extax = value[3] if isinstance(value[3], list) else []
+    if any(not (isinstance(e, float) and e >= 9e9) for e in extax):
+        state.issue(st, "unsupported", "external axis values (not 9E9) are not modelled")
     config = RapidConfig(*(int(c) for c in conf))
     T_base_tcp = T_base_user @ T_user_tcp if T_base_user is not None else None
     kind: MotionKind = "linear" if upper in ("MOVEL", "SPOTL") else "joint"
@@ -417,10 +421,6 @@ def _literal_or_data(st: _Statement, text: str, type_: str, state: _State) -> Va
         state.issue(st, "unsupported", f"{text} is a {data.type}, not a {type_}")
         return None
     return data.value
-
-
-def _frame_data(st: _Statement, name: str, type_: str, state: _State) -> Value | None:
-    return _literal_or_data(st, name, type_, state)
 
 
 def _tool_frame(st: _Statement, tool: Value, state: _State) -> FloatArray | None:

@@ -169,3 +169,12 @@ def test_j2_j3_coupling_counts_j3_from_the_horizontal() -> None:
     assert urdf_joints_deg(controller, j23_coupling=True) == urdf
     assert controller_joints_deg(urdf, j23_coupling=False) == urdf
     assert run_fanuc(PROGRAM, utools={2: T_TOOL}, j23_coupling=True).j23_coupling
+
+
+def test_extended_axes_are_reported() -> None:
+    position = _joint(1, 0, 0, (0, 0, 0, 0, -90, 0)).replace("\n};", ",\tE1= 350.000  mm\n};")
+    program = HEADER.format(name="RAIL") + "   1:  UFRAME_NUM=0 ;\n   2:  UTOOL_NUM=0 ;\n   3:J P[1] 100% FINE ;\n" \
+        + "/POS\n" + position + "/END\n"
+    run = run_fanuc(program)
+    assert len(run.motions) == 1
+    assert [(i.where.line, i.kind) for i in run.issues] == [(8, "unsupported")]

@@ -147,3 +147,16 @@ ENDMODULE
     assert_allclose(_known(m.T_base_tcp), _pose((1.0, 0.0, 0.8), np.diag([-1.0, 1.0, -1.0])), atol=POS_TOL_M)
     (call,) = run.calls
     assert (call.name, call.args) == ("SpotL", ("spot1", "gun1"))
+
+
+def test_external_axis_values_are_reported() -> None:
+    module = """MODULE M
+  PROC main()
+    MoveL [[0, 0, 0], [1, 0, 0, 0], [0, 0, 0, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]], v100, fine, tool0;
+    MoveL [[0, 0, 0], [1, 0, 0, 0], [0, 0, 0, 0], [1500, 9E9, 9E9, 9E9, 9E9, 9E9]], v100, fine, tool0;
+  ENDPROC
+ENDMODULE
+"""
+    run = run_rapid([module])
+    assert len(run.motions) == 2
+    assert [(i.where.line, i.kind) for i in run.issues] == [(4, "unsupported")]
