@@ -414,7 +414,7 @@ def _motion(line: _Line, statement: str, rest: str, positions: dict[int, _Positi
         state.issue(line, "unsupported", "motion to a position register (its value is not modelled)")
         return
     index, tail = int(target.group(1)), target.group(2)
-    m = re.match(r"^(\S+)\s+(FINE|CNT\s*\d+|CNT\s+R\[[^\]]*\]|CR\s*\d+)\s*(.*)$", tail, re.IGNORECASE)
+    m = re.match(r"^(R\[[^\]]*\]\S*|\S+)\s+(FINE|CNT\s*\d+|CNT\s+R\[[^\]]*\]|CR\s*\d+)\s*(.*)$", tail, re.IGNORECASE)
     if not m:
         state.issue(line, "unsupported", "speed or termination outside the modelled subset")
         return

@@ -124,3 +124,24 @@ def test_an_unknown_tcp_is_reported() -> None:
     assert run.motions[0].T_flange_tcp is None
     run = run_urscript("movel(p[0.1, 0, 0, 0, 0, 0])\n", tcp=np.eye(4))
     assert run.clean
+
+
+def test_a_def_called_at_the_top_level_runs_and_input_waits_read_both_ways() -> None:
+    script = """def prog():
+  set_tcp(p[0, 0, 0.1, 0, 0, 0])
+  movel(p[0.5, 0, 0.5, 0, 0, 0], 1.2, 0.25, 0, 0)
+  while (get_standard_digital_in(5) != True):
+    sync()
+  end
+  while get_standard_digital_in(6) == True:
+    sleep(0.01)
+  end
+end
+
+prog()
+"""
+    run = run_urscript(script)
+    assert run.clean, run.issues
+    (m,) = run.motions
+    assert m.where.line == 3 and m.stops
+    assert [(w.input_number, w.state) for w in run.waits] == [(5, True), (6, False)]

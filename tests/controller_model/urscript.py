@@ -20,9 +20,11 @@ rotation vector).
   ``pose_trans(p_from, p_from_to)`` = p_from · p_from_to. Pose and joint-vector variables
   (``name = p[...]``, ``global``) hold their value.
 - ``def name(): ... end`` defines a function: a call is recorded (name, args), not followed; a call
-  of a defined function that moves or sets the TCP is reported. ``sleep(t)`` waits t s; the loop
-  ``while not get_standard_digital_in(n): sync() end`` waits for input n.
-- A script that is one ``def`` runs that function's body.
+  of a defined function that moves or sets the TCP is reported. ``sleep(t)`` waits t s; a loop
+  doing only ``sync()`` / ``sleep`` while a standard digital input is not yet in a state
+  (``while not get_standard_digital_in(n):``, ``while (get_standard_digital_in(n) != True):``,
+  ...) waits for it.
+- A script that is one ``def``, or ``def`` blocks and one call of one of them, runs that function.
 
 Outside this subset (control flow, threads, other motion functions, pose arithmetic other than
 pose_trans, inverse kinematics in the script, functions the model does not know) a statement is
@@ -111,11 +113,32 @@ def run_urscript(script: str, *, name: str = "program.script", tcp: FloatArray |
     lines = [_Line(Where(name, i), strip_comment(raw, "#").strip(), raw) for i, raw in enumerate(script.splitlines(), 1)]
     lines = [ln for ln in lines if ln.code and not ln.code.startswith("$")]   # "$ 2 ..." PolyScope line markers
     state = _State(tool=tcp, variables={k: _Var(pose=v) for k, v in (variables or {}).items()})
-    body = lines
-    if lines and re.match(r"^def\s+\w+\s*\(\s*\)\s*:$", lines[0].code) and _block_end(lines, 0) == len(lines) - 1:
-        body = lines[1:-1]
-    _block(body, state)
+    _block(_program_body(lines), state)
     return ProgramRun("urscript", tuple(state.events), tuple(state.issues))
+
+
+def _program_body(lines: list[_Line]) -> list[_Line]:
+    """What the controller runs: the body of a script that is one ``def`` (as PolyScope sends it),
+    or that is ``def`` blocks and one call of one of them without arguments (as RoboDK writes it);
+    otherwise the script's top level."""
+    top: list[tuple[int, int]] = []   # (first, last) index of each top-level statement or block
+    i = 0
+    while i < len(lines):
+        end = _block_end(lines, i) if _opens(lines[i].code) else i
+        top.append((i, end))
+        i = end + 1
+    defs = {m.group(1): (a, b) for a, b in top
+            if (m := re.match(r"^def\s+(\w+)\s*\(\s*\)\s*:$", lines[a].code)) and b < len(lines)}
+    rest = [lines[a].code for a, b in top if not re.match(r"^def\s", lines[a].code)]
+    if len(top) == 1 and defs:
+        a, b = next(iter(defs.values()))
+        return lines[a + 1:b]
+    called = re.fullmatch(r"(\w+)\(\s*\)", rest[0]) if len(rest) == 1 else None
+    if called and called.group(1) in defs and len(top) == len(defs) + 1:
+        a, b = defs[called.group(1)]
+        return [ln for first, last in top if first != a for ln in lines[first:last + 1]
+                if re.match(r"^def\s", lines[first].code)] + lines[a + 1:b]
+    return lines
 
 
 def _opens(code: str) -> bool:
@@ -138,6 +161,25 @@ def _block_end(lines: list[_Line], start: int) -> int:
     return len(lines)
 
 
+def _input_wait(code: str) -> tuple[int, bool] | None:
+    """(input, awaited state) of a loop header that waits for a standard digital input:
+    ``while not get_standard_digital_in(n):``, ``while get_standard_digital_in(n):`` or
+    ``while (get_standard_digital_in(n) != True):`` (``==``, ``False`` likewise)."""
+    text = re.sub(r"^while\s*|\s*:$", "", code).strip()
+    while text.startswith("(") and text.endswith(")"):
+        text = text[1:-1].strip()
+    negated = text.startswith("not ")
+    text = text.removeprefix("not ").strip()
+    m = re.fullmatch(r"\(?\s*get_standard_digital_in\(\s*(\d+)\s*\)\s*\)?(?:\s*(==|!=)\s*(True|False))?", text)
+    if not code.startswith("while") or not m:
+        return None
+    loops_while = not negated   # the loop runs while the input is True
+    if m.group(2):
+        loops_while = (m.group(2) == "==") == (m.group(3) == "True")
+        loops_while = loops_while != negated
+    return int(m.group(1)), not loops_while
+
+
 def _moves(body: list[_Line]) -> bool:
     return any(re.match(r"^(movej|movel|movep|movec|servoj|speedj|speedl|set_tcp)\s*\(", ln.code) for ln in body)
 
@@ -153,13 +195,13 @@ def _block(lines: list[_Line], state: _State) -> None:
             state.functions[definition.group(2)] = lines[i + 1:end]
             i = end + 1
             continue
-        wait = re.fullmatch(r"while\s*\(?\s*(not\s+)?get_standard_digital_in\(\s*(\d+)\s*\)\s*\)?\s*:", code)
-        if wait:
+        wait = _input_wait(code)
+        if wait is not None:
             end = _block_end(lines, i)
             inner = [ln.code for ln in lines[i + 1:end]]
             if all(re.fullmatch(r"sync\(\)|sleep\(\s*[\d.]+\s*\)", c) for c in inner):
-                state.events.append(Wait(line.where, signal=f"get_standard_digital_in({wait.group(2)})",
-                                         input_number=int(wait.group(2)), state=bool(wait.group(1))))
+                state.events.append(Wait(line.where, signal=f"get_standard_digital_in({wait[0]})",
+                                         input_number=wait[0], state=wait[1]))
                 i = end + 1
                 continue
         if re.match(r"^(if|elif|else|while|for|return|break|continue|halt|run|kill|join)\b", code):
