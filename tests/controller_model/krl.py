@@ -70,7 +70,6 @@ from .common import (
 _AXES = ("A1", "A2", "A3", "A4", "A5", "A6")
 _CART = ("X", "Y", "Z", "A", "B", "C")
 _POSITION_TYPES = {"E6POS", "POS", "FRAME", "E6AXIS", "AXIS"}
-_APPROX = {"C_PTP", "C_DIS", "C_VEL", "C_ORI"}
 # Assignments that change speed, acceleration, approximation, outputs or the display only.
 _INERT_SYSVARS = re.compile(
     r"^\$(VEL|VEL_AXIS|ACC|ACC_AXIS|APO|ADVANCE|OV_PRO|OUT|BWDSTART|LOAD|ORI_TYPE|CIRC_TYPE|ACT_TOOL|"
@@ -80,8 +79,8 @@ _INERT_BAS = {"PTP_DAT", "CP_DAT", "VEL_PTP", "VEL_CP", "ACC_PTP", "ACC_CP", "OU
 _FRAME_BAS = {"PTP_PARAMS", "CP_PARAMS", "FRAMES"}
 _CONTROL = re.compile(
     r"^(IF|ELSE|ENDIF|FOR|ENDFOR|WHILE|ENDWHILE|LOOP|ENDLOOP|REPEAT|UNTIL|SWITCH|CASE|DEFAULT|ENDSWITCH|"
-    r"GOTO|EXIT|HALT|RETURN|CONTINUE|BRAKE|RESUME|TRIGGER|ON_ERROR_PROCEED|ERR_RAISE|ANIN|ANOUT|"
-    r"PULSE|ASYPTP|ASYSTOP|ASYCONT|ASYCANCEL)\b", re.IGNORECASE)
+    r"GOTO|EXIT|HALT|RETURN|CONTINUE|BRAKE|RESUME|TRIGGER|ON_ERROR_PROCEED|ERR_RAISE|ASYPTP|ASYSTOP|ASYCONT|"
+    r"ASYCANCEL)\b", re.IGNORECASE)
 _UNSUPPORTED_MOTION = re.compile(
     r"^(PTP_REL|LIN_REL|CIRC|CIRC_REL|SPTP|SPTP_REL|SLIN|SLIN_REL|SCIRC|SCIRC_REL|SPL|SPLINE|ENDSPLINE|"
     r"PTP_SPLINE|ENDPTP_SPLINE|TIME_BLOCK|CONST_VEL)\b", re.IGNORECASE)
@@ -121,9 +120,9 @@ class _State:
 
 
 def run_krl(src: str, dat: str = "", *, src_name: str = "program.src", dat_name: str = "program.dat",
-            data: Mapping[str, str] | None = None, setup: Mapping[str, str] | None = None, tool_data: Mapping[int, FloatArray] | None = None,
-            base_data: Mapping[int, FloatArray] | None = None, tool: FloatArray | None = None,
-            base: FloatArray | None = None) -> ProgramRun:
+            data: Mapping[str, str] | None = None, setup: Mapping[str, str] | None = None,
+            tool_data: Mapping[int, FloatArray] | None = None, base_data: Mapping[int, FloatArray] | None = None,
+            tool: FloatArray | None = None, base: FloatArray | None = None) -> ProgramRun:
     """Runs the first routine (``DEF``) of `src`, with the points of `dat`, as KSS 8.x would.
 
     Parameters
@@ -386,6 +385,8 @@ def _execute(line: _Line, state: _State, moving: set[str]) -> None:
         if name == "BAS":
             _bas(line, args, state)
             return
+        if name == "PULSE":
+            return   # an output pulse
         if name in moving:
             state.issue(line, "unsupported", f"{call.group(1)} moves the robot or changes frames; calls are not followed")
         state.events.append(Call(line.where, call.group(1), tuple(arg_value(a) for a in args)))
