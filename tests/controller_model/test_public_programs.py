@@ -1,0 +1,123 @@
+"""The models on real programs from public repositories (tests/data/programs, see SOURCES.md there):
+each is read without an exception, its motion subset is executed, and everything outside the
+subset is reported at its line instead of being skipped."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from controller_model.common import FanucConfig, FloatArray, ProgramRun
+from controller_model.fanuc import run_fanuc
+from controller_model.krl import run_krl
+from controller_model.rapid import run_rapid
+from controller_model.urscript import run_urscript
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "programs"
+POS_TOL_M = 1e-9
+
+
+def _text(name: str) -> str:
+    return (DATA / name).read_text(encoding="utf-8", errors="replace")
+
+
+READERS: dict[str, Callable[[str], ProgramRun]] = {
+    "ros_rsi.src": lambda n: run_krl(_text(n), src_name=n),
+    "Grey_T_ROB1.mod": lambda n: run_rapid({n: _text(n)}),
+    "test_4.mod": lambda n: run_rapid({n: _text(n)}),
+    "ros_movesm.ls": lambda n: run_fanuc(_text(n), name=n),
+    "up222.ls": lambda n: run_fanuc(_text(n), name=n),
+    "timing_debug.script": lambda n: run_urscript(_text(n), name=n),
+}
+
+
+def _known(T: FloatArray | None) -> FloatArray:
+    assert T is not None, "the model left this frame undefined"
+    return T
+
+
+@pytest.mark.parametrize("name", sorted(READERS))
+def test_every_issue_names_a_real_statement(name: str) -> None:
+    run = READERS[name](name)
+    lines = _text(name).splitlines()
+    assert run.issues, "a real program outside the subset reads without a single issue"
+    for issue in run.issues:
+        assert issue.where.source == name
+        text = lines[issue.where.line - 1].strip()
+        assert text and issue.text.startswith(text), (issue, text)
+
+
+def _unsupported_lines(run: ProgramRun) -> set[int]:
+    return {i.where.line for i in run.unsupported}
+
+
+def test_kuka_rsi_program() -> None:
+    run = READERS["ros_rsi.src"]("ros_rsi.src")
+    assert [m.joints_deg for m in run.motions] == [(0.0, -90.0, 90.0, 0.0, 90.0, 0.0)] * 2
+    assert [c.name for c in run.calls] == ["RSI_MOVECORR"]   # a sensor-guided motion: recorded, not followed
+    # RSI_CREATE / RSI_ON / RSI_OFF in assignments and the IF ... HALT ... ENDIF around each
+    assert _unsupported_lines(run) == {72, 73, 74, 75, 78, 79, 80, 81, 87, 88, 89, 90}
+    assert {i.kind for i in run.issues} == {"unsupported"}
+
+
+def test_abb_synchronised_program() -> None:
+    run = READERS["Grey_T_ROB1.mod"]("Grey_T_ROB1.mod")
+    first, second = run.motions[:2]
+    assert len(run.motions) == 11 and first.statement == "MoveAbsJ"
+    assert first.joints_deg == (82.467, -17.016, 48.414, 85.948, 96.306, -31.779)
+    # DefaultFrame has identity frames, so the TCP is the robtarget; q = [0.5, 0.5, 0.5, 0.5]
+    assert_allclose(_known(second.T_base_tcp)[:3, 3], [0.61391, 2.32615, 1.04068], atol=POS_TOL_M)
+    assert_allclose(_known(second.T_base_tcp)[:3, :3], [[0, 0, 1], [1, 0, 0], [0, 1, 0]], atol=1e-12)
+    # ConfL \Off, SyncMoveOn, SyncMoveOff, and the track (extax a) each MoveJ moves
+    assert _unsupported_lines(run) == {11, 12, 24} | set(range(14, 24))
+
+
+def test_abb_gripper_program() -> None:
+    run = READERS["test_4.mod"]("test_4.mod")
+    assert [m.statement for m in run.motions] == ["MoveJ", "MoveL", "MoveL", "MoveJ", "MoveJ", "MoveL"]
+    assert [w.seconds for w in run.waits] == [None, 0.9, 1.0, 0.9, 1.0]
+    assert run.waits[0].signal == "Stavbar_opt" and run.waits[0].state is False
+    # the tool is custom_tool1's tframe
+    assert_allclose(_known(run.motions[0].T_flange_tcp)[:3, 3], [-0.14418, -0.1544, 0.03477], atol=POS_TOL_M)
+    # ConfL \Off, ConfJ \Off, IF, ENDIF, and extax a = 0 (an external axis, if there is one, goes to 0)
+    assert _unsupported_lines(run) == {6, 7, 10, 12} | {m.where.line for m in run.motions}
+
+
+def test_fanuc_ros_relay_program() -> None:
+    run = READERS["ros_movesm.ls"]("ros_movesm.ls")
+    assert not run.motions            # its only motion goes to a position register
+    assert _unsupported_lines(run) == {33, 43, 46}     # WAIT on a flag, J PR[...], JMP
+    assert [(i.where.line, i.kind) for i in run.issues if i.kind != "unsupported"] == [(36, "undefined")]
+
+
+def test_fanuc_backup_program() -> None:
+    run = READERS["up222.ls"]("up222.ls")
+    assert len(run.motions) == 25
+    first = run.motions[0]
+    assert isinstance(first.config, FanucConfig) and first.config.text == "N U T, 0, 0, 0"
+    assert_allclose(_known(first.T_base_tcp)[:3, 3], [1.111865, 0.118787, 1.806347], atol=POS_TOL_M)
+    R = _known(first.T_base_tcp)[:3, :3]
+    w, p, r = np.radians([-70.737, 11.951, -35.487])
+    Rz = np.array([[np.cos(r), -np.sin(r), 0], [np.sin(r), np.cos(r), 0], [0, 0, 1]])
+    Ry = np.array([[np.cos(p), 0, np.sin(p)], [0, 1, 0], [-np.sin(p), 0, np.cos(p)]])
+    Rx = np.array([[1, 0, 0], [0, np.cos(w), -np.sin(w)], [0, np.sin(w), np.cos(w)]])
+    assert_allclose(R, Rz @ Ry @ Rx, atol=1e-12)
+    # its tool frames live on the controller: each Cartesian motion reports UTOOL[n] as undefined
+    assert sum(i.kind == "undefined" for i in run.issues) == 25
+    # every motion line carries TB ..,P-SPS (a program run before the end of the motion), point logic
+    # follows it, and positions move three more motion groups
+    motion_lines = {m.where.line for m in run.motions}
+    assert motion_lines <= _unsupported_lines(run)
+
+
+def test_ur_polyscope_program() -> None:
+    run = READERS["timing_debug.script"]("timing_debug.script")
+    assert not run.motions
+    unsupported = {i.where.line: i.text for i in run.unsupported}
+    assert {179, 183} <= set(unsupported)           # movej(get_inverse_kin(...)): IK in the script
+    assert unsupported[171] == "while (True):"
+    assert all("run " in unsupported[line] for line in (46, 104, 141, 160, 170))   # threads started
