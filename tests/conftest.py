@@ -65,6 +65,44 @@ def place_cell(data: dict[str, Any], xyz: tuple[float, float, float], yaw_deg: f
                 spot[k] = [round(float(v), 12) for v in T[:3, :3] @ np.asarray(spot[k], dtype=float)]
 
 
+# Where the small cell's robot passes about 0.8 s into its first move (tests/plan/test_waiting.py
+# derives it from the plan; frozen here so the process cell is a fixed file).
+DOOR = {"name": "door", "box": [0.12, 0.12, 0.12], "pose": {"xyz": [1.4616, -0.0182, 1.2151]}, "present": [[0, 1.5]]}
+
+
+def _write_process_cell(folder: Path, name: str = "process_cell") -> Path:
+    """The small cell with a door to wait for, clamp 1 behind an input, gun 2 and s8 welded longer
+    with its own schedule; placed as a station places it (1.6 m off the origin, turned 30 deg, on a
+    0.45 m riser tilted 2 deg), with the integrator's numbers: tool 2, user frame 3 on the fixture
+    plate, position registers 40 and 41 for the frames, the clamp on input 5, the door on 6."""
+    path = _write_small_cell(folder, name=name)
+    data = yaml.safe_load(path.read_text())
+    data["dynamic"] = [dict(DOOR)]
+    data["process"]["gun"] = 2
+    data["process"]["schedule"] = 4
+    for obj in data["objects"]:
+        if obj["name"] == "clamp1_jaw":
+            obj["signal"] = "clamp1_closed"
+    for spot in data["seams"][0]["spots"]:
+        if spot["name"] == "s8":
+            spot.update(weld_time=0.8, schedule=7)
+    place_cell(data, (1.2, -1.05, 0.45), 30.0, roll_deg=2.0)
+    data["robot"]["controller"] = {
+        "tool": {"number": 2, "name": "gun2"},
+        "frame": {"number": 3, "object": "fixture_plate"},
+        "registers": {"position": [40, 41]},
+        "inputs": {"clamp1_closed": {"number": 5, "name": "diClamp1Closed"}, "door_clear": 6},
+    }
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+@pytest.fixture(scope="session")
+def write_process_cell() -> Callable[..., Path]:
+    """Writes the process cell into a folder: write_process_cell(folder, name=...)."""
+    return _write_process_cell
+
+
 @pytest.fixture(scope="session")
 def write_small_cell() -> SmallCell:
     """Writes the small test cell into a folder: write_small_cell(folder, name=..., extra_spots=...)."""

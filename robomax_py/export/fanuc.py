@@ -394,10 +394,13 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
                                                 "controller stops with an alarm)"))
                     where.append(number)
                     continue
+                # A program that selects no frame numbers runs only if the numbers left active by
+                # whatever ran before match its positions': unknown here.
                 instructions.append(LinMove((fields["X"], fields["Y"], fields["Z"]), (fields["R"], fields["P"], fields["W"]),
                                             config, speed, flyby=cnt * CNT_DEG,
                                             accel=(float(acc.group(1)) if acc else 100.0) / 100,
-                                            tool=_frame_ref("UTOOL", ut), base=_frame_ref("UFRAME", uf)))
+                                            tool=_frame_ref("UTOOL", ut if active["UTOOL"] is not None else None),
+                                            base=_frame_ref("UFRAME", uf if active["UFRAME"] is not None else None)))
             else:                          # a joint move to a Cartesian point, or the other way round
                 ignored.append((number, stmt))
                 instructions.append(Comment(f"not simulated: {stmt}"))

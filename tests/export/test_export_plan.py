@@ -8,8 +8,6 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-import yaml
-from conftest import place_cell
 
 from robomax_py.export import DIALECTS
 from robomax_py.export.plan_program import identifier, program_from_plan
@@ -22,9 +20,6 @@ from robomax_py.publish import publish
 REPO = Path(__file__).resolve().parents[2]
 GOLDEN = REPO / "tests" / "golden"
 ALL = tuple(DIALECTS)
-# Where the small cell's robot passes about 0.8 s into its first move (tests/plan/test_waiting.py
-# derives it from the plan; frozen here so the golden cell is a fixed file).
-DOOR = {"name": "door", "box": [0.12, 0.12, 0.12], "pose": {"xyz": [1.4616, -0.0182, 1.2151]}, "present": [[0, 1.5]]}
 
 
 def _planned(path: Path) -> dict[str, Any]:
@@ -42,32 +37,10 @@ def small(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> dict[st
 
 
 @pytest.fixture(scope="module")
-def process_cell(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> dict[str, Any]:  # type: ignore[no-untyped-def]
-    """The small cell with a door to wait for, clamp 1 behind an input, gun 2 and s8 welded longer
-    with its own schedule; placed as a station places it (1.6 m off the origin, turned 30 deg, on a
-    0.45 m riser tilted 2 deg), with the integrator's numbers: tool 2, user frame 3 on the fixture
-    plate, position registers 40 and 41 for the frames, the clamp on input 5."""
-    tmp = tmp_path_factory.mktemp("process")
-    path = write_small_cell(tmp, name="process_cell")
-    data = yaml.safe_load(path.read_text())
-    data["dynamic"] = [DOOR]
-    data["process"]["gun"] = 2
-    data["process"]["schedule"] = 4
-    for obj in data["objects"]:
-        if obj["name"] == "clamp1_jaw":
-            obj["signal"] = "clamp1_closed"
-    for spot in data["seams"][0]["spots"]:
-        if spot["name"] == "s8":
-            spot.update(weld_time=0.8, schedule=7)
-    place_cell(data, (1.2, -1.05, 0.45), 30.0, roll_deg=2.0)
-    data["robot"]["controller"] = {
-        "tool": {"number": 2, "name": "gun2"},
-        "frame": {"number": 3, "object": "fixture_plate"},
-        "registers": {"position": [40, 41]},
-        "inputs": {"clamp1_closed": {"number": 5, "name": "diClamp1Closed"}, "door_clear": 6},
-    }
-    path.write_text(yaml.safe_dump(data, sort_keys=False))
-    return _planned(path)
+def process_cell(tmp_path_factory: pytest.TempPathFactory, write_process_cell) -> dict[str, Any]:  # type: ignore[no-untyped-def]
+    """The process cell (tests/conftest.py): a door, a clamp input, gun 2, s8 welded longer; placed
+    off the origin with the integrator's numbers."""
+    return _planned(write_process_cell(tmp_path_factory.mktemp("process")))
 
 
 def _golden(planned: dict[str, Any], update: bool) -> None:

@@ -1,0 +1,79 @@
+"""The process cell's programs in every dialect, written once, and mutants of them: a program edited
+the way a mistaken convention would write it, verified as `robomax verify` reads it from disk."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+from robomax_py.export import DIALECTS
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.plan import plan_cell
+from robomax_py.publish import publish
+from robomax_py.robot import RobotModel
+from robomax_py.spec import CellSpec
+from robomax_py.verify import VerifyReport, verify_program
+
+MAIN = {"krl": ".src", "rapid": ".mod", "fanuc": ".ls", "urscript": ".script", "srcl": ".srcl"}
+Edit = Callable[[str], str]
+
+
+@dataclass(frozen=True)
+class Placed:
+    """A planned placed cell and its files (name -> text) in `folder`."""
+
+    folder: Path
+    cell_path: Path
+    cell: CellSpec
+    robot: RobotModel
+    files: dict[str, str]
+    name: str
+
+    def mutant(self, fmt: str, edits: Mapping[str, Edit], tag: str) -> Path:
+        """A folder with every file of `fmt`'s program, those named by `edits` (a file name, or a
+        suffix after the program's name such as ".dat" or "_frames.src") edited; its main file.
+        An edit that changes nothing fails the test: the mutant must differ from the program."""
+        folder = self.folder / f"mutant_{fmt}_{tag}"
+        folder.mkdir()
+        wanted = {k if not k.startswith((".", "_")) else self.name + k: edit for k, edit in edits.items()}
+        for file, text in self.files.items():
+            if file not in wanted:
+                (folder / file).write_text(text)
+                continue
+            new = wanted.pop(file)(text)
+            assert new != text, f"the edit of {file} changed nothing"
+            (folder / file).write_text(new)
+        assert not wanted, f"no such files: {sorted(wanted)}"
+        return folder / f"{self.name}{MAIN[fmt]}"
+
+    def verify(self, fmt: str, edits: Mapping[str, Edit], tag: str) -> VerifyReport:
+        return verify_program(self.cell, self.robot, self.mutant(fmt, edits, tag))
+
+
+@pytest.fixture(scope="session")
+def placed(tmp_path_factory: pytest.TempPathFactory, write_process_cell: Callable[..., Path]) -> Placed:
+    """The process cell (robot off the origin, turned, on a tilted riser; tool 2, user frame 3,
+    registers, inputs) planned once, every dialect written."""
+    folder = tmp_path_factory.mktemp("placed")
+    path = write_process_cell(folder, name="placed")
+    cell = load_cell(path)
+    robot = load_cell_robot(cell)
+    result = plan_cell(cell, robot)
+    assert result.status == "planned", result.message
+    files, _ = publish(result, cell, robot, tuple(DIALECTS))
+    for name, text in files.items():
+        (folder / name).write_text(text)
+    return Placed(folder, path, cell, robot, files, "placed")
+
+
+def placement_mm_zyx(cell: CellSpec) -> tuple[list[float], list[float]]:
+    """The robot's placement in the cell (robot.base) as a frame is written: mm and ZYX angles (deg,
+    R = Rz(A)·Ry(B)·Rx(C)), computed with scipy, not with robomax's conversions."""
+    from scipy.spatial.transform import Rotation
+
+    T = cell.T_world_base
+    zyx = Rotation.from_matrix(T[:3, :3]).as_euler("ZYX", degrees=True)
+    return [float(v) * 1000.0 for v in T[:3, 3]], [float(v) for v in zyx]
