@@ -273,13 +273,19 @@ class LinMove:
 @dataclass(frozen=True, slots=True)
 class Spot:
     """Weld spot `name` of seam `seam` at the current point, holding for `time_s` s (3 decimals),
-    with weld gun `gun` and weld schedule `schedule`."""
+    with weld gun `gun` and weld schedule `schedule`.
+
+    package : the weld is the controller's process package instruction (FANUC SPOT[], ABB SpotL,
+        KUKA's spot technology): the program names gun and schedule only, the weld time is the
+        schedule's on the controller, and `time_s` is 0 (the cell's schedule gives it back).
+    """
 
     name: str
     seam: str
     time_s: float
     gun: int = 1
     schedule: int = 1
+    package: bool = False
 
     def __post_init__(self) -> None:
         _set(self, "time_s", _fixed(self.time_s, TIME_DECIMALS))

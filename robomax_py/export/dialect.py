@@ -131,6 +131,28 @@ def numbered_inputs(program: Program, dialect: str, low: int, high: int) -> None
             raise ControllerSetupError(key, f"input {ins.number} is outside {dialect}'s inputs {low}..{high}")
 
 
+def with_package_welds(program: Program, dialect: str) -> Program:
+    """With `weld: package` (the cell's `robot.controller.weld`), every weld as the controller's
+    process package states it: gun and schedule, the weld time the schedule's on the controller
+    (so every weld of one gun and schedule must take the same time). Otherwise unchanged."""
+    if program.setup.weld != "package":
+        return program
+    times: dict[tuple[int, int], tuple[float, str]] = {}
+    out: list[Instruction] = []
+    for ins in program.instructions:
+        if isinstance(ins, Spot):
+            key = (ins.gun, ins.schedule)
+            first = times.setdefault(key, (ins.time_s, f"{ins.seam}/{ins.name}"))
+            if first[0] != ins.time_s:
+                raise ControllerSetupError("robot.controller.weld", f"{dialect}'s process package takes the weld time "
+                                           f"from the schedule: gun {key[0]} schedule {key[1]} welds {first[1]} for "
+                                           f"{first[0]:.3f} s and {ins.seam}/{ins.name} for {ins.time_s:.3f} s; give "
+                                           "each weld time its own schedule")
+            ins = dataclasses.replace(ins, time_s=0.0, package=True)
+        out.append(ins)
+    return dataclasses.replace(program, instructions=tuple(out))
+
+
 def numbered_frames(program: Program, dialect: str, tools: int, bases: int) -> None:
     """Every frame's number within the controller's slots (1..tools, 1..bases)."""
     for f in program.frames:

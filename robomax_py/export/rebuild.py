@@ -12,6 +12,7 @@ program, reported with the time it happens; what makes the program unreadable fo
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -209,6 +210,8 @@ class _Builder:
             label = f"{ins.seam}/{ins.name}"
             if isinstance(ins, Spot):
                 self._check_interlocks(ins, label)
+                if ins.package:
+                    ins = dataclasses.replace(ins, time_s=self._schedule_time(ins))
             self._check_action(ins, label)
             self.segments.append(dwell(self.q, ins.time_s, kind="weld", label=label))
             config = self.last_config or self.config_text(self.q)
@@ -322,6 +325,20 @@ class _Builder:
             self.segments.append(dwell(self.q, seconds, kind="wait", label=label))
             self.spans.append(Span(self.t, self.t + seconds, self.line))
             self.t += seconds
+
+    def _schedule_time(self, ins: Spot) -> float:
+        """The weld time of a process-package weld: its gun and schedule's, as the cell's spots
+        with that schedule take it (the controller's schedule table holds one time each); 0 with a
+        problem when the cell has no spot of that schedule or several times for it."""
+        process = self.cell.process
+        times = {process.weld_time_of(spot) for seam in self.cell.seams for spot in seam.spots
+                 if process.gun == ins.gun and process.schedule_of(spot) == ins.schedule}
+        if len(times) != 1:
+            what = "no spot of the cell" if not times else f"the cell's spots {sorted(times)} s"
+            self.problems.append(Problem(self.t, "weld", f"gun {ins.gun} schedule {ins.schedule}: {what} gives its weld "
+                                                         "time", self.line))
+            return 0.0
+        return times.pop()
 
     def _check_action(self, ins: Spot | Gripper, label: str) -> None:
         """A tending station gets its gripper action, a weld spot a weld."""
