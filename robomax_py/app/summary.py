@@ -35,6 +35,32 @@ def describe_shape(obj: ObjectSpec) -> str:
     return type(s).__name__
 
 
+def controller_summary(cell: CellSpec) -> str:
+    """What the programs select on the robot's controller (`robot.controller`), in one line."""
+    setup = cell.controller
+    tool = setup.tool
+    parts = [f"tool {tool.number} '{tool.name}'" + (" (on the controller)" if tool.existing else "")
+             if tool is not None else f"tool 1 '{cell.tool.name}_tcp'"]
+    if setup.frame is None:
+        parts.append("targets in the robot base frame")
+    else:
+        f = setup.frame
+        xyz = ", ".join(f"{v:.3f}" for v in f.T_world_frame[:3, 3])
+        parts.append(f"user frame {f.frame.number} '{f.frame.name}' at [{xyz}] m in the cell")
+    if setup.inputs:
+        parts.append("inputs " + ", ".join(f"{i.signal} {i.number}" + (f" ({i.name})" if i.name else "")
+                                           for i in setup.inputs))
+    unmapped = [s for s in cell.signals if setup.input_of(s) is None]
+    if unmapped:
+        parts.append("signals without an input (KRL, TP, URScript need one): " + ", ".join(unmapped))
+    registers = [f"{kind} {list(regs)}" for kind, regs in (("PR", setup.position_registers),
+                                                            ("R", setup.numeric_registers)) if regs]
+    if registers:
+        parts.append("registers " + ", ".join(registers))
+    parts.append(f"welds: {'the controller package' if setup.weld == 'package' else 'spot_weld calls'}")
+    return "; ".join(parts)
+
+
 def cell_summary(cell: CellSpec, robot: Any) -> Group:
     """Robot, tool, objects, seams and spots of a cell, as rich tables."""
     head = Table.grid(padding=(0, 2))
@@ -46,6 +72,7 @@ def cell_summary(cell: CellSpec, robot: Any) -> Group:
     p = cell.process
     head.add_row("process", f"weld {p.weld_time:.2f} s, approach {p.approach * 1000:.1f} mm, "
                             f"clearance {p.clearance * 1000:.1f} mm")
+    head.add_row("controller", controller_summary(cell))
 
     objects = Table(title="objects", title_justify="left")
     for col in ("name", "shape", "position (m)", "role"):
