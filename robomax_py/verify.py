@@ -21,6 +21,7 @@ import numpy as np
 from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
 from robomax_py.export.trajectory_json import load_trajectory_file
+from robomax_py.io.files import check_set
 from robomax_py.plan.loads import Loads, check_carried_motion
 from robomax_py.plan.poses import nominal_rotation
 from robomax_py.robot import RobotModel, fk_tcp
@@ -54,6 +55,7 @@ class VerifyReport:
     ignored: tuple[tuple[int, str], ...] = ()     # (line, statement) read but without effect on motion
     clearance: Clearance | None = None            # the smallest distance reached (None: not measured)
     clearance_line: int | None = None             # the program line moving the robot then
+    notes: tuple[str, ...] = ()                   # about the file, not the motion (its plan's set)
 
     @property
     def clean(self) -> bool:
@@ -67,16 +69,18 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
 
     suffix = path.suffix.lower()
     if suffix == ".json":
-        return verify_trajectory_file(cell, robot, path)
+        return _with_set(cell, path, (path,), verify_trajectory_file(cell, robot, path))
     dialect = dialect_for_file(suffix)
     if dialect is None:
         known = ", ".join(sorted({e for d in DIALECTS.values() for e in d.extensions}))
         raise ProgramError(path, None, f"expected a trajectory file (.json) or a program ({known})")
     texts = {}
+    read = []
     for ext in dialect.extensions:
         sibling = path.with_suffix(ext) if suffix != ext else path
         if sibling == path or sibling.exists():
             texts[ext] = read_text(sibling, LIMITS.program, ProgramError, "program file")
+            read.append(sibling)
     main = path.with_suffix(dialect.extensions[0])
     if dialect.extensions[0] not in texts:
         raise ProgramError(main, None, f"{path.name} needs its main file {main.name} beside it")
@@ -86,6 +90,7 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
         companion = main.with_name(main.stem + key)
         if companion.exists():
             texts[key] = read_text(companion, LIMITS.program, ProgramError, "program file")
+            read.append(companion)
     from robomax_py.export.rebuild import rebuild
 
     parsed = dialect.parse(texts, str(main), robot)
@@ -93,8 +98,29 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
     report = verify_rebuilt(cell, robot, str(path), rebuilt)
     unsimulated = tuple(Violation(None, "unsupported", f"{text} is not simulated: the program cannot be verified", line)
                         for line, text in parsed.ignored if _is_motion(parsed, line))
-    return dataclasses.replace(report, violations=unsimulated + report.violations,
-                               ignored=tuple(i for i in parsed.ignored if not _is_motion(parsed, i[0])))
+    report = dataclasses.replace(report, violations=unsimulated + report.violations,
+                                 ignored=tuple(i for i in parsed.ignored if not _is_motion(parsed, i[0])))
+    return _with_set(cell, path, tuple(read), report)
+
+
+def _with_set(cell: CellSpec, path: Path, read: tuple[Path, ...], report: VerifyReport) -> VerifyReport:
+    """The report with what the manifest of the program's set says: files read (those beside the
+    program, as a controller would be loaded with them) that are not the ones the plan wrote
+    together (a folder mixing plans, or an edited file) are a `set` violation; a
+    program without a manifest is verified as a lone program, and one planned from another
+    version of the cell file is noted (the motion is what verify judges)."""
+    check = check_set(path, read)
+    if check.manifest is None:
+        lone = f"no {path.stem}.manifest.json beside it: verified as a lone program, not as one plan's set"
+        return dataclasses.replace(report, notes=(*report.notes, lone))
+    found = tuple(Violation(None, "set", f"not one plan's set with {path.stem}.manifest.json: {m}")
+                  for m in check.mismatched)
+    notes = report.notes
+    if check.cell_sha256 and check.cell_sha256 != cell.digest:
+        other = (f"planned from another version of the cell file (sha256 {check.cell_sha256[:12]}..., "
+                 f"this one {cell.digest[:12]}...)")
+        notes = (*notes, other)
+    return dataclasses.replace(report, violations=found + report.violations, notes=notes)
 
 
 def _is_motion(parsed: Any, line: int) -> bool:

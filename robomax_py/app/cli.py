@@ -158,7 +158,7 @@ def plan(
         from robomax_py.app.report import plan_report, report_tables
         from robomax_py.export import format_names
         from robomax_py.io.cell import load_cell, load_cell_robot
-        from robomax_py.io.files import write_programs
+        from robomax_py.io.files import commit_set
         from robomax_py.plan import PlanOptions, plan_cell
         from robomax_py.publish import publish
 
@@ -168,24 +168,31 @@ def plan(
         robot = load_cell_robot(spec)
         _warn(robot.warnings)
         names = format_names(formats, robot.controller.brand)
+        set_name = spec.name + ("_baseline" if baseline else "")
         with stage_bars(err, enabled=not verbose) as progress:
             result = plan_cell(spec, robot, PlanOptions(baseline=baseline, speed=speed), progress)
         seconds = time.perf_counter() - t0
         written: list[Path] = []
         checked = []
+        removed: tuple[str, ...] = ()
+        unlisted: tuple[str, ...] = ()
         if result.status == "planned":
             from robomax_py.app.chart import cycle_chart, render_png
-            from robomax_py.io.files import write_atomic_bytes
 
             date = datetime.date.today().isoformat() if stamp else ""
             texts, checked = publish(result, spec, robot, names, stamp=date, baseline=baseline)  # all proven before any write
-            png = render_png(cycle_chart(result)) if plot else None
-            written = write_programs(out_dir, texts)
-            if png is not None:
-                path = out_dir / f"{spec.name}{'_baseline' if baseline else ''}.png"
-                write_atomic_bytes(path, png)
-                written.append(path)
+            files: dict[str, str | bytes] = dict(texts)
+            if plot:
+                files[f"{set_name}.png"] = render_png(cycle_chart(result))
+            committed = commit_set(out_dir, set_name, files, spec.digest)
+            written = [*committed.paths, committed.manifest]
+            removed = committed.removed
+            unlisted = committed.unlisted
         report = plan_report(result, seconds, written, robot.defaulted_limits, checked)
+        if result.status == "planned":
+            report["removed"] = [str(out_dir / n) for n in removed]
+            report["not_of_this_plan"] = [str(out_dir / n) for n in _stale_programs(out_dir, set_name)]
+            report["unlisted"] = [str(out_dir / n) for n in unlisted]
         if as_json:
             out.print_json(_json.dumps(report))
         else:
@@ -200,24 +207,35 @@ def plan(
                 r = reach.get((f.seam, f.name))
                 far = f"; {r.out_by_m:.3f} m out of reach at the best orientation" if r and not r.reachable else ""
                 err.print(f"  {f.seam}/{f.name}: {f.reason} ({f.detail}{far})", soft_wrap=True)
-            stale = _stale_programs(out_dir, spec.name + ("_baseline" if baseline else ""))
+            stale = _stale_programs(out_dir, set_name, every=True)
             if stale:
                 err.print(f"[yellow]note:[/] {', '.join(stale)} in {out_dir} are from an earlier plan, not this one "
                           "(nothing was written)", soft_wrap=True)
             return EXIT_INFEASIBLE
+        if report["not_of_this_plan"]:
+            err.print(f"[yellow]note:[/] {', '.join(Path(p).name for p in report['not_of_this_plan'])} in {out_dir} "
+                      "are not of this plan (written by an older robomax or by hand; left as they are)", soft_wrap=True)
+        if unlisted:
+            err.print(f"[yellow]note:[/] {', '.join(unlisted)} in {out_dir}: no plan's set there names it any more "
+                      "(left as it is: it may hold the integrator's routine)", soft_wrap=True)
         return EXIT_OK
 
     code = _guarded(run)
     raise typer.Exit(code)
 
 
-def _stale_programs(out_dir: Path, name: str) -> list[str]:
-    """Program files of an earlier plan of the cell in the output folder."""
+def _stale_programs(out_dir: Path, name: str, every: bool = False) -> list[str]:
+    """Program files of the cell in the output folder that are not of its current set: regular
+    files named as its programs (an older robomax's, or put there by hand; a plan writes its set
+    as links into the set's folder). With `every`, the current set's files too."""
     from robomax_py.export import DIALECTS
+    from robomax_py.io.files import MANIFEST_SUFFIX
 
-    suffixes = {".json", ".png", *(e for d in DIALECTS.values() for e in d.extensions)}
+    names = {f"{name}{key}" for key in (".json", ".png", MANIFEST_SUFFIX,
+                                        *(k for d in DIALECTS.values() for k in (*d.extensions, *d.companions)))}
     try:
-        return sorted(p.name for p in out_dir.iterdir() if p.stem == name and p.suffix in suffixes)
+        return sorted(p.name for p in out_dir.iterdir()
+                      if p.name in names and p.exists() and (every or not p.is_symlink()))
     except OSError:
         return []
 
@@ -249,6 +267,8 @@ def verify(
             out.print(f"  smallest clearance {c.distance_m * 1000:.1f} mm ({at}t = {c.t:.3f} s, {c.between})")
         if report.ignored:
             out.print(f"  {len(report.ignored)} statement(s) read but without effect on the motion (I/O, declarations ...)")
+        for note in report.notes:
+            out.print(f"  note: {note}", soft_wrap=True, markup=False)
         if report.clean:
             done = ("every station's gripper action at rest on its pose" if spec.tending
                     else "every spot welded within tolerance")
