@@ -6,8 +6,10 @@ Heavy modules are imported inside commands so `robomax --help` stays fast.
 
 from __future__ import annotations
 
+import signal
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, TypeVar
 
@@ -154,23 +156,31 @@ def plan(
         import json as _json
         import time
 
-        from robomax_py.app.progress import configure_logging, stage_bars
-        from robomax_py.app.report import plan_report, report_tables
-        from robomax_py.export import format_names
-        from robomax_py.io.cell import load_cell, load_cell_robot
-        from robomax_py.io.files import commit_set
-        from robomax_py.plan import PlanOptions, plan_cell
-        from robomax_py.publish import publish
+        with _signals_deferred():
+            from robomax_py.app.progress import configure_logging, stage_bars
+            from robomax_py.app.report import plan_report, report_tables
+            from robomax_py.export import format_names
+            from robomax_py.io.cell import load_cell, load_cell_robot
+            from robomax_py.io.files import commit_set
+            from robomax_py.plan import PlanOptions, plan_cell
+            from robomax_py.publish import publish
+        _honour_signals()
 
         configure_logging(err, verbose)
         t0 = time.perf_counter()
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
+        _honour_signals()
         _warn(robot.warnings)
         names = format_names(formats, robot.controller.brand)
         set_name = spec.name + ("_baseline" if baseline else "")
-        with stage_bars(err, enabled=not verbose) as progress:
+        with stage_bars(err, enabled=not verbose) as bars:
+            def progress(stage: str, done: int, total: int) -> None:
+                _honour_signals()
+                bars(stage, done, total)
+
             result = plan_cell(spec, robot, PlanOptions(baseline=baseline, speed=speed), progress)
+        _honour_signals()
         seconds = time.perf_counter() - t0
         written: list[Path] = []
         checked = []
@@ -184,6 +194,7 @@ def plan(
             files: dict[str, str | bytes] = dict(texts)
             if plot:
                 files[f"{set_name}.png"] = render_png(cycle_chart(result))
+            _honour_signals()                   # nothing is written after an interrupt
             committed = commit_set(out_dir, set_name, files, spec.digest)
             written = [*committed.paths, committed.manifest]
             removed = committed.removed
@@ -591,21 +602,60 @@ def _library_flags_first(argv: list[str]) -> list[str]:
     return front + rest
 
 
-def _terminate(signum: int, frame: object) -> None:
-    # SIGTERM unwinds like Ctrl-C, so a write in progress removes its temporary file.
+class _Received:
+    """The termination signal this process received (SIGINT or SIGTERM), for `_honour_signals`.
+    Process state by nature: a signal handler has nowhere else to leave it."""
+
+    signum: int | None = None
+
+
+def _on_signal(signum: int, frame: object) -> None:
+    # SIGTERM unwinds like Ctrl-C (KeyboardInterrupt, which the preview ends on), so a write in
+    # progress removes its temporary files; the signal is also kept for `_honour_signals`, since a
+    # dependency that catches BaseException (trimesh, on import and in some mesh functions) can
+    # swallow the exception.
+    _Received.signum = signum
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
     raise SystemExit(128 + signum)
+
+
+def _honour_signals() -> None:
+    """End the run as an earlier SIGINT or SIGTERM asked, if its exception was swallowed: called
+    between stages and before anything is written."""
+    if _Received.signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    if _Received.signum is not None:
+        raise SystemExit(128 + _Received.signum)
+
+
+@contextmanager
+def _signals_deferred() -> Iterator[None]:
+    """SIGINT and SIGTERM held while the heavy modules are imported (a few seconds at most): an
+    import that catches BaseException would swallow the interrupt and leave half-imported modules
+    behind. A signal that arrived meanwhile is delivered when the imports are done."""
+    held = {signal.SIGINT, signal.SIGTERM}
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def main() -> None:
     """Console entry point."""
-    import signal
-
-    signal.signal(signal.SIGTERM, _terminate)
+    signal.signal(signal.SIGTERM, _on_signal)
+    if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:            # not when started ignoring it (nohup, &)
+        signal.signal(signal.SIGINT, _on_signal)
     try:
         app(args=_bare_ray_flag(_library_flags_first(sys.argv[1:])))
     except KeyboardInterrupt:
         err.print("interrupted")
         sys.exit(130)
+    except SystemExit as exc:
+        if _Received.signum == signal.SIGTERM and exc.code == 128 + signal.SIGTERM:
+            err.print("terminated")
+        raise
 
 
 if __name__ == "__main__":
