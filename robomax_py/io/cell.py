@@ -10,6 +10,7 @@ import dataclasses
 import hashlib
 import math
 import re
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -77,6 +78,25 @@ TENDING_SEAM = "tending"
 PICK_PLACE_SEAM = "transfers"
 # Dynamic windows beyond a day of program time are a typo, and would overflow the time grid.
 MAX_WINDOW_S = 86_400.0
+
+
+@dataclass(frozen=True, slots=True)
+class CellLimits:
+    """The most one cell may ask for (README, "Limits on the files robomax reads"), checked at load
+    before anything is planned: planning time and memory grow with each. A spot costs its seam's
+    orientations x approach samples x IK columns of IK table and its candidates' approach lines;
+    every object adds pairs to every collision check; triangles are held in memory as BVHs."""
+
+    spots: int = 2_000                  # spots of all seams together (a robot welds tens per cycle)
+    objects: int = 1_000                # objects and dynamic objects together
+    orientations: int = 1_000           # per seam: its grid's orientations and its spots' pinned ones
+    mesh_triangles: int = 2_000_000     # one mesh
+    cell_triangles: int = 5_000_000     # every mesh of the cell and its tool together
+
+
+CELL_LIMITS = CellLimits()
+# A tolerance range this narrow is one orientation sample (as `plan.poses.axis_samples` takes it).
+SAME_ORIENTATION_RAD = 1e-9
 
 
 def _printable_name(v: str) -> str:
@@ -412,6 +432,7 @@ def load_cell(path: str | Path) -> CellSpec:
     data = read_yaml_mapping(path, CellFileError, "cell file", LIMITS.cell)
     # Programs name the exact cell file they were planned from (their header).
     digest = hashlib.sha256(read_text(path, LIMITS.cell, CellFileError, "cell file").encode("utf-8")).hexdigest()
+    _check_counts(data, path)              # before validating what may be a very long list
     version = data.get("robomax")
     if "robomax" in data and version not in SUPPORTED_VERSIONS:
         supported = ", ".join(str(v) for v in SUPPORTED_VERSIONS)
@@ -421,7 +442,9 @@ def load_cell(path: str | Path) -> CellSpec:
     except ValidationError as exc:
         raise validation_error(exc, CellFile, path, CellFileError) from None
     _check_unique_names(parsed, path)
-    machines, doors = _machines(parsed, path)
+    _check_orientations(parsed, path)
+    triangles: list[int] = []              # of every mesh read, for the cell's total
+    machines, doors = _machines(parsed, path, triangles)
 
     robot_file = checked_file(resolve_robot_file(parsed.robot.model, path), LIMITS.description,
                               named_by(CellFileError, path, "robot.model"), f"unknown robot '{parsed.robot.model}':")
@@ -430,7 +453,13 @@ def load_cell(path: str | Path) -> CellSpec:
     robot_spec = load_robot_spec(robot_file)
     tool_spec = load_tool_spec(tool_file)
     for key, mesh in (("body", tool_spec.body), ("tips", tool_spec.tips)):
-        _check_mesh_readable(mesh, RobotModelError(tool_file, key, f"cannot read mesh {mesh}"))
+        triangles.append(_check_mesh_readable(mesh, RobotModelError(tool_file, key, f"cannot read mesh {mesh}")))
+    objects = tuple(_object(o, path, f"objects[{i}]", triangles) for i, o in enumerate(parsed.objects))
+    dynamic = tuple(_object(o, path, f"dynamic[{i}]", triangles) for i, o in enumerate(parsed.dynamic))
+    parts = _parts(parsed, path, robot_spec, triangles)
+    if sum(triangles) > CELL_LIMITS.cell_triangles:
+        raise CellFileError(path, "objects", f"its meshes and its tool's have {sum(triangles):,} triangles together, "
+                            f"more than the {CELL_LIMITS.cell_triangles:,} a cell may have (cell_triangles)")
 
     cell = CellSpec(
         name=parsed.name or _stem_name(path),
@@ -439,7 +468,7 @@ def load_cell(path: str | Path) -> CellSpec:
         T_world_base=frozen_array(_pose(parsed.robot.base)),
         home=frozen_array(_home(parsed, robot_spec, path)),
         tool=tool_spec,
-        objects=tuple(_object(o, path, f"objects[{i}]") for i, o in enumerate(parsed.objects)),
+        objects=objects,
         seams=_job_seams(parsed, path),
         process=ProcessSpec(
             weld_time=parsed.process.weld_time,
@@ -452,10 +481,10 @@ def load_cell(path: str | Path) -> CellSpec:
         planner=PlannerSpec(seed=parsed.planner.seed, speed=parsed.planner.speed, tcp_speed=parsed.planner.tcp_speed,
                             detour_speed=parsed.planner.detour_speed, detours=parsed.planner.detours,
                             dynamic=parsed.planner.dynamic, max_wait=parsed.planner.max_wait),
-        dynamic=tuple(_object(o, path, f"dynamic[{i}]") for i, o in enumerate(parsed.dynamic)) + doors,
+        dynamic=dynamic + doors,
         digest=digest,
         machines=machines,
-        parts=_parts(parsed, path, robot_spec),
+        parts=parts,
         tcp_limits=_tcp_limits(parsed.pick_place.unloaded) if parsed.pick_place is not None else None,
     )
     return dataclasses.replace(cell, controller=_controller(parsed.robot.controller, cell, path))
@@ -510,7 +539,7 @@ def _tcp_limits(limits: TcpLimitsFile | None) -> TcpLimits | None:
     return None if limits is None else TcpLimits(limits.v, limits.a_T, limits.a_R, limits.j_T, limits.j_R)
 
 
-def _parts(parsed: CellFile, path: Path, robot: RobotSpec) -> tuple[PartSpec, ...]:
+def _parts(parsed: CellFile, path: Path, robot: RobotSpec, triangles: list[int]) -> tuple[PartSpec, ...]:
     """The parts with their held pose in the TCP frame and the supports of the locations they visit."""
     job = parsed.pick_place
     if job is None:
@@ -521,7 +550,7 @@ def _parts(parsed: CellFile, path: Path, robot: RobotSpec) -> tuple[PartSpec, ..
         if robot.payload_kg is not None and part.mass > robot.payload_kg:
             raise CellFileError(path, f"{key}.mass", f"{part.mass:g} kg is above the robot's rated payload "
                                 f"{robot.payload_kg:g} kg ({robot.source})")
-        shape = _object(part, path, key).shape
+        shape = _object(part, path, key, triangles).shape
         at = {t.from_ for t in job.transfers if t.part == part.name} | {t.to for t in job.transfers if t.part == part.name}
         supports = sorted({name for loc in job.locations if loc.name in at for name in loc.support})
         out.append(PartSpec(name=part.name, shape=shape, mass=part.mass,
@@ -642,7 +671,9 @@ def _pose(pose: PoseFile) -> np.ndarray:
     return pose_matrix(pose.xyz, [deg_to_rad(a) for a in pose.rpy])
 
 
-def _object(obj: ObjectFile, path: Path, key: str) -> ObjectSpec:
+def _object(obj: ObjectFile, path: Path, key: str, triangles: list[int]) -> ObjectSpec:
+    """The object's spec; a mesh is read (and refused when unreadable or too large) and its
+    triangles are added to `triangles`."""
     shape: Shape
     if obj.box is not None:
         shape = Box(extents=(obj.box[0], obj.box[1], obj.box[2]))
@@ -656,7 +687,7 @@ def _object(obj: ObjectFile, path: Path, key: str) -> ObjectSpec:
         assert obj.mesh is not None  # guaranteed by ObjectFile._one_shape
         named = path.parent / obj.mesh
         mesh = checked_file(named, LIMITS.mesh, named_by(CellFileError, path, f"{key}.mesh"), f"mesh {named}")
-        _check_mesh_readable(mesh, CellFileError(path, f"{key}.mesh", f"cannot read mesh {mesh}"))
+        triangles.append(_check_mesh_readable(mesh, CellFileError(path, f"{key}.mesh", f"cannot read mesh {mesh}")))
         shape = MeshShape(path=mesh)
     present = None
     if isinstance(obj, DynamicObjectFile):
@@ -690,14 +721,70 @@ def _stem_name(path: Path) -> str:
 
 
 
-def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError) -> None:
+def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError) -> int:
+    """The mesh's triangles, when it reads and has at most `CELL_LIMITS.mesh_triangles`."""
+    limit = CELL_LIMITS.mesh_triangles
+    declared = _stl_triangles(mesh)          # a binary STL says how many before it is read
+    if declared is not None and declared > limit:
+        raise type(error)(error.file, error.key, f"mesh {mesh} has {declared:,} triangles, more than the "
+                                                 f"{limit:,} a mesh may have (mesh_triangles)")
     try:
-        load_mesh(mesh)
+        n = len(load_mesh(mesh).faces)
     except Exception as exc:  # trimesh raises many kinds for unreadable files
         raise type(error)(error.file, error.key, f"{error.problem}: {exc}") from None
+    if n > limit:
+        raise type(error)(error.file, error.key, f"mesh {mesh} has {n:,} triangles, more than the {limit:,} a mesh "
+                                                 "may have (mesh_triangles)")
+    return n
 
 
-def _machines(parsed: CellFile, path: Path) -> tuple[tuple[MachineSpec, ...], tuple[ObjectSpec, ...]]:
+def _stl_triangles(mesh: Path) -> int | None:
+    """The triangle count a binary STL's header states, when the file is one (its size is 84 bytes
+    plus 50 per triangle); None otherwise."""
+    try:
+        size = mesh.stat().st_size
+        with open(mesh, "rb") as fh:
+            head = fh.read(84)
+    except OSError:
+        return None
+    if len(head) < 84:
+        return None
+    n = int.from_bytes(head[80:84], "little")
+    return n if size == 84 + 50 * n else None
+
+
+def _check_counts(data: dict[str, Any], path: Path) -> None:
+    """Spots and objects within `CELL_LIMITS`, counted in the file's data before it is validated."""
+    seams = data.get("seams")
+    spots = sum(len(s["spots"]) for s in seams if isinstance(s, dict) and isinstance(s.get("spots"), list)) \
+        if isinstance(seams, list) else 0
+    if spots > CELL_LIMITS.spots:
+        raise CellFileError(path, "seams", f"{spots:,} spots, more than the {CELL_LIMITS.spots:,} a cell may have "
+                                           "(spots); split the job into cells")
+    objects = sum(len(v) for v in (data.get("objects"), data.get("dynamic")) if isinstance(v, list))
+    if objects > CELL_LIMITS.objects:
+        raise CellFileError(path, "objects", f"{objects:,} objects and dynamic objects, more than the "
+                                             f"{CELL_LIMITS.objects:,} a cell may have (objects)")
+
+
+def _check_orientations(parsed: CellFile, path: Path) -> None:
+    """Each seam's orientations (its grid's samples, as `plan.poses.orientation_grid` takes them,
+    and its spots' pinned orientations) within `CELL_LIMITS.orientations`: every spot of the seam
+    is solved at every one of them."""
+    for i, seam in enumerate(parsed.seams):
+        tol = seam.tolerance
+        ranges = (2 * deg_to_rad(tol.alpha), 2 * deg_to_rad(tol.beta), deg_to_rad(tol.gamma[1] - tol.gamma[0]))
+        grid = 1
+        for r in ranges:
+            grid *= 1 if seam.grid == 1 or r <= SAME_ORIENTATION_RAD else seam.grid
+        pinned = sum(1 for s in seam.spots if s.alpha is not None and not s.skip)
+        if grid + pinned > CELL_LIMITS.orientations:
+            raise CellFileError(path, f"seams[{i}].grid", f"{grid:,} grid orientations and {pinned:,} pinned ones, "
+                                f"more than the {CELL_LIMITS.orientations:,} a seam may have (orientations): "
+                                "every spot is solved at each")
+
+
+def _machines(parsed: CellFile, path: Path, triangles: list[int]) -> tuple[tuple[MachineSpec, ...], tuple[ObjectSpec, ...]]:
     """Each machine and its door, a dynamic object closed in the schedule's windows."""
     if parsed.tending is None:
         return (), ()
@@ -710,7 +797,7 @@ def _machines(parsed: CellFile, path: Path) -> tuple[tuple[MachineSpec, ...], tu
         if windows[-1][1] > MAX_WINDOW_S:
             raise CellFileError(path, f"tending.machines[{i}].schedule", f"the last machining ends at "
                                 f"{windows[-1][1]:g} s, beyond a day ({MAX_WINDOW_S:g} s) of program time")
-        door = _object(m.door, path, f"tending.machines[{i}].door")
+        door = _object(m.door, path, f"tending.machines[{i}].door", triangles)
         doors.append(ObjectSpec(name=door.name, shape=door.shape, T_world_object=door.T_world_object,
                                 present=windows, door=True))
         machines.append(MachineSpec(m.name, door.name, windows))
