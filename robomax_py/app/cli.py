@@ -367,14 +367,21 @@ def preview(
     voxels: Annotated[float | None, typer.Option("--voxels", min=0.005, max=0.5, metavar="PRECISION",
                                                  help="also draw the voxel map of the static objects (blocked leaves) "
                                                       "at this precision limit, m")] = None,
+    host: Annotated[str, typer.Option("--host", help="address to serve the page on (default: this machine only); "
+                                                     "any other makes the cell visible to the network")] = "127.0.0.1",
+    port: Annotated[int | None, typer.Option("--port", min=1, max=65535,
+                                             help="web port (default: the first free one from 7000)")] = None,
 ) -> None:
     """Show the cell in meshcat, animated along a program (serves until Ctrl-C, or writes --html)."""
 
     def run() -> None:
         from robomax_py.app.preview import serve, write_html
         from robomax_py.app.preview_program import home_program, load_program
+        from robomax_py.app.preview_server import LOOPBACK, WILDCARDS, is_loopback
         from robomax_py.io.cell import load_cell, load_cell_robot
 
+        if html is not None and (host != LOOPBACK or port is not None):
+            raise typer.BadParameter("--html writes a file; --host and --port are for serving", param_hint="--host/--port")
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
         shown = home_program(spec) if program is None else load_program(program, spec, robot)
@@ -395,7 +402,16 @@ def preview(
             drawn = f", {content.voxels} blocked voxels" if vmap is not None else ""
             out.print(f"wrote {html} ({content.frames} animation frames, cycle {content.duration:.3f} s{drawn})")
             return
-        serve(spec, robot, shown, lambda url: out.print(f"meshcat preview at {url}  (Ctrl-C to stop)"), voxels=vmap)
+
+        def announce(url: str) -> None:
+            # Said once the server listens, so a host it cannot bind gets only the error.
+            if not is_loopback(host):
+                where = "every interface of this machine" if host.strip("[]") in WILDCARDS else host
+                _warn([(f"--host {host}: the preview listens on {where}; anyone who can reach it on the network "
+                        "can open the page and see the cell (no password)")])
+            out.print(f"meshcat preview at {url}  (Ctrl-C to stop)", soft_wrap=True)
+
+        serve(spec, robot, shown, announce, voxels=vmap, host=host, port=port)
         out.print("preview stopped")
 
     _guarded(run)
