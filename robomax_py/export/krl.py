@@ -628,7 +628,7 @@ class _Reader:
     def on_data_act(self, tree: Tree[Token], comment: str, line: int) -> None:
         var, name = (str(c).upper() for c in tree.children)
         self.act[var[:4]] = name
-        if self.fold is not None:
+        if self.fold is not None and var[:4] != "FDAT":
             self.fold.done["data"] = name
 
     def bas_value(self, node: object, line: int) -> float | None:
