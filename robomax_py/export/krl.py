@@ -27,12 +27,14 @@ What a program states, in KRL's own terms:
   frames' values go into a setup program `<name>_frames.src` (``TOOL_DATA[t] = {...}``, ``BASE_DATA[b]
   = {...}``) that the integrator runs once or compares with the calibrated values; KSS declares
   TOOL_DATA[16] and BASE_DATA[32] in $config.dat. The robot's placement in the cell is never written.
-- Speeds: PTP ``Vel`` in whole percent; LIN ``Vel`` in m/s, stated exactly in BAS's argument and the
-  LDAT's VEL, and in the fold text (``Vel=``, ``5:``) to 3 decimals (1 mm/s). Accelerations: the
+- Speeds: PTP ``Vel`` in whole percent; LIN ``Vel`` in m/s, stated exactly in BAS's argument (what
+  the controller moves at) and the LDAT's VEL, and in the fold text (``Vel=``, ``5:``) to 3 decimals
+  (1 mm/s; the inline form's own display precision is UNCONFIRMED, and a person who opens and saves
+  the form gets BAS written from what it shows). Accelerations: the
   PDAT's / LDAT's ACC in whole percent. Blends: ``C_DIS`` with the TCP distance in the point's
   APO_DIST (mm; PDAT ``APO_MODE #CDIS``); an exact stop keeps the inline form's default APO_DIST 100.
 - The INI fold opens the program (``;FOLD INI;%{PE}`` ... ``BAS (#INITMOV,0 )`` ... ``;ENDFOLD
-  (INI)``, NAQIU KRC/R1/Program/honai.src 4-17); a move's note is a comment line before its fold.
+  (INI)``, NAQIU KRC/R1/Program/honai.src 5-20); a move's note is a comment line before its fold.
 - A weld, with the cell's ``weld: call`` (default): an exact LIN to the spot followed by
   ``spot_weld(n, weld_time) ; seam/name gun G schedule S``, and `spot_weld` defined after the main
   program (rest for `weld_time`; the integrator replaces it). With ``weld: package``, the weld is
@@ -41,22 +43,22 @@ What a program states, in KRL's own terms:
   0.0,PGNO2 0,PRESS2 0.0}`` in the .dat, the ``;FOLD SPOTTECH INI`` / ``USERSPOT(#INIT)`` fold in
   INI and ``EXT USERSPOT (S_COMMAND :IN,SPOT_TYPE :IN )`` in the .dat's SPOTTECH EXT fold.
   Confirmed from public files: the package's data type and user routine (ZINK
-  KRC/R1/TP/GripperSpotTech/Spot_Data.dat 9-17: ``GLOBAL STRUC SPOT_TYPE INT GUN,S_PAIR_SLCT PAIR,
+  KRC/R1/TP/GripperSpotTech/Spot_Data.dat 9-16: ``GLOBAL STRUC SPOT_TYPE INT GUN,S_PAIR_SLCT PAIR,
   COMMAND_RETR RETR,INT CLO_TM,INT PGNO1,REAL PRESS1,INT PGNO2,REAL PRESS2``, SDEFAULT; Spot_User.src
-  13-36: ``GLOBAL DEF USERSPOT (CMD :IN,S :IN )`` with ``CASE #SPOT``), the INI and EXT folds
-  (NAQIU honai.src 11-13, honai.dat 5-7). Not public, so not written: the package's own SPOT
+  13-41: ``GLOBAL DEF USERSPOT (CMD :IN,S :IN )`` with ``CASE #SPOT``), the INI and EXT folds
+  (NAQIU honai.src 11-13, honai.dat 7-9). Not public, so not written: the package's own SPOT
   inline form (vendor_research §1.6); the call of its user routine with a SPOT_TYPE per weld is
   the closest published form. The weld time is the schedule's on the controller (PGNO1).
 - ``WAIT SEC t``, and ``WAIT FOR <signal>`` with ``SIGNAL <signal> $IN[k]`` declared, k the input
   the cell maps the signal to (`robot.controller.inputs`).
 
 What the statements do (NAQIU KRC/R1/System/bas.src; the same logic in CHINA and ZINK): the fold
-line is a comment; the statements inside run. ``BAS(#PTP_PARAMS,v)`` (28-52) runs PTP_DAT: ACC_PTP
+line is a comment; the statements inside run. ``BAS(#PTP_PARAMS,v)`` (43-47) runs PTP_DAT: ACC_PTP
 (PDAT_ACT.ACC) and, with ``APO_MODE #CDIS``, ``$APO.CDIS = APO_DIST`` (else ``$APO.CPTP``) (560-584);
 then FRAMES; then VEL_PTP(v): ``$VEL_AXIS[i] = DEF_VEL_PTP·v/100`` with DEF_VEL_PTP = 100 (362-376).
 ACC_PTP sets ``$ACC_AXIS[i] = ACC`` itself when ``$ADAP_ACC <> #NONE`` (305-324), and the machine
 data of all three backups has ``$ADAP_ACC=#STEP2`` (KRC/R1/Mada/$robcor.dat: NAQIU 7, CHINA 9,
-ZINK 8). ``BAS(#CP_PARAMS,v)`` runs CP_DAT: ACC_CP(LDAT_ACT.ACC), ``$APO.CDIS = APO_DIST`` (586-599);
+ZINK 8). ``BAS(#CP_PARAMS,v)`` (48-52) runs CP_DAT: ACC_CP(LDAT_ACT.ACC), ``$APO.CDIS = APO_DIST`` (586-599);
 FRAMES; VEL_CP(v): ``$VEL.CP = v`` m/s, at most DEF_VEL_CP = 2 (331-339). FRAMES (462-557): TOOL
 (TOOL_NO) gives ``$TOOL = TOOL_DATA[n]``, or ``$NULLFRAME`` for 0 (404-441); BASE(BASE_NO) gives
 ``$BASE = BASE_DATA[n]``, or ``$WORLD`` for 0 (159-186); ``$IPO_MODE = IPO_FRAME`` (#TCP: an external
@@ -69,7 +71,8 @@ selects no frame). A fold without its BAS line changes no frame, speed or blend.
 robomax's model of a LIN's acceleration: the LDAT's ACC is the fraction of the axes' acceleration
 (and jerk) limits the line may use, as a PTP's (a part in the gripper slows the lines that carry
 it). KSS bounds a classical LIN by the path acceleration instead, ``$ACC.CP = DEF_ACC_CP·ACC/100``
-(ACC_CP, bas.src 275-288): the .dat says so when a LIN's ACC is below 100 %.
+(ACC_CP, bas.src 275-288): the .dat says so when a LIN's ACC is below 100 %. A plain
+``$ACC_AXIS[i] = a`` (robomax's earlier KRL) bounds a LIN's axes in the same model.
 
 The reader takes the motion subset of any KRL program, inline forms or plain statements: PTP and
 LIN to points declared in the .dat or the .src, or written in place (E6AXIS/AXIS, E6POS/POS/FRAME
@@ -303,8 +306,8 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     w = _Writer(program)
     w.src = ["&ACCESS RVP", "&REL 1", "&PARAM EDITMASK = *", r"&PARAM TEMPLATE = C:\KRC\Roboter\Template\vorgabe",
              f"DEF {name}( )", *(f"; {text}" for text in header_lines(program.header)),
-             f"; {_NOTE}: inline forms; mm, deg; PTP Vel %, LIN Vel m/s; blends C_DIS with the APO_DIST (mm) of each "
-             "point's PDAT / LDAT"]
+             (f"; {_NOTE}: inline forms; mm, deg; PTP Vel %, LIN Vel m/s; blends C_DIS with the APO_DIST (mm) of "
+              "each point's PDAT / LDAT")]
     w.src += [f"SIGNAL {sig} $IN[{k}]" for sig, k in _signals(program).items()]
     w.src += [";FOLD INI;%{PE}", "  ;FOLD BASISTECH INI", "    GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
               "    INTERRUPT ON 3 ", "    BAS (#INITMOV,0 )", "  ;ENDFOLD (BASISTECH INI)"]
@@ -434,22 +437,22 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 
 # Motions KRL has that this reader does not simulate: a program with one is not verified clean.
 _UNSIMULATED = re.compile(r"^(CIRC|SPTP|SLIN|SCIRC|PTP_REL|LIN_REL|CIRC_REL|SPTP_REL|SLIN_REL|SPLINE|PTP_SPLINE|RSI_MOVECORR)\b",
-                          re.I)
+                          re.IGNORECASE)
 _KNOWN = re.compile(r"^(PTP|LIN|\$|spot_weld\s*\(|(grip|release)\s*\(|WAIT\s+(SEC|FOR)\b|SIGNAL\b|"
                     rf"DECL\s+({'|'.join(_DATA_TYPES)})\b|(TOOL|BASE)_DATA\s*\[|(PDAT|LDAT|FDAT)_ACT\b|BAS\s*\(|"
-                    r"USERSPOT\s*\()", re.I)
+                    r"USERSPOT\s*\()", re.IGNORECASE)
 # A motion to a named point or an aggregate; anything else (an array element, a system variable, an
 # expression) is not simulated.
-_PLAIN_MOTION = re.compile(r"^(PTP|LIN)\s+([A-Za-z_][A-Za-z0-9_$]*|\{.*\})(\s+C_(DIS|PTP|VEL|ORI))*$", re.I)
-_PLAIN_WAIT_FOR = re.compile(r"^WAIT\s+FOR\s+([A-Za-z_]\w*|\$IN\s*\[\s*\d+\s*\])(\s*==\s*TRUE)?$", re.I)
+_PLAIN_MOTION = re.compile(r"^(PTP|LIN)\s+([A-Za-z_][A-Za-z0-9_$]*|\{.*\})(\s+C_(DIS|PTP|VEL|ORI))*$", re.IGNORECASE)
+_PLAIN_WAIT_FOR = re.compile(r"^WAIT\s+FOR\s+([A-Za-z_]\w*|\$IN\s*\[\s*\d+\s*\])(\s*==\s*TRUE)?$", re.IGNORECASE)
 # The template's stop-message interrupt (BASISTECH INI): no effect on the motion.
 _TEMPLATE = re.compile(r"^((GLOBAL\s+)?INTERRUPT\s+DECL\s+3\s+WHEN\s+\$STOPMESS\s*==\s*TRUE\s+DO\s+IR_STOPM\s*\(\s*\)|"
-                       r"INTERRUPT\s+ON\s+3)$", re.I)
+                       r"INTERRUPT\s+ON\s+3)$", re.IGNORECASE)
 
-_BLOCK_START = re.compile(r"^(IF\b.*\bTHEN|LOOP|WHILE\b.*|FOR\b.*|REPEAT|SWITCH\b.*)$", re.I)
-_BLOCK_END = re.compile(r"^(ENDIF|ENDLOOP|ENDWHILE|ENDFOR|UNTIL\b.*|ENDSWITCH)$", re.I)
+_BLOCK_START = re.compile(r"^(IF\b.*\bTHEN|LOOP|WHILE\b.*|FOR\b.*|REPEAT|SWITCH\b.*)$", re.IGNORECASE)
+_BLOCK_END = re.compile(r"^(ENDIF|ENDLOOP|ENDWHILE|ENDFOR|UNTIL\b.*|ENDSWITCH)$", re.IGNORECASE)
 # An inline form's fold: `;FOLD PTP P1 ... ;%{PE}%R 8.3.48,...,%P 1:PTP, 2:P1, 3:C_DIS, 5:100, 7:PDAT1`.
-_MOTION_FOLD = re.compile(r"^;FOLD\s+(PTP|LIN)\b.*;%\{PE\}.*%P\s+(.*)$", re.I)
+_MOTION_FOLD = re.compile(r"^;FOLD\s+(PTP|LIN)\b.*;%\{PE\}.*%P\s+(.*)$", re.IGNORECASE)
 
 
 @lru_cache(maxsize=1)
@@ -565,10 +568,10 @@ class _Reader:
         if not _KNOWN.match(text):
             self.ignored.append((line, text))
             return
-        if re.match(r"^(PTP|LIN)\b", text, re.I) and not _PLAIN_MOTION.match(text):
+        if re.match(r"^(PTP|LIN)\b", text, re.IGNORECASE) and not _PLAIN_MOTION.match(text):
             self.unsimulated(text, line, "a motion to an expression")
             return
-        if re.match(r"^WAIT\s+FOR\b", text, re.I) and not _PLAIN_WAIT_FOR.match(text):
+        if re.match(r"^WAIT\s+FOR\b", text, re.IGNORECASE) and not _PLAIN_WAIT_FOR.match(text):
             self.unsimulated(text, line, "a wait for a condition other than an input")
             return
         if text.upper().startswith("DECL"):
@@ -610,8 +613,8 @@ class _Reader:
         if "7" in said and "data" in done and done["data"] != prefix + said["7"].upper():
             differ.append(f"data {said['7']} (the statements use {done['data']})")
         if differ:
-            self.ignored.append((fold.line, f"the fold's text is not what its statements do: {'; '.join(differ)}; "
-                                            "the statements run"))
+            self.ignored.append((fold.line, (f"the fold's text is not what its statements do: {'; '.join(differ)}; "
+                                             "the statements run")))
 
     def fields(self, kind: str, line: int) -> dict[str, object] | None:
         """The PDAT / LDAT / FDAT that *_ACT names; None when the program has not set it (the
@@ -747,8 +750,8 @@ class _Reader:
         said = read_spot_label(comment, self.n_package, 0.0, self.file, line)
         spot = dataclasses.replace(said, gun=int(gun), schedule=int(schedule), package=True)
         if comment and re.search(r"\bgun\b", comment) and (said.gun, said.schedule) != (spot.gun, spot.schedule):
-            self.ignored.append((line, f"the comment says gun {said.gun} schedule {said.schedule}, {name} has GUN "
-                                       f"{spot.gun} PGNO1 {spot.schedule}: the data holds"))
+            self.ignored.append((line, (f"the comment says gun {said.gun} schedule {said.schedule}, {name} has GUN "
+                                        f"{spot.gun} PGNO1 {spot.schedule}: the data holds")))
         self.add(spot, line)
 
     # ------------------------------------------------------------------ statements
@@ -864,15 +867,16 @@ class _Reader:
                          accel=self.lin_accel, tool=self.tool, base=self.base), line)
 
     def on_weld(self, tree: Tree[Token], comment: str, line: int) -> None:
-        n, seconds = (float(t) for t in tree.children)
+        n, seconds = (float(str(t)) for t in tree.children)
         self.add(read_spot_label(comment, int(n), seconds, self.file, line), line)
 
     def on_gripper(self, tree: Tree[Token], comment: str, line: int) -> None:
         action, n, seconds = tree.children
-        self.add(read_gripper(str(action).lower(), comment, int(float(n)), float(seconds), self.file, line), line)
+        self.add(read_gripper(str(action).lower(), comment, int(float(str(n))), float(str(seconds)), self.file,
+                                  line), line)
 
     def on_wait_sec(self, tree: Tree[Token], comment: str, line: int) -> None:
-        self.add(Wait(float(tree.children[0])), line)
+        self.add(Wait(float(str(tree.children[0]))), line)
 
     def on_wait_for(self, tree: Tree[Token], comment: str, line: int) -> None:
         """`WAIT FOR <signal>` (its SIGNAL declaration gives the input) or `WAIT FOR $IN[k]`, either
@@ -894,7 +898,7 @@ class _Reader:
 
 
 def _dat_name(file: str) -> str:
-    return re.sub(r"\.src$", ".dat", file, flags=re.I) if file.lower().endswith(".src") else file + " (.dat)"
+    return re.sub(r"\.src$", ".dat", file, flags=re.IGNORECASE) if file.lower().endswith(".src") else file + " (.dat)"
 
 
 def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
@@ -902,12 +906,12 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
     reader = _Reader(file, robot)
     for number, raw in enumerate(texts.get(FRAMES_FILE, "").splitlines(), start=1):
         stmt, _ = _statement(raw)
-        if re.match(r"^(TOOL|BASE)_DATA\s*\[", stmt, re.I):
+        if re.match(r"^(TOOL|BASE)_DATA\s*\[", stmt, re.IGNORECASE):
             reader.statement(stmt, "", number)
     dat_reader = _Reader(_dat_name(file), robot)
     for number, raw in enumerate(texts.get(".dat", "").splitlines(), start=1):
         stmt, _ = _statement(raw)
-        match = re.match(rf"^DECL\s+(GLOBAL\s+)?({'|'.join(_DATA_TYPES)})\s", stmt, re.I)
+        match = re.match(rf"^DECL\s+(GLOBAL\s+)?({'|'.join(_DATA_TYPES)})\s", stmt, re.IGNORECASE)
         if match:
             dat_reader.declare(stmt[:match.start(1)] + stmt[match.end(1):] if match[1] else stmt, number)
     reader.data.update(dat_reader.data)
@@ -918,7 +922,7 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
     header_comments: list[str] = []
     for number, raw in enumerate(src, start=1):
         stmt, comment = _statement(raw)
-        head = re.match(r"^(GLOBAL\s+)?DEF\s+([A-Za-z_][A-Za-z0-9_]*)\s*\(", stmt, re.I)
+        head = re.match(r"^(GLOBAL\s+)?DEF\s+([A-Za-z_][A-Za-z0-9_]*)\s*\(", stmt, re.IGNORECASE)
         if head:
             if main_name:
                 break                                   # the main program ends; local routines follow
@@ -926,15 +930,15 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             continue
         if not in_main or stmt.startswith("&"):
             continue
-        if re.match(r"^END\b", stmt, re.I):
+        if re.match(r"^END\b", stmt, re.IGNORECASE):
             in_main = False
             continue
         if not stmt:
             line = raw.strip()
-            if re.match(r"^;FOLD\b", line, re.I):
+            if re.match(r"^;FOLD\b", line, re.IGNORECASE):
                 folds += 1
                 reader.open_fold(line, number, folds)
-            elif re.match(r"^;ENDFOLD\b", line, re.I):
+            elif re.match(r"^;ENDFOLD\b", line, re.IGNORECASE):
                 reader.close_fold(folds)
                 folds = max(0, folds - 1)
             elif line.startswith(";") and folds == 0:

@@ -67,11 +67,11 @@ def _robot_base(placed: Placed) -> dict[str, Edit]:
 
 
 def _fdat_act_deleted(placed: Placed) -> dict[str, Edit]:
-    return {".src": lambda t: re.sub(r"^FDAT_ACT=.*\n", "", t, flags=re.M)}
+    return {".src": lambda t: re.sub(r"^FDAT_ACT=.*\n", "", t, flags=re.MULTILINE)}
 
 
 def _bas_deleted(placed: Placed) -> dict[str, Edit]:
-    return {".src": lambda t: re.sub(r"^BAS\(#(PTP|CP)_PARAMS,.*\n", "", t, flags=re.M)}
+    return {".src": lambda t: re.sub(r"^BAS\(#(PTP|CP)_PARAMS,.*\n", "", t, flags=re.MULTILINE)}
 
 
 MUTANTS = {
