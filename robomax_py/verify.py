@@ -76,7 +76,8 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
     for ext in dialect.extensions:
         sibling = path.with_suffix(ext) if suffix != ext else path
         if sibling == path or sibling.exists():
-            texts[ext] = read_text(sibling, LIMITS.program, ProgramError, "program file")
+            texts[ext] = read_text(sibling, LIMITS.program, ProgramError, "program file",
+                                   fallback=dialect.fallback_encoding)
     main = path.with_suffix(dialect.extensions[0])
     if dialect.extensions[0] not in texts:
         raise ProgramError(main, None, f"{path.name} needs its main file {main.name} beside it")
@@ -85,7 +86,8 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
         # without one, the controller holds the cell's calibrated frames (`controller_frames`).
         companion = main.with_name(main.stem + key)
         if companion.exists():
-            texts[key] = read_text(companion, LIMITS.program, ProgramError, "program file")
+            texts[key] = read_text(companion, LIMITS.program, ProgramError, "program file",
+                                   fallback=dialect.fallback_encoding)
     from robomax_py.export.rebuild import rebuild
 
     parsed = dialect.parse(texts, str(main), robot)

@@ -26,7 +26,7 @@ __all__ = ["DIALECTS", "Dialect", "controller_frames", "dialect_for_file", "form
 DIALECTS: dict[str, Dialect] = {
     "srcl": Dialect("srcl", (".srcl",), "", srcl.adapt, srcl.write, srcl.parse),
     "krl": Dialect("krl", (".src", ".dat"), "kuka", krl.adapt, krl.write, krl.parse, krl.frame_name,
-                   (krl.FRAMES_FILE,)),
+                   (krl.FRAMES_FILE,), krl.FILE_ENCODING),
     "rapid": Dialect("rapid", (".mod",), "abb", rapid.adapt, rapid.write, rapid.parse, companions=(rapid.FRAMES_FILE,)),
     "fanuc": Dialect("fanuc", (".ls",), "fanuc", fanuc.adapt, fanuc.write, fanuc.parse, fanuc.frame_name,
                      (fanuc.FRAMES_FILE,)),

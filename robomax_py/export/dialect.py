@@ -91,7 +91,8 @@ def own_name(frame: FrameDef) -> str:
 class Dialect:
     """A controller dialect: its files (the first is the main one; keys starting with "_" are
     companions named `<program>_...`, such as a frames setup file), its brand, both directions,
-    and how it refers to a numbered frame (`frame_name`: e.g. KRL "TOOL_DATA[1]")."""
+    how it refers to a numbered frame (`frame_name`: e.g. KRL "TOOL_DATA[1]"), and the encoding
+    its files are read in when they are not UTF-8 (`fallback_encoding`, "" for none)."""
 
     name: str
     extensions: tuple[str, ...]
@@ -101,6 +102,7 @@ class Dialect:
     parse: Callable[[dict[str, str], str, RobotModel], Parsed]
     frame_name: Callable[[FrameDef], str] = own_name
     companions: tuple[str, ...] = ()
+    fallback_encoding: str = ""
 
 
 def with_frame_names(program: Program, name_of: Callable[[FrameDef], str]) -> Program:

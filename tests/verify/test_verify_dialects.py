@@ -119,8 +119,15 @@ def test_another_configuration_is_rejected_with_its_line(written: dict[str, Any]
 
 # ------------------------------------------------------------------ a blended weld point
 
+def _krl_cont(fold: re.Match[str]) -> str:
+    """An exact-stop LIN fold made CONT, as the smartPAD's inline form writes it."""
+    text = fold[0].replace(" Vel=", " CONT Vel=", 1).replace("3:, ", "3:C_DIS C_DIS, ", 1)
+    return text[:-len(" \n")] + " C_DIS C_DIS\n"
+
+
 BLENDED: dict[str, Callable[[str], str]] = {
-    "krl": lambda t: _first(r"^(LIN XP\d+)( ; approach)", t, lambda m: m[1] + " C_DIS" + m[2]),
+    "krl": lambda t: re.sub(r"^;FOLD LIN (P\d+) Vel=.*?\nLIN X\1 \n", _krl_cont, t, count=1,
+                             flags=re.MULTILINE | re.DOTALL),
     "rapid": lambda t: _first(r"^(\s*MoveL p\d+, v_lin\d+, )fine", t, lambda m: m[1] + "z10"),
     "fanuc": lambda t: _first(r"^(\s*\d+:\s+L P\[\d+\] \d+mm/sec )FINE", t, lambda m: m[1] + "CNT50"),
     "urscript": lambda t: _first(r"^(\s*movel\(.*)r=0\.000000000\)(  # approach)", t, lambda m: m[1] + "r=0.010000000)" + m[2]),
