@@ -2,7 +2,7 @@
 naming a line: each mutant is the placed process cell's module edited as a mistaken writer would
 have written it (the robot's placement as the work object's user frame, quaternions in x-y-z-w
 order, the targets' rotations in another order, lengths in metres, joint values in radians, the
-wrist bit of cfx flipped, the work object or the tool left out)."""
+wrist bit of cfx flipped, the work object or the tool left out, the data module not loaded)."""
 
 from __future__ import annotations
 
@@ -10,9 +10,10 @@ import math
 import re
 
 import pytest
+from conftest import Edit, Placed, placement_mm_zyx
 from scipy.spatial.transform import Rotation
 
-from conftest import Edit, Placed, placement_mm_zyx
+from robomax_py.verify import verify_program
 
 QUAT = r"\[(-?[\d.]+), (-?[\d.]+), (-?[\d.]+), (-?[\d.]+)\]"
 
@@ -97,3 +98,18 @@ def test_rapid_mutant_is_rejected_with_a_line(placed: Placed, kind: str) -> None
 def test_the_written_rapid_module_is_clean(placed: Placed) -> None:
     report = placed.verify("rapid", {}, "unchanged")
     assert report.clean, report.violations
+
+
+@pytest.mark.slow
+def test_without_the_data_module_a_frame_it_declares_is_unknown(placed: Placed) -> None:
+    """The controller holds only the frames the cell names (the tool gun2); the user frame
+    fixture_plate exists only in the data module: without it the program refers to undeclared
+    data, which verify reports at the first move that uses it."""
+    folder = placed.folder / "mutant_rapid_no_data_module"
+    folder.mkdir()
+    for file, text in placed.files.items():
+        if file != f"{placed.name}_frames.mod":
+            (folder / file).write_text(text)
+    report = verify_program(placed.cell, placed.robot, folder / f"{placed.name}.mod")
+    assert not report.clean
+    assert any("fixture_plate" in v.detail and v.line is not None for v in report.violations), report.violations
