@@ -91,8 +91,9 @@ def own_name(frame: FrameDef) -> str:
 class Dialect:
     """A controller dialect: its files (the first is the main one; keys starting with "_" are
     companions named `<program>_...`, such as a frames setup file), its brand, both directions,
-    how it refers to a numbered frame (`frame_name`: e.g. KRL "TOOL_DATA[1]"), and the encoding
-    its files are read in when they are not UTF-8 (`fallback_encoding`, "" for none)."""
+    how it refers to a numbered frame (`frame_name`: e.g. KRL "TOOL_DATA[1]"), the encoding its
+    files are read in when they are not UTF-8 (`fallback_encoding`, "" for none), and which frames a
+    controller set up for the cell holds (`named_frames_only`)."""
 
     name: str
     extensions: tuple[str, ...]
@@ -103,6 +104,9 @@ class Dialect:
     frame_name: Callable[[FrameDef], str] = own_name
     companions: tuple[str, ...] = ()
     fallback_encoding: str = ""
+    # The controller holds only the frames the cell names (`ControllerFrame.existing`), as RAPID
+    # data exist only where a loaded module declares them; otherwise every frame slot it selects.
+    named_frames_only: bool = False
 
 
 def with_frame_names(program: Program, name_of: Callable[[FrameDef], str]) -> Program:

@@ -37,6 +37,7 @@ READERS: dict[str, Callable[[str], ProgramRun]] = {
     "spindle_main.src": _krl,
     "Grey_T_ROB1.mod": lambda n: run_rapid({n: _text(n)}),
     "test_4.mod": lambda n: run_rapid({n: _text(n)}),
+    "robodk_Program.mod": lambda n: run_rapid({n: _text(n)}, entry="Main"),
     "ros_movesm.ls": lambda n: run_fanuc(_text(n), name=n),
     "up222.ls": lambda n: run_fanuc(_text(n), name=n),
     "timing_debug.script": lambda n: run_urscript(_text(n), name=n),
@@ -115,6 +116,22 @@ def test_abb_gripper_program() -> None:
     assert_allclose(_known(run.motions[0].T_flange_tcp)[:3, 3], [-0.14418, -0.1544, 0.03477], atol=POS_TOL_M)
     # ConfL \Off, ConfJ \Off, IF, ENDIF, and extax a = 0 (an external axis, if there is one, goes to 0)
     assert _unsupported_lines(run) == {6, 7, 10, 12} | {m.where.line for m in run.motions}
+
+
+def test_abb_program_in_a_work_object() -> None:
+    """RoboDK's module: MoveAbsJ and MoveL with `,\\WObj:=Frame2` (Frame2's uframe 399.855 mm along x,
+    100 mm up, its oframe identity): a target in Frame2 is the user frame's offset plus the target."""
+    run = READERS["robodk_Program.mod"]("robodk_Program.mod")
+    assert [m.statement for m in run.motions] == ["MoveAbsJ"] * 2 + ["MoveL"] * 4
+    in_wobj0, in_frame2 = run.motions[2], run.motions[3]
+    assert_allclose(_known(in_wobj0.T_base_tcp)[:3, 3], [0.018715, 0.147321, 0.458168], atol=POS_TOL_M)
+    assert_allclose(_known(in_frame2.T_base_tcp)[:3, 3], [0.403136, 0.147321, 0.394993], atol=POS_TOL_M)
+    assert_allclose(_known(in_frame2.T_base_user)[:3, 3], [0.399855, 0.0, 0.1], atol=POS_TOL_M)
+    # the tool: TCP at (-30, 0, 40) mm, turned -60 deg about y (q = [cos 30, 0, -sin 30, 0])
+    assert_allclose(_known(in_frame2.T_flange_tcp)[:3, 3], [-0.03, 0.0, 0.04], atol=POS_TOL_M)
+    # ConfL \Off and STOP are outside the subset; the call of Subprog (not in the module) is recorded
+    assert _unsupported_lines(run) == {18, 28}
+    assert [(c.name, c.where.line) for c in run.calls] == [("Subprog", 30)]
 
 
 def test_fanuc_ros_relay_program() -> None:

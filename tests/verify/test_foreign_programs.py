@@ -7,12 +7,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
+from numpy.testing import assert_allclose
+from scipy.spatial.transform import Rotation
 
 from robomax_py.errors import ProgramError
-from robomax_py.export import dialect_for_file
+from robomax_py.export import dialect_for_file, rapid
 from robomax_py.io.cell import load_cell, load_cell_robot
-from robomax_py.program import Comment, LinMove, PtpMove, Wait, WaitFor
+from robomax_py.program import Comment, LinMove, PtpMove, Wait, WaitFor, lin_pose
 from robomax_py.robot import RobotModel
 from robomax_py.safe_files import LIMITS, read_text
 from robomax_py.verify import verify_program
@@ -105,6 +108,57 @@ def test_rapid_program_with_conditions(kr125) -> None:  # type: ignore[no-untype
     assert 11 in lines                                                      # WaitDI inside IF ... ENDIF
     tool = parsed.program.frames[0]
     assert tool.name == "custom_tool1" and tool.xyz_mm == (-144.18, -154.4, 34.77)
+
+
+def _T(xyz_mm: list[float], q_wxyz: list[float]) -> np.ndarray:
+    """A RAPID pose [[x, y, z], [q1, q2, q3, q4]] (q1 = w) as (4, 4) in metres, by scipy."""
+    w, x, y, z = q_wxyz
+    T = np.eye(4)
+    T[:3, :3] = Rotation.from_quat([x, y, z, w]).as_matrix()
+    T[:3, 3] = np.asarray(xyz_mm) / 1000.0
+    return T
+
+
+def _assert_pose(T: np.ndarray, want: np.ndarray) -> None:
+    assert_allclose(T[:3, 3], want[:3, 3], atol=1e-6)                                 # 1 µm
+    assert Rotation.from_matrix(T[:3, :3].T @ want[:3, :3]).magnitude() < 1e-6
+
+
+def test_rapid_robodk_program_in_its_work_object(kr125) -> None:  # type: ignore[no-untyped-def]
+    """RoboDK's module moves in Frame2 (a user frame 399.855 mm along x, 100 mm up) and once in
+    WObj0: each target lands at uframe · oframe · target, with the tool the statement names."""
+    parsed = _read("robodk_Program.mod", kr125[1])
+    frames = {f.name: f for f in parsed.program.frames}
+    assert set(frames) == {"Tool", "Frame2"}
+    lins = [i for i in parsed.program.instructions if isinstance(i, LinMove)]
+    assert [(lin.tool, lin.base) for lin in lins] == [("Tool", ""), ("Tool", "Frame2"), ("Tool", "Frame2"),
+                                                      ("Tool", "Frame2")]
+    q = [0.0, -0.97969618, 0.0, 0.20048792]
+    _assert_pose(lin_pose(lins[0]), _T([18.715, 147.321, 458.168], q))
+    uframe = _T([399.855, 0.0, 100.0], [1.0, 0.0, 0.0, 0.0])
+    _assert_pose(frames["Frame2"].pose @ lin_pose(lins[1]), uframe @ _T([3.281, 147.321, 294.993], q))
+    _assert_pose(frames["Tool"].pose, _T([-30.0, 0.0, 40.0], [0.86602540, 0.0, -0.5, 0.00000001]))
+    moves = [i for i in parsed.program.instructions if isinstance(i, PtpMove)]
+    assert moves[1].target_deg[4] == -56.1147                                 # `,\\WObj:=` on MoveAbsJ: harmless
+
+
+def test_rapid_calibration_module_as_the_data_module(kr125) -> None:  # type: ignore[no-untyped-def]
+    """SMR1's calibration module (TASK PERS work objects whose oframe is the calibrated one, CRLF)
+    loaded beside a main module: a target in Mandrell lands at uframe · oframe · target."""
+    main = ("MODULE Main\n  PROC main()\n    MoveAbsJ [[0, -30, 30, 0, 60, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]], "
+            "v100, fine, Gripper;\n    MoveL [[100, -50, 20], [0.7071068, 0, 0.7071068, 0], [0, 0, 0, 0], "
+            "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]], v100, fine, Gripper_Sleeve \\WObj:=Mandrell;\n  ENDPROC\nENDMODULE\n")
+    data = (DATA / "smr1_CalibData.mod").read_text(encoding="utf-8")
+    parsed = rapid.parse({".mod": main, rapid.FRAMES_FILE: data}, "Main.mod", kr125[1])
+    frames = {f.name: f for f in parsed.program.frames}
+    assert {"Gripper", "Sleeves", "Mandrell", "Laser", "Gripper_Sleeve"} <= set(frames)
+    (lin,) = [i for i in parsed.program.instructions if isinstance(i, LinMove)]
+    assert (lin.tool, lin.base) == ("Gripper_Sleeve", "Mandrell")
+    uframe = _T([0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0])
+    oframe = _T([2812.88, -226.05, 592.36], [0.27444, 0.27271, 0.64992, 0.65415])    # scipy normalises it
+    target = _T([100.0, -50.0, 20.0], [0.7071068, 0.0, 0.7071068, 0.0])
+    _assert_pose(frames["Mandrell"].pose @ lin_pose(lin), uframe @ oframe @ target)
+    _assert_pose(frames["Gripper_Sleeve"].pose, _T([0.0, 6.4, 1700.0], [1.0, -0.00161, 0.0, 0.0]))
 
 
 def test_fanuc_streaming_program(kr125) -> None:  # type: ignore[no-untyped-def]
