@@ -191,7 +191,8 @@ def program_name(name: str) -> str:
 def remarks(text: str) -> list[str]:
     """A text as TP remark texts of at most REMARK_CHARS characters: the first, then continuations
     starting with `+`, each followed by the rest of the text as it goes on. A line breaks after a
-    comma, else before a space (which its continuation keeps), else where it is full."""
+    comma, else before a space or after a `/`, else after a `_`, else where it is full; it never
+    ends in a space (the controller may pad remarks with spaces)."""
     out: list[str] = []
     rest, room = text, REMARK_CHARS
     while len(rest) > room:
@@ -203,9 +204,16 @@ def remarks(text: str) -> list[str]:
 
 
 def _break_at(text: str, room: int) -> int:
-    spaces = [k for k in range(1, room + 1) if text[k] == " " and text[k - 1] != " "]
-    after_comma = [k for k in spaces if text[k - 1] == ","]
-    return (after_comma or spaces or [room])[-1]
+    """Where to break `text` (longer than `room`): the number of characters the line keeps."""
+    def space(k: int) -> bool:
+        return text[k] == " " and text[k - 1] != " "
+
+    for fits in (lambda k: space(k) and text[k - 1] == ",", lambda k: space(k) or text[k - 1] == "/",
+                 lambda k: text[k - 1] == "_" and text[k] != " "):
+        cuts = [k for k in range(1, room + 1) if fits(k)]
+        if cuts:
+            return cuts[-1]
+    return room
 
 
 def _number(name: str) -> int:

@@ -211,6 +211,7 @@ class _Builder:
             if isinstance(ins, Spot):
                 self._check_interlocks(ins, label)
                 if ins.package:
+                    self._check_schedule(ins, label)
                     ins = dataclasses.replace(ins, time_s=self._schedule_time(ins))
             self._check_action(ins, label)
             self.segments.append(dwell(self.q, ins.time_s, kind="weld", label=label))
@@ -339,6 +340,18 @@ class _Builder:
                                                          "time", self.line))
             return 0.0
         return times.pop()
+
+    def _check_schedule(self, ins: Spot, label: str) -> None:
+        """A process-package weld names the schedule the cell welds that spot with: the schedule is
+        the weld (current, time), not only its duration."""
+        from robomax_py.export.plan_program import identifier
+
+        seam = next((s for s in self.cell.seams if identifier(s.name) == ins.seam), None)
+        spec = next((p for p in seam.spots if identifier(p.name) == ins.name), None) if seam else None
+        if spec is not None and spec.action is None and self.cell.process.schedule_of(spec) != ins.schedule:
+            self.problems.append(Problem(self.t, "weld", f"{label} is welded with schedule {ins.schedule}; the cell "
+                                                         f"welds it with schedule {self.cell.process.schedule_of(spec)}",
+                                         self.line))
 
     def _check_action(self, ins: Spot | Gripper, label: str) -> None:
         """A tending station gets its gripper action, a weld spot a weld."""
