@@ -205,12 +205,10 @@ def remarks(text: str) -> list[str]:
 
 def _break_at(text: str, room: int) -> int:
     """Where to break `text` (longer than `room`): the number of characters the line keeps."""
-    def space(k: int) -> bool:
-        return text[k] == " " and text[k - 1] != " "
-
-    for fits in (lambda k: space(k) and text[k - 1] == ",", lambda k: space(k) or text[k - 1] == "/",
-                 lambda k: text[k - 1] == "_" and text[k] != " "):
-        cuts = [k for k in range(1, room + 1) if fits(k)]
+    spaces = [k for k in range(1, room + 1) if text[k] == " " and text[k - 1] != " "]
+    for cuts in ([k for k in spaces if text[k - 1] == ","],
+                 sorted({*spaces, *(k for k in range(1, room + 1) if text[k - 1] == "/")}),
+                 [k for k in range(1, room + 1) if text[k - 1] == "_" and text[k] != " "]):
         if cuts:
             return cuts[-1]
     return room
@@ -434,33 +432,33 @@ def _ls(name: str, comment: str, mn: list[str], pos: list[str], *, stamp: str = 
 _NUMBERED = re.compile(r"^\s*([0-9]+):(.*)$")
 _CONTINUED = re.compile(r"^\s*:(.*)$")
 _MOVE = re.compile(r"^(J|L)\s+P\[([0-9]+)(?::[^\]]*)?\]\s+([0-9.]+)\s*(%|mm/sec|cm/min|inch/min|deg/sec|sec|msec)\s+"
-                   r"(FINE|CNT\s*([0-9]+))(.*)$", re.I)
-_CALL = re.compile(r"^CALL\s+(SPOT_WELD|GRIP|RELEASE)\s*\(\s*([0-9]+)\s*,\s*([0-9]*\.?[0-9]+)\s*\)$", re.I)
-_WAIT = re.compile(r"^WAIT\s+([0-9]*\.?[0-9]+)\s*\(sec\)$", re.I)
-_WAIT_DI = re.compile(r"^WAIT\s+DI\[([0-9]+)(?::([^\]]*))?\]\s*=\s*ON$", re.I)
-_PR_ELEMENT = re.compile(r"^PR\[([0-9]+),([1-6])\]\s*=\s*\(?\s*([+-]?[0-9]*\.?[0-9]+)\s*\)?$", re.I)
-_FRAME_SET = re.compile(r"^(UTOOL|UFRAME)\[([0-9]+)\]\s*=\s*PR\[([0-9]+)\]$", re.I)
-_FRAME_NUM = re.compile(r"^(UTOOL|UFRAME)_NUM\s*=\s*([0-9]+)$", re.I)
-_PR_RESET = re.compile(r"^PR\[([0-9]+)\]\s*=\s*(LPOS|PR\[([0-9]+)\]\s*-\s*PR\[([0-9]+)\])$", re.I)
-_UF_UT = re.compile(r"\bUF\s*:\s*([0-9]+)\s*,\s*UT\s*:\s*([0-9]+)", re.I)
-_POS_HEAD = re.compile(r"^P\[([0-9]+)(?::[^\]]*)?\]\s*\{", re.I)
-_FIELD = re.compile(r"\b(X|Y|Z|W|P|R|J[1-6])\s*=\s*([+-]?[0-9]*\.?[0-9]+)\s*(mm|deg)", re.I)
-_CONFIG = re.compile(r"CONFIG\s*:\s*'([^']*)'", re.I)
-_SPOT = re.compile(r"\bSPOT\[([^\]]*)\]", re.I)
-_EQUIPMENT = re.compile(r"SPOT\s+Welding\s+Equipment\s+Number\s*:\s*([0-9]+)", re.I)
+                   r"(FINE|CNT\s*([0-9]+))(.*)$", re.IGNORECASE)
+_CALL = re.compile(r"^CALL\s+(SPOT_WELD|GRIP|RELEASE)\s*\(\s*([0-9]+)\s*,\s*([0-9]*\.?[0-9]+)\s*\)$", re.IGNORECASE)
+_WAIT = re.compile(r"^WAIT\s+([0-9]*\.?[0-9]+)\s*\(sec\)$", re.IGNORECASE)
+_WAIT_DI = re.compile(r"^WAIT\s+DI\[([0-9]+)(?::([^\]]*))?\]\s*=\s*ON$", re.IGNORECASE)
+_PR_ELEMENT = re.compile(r"^PR\[([0-9]+),([1-6])\]\s*=\s*\(?\s*([+-]?[0-9]*\.?[0-9]+)\s*\)?$", re.IGNORECASE)
+_FRAME_SET = re.compile(r"^(UTOOL|UFRAME)\[([0-9]+)\]\s*=\s*PR\[([0-9]+)\]$", re.IGNORECASE)
+_FRAME_NUM = re.compile(r"^(UTOOL|UFRAME)_NUM\s*=\s*([0-9]+)$", re.IGNORECASE)
+_PR_RESET = re.compile(r"^PR\[([0-9]+)\]\s*=\s*(LPOS|PR\[([0-9]+)\]\s*-\s*PR\[([0-9]+)\])$", re.IGNORECASE)
+_UF_UT = re.compile(r"\bUF\s*:\s*([0-9]+)\s*,\s*UT\s*:\s*([0-9]+)", re.IGNORECASE)
+_POS_HEAD = re.compile(r"^P\[([0-9]+)(?::[^\]]*)?\]\s*\{", re.IGNORECASE)
+_FIELD = re.compile(r"\b(X|Y|Z|W|P|R|J[1-6])\s*=\s*([+-]?[0-9]*\.?[0-9]+)\s*(mm|deg)", re.IGNORECASE)
+_CONFIG = re.compile(r"CONFIG\s*:\s*'([^']*)'", re.IGNORECASE)
+_SPOT = re.compile(r"\bSPOT\[([^\]]*)\]", re.IGNORECASE)
+_EQUIPMENT = re.compile(r"SPOT\s+Welding\s+Equipment\s+Number\s*:\s*([0-9]+)", re.IGNORECASE)
 # Motion options that change the target or the way the robot moves to it (remote TCP: the part
 # moves past a fixed tool); TB/TA/DB triggers and ACC are read or do not.
-_TARGET_OPTIONS = re.compile(r"\b(Offset|Tool_Offset|INC|VOFFSET|Skip|RTCP)\b", re.I)
+_TARGET_OPTIONS = re.compile(r"\b(Offset|Tool_Offset|INC|VOFFSET|Skip|RTCP)\b", re.IGNORECASE)
 # Motions this reader does not simulate, and control flow (jumps, conditions): the program's
 # motion then depends on what the reader cannot follow.
 _UNSIMULATED = re.compile(r"^(C|A)\s+P|^(J|L|C|A)\s+PR\[|^JMP\b|^IF\b|^SELECT\b|^FOR\b|"
-                          r"^CALL\s+(?!(SPOT_WELD|GRIP|RELEASE)\b)", re.I)
+                          r"^CALL\s+(?!(SPOT_WELD|GRIP|RELEASE)\b)", re.IGNORECASE)
 
 
 def _positions(text: str) -> dict[int, tuple[dict[str, float], str, tuple[int, int] | None]]:
     """P[k] -> its fields (X..R, J1..J6), its CONFIG and its (UF, UT) numbers."""
     out: dict[int, tuple[dict[str, float], str, tuple[int, int] | None]] = {}
-    for block in re.split(r"(?=^P\[)", text, flags=re.M):
+    for block in re.split(r"(?=^P\[)", text, flags=re.MULTILINE):
         head = _POS_HEAD.match(block)
         if head:
             group1 = re.split(r"\bGP[2-9]\s*:", block)[0]         # the robot's group; others are positioners
@@ -590,7 +588,7 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             kind, k, speed, unit = move.group(1).upper(), int(move.group(2)), float(move.group(3)), move.group(4).lower()
             cnt = 0 if move.group(5).upper() == "FINE" else int(move.group(6))
             options = move.group(7) or ""
-            acc = re.search(r"ACC\s*([0-9]+)", options, re.I)
+            acc = re.search(r"ACC\s*([0-9]+)", options, re.IGNORECASE)
             if k not in positions:
                 raise error(number, f"P[{k}] has no position in /POS")
             fields, config, numbers = positions[k]
@@ -620,13 +618,14 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             else:                          # a joint move to a Cartesian point, or the other way round
                 not_simulated(number, s, stmt)
                 continue
-            spot = _SPOT.search(options)
-            if spot:
-                fields_spot = dict(part.split("=", 1) for part in spot.group(1).replace(" ", "").split(",") if "=" in part)
-                if not fields_spot.get("S", "").isdigit():
-                    raise error(number, f"SPOT[{spot.group(1)}] names no weld schedule S")
+            spot_option = _SPOT.search(options)
+            if spot_option:
+                schedules = dict(part.split("=", 1) for part in spot_option.group(1).replace(" ", "").split(",")
+                                 if "=" in part)
+                if not schedules.get("S", "").isdigit():
+                    raise error(number, f"SPOT[{spot_option.group(1)}] names no weld schedule S")
                 n = sum(isinstance(i, Spot) for i in instructions) + 1
-                add(Spot(f"spot{n}", "unnamed", 0.0, equipment, int(fields_spot["S"]), package=True), number, s)
+                add(Spot(f"spot{n}", "unnamed", 0.0, equipment, int(schedules["S"]), package=True), number, s)
             continue
         if re.match(r"^(J|L|C|A)\s", stmt):     # a motion in a form not read above (register speeds...)
             not_simulated(number, s, stmt)

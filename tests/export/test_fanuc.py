@@ -110,7 +110,7 @@ def test_long_names_stay_within_the_controllers_limits(long_names: dict[str, str
         prog = re.match(r"^/PROG  (\S+)\r\n", text)
         assert prog and f"{prog.group(1)}.ls" == file and TP_NAME.match(prog.group(1))
         assert len(prog.group(1)) <= NAME_CHARS
-        comment = re.search(r'^COMMENT\t\t= "([^"]*)";', text, re.M)
+        comment = re.search(r'^COMMENT\t\t= "([^"]*)";', text, re.MULTILINE)
         assert comment and len(comment.group(1)) <= 16
         statements = _statements(text)
         assert f"LINE_COUNT\t= {len(statements)};" in text
