@@ -215,9 +215,12 @@ def _stale_programs(out_dir: Path, name: str) -> list[str]:
     """Program files of an earlier plan of the cell in the output folder."""
     from robomax_py.export import DIALECTS
 
+    from robomax_py.export.plan_program import identifier
+
     suffixes = {".json", ".png", *(e for d in DIALECTS.values() for e in d.extensions)}
+    stems = {name, *(d.program_name(identifier(name)) for d in DIALECTS.values() if d.program_name)}
     try:
-        return sorted(p.name for p in out_dir.iterdir() if p.stem == name and p.suffix in suffixes)
+        return sorted(p.name for p in out_dir.iterdir() if p.stem in stems and p.suffix in suffixes)
     except OSError:
         return []
 

@@ -30,7 +30,8 @@ DIALECTS: dict[str, Dialect] = {
     "rapid": Dialect("rapid", (".mod",), "abb", rapid.adapt, rapid.write, rapid.parse, companions=(rapid.FRAMES_FILE,),
                      named_frames_only=True),
     "fanuc": Dialect("fanuc", (".ls",), "fanuc", fanuc.adapt, fanuc.write, fanuc.parse, fanuc.frame_name,
-                     (fanuc.FRAMES_FILE,)),
+                     (fanuc.FRAMES_FILE,), program_name=fanuc.program_name,
+                     shared=tuple(f"{name}.ls" for name in fanuc.ROUTINES)),
     "urscript": Dialect("urscript", (".script",), "ur", urscript.adapt, urscript.write, urscript.parse),
 }
 

@@ -92,8 +92,8 @@ class Dialect:
     """A controller dialect: its files (the first is the main one; keys starting with "_" are
     companions named `<program>_...`, such as a frames setup file), its brand, both directions,
     how it refers to a numbered frame (`frame_name`: e.g. KRL "TOOL_DATA[1]"), the encoding its
-    files are read in when they are not UTF-8 (`fallback_encoding`, "" for none), and which frames a
-    controller set up for the cell holds (`named_frames_only`)."""
+    files are read in when they are not UTF-8 (`fallback_encoding`, "" for none), which frames a
+    controller set up for the cell holds (`named_frames_only`), and what its files are named after."""
 
     name: str
     extensions: tuple[str, ...]
@@ -107,6 +107,11 @@ class Dialect:
     # The controller holds only the frames the cell names (`ControllerFrame.existing`), as RAPID
     # data exist only where a loaded module declares them; otherwise every frame slot it selects.
     named_frames_only: bool = False
+    # The name the dialect gives a program of a given name (`adapt` names it so), when its files are
+    # named after it rather than after the cell: FANUC, whose programs are named as their files.
+    program_name: Callable[[str], str] | None = None
+    # Whole file names every program of the dialect writes alike (FANUC's default routines).
+    shared: tuple[str, ...] = ()
 
 
 def with_frame_names(program: Program, name_of: Callable[[FrameDef], str]) -> Program:

@@ -272,10 +272,12 @@ def _run(plan: Plan, dialect: str) -> ProgramRun:
     if dialect == "rapid":
         return run_rapid({f: plan.text(f) for f in files if f.endswith(".mod")})
     if dialect == "fanuc":
-        others = [f for f in files if f.endswith(".ls") and f != f"{plan.name}.ls"]
+        # A TP program is named as its file, in capitals (PLACED_CELL.ls, PLACED_CELL_FRAMES.ls).
+        main = f"{plan.name.upper()}.ls"
+        others = [f for f in files if f.endswith(".ls") and f != main]
         # The cell hands no position registers, so the setup program only lists the frames: the
         # controller holds the integrator's calibrated gun TCP as tool 1 (the default number).
-        return run_fanuc(plan.text(f"{plan.name}.ls"), name=f"{plan.name}.ls",
+        return run_fanuc(plan.text(main), name=main,
                          setup={f: plan.text(f) for f in others if "frames" in f.lower()},
                          called={f: plan.text(f) for f in others if "frames" not in f.lower()},
                          utools={1: plan.arm.T_flange_tcp}, j23_coupling=plan.arm.j23_coupling)
