@@ -86,8 +86,10 @@ def checked_file(path: Path, limit: int, error: ErrorFactory, what: str, key: st
     return resolved
 
 
-def read_text(path: Path, limit: int, error: ErrorFactory, what: str, key: str | None = None) -> str:
-    """The UTF-8 text of a checked file (`checked_file`); a BOM is dropped."""
+def read_text(path: Path, limit: int, error: ErrorFactory, what: str, key: str | None = None,
+              fallback: str = "") -> str:
+    """The UTF-8 text of a checked file (`checked_file`); a BOM is dropped. fallback: the encoding
+    to read a file in that is not UTF-8 (KRL files are Windows-1252 when written on the controller)."""
     safe = checked_file(path, limit, error, what, key)
     try:
         data = safe.read_bytes()
@@ -98,8 +100,15 @@ def read_text(path: Path, limit: int, error: ErrorFactory, what: str, key: str |
     try:
         return data.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError as exc:
+        if fallback:
+            try:
+                return data.decode(fallback)
+            except UnicodeDecodeError:
+                pass
         line = data[:exc.start].count(b"\n") + 1
-        raise error(path, f"line {line}", f"{what} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start})") from None
+        encodings = "UTF-8" + (f" or {fallback}" if fallback else "")
+        raise error(path, f"line {line}", f"{what} is not {encodings} text (byte 0x{data[exc.start]:02x} at offset "
+                                          f"{exc.start})") from None
 
 
 def printable(text: str, limit: int = 200) -> str:

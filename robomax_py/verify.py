@@ -79,7 +79,8 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
     for ext in dialect.extensions:
         sibling = path.with_suffix(ext) if suffix != ext else path
         if sibling == path or sibling.exists():
-            texts[ext] = read_text(sibling, LIMITS.program, ProgramError, "program file")
+            texts[ext] = read_text(sibling, LIMITS.program, ProgramError, "program file",
+                                   fallback=dialect.fallback_encoding)
             read.append(sibling)
     main = path.with_suffix(dialect.extensions[0])
     if dialect.extensions[0] not in texts:
@@ -87,9 +88,10 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
     for key in dialect.companions:
         # A setup file beside the program (its frames) is what the controller was loaded with;
         # without one, the controller holds the cell's calibrated frames (`controller_frames`).
-        companion = main.with_name(main.stem + key)
-        if companion.exists():
-            texts[key] = read_text(companion, LIMITS.program, ProgramError, "program file")
+        companion = _beside(main, main.stem + key)
+        if companion is not None:
+            texts[key] = read_text(companion, LIMITS.program, ProgramError, "program file",
+                                   fallback=dialect.fallback_encoding)
             read.append(companion)
     from robomax_py.export.rebuild import rebuild
 
@@ -111,16 +113,27 @@ def _with_set(cell: CellSpec, path: Path, read: tuple[Path, ...], report: Verify
     version of the cell file is noted (the motion is what verify judges)."""
     check = check_set(path, read)
     if check.manifest is None:
-        lone = f"no {path.stem}.manifest.json beside it: verified as a lone program, not as one plan's set"
+        lone = "no plan's manifest beside it names it: verified as a lone program, not as one plan's set"
         return dataclasses.replace(report, notes=(*report.notes, lone))
-    found = tuple(Violation(None, "set", f"not one plan's set with {path.stem}.manifest.json: {m}")
-                  for m in check.mismatched)
+    found = tuple(Violation(None, "set", m) for m in check.mismatched)
     notes = report.notes
     if check.cell_sha256 and check.cell_sha256 != cell.digest:
         other = (f"planned from another version of the cell file (sha256 {check.cell_sha256[:12]}..., "
                  f"this one {cell.digest[:12]}...)")
         notes = (*notes, other)
     return dataclasses.replace(report, violations=found + report.violations, notes=notes)
+
+
+def _beside(path: Path, name: str) -> Path | None:
+    """The file `name` in `path`'s folder; on a case-sensitive file system also one whose name
+    differs in case only (a controller's backup writes `home.ls` for the program HOME)."""
+    exact = path.with_name(name)
+    if exact.exists():
+        return exact
+    try:
+        return next((p for p in path.parent.iterdir() if p.name.lower() == name.lower() and p.is_file()), None)
+    except OSError:
+        return None
 
 
 def _is_motion(parsed: Any, line: int) -> bool:

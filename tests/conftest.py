@@ -116,9 +116,14 @@ def _plan_set_state(folder: Path, name: str) -> str | None:
     import hashlib
     import json
 
+    import re
+
+    # The set's own names: the cell's, and FANUC's, named as its TP program (capitals; for short
+    # names such as the tests', `export.fanuc.program_name` without importing the exporters).
+    stems = {name, re.sub(r"[^A-Za-z0-9_]", "_", name).upper()}
     manifest = folder / f"{name}.manifest.json"
     readable = {p.name for p in folder.iterdir() if not p.name.startswith(".") and p.exists()
-                and p.name.startswith((f"{name}.", f"{name}_"))}
+                and p.name.startswith(tuple(f"{stem}{sep}" for stem in stems for sep in "._"))}
     if not manifest.exists():
         assert not readable, f"program files without a manifest: {sorted(readable)}"
         return None

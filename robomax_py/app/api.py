@@ -63,14 +63,14 @@ def write_programs(cell: LoadedCell, result: PlanResult, out_dir: str | Path, fo
     Raises ExportError for a plan that is not complete or a program that does not prove: nothing
     is written then.
     """
-    from robomax_py.export import format_names
+    from robomax_py.export import SHARED_FILES, format_names
     from robomax_py.io.files import commit_set
     from robomax_py.publish import publish
 
     names = format_names(formats, cell.robot.controller.brand)
     files, _ = publish(result, cell.spec, cell.robot, names, stamp=stamp, baseline=result.baseline)
     name = result.cell + ("_baseline" if result.baseline else "")
-    return list(commit_set(Path(out_dir), name, files, cell.spec.digest).paths)
+    return list(commit_set(Path(out_dir), name, files, cell.spec.digest, SHARED_FILES).paths)
 
 
 def verify_program(cell: LoadedCell, path: str | Path) -> VerifyReport:

@@ -327,8 +327,10 @@ def write_outcome_programs(out_dir: Path, outcome: CellOutcome, taken: dict[str,
 
     if outcome.status != PLANNED:
         return outcome
-    # Files every cell writes alike (FANUC's spot_weld.ls) do not belong to one cell.
-    own = [name for name, _ in outcome.programs if name.startswith(outcome.cell)]
+    from robomax_py.export import SHARED_FILES
+
+    # Files every cell writes alike (FANUC's SPOT_WELD.ls) do not belong to one cell.
+    own = [name for name, _ in outcome.programs if name not in SHARED_FILES]
     clash = next((taken[name] for name in own if name in taken), None)
     if clash is not None:
         return replace(outcome, status=BAD_INPUT, programs=(), cycle_time=None, detours=None,
@@ -336,7 +338,7 @@ def write_outcome_programs(out_dir: Path, outcome: CellOutcome, taken: dict[str,
                                "its programs would overwrite those")
     # The set is named as its trajectory file (publish renders it first): the cell, or <cell>_baseline.
     name = next((n.removesuffix(".json") for n, _ in outcome.programs if n.endswith(".json")), outcome.cell)
-    committed = commit_set(out_dir, name, dict(outcome.programs), outcome.cell_sha256)
+    committed = commit_set(out_dir, name, dict(outcome.programs), outcome.cell_sha256, SHARED_FILES)
     written = [*committed.paths, committed.manifest]
     for name in own:
         taken[name] = outcome.file

@@ -159,7 +159,7 @@ def plan(
         with _signals_deferred():
             from robomax_py.app.progress import configure_logging, stage_bars
             from robomax_py.app.report import plan_report, report_tables
-            from robomax_py.export import format_names
+            from robomax_py.export import SHARED_FILES, format_names
             from robomax_py.io.cell import load_cell, load_cell_robot
             from robomax_py.io.files import commit_set
             from robomax_py.plan import PlanOptions, plan_cell
@@ -195,7 +195,7 @@ def plan(
             if plot:
                 files[f"{set_name}.png"] = render_png(cycle_chart(result))
             _honour_signals()                   # nothing is written after an interrupt
-            committed = commit_set(out_dir, set_name, files, spec.digest)
+            committed = commit_set(out_dir, set_name, files, spec.digest, SHARED_FILES)
             written = [*committed.paths, committed.manifest]
             removed = committed.removed
             unlisted = committed.unlisted
@@ -240,10 +240,13 @@ def _stale_programs(out_dir: Path, name: str, every: bool = False) -> list[str]:
     files named as its programs (an older robomax's, or put there by hand; a plan writes its set
     as links into the set's folder). With `every`, the current set's files too."""
     from robomax_py.export import DIALECTS
+    from robomax_py.export.plan_program import identifier
     from robomax_py.io.files import MANIFEST_SUFFIX
 
-    names = {f"{name}{key}" for key in (".json", ".png", MANIFEST_SUFFIX,
-                                        *(k for d in DIALECTS.values() for k in (*d.extensions, *d.companions)))}
+    # FANUC's files are named as its TP program (capitals), the others' as the cell.
+    stems = {name, *(d.program_name(identifier(name)) for d in DIALECTS.values() if d.program_name)}
+    keys = (".json", ".png", MANIFEST_SUFFIX, *(k for d in DIALECTS.values() for k in (*d.extensions, *d.companions)))
+    names = {f"{stem}{key}" for stem in stems for key in keys}
     try:
         return sorted(p.name for p in out_dir.iterdir()
                       if p.name in names and p.exists() and (every or not p.is_symlink()))
@@ -398,14 +401,21 @@ def preview(
     voxels: Annotated[float | None, typer.Option("--voxels", min=0.005, max=0.5, metavar="PRECISION",
                                                  help="also draw the voxel map of the static objects (blocked leaves) "
                                                       "at this precision limit, m")] = None,
+    host: Annotated[str, typer.Option("--host", help="address to serve the page on (default: this machine only); "
+                                                     "any other makes the cell visible to the network")] = "127.0.0.1",
+    port: Annotated[int | None, typer.Option("--port", min=1, max=65535,
+                                             help="web port (default: the first free one from 7000)")] = None,
 ) -> None:
     """Show the cell in meshcat, animated along a program (serves until Ctrl-C, or writes --html)."""
 
     def run() -> None:
         from robomax_py.app.preview import serve, write_html
         from robomax_py.app.preview_program import home_program, load_program
+        from robomax_py.app.preview_server import LOOPBACK, WILDCARDS, is_loopback
         from robomax_py.io.cell import load_cell, load_cell_robot
 
+        if html is not None and (host != LOOPBACK or port is not None):
+            raise typer.BadParameter("--html writes a file; --host and --port are for serving", param_hint="--host/--port")
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
         shown = home_program(spec) if program is None else load_program(program, spec, robot)
@@ -426,7 +436,16 @@ def preview(
             drawn = f", {content.voxels} blocked voxels" if vmap is not None else ""
             out.print(f"wrote {html} ({content.frames} animation frames, cycle {content.duration:.3f} s{drawn})")
             return
-        serve(spec, robot, shown, lambda url: out.print(f"meshcat preview at {url}  (Ctrl-C to stop)"), voxels=vmap)
+
+        def announce(url: str) -> None:
+            # Said once the server listens, so a host it cannot bind gets only the error.
+            if not is_loopback(host):
+                where = "every interface of this machine" if host.strip("[]") in WILDCARDS else host
+                _warn([(f"--host {host}: the preview listens on {where}; anyone who can reach it on the network "
+                        "can open the page and see the cell (no password)")])
+            out.print(f"meshcat preview at {url}  (Ctrl-C to stop)", soft_wrap=True)
+
+        serve(spec, robot, shown, announce, voxels=vmap, host=host, port=port)
         out.print("preview stopped")
 
     _guarded(run)

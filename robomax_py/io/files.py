@@ -12,12 +12,13 @@ never a mix. A file of the old set that the new one lacks (a dialect not written
 names nothing and is removed; a regular file of the set's names that robomax did not write as
 part of a set (an older robomax's, or one a user put there) is replaced when the new set has that
 name and otherwise left alone (`robomax plan` names it). Files every plan of the folder
-writes alike (FANUC's `spot_weld.ls`) are not the cell's: they are plain files, each replaced
-atomically before the switch, and listed in the manifest with the rest.
+writes alike (`shared`: FANUC's `SPOT_WELD.ls`) are not the cell's: they are plain files, each
+replaced atomically before the switch, and listed in the manifest apart from the set's own files
+(`shared`), outside its sums, since any later plan of the folder may replace them.
 
 Where the folder cannot hold symbolic links (a FAT-formatted stick), the files are replaced one by
-one and the manifest last: a kill can then leave a mix, which the manifest's sha256 sums expose
-(`check_set`, which `robomax verify` uses).
+one, the manifest last, and then the old set's files the new one lacks are removed: a kill can
+leave a mix, which the manifest's sha256 sums expose (`check_set`, which `robomax verify` uses).
 
 Everything is done under an exclusive lock on the folder (flock on its directory descriptor: no
 lock file is left), so two plans writing one folder at once end with one plan's complete set. The
@@ -37,7 +38,7 @@ import shutil
 import signal
 import tempfile
 import threading
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Collection, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -84,7 +85,7 @@ class CommittedSet:
     manifest : `DIR/<name>.manifest.json`.
     plan : the set's id, the sha256 of its manifest's file list and cell digest.
     removed : names of the previous set's files that this set lacks; removed from `DIR`.
-    unlisted : files every plan writes alike (FANUC's `spot_weld.ls`) that the previous set
+    unlisted : files every plan writes alike (FANUC's `SPOT_WELD.ls`) that the previous set
         listed, this one does not, and no other set of the folder lists: left in `DIR` (the
         integrator may have put the gun's routine there), but no plan's any more.
     linked : False where the folder holds no symbolic links (files replaced one by one).
@@ -98,61 +99,70 @@ class CommittedSet:
     linked: bool = True
 
 
-def manifest_text(name: str, files: Mapping[str, bytes], cell_sha256: str) -> tuple[str, str]:
+def manifest_text(name: str, files: Mapping[str, bytes], cell_sha256: str,
+                  shared: Collection[str] = ()) -> tuple[str, str]:
     """The manifest of a set (its text) and the set's id. Deterministic: the same files of the same
-    cell give the same bytes."""
-    listed = [{"name": n, "sha256": hashlib.sha256(data).hexdigest()} for n, data in files.items()]
-    plan = hashlib.sha256(json.dumps({"cell_sha256": cell_sha256, "files": listed}, sort_keys=True,
+    cell give the same bytes. `files` lists the set's own files; `shared` those of `files` every
+    plan of the folder writes alike, listed apart: any later plan of the folder may replace them
+    (FANUC's `SPOT_WELD.ls` with another `--stamp` date), so they are not part of the set's sums."""
+    def entries(names: list[str]) -> list[dict[str, str]]:
+        return [{"name": n, "sha256": hashlib.sha256(files[n]).hexdigest()} for n in names]
+
+    own = entries([n for n in files if n not in shared])
+    alike = entries([n for n in files if n in shared])
+    plan = hashlib.sha256(json.dumps({"cell_sha256": cell_sha256, "files": own, "shared": alike}, sort_keys=True,
                                      separators=(",", ":")).encode("utf-8")).hexdigest()
-    doc = {"format": MANIFEST_FORMAT, "name": name, "plan": plan, "cell_sha256": cell_sha256, "files": listed}
+    doc = {"format": MANIFEST_FORMAT, "name": name, "plan": plan, "cell_sha256": cell_sha256, "files": own,
+           "shared": alike}
     return json.dumps(doc, indent=1) + "\n", plan
 
 
-def owns(name: str, file_name: str) -> bool:
-    """Whether a file of that name is a set `name`'s own (`<name>.<ext>`, `<name>_<...>`) rather
-    than one every plan of the folder writes alike."""
-    return file_name.startswith((f"{name}.", f"{name}_"))
-
-
-def commit_set(out_dir: Path, name: str, files: Mapping[str, str | bytes], cell_sha256: str = "") -> CommittedSet:
+def commit_set(out_dir: Path, name: str, files: Mapping[str, str | bytes], cell_sha256: str = "",
+               shared: Collection[str] = ()) -> CommittedSet:
     """Write a plan's files (file name -> text or bytes) into `out_dir` as one set with its
     manifest, switched in whole (see the module docstring); what was done.
 
-    `name` is the set's name (the cell's, or `<cell>_baseline`); files not named after it (FANUC's
-    `spot_weld.ls`) are written as plain files beside the set.
+    `name` is the set's name (the cell's, or `<cell>_baseline`): its pointer and manifest are named
+    after it, its files may be named otherwise (FANUC's `<NAME>.ls`). Files named in `shared`
+    (those every plan of a folder writes alike, `export.SHARED_FILES`: FANUC's `SPOT_WELD.ls`) are
+    written as plain files beside the set.
     """
     data = {n: (v.encode("utf-8") if isinstance(v, str) else bytes(v)) for n, v in files.items()}
     for n in data:
         if "/" in n or n in ("", ".", "..") or n.startswith("."):
             raise ValueError(f"not a file name: {n!r}")
     manifest = f"{name}{MANIFEST_SUFFIX}"
-    text, plan = manifest_text(name, data, cell_sha256)
-    own = {n: b for n, b in data.items() if owns(name, n)}
+    text, plan = manifest_text(name, data, cell_sha256, shared)
+    if manifest in data:
+        raise ValueError(f"{manifest} is the set's manifest, not one of its files")
+    own = {n: b for n, b in data.items() if n not in shared}
     own[manifest] = text.encode("utf-8")
-    shared = {n: b for n, b in data.items() if not owns(name, n)}
+    alike = {n: b for n, b in data.items() if n in shared}
     paths = tuple(out_dir / n for n in data)
     with folder_lock(out_dir):
         before = _listed(out_dir / manifest)
-        for n, b in shared.items():
+        for n, b in alike.items():
             write_atomic_bytes(out_dir / n, b)
         try:
             removed = _switch(out_dir, name, own, plan)
             linked = True
         except _NoLinks:
             _clean_leftovers(out_dir, name, None)
-            removed = _replace_one_by_one(out_dir, own, manifest)
+            gone = sorted(n for n in before if n not in own and n not in shared)
+            removed = _replace_one_by_one(out_dir, own, manifest, gone)
             linked = False
         others = {n for m in out_dir.glob(f"*{MANIFEST_SUFFIX}") for n in _listed(m)}
-        unlisted = tuple(sorted(n for n in before if not owns(name, n) and n not in data and n not in others
+        unlisted = tuple(sorted(n for n in before if n in shared and n not in data and n not in others
                                 and (out_dir / n).exists()))
     return CommittedSet(paths, out_dir / manifest, plan, removed, unlisted, linked)
 
 
 def _listed(manifest: Path) -> set[str]:
-    """The file names a manifest lists (none when it cannot be read)."""
+    """The file names a manifest lists, its own and shared ones (none when it cannot be read)."""
     try:
-        return {str(f["name"]) for f in json.loads(manifest.read_text(encoding="utf-8"))["files"]}
-    except (OSError, ValueError, KeyError, TypeError):
+        doc = json.loads(manifest.read_text(encoding="utf-8"))
+        return {str(f["name"]) for key in ("files", "shared") for f in doc.get(key, [])}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return set()
 
 
@@ -299,13 +309,21 @@ def _replace_link(path: Path, target: str) -> None:
         raise
 
 
-def _replace_one_by_one(out_dir: Path, own: Mapping[str, bytes], manifest: str) -> tuple[str, ...]:
-    """Without symbolic links: each file replaced atomically, the manifest last."""
+def _replace_one_by_one(out_dir: Path, own: Mapping[str, bytes], manifest: str,
+                        gone: Sequence[str]) -> tuple[str, ...]:
+    """Without symbolic links: each file replaced atomically, the manifest last, then the previous
+    set's own files that this one lacks (`gone`) removed; the names removed."""
     for n, b in own.items():
         if n != manifest:
             write_atomic_bytes(out_dir / n, b)
     write_atomic_bytes(out_dir / manifest, own[manifest])
-    return ()
+    removed = []
+    for n in gone:
+        path = out_dir / n
+        if path.is_file() and not path.is_symlink():
+            path.unlink(missing_ok=True)
+            removed.append(n)
+    return tuple(removed)
 
 
 def _entries(folder: Path) -> list[Path]:
@@ -344,12 +362,12 @@ def _signals_held() -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
-def write_programs(out_dir: Path, texts: Mapping[str, str]) -> list[Path]:
+def write_programs(out_dir: Path, texts: Mapping[str, str], shared: Collection[str] = ()) -> list[Path]:
     """Write rendered program files (file name -> text) into `out_dir` as one set (`commit_set`,
     named after the first `.json` file, the trajectory file); the paths written."""
     first_json = next((n for n in texts if n.endswith(".json")), None)
     name = first_json[: -len(".json")] if first_json else Path(next(iter(texts))).stem
-    return list(commit_set(out_dir, name, texts).paths)
+    return list(commit_set(out_dir, name, texts, shared=shared).paths)
 
 
 @dataclass(frozen=True, slots=True)
@@ -357,38 +375,45 @@ class SetCheck:
     """Whether a program file is one of the files of the plan's set beside it.
 
     manifest : the manifest found (None: the file has none beside it; a lone program).
-    mismatched : the files read whose bytes are not the ones the manifest names (or that it does
-        not name), with what is wrong.
+    mismatched : one line per file read that is not the file the manifest names (another plan's,
+        an edited one, or one the manifest does not list), naming it.
     cell_sha256 : the cell digest the manifest names ("" without a manifest).
+    plan : the plan id the manifest names ("" without a manifest).
     """
 
     manifest: Path | None
     mismatched: tuple[str, ...] = ()
     cell_sha256: str = ""
+    plan: str = ""
 
     @property
     def whole(self) -> bool:
         return self.manifest is not None and not self.mismatched
 
 
-def set_member(path: Path) -> Path:
-    """The file a program path reads: through a set's link, the file in the set's folder, so that
-    the program and its companion files come from one set even while a new one is switched in."""
-    if path.is_symlink():
-        try:
-            return path.resolve(strict=True)
-        except (OSError, RuntimeError):
-            return path
-    return path
+def find_manifest(path: Path) -> Path | None:
+    """The manifest of the set a program file belongs to: the one beside it, as the folder shows
+    it (what a copy of the folder would hold), that lists its name; else one named as the program,
+    case aside (FANUC's `SMALL_CELL.ls` is the set `small_cell`'s), which then does not list it;
+    None for a lone program."""
+    folder = path.parent
+    try:
+        manifests = sorted(p for p in folder.glob(f"*{MANIFEST_SUFFIX}") if p.is_file())
+    except OSError:
+        return None
+    listing = next((m for m in manifests if path.name in _listed(m)), None)
+    if listing is not None:
+        return listing
+    stem = path.name.split(".", 1)[0].lower()
+    return next((m for m in manifests if m.name[: -len(MANIFEST_SUFFIX)].lower() == stem), None)
 
 
 def check_set(path: Path, read: Sequence[Path] = ()) -> SetCheck:
     """Check a program file and the files read with it (its companions; default: the file alone)
-    against the manifest of its set, `<stem>.manifest.json` beside it; ProgramError for a
-    manifest that cannot be read."""
-    member = set_member(path)
-    manifest = member.parent / f"{path.stem}{MANIFEST_SUFFIX}"
-    if not manifest.is_file():
+    against the manifest of its set (`find_manifest`); ProgramError for a manifest that cannot be
+    read."""
+    manifest = find_manifest(path)
+    if manifest is None:
         return SetCheck(None)
     text = read_text(manifest, LIMITS.program, ProgramError, "manifest")
     try:
@@ -396,22 +421,28 @@ def check_set(path: Path, read: Sequence[Path] = ()) -> SetCheck:
         if doc.get("format") != MANIFEST_FORMAT:
             raise ValueError(f"format {doc.get('format')!r}")
         listed = {str(f["name"]): str(f["sha256"]) for f in doc["files"]}
+        alike = {str(f["name"]) for f in doc.get("shared", [])}
         cell = str(doc.get("cell_sha256", ""))
+        plan = str(doc.get("plan", ""))
     except (ValueError, KeyError, TypeError, AttributeError) as exc:
         raise ProgramError(manifest, None, f"not a robomax manifest ({exc})") from None
     bad = []
-    for file in read or (member,):
+    for file in read or (path,):
+        if file.name in alike:
+            continue                 # every plan's of the folder, as the last one wrote it
         want = listed.get(file.name)
         try:
-            got = hashlib.sha256(set_member(file).read_bytes()).hexdigest()
+            got = hashlib.sha256(file.read_bytes()).hexdigest()
         except OSError as exc:
             bad.append(f"{file.name} cannot be read ({exc.strerror or exc})")
             continue
         if want is None:
-            bad.append(f"{file.name} is not one of its files")
+            bad.append(f"{file.name} is not one of the files of plan {plan[:12]} that {manifest.name} lists "
+                       "(another plan's, or put there by hand)")
         elif want != got:
-            bad.append(f"{file.name} has sha256 {got[:12]}..., the manifest names {want[:12]}...")
-    return SetCheck(manifest, tuple(bad), cell)
+            bad.append(f"{file.name} is not the file of plan {plan[:12]} that {manifest.name} lists (sha256 "
+                       f"{got[:12]}..., the manifest's {want[:12]}...): another plan's, or edited")
+    return SetCheck(manifest, tuple(bad), cell, plan)
 
 
 def write_atomic_bytes(path: Path, data: bytes) -> None:
