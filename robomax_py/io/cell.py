@@ -10,6 +10,7 @@ import dataclasses
 import hashlib
 import math
 import re
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -32,7 +33,7 @@ from robomax_py.io.robot import (
     resolve_robot_file,
     resolve_tool_file,
 )
-from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
+from robomax_py.io.yaml_files import count_items, read_yaml_mapping, validation_error
 from robomax_py.robot.geometry import load_mesh
 from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
 from robomax_py.spec import (
@@ -429,10 +430,14 @@ def load_cell(path: str | Path) -> CellSpec:
     meshes are read later, by `load_cell_robot`.
     """
     path = Path(path)
-    data = read_yaml_mapping(path, CellFileError, "cell file", LIMITS.cell)
+    text = read_text(path, LIMITS.cell, CellFileError, "cell file")
     # Programs name the exact cell file they were planned from (their header).
-    digest = hashlib.sha256(read_text(path, LIMITS.cell, CellFileError, "cell file").encode("utf-8")).hexdigest()
-    _check_counts(data, path)              # before validating what may be a very long list
+    digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    early = count_items(text, (("seams", "*", "spots"), ("objects",), ("dynamic",)))
+    if early is not None:                  # before the guarded reader composes what may be a very long list
+        _refuse_counts(early[("seams", "*", "spots")], early[("objects",)] + early[("dynamic",)], path)
+    data = read_yaml_mapping(path, CellFileError, "cell file", LIMITS.cell)
+    _check_counts(data, path)              # before validating: the data as read, aliases expanded
     version = data.get("robomax")
     if "robomax" in data and version not in SUPPORTED_VERSIONS:
         supported = ", ".join(str(v) for v in SUPPORTED_VERSIONS)
@@ -443,6 +448,7 @@ def load_cell(path: str | Path) -> CellSpec:
         raise validation_error(exc, CellFile, path, CellFileError) from None
     _check_unique_names(parsed, path)
     _check_orientations(parsed, path)
+    _check_declared_triangles(parsed, path)
     triangles: list[int] = []              # of every mesh read, for the cell's total
     machines, doors = _machines(parsed, path, triangles)
 
@@ -453,7 +459,8 @@ def load_cell(path: str | Path) -> CellSpec:
     robot_spec = load_robot_spec(robot_file)
     tool_spec = load_tool_spec(tool_file)
     for key, mesh in (("body", tool_spec.body), ("tips", tool_spec.tips)):
-        triangles.append(_check_mesh_readable(mesh, RobotModelError(tool_file, key, f"cannot read mesh {mesh}")))
+        triangles.append(_check_mesh_readable(mesh, RobotModelError(tool_file, key, f"cannot read mesh {mesh}"),
+                                              triangles))
     objects = tuple(_object(o, path, f"objects[{i}]", triangles) for i, o in enumerate(parsed.objects))
     dynamic = tuple(_object(o, path, f"dynamic[{i}]", triangles) for i, o in enumerate(parsed.dynamic))
     parts = _parts(parsed, path, robot_spec, triangles)
@@ -687,7 +694,8 @@ def _object(obj: ObjectFile, path: Path, key: str, triangles: list[int]) -> Obje
         assert obj.mesh is not None  # guaranteed by ObjectFile._one_shape
         named = path.parent / obj.mesh
         mesh = checked_file(named, LIMITS.mesh, named_by(CellFileError, path, f"{key}.mesh"), f"mesh {named}")
-        triangles.append(_check_mesh_readable(mesh, CellFileError(path, f"{key}.mesh", f"cannot read mesh {mesh}")))
+        triangles.append(_check_mesh_readable(mesh, CellFileError(path, f"{key}.mesh", f"cannot read mesh {mesh}"),
+                                              triangles))
         shape = MeshShape(path=mesh)
     present = None
     if isinstance(obj, DynamicObjectFile):
@@ -721,13 +729,21 @@ def _stem_name(path: Path) -> str:
 
 
 
-def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError) -> int:
-    """The mesh's triangles, when it reads and has at most `CELL_LIMITS.mesh_triangles`."""
-    limit = CELL_LIMITS.mesh_triangles
-    declared = _stl_triangles(mesh)          # a binary STL says how many before it is read
-    if declared is not None and declared > limit:
-        raise type(error)(error.file, error.key, f"mesh {mesh} has {declared:,} triangles, more than the "
+def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError, triangles: list[int]) -> int:
+    """The mesh's triangles, when it reads, has at most `CELL_LIMITS.mesh_triangles` and keeps the
+    cell's meshes read so far (`triangles`) within `CELL_LIMITS.cell_triangles`. What the file
+    states of its size is judged before it is read (reading a mesh of millions of triangles takes
+    seconds)."""
+    limit, total = CELL_LIMITS.mesh_triangles, sum(triangles)
+    declared, exact = _declared_triangles(mesh)
+    more = "" if exact else " or more"
+    if declared > limit:
+        raise type(error)(error.file, error.key, f"mesh {mesh} has {declared:,} triangles{more}, more than the "
                                                  f"{limit:,} a mesh may have (mesh_triangles)")
+    if total + declared > CELL_LIMITS.cell_triangles:
+        raise type(error)(error.file, error.key, f"mesh {mesh} brings the cell's meshes and its tool's to "
+                                                 f"{total + declared:,} triangles{more}, more than the "
+                                                 f"{CELL_LIMITS.cell_triangles:,} a cell may have (cell_triangles)")
     try:
         n = len(load_mesh(mesh).faces)
     except Exception as exc:  # trimesh raises many kinds for unreadable files
@@ -738,19 +754,61 @@ def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError) -> 
     return n
 
 
-def _stl_triangles(mesh: Path) -> int | None:
-    """The triangle count a binary STL's header states, when the file is one (its size is 84 bytes
-    plus 50 per triangle); None otherwise."""
+def _declared_triangles(mesh: Path) -> tuple[int, bool]:
+    """As many triangles as the file states before it is read, at least, and whether exactly: a
+    binary STL's count (exact: its size is 84 bytes plus 50 per triangle), a PLY header's faces, an
+    OBJ's face lines (a face is one triangle or more); 0 for other formats or a file that cannot
+    be read, is not a regular file or is larger than LIMITS.mesh (refused when it is checked)."""
+    suffix = mesh.suffix.lower()
     try:
-        size = mesh.stat().st_size
-        with open(mesh, "rb") as fh:
-            head = fh.read(84)
+        info = mesh.stat()
+        size = info.st_size
+        if not stat.S_ISREG(info.st_mode) or size > LIMITS.mesh:
+            return 0, False
+        if suffix == ".stl":
+            with open(mesh, "rb") as fh:
+                head = fh.read(84)
+            n = int.from_bytes(head[80:84], "little") if len(head) == 84 else 0
+            return (n, True) if size == 84 + 50 * n else (0, False)
+        if suffix == ".ply":
+            with open(mesh, "rb") as fh:
+                header = fh.read(4096).split(b"end_header", 1)[0]
+            found = re.search(rb"^element\s+face\s+(\d{1,12})\s*$", header, re.MULTILINE)
+            return (int(found.group(1)) if found else 0), False
+        if suffix == ".obj":
+            faces, tail = 0, b"\n"             # a face line starts the file or follows a line end
+            with open(mesh, "rb") as fh:
+                while chunk := fh.read(1 << 24):
+                    data = tail + chunk
+                    faces += data.count(b"\nf ") + data.count(b"\nf\t")
+                    tail = data[-2:]
+            return faces, False
     except OSError:
-        return None
-    if len(head) < 84:
-        return None
-    n = int.from_bytes(head[80:84], "little")
-    return n if size == 84 + 50 * n else None
+        pass
+    return 0, False
+
+
+def _check_declared_triangles(parsed: CellFile, path: Path) -> None:
+    """The cell's meshes within `CELL_LIMITS.cell_triangles` by what their files state
+    (`_declared_triangles`), before any is read: three meshes of 1.9 million triangles each were
+    read, 20 s of CPU, before the third was refused. The tool's meshes and what the files do not
+    state are counted as they are read."""
+    named = [(f"objects[{i}]", o) for i, o in enumerate(parsed.objects)]
+    named += [(f"dynamic[{i}]", o) for i, o in enumerate(parsed.dynamic)]
+    if parsed.tending is not None:
+        named += [(f"tending.machines[{i}].door", m.door) for i, m in enumerate(parsed.tending.machines)]
+    if parsed.pick_place is not None:
+        named += [(f"pick_place.parts[{i}]", p) for i, p in enumerate(parsed.pick_place.parts)]
+    total, exact = 0, True
+    for key, obj in named:
+        if obj.mesh is None:
+            continue
+        n, known = _declared_triangles(path.parent / obj.mesh)
+        total, exact = total + n, exact and known
+        if total > CELL_LIMITS.cell_triangles:
+            raise CellFileError(path, f"{key}.mesh", f"the cell's meshes up to this one have {total:,} triangles"
+                                f"{'' if exact else ' or more'}, more than the {CELL_LIMITS.cell_triangles:,} a "
+                                "cell may have (cell_triangles)")
 
 
 def _check_counts(data: dict[str, Any], path: Path) -> None:
@@ -758,10 +816,14 @@ def _check_counts(data: dict[str, Any], path: Path) -> None:
     seams = data.get("seams")
     spots = sum(len(s["spots"]) for s in seams if isinstance(s, dict) and isinstance(s.get("spots"), list)) \
         if isinstance(seams, list) else 0
+    objects = sum(len(v) for v in (data.get("objects"), data.get("dynamic")) if isinstance(v, list))
+    _refuse_counts(spots, objects, path)
+
+
+def _refuse_counts(spots: int, objects: int, path: Path) -> None:
     if spots > CELL_LIMITS.spots:
         raise CellFileError(path, "seams", f"{spots:,} spots, more than the {CELL_LIMITS.spots:,} a cell may have "
                                            "(spots); split the job into cells")
-    objects = sum(len(v) for v in (data.get("objects"), data.get("dynamic")) if isinstance(v, list))
     if objects > CELL_LIMITS.objects:
         raise CellFileError(path, "objects", f"{objects:,} objects and dynamic objects, more than the "
                                              f"{CELL_LIMITS.objects:,} a cell may have (objects)")

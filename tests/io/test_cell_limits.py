@@ -21,6 +21,7 @@ from robomax_py.app.cli import EXIT_BAD_INPUT, app
 from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.io import cell as cell_io
 from robomax_py.io.cell import CELL_LIMITS, load_cell, load_cell_robot
+from robomax_py.io.yaml_files import count_items
 from robomax_py.plan import candidates
 from robomax_py.plan.candidates import check_ik_work, seam_candidates
 from robomax_py.world.collision import CollisionWorld
@@ -62,6 +63,33 @@ def test_a_10000_spot_seam_is_refused_before_the_robot_is_even_looked_up(tmp_pat
     assert "10,002 spots" in out and f"{CELL_LIMITS.spots:,}" in out
 
 
+def test_the_spots_are_counted_from_the_parser_s_events_before_the_document_is_built(
+        tmp_path: Path, write_small_cell: SmallCell, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The guarded reader composes YAML in Python, 25 times slower than libyaml's events: a cell
+    of too many spots is refused from the events alone."""
+    if count_items("a: 1", ()) is None:
+        pytest.skip("PyYAML without libyaml: the spots are counted after reading")
+    cell = _edit(write_small_cell(tmp_path), lambda d: d["seams"][0]["spots"].extend(_spot(k) for k in range(2_000)))
+
+    def not_read(*_: object, **__: object) -> None:
+        raise AssertionError("the document was composed")
+
+    monkeypatch.setattr(cell_io, "read_yaml_mapping", not_read)
+    with pytest.raises(CellFileError, match=r"2,002 spots, more than the 2,000 a cell may have \(spots\)"):
+        load_cell(cell)
+
+
+def test_count_items_counts_the_lists_at_their_key_paths_only() -> None:
+    targets = (("seams", "*", "spots"), ("objects",))
+    text = ("seams: [{spots: [{a: 1}, {b: 2}]}, {name: x, spots: &s [1, 2, 3]}, {spots: *s}]\n"
+            "objects:\n- {name: a}\n- *s\nother: {objects: [1, 2], seams: [{spots: [1]}]}\n"
+            "? [complex, key]\n: {spots: [1]}\n")
+    # `spots: *s` (a list reached through an alias) is left to the count after reading; an alias
+    # as an item of a list is one item; lists under other keys are not counted.
+    assert count_items(text, targets) in ({targets[0]: 5, targets[1]: 2}, None)
+    assert count_items("seams: [", targets) is None
+
+
 def test_too_many_objects_are_refused(tmp_path: Path, write_small_cell: SmallCell) -> None:
     def crowd(data: dict[str, Any]) -> None:
         data["objects"] += [{"name": f"b{k}", "box": [0.1, 0.1, 0.1], "pose": {"xyz": [20, k, 0]}}
@@ -92,6 +120,49 @@ def test_a_mesh_of_too_many_triangles_is_refused(tmp_path: Path, write_small_cel
         load_cell(cell)
     monkeypatch.setattr(cell_io, "CELL_LIMITS", dataclasses.replace(CELL_LIMITS, cell_triangles=n - 1))
     with pytest.raises(CellFileError, match=r"\(cell_triangles\)"):
+        load_cell(cell)
+
+
+def test_an_obj_of_too_many_faces_is_refused_before_it_is_read(tmp_path: Path, write_small_cell: SmallCell,
+                                                              monkeypatch: pytest.MonkeyPatch) -> None:
+    """Reading a mesh of millions of triangles takes seconds: what the file states is judged first."""
+    def boxes(data: dict[str, Any]) -> None:
+        data["objects"].append({"name": "grid", "mesh": "grid.obj", "pose": {"xyz": [20, 0, 0]}})
+
+    cell = _edit(write_small_cell(tmp_path), boxes)
+    # Above every other mesh of the cell and its tool, so that this one is the first refused.
+    panel = int.from_bytes((tmp_path / "parts" / "cabin_panel.stl").read_bytes()[80:84], "little")
+    limit = max(panel, 10_000)
+    (tmp_path / "grid.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n" + "f 1 2 3\nf 2 4 3\n" * (limit // 2 + 1))
+    monkeypatch.setattr(cell_io, "CELL_LIMITS", dataclasses.replace(CELL_LIMITS, mesh_triangles=limit))
+    read = cell_io.load_mesh
+
+    def only_others(mesh: Path) -> Any:
+        assert mesh.name != "grid.obj", "the refused mesh was read"
+        return read(mesh)
+
+    monkeypatch.setattr(cell_io, "load_mesh", only_others)
+    with pytest.raises(CellFileError, match=rf"grid.obj has {2 * (limit // 2 + 1):,} triangles or more, more than "
+                                            rf"the {limit:,} a mesh may have \(mesh_triangles\)"):
+        load_cell(cell)
+
+
+def test_the_cell_s_meshes_are_totalled_by_what_they_state_before_any_is_read(
+        tmp_path: Path, write_small_cell: SmallCell, monkeypatch: pytest.MonkeyPatch) -> None:
+    def twice_more(data: dict[str, Any]) -> None:
+        data["objects"] += [{"name": f"copy{k}", "mesh": "parts/cabin_panel.stl", "pose": {"xyz": [20, k, 0]}}
+                            for k in range(2)]
+
+    cell = _edit(write_small_cell(tmp_path), twice_more)
+    n = int.from_bytes((tmp_path / "parts" / "cabin_panel.stl").read_bytes()[80:84], "little")
+    monkeypatch.setattr(cell_io, "CELL_LIMITS", dataclasses.replace(CELL_LIMITS, cell_triangles=2 * n))
+
+    def not_read(mesh: Path) -> Any:
+        raise AssertionError(f"{mesh} was read")
+
+    monkeypatch.setattr(cell_io, "load_mesh", not_read)
+    with pytest.raises(CellFileError, match=rf"objects\[\d+\]\.mesh: the cell's meshes up to this one have {3 * n:,} "
+                                            rf"triangles, more than the {2 * n:,} a cell may have \(cell_triangles\)"):
         load_cell(cell)
 
 
