@@ -129,14 +129,16 @@ def expand(source: Path, roots: Sequence[Path], limits: FileLimits = LIMITS) -> 
     }
     seconds = f"xacro expansion exceeds {limits.xacro_cpu_s:g} s of CPU time"
     memory = f"xacro expansion exceeds {limits.xacro_memory / MB:.0f} MB of memory"
-    # The CPU limit ends a busy child; the wall-clock limit one that waits (a loaded machine gets slack).
-    wall_s = 3 * limits.xacro_cpu_s + 10
+    # The CPU limit ends a busy child; the wall-clock limit one that waits (with slack for a busy
+    # machine, where a process gets a fraction of a CPU).
+    wall_s = 10 * limits.xacro_cpu_s + 30
     try:
         done = subprocess.run([sys.executable, "-I", "-X", "utf8", str(Path(xacro_sandbox.__file__))],
                               input=json.dumps(request).encode(), capture_output=True, timeout=wall_s,
                               env={}, check=False)
     except subprocess.TimeoutExpired:
-        raise RobotModelError(source, None, seconds) from None
+        raise RobotModelError(source, None, f"xacro expansion exceeds {wall_s:g} s of waiting "
+                              f"({limits.xacro_cpu_s:g} s of CPU time allowed)") from None
     if done.returncode in (-signal.SIGXCPU, -signal.SIGKILL):
         raise RobotModelError(source, None, seconds)
     try:

@@ -513,6 +513,30 @@ def test_check_at_load_applies_the_same_rules(imported: Path, tmp_path: Path, ed
         load_robot_spec(folder / "robot.yaml")
 
 
+def test_robomax_check_refuses_an_absurd_velocity(imported: Path, tmp_path: Path) -> None:
+    """Regression: a URDF velocity of 1e-300 passed `check` and ended `plan` in a traceback."""
+    folder = tmp_path / "m20ia"
+    shutil.copytree(imported, folder)
+    urdf = folder / "m20ia.urdf"
+    urdf.write_text(urdf.read_text().replace('velocity="3.054326"', 'velocity="1e-300"', 1))
+    cell = tmp_path / "cell.yaml"
+    cell.write_text(f"""robomax: 1
+robot: {{model: {folder / "robot.yaml"}, home: [0, 0, 0, 0, 30, 0]}}
+tool: spot_gun_light
+objects:
+  - {{name: flange, box: [0.002, 0.8, 0.06], pose: {{xyz: [1.05, 0, 0.93]}}, workpiece: true}}
+seams:
+  - name: flange
+    tolerance: {{alpha: 10, beta: 10, gamma: [-180, 180]}}
+    spots:
+      - {{name: s1, xyz: [1.05, 0, 0.95], normal: [-1, 0, 0], direction: [0, 1, 0]}}
+process: {{weld_time: 0.3, approach: 0.03, clearance: 0}}
+""")
+    result = runner.invoke(app, ["check", str(cell)])
+    assert result.exit_code == 2, result.output
+    assert "joint joint_2: limit velocity 1e-300 rad/s is outside" in " ".join(result.output.split())
+
+
 def test_check_at_load_refuses_a_nan_vertex(imported: Path, tmp_path: Path) -> None:
     folder = tmp_path / "m20ia"
     shutil.copytree(imported, folder)
