@@ -1,14 +1,24 @@
 """The programs robomax writes, judged by the controller models.
 
-A small cell (s7 and s8 of the frozen reference cell, grid 3, gamma 0) is moved as a whole by one
-rigid transform -- the robot 1.5 m from the cell origin, turned 30 deg, on a 0.4 m riser -- and
-planned with ``robomax plan --format all``. Each written program is read by its controller model,
-and every weld target (the motion right before the n-th ``spot_weld`` call) is placed in the
-world as the controller places it: cell placement · controller base · the model's TCP in the
-robot base. It must be at the spot (the cell file's xyz) and at the TCP of the trajectory file's
-joints at the spot's arrival (pinocchio FK from the robot's URDF and the tool.yaml tcp). Joint
-targets must lie on the trajectory, and the configuration data must name the planned joints'
-configuration as each vendor defines it (computed here from the arm's geometry).
+Two cells, each planned with ``robomax plan --format all``:
+
+- the small cell (s7 and s8 of the frozen reference cell, grid 3, gamma 0) moved as a whole by one
+  rigid transform -- the robot 1.5 m from the cell origin, turned 30 deg, on a 0.4 m riser -- with
+  the controller's default frames (no user frame: targets in the robot base; the calibrated tool 1);
+- the process cell (tests/conftest.py `write_process_cell`: the robot 1.6 m off the origin, turned
+  30 deg, on a riser tilted 2 deg) with the integrator's numbers: tool 2 named gun2, user frame 3
+  on the fixture plate, position registers 40 and 41 that the FANUC setup program fills before
+  setting UTOOL[2] and UFRAME[3], the clamp and door on inputs 5 and 6.
+
+Each written program is read by its controller model (with its frames setup file, run first on
+the same controller), and every weld target (the motion right before the n-th ``spot_weld`` call)
+is placed in the world as the controller places it: cell placement · controller base · the
+model's TCP in the robot base (the user frame composed in by the model). It must be at the spot
+(the cell file's xyz) and at the TCP of the trajectory file's joints at the spot's arrival
+(pinocchio FK from the robot's URDF and the tool.yaml tcp). The user frame in force must be the
+one the cell names, placed in the world the same way; joint targets must lie on the trajectory,
+and the configuration data must name the planned joints' configuration as each vendor defines it
+(computed here from the arm's geometry).
 
 These caught the robot's placement written as KRL `$BASE` and as the RAPID work object's uframe
 (every weld 1.1 m and 30 deg off) and FANUC's flip letter inverted, all of which the writers'
@@ -222,6 +232,7 @@ class Plan:
     q: FloatArray
     spot_times: list[tuple[str, float]]    # (name, t_arrive) in weld order
     arm: Arm
+    cell: dict[str, Any]               # the cell file as written
 
     def q_at(self, t: float) -> FloatArray:
         return np.asarray([np.interp(t, self.t, self.q[:, j]) for j in range(self.q.shape[1])])
@@ -232,27 +243,70 @@ class Plan:
     def text(self, name: str) -> str:
         return (self.folder / name).read_text(encoding="utf-8")
 
+    @property
+    def controller(self) -> dict[str, Any]:
+        """The cell's `robot.controller` (empty: the controller's default frames)."""
+        return dict(self.cell["robot"].get("controller") or {})
 
-@pytest.fixture(scope="module")
-def plan(tmp_path_factory: pytest.TempPathFactory, write_small_cell: Callable[..., Path]) -> Plan:
-    folder = tmp_path_factory.mktemp("placed_cell")
-    cell = write_small_cell(folder, name="placed_cell")
-    G = _T(PLACEMENT_XYZ_M, (0.0, 0.0, PLACEMENT_YAW_DEG))
-    _place_cell(cell, G)
-    out = folder / "programs"
+    def user_frame_world(self) -> FloatArray | None:
+        """The user frame the cell names, in the world (its object's pose or its own pose); None
+        when the cell names none (the robot base frame is the user frame)."""
+        frame = self.controller.get("frame")
+        if frame is None:
+            return None
+        if "object" in frame:
+            pose = next(o for o in self.cell["objects"] if o["name"] == frame["object"]).get("pose", {})
+        else:
+            pose = frame["pose"]
+        return _T(pose.get("xyz", (0, 0, 0)), pose.get("rpy", (0, 0, 0)))
+
+
+CELLS = ("small", "process")
+
+
+def _plan_cell(cell: Path, name: str) -> Plan:
+    out = cell.parent / "programs"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
     done = subprocess.run([sys.executable, "-m", "robomax_py", "plan", str(cell), "-o", str(out), "--format", "all"],
-                          capture_output=True, text=True, env=env, cwd=folder, check=False)
+                          capture_output=True, text=True, env=env, cwd=cell.parent, check=False)
     assert done.returncode == 0, done.stdout + done.stderr
     data = yaml.safe_load(cell.read_text())
-    trajectory = json.loads((out / "placed_cell.json").read_text())
+    trajectory = json.loads((out / f"{name}.json").read_text())
     robot_yaml = ROBOTS / data["robot"]["model"] / "robot.yaml"
     tool_yaml = ROBOTS / "tools" / data["tool"] / "tool.yaml"
     base = data["robot"]["base"]
     spots = {s["name"]: np.asarray(s["xyz"]) for seam in data["seams"] for s in seam["spots"]}
     order = sorted(((s["name"], float(s["t_arrive"])) for s in trajectory["spots"]), key=lambda s: s[1])
-    return Plan(out, "placed_cell", _T(base["xyz"], base["rpy"]), spots, np.asarray(trajectory["t"]),
-                np.asarray(trajectory["q"]), order, _load_arm(robot_yaml, tool_yaml, trajectory["joints"]))
+    return Plan(out, name, _T(base["xyz"], base["rpy"]), spots, np.asarray(trajectory["t"]),
+                np.asarray(trajectory["q"]), order, _load_arm(robot_yaml, tool_yaml, trajectory["joints"]), data)
+
+
+@pytest.fixture(scope="module", params=CELLS)
+def plan(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory,
+         write_small_cell: Callable[..., Path], write_process_cell: Callable[..., Path]) -> Plan:
+    """The small cell moved off the origin with default frames, or the process cell with the
+    integrator's tool, user frame, registers and inputs; planned, every dialect written."""
+    folder = tmp_path_factory.mktemp(f"{request.param}_cell")
+    if request.param == "small":
+        cell = write_small_cell(folder, name="placed_cell")
+        _place_cell(cell, _T(PLACEMENT_XYZ_M, (0.0, 0.0, PLACEMENT_YAW_DEG)))
+        return _plan_cell(cell, "placed_cell")
+    return _plan_cell(write_process_cell(folder, name="process_cell"), "process_cell")
+
+
+def _rapid_held(plan: Plan) -> dict[str, str]:
+    """A tool the cell names exists on the controller (the integrator calibrated it), so the
+    program refers to it without declaring it: the controller's system module holding it, with the
+    tool.yaml tcp (quaternion [w, x, y, z] from scipy, mm)."""
+    tool = plan.controller.get("tool") or {}
+    if "name" not in tool:
+        return {}
+    T = plan.arm.T_flange_tcp
+    x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
+    mm = ", ".join(f"{v * 1000.0:.6f}" for v in T[:3, 3])
+    return {"user.sys": f"MODULE user(SYSMODULE)\n  PERS tooldata {tool['name']} := [TRUE, [[{mm}], "
+                        f"[{w:.12f}, {x:.12f}, {y:.12f}, {z:.12f}]], [1, [0, 0, 0.001], [1, 0, 0, 0], 0, 0, 0]];\n"
+                        "ENDMODULE\n"}
 
 
 def _run(plan: Plan, dialect: str) -> ProgramRun:
@@ -262,15 +316,17 @@ def _run(plan: Plan, dialect: str) -> ProgramRun:
         return run_krl(plan.text(f"{plan.name}.src"), plan.text(f"{plan.name}.dat"), src_name=f"{plan.name}.src",
                        dat_name=f"{plan.name}.dat", setup=setup)
     if dialect == "rapid":
-        return run_rapid({f: plan.text(f) for f in files if f.endswith(".mod")})
+        return run_rapid({**_rapid_held(plan), **{f: plan.text(f) for f in files if f.endswith(".mod")}})
     if dialect == "fanuc":
         others = [f for f in files if f.endswith(".ls") and f != f"{plan.name}.ls"]
-        # The cell hands no position registers, so the setup program only lists the frames: the
-        # controller holds the integrator's calibrated gun TCP as tool 1 (the default number).
+        # Without position registers the setup program only lists the frames: the controller holds
+        # the integrator's calibrated gun TCP as tool 1 (the default number). With registers the
+        # setup program sets every frame the program uses, so the controller is given none.
+        held = {} if plan.controller.get("registers", {}).get("position") else {1: plan.arm.T_flange_tcp}
         return run_fanuc(plan.text(f"{plan.name}.ls"), name=f"{plan.name}.ls",
                          setup={f: plan.text(f) for f in others if "frames" in f.lower()},
                          called={f: plan.text(f) for f in others if "frames" not in f.lower()},
-                         utools={1: plan.arm.T_flange_tcp}, j23_coupling=plan.arm.j23_coupling)
+                         utools=held, j23_coupling=plan.arm.j23_coupling)
     return run_urscript(plan.text(f"{plan.name}.script"), name=f"{plan.name}.script")
 
 
@@ -344,6 +400,47 @@ def test_weld_tool_frame_is_the_tools_tcp(plan: Plan, dialect: str) -> None:
         assert tool is not None, f"{dialect}: no tool frame in force at {weld.spot}"
         assert np.linalg.norm(tool[:3, 3] - plan.arm.T_flange_tcp[:3, 3]) <= POS_TOL_M
         assert _angle_deg(tool[:3, :3], plan.arm.T_flange_tcp[:3, :3]) <= ANGLE_TOL_DEG
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("dialect", DIALECTS)
+def test_weld_user_frame_is_the_cells(plan: Plan, dialect: str) -> None:
+    """The user frame in force at every weld, placed in the world as the controller places it, is
+    the one the cell names (the fixture plate), or the robot base frame when it names none; URScript
+    commands its targets in the base, so the model reports the identity there and the user frame is
+    judged by the weld positions alone."""
+    want = plan.user_frame_world()
+    for weld in _welds(plan, _run(plan, dialect)):
+        user = weld.motion.T_base_user
+        assert user is not None, f"{dialect}: no user frame in force at {weld.spot}"
+        if dialect == "urscript":
+            continue
+        got = plan.world(user)
+        expected = plan.world(np.eye(4)) if want is None else want
+        off = np.linalg.norm(got[:3, 3] - expected[:3, 3])
+        turned = _angle_deg(got[:3, :3], expected[:3, :3])
+        assert off <= POS_TOL_M and turned <= ANGLE_TOL_DEG, \
+            f"{dialect}: user frame at {weld.spot} is {off * 1e3:.3f} mm and {turned:.4f} deg off the cell's"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("dialect", DIALECTS)
+def test_waits_are_for_the_cells_inputs(plan: Plan, dialect: str) -> None:
+    """Every input wait names an input the cell maps: by number (KRL $IN through its SIGNAL, FANUC
+    DI, UR standard digital input) or, in RAPID, by the signal name the cell gives (else the cell's
+    signal name)."""
+    inputs = plan.controller.get("inputs", {})
+    numbers = {v if isinstance(v, int) else v["number"] for v in inputs.values()}
+    names = {(v.get("name") if isinstance(v, dict) else None) or k for k, v in inputs.items()}
+    waits = [w for w in _run(plan, dialect).waits if w.seconds is None]
+    assert bool(waits) == bool(inputs), f"{dialect}: waits {waits} for the cell's inputs {inputs}"
+    for wait in waits:
+        if dialect == "rapid":
+            assert wait.signal in names, f"{dialect}: {wait.signal} at {wait.where} is none of {sorted(names)}"
+        else:
+            assert wait.input_number in numbers, f"{dialect}: input {wait.input_number} at {wait.where} is none " \
+                                                 f"of {sorted(numbers)}"
+        assert wait.state is not False, f"{dialect}: waits for the input to go off at {wait.where}"
 
 
 @pytest.mark.slow
