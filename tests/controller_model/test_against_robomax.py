@@ -38,7 +38,13 @@ import numpy as np
 import pytest
 import yaml
 
-from controller_model.common import FanucConfig, FloatArray, KrlConfig, ProgramRun
+from controller_model.common import (
+    FanucConfig,
+    FloatArray,
+    KrlConfig,
+    ProgramRun,
+    RapidConfig,
+)
 from controller_model.fanuc import controller_joints_deg
 from controller_model.world import (
     DIALECTS,
@@ -49,8 +55,10 @@ from controller_model.world import (
     Weld,
     abb_config,
     angle_deg,
+    config_mismatch,
     deviation,
     fanuc_letters,
+    geometry,
     kuka_config,
     load_arm,
     read_plan,
@@ -270,3 +278,57 @@ def test_the_gun_lands_where_the_plan_puts_it(plan: Plan, dialect: str) -> None:
     assert dev.tcp_mm <= POS_TOL_M * 1e3 and dev.spot_mm <= POS_TOL_M * 1e3, dev
     assert dev.tcp_deg <= ANGLE_TOL_DEG and dev.joint_deg <= JOINT_TOL_DEG, dev
     assert dev.via_deg <= BLEND_APPROACH_DEG and not dev.configs, dev
+
+
+def test_a_joint_on_a_boundary_names_both_sides_and_only_there() -> None:
+    """A4 planned at -1e-12 rad (written -0.0 in the trajectory file): the KUKA Turn bit and the ABB
+    quadrant of either side name it; half a degree off the boundary, only its own side does."""
+    robot = ROBOTS / "kr125" / "robot.yaml"
+    arm = load_arm(robot, ROBOTS / "tools" / "spot_gun_c" / "tool.yaml", [f"joint_a{i}" for i in range(1, 7)])
+    on = np.radians([10.0, -80.0, 100.0, 0.0, 40.0, 20.0])
+    on[3] = -1e-12
+    status, turn = kuka_config(arm, on).status, (kuka_config(arm, on).turn or 0) & ~8    # bit 3: A4 < 0
+    for t in (turn, turn | 8):
+        assert config_mismatch(arm, "krl", KrlConfig(status, t), on) is None
+    for cf4 in (-1, 0):
+        assert config_mismatch(arm, "rapid", RapidConfig(0, cf4, 0, abb_config(arm, on).cfx), on) is None
+    off = on.copy()
+    off[3] = np.radians(-0.5)
+    assert config_mismatch(arm, "krl", KrlConfig(status, turn), off) is not None
+    assert config_mismatch(arm, "rapid", RapidConfig(0, 0, 0, abb_config(arm, off).cfx), off) is not None
+
+
+def _serial_arm(folder: Path, joints: list[tuple[tuple[float, float, float], tuple[int, int, int]]]) -> Path:
+    """robot.yaml of a bare six-axis URDF: each joint's origin in its parent (m) and axis."""
+    links = "".join(f'<link name="l{i}"/>' for i in range(7)) + '<link name="tool0"/>'
+    chain = "".join(
+        f'<joint name="j{i + 1}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        f'<origin xyz="{x} {y} {z}"/><axis xyz="{ax} {ay} {az}"/>'
+        f'<limit lower="-6" upper="6" effort="1" velocity="1"/></joint>'
+        for i, ((x, y, z), (ax, ay, az)) in enumerate(joints))
+    chain += '<joint name="flange" type="fixed"><parent link="l6"/><child link="tool0"/></joint>'
+    (folder / "arm.urdf").write_text(f'<robot name="arm">{links}{chain}</robot>')
+    (folder / "robot.yaml").write_text("name: arm\nurdf: arm.urdf\nflange: tool0\n")
+    return folder / "robot.yaml"
+
+
+def test_configuration_geometry_takes_front_and_up_from_the_a1_frame(tmp_path: Path) -> None:
+    """The A1 frame is the robot base turned with A1, not the arm's shape: a ROS-Industrial KUKA URDF
+    (A1 joint at shoulder height turning about -z) at KUKA's HOME is S 'B010'; an arm without a
+    shoulder offset (a Staubli TX60's shape) whose upper arm leans 5 deg back while the forearm
+    reaches forward has its wrist point in front of A1."""
+    tool = ROBOTS / "tools" / "spot_gun_c" / "tool.yaml"
+    (tmp_path / "kuka").mkdir()
+    kuka = _serial_arm(tmp_path / "kuka", [((0, 0, 0.675), (0, 0, -1)), ((0.26, 0, 0), (0, 1, 0)),
+                                           ((0.68, 0, 0), (0, 1, 0)), ((0.67, 0, -0.035), (-1, 0, 0)),
+                                           ((0, 0, 0), (0, 1, 0)), ((0.158, 0, 0), (-1, 0, 0))])
+    arm = load_arm(kuka, tool, [f"j{i}" for i in range(1, 7)])
+    assert kuka_config(arm, np.radians([0, -90, 90, 0, 30, 0])).status == 2
+    assert kuka_config(arm, np.radians([120, -90, 90, 0, 30, 0])).status == 2     # turned with A1
+    (tmp_path / "tx60").mkdir()
+    staubli = _serial_arm(tmp_path / "tx60", [((0, 0, 0.375), (0, 0, 1)), ((0, 0, 0), (0, 1, 0)),
+                                              ((0, 0.02, 0.29), (0, 1, 0)), ((0, 0, 0.31), (0, 0, 1)),
+                                              ((0, 0, 0), (0, 1, 0)), ((0, 0, 0.07), (0, 0, 1))])
+    arm = load_arm(staubli, tool, [f"j{i}" for i in range(1, 7)])
+    assert geometry(arm, np.radians([0, -5, 90, 0, 30, 0])).wrist_behind_axis1 is False
+    assert geometry(arm, np.radians([0, 5, -90, 0, 30, 0])).wrist_behind_axis1 is True

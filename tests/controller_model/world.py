@@ -100,6 +100,12 @@ class Arm:
         """(4, 4) TCP in the URDF root."""
         return self.flange(q_urdf) @ self.T_flange_tcp
 
+    def a1_frame(self, q_urdf: FloatArray) -> FloatArray:
+        """(3, 3) orientation of axis 1's joint frame (turning with A1), in the URDF root."""
+        data = self.model.createData()
+        pin.forwardKinematics(self.model, data, self._q(q_urdf))
+        return np.asarray(data.oMi[self.joint_ids[0]].rotation)
+
     def axes(self, q_urdf: FloatArray) -> list[tuple[FloatArray, FloatArray]]:
         """(point on the axis, unit axis direction) of each joint, in the URDF root."""
         model, data = self.model, self.model.createData()
@@ -167,14 +173,20 @@ def geometry(arm: Arm, q_urdf: FloatArray) -> Geometry:
     """KUKA's definitions (the Sinumerik copy of KUKA's Status table, vendor_research §1.5): bit 0 is
     the wrist point (axes 4, 5, 6) at negative x of the A1 coordinate system; bit 1 the wrist point
     on the A3 >= phi side of the line through the A2 and A3 axes ('elbow up'). ABB cfx and FANUC
-    U/D, T/B use the same geometry (vendor_research §2.3, §3.1)."""
-    (p1, a1), (p2, a2), (p3, _), (p4, a4), (p5, a5), _ = arm.axes(q_urdf)
+    U/D, T/B use the same geometry (vendor_research §2.3, §3.1).
+
+    The A1 coordinate system is the controller's robot base frame turned with axis 1: its x is the
+    base's x turned as far as A1 has turned from zero, its z (up) the A1 axis pointing the way the
+    base's z does. Neither comes from the arm's shape: a ROS-Industrial KUKA URDF puts the A1 joint
+    at shoulder height and turns it about -z, and an arm without a shoulder offset (Staubli, UR)
+    has no offset to tell front from back."""
+    (p1, a1), (p2, _), (p3, _), (p4, a4), (p5, a5), _ = arm.axes(q_urdf)
     wrist = _closest_point(p4, a4, p5, a5)
-    shoulder = p2 - p1
-    up = a1 if shoulder @ a1 >= 0 else -a1
-    forward = shoulder - (shoulder @ up) * up
-    if np.linalg.norm(forward) < 1e-6:    # no shoulder offset: the plane of the arm
-        forward = np.cross(a2, up) if np.cross(a2, up) @ (p3 - p1) >= 0 else -np.cross(a2, up)
+    base_x, base_z = arm.T_root_base[:3, 0], arm.T_root_base[:3, 2]
+    up = a1 if a1 @ base_z >= 0 else -a1
+    turned = arm.a1_frame(q_urdf) @ arm.a1_frame(np.zeros_like(q_urdf)).T
+    forward = turned @ base_x
+    forward = forward - (forward @ up) * up
     forward = forward / np.linalg.norm(forward)
     behind = float((wrist - p1) @ forward) < 0
 
@@ -206,24 +218,53 @@ def fanuc_letters(arm: Arm, q_urdf: FloatArray) -> tuple[str, str, str]:
     return ("F" if j5 > 0 else "N", "U" if g.wrist_before_a2_a3_line else "D", "B" if g.wrist_behind_axis1 else "T")
 
 
+# A planned joint this close to a sign or quadrant boundary names both sides: the trajectory file
+# rounds to 1e-9 rad (6e-8 deg), so a joint planned at -1e-12 rad is written -0.0 there, while the
+# writer, which saw the unrounded value, may state the negative side. Both name the same posture.
+BOUNDARY_DEG = 1e-6
+
+
+def _near(value: float, step: float) -> bool:
+    """`value` within BOUNDARY_DEG of a multiple of `step` (0 for the sign alone)."""
+    if step == 0.0:
+        return abs(value) < BOUNDARY_DEG
+    return abs(value - step * round(value / step)) < BOUNDARY_DEG
+
+
+def _quadrants(value: float) -> set[int]:
+    """ABB quadrants floor(angle / 90 deg) the value names: both neighbours on a boundary."""
+    k = round(value / 90.0)
+    return {k - 1, k} if _near(value, 90.0) else {math.floor(value / 90.0)}
+
+
 def config_mismatch(arm: Arm, dialect: str, config: object, q_urdf: FloatArray) -> str | None:
     """Why the configuration data written does not name the planned joints' configuration as the
-    vendor defines it (None when it does; URScript targets carry none)."""
+    vendor defines it (None when it does; URScript targets carry none). A joint within
+    BOUNDARY_DEG of a sign or quadrant boundary is accepted on either side."""
+    deg = np.degrees(q_urdf)
     if dialect == "krl":
         want = kuka_config(arm, q_urdf)
-        if not (isinstance(config, KrlConfig) and config.status is not None
-                and (config.status & 7, config.turn) == (want.status, want.turn)):   # bit 4: KSS 8 teaching
+        loose_turn = sum(1 << i for i, v in enumerate(deg) if _near(v, 0.0))
+        loose_status = 4 if _near(deg[4], 0.0) else 0
+        if not (isinstance(config, KrlConfig) and config.status is not None and config.turn is not None
+                and ((config.status & 7) ^ (want.status or 0)) & ~loose_status == 0     # bit 4: KSS 8 teaching
+                and (config.turn ^ (want.turn or 0)) & ~loose_turn == 0):
             return f"S/T {config} where the joints are S {want.status} T {want.turn}"
     elif dialect == "rapid":
         want_abb = abb_config(arm, q_urdf)
-        if config != want_abb:
+        if not isinstance(config, RapidConfig):
+            return f"confdata {config} where the joints are {want_abb}"
+        quadrants_ok = all(got in _quadrants(deg[i]) for got, i in ((config.cf1, 0), (config.cf4, 3), (config.cf6, 5)))
+        cfx_ok = config.cfx == want_abb.cfx or (_near(deg[4], 0.0) and config.cfx ^ want_abb.cfx == 1)
+        if not (quadrants_ok and cfx_ok):
             return f"confdata {config} where the joints are {want_abb}"
     elif dialect == "fanuc":
         letters = fanuc_letters(arm, q_urdf)
-        if not isinstance(config, FanucConfig) or (config.flip, config.elbow, config.front) != letters:
+        ctrl = controller_joints_deg(tuple(deg), arm.j23_coupling)
+        if not isinstance(config, FanucConfig) or (config.elbow, config.front) != letters[1:] \
+                or (config.flip != letters[0] and not _near(ctrl[4], 0.0)):
             return f"CONFIG {getattr(config, 'text', config)} where the joints are {' '.join(letters)}"
-        deg = controller_joints_deg(tuple(np.degrees(q_urdf)), arm.j23_coupling)
-        if all(-180.0 < deg[i] < 180.0 for i in (0, 3, 4, 5)) and config.turns != (0, 0, 0):
+        if all(-180.0 < ctrl[i] < 180.0 for i in (0, 3, 4, 5)) and config.turns != (0, 0, 0):
             return f"CONFIG turns {config.turns} where every axis is within +-180 deg"
     return None
 
