@@ -4,23 +4,24 @@ a test).
     python tests/bench/bench_controller_frames.py --quick [--out FILE.md]
     python tests/bench/bench_controller_frames.py --packages DIR [--arms a,b,...] [--out FILE.md]
 
-For every arm: `import-urdf` it (ROS-Industrial support packages; the shipped kr16, kr125 and ur10
-are used as they are), generate a seeded panel cell around it as a station places a robot (1.1 to
-1.8 m off the cell origin, turned; about every second arm (by its name's hash) on a riser tilted 2 deg), plan it and write
-every dialect (`plan --format all`: plan_cell + publish, the programs proven by robomax's own
-readers before writing), then run each written program through the independent controller models
-(tests/controller_model, written from vendor documentation) and compare what they execute with the
-trajectory file (FK with pinocchio from the URDF): the gun's real TCP at every weld (mm, deg: the
-flange at target · tool⁻¹ in force, the user frame composed in, placed by the cell's placement and
-the controller's base), each joint stop point (deg), and the configuration data.
+For every arm: `import-urdf` it (ROS-Industrial support packages, with the MoveIt SRDF where one
+exists; the shipped kr16, kr125 and ur10 are used as they are), generate a seeded panel cell around
+it as a station places a robot (1.1 to 1.8 m off the cell origin, turned; about every second arm,
+by its name's hash, on a riser tilted 2 deg), plan it and write every dialect (`plan --format all`:
+plan_cell + publish, the programs proven by robomax's own readers before writing), then run each
+written program through the independent controller models (tests/controller_model, written from
+vendor documentation) and compare what they execute with the trajectory file (FK with pinocchio
+from the URDF): the gun's real TCP at every weld (mm, deg: the flange at target · tool⁻¹ in force,
+the user frame composed in, placed by the cell's placement and the controller's base), each joint
+stop point (deg), and the configuration data.
 
 The cell: four spots on the robot-side face of a sheet standing on a fixture plate, at 50-70 % of
 the arm's reach in front of it (the row turned up to 25 deg about the robot's axis 1), at 5 % of
-the reach above the shoulder; the plate is user frame 3..5 of the program, the gun tool 1..4,
-position registers 40 and 41 for the FANUC setup program. The C-gun (spot_gun_c) on arms reaching
-1.4 m or more, the light gun below. Home: of the postures with J1, J4, J6 = 0 and J5 = +-30, 60 or 90 deg,
-the collision-free one whose wrist point is nearest to 40 % of the reach in front of and 45 %
-above the shoulder.
+the reach above the shoulder (at least 0.2 m above the base); the plate is user frame 3..5 of the
+program, the gun tool 1..4, position registers 40 and 41 for the FANUC setup program. The C-gun
+(spot_gun_c) on arms reaching 1.4 m or more, the light gun below. Home: of the postures with J1,
+J4, J6 = 0 and J5 = +-30, 60 or 90 deg, the collision-free one whose wrist point is nearest to
+40 % of the reach in front of and 45 % above the shoulder.
 
 Quick mode (CI; no network): the arms kept in tests/data/rosi (FANUC m20ia, ABB irb2400, KUKA
 kr120) and the shipped kr16, kr125, ur10. Full mode also imports the arms of `FULL_ARMS` found
@@ -319,7 +320,7 @@ def panel_cell(name: str, robot_yaml: Path, shape: ArmShape, arm: str, seed: int
     tool = "spot_gun_c" if R >= BIG_GUN_REACH_M else "spot_gun_light"
     d = rng.uniform(0.5, 0.7) * R
     turn = rng.uniform(-25.0, 25.0)
-    zs = shape.shoulder_z_m + 0.05 * R
+    zs = max(shape.shoulder_z_m + 0.05 * R, 0.2)     # a table-top arm (UR5): room for the plate and its stand
     pitch = float(np.clip(0.06 * R, 0.05, 0.1))
     riser = key % 2 == 1
     riser_h = float(rng.uniform(0.3, 0.5)) if riser else 0.0
