@@ -25,7 +25,7 @@ MB = 1024 * 1024
 
 @dataclass(frozen=True, slots=True)
 class FileLimits:
-    """Largest files read, by kind (bytes), and the YAML bounds."""
+    """Largest files read, by kind (bytes), the YAML bounds, and the bounds of a xacro expansion."""
 
     cell: int = 10 * MB
     description: int = 1 * MB          # robot.yaml, tool.yaml, SRDF
@@ -37,6 +37,11 @@ class FileLimits:
     yaml_nodes: int = 1_000_000        # after expanding aliases
     yaml_depth: int = 64               # nested collections
     int_digits: int = 30               # no quantity in a cell needs more
+    urdf_links: int = 1000             # links (and joints) of one URDF; arms have fewer than 50
+    # One xacro expansion (`import-urdf`, run in a process of its own): CPU seconds and address
+    # space. The ROS-Industrial support packages expand in under 0.2 s and 60 MB.
+    xacro_cpu_s: float = 30.0
+    xacro_memory: int = 1024 * MB
 
 
 LIMITS = FileLimits()

@@ -562,10 +562,19 @@ def import_urdf_command(
     brand: Annotated[str | None, typer.Option("--brand", help="kuka | abb | fanuc | ur (default: guessed from the name)")] = None,
     name: Annotated[str | None, typer.Option("--name", help="robot name (default: the folder name)")] = None,
     force: Annotated[bool, typer.Option("--force", help="replace a folder that exists with other content")] = False,
+    xacro_cpu_s: Annotated[float | None, typer.Option("--xacro-cpu-s", min=1, help="CPU seconds the xacro "
+                                                      "expansion may take (default 30)")] = None,
+    xacro_mb: Annotated[int | None, typer.Option("--xacro-mb", min=64, help="memory (MB) the xacro expansion may "
+                                                 "use (default 1024)")] = None,
 ) -> None:
-    """Make a self-contained robot folder from a URDF or xacro: meshes copied, IK fitted and checked."""
+    """Make a self-contained robot folder from a URDF or xacro: meshes copied, IK fitted and checked.
+
+    The package is read as untrusted data: only files below --packages folders and the source's
+    folder, xacro expanded without running Python, in a process bounded in CPU time and memory."""
 
     def run() -> None:
+        import dataclasses
+
         from robomax_py.app.import_urdf import import_urdf
         from robomax_py.errors import RobotModelError
 
@@ -573,8 +582,12 @@ def import_urdf_command(
             raise RobotModelError(None, "--solver", f"expected opw, ur or numeric, got {solver!r}")
         if brand not in (None, "kuka", "abb", "fanuc", "ur"):
             raise RobotModelError(None, "--brand", f"expected kuka, abb, fanuc or ur, got {brand!r}")
+        from robomax_py.safe_files import LIMITS, MB
+
+        limits = dataclasses.replace(LIMITS, xacro_cpu_s=xacro_cpu_s or LIMITS.xacro_cpu_s,
+                                     xacro_memory=LIMITS.xacro_memory if xacro_mb is None else xacro_mb * MB)
         r = import_urdf(source, out_dir, packages or (), name=name, flange=flange, srdf=srdf, solver=solver,
-                        brand=brand, force=force)
+                        brand=brand, force=force, limits=limits)
         _warn(r.warnings)
         what = "unchanged" if r.unchanged else "wrote"
         out.print(f"{what} {r.folder}: robot {r.name}, IK {r.solver} (FK agrees with the URDF within "

@@ -91,36 +91,13 @@ def kinematic_model(spec: RobotSpec) -> pin.Model:
     for j in range(1, model.njoints):
         if model.joints[j].nq != 1 or model.joints[j].nv != 1:
             raise RobotModelError(spec.urdf, f"joint {model.names[j]}", "only revolute and prismatic joints are supported")
-        _check_limits(model, j, spec)
+        i = model.joints[j].idx_q
+        lo, hi, v = model.lowerPositionLimit[i], model.upperPositionLimit[i], model.velocityLimit[i]
+        if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+            raise RobotModelError(spec.urdf, f"joint {model.names[j]}", "needs finite position limits lower < upper")
+        if not (np.isfinite(v) and v > 0):
+            raise RobotModelError(spec.urdf, f"joint {model.names[j]}", "needs a velocity limit > 0")
     return model
-
-
-# The joint limits a URDF may state (SI). Beyond them a value is a typo or a placeholder, and the
-# planner would divide by it (a velocity of 1e-300 rad/s made every duration infinite) or solve
-# for turn variants without end (a revolute range of many turns).
-REVOLUTE_RANGE_RAD = 4 * np.pi            # |lower|, |upper|: two turns either way
-PRISMATIC_RANGE_M = 100.0
-REVOLUTE_VELOCITY_RAD_S = (1e-3, 100.0)   # 0.06 deg/s .. 5,700 deg/s
-PRISMATIC_VELOCITY_M_S = (1e-4, 100.0)
-
-
-def _check_limits(model: pin.Model, j: int, spec: RobotSpec) -> None:
-    """Joint j's position and velocity limits finite, ordered and within the plausible ranges above."""
-    i = model.joints[j].idx_q
-    lo, hi, v = float(model.lowerPositionLimit[i]), float(model.upperPositionLimit[i]), float(model.velocityLimit[i])
-    where = f"joint {model.names[j]}"
-    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
-        raise RobotModelError(spec.urdf, where, "needs finite position limits lower < upper")
-    prismatic = model.joints[j].shortname().startswith("JointModelP")
-    reach, (v_min, v_max), unit = ((PRISMATIC_RANGE_M, PRISMATIC_VELOCITY_M_S, "m") if prismatic
-                                   else (REVOLUTE_RANGE_RAD, REVOLUTE_VELOCITY_RAD_S, "rad"))
-    if max(abs(lo), abs(hi)) > reach:
-        raise RobotModelError(spec.urdf, where, f"position limits [{lo:g}, {hi:g}] {unit} reach beyond +-{reach:g} {unit}")
-    if not (np.isfinite(v) and v > 0):
-        raise RobotModelError(spec.urdf, where, "needs a velocity limit > 0")
-    if not v_min <= v <= v_max:
-        raise RobotModelError(spec.urdf, where, f"velocity limit {v:g} {unit}/s is outside [{v_min:g}, {v_max:g}] {unit}/s "
-                                                "(a typo or a placeholder)")
 
 
 def prismatic_mask(model: pin.Model) -> np.ndarray:
@@ -146,7 +123,7 @@ def load_robot(spec: RobotSpec) -> RobotModel:
     jerk = _limit_vector(spec, "jerk", spec.jerk, acceleration / DEFAULT_TIME_TO_FULL_ACCEL_S, n)
 
     package_dirs = [str(spec.urdf.parent), *[str(d) for d in spec.package_dirs]]
-    warnings: list[str] = []
+    warnings: list[str] = list(spec.warnings)
     collision = _build_geometry(model, spec, pin.GeometryType.COLLISION, package_dirs)
     _make_meshes_convex(collision, spec)
     try:
@@ -196,6 +173,9 @@ def checked_ik_params(spec: RobotSpec, model: pin.Model) -> Any:
         return _table_steps(spec, model)
     if spec.ik_solver not in ("opw", "ur"):
         return spec.ik_params
+    if model.nq != 6:
+        raise RobotModelError(spec.source, "ik.solver", f"the {spec.ik_solver} solver is for six joints; the URDF "
+                              f"{spec.urdf.name} has {model.nq} ({', '.join(model.names[1:])}): use numeric or table")
     frame_id = int(model.getFrameId(spec.flange))
     params = spec.ik_params
     origin = "ik.params"

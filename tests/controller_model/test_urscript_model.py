@@ -145,3 +145,28 @@ prog()
     (m,) = run.motions
     assert m.where.line == 3 and m.stops
     assert [(w.input_number, w.state) for w in run.waits] == [(5, True), (6, False)]
+
+
+def test_a_function_that_only_waits_for_its_input_is_that_wait() -> None:
+    """A call of ``def wait_for_signal(n)`` whose body is a wait loop on input n waits for the
+    input the call passes; a function doing more stays a call."""
+    script = """def prog():
+  def wait_for_signal(n):
+    while not get_standard_digital_in(n):
+      sync()
+    end
+  end
+  def wait_and_tell(n):
+    while not get_standard_digital_in(n):
+      sync()
+    end
+    textmsg("in")
+  end
+  wait_for_signal(5)
+  wait_and_tell(6)
+end
+"""
+    run = run_urscript(script)
+    assert run.clean, run.issues
+    assert [(w.input_number, w.state, w.where.line) for w in run.waits] == [(5, True, 13)]
+    assert [(c.name, c.args) for c in run.calls] == [("wait_and_tell", (6.0,))]

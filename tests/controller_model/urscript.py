@@ -20,7 +20,9 @@ rotation vector).
   ``pose_trans(p_from, p_from_to)`` = p_from · p_from_to. Pose and joint-vector variables
   (``name = p[...]``, ``global``) hold their value.
 - ``def name(): ... end`` defines a function: a call is recorded (name, args), not followed; a call
-  of a defined function that moves or sets the TCP is reported. ``sleep(t)`` waits t s; a loop
+  of a defined function that moves or sets the TCP is reported. A function whose body is only an
+  input wait on one of its parameters (``def wait_for_signal(n): while not
+  get_standard_digital_in(n): sync() end end``) waits for the input its call passes. ``sleep(t)`` waits t s; a loop
   doing only ``sync()`` / ``sleep`` while a standard digital input is not yet in a state
   (``while not get_standard_digital_in(n):``, ``while (get_standard_digital_in(n) != True):``,
   ...) waits for it.
@@ -86,6 +88,7 @@ class _State:
     tool: FloatArray | None
     variables: dict[str, _Var] = field(default_factory=dict)
     functions: dict[str, list[_Line]] = field(default_factory=dict)
+    parameters: dict[str, list[str]] = field(default_factory=dict)
     events: list[Event] = field(default_factory=list)
     issues: list[Issue] = field(default_factory=list)
 
@@ -189,10 +192,11 @@ def _block(lines: list[_Line], state: _State) -> None:
     while i < len(lines):
         line = lines[i]
         code = line.code
-        definition = re.match(r"^(def|thread)\s+(\w+)\s*\(.*\)\s*:$", code)
+        definition = re.match(r"^(def|thread)\s+(\w+)\s*\((.*)\)\s*:$", code)
         if definition:
             end = _block_end(lines, i)
             state.functions[definition.group(2)] = lines[i + 1:end]
+            state.parameters[definition.group(2)] = [a for a in split_top(definition.group(3)) if a]
             i = end + 1
             continue
         wait = _input_wait(code)
@@ -243,6 +247,11 @@ def _statement(line: _Line, state: _State) -> None:
             state.issue(line, "unsupported", "sleep with an expression")
         return
     if func in state.functions:
+        waited = _wait_function(state.functions[func], state.parameters.get(func, []), args)
+        if waited is not None:
+            state.events.append(Wait(line.where, signal=f"get_standard_digital_in({waited[0]})",
+                                     input_number=waited[0], state=waited[1]))
+            return
         if _moves(state.functions[func]):
             state.issue(line, "unsupported", f"{func} moves the robot or sets the TCP; calls are not followed")
         state.events.append(Call(line.where, func, tuple(arg_value(a) for a in args)))
@@ -253,6 +262,23 @@ def _statement(line: _Line, state: _State) -> None:
         state.issue(line, "unsupported", "motion function outside the modelled subset (movej, movel)")
         return
     state.issue(line, "unsupported", f"call of {func}, which the model does not know")
+
+
+def _wait_function(body: list[_Line], parameters: list[str], args: list[str]) -> tuple[int, bool] | None:
+    """(input, awaited state) when `body` is only a wait loop on a standard digital input named by a
+    parameter, the call passing its number as a literal; else None."""
+    if not body or len(parameters) != len(args):
+        return None
+    header = re.sub(r"get_standard_digital_in\(\s*(\w+)\s*\)",
+                    lambda m: f"get_standard_digital_in({args[parameters.index(m.group(1))]})"
+                    if m.group(1) in parameters else m.group(0), body[0].code)
+    wait = _input_wait(header)
+    end = _block_end(body, 0)
+    inner = [ln.code for ln in body[1:end]]
+    if wait is None or end != len(body) - 1 or not all(re.fullmatch(r"sync\(\)|sleep\(\s*[\d.]+\s*\)", c)
+                                                       for c in inner):
+        return None
+    return wait
 
 
 def _assign(name: str, expr: str, state: _State) -> None:

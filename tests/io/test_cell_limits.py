@@ -175,10 +175,11 @@ def test_a_urdf_velocity_of_1e300_is_refused_at_load(tmp_path: Path, write_small
     assert first is not None
     urdf.write_text(text[:first.start()] + 'velocity="1e-300"' + text[first.end():])
     cell = _edit(write_small_cell(tmp_path), lambda d: d["robot"].update(model="robots/kr125/robot.yaml"))
-    with pytest.raises(RobotModelError, match=r"velocity limit 1e-300 rad/s is outside \[0.001, 100\]"):
-        load_cell_robot(load_cell(cell))
+    # Refused when the robot's files are read (`io.robot.check_urdf`), before any model is built.
+    with pytest.raises(RobotModelError, match=r"limit velocity 1e-300 rad/s is outside \[0.001, 100\]"):
+        load_cell(cell)
     result = runner.invoke(app, ["plan", str(cell), "-o", str(tmp_path / "out")])
-    assert result.exit_code == EXIT_BAD_INPUT and "velocity limit 1e-300" in result.output, result.output
+    assert result.exit_code == EXIT_BAD_INPUT and "limit velocity 1e-300" in result.output, result.output
     assert not (tmp_path / "out").exists()
 
 
