@@ -115,7 +115,6 @@ def _plan_set_state(folder: Path, name: str) -> str | None:
     sha256, and no other file named as the set's files are can be read. AssertionError otherwise."""
     import hashlib
     import json
-
     import re
 
     # The set's own names: the cell's, and FANUC's, named as its TP program (capitals; for short

@@ -79,8 +79,8 @@ def test_plan_small_cell_writes_the_trajectory(tmp_path: Path, write_small_cell:
     # The set's links and manifest; hidden, its pointer and its one folder (no temporary files left).
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
         "small.json", "small.manifest.json", "small.srcl"]
-    assert sorted(p.name for p in out.iterdir() if p.name.startswith("."))[0] == ".small.robomax-set"
-    assert len([p for p in out.iterdir() if p.name.startswith(".")]) == 2
+    hidden = sorted(p.name for p in out.iterdir() if p.name.startswith("."))
+    assert len(hidden) == 2 and hidden[0] == ".small.robomax-set", hidden
 
 
 @pytest.mark.slow

@@ -103,8 +103,8 @@ def test_check_set_finds_the_manifest_of_a_program_named_apart_and_tells_a_file_
     (tmp_path / "C.ls").write_text(OLD["C.ls"])
     check = check_set(tmp_path / "C.ls")
     assert check.manifest == tmp_path / "c.manifest.json" and check.plan != old.plan
-    assert check.mismatched == (f"C.ls is not one of the files of plan {check.plan[:12]} that c.manifest.json "
-                                "lists (another plan's, or put there by hand)",)
+    assert check.mismatched == ((f"C.ls is not one of the files of plan {check.plan[:12]} that c.manifest.json "
+                                 "lists (another plan's, or put there by hand)"),)
 
 
 def test_without_symbolic_links_files_are_replaced_one_by_one_and_the_manifest_last(
