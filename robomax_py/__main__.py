@@ -1,20 +1,12 @@
 """`python -m robomax_py`: the `robomax` command."""
 
 import signal
-import sys
 
+# SIGINT and SIGTERM held from the first instant while the command is imported: an import that
+# catches BaseException would swallow the exception a handler raises and the run would go on. A
+# signal that came meanwhile is delivered once `main` has installed its handlers.
+_before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
 
-def _early(signum: int, frame: object) -> None:
-    # SIGINT or SIGTERM while the command itself is being imported: nothing has started, so the
-    # run ends quietly with 128 + signum; `cli.main` installs the handlers for the run.
-    sys.exit(128 + signum)
-
-
-signal.signal(signal.SIGTERM, _early)
-if signal.getsignal(signal.SIGINT) is signal.default_int_handler:      # not when started ignoring it
-    signal.signal(signal.SIGINT, _early)
-
-# Imported after the handlers: importing the command takes a while.
 from robomax_py.app.cli import main
 
-main()
+main(restore_mask=_before)

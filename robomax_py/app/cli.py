@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import signal
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated, TypeVar
+from typing import Annotated, Any, TypeVar
 
 import typer
 from rich.console import Console
@@ -196,6 +196,7 @@ def plan(
                 files[f"{set_name}.png"] = render_png(cycle_chart(result))
             _honour_signals()                   # nothing is written after an interrupt
             committed = commit_set(out_dir, set_name, files, spec.digest, SHARED_FILES)
+            _honour_signals()                   # one that came during the commit: the new set is whole
             written = [*committed.paths, committed.manifest]
             removed = committed.removed
             unlisted = committed.unlisted
@@ -674,12 +675,30 @@ def _signals_deferred() -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
-def main() -> None:
-    """Console entry point."""
+def _unraisable(default: Callable[[Any], object]) -> Callable[[Any], None]:
+    """sys.unraisablehook that keeps quiet about the interrupt raised where Python cannot pass it
+    on (a finaliser, a weakref callback: it prints "Exception ignored" and a traceback, and the run
+    goes on); `_honour_signals` ends the run at the next stage."""
+
+    def hook(unraisable: Any) -> None:         # sys.UnraisableHookArgs
+        if _Received.signum is not None and isinstance(getattr(unraisable, "exc_value", None),
+                                                       (SystemExit, KeyboardInterrupt)):
+            return
+        default(unraisable)
+
+    return hook
+
+
+def main(restore_mask: Iterable[int] | None = None) -> None:
+    """Console entry point. `restore_mask`: the signal mask to set once the handlers are installed
+    (`python -m robomax_py` holds SIGINT and SIGTERM while it imports the command)."""
     signal.signal(signal.SIGTERM, _on_signal)
     if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:            # not when started ignoring it (nohup, &)
         signal.signal(signal.SIGINT, _on_signal)
+    sys.unraisablehook = _unraisable(sys.unraisablehook)
     try:
+        if restore_mask is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, restore_mask)     # a held signal is delivered here
         app(args=_bare_ray_flag(_library_flags_first(sys.argv[1:])))
     except KeyboardInterrupt:
         err.print("interrupted")
