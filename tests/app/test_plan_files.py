@@ -86,10 +86,17 @@ def _snapshot(folder: Path) -> dict[str, bytes | str]:
     return out
 
 
+# `python -m robomax_py` with Ctrl-C as a terminal delivers it: a test run started as a shell's
+# background job would hand the command SIGINT ignored, which `robomax` keeps (as for nohup).
+ROBOMAX_INTERRUPTIBLE = [sys.executable, "-c", ("import runpy, signal; signal.signal(signal.SIGINT, "
+                                                "signal.default_int_handler); runpy.run_module('robomax_py', "
+                                                "run_name='__main__', alter_sys=True)")]
+
+
 def _trial(sets: Sets, folder: Path, sig: signal.Signals, delay: float, *extra: str) -> tuple[int, str]:
     shutil.copytree(sets.old, folder, symlinks=True)
-    proc = subprocess.Popen([*ROBOMAX, "plan", str(sets.cell), "-o", str(folder), "--format", "all", *extra],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=ENV)
+    proc = subprocess.Popen([*ROBOMAX_INTERRUPTIBLE, "plan", str(sets.cell), "-o", str(folder), "--format", "all",
+                             *extra], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=ENV)
     time.sleep(delay)
     proc.send_signal(sig)
     _, stderr = proc.communicate(timeout=600)
