@@ -155,13 +155,7 @@ class Clearance:
 def min_clearance(world: CollisionWorld, t: FloatArray, q: FloatArray) -> Clearance | None:
     """The smallest distance over the samples of a motion, refined on the steps either side of
     the closest sample (10 sub-steps each); None when no pair is checked."""
-    best_i, best = (0, math.inf) if world.has_dynamic else _closest_sample(world, q)
-    if world.has_dynamic:
-        # Obstacles that come and go change distances without motion: every sample, every pair.
-        for i in range(len(t)):
-            d = world.closest(q[i], float(t[i])).distance
-            if d < best:
-                best_i, best = i, d
+    best_i, best = _closest_sample(world, q, t if world.has_dynamic else None)
     if not math.isfinite(best):
         return None
     best_t, best_q = float(t[best_i]), q[best_i]
@@ -178,14 +172,18 @@ def min_clearance(world: CollisionWorld, t: FloatArray, q: FloatArray) -> Cleara
     return Clearance(float(best), best_t, between)
 
 
-def _closest_sample(world: CollisionWorld, q: FloatArray) -> tuple[int, float]:
-    """The first sample of the least distance over every enabled pair, and that distance (static scene).
+def _closest_sample(world: CollisionWorld, q: FloatArray, t: FloatArray | None = None) -> tuple[int, float]:
+    """The first sample of the least distance over every enabled pair, and that distance.
 
     A pair is computed again only where the motion since it was last computed could have brought
     it below the best so far: no point moves farther than `sweep_length`, so a pair's distance
     shrinks by at most its approach factor times the sweep (1 against a static obstacle, 2 between
     two moving bodies). The answer is the minimum over every pair and sample, exactly as computing
     them all; the closest few pairs are computed at most samples, the rest rarely.
+
+    With `t` (a scene whose obstacles come and go), only the pairs counting at each sample's time
+    are candidates there: a dynamic obstacle stands still while present, so the bound holds for
+    its pairs across its absences too (their distances are geometry, not time).
     """
     n_pairs = world.n_pairs
     if n_pairs == 0 or len(q) == 0:
@@ -195,10 +193,14 @@ def _closest_sample(world: CollisionWorld, q: FloatArray) -> tuple[int, float]:
     everything = np.arange(n_pairs)
     last = world.pair_distances(q[0], everything)              # distance of each pair where last computed
     where = np.repeat(np.asarray(q[:1], dtype=float), n_pairs, axis=0)
-    best_i, best = 0, float(np.min(last))
+    counts = world.active_pairs(float(t[0])) if t is not None else np.ones(n_pairs, dtype=bool)
+    best_i, best = 0, float(np.min(last[counts])) if counts.any() else math.inf
     for i in range(1, len(q)):
         bound = last - factor * (np.abs(q[i] - where) @ lever)
-        due = np.flatnonzero(bound < best)
+        wanted = bound < best
+        if t is not None:
+            wanted &= world.active_pairs(float(t[i]))
+        due = np.flatnonzero(wanted)
         if not len(due):
             continue
         d = world.pair_distances(q[i], due)
