@@ -88,15 +88,32 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
         if companion is not None:
             texts[key] = read_text(companion, LIMITS.program, ProgramError, "program file",
                                    fallback=dialect.fallback_encoding)
+    for name in dialect.shared:
+        # The dialect's routines every program calls alike (FANUC's SPOT_WELD.ls): the reader
+        # checks that the one beside the program does what a weld call is taken to do.
+        routine = _beside(main, name)
+        if routine is not None:
+            texts[name] = read_text(routine, LIMITS.program, ProgramError, "program file",
+                                    fallback=dialect.fallback_encoding)
     from robomax_py.export.rebuild import rebuild
+    from robomax_py.program import LinMove, PtpMove
 
     parsed = dialect.parse(texts, str(main), robot)
+    unsimulated = tuple(Violation(None, "unsupported", f"{text} is not simulated: the program cannot be verified", line)
+                        for line, text in _not_simulated(parsed))
+    stated = tuple(Violation(None, kind, detail, line) for line, kind, detail in parsed.problems)
+    ignored = tuple(i for i in parsed.ignored if not _is_motion(parsed, i[0]))
+    if not any(isinstance(i, (PtpMove, LinMove)) for i in parsed.program.instructions):
+        # No motion runs (the program ends, or jumps past them, before its first motion): it
+        # welds nothing.
+        nowhere = () if stated or unsimulated else (
+            Violation(None, "flow", "no motion of the program runs: it moves the robot nowhere"),)
+        never = tuple(Violation(None, "spot", f"{seam.name}/{spot.name} is never welded")
+                      for seam in cell.seams for spot in seam.spots)
+        return VerifyReport(str(path), 0, float("nan"), 0, unsimulated + stated + nowhere + never, ignored)
     rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
     report = verify_rebuilt(cell, robot, str(path), rebuilt)
-    unsimulated = tuple(Violation(None, "unsupported", f"{text} is not simulated: the program cannot be verified", line)
-                        for line, text in parsed.ignored if _is_motion(parsed, line))
-    return dataclasses.replace(report, violations=unsimulated + report.violations,
-                               ignored=tuple(i for i in parsed.ignored if not _is_motion(parsed, i[0])))
+    return dataclasses.replace(report, violations=unsimulated + stated + report.violations, ignored=ignored)
 
 
 def _beside(path: Path, name: str) -> Path | None:
@@ -109,6 +126,15 @@ def _beside(path: Path, name: str) -> Path | None:
         return next((p for p in path.parent.iterdir() if p.name.lower() == name.lower() and p.is_file()), None)
     except OSError:
         return None
+
+
+def _not_simulated(parsed: Any) -> list[tuple[int, str]]:
+    """(line, statement and why) of every statement the reader marks as not simulated."""
+    from robomax_py.program import Comment
+
+    mark = "not simulated: "
+    return [(at, ins.text[len(mark):]) for ins, at in zip(parsed.program.instructions, parsed.lines)
+            if isinstance(ins, Comment) and ins.text.startswith(mark)]
 
 
 def _is_motion(parsed: Any, line: int) -> bool:
