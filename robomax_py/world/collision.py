@@ -396,6 +396,11 @@ class CollisionWorld:
         return sorted({float(w0) for i in s.dynamic_ids for w0, _ in (s.obstacles[int(i)].present or ())
                        if ta < w0 <= tb})
 
+    def presence_at(self, t: float) -> tuple[bool, ...]:
+        """Which of the obstacles that come and go exist at time t (s), in a fixed order."""
+        s = self._s
+        return tuple(_present_during(s.obstacles[int(i)], t, t) for i in s.dynamic_ids)
+
     @property
     def has_dynamic(self) -> bool:
         """Whether some obstacle comes and goes (present only in time windows)."""
