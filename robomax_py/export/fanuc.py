@@ -482,6 +482,13 @@ def _positions(text: str) -> dict[int, tuple[dict[str, float], str, tuple[int, i
     return out
 
 
+def _program_positions(text: str) -> dict[int, tuple[dict[str, float], str, tuple[int, int] | None]]:
+    """The /POS positions of a whole TP program text."""
+    lines = text.splitlines()
+    at = next((i for i, ln in enumerate(lines) if ln.strip() == "/POS"), len(lines))
+    return _positions("\n".join(lines[at + 1:]))
+
+
 def _statements(lines: list[str], start: int, end: int) -> list[tuple[int, str]]:
     """(file line, statement) of the /MN lines start..end-1: a numbered line with its continuation
     lines (`    :  SPOT[...]`), without the closing `;`; a remark's continuations (`!+...`, see
@@ -698,9 +705,12 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             cnt = 0 if move.group(5).upper() == "FINE" else int(move.group(6))
             options = move.group(7) or ""
             acc = re.search(r"ACC\s*([0-9]+)", options, re.IGNORECASE)
-            if k not in positions:
-                raise error(number, f"P[{k}] has no position in /POS")
-            fields, config, numbers = positions[k]
+            # A called program's P[k] is in its own /POS.
+            own = positions if step.statement.source == "" else _program_positions(texts.get(step.statement.source, ""))
+            if k not in own:
+                raise error(number, f"P[{k}] has no position in /POS"
+                                    + ("" if step.statement.source == "" else f" of {step.statement.source}"))
+            fields, config, numbers = own[k]
             if (kind == "J" and unit != "%") or (kind == "L" and unit not in _LINEAR_UNITS):
                 # A move stated by its time (sec, msec) or by its orientation speed (deg/sec).
                 not_simulated(number, s, stmt, f" (a {'joint' if kind == 'J' else 'linear'} move's speed in {unit})")

@@ -106,3 +106,24 @@ def placement_mm_zyx(cell: CellSpec) -> tuple[list[float], list[float]]:
     T = cell.T_world_base
     zyx = Rotation.from_matrix(T[:3, :3]).as_euler("ZYX", degrees=True)
     return [float(v) * 1000.0 for v in T[:3, 3]], [float(v) for v in zyx]
+
+
+def detour_into_the_part(placed: Placed) -> tuple[list[float], list[float]]:
+    """Joint values (deg) of the joint target the program reaches the first weld's approach from,
+    and the same with A2 turned 10 deg further: a detour that drives the gun into the part (the
+    static world says so; a mutant calls a routine that makes it and comes back)."""
+    import re
+
+    import numpy as np
+
+    from robomax_py.world.collision import CollisionWorld
+    from robomax_py.world.scene import build_scene
+
+    srcl = placed.files[f"{placed.name}.srcl"]
+    body = srcl[:srcl.index("MOVE LIN")]
+    back = [float(v) for v in re.findall(r"MOVE PTP AXIS\(([^)]*)\)", body)[-1].split(",")]
+    detour = [v + (10.0 if i == 1 else 0.0) for i, v in enumerate(back)]
+    world = CollisionWorld(placed.robot, build_scene(placed.cell, placed.robot), placed.cell.process.clearance)
+    contact = world.first_contact(np.radians(detour))
+    assert contact is not None and contact.kind_b == "object", contact
+    return detour, back
