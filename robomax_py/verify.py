@@ -63,11 +63,37 @@ class VerifyReport:
 def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
     """Verify a trajectory file (.json) or a program of any dialect robomax writes (its motion
     rebuilt from its statements alone)."""
-    from robomax_py.export import DIALECTS, controller_frames, dialect_for_file
+    from robomax_py.export import controller_frames
+    from robomax_py.export.rebuild import rebuild
+    from robomax_py.program import LinMove, PtpMove
+
+    if path.suffix.lower() == ".json":
+        return verify_trajectory_file(cell, robot, path)
+    dialect, main, parsed = read_program(robot, path)
+    unsimulated = tuple(Violation(None, "unsupported", f"{text} is not simulated: the program cannot be verified", line)
+                        for line, text in _not_simulated(parsed))
+    stated = tuple(Violation(None, kind, detail, line) for line, kind, detail in parsed.problems)
+    ignored = tuple(i for i in parsed.ignored if not _is_motion(parsed, i[0]))
+    if not any(isinstance(i, (PtpMove, LinMove)) for i in parsed.program.instructions):
+        # No motion runs (the program ends, or jumps past them, before its first motion): it
+        # welds nothing.
+        nowhere = () if stated or unsimulated else (
+            Violation(None, "flow", "no motion of the program runs: it moves the robot nowhere"),)
+        never = tuple(Violation(None, "spot", f"{seam.name}/{spot.name} is never welded")
+                      for seam in cell.seams for spot in seam.spots)
+        return VerifyReport(str(path), 0, float("nan"), 0, unsimulated + stated + nowhere + never, ignored)
+    rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
+    report = verify_rebuilt(cell, robot, str(path), rebuilt)
+    return dataclasses.replace(report, violations=unsimulated + stated + report.violations, ignored=ignored)
+
+
+def read_program(robot: RobotModel, path: Path) -> tuple[Any, Path, Any]:
+    """A program's files read as verify reads them: (its `Dialect`, its main file, the `Parsed`
+    program), with the files beside it the dialect reads too (a KRL .dat, the companions, the
+    dialect's shared routines)."""
+    from robomax_py.export import DIALECTS, dialect_for_file
 
     suffix = path.suffix.lower()
-    if suffix == ".json":
-        return verify_trajectory_file(cell, robot, path)
     dialect = dialect_for_file(suffix)
     if dialect is None:
         known = ", ".join(sorted({e for d in DIALECTS.values() for e in d.extensions}))
@@ -95,25 +121,7 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
         if routine is not None:
             texts[name] = read_text(routine, LIMITS.program, ProgramError, "program file",
                                     fallback=dialect.fallback_encoding)
-    from robomax_py.export.rebuild import rebuild
-    from robomax_py.program import LinMove, PtpMove
-
-    parsed = dialect.parse(texts, str(main), robot)
-    unsimulated = tuple(Violation(None, "unsupported", f"{text} is not simulated: the program cannot be verified", line)
-                        for line, text in _not_simulated(parsed))
-    stated = tuple(Violation(None, kind, detail, line) for line, kind, detail in parsed.problems)
-    ignored = tuple(i for i in parsed.ignored if not _is_motion(parsed, i[0]))
-    if not any(isinstance(i, (PtpMove, LinMove)) for i in parsed.program.instructions):
-        # No motion runs (the program ends, or jumps past them, before its first motion): it
-        # welds nothing.
-        nowhere = () if stated or unsimulated else (
-            Violation(None, "flow", "no motion of the program runs: it moves the robot nowhere"),)
-        never = tuple(Violation(None, "spot", f"{seam.name}/{spot.name} is never welded")
-                      for seam in cell.seams for spot in seam.spots)
-        return VerifyReport(str(path), 0, float("nan"), 0, unsimulated + stated + nowhere + never, ignored)
-    rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
-    report = verify_rebuilt(cell, robot, str(path), rebuilt)
-    return dataclasses.replace(report, violations=unsimulated + stated + report.violations, ignored=ignored)
+    return dialect, main, dialect.parse(texts, str(main), robot)
 
 
 def _beside(path: Path, name: str) -> Path | None:
