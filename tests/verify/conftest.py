@@ -127,3 +127,35 @@ def detour_into_the_part(placed: Placed) -> tuple[list[float], list[float]]:
     contact = world.first_contact(np.radians(detour))
     assert contact is not None and contact.kind_b == "object", contact
     return detour, back
+
+
+@dataclass(frozen=True)
+class Execution:
+    """What a program runs, as robomax's reader has it or as a controller model runs it: the lines
+    of the weld calls that run, in order; how many motions run; the line the program ends at
+    before its last statement (None: it runs to its end)."""
+
+    welds: tuple[int, ...]
+    motions: int
+    stopped: int | None
+
+
+def read_execution(placed: Placed, fmt: str, edits: Mapping[str, Edit], tag: str) -> tuple[Path, Execution]:
+    """A mutant's main file and what robomax's reader (as verify reads it) says runs."""
+    from robomax_py.program import LinMove, PtpMove, Spot
+    from robomax_py.verify import read_program
+
+    main = placed.mutant(fmt, edits, tag)
+    _, _, parsed = read_program(placed.robot, main)
+    pairs = list(zip(parsed.program.instructions, parsed.lines))
+    ends = [line for line, kind, _ in parsed.problems if kind == "flow"]
+    return main, Execution(tuple(line for ins, line in pairs if isinstance(ins, Spot)),
+                           sum(isinstance(ins, (PtpMove, LinMove)) for ins, _ in pairs), ends[0] if ends else None)
+
+
+def model_execution(run: object, weld: str) -> Execution:
+    """What a controller model's run (`controller_model.common.ProgramRun`) says runs; `weld`: the
+    weld routine's name."""
+    calls = [c.where.line for c in run.calls if c.name.lower() == weld.lower()]       # type: ignore[attr-defined]
+    stopped = run.stopped.line if run.stopped is not None else None                    # type: ignore[attr-defined]
+    return Execution(tuple(calls), len(run.motions), stopped)                           # type: ignore[attr-defined]

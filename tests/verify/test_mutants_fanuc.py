@@ -13,7 +13,8 @@ from collections.abc import Callable
 
 import pytest
 
-from conftest import Edit, Placed, detour_into_the_part, placement_mm_zyx
+from conftest import Edit, Placed, detour_into_the_part, model_execution, placement_mm_zyx, read_execution
+from controller_model.fanuc import run_fanuc
 
 
 def _placement_as_uframe(placed: Placed) -> dict[str, Edit]:
@@ -199,3 +200,19 @@ def test_fanuc_flow_the_controller_follows_exactly_is_clean(placed: Placed) -> N
         return _before_first_line("LBL[7:approach]")(_before_first_line("JMP LBL[7]")(t))
     report = placed.verify("fanuc", {".ls": edit}, "flow_followed")
     assert report.clean, report.violations
+
+
+# The controller model (tests/controller_model, written from the vendors' documents) runs the same
+# mutants: the welds that run, the motions and where the program stops agree with robomax's reading.
+MODEL_CHECKED = ("ABORT before the first motion", "END before the first motion", "PAUSE before the first motion",
+                 "END after the first weld", "JMP over a weld", "colliding move inside the called frames program")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", MODEL_CHECKED)
+def test_fanuc_flow_mutant_reads_as_the_controller_model_runs_it(placed: Placed, kind: str) -> None:
+    edit, _ = FLOW_MUTANTS[kind]
+    main, read = read_execution(placed, "fanuc", edit(placed), "model_" + re.sub(r"\W+", "_", kind))
+    frames = main.with_name(main.stem + "_FRAMES.ls")
+    run = run_fanuc(main.read_text(), name=main.name, called={frames.name: frames.read_text()})
+    assert model_execution(run, "SPOT_WELD") == read

@@ -19,7 +19,8 @@ from collections.abc import Callable
 import pytest
 from scipy.spatial.transform import Rotation
 
-from conftest import Edit, Placed, detour_into_the_part, placement_mm_zyx
+from conftest import Edit, Placed, detour_into_the_part, model_execution, placement_mm_zyx, read_execution
+from controller_model.krl import run_krl
 
 FRAME = re.compile(r"\{X (-?[\d.]+), Y (-?[\d.]+), Z (-?[\d.]+), A (-?[\d.]+), B (-?[\d.]+), C (-?[\d.]+)\}")
 
@@ -188,3 +189,18 @@ def test_krl_flow_the_controller_follows_exactly_is_clean(placed: Placed) -> Non
              + "\nDEF noop( )\n  ; nothing to do\nEND\n"}
     report = placed.verify("krl", edits, "flow_followed")
     assert report.clean, report.violations
+
+
+# The controller model (tests/controller_model, written from the vendors' documents) runs the same
+# mutants: the welds that run, the motions and where the program stops agree with robomax's reading.
+MODEL_CHECKED = ("RETURN before the first motion", "HALT before the first motion", "RETURN after the first weld", "GOTO over a weld",
+                 "colliding move inside a called DEF")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", MODEL_CHECKED)
+def test_krl_flow_mutant_reads_as_the_controller_model_runs_it(placed: Placed, kind: str) -> None:
+    edit, _ = FLOW_MUTANTS[kind]
+    main, read = read_execution(placed, "krl", edit(placed), "model_" + re.sub(r"\W+", "_", kind))
+    run = run_krl(main.read_text(), main.with_suffix(".dat").read_text(), src_name=main.name)
+    assert model_execution(run, "spot_weld") == read

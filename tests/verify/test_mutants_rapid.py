@@ -19,7 +19,7 @@ import pytest
 import yaml
 from scipy.spatial.transform import Rotation
 
-from conftest import Edit, Placed, detour_into_the_part, placement_mm_zyx
+from conftest import Edit, Placed, detour_into_the_part, model_execution, placement_mm_zyx, read_execution
 from controller_model.common import Call, Motion
 from controller_model.rapid import run_rapid
 from robomax_py.io.cell import load_cell, load_cell_robot
@@ -289,3 +289,18 @@ def test_rapid_flow_the_controller_follows_exactly_is_clean(placed: Placed) -> N
         return _with_proc("  PROC noop()\n    ! nothing to do\n  ENDPROC\n")(t)
     report = placed.verify("rapid", {".mod": edit}, "flow_followed")
     assert report.clean, report.violations
+
+
+# The controller model (tests/controller_model, written from the vendors' documents) runs the same
+# mutants: the welds that run, the motions and where the program stops agree with robomax's reading.
+MODEL_CHECKED = ("RETURN before the first motion", "Stop before the first motion", "EXIT after the first weld", "GOTO over a weld",
+                 "colliding move inside a called PROC", "colliding move inside the data module's PROC")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", MODEL_CHECKED)
+def test_rapid_flow_mutant_reads_as_the_controller_model_runs_it(placed: Placed, kind: str) -> None:
+    edit, _ = FLOW_MUTANTS[kind]
+    main, read = read_execution(placed, "rapid", edit(placed), "model_" + re.sub(r"\W+", "_", kind))
+    run = run_rapid({p.name: p.read_text() for p in (main, main.with_name(main.stem + "_frames.mod"))})
+    assert model_execution(run, "spot_weld") == read

@@ -12,7 +12,8 @@ from collections.abc import Callable
 import pytest
 from scipy.spatial.transform import Rotation
 
-from conftest import Edit, Placed, detour_into_the_part, placement_mm_zyx
+from conftest import Edit, Placed, detour_into_the_part, model_execution, placement_mm_zyx, read_execution
+from controller_model.urscript import run_urscript
 
 
 def _placement_as_feature(placed: Placed) -> dict[str, Edit]:
@@ -148,3 +149,18 @@ def test_urscript_flow_the_controller_follows_exactly_is_clean(placed: Placed) -
         _before_first_line("note()")(t))}
     report = placed.verify("urscript", edit, "flow_followed")
     assert report.clean, report.violations
+
+
+# The controller model (tests/controller_model, written from the vendors' documents) runs the same
+# mutants: the welds that run, the motions and where the program stops agree with robomax's reading.
+MODEL_CHECKED = ("return before the first motion", "halt() before the first motion", "halt() after the first weld",
+                 "colliding move inside a called def")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", MODEL_CHECKED)
+def test_urscript_flow_mutant_reads_as_the_controller_model_runs_it(placed: Placed, kind: str) -> None:
+    edit, _ = FLOW_MUTANTS[kind]
+    main, read = read_execution(placed, "urscript", edit(placed), "model_" + re.sub(r"\W+", "_", kind))
+    run = run_urscript(main.read_text(), name=main.name)
+    assert model_execution(run, "spot_weld") == read
