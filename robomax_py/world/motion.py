@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomax_py._typing import FloatArray
+from robomax_py._typing import FloatArray, IntArray
 from robomax_py.robot import JointLimits, RobotModel
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision import CollisionWorld
@@ -83,7 +83,20 @@ def check_motion(
     checks = 0
     limit = 1 if stop_at_first else max_collisions
     collisions: list[Violation] = []
+    rest_end = _rest_ends(q)
+    skip_to = 0
     for i in range(len(t) - 1):
+        if i < skip_to:
+            continue
+        j = int(rest_end[i])
+        if j > i + 1:
+            # A rest (a long weld or wait): one configuration among the obstacles present at any
+            # time of it, checked once; sample by sample only where that finds a collision.
+            res = world.check_segment(q[i], q[i], float(t[i]), float(t[j]))
+            checks += res.checks
+            if res.free:
+                skip_to = j
+                continue
         res = world.check_segment(q[i], q[i + 1], float(t[i]), float(t[i + 1]))
         checks += res.checks
         if res.free:
@@ -103,6 +116,20 @@ def check_motion(
             break
     out.extend(collisions)
     return MotionCheck(tuple(out), checks)
+
+
+def _rest_ends(q: FloatArray) -> IntArray:
+    """For each sample i, the last sample j >= i of the rest it starts: samples i..j all within
+    REST_Q_TOL_RAD of sample i (j = i where the robot moves on)."""
+    n = len(q)
+    out = np.arange(n)
+    if n < 2:
+        return out
+    still = np.abs(np.diff(q, axis=0)).max(axis=1) <= REST_Q_TOL_RAD
+    for i in range(n - 2, -1, -1):
+        if still[i] and float(np.abs(q[int(out[i + 1])] - q[i]).max()) <= REST_Q_TOL_RAD:
+            out[i] = out[i + 1]
+    return out
 
 
 def rate_violations(lim: JointLimits, names: tuple[str, ...], t: FloatArray, q: FloatArray,
@@ -150,6 +177,11 @@ class Clearance:
     distance_m: float
     t: float
     between: str
+
+
+# Samples of a rest this close to each other (rad) are one configuration: interpolating a rest
+# moves no point farther than the lever arms (a few m) times this.
+REST_Q_TOL_RAD = 1e-12
 
 
 def min_clearance(world: CollisionWorld, t: FloatArray, q: FloatArray) -> Clearance | None:
