@@ -77,7 +77,8 @@ It follows the program as the controller runs it (`export.flow`): END and ABORT 
 stops it until it is started again (the verified cycle ends there), JMP LBL[n] continues at
 LBL[n]; a CALL of the frames setup program runs it in place. A CALL of any other program (the
 default routines aside), RUN, conditional jumps and calls (IF ..., SELECT, WAIT ... TIMEOUT,LBL),
-a speed OVERRIDE, and what runs inside IF ... THEN / FOR blocks are reported, never skipped. A
+a speed OVERRIDE, waits other than `WAIT t(sec)` and `WAIT DI[k]=ON` (on a register, a flag, an
+expression), and what runs inside IF ... THEN / FOR blocks are reported, never skipped. A
 CALL SPOT_WELD / GRIP / RELEASE is the weld or gripper action it names while the routine shipped
 beside the program (SPOT_WELD.ls ...) does nothing but `WAIT AR[2]`; the time is the call's second
 argument, in s. Linear speeds in mm/sec, cm/min or inch/min are read in their units; a move
@@ -763,6 +764,10 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         wait_di = _WAIT_DI.match(stmt)
         if wait_di:
             add(WaitFor((wait_di.group(2) or f"DI{wait_di.group(1)}").strip(), int(wait_di.group(1))), number, s)
+            continue
+        if re.match(r"^WAIT\b", stmt, re.IGNORECASE):
+            # A wait on a register, a flag, an expression: how long it holds the robot is not known.
+            not_simulated(number, s, stmt, " (a wait other than WAIT t(sec) or WAIT DI[k]=ON)")
             continue
         selected = _FRAME_NUM.match(stmt)
         if selected:

@@ -175,6 +175,22 @@ def test_a_position_in_user_frame_7_is_read_relative_to_uframe_7(kr125: RobotMod
     assert fanuc.frame_name(frame) == move.base
 
 
+def test_linear_speeds_are_read_in_their_units(kr125: RobotModel) -> None:
+    """A linear move's speed in mm/sec, cm/min or inch/min is a TCP speed (mm/s); one stated by the
+    move's time (sec) or its orientation speed (deg/sec) is reported, not guessed."""
+    base = _unconditional((DATA / "gratowanie.ls").read_text())
+    speeds = {}
+    for unit, value in (("mm/sec", "250"), ("cm/min", "1500"), ("inch/min", "590.551")):
+        parsed = _read("gratowanie.ls", kr125, base.replace("L P[1] 250mm/sec FINE", f"L P[1] {value}{unit} FINE"))
+        (move,) = [i for i in parsed.program.instructions if isinstance(i, LinMove)]
+        speeds[unit] = move.speed_mm_s
+    assert speeds["mm/sec"] == speeds["cm/min"] == 250.0 and abs(speeds["inch/min"] - 250.0) < 1e-3
+    for unit in ("sec", "deg/sec"):
+        parsed = _read("gratowanie.ls", kr125, base.replace("L P[1] 250mm/sec FINE", f"L P[1] 2{unit} FINE"))
+        assert not any(isinstance(i, LinMove) for i in parsed.program.instructions)
+        assert any(f"speed in {unit}" in i.text for i in parsed.program.instructions if isinstance(i, Comment))
+
+
 def test_a_position_in_another_user_frame_is_an_alarm(kr125: RobotModel) -> None:
     text = _unconditional((DATA / "gratowanie.ls").read_text())
     text = text.replace("UF : 7, UT : 1,", "UF : 3, UT : 1,")
