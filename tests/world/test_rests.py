@@ -32,7 +32,7 @@ def door(tmp_path_factory: pytest.TempPathFactory, write_process_cell: Callable[
 
 
 def _rest(q: np.ndarray, t0: float, t1: float) -> tuple[np.ndarray, np.ndarray]:
-    t = np.linspace(t0, t1, int(round((t1 - t0) / 0.01)) + 1)
+    t = np.linspace(t0, t1, round((t1 - t0) / 0.01) + 1)
     return t, np.repeat(q[None, :], len(t), axis=0) + 1e-15 * np.arange(len(t))[:, None]   # interpolation round-off
 
 
@@ -53,7 +53,7 @@ def test_a_rest_after_the_door_is_gone_is_free(door) -> None:  # type: ignore[no
 
 
 def test_the_smallest_clearance_of_a_rest_is_the_sample_by_sample_one(door) -> None:  # type: ignore[no-untyped-def]
-    robot, world, q = door
+    _, world, q = door
     t, qs = _rest(q, 1.0, 3.0)
     brute = min(world.closest(qi, float(ti)).distance for ti, qi in zip(t, qs))
     report = min_clearance(world, t, qs)
