@@ -5,14 +5,14 @@ A reader splits its files into routines (`Routine`: a KRL DEF, a RAPID PROC, a U
 FANUC TP program) of statements (`Statement`) and says, per statement, what it does to the flow
 (`Flow`); `follow` then walks the main routine as the controller does:
 
-- an unconditional end (`Flow.end`) stops the program: RETURN / END of the main routine, EXIT,
+- an unconditional end (kind "end") stops the program: RETURN / END of the main routine, EXIT,
   ABORT, halt(). A pause (KRL HALT, RAPID Stop and Break, FANUC PAUSE) stops it too until an
   operator restarts it: a cycle does not go on past a pause by itself, so verify checks the cycle
   up to it (RoboDK's post processors write exactly these statements for "Pause the robot program":
   ros-industrial-attic/robodk_postprocessors@d7e6c1c0 KUKA_KRC4.py:281-286 `HALT`,
   ABB_RAPID_IRC5.py:381-386 `STOP;`, Fanuc_R30iA.py:405-410 `PAUSE ;`, Universal_Robots.py:634-639
   `halt()`). A RETURN in a called routine returns to the caller;
-- an unconditional jump (`Flow.goto`) continues at its label in the same routine. Nothing here
+- an unconditional jump (kind "goto") continues at its label in the same routine. Nothing here
   depends on data (conditions are not evaluated), so a jump back to a statement that already ran
   repeats forever: that is reported (`unsupported`) and ends the walk, as the program never gets
   past the jump. A jump into a block (IF, WHILE, ...) or to a label the routine does not have is
@@ -21,10 +21,11 @@ FANUC TP program) of statements (`Statement`) and says, per statement, what it d
   body in place, up to `MAX_CALL_DEPTH` deep; a call of a routine that is already running (a
   recursion, unconditional here, so endless), a call with arguments (their binding is not
   modelled) and a call of a routine the texts do not define are reported. The dialect's own
-  weld, gripper and wait routines are plain statements to the reader (`Flow.plain`);
+  weld, gripper and wait routines are plain statements to the reader (kind "plain");
 - inside a block (IF, WHILE, FOR, LOOP, TEST, SWITCH ...) the reader cannot tell whether, or how
-  often, a statement runs: every jump, end, call and label there is reported, and the other
-  statements are passed on marked `conditional` (the readers report the motions among them).
+  often, a statement runs: every jump, end and call there is reported (a label there is passed
+  over), and the other statements are passed on marked `conditional` (the readers report the
+  motions among them).
 
 What is reported becomes an `unsupported` violation in verify: never a skipped statement.
 """
@@ -95,10 +96,6 @@ class Flow:
     scope: Literal["routine", "program"] = "routine"
     pause: bool = False
     why: str = ""
-
-    @staticmethod
-    def plain() -> Flow:
-        return Flow()
 
 
 @dataclass(frozen=True, slots=True)
