@@ -3,7 +3,9 @@ trajectory file and every dialect's program, and `robomax verify` passes on each
 rebuilt from the program's own statements); the frame's seams are all welded and its ordered
 pillar seam keeps its order; the programs are byte for byte the committed ones
 (tests/golden/shipped: the .srcl text, and the SHA-256 of every other file), so a restructuring
-that changes no behaviour is shown to change no program. Slow: each cell plans in 10-40 s."""
+that changes no behaviour is shown to change no program. The tending cell's program waits in front
+of the doors for their signals and grips and releases at the stations, and its motion keeps the
+clearance from every door while it is closed. Slow: each cell plans in 10-60 s."""
 
 from __future__ import annotations
 
@@ -11,6 +13,7 @@ import hashlib
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 from typer.testing import CliRunner
@@ -18,6 +21,9 @@ from typer.testing import CliRunner
 from robomax_py.app.cli import EXIT_OK, app
 from robomax_py.export import dialect_for_file
 from robomax_py.export.plan_program import identifier
+from robomax_py.export.srcl import parse_program
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.program import Gripper, Spot, WaitFor
 
 REPO = Path(__file__).resolve().parents[1]
 CELLS = sorted((REPO / "cells").glob("*.yaml"))
@@ -93,6 +99,33 @@ def test_shipped_cell_plans_and_verifies(cell: Path, tmp_path: Path, update_gold
         if seam.get("ordered"):
             got = [name for s, name in welded if s == seam["name"]]
             assert got == [p["name"] for p in seam["spots"]], f"{seam['name']} welded out of order"
+
+
+    if "tending" in spec:
+        _tending_program_and_doors(cell, tmp_path / f"{name}.srcl", data)
+
+
+def _tending_program_and_doors(cell_path: Path, srcl: Path, data: dict[str, object]) -> None:
+    """The tending cell's written program and motion: waits only for the door signals, and some;
+    grip then release at each machine, three cycles; no weld; never within the process clearance of
+    a door while it is closed (every sample's exact minimum, refined between samples)."""
+    from dataclasses import replace
+
+    from robomax_py.world.collision import CollisionWorld
+    from robomax_py.world.motion import min_clearance
+    from robomax_py.world.scene import build_scene
+
+    program = parse_program(srcl.read_text(), srcl)
+    waits = [i.signal for i in program.instructions if isinstance(i, WaitFor)]
+    assert waits and set(waits) <= {"cnc1_door_open", "cnc2_door_open"}, waits
+    actions = [i.action for i in program.instructions if isinstance(i, Gripper)]
+    assert actions == ["grip", "release", "grip", "release"] * 3, actions
+    assert not any(isinstance(i, Spot) for i in program.instructions)
+    cell = load_cell(cell_path)
+    robot = load_cell_robot(cell)
+    doors = CollisionWorld(robot, build_scene(replace(cell, objects=()), robot), 0.0).restricted(self_pairs=False)
+    least = min_clearance(doors, np.asarray(data["t"], dtype=float), np.asarray(data["q"], dtype=float))
+    assert least is not None and least.distance_m >= cell.process.clearance, least
 
 
 def test_frame_has_an_ordered_seam_and_several_seams() -> None:
