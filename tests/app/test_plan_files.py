@@ -174,15 +174,15 @@ def kill_trial(cell: Path, folder: Path, sig: signal.Signals, rng: np.random.Gen
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM])
 def test_plan_killed_at_random_instants_leaves_the_old_set_or_the_new_one(
         write_small_cell: Callable[..., Path], tmp_path: Path, sig: signal.Signals, plan_set_state: StateOf) -> None:
-    """Seven runs per signal, signalled at seeded CPU instants over the whole run; the last SIGKILL
+    """Four runs per signal, signalled at seeded CPU instants over the whole run; the last SIGKILL
     inside the commit (a run that gets that far costs ~13 s of CPU: SIGTERM during the commit, held
     until the set is whole, is tried in tests/io/test_plan_set.py and by the script). Each leaves
     the older set or the new one whole; a run that ends 0 wrote the new one; every new set is the
-    same plan. About 50 s of CPU in all."""
+    same plan. About 30 s of CPU in all; `python tests/app/test_plan_files.py` runs more."""
     cell = write_small_cell(tmp_path)
     rng = np.random.default_rng(30 + int(sig))
-    outcomes = [kill_trial(cell, tmp_path / f"t{k}", sig, rng, k == 6 and sig == signal.SIGKILL, plan_set_state)
-                for k in range(7)]
+    outcomes = [kill_trial(cell, tmp_path / f"t{k}", sig, rng, k == 3 and sig == signal.SIGKILL, plan_set_state)
+                for k in range(4)]
     print(f"\n{sig.name}: " + "; ".join(f"{o.aim} -> exit {o.code}, {o.state}" for o in outcomes))
     for o in outcomes:
         assert o.state in ("old", "new"), o

@@ -56,7 +56,7 @@ def test_plan_killed_mid_run_leaves_no_partial_program(tmp_path: Path, write_sma
     cell = write_small_cell(tmp_path)
     out = tmp_path / "programs"
     robomax = [sys.executable, "-m", "robomax_py"]
-    for k, delay in enumerate((0.5, 2.0, 4.0, 6.0, 8.0)):
+    for k, delay in enumerate((0.5, 4.0)):
         proc = subprocess.Popen([*robomax, "plan", str(cell), "-o", str(out)],
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         time.sleep(delay)
