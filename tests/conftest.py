@@ -142,6 +142,46 @@ def plan_set_state() -> Callable[[Path, str], str | None]:
     return _plan_set_state
 
 
+@pytest.fixture(scope="session")
+def shared_once(tmp_path_factory: pytest.TempPathFactory, worker_id: str) -> Callable[[str, Callable[[], Any]], Any]:
+    """shared_once(key, compute): `compute()` run once per test run, across the run's test workers
+    (pytest-xdist gives each worker its own session fixtures: a plan that several test files use
+    would otherwise be made once per worker). The first worker to ask computes under a file lock
+    and pickles the answer into the run's temporary folder; the others read it. `key` names all
+    the answer depends on (a cell file's bytes, the options): one key, one answer."""
+    import hashlib
+    import pickle
+
+    from filelock import FileLock
+
+    root = tmp_path_factory.getbasetemp()
+    folder = (root.parent if worker_id != "master" else root) / "shared-once"
+    folder.mkdir(exist_ok=True)
+
+    def get(key: str, compute: Callable[[], Any]) -> Any:
+        path = folder / f"{hashlib.sha256(key.encode()).hexdigest()[:32]}.pickle"
+        with FileLock(str(path) + ".lock"):
+            if path.exists():
+                return pickle.loads(path.read_bytes())
+            value = compute()
+            path.write_bytes(pickle.dumps(value))
+            return value
+
+    return get
+
+
+# The files that take longest, started first, so that test workers finish together (with
+# `--dist loadfile` a file is one unit of work; the longest units first is the classic LPT rule).
+LONGEST_FIRST = ("tests/test_shipped_cells.py", "tests/io/test_hostile.py", "tests/app/test_plan_files.py",
+                 "tests/plan/test_tending_plan.py", "tests/controller_model/test_against_robomax.py",
+                 "tests/plan/test_waiting.py", "tests/app/test_import_hostile.py", "tests/io/test_files.py")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    rank = {name: k for k, name in enumerate(LONGEST_FIRST)}
+    items.sort(key=lambda item: rank.get(item.nodeid.split("::")[0], len(rank)))      # stable: the rest keep order
+
+
 def pytest_addoption(parser: pytest.Parser) -> None:
     parser.addoption("--update-golden", action="store_true", help="rewrite tests/golden/* from current output")
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -62,23 +63,39 @@ class Placed:
 
 
 @pytest.fixture(scope="session")
-def placed(tmp_path_factory: pytest.TempPathFactory, write_process_cell: Callable[..., Path]) -> Placed:
+def placed(tmp_path_factory: pytest.TempPathFactory, write_process_cell: Callable[..., Path],
+           shared_once: SharedOnce) -> Placed:
     """The process cell (robot off the origin, turned, on a tilted riser; tool 2, user frame 3,
-    registers, inputs) planned once, every dialect written."""
+    registers, inputs) planned once per test run, every dialect written."""
     folder = tmp_path_factory.mktemp("placed")
     path = write_process_cell(folder, name="placed")
+    return _planned(path, "placed", tuple(DIALECTS), shared_once)
+
+
+SharedOnce = Callable[[str, Callable[[], Any]], Any]
+
+
+def _planned(path: Path, name: str, dialects: tuple[str, ...], shared_once: SharedOnce) -> Placed:
+    """The cell at `path` planned and published in `dialects` (once per test run: the files are
+    shared between test workers by the cell file's bytes), its files written beside it."""
     cell = load_cell(path)
     robot = load_cell_robot(cell)
-    result = plan_cell(cell, robot)
-    assert result.status == "planned", result.message
-    files, _ = publish(result, cell, robot, tuple(DIALECTS))
-    for name, text in files.items():
-        (folder / name).write_text(text)
-    return Placed(folder, path, cell, robot, files, "placed")
+
+    def compute() -> dict[str, str]:
+        result = plan_cell(cell, robot)
+        assert result.status == "planned", result.message
+        files, _ = publish(result, cell, robot, dialects)
+        return dict(files)
+
+    files: dict[str, str] = shared_once(f"placed|{name}|{dialects}|{path.read_text()}", compute)
+    for file, text in files.items():
+        (path.parent / file).write_text(text)
+    return Placed(path.parent, path, cell, robot, files, name)
 
 
 @pytest.fixture(scope="session")
-def placed_package(tmp_path_factory: pytest.TempPathFactory, write_process_cell: Callable[..., Path]) -> Placed:
+def placed_package(tmp_path_factory: pytest.TempPathFactory, write_process_cell: Callable[..., Path],
+                   shared_once: SharedOnce) -> Placed:
     """The placed process cell with `weld: package`: the welds as the controller's process package
     states them (FANUC SpotTool+ SPOT[]), gun 2, s7 with schedule 4 (0.5 s), s8 with 7 (0.8 s)."""
     import yaml
@@ -88,14 +105,7 @@ def placed_package(tmp_path_factory: pytest.TempPathFactory, write_process_cell:
     data = yaml.safe_load(path.read_text())
     data["robot"]["controller"]["weld"] = "package"
     path.write_text(yaml.safe_dump(data, sort_keys=False))
-    cell = load_cell(path)
-    robot = load_cell_robot(cell)
-    result = plan_cell(cell, robot)
-    assert result.status == "planned", result.message
-    files, _ = publish(result, cell, robot, ("fanuc",))
-    for name, text in files.items():
-        (folder / name).write_text(text)
-    return Placed(folder, path, cell, robot, files, "placed_package")
+    return _planned(path, "placed_package", ("fanuc",), shared_once)
 
 
 def placement_mm_zyx(cell: CellSpec) -> tuple[list[float], list[float]]:
