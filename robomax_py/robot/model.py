@@ -124,10 +124,9 @@ def load_robot(spec: RobotSpec) -> RobotModel:
 
     package_dirs = [str(spec.urdf.parent), *[str(d) for d in spec.package_dirs]]
     warnings: list[str] = list(spec.warnings)
-    collision = _build_geometry(model, spec, pin.GeometryType.COLLISION, package_dirs)
-    _make_meshes_convex(collision, spec)
+    collision = _geometry(model, spec, pin.GeometryType.COLLISION, package_dirs)
     try:
-        visual = _build_geometry(model, spec, pin.GeometryType.VISUAL, package_dirs)
+        visual = _geometry(model, spec, pin.GeometryType.VISUAL, package_dirs)
     except RobotModelError as exc:
         # Visual meshes only serve the preview: plan with the collision meshes shown instead.
         warnings.append(f"{spec.urdf}: visual meshes not loaded ({exc.problem}); the preview shows the collision meshes")
@@ -285,6 +284,43 @@ def _limit_vector(spec: RobotSpec, key: str, given: FloatArray | None, default: 
     if len(given) != n:
         raise RobotModelError(spec.source, f"limits.{key}", f"expected {n} values (one per joint), got {len(given)}")
     return np.asarray(given, dtype=float)
+
+
+# Link geometry already built in this process, by (URDF, package folders, kind): with the state
+# (size, modification time, inode) of the URDF and of every mesh file it read. Loading an arm
+# builds its meshes and their convex hulls (0.3-0.6 s); a batch, a preview that reloads or a
+# sweep of checks loads the same arm again and again. An entry is used only while none of those
+# files has changed, and a copy is handed out (the geometry objects are shared, never modified).
+_GEOMETRY: dict[tuple[str, tuple[str, ...], str], tuple[tuple[tuple[str, int, int, int], ...], pin.GeometryModel]] = {}
+_GEOMETRY_ENTRIES = 8
+
+
+def _file_states(urdf: Path, geom_model: pin.GeometryModel) -> tuple[tuple[str, int, int, int], ...] | None:
+    """(path, size, mtime_ns, inode) of the URDF and of each mesh file the model was built from;
+    None when one cannot be read (then nothing is kept)."""
+    paths = [str(urdf), *sorted({o.meshPath for o in geom_model.geometryObjects if o.meshPath
+                                 and o.meshPath not in ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE")})]
+    try:
+        return tuple((p, (st := Path(p).stat()).st_size, st.st_mtime_ns, st.st_ino) for p in paths)
+    except OSError:
+        return None
+
+
+def _geometry(model: pin.Model, spec: RobotSpec, kind: Any, package_dirs: list[str]) -> pin.GeometryModel:
+    """The links' geometry of `kind` (collision meshes as convex hulls), built or reused."""
+    key = (str(Path(spec.urdf).resolve()), tuple(package_dirs), f"{kind}|{model.njoints}|{model.nframes}")
+    hit = _GEOMETRY.get(key)
+    if hit is not None and _file_states(spec.urdf, hit[1]) == hit[0]:
+        return hit[1].copy()
+    geom_model = _build_geometry(model, spec, kind, package_dirs)
+    if kind == pin.GeometryType.COLLISION:
+        _make_meshes_convex(geom_model, spec)
+    states = _file_states(spec.urdf, geom_model)
+    if states is not None:
+        if len(_GEOMETRY) >= _GEOMETRY_ENTRIES:
+            del _GEOMETRY[next(iter(_GEOMETRY))]
+        _GEOMETRY[key] = (states, geom_model)
+    return geom_model.copy()
 
 
 def _build_geometry(model: pin.Model, spec: RobotSpec, kind: Any, package_dirs: list[str]) -> pin.GeometryModel:
