@@ -44,12 +44,13 @@ def _file(name: str, ext: str) -> str:
 
 
 def _verified(cell: Path) -> tuple[str, ...]:
-    """The files `robomax verify` reads back for a cell: the trajectory file, the SRCL program and one
-    controller dialect, a different one for each shipped cell in turn, so that every dialect is
-    verified from disk through the command line. (`plan` has already proven every program it wrote:
-    read back, rebuilt and verified in-process, before writing.)"""
-    dialects = (".src", ".mod", ".ls", ".script")
-    return ".json", ".srcl", dialects[CELLS.index(cell) % len(dialects)]
+    """The files `robomax verify` reads back for a cell: the trajectory file and one program, a
+    different dialect for each shipped cell in turn (SRCL, KRL, RAPID, FANUC TP, URScript: the
+    seven cells cover each), so that every dialect is verified from disk through the command line.
+    (`plan` has already proven every program it wrote: read back, rebuilt and verified in-process,
+    before writing; and every file is compared with its golden copy below.)"""
+    dialects = (".srcl", ".src", ".mod", ".ls", ".script")
+    return ".json", dialects[CELLS.index(cell) % len(dialects)]
 
 
 def _plan(cell: Path, out: Path) -> dict[str, object]:
