@@ -245,11 +245,36 @@ def _scene_object(obj: ObjectSpec, T_base_world: FloatArray, source: Path, key: 
 
 
 def _mesh_pieces(
-    path: Path, error: type[CellFileError] | type[RobotModelError], file: Path | None, key: str | None
+    path: Path, error: type[CellFileError | RobotModelError], file: Path | None, key: str | None
 ) -> tuple[tuple[coal.CollisionGeometry, ...], str]:
     """Convex pieces if the mesh is a set of closed convex shells, else one exact BVH (see module doc)."""
     if not Path(path).is_file():
         raise error(file, key, f"mesh file not found: {path}")
+    try:
+        st = Path(path).stat()
+        state: tuple[str, int, int, int] | None = (str(Path(path).resolve()), st.st_size, st.st_mtime_ns, st.st_ino)
+    except OSError:
+        state = None
+    if state is not None and state in _MESH_PIECES:
+        return _MESH_PIECES[state]
+    built = _build_mesh_pieces(path, error, file, key)
+    if state is not None:
+        if len(_MESH_PIECES) >= _MESH_ENTRIES:
+            del _MESH_PIECES[next(iter(_MESH_PIECES))]
+        _MESH_PIECES[state] = built
+    return built
+
+
+# A cell's meshes split into pieces, by (path, size, modification time, inode): a plan, its proof
+# and `verify` build the scene several times, and splitting a part mesh takes up to a second. The
+# pieces are shared between scenes and never modified.
+_MESH_PIECES: dict[tuple[str, int, int, int], tuple[tuple[coal.CollisionGeometry, ...], str]] = {}
+_MESH_ENTRIES = 32
+
+
+def _build_mesh_pieces(
+    path: Path, error: type[CellFileError | RobotModelError], file: Path | None, key: str | None
+) -> tuple[tuple[coal.CollisionGeometry, ...], str]:
     try:
         mesh = load_mesh(Path(path))
     except Exception as exc:  # trimesh raises many kinds for unreadable files
