@@ -67,7 +67,7 @@ def write_programs(cell: LoadedCell, result: PlanResult, out_dir: str | Path, fo
     from robomax_py.io.files import commit_set
     from robomax_py.publish import publish
 
-    names = format_names(formats, cell.robot.controller.brand)
+    names = format_names(formats, cell.robot.controller.brand, cell.robot.source)
     files, _ = publish(result, cell.spec, cell.robot, names, stamp=stamp, baseline=result.baseline)
     name = result.cell + ("_baseline" if result.baseline else "")
     return list(commit_set(Path(out_dir), name, files, cell.spec.digest, SHARED_FILES).paths)

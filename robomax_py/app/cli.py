@@ -172,7 +172,7 @@ def plan(
         robot = load_cell_robot(spec)
         _honour_signals()
         _warn(robot.warnings)
-        names = format_names(formats, robot.controller.brand)
+        names = format_names(formats, robot.controller.brand, robot.source)
         set_name = spec.name + ("_baseline" if baseline else "")
         with stage_bars(err, enabled=not verbose) as bars:
             def progress(stage: str, done: int, total: int) -> None:
@@ -560,7 +560,7 @@ def import_urdf_command(
     flange: Annotated[str, typer.Option("--flange", help="URDF frame the tool mounts on")] = "tool0",
     srdf: Annotated[Path | None, typer.Option("--srdf", help="MoveIt SRDF whose disable_collisions are kept")] = None,
     solver: Annotated[str | None, typer.Option("--solver", help="opw | ur | numeric (default: the first that fits)")] = None,
-    brand: Annotated[str | None, typer.Option("--brand", help="kuka | abb | fanuc | ur (default: guessed from the name)")] = None,
+    brand: Annotated[str | None, typer.Option("--brand", help="kuka | abb | fanuc | ur | yaskawa | kawasaki | staubli | comau | nachi (default: guessed from the name)")] = None,
     name: Annotated[str | None, typer.Option("--name", help="robot name (default: the folder name)")] = None,
     force: Annotated[bool, typer.Option("--force", help="replace a folder that exists with other content")] = False,
     xacro_cpu_s: Annotated[float | None, typer.Option("--xacro-cpu-s", min=1, help="CPU seconds the xacro "
@@ -581,8 +581,10 @@ def import_urdf_command(
 
         if solver not in (None, "opw", "ur", "numeric"):
             raise RobotModelError(None, "--solver", f"expected opw, ur or numeric, got {solver!r}")
-        if brand not in (None, "kuka", "abb", "fanuc", "ur"):
-            raise RobotModelError(None, "--brand", f"expected kuka, abb, fanuc or ur, got {brand!r}")
+        from robomax_py.spec import BRANDS
+
+        if brand is not None and brand not in BRANDS:
+            raise RobotModelError(None, "--brand", f"expected one of {', '.join(BRANDS)}, got {brand!r}")
         from robomax_py.safe_files import LIMITS, MB
 
         limits = dataclasses.replace(LIMITS, xacro_cpu_s=xacro_cpu_s or LIMITS.xacro_cpu_s,

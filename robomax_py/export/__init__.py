@@ -2,8 +2,9 @@
 deterministic, fixed float formats), and program files -> what `robomax verify` checks.
 
 `plan_program` turns a plan into the dialect-free `Program` (`planned_program`); each dialect
-module owns its adapter, writer and reader (`srcl`, `krl`, `rapid`, `fanuc`, `urscript`;
-`dialect` holds what they share); `trajectory_json` is the sampled trajectory file (SPEC §5);
+module owns its adapter, writer and reader (`srcl`, `krl`, `rapid`, `fanuc`, `urscript`,
+`inform`, `kawasaki_as`; `dialect` holds what they share), registered as entry points of the group
+`robomax_py.dialects` (`shipped`; other packages add dialects the same way); `trajectory_json` is the sampled trajectory file (SPEC §5);
 `rebuild` turns a parsed program back into motion.
 """
 
@@ -11,8 +12,10 @@ from __future__ import annotations
 
 import dataclasses
 
+from importlib import metadata
+
 from robomax_py.errors import ExportError
-from robomax_py.export import fanuc, krl, rapid, srcl, trajectory_json, urscript
+from robomax_py.export import trajectory_json
 from robomax_py.export.dialect import Dialect
 from robomax_py.export.plan_program import frame_defs, identifier
 from robomax_py.plan import PlanResult
@@ -20,20 +23,41 @@ from robomax_py.plan.program_frames import cell_program_frames
 from robomax_py.program import FrameDef
 from robomax_py.spec import CellSpec
 
-__all__ = ["DIALECTS", "SHARED_FILES", "Dialect", "controller_frames", "dialect_for_file", "format_names", "render_trajectory"]
+__all__ = ["DIALECTS", "ENTRY_POINT_GROUP", "SHARED_FILES", "Dialect", "controller_frames", "dialect_for_file",
+           "format_names", "load_dialects", "native_dialect", "render_trajectory"]
+
+# The entry point group program dialects register under (pyproject.toml): each entry point names a
+# `Dialect` object; its name is the `--format` name.
+ENTRY_POINT_GROUP = "robomax_py.dialects"
+
+
+def load_dialects() -> dict[str, Dialect]:
+    """Every registered dialect by `--format` name: the shipped ones first, in their order (the
+    order files are written in), then the others by name. The shipped dialects come from
+    `export.shipped` when the package's own entry points are not installed; an entry point that
+    does not load, or names something that is not a Dialect of its own name, is an ExportError."""
+    from robomax_py.export.shipped import SHIPPED
+
+    found: dict[str, Dialect] = {d.name: d for d in SHIPPED}
+    shipped = set(found)
+    others: dict[str, Dialect] = {}
+    for ep in metadata.entry_points(group=ENTRY_POINT_GROUP):
+        if ep.name in shipped and ep.value.startswith("robomax_py.export.shipped:"):
+            continue                      # the package's own registration of a shipped dialect
+        try:
+            dialect = ep.load()
+        except Exception as exc:          # a plug-in's import fails in its own way
+            raise ExportError(f"program dialect plug-in {ep.name} ({ep.value}) does not load: {exc}") from None
+        if not isinstance(dialect, Dialect) or dialect.name != ep.name:
+            raise ExportError(f"program dialect plug-in {ep.name} ({ep.value}) is not a Dialect named {ep.name!r}")
+        if ep.name in found or ep.name in others:
+            raise ExportError(f"two program dialects are registered as {ep.name!r}")
+        others[ep.name] = dialect
+    return {**found, **dict(sorted(others.items()))}
+
 
 # Registry order is the order files are written in (after the trajectory file).
-DIALECTS: dict[str, Dialect] = {
-    "srcl": Dialect("srcl", (".srcl",), "", srcl.adapt, srcl.write, srcl.parse),
-    "krl": Dialect("krl", (".src", ".dat"), "kuka", krl.adapt, krl.write, krl.parse, krl.frame_name,
-                   (krl.FRAMES_FILE,), krl.FILE_ENCODING),
-    "rapid": Dialect("rapid", (".mod",), "abb", rapid.adapt, rapid.write, rapid.parse, companions=(rapid.FRAMES_FILE,),
-                     named_frames_only=True),
-    "fanuc": Dialect("fanuc", (".ls",), "fanuc", fanuc.adapt, fanuc.write, fanuc.parse, fanuc.frame_name,
-                     (fanuc.FRAMES_FILE,), program_name=fanuc.program_name,
-                     shared=tuple(f"{name}.ls" for name in fanuc.ROUTINES)),
-    "urscript": Dialect("urscript", (".script",), "ur", urscript.adapt, urscript.write, urscript.parse),
-}
+DIALECTS: dict[str, Dialect] = load_dialects()
 # Whole file names every program of a dialect writes alike (FANUC's routines): not one cell's files.
 SHARED_FILES: frozenset[str] = frozenset(name for d in DIALECTS.values() for name in d.shared)
 
@@ -52,20 +76,28 @@ def controller_frames(dialect: Dialect, cell: CellSpec) -> tuple[FrameDef, ...]:
             named.add(("base", identifier(setup.frame.frame.name)))
         frames = tuple(f for f in frames if (f.kind, f.name) in named)
     return tuple(dataclasses.replace(f, name=dialect.frame_name(f)) for f in frames)
-NATIVE = {"kuka": "krl", "abb": "rapid", "fanuc": "fanuc", "ur": "urscript"}
+def native_dialect(brand: str, dialects: dict[str, Dialect] | None = None) -> str | None:
+    """The `--format` name of a controller brand's own dialect (the first registered for it), or
+    None for a brand robomax has no dialect for."""
+    return next((name for name, d in (dialects or DIALECTS).items() if d.brand and d.brand == brand), None)
 
 
-def format_names(spec: str, brand: str) -> tuple[str, ...]:
+def format_names(spec: str, brand: str, robot_file: object = None) -> tuple[str, ...]:
     """`--format` LIST (SPEC §6): names, `all` or `native` (the robot's brand), comma-separated,
-    in registry order without repeats; ExportError for an unknown name."""
+    in registry order without repeats; ExportError for an unknown name, and for `native` when the
+    robot's brand has no dialect (naming the robot file and its key, never another brand's)."""
     wanted: set[str] = set()
     for part in (p.strip().lower() for p in spec.split(",")):
         if part == "all":
             wanted.update(DIALECTS)
         elif part == "native":
-            if brand not in NATIVE:
-                raise ExportError("--format native: the robot names no controller brand (controller.brand in robot.yaml)")
-            wanted.add(NATIVE[brand])
+            native = native_dialect(brand)
+            if native is None:
+                where = f"{robot_file}: " if robot_file else ""
+                having = ", ".join(sorted({d.brand for d in DIALECTS.values() if d.brand}))
+                raise ExportError(f"--format native: {where}controller.brand: robomax writes no program for "
+                                  f"brand {brand!r} (native programs for {having}); name a format instead")
+            wanted.add(native)
         elif part in DIALECTS:
             wanted.add(part)
         else:

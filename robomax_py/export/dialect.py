@@ -115,6 +115,8 @@ class Dialect:
     program_name: Callable[[str], str] | None = None
     # Whole file names every program of the dialect writes alike (FANUC's default routines).
     shared: tuple[str, ...] = ()
+    # Each of its extensions names a whole program of its own (AS's `.as` and `.pg`), read as the first.
+    any_extension: bool = False
 
 
 def with_frame_names(program: Program, name_of: Callable[[FrameDef], str]) -> Program:

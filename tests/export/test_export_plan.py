@@ -9,13 +9,14 @@ from typing import Any
 
 import pytest
 
-from robomax_py.export import DIALECTS
+from robomax_py.export import DIALECTS, SHARED_FILES
 from robomax_py.export.plan_program import identifier, program_from_plan
 from robomax_py.export.srcl import parse_program, write_program
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import plan_cell
 from robomax_py.program import Spot, WaitFor
 from robomax_py.publish import publish
+from tests.conftest import with_pulses
 
 REPO = Path(__file__).resolve().parents[2]
 GOLDEN = REPO / "tests" / "golden"
@@ -24,7 +25,7 @@ ALL = tuple(DIALECTS)
 
 def _planned(path: Path) -> dict[str, Any]:
     cell = load_cell(path)
-    robot = load_cell_robot(cell)
+    robot = with_pulses(load_cell_robot(cell))        # INFORM counts joint positions in pulses
     result = plan_cell(cell, robot)
     assert result.status == "planned", result.message
     files, checked = publish(result, cell, robot, ALL)

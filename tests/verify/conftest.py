@@ -17,8 +17,10 @@ from robomax_py.publish import publish
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.verify import VerifyReport, verify_program
+from tests.conftest import with_pulses
 
-MAIN = {"krl": ".src", "rapid": ".mod", "fanuc": ".ls", "urscript": ".script", "srcl": ".srcl"}
+MAIN = {"krl": ".src", "rapid": ".mod", "fanuc": ".ls", "urscript": ".script", "srcl": ".srcl", "inform": ".jbi",
+        "as": ".as"}
 Edit = Callable[[str], str]
 
 
@@ -68,7 +70,7 @@ def placed(tmp_path_factory: pytest.TempPathFactory, write_process_cell: Callabl
     folder = tmp_path_factory.mktemp("placed")
     path = write_process_cell(folder, name="placed")
     cell = load_cell(path)
-    robot = load_cell_robot(cell)
+    robot = with_pulses(load_cell_robot(cell))          # INFORM counts joint positions in pulses
     result = plan_cell(cell, robot)
     assert result.status == "planned", result.message
     files, _ = publish(result, cell, robot, tuple(DIALECTS))
