@@ -11,7 +11,6 @@ module owns its adapter, writer and reader (`srcl`, `krl`, `rapid`, `fanuc`, `ur
 from __future__ import annotations
 
 import dataclasses
-
 from importlib import metadata
 
 from robomax_py.errors import ExportError
@@ -46,7 +45,7 @@ def load_dialects() -> dict[str, Dialect]:
             continue                      # the package's own registration of a shipped dialect
         try:
             dialect = ep.load()
-        except Exception as exc:          # a plug-in's import fails in its own way
+        except Exception as exc:  # noqa: BLE001 - a plug-in's import fails in its own way
             raise ExportError(f"program dialect plug-in {ep.name} ({ep.value}) does not load: {exc}") from None
         if not isinstance(dialect, Dialect) or dialect.name != ep.name:
             raise ExportError(f"program dialect plug-in {ep.name} ({ep.value}) is not a Dialect named {ep.name!r}")

@@ -126,7 +126,7 @@ def _pulses(robot: RobotModel) -> tuple[float, ...]:
 
 
 def _to_pulses(q_deg: tuple[float, ...], ppd: tuple[float, ...]) -> tuple[int, ...]:
-    return tuple(int(round(v * k)) for v, k in zip(q_deg, ppd))
+    return tuple(round(v * k) for v, k in zip(q_deg, ppd))
 
 
 def _from_pulses(pulses: tuple[int, ...], ppd: tuple[float, ...]) -> tuple[float, ...]:
@@ -206,8 +206,8 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                         pos.append(f"///USER {user}")
                     pos += [f"///TOOL {tool}", f"///POSTYPE {'USER' if user else 'BASE'}", "///RECTAN",
                             f"///RCONF {ins.config}"]
-                a, b, c = ins.zyx_deg
-                values = [*(_num(v, 3) for v in ins.position_mm), *(_num(v, ANGLE_DECIMALS) for v in (c, b, a))]
+                rz, ry, rx = ins.zyx_deg
+                values = [*(_num(v, 3) for v in ins.position_mm), *(_num(v, ANGLE_DECIMALS) for v in (rx, ry, rz))]
                 pos.append(f"C{k:05d}=" + ",".join(values))
                 inst.append(f"MOVL C{k:05d} V={_num(ins.speed_mm_s, 1)}{end}")
             state = head

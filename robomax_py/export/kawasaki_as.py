@@ -222,8 +222,8 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
             raise ExportError(f"AS cannot write {type(ins).__name__}")
     lines = [f".PROGRAM {program.name}()", *(f"  {b}" for b in body), ".END"]
     for routine in ("spot_weld", *sorted(k for k in calls if k != "spot_weld")):
-        lines += [f".PROGRAM {routine}(n,t)", f"  ; default {routine.replace('_', ' ')}: rests t s, for the "
-                  "integrator to replace", "  TWAIT t", ".END"]
+        note = f"  ; default {routine.replace('_', ' ')}: rests t s, for the integrator to replace"
+        lines += [f".PROGRAM {routine}(n,t)", note, "  TWAIT t", ".END"]
     return {EXT: "\r\n".join(lines) + "\r\n"}
 
 
@@ -343,9 +343,8 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             if (sp.group(2) or "").upper() == "S":
                 not_simulated(number, stmt, " (a motion stated by its time)")
                 continue
-            value = float(sp.group(1)) / (60.0 if unit == "mm/min" else 1.0)
-            key = "%" if unit == "%" else "mm/s"
-            (always if sp.group(3) else speed)[key] = value
+            per_s = float(sp.group(1)) / (60.0 if unit == "mm/min" else 1.0)
+            (always if sp.group(3) else speed)["%" if unit == "%" else "mm/s"] = per_s
             continue
         acc = _ACCURACY.match(stmt)
         if acc:

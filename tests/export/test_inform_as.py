@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-import robomax_py.export as export
+from robomax_py import export
 from robomax_py.errors import ExportError
 from robomax_py.export import inform, kawasaki_as
 from robomax_py.export.dialect import Dialect

@@ -9,7 +9,6 @@ import math
 import re
 
 import pytest
-
 from conftest import Edit, Placed, placement_mm_zyx
 
 

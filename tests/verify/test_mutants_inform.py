@@ -8,7 +8,6 @@ from __future__ import annotations
 import re
 
 import pytest
-
 from conftest import Edit, Placed
 
 
@@ -21,14 +20,14 @@ def _rx_rz_swapped(placed: Placed) -> dict[str, Edit]:
         v = m[2].split(",")
         return m[1] + ",".join([*v[:3], v[5], v[4], v[3]])
     return {".jbi": lambda t: re.sub(r"^(C\d{5}=)((?:-?[\d.]+,){5}-?[\d.]+)(?=\r?$)",
-                                     lambda m: swap(m) if "." in m[2] else m[0], t, flags=re.M)}
+                                     lambda m: swap(m) if "." in m[2] else m[0], t, flags=re.MULTILINE)}
 
 
 def _pulses_as_degrees(placed: Placed) -> dict[str, Edit]:
     ppd = placed.robot.controller.pulses_per_degree
     return {".jbi": lambda t: re.sub(r"^(C\d{5}=)((?:-?\d+,){5}-?\d+)(?=\r?$)",
                                      lambda m: m[1] + ",".join(str(round(int(p) / k)) for p, k in zip(m[2].split(","), ppd)),
-                                     t, flags=re.M)}
+                                     t, flags=re.MULTILINE)}
 
 
 def _front_rear_flipped(placed: Placed) -> dict[str, Edit]:
