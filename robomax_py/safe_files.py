@@ -32,6 +32,10 @@ class FileLimits:
     urdf: int = 20 * MB
     mesh: int = 200 * MB
     program: int = 50 * MB
+    # Lines of one program file: the readers parse about 5,000 statements a CPU second, so this
+    # bounds a read to about ten seconds; plans write about 15 lines a spot (a 240-spot cell about
+    # 4,000 lines).
+    program_lines: int = 50_000
     path_chars: int = 4096             # PATH_MAX on Linux
     name_chars: int = 255              # NAME_MAX: one path component
     yaml_nodes: int = 1_000_000        # after expanding aliases
@@ -92,9 +96,10 @@ def checked_file(path: Path, limit: int, error: ErrorFactory, what: str, key: st
 
 
 def read_text(path: Path, limit: int, error: ErrorFactory, what: str, key: str | None = None,
-              fallback: str = "") -> str:
+              fallback: str = "", max_lines: int | None = None) -> str:
     """The UTF-8 text of a checked file (`checked_file`); a BOM is dropped. fallback: the encoding
-    to read a file in that is not UTF-8 (KRL files are Windows-1252 when written on the controller)."""
+    to read a file in that is not UTF-8 (KRL files are Windows-1252 when written on the controller).
+    max_lines: refuse a file of more lines (before any parsing)."""
     safe = checked_file(path, limit, error, what, key)
     try:
         data = safe.read_bytes()
@@ -102,6 +107,8 @@ def read_text(path: Path, limit: int, error: ErrorFactory, what: str, key: str |
         raise error(path, key, f"cannot read {what}: {exc.strerror or exc}") from None
     if len(data) > limit:      # grew since the check
         raise error(path, key, f"{what}: more than the {limit / MB:.0f} MB allowed")
+    if max_lines is not None and (lines := data.count(b"\n") + 1) > max_lines:
+        raise error(path, key, f"{what}: {lines} lines is more than the {max_lines} allowed")
     try:
         return data.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError as exc:

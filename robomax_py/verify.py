@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
@@ -119,7 +120,7 @@ def _read_program(robot: RobotModel, path: Path) -> tuple[Any, Path, Any, tuple[
         sibling = path.with_suffix(ext) if suffix != ext else path
         if sibling == path or sibling.exists():
             texts[ext] = read_text(sibling, LIMITS.program, ProgramError, "program file",
-                                   fallback=dialect.fallback_encoding)
+                                   fallback=dialect.fallback_encoding, max_lines=LIMITS.program_lines)
             read.append(sibling)
     main = path.with_suffix(dialect.extensions[0])
     if dialect.extensions[0] not in texts:
@@ -130,7 +131,7 @@ def _read_program(robot: RobotModel, path: Path) -> tuple[Any, Path, Any, tuple[
         companion = _beside(main, main.stem + key)
         if companion is not None:
             texts[key] = read_text(companion, LIMITS.program, ProgramError, "program file",
-                                   fallback=dialect.fallback_encoding)
+                                   fallback=dialect.fallback_encoding, max_lines=LIMITS.program_lines)
             read.append(companion)
     for name in dialect.shared:
         # The dialect's routines every program calls alike (FANUC's SPOT_WELD.ls): the reader
@@ -138,7 +139,7 @@ def _read_program(robot: RobotModel, path: Path) -> tuple[Any, Path, Any, tuple[
         routine = _beside(main, name)
         if routine is not None:
             texts[name] = read_text(routine, LIMITS.program, ProgramError, "program file",
-                                    fallback=dialect.fallback_encoding)
+                                    fallback=dialect.fallback_encoding, max_lines=LIMITS.program_lines)
     return dialect, main, dialect.parse(texts, str(main), robot), tuple(read)
 
 
@@ -305,7 +306,7 @@ def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> lis
     for seam in cell.seams:
         if seam.ordered:
             times = [seen[(seam.name, s.name)] for s in seam.spots if (seam.name, s.name) in seen]
-            if any(b < a for a, b in zip(times[:-1], times[1:])):
+            if any(b < a for a, b in pairwise(times)):
                 out.append(Violation(None, "order", f"seam {seam.name} is ordered but welded out of order"))
     return out
 

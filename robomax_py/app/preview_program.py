@@ -147,7 +147,8 @@ def _load_srcl(path: Path, cell: CellSpec, robot: RobotModel) -> ShownProgram:
     from robomax_py.export.rebuild import rebuild
     from robomax_py.export.srcl import parse_program
 
-    program = parse_program(read_text(path, LIMITS.program, ProgramError, "program file"), path)
+    program = parse_program(read_text(path, LIMITS.program, ProgramError, "program file",
+                                      max_lines=LIMITS.program_lines), path)
     if program.header.cell != cell.name:
         raise ProgramError(path, "CELL", f"program is for cell {program.header.cell!r}, not {cell.name!r}")
     rebuilt = rebuild(program, cell, robot, path)

@@ -43,6 +43,7 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.robot import RobotModel
+from robomax_py.world.acm_cache import SampledPairs, cached_self_analysis
 from robomax_py.world.bounds import KinematicBounds, joint_path, support_points
 from robomax_py.world.prefilter import Prefilter
 from robomax_py.world.scene import Scene, SceneObject
@@ -232,13 +233,19 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
     disabled, obstacle_pairs, self_candidates = rules.disabled, rules.obstacle_pairs, rules.self_candidates
     flange_candidates, base_obstacle = rules.flange_candidates, rules.base_obstacle
 
-    bounds = KinematicBounds.of(model)
     provable = {
         (a, b) for a, b in self_candidates
         if 0 < len(joint_path(model, pieces[a].joint, pieces[b].joint) or ()) <= options.acm_proof_joints
     }
-    sampled = _sample_self_pairs(robot, gm, self_candidates, provable, flange_candidates, options)
-    proved_far = _prove_never_close(robot, gm, bounds, sorted(sampled.never_near), options)
+    n_self = sum(1 for p in pieces if p.kind in ROBOT_KINDS)
+    bounds = KinematicBounds.of(model)
+
+    def analyse() -> tuple[SampledPairs, set[tuple[int, int]]]:
+        sampled = _sample_self_pairs(robot, gm, self_candidates, provable, flange_candidates, options)
+        return sampled, _prove_never_close(robot, gm, bounds, sorted(sampled.never_near), options)
+
+    sampled, proved_far = cached_self_analysis(
+        robot, gm, n_self, (self_candidates, sorted(provable), sorted(flange_candidates)), options, analyse)
     self_pairs: list[tuple[int, int]] = []
     for pair in self_candidates:
         a, b = pair
@@ -369,11 +376,7 @@ def acm_samples(robot: RobotModel, count: int, seed: int) -> FloatArray:
     return np.asarray(qs, dtype=float)
 
 
-@dataclass(frozen=True, slots=True)
-class _SampledPairs:
-    never_near: frozenset[tuple[int, int]]     # never within acm_margin in any sample
-    flange_touch: frozenset[tuple[int, int]]   # flange pairs within flange_contact_m in every sample
-    always_touch: frozenset[tuple[int, int]]   # touching (margin 0) in every sample
+
 
 
 def _sample_self_pairs(
@@ -383,13 +386,13 @@ def _sample_self_pairs(
     provable: set[tuple[int, int]],
     flange_candidates: set[tuple[int, int]],
     options: CollisionOptions,
-) -> _SampledPairs:
+) -> SampledPairs:
     """Run the seeded ACM samples over the candidate self pairs (decided pairs drop out early).
 
     Only `provable` pairs are tested against `acm_margin` (the others can never be disabled).
     """
     if not candidates:
-        return _SampledPairs(frozenset(), frozenset(), frozenset())
+        return SampledPairs(frozenset(), frozenset(), frozenset())
     tmp = pin.GeometryModel()
     for g in gm.geometryObjects:
         tmp.addGeometryObject(pin.GeometryObject(g))
@@ -423,7 +426,7 @@ def _sample_self_pairs(
             for p in decided:
                 undecided.discard(p)
                 gd.deactivateCollisionPair(p)
-    return _SampledPairs(
+    return SampledPairs(
         never_near=frozenset(candidates[p] for p in undecided_near),
         flange_touch=frozenset(candidates[p] for p in undecided_flange),
         always_touch=frozenset(candidates[p] for p in undecided_touch),

@@ -36,7 +36,10 @@ from robomax_py.app.cli import app
 REPO = Path(__file__).resolve().parents[2]
 CELLS = sorted((REPO / "cells").glob("*.yaml"))
 ROBOTS = REPO / "robomax_py" / "robots"
-SECONDS_PER_FILE = 30.0          # a refusal takes well under a second; a full check a few seconds
+CPU_S_PER_FILE = 30.0            # a refusal takes well under a CPU second; a full check a few
+# A run blocked without using CPU (a read from a FIFO) is caught by a wall-clock guard far above any
+# run's time on a loaded machine: it stops a hang, it does not judge speed.
+HANG_GUARD_S = 600.0
 PEAK_RSS_MB = 3000               # the whole test process, after every mutant
 runner = CliRunner()
 
@@ -53,17 +56,23 @@ class Hang(Exception):
 
 
 @contextmanager
-def _deadline(seconds: float) -> Iterator[None]:
-    def alarm(signum: int, frame: Any) -> None:
-        raise Hang(f"still running after {seconds} s")
+def _bounded(cpu_s: float, guard_s: float = HANG_GUARD_S) -> Iterator[None]:
+    """Hang raised once the process has used `cpu_s` CPU seconds (user + system, ITIMER_PROF: the
+    same on a loaded machine as on a quiet one), or after `guard_s` seconds of blocking."""
+    def stop(signum: int, frame: Any) -> None:
+        what = f"{cpu_s} CPU s" if signum == signal.SIGPROF else f"{guard_s} s without ending"
+        raise Hang(f"still running after {what}")
 
-    old = signal.signal(signal.SIGALRM, alarm)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
+    old = {s: signal.signal(s, stop) for s in (signal.SIGPROF, signal.SIGALRM)}
+    signal.setitimer(signal.ITIMER_PROF, cpu_s)
+    signal.setitimer(signal.ITIMER_REAL, guard_s)
     try:
         yield
     finally:
+        signal.setitimer(signal.ITIMER_PROF, 0)
         signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
+        for s, handler in old.items():
+            signal.signal(s, handler)
 
 
 def _base(cell: Path) -> dict[str, Any]:
@@ -368,11 +377,12 @@ def _files(folder: Path) -> set[str]:
 
 
 def _run(command: list[str], folder: Path) -> tuple[int, str, float]:
-    """Exit code, output and seconds of one in-process run; AssertionError on a traceback or a hang."""
-    t0 = time.perf_counter()
-    with _deadline(SECONDS_PER_FILE):
+    """Exit code, output and CPU seconds of one in-process run; AssertionError on a traceback, Hang
+    past the CPU bound."""
+    t0 = time.process_time()
+    with _bounded(CPU_S_PER_FILE):
         result = runner.invoke(app, command)
-    seconds = time.perf_counter() - t0
+    seconds = time.process_time() - t0
     if result.exception is not None and not isinstance(result.exception, SystemExit):
         raise AssertionError(f"traceback: {type(result.exception).__name__}: {result.exception}\n{result.output}")
     return result.exit_code, result.output, seconds
@@ -426,8 +436,8 @@ def test_every_mutant_is_refused_cleanly_by_check(tmp_path: Path, chunk: int) ->
             failures.append(f"{m.name}: peak memory {rss_mb:.0f} MB")
             break
         shutil.rmtree(folder, ignore_errors=True)
-    print(f"\nmutants by exit code: {dict(codes)}; slowest {slowest[0]:.2f} s ({slowest[1]}); slowest refusal "
-          f"{slowest_refusal[0]:.2f} s ({slowest_refusal[1]}); "
+    print(f"\nmutants by exit code: {dict(codes)}; slowest {slowest[0]:.2f} CPU s ({slowest[1]}); slowest refusal "
+          f"{slowest_refusal[0]:.2f} CPU s ({slowest_refusal[1]}); "
           f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB")
     assert not failures, f"{len(failures)} failures:\n" + "\n".join(failures[:20])
 
@@ -582,7 +592,7 @@ def test_broken_controller_programs_are_refused_cleanly_by_verify(tmp_path: Path
                 (folder / _golden_name(ext)).write_bytes((GOLDEN / "small_cell" / _golden_name(ext)).read_bytes())
         (folder / _golden_name(suffix)).write_bytes(content)
         try:
-            with _deadline(60):
+            with _bounded(60.0):
                 report = verify_program(cell, robot, folder / _golden_name(main))
             outcomes["clean" if report.clean else "violations"] += 1
         except RobomaxError as exc:
