@@ -20,10 +20,12 @@ from robomax_py.export.plan_program import frame_defs, identifier
 from robomax_py.plan import PlanResult
 from robomax_py.plan.program_frames import cell_program_frames
 from robomax_py.program import FrameDef
+from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 
-__all__ = ["DIALECTS", "ENTRY_POINT_GROUP", "SHARED_FILES", "Dialect", "controller_frames", "dialect_for_file",
-           "format_names", "load_dialects", "native_dialect", "render_trajectory"]
+__all__ = ["DIALECTS", "ENTRY_POINT_GROUP", "SHARED_FILES", "Dialect", "FormatChoice", "SkippedFormat",
+           "choose_formats", "controller_frames", "dialect_for_file", "format_names", "load_dialects", "native_dialect",
+           "render_trajectory", "require_calibration"]
 
 # The entry point group program dialects register under (pyproject.toml): each entry point names a
 # `Dialect` object; its name is the `--format` name.
@@ -81,14 +83,13 @@ def native_dialect(brand: str, dialects: dict[str, Dialect] | None = None) -> st
     return next((name for name, d in (dialects or DIALECTS).items() if d.brand and d.brand == brand), None)
 
 
-def format_names(spec: str, brand: str, robot_file: object = None) -> tuple[str, ...]:
-    """`--format` LIST (SPEC §6): names, `all` or `native` (the robot's brand), comma-separated,
-    in registry order without repeats; ExportError for an unknown name, and for `native` when the
-    robot's brand has no dialect (naming the robot file and its key, never another brand's)."""
-    wanted: set[str] = set()
+def _requested(spec: str, brand: str, robot_file: object) -> tuple[set[str], set[str]]:
+    """The dialects `--format` names one by one (a name, `native`) and those it takes in with `all`."""
+    named: set[str] = set()
+    every: set[str] = set()
     for part in (p.strip().lower() for p in spec.split(",")):
         if part == "all":
-            wanted.update(DIALECTS)
+            every.update(DIALECTS)
         elif part == "native":
             native = native_dialect(brand)
             if native is None:
@@ -96,15 +97,76 @@ def format_names(spec: str, brand: str, robot_file: object = None) -> tuple[str,
                 having = ", ".join(sorted({d.brand for d in DIALECTS.values() if d.brand}))
                 raise ExportError(f"--format native: {where}controller.brand: robomax writes no program for "
                                   f"brand {brand!r} (native programs for {having}); name a format instead")
-            wanted.add(native)
+            named.add(native)
         elif part in DIALECTS:
-            wanted.add(part)
+            named.add(part)
         else:
             known = ", ".join([*DIALECTS, "native", "all"])
             raise ExportError(f"unknown program format '{part}'; known: {known}")
-    if not wanted:
+    if not named and not every:
         raise ExportError("--format names no program format")
-    return tuple(name for name in DIALECTS if name in wanted)
+    return named, every
+
+
+def format_names(spec: str, brand: str, robot_file: object = None) -> tuple[str, ...]:
+    """`--format` LIST (SPEC §6): names, `all` or `native` (the robot's brand), comma-separated,
+    in registry order without repeats; ExportError for an unknown name, and for `native` when the
+    robot's brand has no dialect (naming the robot file and its key, never another brand's).
+    What the robot lacks for a dialect is not looked at here (`choose_formats`)."""
+    named, every = _requested(spec, brand, robot_file)
+    return tuple(name for name in DIALECTS if name in named | every)
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class SkippedFormat:
+    """A dialect `--format all` passes over: the robot file does not state `key`, which it needs."""
+
+    format: str
+    robot_file: str
+    key: str
+    why: str
+
+    @property
+    def message(self) -> str:
+        return (f"{self.robot_file}: {self.key} is not given: no {self.format} program written ({self.why}); "
+                f"state it to have one")
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class FormatChoice:
+    """The dialects to write for a robot, in registry order, and those `all` passed over."""
+
+    names: tuple[str, ...]
+    skipped: tuple[SkippedFormat, ...] = ()
+
+
+def require_calibration(fmt: str, robot: RobotModel) -> None:
+    """ExportError naming the robot file and the key when `robot` lacks what dialect `fmt` needs."""
+    lacking = DIALECTS[fmt].needs(robot)
+    if lacking:
+        key, why = lacking[0]
+        raise ExportError(f"--format {fmt}: {robot.source}: {key} is not given for {robot.name}: {why}")
+
+
+def choose_formats(spec: str, robot: RobotModel) -> FormatChoice:
+    """`--format` LIST for `robot` (`format_names`): a dialect named (or `native`) that needs data
+    the robot file lacks is an ExportError naming the file and the key (checked before anything is
+    planned or written); `all` means every dialect the robot can be written in, the others skipped
+    with the reason (`FormatChoice.skipped`), so that a whole set never fails for a missing calibration."""
+    named, every = _requested(spec, robot.controller.brand, robot.source)
+    names: list[str] = []
+    skipped: list[SkippedFormat] = []
+    for name in DIALECTS:
+        if name in named:
+            require_calibration(name, robot)
+            names.append(name)
+        elif name in every:
+            lacking = DIALECTS[name].needs(robot)
+            if lacking:
+                skipped.extend(SkippedFormat(name, str(robot.source), key, why) for key, why in lacking)
+            else:
+                names.append(name)
+    return FormatChoice(tuple(names), tuple(skipped))
 
 
 def dialect_for_file(suffix: str) -> Dialect | None:

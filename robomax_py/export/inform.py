@@ -84,7 +84,7 @@ from robomax_py.program import (
 )
 from robomax_py.robot import RobotModel
 
-__all__ = ["ROUTINES", "adapt", "frame_name", "parse", "program_name", "write"]
+__all__ = ["ROUTINES", "adapt", "frame_name", "needs", "parse", "program_name", "write"]
 
 NAME_CHARS = 32              # a job name (DX100; the NX100 took 8)
 TOOL_SLOTS, USER_SLOTS = 23, 23       # ///TOOL 0..23, ///USER 0..23 (NX100 §4.1.3)
@@ -117,11 +117,19 @@ def _number(name: str) -> int:
     return int(match.group(1)) if match else 0
 
 
+PULSES_KEY = "controller.pulses_per_degree"
+PULSES_WHY = "INFORM joint positions count encoder pulses (the controller's pulse/degree parameters, 6 axes)"
+
+
+def needs(robot: RobotModel) -> tuple[tuple[str, str], ...]:
+    """What robot.yaml must state for a job and `robot` does not: its encoder pulses per degree."""
+    return () if len(robot.controller.pulses_per_degree) == 6 else ((PULSES_KEY, PULSES_WHY),)
+
+
 def _pulses(robot: RobotModel) -> tuple[float, ...]:
     ppd = robot.controller.pulses_per_degree
     if len(ppd) != 6:
-        raise ExportError(f"INFORM joint positions count encoder pulses: {robot.source}: controller.pulses_per_degree "
-                          f"is not given for {robot.name} (the controller's pulse/degree parameters, 6 axes)")
+        raise ExportError(f"--format inform: {robot.source}: {PULSES_KEY} is not given for {robot.name}: {PULSES_WHY}")
     return ppd
 
 

@@ -5,6 +5,7 @@ plug-ins, and the brands without a dialect."""
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -167,3 +168,41 @@ def test_inform_without_pulses_says_what_is_missing(robot6) -> None:  # type: ig
     with pytest.raises(ExportError, match="controller.pulses_per_degree"):
         inform._pulses(bare)
     assert math.isfinite(sum(robot6.controller.pulses_per_degree))
+
+
+def test_all_passes_over_inform_for_an_arm_without_pulse_counts(robot6) -> None:  # type: ignore[no-untyped-def]
+    """`all` is every dialect the robot file has the data for: INFORM without pulse counts is
+    skipped, naming the robot file, the key and the dialect; named, it is refused before anything
+    is planned, with the same file and key; with the counts it is written like the others."""
+    import dataclasses
+
+    bare = dataclasses.replace(robot6, controller=dataclasses.replace(robot6.controller, pulses_per_degree=()))
+    chosen = export.choose_formats("all", bare)
+    assert chosen.names == ("srcl", "krl", "rapid", "fanuc", "urscript", "as")
+    assert [(k.format, k.robot_file, k.key) for k in chosen.skipped] == [
+        ("inform", str(bare.source), "controller.pulses_per_degree")]
+    message = chosen.skipped[0].message
+    assert str(bare.source) in message and "controller.pulses_per_degree" in message and "inform" in message
+    assert export.choose_formats("all,krl", bare).names == chosen.names
+    for spec in ("inform", "srcl,inform", "all,inform"):
+        with pytest.raises(ExportError, match=rf"--format inform: {re.escape(str(bare.source))}: "
+                                              r"controller.pulses_per_degree is not given"):
+            export.choose_formats(spec, bare)
+    yaskawa = dataclasses.replace(bare, controller=dataclasses.replace(bare.controller, brand="yaskawa"))
+    with pytest.raises(ExportError, match="controller.pulses_per_degree"):
+        export.choose_formats("native", yaskawa)
+    full = export.choose_formats("all", robot6)
+    assert full.names == tuple(export.DIALECTS) and full.skipped == ()
+    assert export.choose_formats("srcl", bare) == export.FormatChoice(("srcl",))
+
+
+def test_publish_refuses_inform_without_pulse_counts_before_proving_any(robot6) -> None:  # type: ignore[no-untyped-def]
+    """publish checks every format's calibration first: no dialect is proven for a set that cannot
+    be whole (the plan is not even looked at)."""
+    import dataclasses
+
+    from robomax_py.publish import publish
+
+    bare = dataclasses.replace(robot6, controller=dataclasses.replace(robot6.controller, pulses_per_degree=()))
+    with pytest.raises(ExportError, match="controller.pulses_per_degree"):
+        publish(None, None, bare, ("srcl", "inform"))  # type: ignore[arg-type]
