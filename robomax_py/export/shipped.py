@@ -22,7 +22,7 @@ FANUC = Dialect("fanuc", (".ls",), "fanuc", fanuc.adapt, fanuc.write, fanuc.pars
                 shared=tuple(f"{name}.ls" for name in fanuc.ROUTINES))
 URSCRIPT = Dialect("urscript", (".script",), "ur", urscript.adapt, urscript.write, urscript.parse)
 INFORM = Dialect("inform", (".jbi",), "yaskawa", inform.adapt, inform.write, inform.parse, inform.frame_name,
-                 program_name=inform.program_name, shared=tuple(f"{name}.JBI" for name in inform.ROUTINES),
+                 program_name=inform.program_name, shared=tuple(f"{name}{inform.EXT}" for name in inform.ROUTINES),
                  needs=inform.needs)
 AS = Dialect("as", (".as", ".pg"), "kawasaki", kawasaki_as.adapt, kawasaki_as.write, kawasaki_as.parse,
              kawasaki_as.frame_name, any_extension=True)
