@@ -26,7 +26,12 @@ from robomax_py.errors import (
     ExportError,
     ProgramError,
 )
-from robomax_py.export import DIALECTS, controller_frames, render_trajectory, require_calibration
+from robomax_py.export import (
+    DIALECTS,
+    controller_frames,
+    render_trajectory,
+    require_calibration,
+)
 from robomax_py.export.dialect import Parsed, PlannedProgram
 from robomax_py.export.plan_program import planned_program
 from robomax_py.export.rebuild import rebuild

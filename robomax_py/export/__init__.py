@@ -156,12 +156,12 @@ def choose_formats(spec: str, robot: RobotModel) -> FormatChoice:
     named, every = _requested(spec, robot.controller.brand, robot.source)
     names: list[str] = []
     skipped: list[SkippedFormat] = []
-    for name in DIALECTS:
+    for name, dialect in DIALECTS.items():
         if name in named:
             require_calibration(name, robot)
             names.append(name)
         elif name in every:
-            lacking = DIALECTS[name].needs(robot)
+            lacking = dialect.needs(robot)
             if lacking:
                 skipped.extend(SkippedFormat(name, str(robot.source), key, why) for key, why in lacking)
             else:
