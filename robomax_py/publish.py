@@ -26,7 +26,12 @@ from robomax_py.errors import (
     ExportError,
     ProgramError,
 )
-from robomax_py.export import DIALECTS, controller_frames, render_trajectory
+from robomax_py.export import (
+    DIALECTS,
+    controller_frames,
+    render_trajectory,
+    require_calibration,
+)
 from robomax_py.export.dialect import Parsed, PlannedProgram
 from robomax_py.export.plan_program import planned_program
 from robomax_py.export.rebuild import rebuild
@@ -92,6 +97,8 @@ def publish(result: PlanResult, cell: CellSpec, robot: RobotModel, formats: tupl
     baseline : name the files `<cell>_baseline.*`, so that a baseline run never replaces the
         optimised program.
     """
+    for fmt in formats:                          # before any dialect is proven: one clear message
+        require_calibration(fmt, robot)
     name = result.cell + ("_baseline" if baseline else "")
     files = {f"{name}.json": render_trajectory(result)}
     planned = planned_program(result, cell.digest, stamp)

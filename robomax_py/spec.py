@@ -22,7 +22,10 @@ def frozen_array(values: Any) -> FloatArray:
     return arr
 
 
-Brand = Literal["kuka", "abb", "fanuc", "ur"]
+Brand = Literal["kuka", "abb", "fanuc", "ur", "yaskawa", "kawasaki", "staubli", "comau", "nachi"]
+# Every controller brand robot.yaml may name (SPEC §6); a brand whose dialect robomax lacks
+# (Stäubli VAL 3, Comau PDL2, Nachi FD) gets no native program.
+BRANDS: tuple[str, ...] = ("kuka", "abb", "fanuc", "ur", "yaskawa", "kawasaki", "staubli", "comau", "nachi")
 
 
 # The input a program waits for before moving through a dynamic object's space: `<name>_open` for a
@@ -47,6 +50,8 @@ class ControllerSpec:
     brand: Brand = "kuka"
     j23_coupling: bool = False        # FANUC: J3 as the controller counts it = J3 - J2 of the URDF
     T_root_base: FloatArray = field(default_factory=_identity)   # (4, 4) controller base in the URDF root
+    # Yaskawa: encoder pulses per degree of each axis, as INFORM counts joint positions; () unknown.
+    pulses_per_degree: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True, slots=True, eq=False)

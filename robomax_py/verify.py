@@ -112,6 +112,10 @@ def _read_program(robot: RobotModel, path: Path) -> tuple[Any, Path, Any, tuple[
         raise ProgramError(path, None, f"expected a trajectory file (.json) or a program ({known})")
     texts = {}
     read = []
+    if dialect.any_extension:
+        texts[dialect.extensions[0]] = read_text(path, LIMITS.program, ProgramError, "program file",
+                                                 fallback=dialect.fallback_encoding)
+        return dialect, path, dialect.parse(texts, str(path), robot), (path,)
     for ext in dialect.extensions:
         sibling = path.with_suffix(ext) if suffix != ext else path
         if sibling == path or sibling.exists():

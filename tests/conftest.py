@@ -202,3 +202,17 @@ def reference_cell_path() -> Path:
     if not REFERENCE_CELL.is_file():
         pytest.skip(f"reference cell not found at {REFERENCE_CELL} (shared/ must sit beside the clone)")
     return REFERENCE_CELL
+
+
+# Encoder pulses per degree stated for the test arms (KUKA kinematics) where a test writes Yaskawa
+# INFORM, whose joint positions count pulses: a controller's pulse/degree parameters, as robot.yaml
+# `controller.pulses_per_degree` states them for a Yaskawa arm.
+TEST_PULSES_PER_DEGREE = (1194.7, 1194.7, 1194.7, 853.3, 853.3, 512.0)
+
+
+def with_pulses(robot):  # type: ignore[no-untyped-def]
+    """The robot with TEST_PULSES_PER_DEGREE stated on its controller (nothing else changes)."""
+    import dataclasses
+
+    return dataclasses.replace(robot, controller=dataclasses.replace(robot.controller,
+                                                                      pulses_per_degree=TEST_PULSES_PER_DEGREE))

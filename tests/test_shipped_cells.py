@@ -1,5 +1,6 @@
 """End to end on every shipped example cell (cells/*.yaml): `robomax plan --format all` writes the
-trajectory file and every dialect's program, and `robomax verify` passes on each (its motion
+trajectory file and every dialect's program the arm's robot.yaml has the data for (no INFORM: no
+shipped arm states its encoder pulses), and `robomax verify` passes on each (its motion
 rebuilt from the program's own statements); the frame's seams are all welded and its ordered
 pillar seam keeps its order; the programs are byte for byte the committed ones
 (tests/golden/shipped: the .srcl text, and the SHA-256 of every other file), so a restructuring
@@ -57,6 +58,11 @@ def _plan(cell: Path, out: Path) -> dict[str, object]:
     result = runner.invoke(app, ["plan", str(cell), "-o", str(out), "--format", "all"])
     assert result.exit_code == EXIT_OK, result.output
     name = yaml.safe_load(cell.read_text()).get("name", cell.stem)
+    # No shipped arm states encoder pulses per degree: `all` passes INFORM over and says so.
+    text = " ".join(result.output.split())
+    assert "robot.yaml: controller.pulses_per_degree is not given: no inform program written" in text, text
+    assert not list(out.glob("*.jbi")) and not list(out.glob("*.JBI"))
+    assert (out / f"{name}.as").is_file()
     for ext in MAIN_FILES:
         program = out / _file(name, ext)
         assert program.is_file(), f"{program} not written"

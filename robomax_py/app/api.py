@@ -21,7 +21,11 @@ from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.verify import VerifyReport
 
-__all__ = ["LoadedCell", "load_cell", "plan_cell", "verify_program", "write_programs"]
+__all__ = ["FormatSkippedWarning", "LoadedCell", "load_cell", "plan_cell", "verify_program", "write_programs"]
+
+
+class FormatSkippedWarning(UserWarning):
+    """`write_programs(formats="all")` passed over a dialect the robot file lacks data for."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -60,15 +64,23 @@ def write_programs(cell: LoadedCell, result: PlanResult, out_dir: str | Path, fo
     write them as one set with its manifest, as `plan` does (`io.files.commit_set`); the paths
     written (the manifest, `<name>.manifest.json`, beside them).
 
-    Raises ExportError for a plan that is not complete or a program that does not prove: nothing
-    is written then.
+    `all` is every dialect the robot file has the data for: one it lacks a key for (INFORM without
+    `controller.pulses_per_degree`) is passed over with a `FormatSkippedWarning` naming the file,
+    the key and the dialect.
+
+    Raises ExportError for a plan that is not complete, a dialect named that the robot file lacks
+    data for, or a program that does not prove: nothing is written then.
     """
-    from robomax_py.export import SHARED_FILES, format_names
+    import warnings
+
+    from robomax_py.export import SHARED_FILES, choose_formats
     from robomax_py.io.files import commit_set
     from robomax_py.publish import publish
 
-    names = format_names(formats, cell.robot.controller.brand)
-    files, _ = publish(result, cell.spec, cell.robot, names, stamp=stamp, baseline=result.baseline)
+    chosen = choose_formats(formats, cell.robot)
+    for skipped in chosen.skipped:
+        warnings.warn(skipped.message, FormatSkippedWarning, stacklevel=2)
+    files, _ = publish(result, cell.spec, cell.robot, chosen.names, stamp=stamp, baseline=result.baseline)
     name = result.cell + ("_baseline" if result.baseline else "")
     return list(commit_set(Path(out_dir), name, files, cell.spec.digest, SHARED_FILES).paths)
 

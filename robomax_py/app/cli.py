@@ -146,7 +146,7 @@ def plan(
     speed: Annotated[float | None, typer.Option("--speed", min=0.01, max=1.0, help="override of every programmed speed, fraction in (0, 1] (default: the cell's planner.speed, else 1)")] = None,
     verbose: Annotated[bool, typer.Option("-v", "--verbose", help="debug logging: stage sizes, counts and times")] = False,
     plot: Annotated[bool, typer.Option("--plot", help="also write DIR/<name>.png: a cycle-time Gantt chart, one row per spot")] = False,
-    formats: Annotated[str, typer.Option("--format", help="program dialects, comma-separated: srcl, krl, rapid, fanuc, urscript, native (the robot's controller brand) or all")] = "srcl",
+    formats: Annotated[str, typer.Option("--format", help="program dialects, comma-separated: srcl, krl, rapid, fanuc, urscript, inform, as, native (the robot's controller brand) or all (every dialect the robot file has the data for; the others are named in a warning)")] = "srcl",
     stamp: Annotated[bool, typer.Option("--stamp", help="write the date into each program's header (otherwise the same cell gives the same bytes)")] = False,
 ) -> None:
     """Plan a cell and write its program files (only when the plan is complete and every program proven)."""
@@ -159,7 +159,7 @@ def plan(
         with _signals_deferred():
             from robomax_py.app.progress import configure_logging, stage_bars
             from robomax_py.app.report import plan_report, report_tables
-            from robomax_py.export import SHARED_FILES, format_names
+            from robomax_py.export import SHARED_FILES, choose_formats
             from robomax_py.io.cell import load_cell, load_cell_robot
             from robomax_py.io.files import commit_set
             from robomax_py.plan import PlanOptions, plan_cell
@@ -172,7 +172,9 @@ def plan(
         robot = load_cell_robot(spec)
         _honour_signals()
         _warn(robot.warnings)
-        names = format_names(formats, robot.controller.brand)
+        chosen = choose_formats(formats, robot)
+        names = chosen.names
+        _warn([s.message for s in chosen.skipped])
         set_name = spec.name + ("_baseline" if baseline else "")
         with stage_bars(err, enabled=not verbose) as bars:
             def progress(stage: str, done: int, total: int) -> None:
@@ -200,7 +202,7 @@ def plan(
             written = [*committed.paths, committed.manifest]
             removed = committed.removed
             unlisted = committed.unlisted
-        report = plan_report(result, seconds, written, robot.defaulted_limits, checked)
+        report = plan_report(result, seconds, written, robot.defaulted_limits, checked, chosen.skipped)
         if result.status == "planned":
             report["removed"] = [str(out_dir / n) for n in removed]
             report["not_of_this_plan"] = [str(out_dir / n) for n in _stale_programs(out_dir, set_name)]
@@ -560,7 +562,7 @@ def import_urdf_command(
     flange: Annotated[str, typer.Option("--flange", help="URDF frame the tool mounts on")] = "tool0",
     srdf: Annotated[Path | None, typer.Option("--srdf", help="MoveIt SRDF whose disable_collisions are kept")] = None,
     solver: Annotated[str | None, typer.Option("--solver", help="opw | ur | numeric (default: the first that fits)")] = None,
-    brand: Annotated[str | None, typer.Option("--brand", help="kuka | abb | fanuc | ur (default: guessed from the name)")] = None,
+    brand: Annotated[str | None, typer.Option("--brand", help="kuka | abb | fanuc | ur | yaskawa | kawasaki | staubli | comau | nachi (default: guessed from the name)")] = None,
     name: Annotated[str | None, typer.Option("--name", help="robot name (default: the folder name)")] = None,
     force: Annotated[bool, typer.Option("--force", help="replace a folder that exists with other content")] = False,
     xacro_cpu_s: Annotated[float | None, typer.Option("--xacro-cpu-s", min=1, help="CPU seconds the xacro "
@@ -581,8 +583,10 @@ def import_urdf_command(
 
         if solver not in (None, "opw", "ur", "numeric"):
             raise RobotModelError(None, "--solver", f"expected opw, ur or numeric, got {solver!r}")
-        if brand not in (None, "kuka", "abb", "fanuc", "ur"):
-            raise RobotModelError(None, "--brand", f"expected kuka, abb, fanuc or ur, got {brand!r}")
+        from robomax_py.spec import BRANDS
+
+        if brand is not None and brand not in BRANDS:
+            raise RobotModelError(None, "--brand", f"expected one of {', '.join(BRANDS)}, got {brand!r}")
         from robomax_py.safe_files import LIMITS, MB
 
         limits = dataclasses.replace(LIMITS, xacro_cpu_s=xacro_cpu_s or LIMITS.xacro_cpu_s,

@@ -69,6 +69,11 @@ _BRAND_PATTERNS = (
     ("abb", re.compile(r"abb|irb\s*\d", re.I)),
     ("fanuc", re.compile(r"fanuc|lrmate|(^|[^a-z])(m|r|cr|crx|arc|lr)[-_]?\d+i[a-z]", re.I)),
     ("ur", re.compile(r"(^|[^a-z])ur\d+e?([^a-z0-9]|$)|universal", re.I)),
+    # ROS-Industrial package names: motoman_*_support, staubli_*_support, kawasaki_* (Yaskawa's
+    # arms are Motoman).
+    ("yaskawa", re.compile(r"motoman|yaskawa", re.I)),
+    ("staubli", re.compile(r"st(a|ä)ubli", re.I)),
+    ("kawasaki", re.compile(r"kawasaki", re.I)),
 )
 
 
@@ -87,7 +92,8 @@ class ImportResult:
 
 
 def guess_brand(*names: str) -> str:
-    """kuka | abb | fanuc | ur from a robot's name or file names; kuka when nothing matches."""
+    """A controller brand (kuka, abb, fanuc, ur, yaskawa, staubli, kawasaki) from a robot's name or
+    file names; kuka when nothing matches."""
     for brand, pattern in _BRAND_PATTERNS:
         if any(pattern.search(n) for n in names):
             return brand
@@ -452,7 +458,8 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
         solver_name, params, fk_error = _fit(model, int(model.getFrameId(flange)), solver)
     except FitError as exc:
         raise RobotModelError(source, "ik.solver", f"not a {solver}-class arm: {exc.problem}") from None
-    brand = brand or guess_brand(name, source.name, str(root.get("name", "")))
+    # The file's folders too: ROS-Industrial packages name the maker (motoman_gp180_support/urdf/...).
+    brand = brand or guess_brand(name, *source.parts[-4:], str(root.get("name", "")))
     _confined(stage, "robot.yaml").write_text(
         _robot_yaml(name, urdf_name, flange, solver_name, params, brand, srdf_name, source, T_root_base),
         encoding="utf-8")

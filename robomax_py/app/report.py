@@ -9,6 +9,7 @@ from typing import Any
 
 from rich.table import Table
 
+from robomax_py.export import SkippedFormat
 from robomax_py.plan import PlanResult
 from robomax_py.publish import CheckedProgram
 
@@ -16,10 +17,12 @@ KINDS = ("move", "detour", "approach", "weld", "retract", "wait")
 
 
 def plan_report(result: PlanResult, seconds: float, written: list[Path],
-                defaulted_limits: tuple[str, ...] = (), checked: Sequence[CheckedProgram] = ()) -> dict[str, Any]:
+                defaulted_limits: tuple[str, ...] = (), checked: Sequence[CheckedProgram] = (),
+                skipped: Sequence[SkippedFormat] = ()) -> dict[str, Any]:
     """A JSON-ready summary: status, cycle time and its split, spots, detours, planning time,
     which of the robot's limits were derived rather than given (`RobotModel.defaulted_limits`),
-    and how each written program proved (`publish.CheckedProgram`)."""
+    how each written program proved (`publish.CheckedProgram`) and which dialects `--format all`
+    passed over for want of the robot file's data (`export.SkippedFormat`)."""
     report: dict[str, Any] = {
         "cell": result.cell, "robot": result.robot, "status": result.status, "message": result.message,
         "method": "baseline" if result.baseline else "optimised", "planning_seconds": round(seconds, 3),
@@ -33,6 +36,8 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
              "prove_cpu_s": round(c.check_seconds, 3)}
             for c in checked
         ],
+        "skipped_formats": [{"format": k.format, "robot_file": k.robot_file, "key": k.key, "why": k.why}
+                            for k in skipped],
     }
     if result.trajectory is None:
         return report
@@ -105,6 +110,8 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
     for p in report.get("programs", []):
         head.add_row("proven", f"{p['format']}: read back, rebuilt within {p['rebuilt_joint_deg']:.4f} deg, "
                                f"{p['rebuilt_tcp_mm']:.3f} mm, {p['rebuilt_time_ms']:.1f} ms of the plan")
+    for k in report.get("skipped_formats", []):
+        head.add_row("not written", f"{k['format']}: {k['robot_file']} does not state {k['key']}")
     for f in report["files"]:
         head.add_row("wrote", f)
     for f in report.get("removed", []):

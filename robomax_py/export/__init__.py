@@ -2,38 +2,63 @@
 deterministic, fixed float formats), and program files -> what `robomax verify` checks.
 
 `plan_program` turns a plan into the dialect-free `Program` (`planned_program`); each dialect
-module owns its adapter, writer and reader (`srcl`, `krl`, `rapid`, `fanuc`, `urscript`;
-`dialect` holds what they share); `trajectory_json` is the sampled trajectory file (SPEC §5);
+module owns its adapter, writer and reader (`srcl`, `krl`, `rapid`, `fanuc`, `urscript`,
+`inform`, `kawasaki_as`; `dialect` holds what they share), registered as entry points of the group
+`robomax_py.dialects` (`shipped`; other packages add dialects the same way); `trajectory_json` is the sampled trajectory file (SPEC §5);
 `rebuild` turns a parsed program back into motion.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from importlib import metadata
 
 from robomax_py.errors import ExportError
-from robomax_py.export import fanuc, krl, rapid, srcl, trajectory_json, urscript
+from robomax_py.export import trajectory_json
 from robomax_py.export.dialect import Dialect
 from robomax_py.export.plan_program import frame_defs, identifier
 from robomax_py.plan import PlanResult
 from robomax_py.plan.program_frames import cell_program_frames
 from robomax_py.program import FrameDef
+from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 
-__all__ = ["DIALECTS", "SHARED_FILES", "Dialect", "controller_frames", "dialect_for_file", "format_names", "render_trajectory"]
+__all__ = ["DIALECTS", "ENTRY_POINT_GROUP", "SHARED_FILES", "Dialect", "FormatChoice", "SkippedFormat",
+           "choose_formats", "controller_frames", "dialect_for_file", "format_names", "load_dialects", "native_dialect",
+           "render_trajectory", "require_calibration"]
+
+# The entry point group program dialects register under (pyproject.toml): each entry point names a
+# `Dialect` object; its name is the `--format` name.
+ENTRY_POINT_GROUP = "robomax_py.dialects"
+
+
+def load_dialects() -> dict[str, Dialect]:
+    """Every registered dialect by `--format` name: the shipped ones first, in their order (the
+    order files are written in), then the others by name. The shipped dialects come from
+    `export.shipped` when the package's own entry points are not installed; an entry point that
+    does not load, or names something that is not a Dialect of its own name, is an ExportError."""
+    from robomax_py.export.shipped import SHIPPED
+
+    found: dict[str, Dialect] = {d.name: d for d in SHIPPED}
+    shipped = set(found)
+    others: dict[str, Dialect] = {}
+    for ep in metadata.entry_points(group=ENTRY_POINT_GROUP):
+        if ep.name in shipped and ep.value.startswith("robomax_py.export.shipped:"):
+            continue                      # the package's own registration of a shipped dialect
+        try:
+            dialect = ep.load()
+        except Exception as exc:  # noqa: BLE001 - a plug-in's import fails in its own way
+            raise ExportError(f"program dialect plug-in {ep.name} ({ep.value}) does not load: {exc}") from None
+        if not isinstance(dialect, Dialect) or dialect.name != ep.name:
+            raise ExportError(f"program dialect plug-in {ep.name} ({ep.value}) is not a Dialect named {ep.name!r}")
+        if ep.name in found or ep.name in others:
+            raise ExportError(f"two program dialects are registered as {ep.name!r}")
+        others[ep.name] = dialect
+    return {**found, **dict(sorted(others.items()))}
+
 
 # Registry order is the order files are written in (after the trajectory file).
-DIALECTS: dict[str, Dialect] = {
-    "srcl": Dialect("srcl", (".srcl",), "", srcl.adapt, srcl.write, srcl.parse),
-    "krl": Dialect("krl", (".src", ".dat"), "kuka", krl.adapt, krl.write, krl.parse, krl.frame_name,
-                   (krl.FRAMES_FILE,), krl.FILE_ENCODING),
-    "rapid": Dialect("rapid", (".mod",), "abb", rapid.adapt, rapid.write, rapid.parse, companions=(rapid.FRAMES_FILE,),
-                     named_frames_only=True),
-    "fanuc": Dialect("fanuc", (".ls",), "fanuc", fanuc.adapt, fanuc.write, fanuc.parse, fanuc.frame_name,
-                     (fanuc.FRAMES_FILE,), program_name=fanuc.program_name,
-                     shared=tuple(f"{name}.ls" for name in fanuc.ROUTINES)),
-    "urscript": Dialect("urscript", (".script",), "ur", urscript.adapt, urscript.write, urscript.parse),
-}
+DIALECTS: dict[str, Dialect] = load_dialects()
 # Whole file names every program of a dialect writes alike (FANUC's routines): not one cell's files.
 SHARED_FILES: frozenset[str] = frozenset(name for d in DIALECTS.values() for name in d.shared)
 
@@ -52,28 +77,96 @@ def controller_frames(dialect: Dialect, cell: CellSpec) -> tuple[FrameDef, ...]:
             named.add(("base", identifier(setup.frame.frame.name)))
         frames = tuple(f for f in frames if (f.kind, f.name) in named)
     return tuple(dataclasses.replace(f, name=dialect.frame_name(f)) for f in frames)
-NATIVE = {"kuka": "krl", "abb": "rapid", "fanuc": "fanuc", "ur": "urscript"}
+def native_dialect(brand: str, dialects: dict[str, Dialect] | None = None) -> str | None:
+    """The `--format` name of a controller brand's own dialect (the first registered for it), or
+    None for a brand robomax has no dialect for."""
+    return next((name for name, d in (dialects or DIALECTS).items() if d.brand and d.brand == brand), None)
 
 
-def format_names(spec: str, brand: str) -> tuple[str, ...]:
-    """`--format` LIST (SPEC §6): names, `all` or `native` (the robot's brand), comma-separated,
-    in registry order without repeats; ExportError for an unknown name."""
-    wanted: set[str] = set()
+def _requested(spec: str, brand: str, robot_file: object) -> tuple[set[str], set[str]]:
+    """The dialects `--format` names one by one (a name, `native`) and those it takes in with `all`."""
+    named: set[str] = set()
+    every: set[str] = set()
     for part in (p.strip().lower() for p in spec.split(",")):
         if part == "all":
-            wanted.update(DIALECTS)
+            every.update(DIALECTS)
         elif part == "native":
-            if brand not in NATIVE:
-                raise ExportError("--format native: the robot names no controller brand (controller.brand in robot.yaml)")
-            wanted.add(NATIVE[brand])
+            native = native_dialect(brand)
+            if native is None:
+                where = f"{robot_file}: " if robot_file else ""
+                having = ", ".join(sorted({d.brand for d in DIALECTS.values() if d.brand}))
+                raise ExportError(f"--format native: {where}controller.brand: robomax writes no program for "
+                                  f"brand {brand!r} (native programs for {having}); name a format instead")
+            named.add(native)
         elif part in DIALECTS:
-            wanted.add(part)
+            named.add(part)
         else:
             known = ", ".join([*DIALECTS, "native", "all"])
             raise ExportError(f"unknown program format '{part}'; known: {known}")
-    if not wanted:
+    if not named and not every:
         raise ExportError("--format names no program format")
-    return tuple(name for name in DIALECTS if name in wanted)
+    return named, every
+
+
+def format_names(spec: str, brand: str, robot_file: object = None) -> tuple[str, ...]:
+    """`--format` LIST (SPEC §6): names, `all` or `native` (the robot's brand), comma-separated,
+    in registry order without repeats; ExportError for an unknown name, and for `native` when the
+    robot's brand has no dialect (naming the robot file and its key, never another brand's).
+    What the robot lacks for a dialect is not looked at here (`choose_formats`)."""
+    named, every = _requested(spec, brand, robot_file)
+    return tuple(name for name in DIALECTS if name in named | every)
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class SkippedFormat:
+    """A dialect `--format all` passes over: the robot file does not state `key`, which it needs."""
+
+    format: str
+    robot_file: str
+    key: str
+    why: str
+
+    @property
+    def message(self) -> str:
+        return (f"{self.robot_file}: {self.key} is not given: no {self.format} program written ({self.why}); "
+                f"state it to have one")
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class FormatChoice:
+    """The dialects to write for a robot, in registry order, and those `all` passed over."""
+
+    names: tuple[str, ...]
+    skipped: tuple[SkippedFormat, ...] = ()
+
+
+def require_calibration(fmt: str, robot: RobotModel) -> None:
+    """ExportError naming the robot file and the key when `robot` lacks what dialect `fmt` needs."""
+    lacking = DIALECTS[fmt].needs(robot)
+    if lacking:
+        key, why = lacking[0]
+        raise ExportError(f"--format {fmt}: {robot.source}: {key} is not given for {robot.name}: {why}")
+
+
+def choose_formats(spec: str, robot: RobotModel) -> FormatChoice:
+    """`--format` LIST for `robot` (`format_names`): a dialect named (or `native`) that needs data
+    the robot file lacks is an ExportError naming the file and the key (checked before anything is
+    planned or written); `all` means every dialect the robot can be written in, the others skipped
+    with the reason (`FormatChoice.skipped`), so that a whole set never fails for a missing calibration."""
+    named, every = _requested(spec, robot.controller.brand, robot.source)
+    names: list[str] = []
+    skipped: list[SkippedFormat] = []
+    for name, dialect in DIALECTS.items():
+        if name in named:
+            require_calibration(name, robot)
+            names.append(name)
+        elif name in every:
+            lacking = dialect.needs(robot)
+            if lacking:
+                skipped.extend(SkippedFormat(name, str(robot.source), key, why) for key, why in lacking)
+            else:
+                names.append(name)
+    return FormatChoice(tuple(names), tuple(skipped))
 
 
 def dialect_for_file(suffix: str) -> Dialect | None:

@@ -90,6 +90,11 @@ def own_name(frame: FrameDef) -> str:
     return frame.name
 
 
+def needs_nothing(robot: RobotModel) -> tuple[tuple[str, str], ...]:
+    """What a dialect that can write a program for any arm needs of robot.yaml: nothing."""
+    return ()
+
+
 @dataclass(frozen=True, slots=True)
 class Dialect:
     """A controller dialect: its files (the first is the main one; keys starting with "_" are
@@ -115,6 +120,12 @@ class Dialect:
     program_name: Callable[[str], str] | None = None
     # Whole file names every program of the dialect writes alike (FANUC's default routines).
     shared: tuple[str, ...] = ()
+    # Each of its extensions names a whole program of its own (AS's `.as` and `.pg`), read as the first.
+    any_extension: bool = False
+    # The robot.yaml keys the dialect needs that `robot` does not state, (key, what it is for): the
+    # controller's calibration data a program counts in (INFORM's encoder pulses per degree). A
+    # dialect asked for by name on such a robot is an error; `--format all` passes it over and says so.
+    needs: Callable[[RobotModel], tuple[tuple[str, str], ...]] = needs_nothing
 
 
 def with_frame_names(program: Program, name_of: Callable[[FrameDef], str]) -> Program:

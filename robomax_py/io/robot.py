@@ -102,8 +102,18 @@ class ControllerFile(_Strict):
     (`urdf_base_link`), else the identity; given (an identity too), it is used as written.
     """
 
-    brand: Literal["kuka", "abb", "fanuc", "ur"] = "kuka"
+    brand: Literal["kuka", "abb", "fanuc", "ur", "yaskawa", "kawasaki", "staubli", "comau", "nachi"] = "kuka"
     j23_coupling: bool = False                # FANUC: J3 counted from the horizontal
+    # Yaskawa: encoder pulses per degree of each axis (the controller's pulse/degree parameters),
+    # which INFORM joint positions are counted in; None: joint moves go to Cartesian positions.
+    pulses_per_degree: list[float] | None = None
+
+    @field_validator("pulses_per_degree")
+    @classmethod
+    def _pulses(cls, v: list[float] | None) -> list[float] | None:
+        if v is not None and (len(v) != 6 or any(not math.isfinite(x) or x == 0 for x in v)):
+            raise ValueError("expected 6 non-zero numbers (negative where the axis counts the other way)")
+        return v
     base: PoseFile | None = None              # None: the URDF's `base` link, else identity
 
 
@@ -631,6 +641,7 @@ def load_robot_spec(path: Path) -> RobotSpec:
         description=parsed.description,
         controller=ControllerSpec(
             brand=ctrl.brand, j23_coupling=ctrl.j23_coupling,
+            pulses_per_degree=tuple(ctrl.pulses_per_degree or ()),
             T_root_base=frozen_array(T_root_base),
         ),
         disabled_links=disabled,

@@ -50,6 +50,20 @@ def test_bad_cell_exits_2_and_writes_nothing(tmp_path: Path, write_small_cell: S
     assert not out.exists()
 
 
+def test_inform_on_an_arm_without_pulse_counts_exits_2_and_writes_nothing(tmp_path: Path,
+                                                                           write_small_cell: SmallCell) -> None:
+    """`--format inform` on an arm whose robot.yaml states no encoder pulses per degree: one message
+    naming the robot file and the key, before anything is planned; nothing written."""
+    cell = write_small_cell(tmp_path, "small")
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["plan", str(cell), "-o", str(out), "--format", "srcl,inform"])
+    assert result.exit_code == EXIT_BAD_INPUT, result.output
+    text = " ".join(result.output.split())
+    assert "--format inform:" in text and "robot.yaml: controller.pulses_per_degree is not given" in text, text
+    assert "Traceback" not in result.output
+    assert not out.exists()
+
+
 def check_trajectory_file(path: Path, n_spots: int, home_deg: list[float], weld_time: float) -> dict:
     """SPEC §5: keys, strictly increasing t at most 10 ms apart, home at both ends, spots."""
     data = json.loads(path.read_text())

@@ -9,13 +9,14 @@ from typing import Any
 
 import pytest
 
-from robomax_py.export import DIALECTS
+from robomax_py.export import DIALECTS, SHARED_FILES
 from robomax_py.export.plan_program import identifier, program_from_plan
 from robomax_py.export.srcl import parse_program, write_program
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import plan_cell
 from robomax_py.program import Spot, WaitFor
 from robomax_py.publish import publish
+from tests.conftest import with_pulses
 
 REPO = Path(__file__).resolve().parents[2]
 GOLDEN = REPO / "tests" / "golden"
@@ -24,7 +25,7 @@ ALL = tuple(DIALECTS)
 
 def _planned(path: Path) -> dict[str, Any]:
     cell = load_cell(path)
-    robot = load_cell_robot(cell)
+    robot = with_pulses(load_cell_robot(cell))        # INFORM counts joint positions in pulses
     result = plan_cell(cell, robot)
     assert result.status == "planned", result.message
     files, checked = publish(result, cell, robot, ALL)
@@ -55,6 +56,7 @@ def _golden(planned: dict[str, Any], update: bool) -> None:
         # Bytes: FANUC's lines end in CRLF, which reading as text would hide.
         assert text.encode() == golden.read_bytes(), f"{name}/{file} changed: review, then pytest --update-golden"
     assert sorted(p.name for p in folder.iterdir()) == sorted(planned["files"])
+    assert {f for f in planned["files"] if f in SHARED_FILES} == {"SPOT_WELD.ls", "SPOTWELD.jbi"}
 
 
 def test_golden_small_cell(small: dict[str, Any], update_golden: bool) -> None:
@@ -105,7 +107,7 @@ def test_srcl_of_a_plan_parses_back_byte_identical(small: dict[str, Any]) -> Non
 def test_stamp_only_when_asked(small: dict[str, Any]) -> None:
     files, _ = publish(small["result"], small["cell"], small["robot"], ALL, stamp="2026-12-02")
     for file, text in files.items():
-        if file.endswith(".json") or file in DIALECTS["fanuc"].shared:
+        if file.endswith(".json") or file in SHARED_FILES:       # the default routines, alike in every set
             continue
         assert "written 2026-12-02" in text, file
         assert "written " not in small["files"][file], file

@@ -18,8 +18,10 @@ from robomax_py.publish import publish
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.verify import VerifyReport, verify_program
+from tests.conftest import with_pulses
 
-MAIN = {"krl": ".src", "rapid": ".mod", "fanuc": ".ls", "urscript": ".script", "srcl": ".srcl"}
+MAIN = {"krl": ".src", "rapid": ".mod", "fanuc": ".ls", "urscript": ".script", "srcl": ".srcl", "inform": ".jbi",
+        "as": ".as"}
 Edit = Callable[[str], str]
 
 
@@ -79,7 +81,7 @@ def _planned(path: Path, name: str, dialects: tuple[str, ...], shared_once: Shar
     """The cell at `path` planned and published in `dialects` (once per test run: the files are
     shared between test workers by the cell file's bytes), its files written beside it."""
     cell = load_cell(path)
-    robot = load_cell_robot(cell)
+    robot = with_pulses(load_cell_robot(cell))          # INFORM counts joint positions in pulses
 
     def compute() -> dict[str, str]:
         result = plan_cell(cell, robot)

@@ -259,7 +259,51 @@ def brand_text(brand: str, status: int, turn: int, q: FloatArray) -> str:
         return ind.to_fanuc(q)
     if brand == "ur":
         return ""
+    if brand == "yaskawa":
+        return yaskawa_rconf(ind, q)
+    if brand == "kawasaki":
+        return kawasaki_config(ind)
+    if brand in ("staubli", "comau", "nachi"):
+        # Brands without a program dialect: robomax's own status and turn form (SRCL).
+        return str(ind)
     raise ValueError(f"unknown controller brand {brand!r}")
+
+
+def _half_turn_bit(angle: float) -> int:
+    """Yaskawa's '< 180' (0) / '>= 180' (1) of an axis angle, rad: 0 for -180 < angle <= 180 deg,
+    the half-open ranges of the manual's Flip / No Flip table (module docstring)."""
+    return 0 if -np.pi < angle <= np.pi else 1
+
+
+def yaskawa_rconf(ind: ConfigIndicator, q: FloatArray) -> str:
+    """Yaskawa's manipulator type as a job's `///RCONF l,m,n,o,p,q,0,0` states it.
+
+    DX100 "Options: Instructions for Interface with an Easy Offline Teaching System" (156191-1CD,
+    HW0482494) §4.1 Job Data Format, RCONF: l 0 Flip / 1 No-flip, m 0 Upper arm / 1 Lower arm,
+    n 0 Front / 1 Rear, o 0 R < 180 / 1 R >= 180, p the same for T, q for S, the rest unused (0).
+    NX100 operator's manual (149235-1CD) §3.9 "Manipulator Types": Flip / No Flip is the R-axis
+    (axis 4) position, Flip for -90 < R <= 90 deg and for 270 < |R| <= 360 deg, No Flip for
+    90 < |R| <= 270 deg; Upper / Lower arm the posture of the L- and U-axes (the elbow above or
+    below the shoulder-wrist line, KUKA's S bit 1); Front / Rear the wrist point in front of or
+    behind the S-axis (S bit 0). 'R < 180' is read as -180 < R <= 180 deg, the table's ranges.
+    """
+    q = np.asarray(q, dtype=float)
+    r = float(np.mod(q[3] + np.pi / 2.0, TWO_PI))           # Flip: R in (-90, 90] mod 360
+    flip = 0.0 < r <= np.pi
+    fields = (0 if flip else 1, 0 if ind.elbow else 1, 1 if ind.overhead else 0,
+              _half_turn_bit(float(q[3])), _half_turn_bit(float(q[5])), _half_turn_bit(float(q[0])), 0, 0)
+    return ",".join(str(f) for f in fields)
+
+
+def kawasaki_config(ind: ConfigIndicator) -> str:
+    """Kawasaki AS's configuration words, `RIGHTY|LEFTY ABOVE|BELOW UWRIST|DWRIST` (Kawasaki AS
+    Language Reference Manual, D series 902091017DEB, configuration instructions LEFTY, RIGHTY,
+    ABOVE, BELOW, UWRIST, DWRIST): RIGHTY with the wrist point in front of JT1 (not S bit 0),
+    ABOVE with the elbow above the shoulder-wrist line (S bit 1), UWRIST with JT5 >= 0 within its
+    turn (not S bit 2). The words name the branch; the turns come from the joint values a joint
+    location states."""
+    return " ".join(("LEFTY" if ind.overhead else "RIGHTY", "ABOVE" if ind.elbow else "BELOW",
+                     "DWRIST" if ind.wrist else "UWRIST"))
 
 
 def same_config(written: str, actual: str) -> bool:
