@@ -372,8 +372,9 @@ def import_urdf(
                     stage, name, urdf_name, flange, solver, brand, source, root, T_root_base,
                     None if srdf_text is None else f"{name}.srdf")
             except RobotModelError as exc:
-                raise _unstaged(exc, stage, source) from None
+                raise _unstaged(exc, stage, source, urdf_name) from None
             warnings.extend(w.replace(str(stage), str(out)) for w in robot_warnings if "limits." in w)
+            warnings.extend(_named_srdf(w, stage, source, urdf_name, srdf) for w in robot_warnings if ": srdf: " in w)
             unchanged = out.is_dir() and not out.is_symlink() and _digest(out) == _digest(stage)
             if not unchanged:
                 if os.path.lexists(out) and not force:
@@ -438,11 +439,11 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
     import pinocchio as pin
 
     from robomax_py.io.robot import load_robot_spec
-    from robomax_py.robot import load_robot
+    from robomax_py.robot import load_robot, urdf_model
     from robomax_py.robot.ik.fit import FitError
 
     try:
-        model = pin.buildModelFromUrdf(str(stage / urdf_name))
+        model = urdf_model((stage / urdf_name).read_text(encoding="utf-8"))
     except Exception as exc:  # Pinocchio raises plain errors for bad URDFs
         raise RobotModelError(source, None, f"cannot parse URDF: {exc}") from None
     if not model.existFrame(flange):
@@ -461,11 +462,19 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
     return solver_name, fk_error, spec, robot.warnings
 
 
-def _unstaged(exc: RobotModelError, stage: Path, source: Path) -> RobotModelError:
-    """An error met loading the staged folder, naming the source and the mesh paths as the URDF
-    names them in the folder rather than the staging folder that is about to vanish."""
+def _unstaged(exc: RobotModelError, stage: Path, source: Path, urdf_name: str) -> RobotModelError:
+    """An error met loading the staged folder, naming the source (for the URDF written there) and
+    the mesh paths as the URDF names them in the folder rather than the staging folder that is
+    about to vanish."""
     file = source if exc.file is None or exc.file.startswith(str(stage)) else exc.file
-    return RobotModelError(file, exc.key, exc.problem.replace(str(stage) + os.sep, ""))
+    problem = exc.problem.replace(str(stage) + os.sep, "").replace(f"URDF {urdf_name}", f"URDF {source.name}")
+    return RobotModelError(file, exc.key, problem)
+
+
+def _named_srdf(warning: str, stage: Path, source: Path, urdf_name: str, srdf: Path | None) -> str:
+    """A warning about the staged folder's SRDF, naming the user's SRDF and source instead."""
+    text = warning.replace(f"{stage / 'robot.yaml'}: srdf:", f"{srdf}:" if srdf is not None else "srdf:")
+    return text.replace(f"URDF {urdf_name}", f"URDF {source.name}").replace(str(stage) + os.sep, "")
 
 
 def _copy(real: Path, dst: Path, limit: int, source: Path, local: str) -> None:

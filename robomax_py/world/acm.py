@@ -235,7 +235,8 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
     bounds = KinematicBounds.of(model)
     provable = {
         (a, b) for a, b in self_candidates
-        if 0 < len(joint_path(model, pieces[a].joint, pieces[b].joint) or ()) <= options.acm_proof_joints
+        if 0 < len(path := joint_path(model, pieces[a].joint, pieces[b].joint) or []) <= options.acm_proof_joints
+        and not _passive_on(model, path)
     }
     sampled = _sample_self_pairs(robot, gm, self_candidates, provable, flange_candidates, options)
     proved_far = _prove_never_close(robot, gm, bounds, sorted(sampled.never_near), options)
@@ -453,7 +454,7 @@ def _prove_never_close(
         ja, jb = int(gm.geometryObjects[a].parentJoint), int(gm.geometryObjects[b].parentJoint)
         distal = b if ja < jb else a
         path = joint_path(model, ja, jb)
-        if path is None or not 0 < len(path) <= options.acm_proof_joints:
+        if path is None or not 0 < len(path) <= options.acm_proof_joints or _passive_on(model, path):
             continue
         groups.setdefault(tuple(path), []).append((a, b, distal))
     proved: set[tuple[int, int]] = set()
@@ -537,3 +538,7 @@ def _layout_contacts(gm: pin.GeometryModel, pieces: list[Piece], pairs: list[tup
     return tuple(out)
 
 
+def _passive_on(model: pin.Model, path: list[int]) -> bool:
+    """A passive (`<mimic>`) joint lies on the path: the proof's box over the path's joint values
+    takes each joint as free, which a joint following another is not; such pairs stay checked."""
+    return any(model.joints[k].nq == 0 for k in path)

@@ -46,6 +46,8 @@ def revolute_mask(model: pin.Model) -> BoolArray:
     """(nq,) bool: which configuration entries belong to revolute joints."""
     mask = np.zeros(model.nq, dtype=bool)
     for j in range(1, model.njoints):
+        if model.joints[j].nq == 0:          # a passive (`<mimic>`) joint owns no entry
+            continue
         mask[model.joints[j].idx_q] = model.joints[j].shortname().startswith("JointModelR")
     return mask
 
