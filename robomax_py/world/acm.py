@@ -79,7 +79,7 @@ class CollisionOptions:
 class DisabledPair:
     piece_a: str
     piece_b: str
-    reason: str      # "rigid" | "adjacent" | "disabled in robot.yaml" | "tips on workpiece" | "fixed base" | "tool touches flange link" | "never close"
+    reason: str      # "rigid" | "adjacent" | "disabled in robot.yaml" | "tips on workpiece" | "fixed base" | "tool touches flange link" | "never close" | "passive linkage: ..."
 
 
 @dataclass(frozen=True, slots=True)
@@ -245,6 +245,13 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
         a, b = pair
         if pair in sampled.flange_touch:
             disabled.append(DisabledPair(pieces[a].name, pieces[b].name, "tool touches flange link"))
+        elif pair in sampled.always_touch and (_is_passive_piece(model, pieces[a].joint)
+                                               or _is_passive_piece(model, pieces[b].joint)):
+            # A passive link (a balancer's cylinder or piston, a parallelogram bar) closes a
+            # linkage: it meets the links it is pinned to by design, in every posture. MoveIt's
+            # Setup Assistant disables such pairs too ("Always" / "Default"); a pair that separates
+            # in some sample stays checked.
+            disabled.append(DisabledPair(pieces[a].name, pieces[b].name, "passive linkage: touching in every sample"))
         elif pair in proved_far:
             disabled.append(DisabledPair(pieces[a].name, pieces[b].name, "never close"))
         else:
@@ -542,3 +549,7 @@ def _passive_on(model: pin.Model, path: list[int]) -> bool:
     """A passive (`<mimic>`) joint lies on the path: the proof's box over the path's joint values
     takes each joint as free, which a joint following another is not; such pairs stay checked."""
     return any(model.joints[k].nq == 0 for k in path)
+
+
+def _is_passive_piece(model: pin.Model, joint: int) -> bool:
+    return joint > 0 and model.joints[joint].nq == 0
