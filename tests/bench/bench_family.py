@@ -45,9 +45,16 @@ sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "tests"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_controller_frames import ROSI, Row, arm_shape, free_home, import_arm, one_line, panel_cell  # noqa: E402
+from bench_controller_frames import (
+    Row,
+    arm_shape,
+    free_home,
+    import_arm,
+    one_line,
+    panel_cell,
+)
 
-from robomax_py.errors import RobomaxError  # noqa: E402
+from robomax_py.errors import RobomaxError
 
 # The robot files kept in tests/data/rosi (see SOURCES.md there): name -> (source, SRDF).
 QUICK_ARMS: dict[str, tuple[str, str]] = {
@@ -58,7 +65,7 @@ QUICK_ARMS: dict[str, tuple[str, str]] = {
     "m900ia260l": ("rosi:fanuc_m900ia_support/urdf/m900ia260l.xacro", ""),
     "kr120r2500pro": ("rosi:kuka_kr120_support/urdf/kr120r2500pro.xacro", ""),
 }
-_NOT_ARMS = re.compile(r"(_macro|^common_|_common|materials|colours|colors|transmission|gazebo)", re.I)
+_NOT_ARMS = re.compile(r"(_macro|^common_|_common|materials|colours|colors|transmission|gazebo)", re.IGNORECASE)
 
 
 @dataclass
@@ -173,12 +180,12 @@ def render(rows: list[FamilyRow], command: str) -> str:
             solvers[r.solver] = solvers.get(r.solver, 0) + 1
     lines = [
         f"Command: `{command}`", "",
-        f"Arms: {len(rows)}; imported unedited: {ok} ({100 * ok / max(len(rows), 1):.0f} %); planned: {planned}; "
-        f"IK solvers: {', '.join(f'{k} {v}' for k, v in sorted(solvers.items()))}.",
-        f"Import CPU: total {sum(imports):.1f} s, median {float(np.median(imports)) if imports else math.nan:.1f} s, "
-        f"max {max(imports, default=math.nan):.1f} s (time.process_time of the worker: fit, load-back and "
-        "meshes; the xacro child process not counted). Fit error: the closed-form solver's largest FK "
-        "difference to the URDF over 300 random configurations.", "",
+        (f"Arms: {len(rows)}; imported unedited: {ok} ({100 * ok / max(len(rows), 1):.0f} %); planned: {planned}; "
+         f"IK solvers: {', '.join(f'{k} {v}' for k, v in sorted(solvers.items()))}."),
+        (f"Import CPU: total {sum(imports):.1f} s, median {float(np.median(imports)) if imports else math.nan:.1f} s, "
+         f"max {max(imports, default=math.nan):.1f} s (time.process_time of the worker: fit, load-back and "
+         "meshes; the xacro child process not counted). Fit error: the closed-form solver's largest FK "
+         "difference to the URDF over 300 random configurations."), "",
         "| arm | package | import | IK solver | fit error mm | plan | cycle s | import CPU s | plan CPU s |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
