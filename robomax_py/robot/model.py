@@ -91,17 +91,34 @@ class RobotModel:
 _MIMIC_CONTINUOUS_LIMIT_RAD = 2 * np.pi
 
 
+# Pinocchio's URDF reader walks the link tree depth first, a link's child joints in the order of
+# their names (urdfdom keeps joints in a sorted map), and refuses a mimic joint met before the joint
+# it follows ("The parent joint of the mimic joint is not in the kinematic tree"): the IRB 6700's
+# `cylinder_joint` hangs from link_1 beside `joint_2`, which it follows
+# (abb_irb6700_support/urdf/irb6700_200_260_macro.xacro). Pinocchio therefore reads every mimic
+# joint under a name sorting after all others (this prefix; `~` is the last printable ASCII
+# character), so that it meets each after its active siblings, and `urdf_model` gives the names back.
+_PASSIVE_PREFIX = "~"
+
+
 def pinocchio_urdf_text(text: str) -> str:
     """A URDF's text as `urdf_model` hands it to Pinocchio: `continuous` mimic joints made revolute
-    (see above); the text unchanged when it has none."""
+    and mimic joints renamed (see above); the text unchanged when it has none."""
     import xml.etree.ElementTree as ET
 
     if "mimic" not in text:
         return text
     root = ET.fromstring(text)
-    changed = False
-    for joint in root.findall("joint"):
-        if joint.find("mimic") is None or joint.get("type") != "continuous":
+    joints = [joint for joint in root.findall("joint") if joint.find("mimic") is not None]
+    if not joints:
+        return text
+    passive = {str(joint.get("name")) for joint in joints}
+    for joint in joints:
+        joint.set("name", _PASSIVE_PREFIX + str(joint.get("name")))
+        mimic = joint.find("mimic")
+        if mimic is not None and mimic.get("joint") in passive:
+            mimic.set("joint", _PASSIVE_PREFIX + str(mimic.get("joint")))
+        if joint.get("type") != "continuous":
             continue
         joint.set("type", "revolute")
         limit = joint.find("limit")
@@ -109,13 +126,19 @@ def pinocchio_urdf_text(text: str) -> str:
             limit = ET.SubElement(joint, "limit", {"effort": "0", "velocity": "1"})
         limit.set("lower", repr(-_MIMIC_CONTINUOUS_LIMIT_RAD))
         limit.set("upper", repr(_MIMIC_CONTINUOUS_LIMIT_RAD))
-        changed = True
-    return ET.tostring(root, encoding="unicode") if changed else text
+    return ET.tostring(root, encoding="unicode")
 
 
 def urdf_model(text: str) -> pin.Model:
     """Pinocchio's model of a URDF's text, `<mimic>` joints as passive joints (JointModelMimic)."""
-    return pin.buildModelFromXML(pinocchio_urdf_text(text), mimic=True)
+    model = pin.buildModelFromXML(pinocchio_urdf_text(text), mimic=True)
+    for j in range(1, model.njoints):
+        if model.names[j].startswith(_PASSIVE_PREFIX) and is_passive(model, j):
+            model.names[j] = model.names[j][len(_PASSIVE_PREFIX):]
+    for frame in model.frames:
+        if frame.type == pin.FrameType.JOINT and frame.name.startswith(_PASSIVE_PREFIX) and is_passive(model, frame.parentJoint):
+            frame.name = frame.name[len(_PASSIVE_PREFIX):]
+    return model
 
 
 def is_passive(model: pin.Model, j: int) -> bool:

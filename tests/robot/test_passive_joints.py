@@ -139,3 +139,73 @@ def test_an_srdf_naming_links_the_urdf_lacks_is_kept_for_the_others(tmp_path: Pa
     assert "link_cylinder" in warning
     robot = load_robot(load_robot_spec(result.folder / "robot.yaml"))
     assert frozenset({"link_2", "link_3"}) in robot.disabled_links
+
+
+# A small arm holding the two published forms the IRB 6700 and IRB 5400 packages use: a balancer
+# cylinder hanging from link_1 whose joint name sorts before the joint it follows, with a
+# placeholder velocity of 100 m/s on its prismatic piston; and an offset wrist whose second half
+# (`joint_5b`) turns by -q5 on the chain to the flange.
+_OFFSET_WRIST = """<robot name="offset_wrist">
+  <link name="base_link"/><link name="link_1"/><link name="link_2"/><link name="link_3"/><link name="link_4"/>
+  <link name="link_5"/><link name="link_5b"/><link name="link_6"/><link name="tool0"/>
+  <link name="cylinder"/><link name="piston"/>
+  <joint name="joint_1" type="revolute"><parent link="base_link"/><child link="link_1"/>
+    <axis xyz="0 0 1"/><limit lower="-3" upper="3" velocity="2" effort="0"/></joint>
+  <joint name="joint_2" type="revolute"><parent link="link_1"/><child link="link_2"/>
+    <origin xyz="0.3 0 0.6"/><axis xyz="0 1 0"/><limit lower="-1.5" upper="1.5" velocity="2" effort="0"/></joint>
+  <joint name="joint_3" type="revolute"><parent link="link_2"/><child link="link_3"/>
+    <origin xyz="0 0 1.1"/><axis xyz="0 1 0"/><limit lower="-1.5" upper="1.5" velocity="2" effort="0"/></joint>
+  <joint name="joint_4" type="revolute"><parent link="link_3"/><child link="link_4"/>
+    <origin xyz="1.2 0 0.2"/><axis xyz="1 0 0"/><limit lower="-6" upper="6" velocity="6" effort="0"/></joint>
+  <joint name="joint_5" type="revolute"><parent link="link_4"/><child link="link_5"/>
+    <origin xyz="0.07 0 0" rpy="0 0.6109 0"/><axis xyz="1 0 0"/><limit lower="-6" upper="6" velocity="6" effort="0"/></joint>
+  <joint name="joint_5b" type="revolute"><parent link="link_5"/><child link="link_5b"/>
+    <origin xyz="0.1 0 0.07" rpy="0 -1.2217 0"/><axis xyz="1 0 0"/>
+    <limit lower="-6" upper="6" velocity="6" effort="0"/><mimic joint="joint_5" multiplier="-1.0"/></joint>
+  <joint name="joint_6" type="revolute"><parent link="link_5b"/><child link="link_6"/>
+    <origin xyz="0.07 0 -0.05" rpy="0 0.6109 0"/><axis xyz="1 0 0"/><limit lower="-6" upper="6" velocity="9" effort="0"/></joint>
+  <joint name="joint_6-tool0" type="fixed"><parent link="link_6"/><child link="tool0"/></joint>
+  <joint name="cylinder_joint" type="revolute"><parent link="link_1"/><child link="cylinder"/>
+    <origin xyz="-0.2 0 0.3"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" velocity="1" effort="0"/>
+    <mimic joint="joint_2" multiplier="-0.25"/></joint>
+  <joint name="piston_joint" type="prismatic"><parent link="cylinder"/><child link="piston"/>
+    <axis xyz="0 0 1"/><limit lower="-0.25" upper="0.25" velocity="100" effort="0"/>
+    <mimic joint="joint_2" multiplier="0.15"/></joint>
+</robot>
+"""
+
+
+def test_mimic_joint_limits_are_not_checked_and_names_sorting_first_load() -> None:
+    from robomax_py.io.robot import check_urdf
+    from robomax_py.robot.model import urdf_model
+
+    assert check_urdf(ET.fromstring(_OFFSET_WRIST), Path("offset_wrist.urdf")) == (
+        "offset_wrist.urdf: no geometry at all (a kinematic model): collisions of the arm are not checked",)
+    model = urdf_model(_OFFSET_WRIST)
+    assert [model.names[j] for j in active_joints(model)] == [f"joint_{i}" for i in range(1, 7)]
+    assert sorted(model.names[j] for j in passive_joints(model)) == ["cylinder_joint", "joint_5b", "piston_joint"]
+    assert model.existFrame("piston_joint") and model.existFrame("piston")
+    assert mimic_relation(model, model.getJointId("piston_joint")) == (1, 0.15, 0.0)
+
+
+def test_a_passive_joint_on_the_flange_chain_moves_it_as_pinocchio_does() -> None:
+    from robomax_py.robot.ik._chain import (
+        chain_to_frame,
+        frame_pose_and_jacobian,
+        joint_axes_at_zero,
+    )
+    from robomax_py.robot.model import urdf_model
+
+    model = urdf_model(_OFFSET_WRIST)
+    frame = model.getFrameId("tool0")
+    chain = chain_to_frame(model, frame)
+    assert list(chain.active) == [True] * 5 + [False, True]
+    assert len(joint_axes_at_zero(model, frame).u) == 6
+    data = model.createData()
+    for q in np.random.default_rng(5).uniform(-2.0, 2.0, (8, 6)):
+        R, p, J = frame_pose_and_jacobian(chain, q[None])
+        pin.framesForwardKinematics(model, data, q)
+        assert_allclose(p[:, 0], data.oMf[frame].translation, atol=POSE_TOL_M)
+        assert_allclose(R[:, :, 0], data.oMf[frame].rotation, atol=POSE_TOL_M)
+        J_pin = pin.computeFrameJacobian(model, data, q, frame, pin.LOCAL_WORLD_ALIGNED)
+        assert_allclose(J[0], J_pin, atol=POSE_TOL_M)
