@@ -6,6 +6,7 @@ Heavy modules are imported inside commands so `robomax --help` stays fast.
 
 from __future__ import annotations
 
+import re
 import signal
 import sys
 from collections.abc import Callable, Iterable, Iterator
@@ -569,6 +570,9 @@ def import_urdf_command(
                                                       "expansion may take (default 30)")] = None,
     xacro_mb: Annotated[int | None, typer.Option("--xacro-mb", min=64, help="memory (MB) the xacro expansion may "
                                                  "use (default 1024)")] = None,
+    xacro_arg: Annotated[list[str] | None, typer.Option("--xacro-arg", metavar="NAME:=VALUE",
+                         help="a xacro argument (repeatable); unset ones take the value the package's "
+                              "launch/load_<robot>.launch passes, else the file's default")] = None,
 ) -> None:
     """Make a self-contained robot folder from a URDF or xacro: meshes copied, IK fitted and checked.
 
@@ -591,8 +595,14 @@ def import_urdf_command(
 
         limits = dataclasses.replace(LIMITS, xacro_cpu_s=xacro_cpu_s or LIMITS.xacro_cpu_s,
                                      xacro_memory=LIMITS.xacro_memory if xacro_mb is None else xacro_mb * MB)
+        xacro_args: dict[str, str] = {}
+        for given in xacro_arg or ():
+            arg_name, sep, value = given.partition(":=")
+            if not sep or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", arg_name):
+                raise RobotModelError(None, "--xacro-arg", f"expected NAME:=VALUE, got {given!r}")
+            xacro_args[arg_name] = value
         r = import_urdf(source, out_dir, packages or (), name=name, flange=flange, srdf=srdf, solver=solver,
-                        brand=brand, force=force, limits=limits)
+                        brand=brand, force=force, limits=limits, xacro_args=xacro_args)
         _warn(r.warnings)
         what = "unchanged" if r.unchanged else "wrote"
         out.print(f"{what} {r.folder}: robot {r.name}, IK {r.solver} (FK agrees with the URDF within "

@@ -39,7 +39,7 @@ import sys
 import tempfile
 import time
 import xml.etree.ElementTree as ET
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
@@ -121,15 +121,37 @@ def _inside(path: Path, roots: Sequence[Path]) -> bool:
     return any(real == str(r) or real.startswith(str(r).rstrip(os.sep) + os.sep) for r in roots)
 
 
-def expand(source: Path, roots: Sequence[Path], limits: FileLimits = LIMITS) -> str:
+@dataclass(frozen=True, slots=True)
+class Expanded:
+    """A URDF's text and the notes its expansion gave (xacro arguments taken from a launch file)."""
+
+    text: str
+    notes: tuple[str, ...] = ()
+
+
+def expand(source: Path, roots: Sequence[Path], limits: FileLimits = LIMITS,
+           args: Mapping[str, str] | None = None) -> str:
+    """The URDF text of a .urdf file, or of a .xacro expanded by `xacro_sandbox` (see `expanded`)."""
+    return expanded(source, roots, limits, args).text
+
+
+def expanded(source: Path, roots: Sequence[Path], limits: FileLimits = LIMITS,
+             args: Mapping[str, str] | None = None) -> Expanded:
     """The URDF text of a .urdf file, or of a .xacro expanded by `xacro_sandbox` in a process of its
     own: only files below `roots` are read, no Python runs from the file, and the expansion ends
-    after `limits.xacro_cpu_s` CPU seconds or `limits.xacro_memory` bytes with a message."""
+    after `limits.xacro_cpu_s` CPU seconds or `limits.xacro_memory` bytes with a message.
+
+    `args` are xacro arguments (name -> value, as `name:=value` on xacro's command line); those not
+    given take the values the package's `launch/load_<robot>.launch` passes where they resolve
+    (`xacro_sandbox.Expansion.launch_defaults`; each noted), else the file's defaults."""
     if source.suffix != ".xacro":
-        return read_text(source, limits.urdf, RobotModelError, "URDF")
+        if args:
+            raise RobotModelError(source, "--xacro-arg", "xacro arguments are given for a URDF, not a .xacro")
+        return Expanded(read_text(source, limits.urdf, RobotModelError, "URDF"))
     checked_file(source, limits.urdf, RobotModelError, "xacro file")
     request = {
         "source": os.path.realpath(source), "roots": [str(r) for r in roots], "parent": os.getpid(),
+        "args": dict(args or {}),
         "max_file_bytes": limits.urdf, "max_yaml_bytes": limits.description, "max_output_chars": limits.urdf,
         "cpu_s": limits.xacro_cpu_s, "memory_bytes": limits.xacro_memory,
     }
@@ -158,7 +180,7 @@ def expand(source: Path, roots: Sequence[Path], limits: FileLimits = LIMITS) -> 
         raise RobotModelError(source, None, f"xacro expansion ended abnormally ({how}; {memory}?)"
                               + (f": {tail}" if tail else ""))
     if "urdf" in answer:
-        return str(answer["urdf"])
+        return Expanded(str(answer["urdf"]), tuple(str(n) for n in answer.get("notes") or ()))
     if answer.get("kind") == "memory":
         raise RobotModelError(answer.get("file") or source, None, memory)
     raise RobotModelError(answer.get("file") or source, answer.get("where"), str(answer.get("problem")))
@@ -320,14 +342,15 @@ def _fit(model: object, frame_id: int, solver: str | None) -> tuple[str, object,
 def import_urdf(
     source: Path, out: Path, packages: Sequence[Path] = (), *, name: str | None = None, flange: str = "tool0",
     srdf: Path | None = None, solver: str | None = None, brand: str | None = None, force: bool = False,
-    limits: FileLimits = LIMITS,
+    limits: FileLimits = LIMITS, xacro_args: Mapping[str, str] | None = None,
 ) -> ImportResult:
     """Write the robot folder `out` from `source` (.urdf or .xacro); see the module docstring.
 
     The source is untrusted data: files are read only below `packages` and the source's folder
     (`allowed_folders`), xacro runs in a bounded process without evaluating Python (`expand`),
     meshes are checked before they are read, every written path stays inside `out`, and nothing is
-    written until everything named has been checked.
+    written until everything named has been checked. `xacro_args` are the xacro arguments (name ->
+    value) as on xacro's command line (see `expanded`).
 
     Raises
     ------
@@ -347,14 +370,16 @@ def import_urdf(
     roots = allowed_folders(source, packages)
     parent = Path(os.path.abspath(out)).parent
     clean_stale_staging(parent)
-    text = expand(source, roots, limits)
+    expansion = expanded(source, roots, limits, xacro_args)
+    text = expansion.text
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:
         raise RobotModelError(source, None, f"not a valid URDF (XML): {exc}") from None
     if root.tag != "robot":
         raise RobotModelError(source, None, f"not a URDF: the root element is <{printable(root.tag)}>, not <robot>")
-    warnings = list(check_urdf(root, source))
+    warnings = [f"{source}: {note}" for note in expansion.notes]
+    warnings.extend(check_urdf(root, source))
     T_root_base = urdf_base_link(root, source)
     meshes, mesh_warnings = _collect_meshes(root, source, roots, limits)
     warnings.extend(mesh_warnings)
@@ -378,8 +403,9 @@ def import_urdf(
                     stage, name, urdf_name, flange, solver, brand, source, root, T_root_base,
                     None if srdf_text is None else f"{name}.srdf")
             except RobotModelError as exc:
-                raise _unstaged(exc, stage, source) from None
+                raise _unstaged(exc, stage, source, urdf_name) from None
             warnings.extend(w.replace(str(stage), str(out)) for w in robot_warnings if "limits." in w)
+            warnings.extend(_named_srdf(w, stage, source, urdf_name, srdf) for w in robot_warnings if ": srdf: " in w)
             unchanged = out.is_dir() and not out.is_symlink() and _digest(out) == _digest(stage)
             if not unchanged:
                 if os.path.lexists(out) and not force:
@@ -444,11 +470,11 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
     import pinocchio as pin
 
     from robomax_py.io.robot import load_robot_spec
-    from robomax_py.robot import load_robot
+    from robomax_py.robot import load_robot, urdf_model
     from robomax_py.robot.ik.fit import FitError
 
     try:
-        model = pin.buildModelFromUrdf(str(stage / urdf_name))
+        model = urdf_model((stage / urdf_name).read_text(encoding="utf-8"))
     except Exception as exc:  # Pinocchio raises plain errors for bad URDFs
         raise RobotModelError(source, None, f"cannot parse URDF: {exc}") from None
     if not model.existFrame(flange):
@@ -468,11 +494,19 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
     return solver_name, fk_error, spec, robot.warnings
 
 
-def _unstaged(exc: RobotModelError, stage: Path, source: Path) -> RobotModelError:
-    """An error met loading the staged folder, naming the source and the mesh paths as the URDF
-    names them in the folder rather than the staging folder that is about to vanish."""
+def _unstaged(exc: RobotModelError, stage: Path, source: Path, urdf_name: str) -> RobotModelError:
+    """An error met loading the staged folder, naming the source (for the URDF written there) and
+    the mesh paths as the URDF names them in the folder rather than the staging folder that is
+    about to vanish."""
     file = source if exc.file is None or exc.file.startswith(str(stage)) else exc.file
-    return RobotModelError(file, exc.key, exc.problem.replace(str(stage) + os.sep, ""))
+    problem = exc.problem.replace(str(stage) + os.sep, "").replace(f"URDF {urdf_name}", f"URDF {source.name}")
+    return RobotModelError(file, exc.key, problem)
+
+
+def _named_srdf(warning: str, stage: Path, source: Path, urdf_name: str, srdf: Path | None) -> str:
+    """A warning about the staged folder's SRDF, naming the user's SRDF and source instead."""
+    text = warning.replace(f"{stage / 'robot.yaml'}: srdf:", f"{srdf}:" if srdf is not None else "srdf:")
+    return text.replace(f"URDF {urdf_name}", f"URDF {source.name}").replace(str(stage) + os.sep, "")
 
 
 def _copy(real: Path, dst: Path, limit: int, source: Path, local: str) -> None:

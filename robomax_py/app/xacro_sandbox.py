@@ -61,6 +61,8 @@ MAX_LOG_CHARS = 20_000
 
 _PACKAGE_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
 _GLOB_CHARS = re.compile(r"[*?\[]")
+# name:=value on a xacro command line; the value runs to a space outside $(...)
+_MAPPING = re.compile(r"([A-Za-z_][A-Za-z0-9_]*):=((?:\$\([^()]*\)|[^\s\"'$])+)")
 
 # The functions a `${...}` may call, by the names xacro files use (xacro exposes math's names at
 # the top level and in `math.`; the builtins are those it has exposed for years, minus `map`,
@@ -355,6 +357,10 @@ class Expansion:
         ns_xacro = xacro.NameSpace()
         ns_xacro.update(helpers)
         self.symbols.update(math=ns_math, xacro=ns_xacro)
+        # xacro before 1.14 offered `load_yaml` at the top level only (motoman_es_support's
+        # es165_macro.xacro `${load_yaml(joint_velocities_file)}`); xacro still accepts it there.
+        self.symbols["load_yaml"] = helpers["load_yaml"]
+        self.launch_hints: list[str] = []       # launch-file values for arguments left unset
         self.extension_functions: dict[str, Any] = {
             **FUNCTIONS, "true": True, "false": False, "True": True, "False": False,
             "arg": self.arg_fn, "dirname": self.dirname_fn, "find": self.find_fn,
@@ -444,9 +450,90 @@ class Expansion:
     def load_yaml(self, filename: Any) -> Any:
         if not isinstance(filename, str):
             self.refuse("xacro.load_yaml", f"expects a file name, got a {type(filename).__name__}")
+        if not filename.strip():
+            self.refuse("xacro.load_yaml('')", "names no file" + self.unset_arguments())
         path = self.x.abs_filename_spec(filename)
+        if os.path.isdir(path):
+            self.refuse(f"xacro.load_yaml({shown(filename)!r})", "names a folder, not a file" + self.unset_arguments())
         real = self.readable(path, self.max_yaml_bytes, f"xacro.load_yaml({shown(filename)!r})")
         return self.original_load_yaml(real)
+
+    def unset_arguments(self) -> str:
+        """The xacro arguments left empty, for a message: a file name built from one names nothing."""
+        args = self.x.substitution_args_context.get("arg", {})
+        empty = sorted(name for name, value in args.items() if str(value).strip() == "")
+        if not empty:
+            return ""
+        names = ", ".join(empty)
+        return (f": the xacro argument {names} is empty (its default); give it with --xacro-arg {empty[0]}:=VALUE"
+                + "".join(f"; {hint}" for hint in self.launch_hints))
+
+    # -- the package's launch file
+    def launch_defaults(self, source: str, given: Mapping[str, str]) -> tuple[dict[str, str], list[str]]:
+        """The xacro arguments the package's `launch/load_<robot>.launch` passes on the xacro command
+        line for `source` (ROS-Industrial's convention, motoman_es_support/launch/load_es165.launch
+        `joint_velocities_file:=$(find motoman_es_support)/config/joint_velocities_$(arg controller).yaml`),
+        but those in `given`; a value is used when its `$(find pkg)` and `$(arg name)` resolve (from
+        `given`, else the launch file's own `<arg default|value>`), else it becomes a hint for the
+        message should the expansion fail. Returns the values and one note per value used."""
+        real = os.path.realpath(source)
+        stem = os.path.splitext(os.path.basename(real))[0]
+        launch = os.path.join(os.path.dirname(os.path.dirname(real)), "launch", f"load_{stem}.launch")
+        if not os.path.isfile(launch) or not self.inside(launch):
+            return {}, []
+        try:
+            import xml.dom.minidom
+            import xml.parsers.expat
+
+            with open(self.readable(launch, self.max_file_bytes, "launch file"), "rb") as f:
+                dom = xml.dom.minidom.parseString(f.read(self.max_file_bytes + 1))
+        except (Refused, OSError, ValueError, self.x.XacroException, xml.parsers.expat.ExpatError):
+            return {}, []
+        launch_args = {}
+        for el in dom.getElementsByTagName("arg"):
+            for attr in ("value", "default"):
+                if el.hasAttribute(attr):
+                    launch_args[el.getAttribute("name")] = el.getAttribute(attr)
+                    break
+        found: dict[str, str] = {}
+        notes: list[str] = []
+        for el in dom.getElementsByTagName("*"):
+            command = el.getAttribute("command")
+            if os.path.basename(real) not in command:
+                continue
+            for name, raw in _MAPPING.findall(command.split(os.path.basename(real), 1)[1]):
+                if name in given or name in found:
+                    continue
+                value, missing = self.launch_value(raw, {**launch_args, **given})
+                if missing is None:
+                    found[name] = value
+                    notes.append(f"xacro argument {name}:={value} from {launch}")
+                else:
+                    self.launch_hints.append(f"{launch} passes {name}:={raw} ({missing})")
+        return found, notes
+
+    def launch_value(self, raw: str, args: Mapping[str, str]) -> tuple[str, str | None]:
+        """A launch file's argument value with `$(find pkg)` and `$(arg name)` resolved, and None;
+        or what is missing."""
+        missing: list[str] = []
+
+        def one(m: re.Match[str]) -> str:
+            words = m.group(1).split()
+            if len(words) == 2 and words[0] == "arg":
+                if words[1] in args:
+                    return str(args[words[1]])
+                missing.append(f"the launch argument {words[1]} has no default: --xacro-arg {words[1]}:=VALUE sets it")
+            elif len(words) == 2 and words[0] == "find":
+                try:
+                    return self.find(words[1])
+                except (Refused, self.x.XacroException):
+                    missing.append(f"no package {words[1]}")
+            else:
+                missing.append(f"$({shown(m.group(1))}) is not resolved here")
+            return ""
+
+        value = re.sub(r"\$\(([^()]*)\)", one, raw)
+        return value, "; ".join(missing) if missing else None
 
     # -- $(...)
     def extension(self, text: str) -> Any:
@@ -509,7 +596,9 @@ class Expansion:
         return self.message("error:", *args)
 
     # -- the expansion itself
-    def run(self, source: str) -> str:
+    def run(self, source: str, args: Mapping[str, str] | None = None) -> str:
+        """The expanded URDF of `source`, xacro arguments `args` (name -> value) set as on xacro's
+        command line."""
         x = self.x
         saved = {name: getattr(x, name) for name in ("safe_eval", "eval_extension", "parse", "get_include_files",
                                                      "load_yaml", "_global_symbols")}
@@ -520,7 +609,7 @@ class Expansion:
         x.load_yaml = self.load_yaml
         x._global_symbols = self.symbols
         try:
-            doc = x.process_file(source)
+            doc = x.process_file(source, mappings=dict(args or {}))
             return str(doc.toprettyxml(indent="  "))
         finally:
             for name, value in saved.items():
@@ -628,8 +717,10 @@ def serve(request: Mapping[str, Any]) -> dict[str, Any]:
     expansion = Expansion(xacro, request["roots"], int(request["max_file_bytes"]), int(request["max_yaml_bytes"]))
     log = _Log()
     sys.stderr = log
+    given = {str(k): str(v) for k, v in dict(request.get("args") or {}).items()}
     try:
-        text = expansion.run(request["source"])
+        defaults, notes = expansion.launch_defaults(request["source"], given)
+        text = expansion.run(request["source"], {**defaults, **given})
     except Exception as exc:  # noqa: BLE001 - xacro raises XacroException, KeyError, NameError, ExpatError, ...
         cause = _cause(exc)
         where = expansion.current_file()
@@ -649,7 +740,7 @@ def serve(request: Mapping[str, Any]) -> dict[str, Any]:
         return {"kind": "size", "file": request["source"], "where": None,
                 "problem": f"the expanded URDF has {len(text)} characters, more than the "
                            f"{int(request['max_output_chars']) / 2**20:.0f} MB allowed"}
-    return {"urdf": text, "log": log.getvalue()}
+    return {"urdf": text, "log": log.getvalue(), "notes": notes}
 
 
 def main() -> int:

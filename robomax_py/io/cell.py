@@ -619,7 +619,7 @@ def load_cell_robot(cell: CellSpec) -> Any:
 
 def _home(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray:
     """`robot.home` in SI, checked against the URDF: deg -> rad, prismatic joints stay in metres."""
-    from robomax_py.robot import kinematic_model, prismatic_mask
+    from robomax_py.robot import active_joints, kinematic_model, prismatic_mask
 
     model = kinematic_model(robot)
     given = np.asarray(parsed.robot.home, dtype=float)
@@ -635,7 +635,7 @@ def _home(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray:
         unit, scale = ("m", 1.0) if prismatic[i] else ("deg", 180 / math.pi)
         raise CellFileError(
             path, f"robot.home[{i}]",
-            f"{model.names[i + 1]} = {given[i]:.3f} {unit} is outside its limits "
+            f"{model.names[active_joints(model)[i]]} = {given[i]:.3f} {unit} is outside its limits "
             f"[{lower[i] * scale:.3f}, {upper[i] * scale:.3f}] {unit}",
         )
     return home

@@ -435,7 +435,7 @@ _SHAPES = ("mesh", "box", "cylinder", "sphere", "capsule")
 def check_urdf(root: ET.Element, urdf: Path) -> tuple[str, ...]:
     """The checks every robot's URDF passes at load (`load_robot_spec`, and `import-urdf` before it
     writes anything): at most LIMITS.urdf_links links and joints; each revolute or prismatic joint
-    with finite limits lower < upper within JOINT_POSITION_BOUND and a velocity within
+    (but the passive `<mimic>` ones, whose limits are never used) with finite limits lower < upper within JOINT_POSITION_BOUND and a velocity within
     JOINT_VELOCITY_RANGE; collision geometry where the robot moves.
 
     Collision geometry: a URDF with `<visual>` but no `<collision>` geometry anywhere is refused
@@ -483,6 +483,11 @@ def _urdf_number(element: ET.Element, attr: str, default: float | None, urdf: Pa
 def _check_joint_limits(joint: ET.Element, urdf: Path) -> None:
     kind = joint.get("type", "")
     if kind not in JOINT_VELOCITY_RANGE:
+        return
+    if joint.find("mimic") is not None:
+        # A passive joint follows the joint it mimics: its own limits are never used (packages
+        # leave placeholders, abb_irb6700_support/urdf/irb6700_200_260_macro.xacro `piston_joint`
+        # velocity="100" m/s), so they are not checked.
         return
     key = f"joint {joint.get('name')}"
     limit = joint.find("limit")

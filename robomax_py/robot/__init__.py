@@ -6,18 +6,22 @@ from robomax_py.robot.model import (
     DEFAULT_TIME_TO_FULL_SPEED_S,
     JointLimits,
     RobotModel,
+    active_joints,
     checked_ik_params,
     fk_flange,
     fk_tcp,
     kinematic_model,
     load_robot,
+    mimic_relation,
     mount_tool,
+    passive_joints,
     prismatic_mask,
     reach,
+    urdf_model,
 )
 
 __all__ = [
     "DEFAULT_TIME_TO_FULL_ACCEL_S", "DEFAULT_TIME_TO_FULL_SPEED_S", "JointLimits", "RobotModel",
-    "checked_ik_params", "fk_flange", "fk_tcp", "kinematic_model", "load_robot", "mount_tool",
-    "prismatic_mask", "reach",
+    "active_joints", "checked_ik_params", "fk_flange", "fk_tcp", "kinematic_model", "load_robot", "mimic_relation", "mount_tool",
+    "passive_joints", "prismatic_mask", "reach", "urdf_model",
 ]

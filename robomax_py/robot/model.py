@@ -80,15 +80,108 @@ class RobotModel:
                                              for k in ("velocity", "acceleration", "jerk")})
 
 
+# A `<mimic>` joint (a parallelogram link, a balancer's cylinder and piston) is passive: its value
+# follows the joint it mimics (multiplier * q + offset), it has no configuration entry of its own
+# and takes no part in IK or programs; its link moves and collides like every other. Pinocchio
+# models it so when the URDF is read with `mimic=True` (JointModelMimic, nq = nv = 0), but the
+# installed Pinocchio refuses a `continuous` joint mimicking a revolute one (their configuration
+# spaces differ: cos/sin against an angle), the form ROS-Industrial ABB packages use for their
+# balancers (abb_irb6640_support/urdf/irb6640_185_280_macro.xacro `joint_piston`). Its value
+# follows a bounded joint, so it is read as a revolute joint with limits of a full turn either way.
+_MIMIC_CONTINUOUS_LIMIT_RAD = 2 * np.pi
+
+
+# Pinocchio's URDF reader walks the link tree depth first, a link's child joints in the order of
+# their names (urdfdom keeps joints in a sorted map), and refuses a mimic joint met before the joint
+# it follows ("The parent joint of the mimic joint is not in the kinematic tree"): the IRB 6700's
+# `cylinder_joint` hangs from link_1 beside `joint_2`, which it follows
+# (abb_irb6700_support/urdf/irb6700_200_260_macro.xacro). Pinocchio therefore reads every mimic
+# joint under a name sorting after all others (this prefix; `~` is the last printable ASCII
+# character), so that it meets each after its active siblings, and `urdf_model` gives the names back.
+_PASSIVE_PREFIX = "~"
+
+
+def pinocchio_urdf_text(text: str) -> str:
+    """A URDF's text as `urdf_model` hands it to Pinocchio: `continuous` mimic joints made revolute
+    and mimic joints renamed (see above); the text unchanged when it has none."""
+    import xml.etree.ElementTree as ET
+
+    if "mimic" not in text:
+        return text
+    root = ET.fromstring(text)
+    joints = [joint for joint in root.findall("joint") if joint.find("mimic") is not None]
+    if not joints:
+        return text
+    passive = {str(joint.get("name")) for joint in joints}
+    for joint in joints:
+        joint.set("name", _PASSIVE_PREFIX + str(joint.get("name")))
+        mimic = joint.find("mimic")
+        if mimic is not None and mimic.get("joint") in passive:
+            mimic.set("joint", _PASSIVE_PREFIX + str(mimic.get("joint")))
+        if joint.get("type") != "continuous":
+            continue
+        joint.set("type", "revolute")
+        limit = joint.find("limit")
+        if limit is None:
+            limit = ET.SubElement(joint, "limit", {"effort": "0", "velocity": "1"})
+        limit.set("lower", repr(-_MIMIC_CONTINUOUS_LIMIT_RAD))
+        limit.set("upper", repr(_MIMIC_CONTINUOUS_LIMIT_RAD))
+    return ET.tostring(root, encoding="unicode")
+
+
+def urdf_model(text: str) -> pin.Model:
+    """Pinocchio's model of a URDF's text, `<mimic>` joints as passive joints (JointModelMimic)."""
+    model = pin.buildModelFromXML(pinocchio_urdf_text(text), mimic=True)
+    for j in range(1, model.njoints):
+        if model.names[j].startswith(_PASSIVE_PREFIX) and is_passive(model, j):
+            model.names[j] = model.names[j][len(_PASSIVE_PREFIX):]
+    for frame in model.frames:
+        if frame.type == pin.FrameType.JOINT and frame.name.startswith(_PASSIVE_PREFIX) and is_passive(model, frame.parentJoint):
+            frame.name = frame.name[len(_PASSIVE_PREFIX):]
+    return model
+
+
+def is_passive(model: pin.Model, j: int) -> bool:
+    """Joint j follows another joint (`<mimic>`): no configuration entry of its own."""
+    return bool(model.joints[j].shortname() == "JointModelMimic")
+
+
+def active_joints(model: pin.Model) -> list[int]:
+    """The joint ids that own a configuration entry, in configuration order (passive ones left out)."""
+    return sorted((j for j in range(1, model.njoints) if not is_passive(model, j)), key=lambda j: int(model.joints[j].idx_q))
+
+
+def passive_joints(model: pin.Model) -> list[int]:
+    """The ids of the `<mimic>` joints."""
+    return [j for j in range(1, model.njoints) if is_passive(model, j)]
+
+
+def mimic_relation(model: pin.Model, j: int) -> tuple[int, float, float]:
+    """A passive joint's relation: (configuration index it follows, multiplier, offset)."""
+    mimic = model.joints[j].extract()
+    return int(mimic.idx_q), float(mimic.scaling), float(mimic.offset)
+
+
+def _urdf_text(urdf: Path, error_file: Path) -> str:
+    from robomax_py.safe_files import LIMITS, named_by, read_text
+
+    return read_text(urdf, LIMITS.urdf, named_by(RobotModelError, error_file, "urdf"), f"URDF {urdf}")
+
+
 def kinematic_model(spec: RobotSpec) -> pin.Model:
-    """The URDF's Pinocchio model, checked: single-axis joints, finite limits, the flange frame exists."""
+    """The URDF's Pinocchio model, checked: single-axis active joints, finite limits, the flange
+    frame exists. `<mimic>` joints are passive (see `urdf_model`)."""
     try:
-        model = pin.buildModelFromUrdf(str(spec.urdf))
+        model = urdf_model(_urdf_text(spec.urdf, spec.source))
+    except RobotModelError:
+        raise
     except Exception as exc:  # Pinocchio raises plain RuntimeError/ValueError for bad URDFs
         raise RobotModelError(spec.urdf, None, f"cannot parse URDF: {exc}") from None
     if not model.existFrame(spec.flange):
         raise RobotModelError(spec.source, "flange", f"URDF {spec.urdf.name} has no frame '{spec.flange}'")
     for j in range(1, model.njoints):
+        if is_passive(model, j):
+            continue
         if model.joints[j].nq != 1 or model.joints[j].nv != 1:
             raise RobotModelError(spec.urdf, f"joint {model.names[j]}", "only revolute and prismatic joints are supported")
         i = model.joints[j].idx_q
@@ -102,7 +195,7 @@ def kinematic_model(spec: RobotSpec) -> pin.Model:
 
 def prismatic_mask(model: pin.Model) -> np.ndarray:
     """(n,) bool: which joints are prismatic (their values are metres, not radians)."""
-    return np.array([model.joints[j].shortname().startswith("JointModelP") for j in range(1, model.njoints)])
+    return np.array([model.joints[j].shortname().startswith("JointModelP") for j in active_joints(model)])
 
 
 def load_robot(spec: RobotSpec) -> RobotModel:
@@ -113,17 +206,17 @@ def load_robot(spec: RobotSpec) -> RobotModel:
     """
     model = kinematic_model(spec)
     ik_params = checked_ik_params(spec, model)
-    disabled = _disabled_links(spec, model)
+    disabled, srdf_warnings = _disabled_links(spec, model)
     n = model.nq
     lower = np.array(model.lowerPositionLimit, dtype=float)
     upper = np.array(model.upperPositionLimit, dtype=float)
     velocity = np.array(model.velocityLimit, dtype=float)
-    names = tuple(model.names[j] for j in range(1, model.njoints))
+    names = tuple(model.names[j] for j in active_joints(model))
     acceleration = _limit_vector(spec, "acceleration", spec.acceleration, velocity / DEFAULT_TIME_TO_FULL_SPEED_S, n)
     jerk = _limit_vector(spec, "jerk", spec.jerk, acceleration / DEFAULT_TIME_TO_FULL_ACCEL_S, n)
 
     package_dirs = [str(spec.urdf.parent), *[str(d) for d in spec.package_dirs]]
-    warnings: list[str] = list(spec.warnings)
+    warnings: list[str] = [*spec.warnings, *srdf_warnings]
     collision = _geometry(model, spec, pin.GeometryType.COLLISION, package_dirs)
     try:
         visual = _geometry(model, spec, pin.GeometryType.VISUAL, package_dirs)
@@ -174,7 +267,8 @@ def checked_ik_params(spec: RobotSpec, model: pin.Model) -> Any:
         return spec.ik_params
     if model.nq != 6:
         raise RobotModelError(spec.source, "ik.solver", f"the {spec.ik_solver} solver is for six joints; the URDF "
-                              f"{spec.urdf.name} has {model.nq} ({', '.join(model.names[1:])}): use numeric or table")
+                              f"{spec.urdf.name} has {model.nq} ({', '.join(model.names[j] for j in active_joints(model))}): "
+                              "use numeric or table")
     frame_id = int(model.getFrameId(spec.flange))
     params = spec.ik_params
     origin = "ik.params"
@@ -215,16 +309,27 @@ def _table_steps(spec: RobotSpec, model: pin.Model) -> Any:
     return out
 
 
-def _disabled_links(spec: RobotSpec, model: pin.Model) -> frozenset[frozenset[str]]:
+def _disabled_links(spec: RobotSpec, model: pin.Model) -> tuple[frozenset[frozenset[str]], tuple[str, ...]]:
+    """The link pairs exempt from collision checks, and warnings.
+
+    robot.yaml's own `collision.disable` must name links of the URDF. An SRDF's pair naming a link
+    the URDF lacks is skipped with a warning, as MoveIt does (srdfdom's model.cpp: "Link ... is not
+    known to URDF. Cannot disable collisions."): a package's SRDF lists the links of the package's
+    URDF, passive links too, and a URDF edited down still loads with it."""
     links = {f.name for f in model.frames if f.type == pin.FrameType.BODY}
-    for key, pairs in (("collision.disable", spec.disabled_links), ("srdf", spec.srdf_disabled_links)):
-        for i, pair in enumerate(pairs):
-            for name in pair:
-                if name not in links:
-                    where = f"{key}[{i}]" if key == "collision.disable" else key
-                    raise RobotModelError(spec.source, where, f"link '{name}' is not in the URDF {spec.urdf.name} "
-                                          f"(links: {', '.join(sorted(links))})")
-    return frozenset(frozenset(p) for p in (*spec.disabled_links, *spec.srdf_disabled_links))
+    for i, pair in enumerate(spec.disabled_links):
+        for name in pair:
+            if name not in links:
+                raise RobotModelError(spec.source, f"collision.disable[{i}]", f"link '{name}' is not in the URDF "
+                                      f"{spec.urdf.name} (links: {', '.join(sorted(links))})")
+    srdf = [p for p in spec.srdf_disabled_links if set(p) <= links]
+    missing = sorted({name for p in spec.srdf_disabled_links for name in p} - links)
+    warnings: tuple[str, ...] = ()
+    if missing:
+        skipped = len(spec.srdf_disabled_links) - len(srdf)
+        warnings = ((f"{spec.source}: srdf: {skipped} disable_collisions pair(s) name links the URDF "
+                     f"{spec.urdf.name} does not have ({', '.join(missing)}); skipped"),)
+    return frozenset(frozenset(p) for p in (*spec.disabled_links, *srdf)), warnings
 
 
 def mount_tool(robot: RobotModel, T_flange_tcp: FloatArray) -> RobotModel:
@@ -324,8 +429,9 @@ def _geometry(model: pin.Model, spec: RobotSpec, kind: Any, package_dirs: list[s
 
 
 def _build_geometry(model: pin.Model, spec: RobotSpec, kind: Any, package_dirs: list[str]) -> pin.GeometryModel:
+    text = pinocchio_urdf_text(_urdf_text(spec.urdf, spec.source))
     try:
-        return pin.buildGeomFromUrdf(model, str(spec.urdf), kind, package_dirs=package_dirs)
+        return pin.buildGeomFromUrdfString(model, text, kind, package_dirs=package_dirs)
     except Exception as exc:  # a missing or unreadable mesh surfaces here
         raise RobotModelError(spec.urdf, None, f"cannot load link geometry: {exc}") from None
 

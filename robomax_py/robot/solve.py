@@ -17,7 +17,7 @@ import numpy as np
 
 from robomax_py._typing import BoolArray, FloatArray, IntArray
 from robomax_py.errors import RobotModelError
-from robomax_py.robot.ik._chain import chain_to_frame, revolute_mask
+from robomax_py.robot.ik._chain import active_positions, chain_to_frame, revolute_mask
 from robomax_py.robot.ik.config import (
     ConfigIndicator,
     brand_text,
@@ -180,7 +180,8 @@ def ik_table_bytes(robot: RobotModel, poses: int) -> int:
 
 def _has_status(model: Any, frame_id: int) -> bool:
     chain = chain_to_frame(model, frame_id)
-    return len(chain.joints) >= 5 and bool(np.all(chain.revolute[:5]))
+    act = active_positions(chain)
+    return len(act) >= 5 and bool(np.all(chain.revolute[act[:5]]))
 
 
 def _by_status(q: FloatArray, valid: BoolArray, status: IntArray) -> tuple[FloatArray, BoolArray, IntArray]:

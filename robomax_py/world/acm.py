@@ -80,7 +80,7 @@ class CollisionOptions:
 class DisabledPair:
     piece_a: str
     piece_b: str
-    reason: str      # "rigid" | "adjacent" | "disabled in robot.yaml" | "tips on workpiece" | "fixed base" | "tool touches flange link" | "never close"
+    reason: str      # "rigid" | "adjacent" | "disabled in robot.yaml" | "tips on workpiece" | "fixed base" | "tool touches flange link" | "never close" | "passive linkage: ..."
 
 
 @dataclass(frozen=True, slots=True)
@@ -235,7 +235,8 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
 
     provable = {
         (a, b) for a, b in self_candidates
-        if 0 < len(joint_path(model, pieces[a].joint, pieces[b].joint) or ()) <= options.acm_proof_joints
+        if 0 < len(path := joint_path(model, pieces[a].joint, pieces[b].joint) or []) <= options.acm_proof_joints
+        and not _passive_on(model, path)
     }
     n_self = sum(1 for p in pieces if p.kind in ROBOT_KINDS)
     bounds = KinematicBounds.of(model)
@@ -251,6 +252,13 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
         a, b = pair
         if pair in sampled.flange_touch:
             disabled.append(DisabledPair(pieces[a].name, pieces[b].name, "tool touches flange link"))
+        elif pair in sampled.always_touch and (_is_passive_piece(model, pieces[a].joint)
+                                               or _is_passive_piece(model, pieces[b].joint)):
+            # A passive link (a balancer's cylinder or piston, a parallelogram bar) closes a
+            # linkage: it meets the links it is pinned to by design, in every posture. MoveIt's
+            # Setup Assistant disables such pairs too ("Always" / "Default"); a pair that separates
+            # in some sample stays checked.
+            disabled.append(DisabledPair(pieces[a].name, pieces[b].name, "passive linkage: touching in every sample"))
         elif pair in proved_far:
             disabled.append(DisabledPair(pieces[a].name, pieces[b].name, "never close"))
         else:
@@ -456,7 +464,7 @@ def _prove_never_close(
         ja, jb = int(gm.geometryObjects[a].parentJoint), int(gm.geometryObjects[b].parentJoint)
         distal = b if ja < jb else a
         path = joint_path(model, ja, jb)
-        if path is None or not 0 < len(path) <= options.acm_proof_joints:
+        if path is None or not 0 < len(path) <= options.acm_proof_joints or _passive_on(model, path):
             continue
         groups.setdefault(tuple(path), []).append((a, b, distal))
     proved: set[tuple[int, int]] = set()
@@ -540,3 +548,11 @@ def _layout_contacts(gm: pin.GeometryModel, pieces: list[Piece], pairs: list[tup
     return tuple(out)
 
 
+def _passive_on(model: pin.Model, path: list[int]) -> bool:
+    """A passive (`<mimic>`) joint lies on the path: the proof's box over the path's joint values
+    takes each joint as free, which a joint following another is not; such pairs stay checked."""
+    return any(model.joints[k].nq == 0 for k in path)
+
+
+def _is_passive_piece(model: pin.Model, joint: int) -> bool:
+    return joint > 0 and model.joints[joint].nq == 0

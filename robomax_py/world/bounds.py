@@ -47,6 +47,7 @@ class KinematicBounds:
     axis: FloatArray          # (njoints, 3) unit axis of each joint in its own frame
     prismatic: BoolArray      # (njoints,)
     travel: FloatArray        # (njoints,) m, largest |q| of prismatic joints (0 for revolute)
+    scale: FloatArray         # (njoints,) |multiplier| of a passive (`<mimic>`) joint, else 1
 
     @staticmethod
     def of(model: pin.Model) -> KinematicBounds:
@@ -57,7 +58,16 @@ class KinematicBounds:
         pin.computeJointJacobians(model, data, pin.neutral(model))
         axis = np.zeros((njoints, 3))
         travel = np.zeros(njoints)
+        scale = np.ones(njoints)
         for j in range(1, njoints):
+            if model.joints[j].nq == 0:
+                axis[j], prismatic[j], scale[j] = _mimic_axis(model, j)
+                if prismatic[j]:
+                    mimic = model.joints[j].extract()
+                    i = int(mimic.idx_q)
+                    travel[j] = scale[j] * max(abs(model.lowerPositionLimit[i]), abs(model.upperPositionLimit[i])) \
+                        + abs(float(mimic.offset))
+                continue
             J = pin.getJointJacobian(model, data, j, pin.ReferenceFrame.LOCAL)
             col = np.asarray(J[:, model.joints[j].idx_v], dtype=float)
             vec = col[:3] if prismatic[j] else col[3:]
@@ -65,7 +75,7 @@ class KinematicBounds:
             if prismatic[j]:
                 i = model.joints[j].idx_q
                 travel[j] = max(abs(model.lowerPositionLimit[i]), abs(model.upperPositionLimit[i]))
-        return KinematicBounds(model=model, axis=axis, prismatic=prismatic, travel=travel)
+        return KinematicBounds(model=model, axis=axis, prismatic=prismatic, travel=travel, scale=scale)
 
     def piece_lever(self, k: int, geometry_object: Any) -> float:
         """Bound (m per rad; 1 for a prismatic k) of dist(p, axis_k) over the piece's points p and all q.
@@ -92,7 +102,9 @@ class KinematicBounds:
         return d_c + chain + float(np.max(np.linalg.norm(pts, axis=1)))
 
     def lever_arms(self, gm: pin.GeometryModel, moving: list[bool]) -> FloatArray:
-        """(n,) per joint: the largest `piece_lever` over every moving piece (robot and tool)."""
+        """(n,) per joint: the largest `piece_lever` over every moving piece (robot and tool). A
+        passive (`<mimic>`) joint turns with the joint it follows, |multiplier| times as fast: its
+        lever, so scaled, adds to that joint's (a bound: the sum of the two largest levers)."""
         lever = np.zeros(self.model.nq)
         for k in range(1, self.model.njoints):
             idx = self.model.joints[k].idx_q
@@ -100,8 +112,29 @@ class KinematicBounds:
             for g, is_moving in zip(gm.geometryObjects, moving):
                 if is_moving and g.parentJoint != 0:
                     best = max(best, self.piece_lever(k, g))
-            lever[idx] = best
+            lever[idx] += self.scale[k] * best
         return lever
+
+
+def _mimic_axis(model: pin.Model, j: int) -> tuple[FloatArray, bool, float]:
+    """A passive joint's unit axis in its own frame, whether it slides, and |multiplier|: from its
+    motion when the joint it follows moves by 1 / multiplier (Pinocchio's JointModelMimic)."""
+    mimic = model.joints[j].extract()
+    scale = float(mimic.scaling)
+    if scale == 0.0:
+        return np.array([0.0, 0.0, 1.0]), False, 0.0
+    data = mimic.createData()
+    q = np.zeros(model.nq)
+    mimic.calc(data, q)
+    M0 = data.M.copy()
+    q[int(mimic.idx_q)] = 1.0 / scale
+    mimic.calc(data, q)
+    step = M0.inverse() * data.M
+    turn = np.asarray(pin.log3(step.rotation), dtype=float)
+    if np.linalg.norm(turn) > 1e-9:
+        return turn / np.linalg.norm(turn), False, abs(scale)
+    slide = np.asarray(step.translation, dtype=float)
+    return slide / np.linalg.norm(slide), True, abs(scale)
 
 
 def joint_path(model: pin.Model, i: int, j: int) -> list[int] | None:

@@ -27,7 +27,11 @@ class Chain:
     configuration is K_0 Z(q_0) K_1 Z(q_1) ... K_{n-1} Z(q_{n-1}) K_n with constant K_i = A_{i-1}^T P_i A_i
     (P_i the joint placement) and Z a rotation about (or translation along) z: cheap column updates.
 
-    joints : Pinocchio joint ids, root first; q_index : their index in q.
+    joints : Pinocchio joint ids, root first; q_index : their index in q (for a passive joint, the
+    index of the joint it follows).
+    scale, offset : (len(joints),) float; joint i moves by scale_i * q[q_index_i] + offset_i (1 and 0
+    for the active joints, a `<mimic>` joint's multiplier and offset for the passive ones).
+    active : (len(joints),) bool; False = passive.
     revolute : (len(joints),) bool; False = prismatic.
     K : (len(joints) + 1, 4, 4) the constant factors above (K_n carries the frame placement).
     A : (len(joints), 4, 4) the axis-aligning rotations.
@@ -36,6 +40,9 @@ class Chain:
 
     joints: tuple[int, ...]
     q_index: tuple[int, ...]
+    scale: FloatArray
+    offset: FloatArray
+    active: BoolArray
     revolute: BoolArray
     K: FloatArray
     A: FloatArray
@@ -46,6 +53,8 @@ def revolute_mask(model: pin.Model) -> BoolArray:
     """(nq,) bool: which configuration entries belong to revolute joints."""
     mask = np.zeros(model.nq, dtype=bool)
     for j in range(1, model.njoints):
+        if model.joints[j].nq == 0:          # a passive (`<mimic>`) joint owns no entry
+            continue
         mask[model.joints[j].idx_q] = model.joints[j].shortname().startswith("JointModelR")
     return mask
 
@@ -88,15 +97,29 @@ def _chain(model: pin.Model, last: int, T_joint_frame: FloatArray) -> Chain:
     A = np.empty((n, 4, 4))
     K = np.empty((n + 1, 4, 4))
     revolute = np.empty(n, dtype=bool)
+    active = np.ones(n, dtype=bool)
+    scale = np.ones(n)
+    offset = np.zeros(n)
     q_index: list[int] = []
     prev_A_T = np.eye(4)
     for i, jid in enumerate(path):
         jm = model.joints[jid]
-        if jm.nq != 1 or jm.nv != 1:
-            raise RobotModelError(None, f"joint {model.names[jid]}", "only revolute and prismatic joints are supported")
         jd = jm.createData()
-        jm.calc(jd, np.zeros(1))
-        S = np.asarray(jd.S).reshape(6)                      # motion subspace: linear, angular
+        if jm.shortname() == "JointModelMimic":
+            # Pinocchio's mimic joint reads q[idx_q] of the joint it follows; its motion subspace
+            # is the mimicking joint's own axis times the multiplier.
+            mimic = jm.extract()
+            active[i] = False
+            scale[i], offset[i] = float(mimic.scaling), float(mimic.offset)
+            if scale[i] == 0.0:
+                raise RobotModelError(None, f"joint {model.names[jid]}", "<mimic multiplier=0>: the joint never moves (make it fixed)")
+            jm.calc(jd, np.zeros(model.nq))
+            S = np.asarray(jd.S).reshape(6) / scale[i]
+        elif jm.nq != 1 or jm.nv != 1:
+            raise RobotModelError(None, f"joint {model.names[jid]}", "only revolute and prismatic joints are supported")
+        else:
+            jm.calc(jd, np.zeros(1))
+            S = np.asarray(jd.S).reshape(6)                  # motion subspace: linear, angular
         revolute[i] = bool(np.linalg.norm(S[3:]) > 0.5)
         axis = S[3:] if revolute[i] else S[:3]
         A[i] = _z_to(axis / np.linalg.norm(axis))
@@ -104,7 +127,13 @@ def _chain(model: pin.Model, last: int, T_joint_frame: FloatArray) -> Chain:
         prev_A_T = A[i].T
         q_index.append(int(jm.idx_q))
     K[n] = prev_A_T @ np.asarray(T_joint_frame, dtype=float)
-    return Chain(joints=tuple(path), q_index=tuple(q_index), revolute=revolute, K=K, A=A, nq=int(model.nq))
+    return Chain(joints=tuple(path), q_index=tuple(q_index), scale=scale, offset=offset, active=active,
+                 revolute=revolute, K=K, A=A, nq=int(model.nq))
+
+
+def active_positions(chain: Chain) -> list[int]:
+    """The positions in `chain.joints` of its active joints, root first."""
+    return [i for i in range(len(chain.joints)) if chain.active[i]]
 
 
 # Internally a pose batch is stored column-major as (4, 3, M): T[c] is column c (3, M) of the top
@@ -133,6 +162,8 @@ def _walk(chain: Chain, q: FloatArray) -> tuple[FloatArray, list[FloatArray]]:
     aligned: list[FloatArray] = []
     for i in range(len(chain.joints)):
         qi = q[:, chain.q_index[i]]
+        if not chain.active[i]:
+            qi = chain.scale[i] * qi + chain.offset[i]
         if chain.revolute[i]:
             c, s = np.cos(qi), np.sin(qi)
             x = T[0].copy()
@@ -194,23 +225,24 @@ def frame_pose_and_jacobian(chain: Chain, q: FloatArray) -> tuple[FloatArray, Fl
         World position of the frame, m.
     J : (M, 6, nq) float
         Rows 0-2: linear velocity of the frame origin (world axes); rows 3-5: angular velocity (world
-        axes), per unit joint velocity. Pinocchio calls this LOCAL_WORLD_ALIGNED.
+        axes), per unit joint velocity. Pinocchio calls this LOCAL_WORLD_ALIGNED. A passive joint adds
+        its multiplier times its own column to the column of the joint it follows.
     """
     q = np.asarray(q, dtype=float)
     T, aligned = _walk(chain, q)
     J = np.zeros((q.shape[0], 6, chain.nq))
     p = T[3]
     for i, Ti in enumerate(aligned):
-        w = Ti[2]
+        w = Ti[2] * chain.scale[i] if not chain.active[i] else Ti[2]
         col = chain.q_index[i]
         if chain.revolute[i]:
             r = p - Ti[3]
-            J[:, 0, col] = w[1] * r[2] - w[2] * r[1]
-            J[:, 1, col] = w[2] * r[0] - w[0] * r[2]
-            J[:, 2, col] = w[0] * r[1] - w[1] * r[0]
-            J[:, 3:, col] = w.T
+            J[:, 0, col] += w[1] * r[2] - w[2] * r[1]
+            J[:, 1, col] += w[2] * r[0] - w[0] * r[2]
+            J[:, 2, col] += w[0] * r[1] - w[1] * r[0]
+            J[:, 3:, col] += w.T
         else:
-            J[:, :3, col] = w.T
+            J[:, :3, col] += w.T
     return T[:3].transpose(1, 0, 2), p, J
 
 
@@ -225,11 +257,13 @@ class JointAxes:
 
 
 def joint_axes_at_zero(model: pin.Model, frame_id: int) -> JointAxes:
-    """The joint axes and origins of the chain to `frame_id` at q = 0 (for fitting and reach bounds)."""
+    """The active joint axes and origins of the chain to `frame_id` at q = 0 (for fitting and reach
+    bounds); passive joints on the chain are left out (their turn at q = 0 is their offset)."""
     chain = chain_to_frame(model, frame_id)
     F = joint_frames(chain, np.zeros((1, model.nq)))[0]
-    u = np.array([F[i, :3, :3] @ chain.A[i, :3, 2] for i in range(len(chain.joints))])
-    p = np.array([F[i, :3, 3] for i in range(len(chain.joints))])
+    act = active_positions(chain)
+    u = np.array([F[i, :3, :3] @ chain.A[i, :3, 2] for i in act])
+    p = np.array([F[i, :3, 3] for i in act])
     data = model.createData()
     pin.framesForwardKinematics(model, data, np.zeros(model.nq))
     return JointAxes(u / np.linalg.norm(u, axis=1, keepdims=True), p, np.asarray(data.oMf[frame_id].homogeneous))

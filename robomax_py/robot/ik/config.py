@@ -61,7 +61,7 @@ import pinocchio as pin
 
 from robomax_py._typing import BoolArray, FloatArray, IntArray
 from robomax_py.errors import ProgramError
-from robomax_py.robot.ik._chain import chain_to_frame, joint_frames
+from robomax_py.robot.ik._chain import active_positions, chain_to_frame, joint_frames
 from robomax_py.robot.ik.opw import OpwParams, to_paper_angles
 from robomax_py.transforms import closest_on_line
 
@@ -203,14 +203,15 @@ def status_generic(model: pin.Model, frame_id: int, q: FloatArray) -> IntArray:
     q = np.asarray(q, dtype=float)
     batch = q.shape[:-1]
     chain = chain_to_frame(model, frame_id)
-    if len(chain.joints) < 5 or not np.all(chain.revolute[:5]):
+    act = active_positions(chain)                  # the arm's axes (passive joints left out)
+    if len(act) < 5 or not np.all(chain.revolute[act[:5]]):
         return np.where(np.isnan(q).any(axis=-1), -1, 0).astype(np.int64)
     flat = q.reshape(-1, q.shape[-1])
     nan_rows: BoolArray = np.asarray(np.isnan(flat).any(axis=-1), dtype=bool)
     F = joint_frames(chain, np.where(nan_rows[:, None], 0.0, flat))     # (m, J, 4, 4)
-    n_axes = min(len(chain.joints), 6)
-    axis = [F[:, i, :3, :3] @ (chain.A[i, :3, 2]) for i in range(n_axes)]   # world joint axes
-    origin = [F[:, i, :3, 3] for i in range(n_axes)]
+    n_axes = min(len(act), 6)
+    axis = [F[:, act[i], :3, :3] @ (chain.A[act[i], :3, 2]) for i in range(n_axes)]   # world joint axes
+    origin = [F[:, act[i], :3, 3] for i in range(n_axes)]
     wrist = closest_on_line(origin[4], axis[4], origin[3], axis[3])           # axes 4 and 5
     wrist_56 = wrist if n_axes < 6 else closest_on_line(origin[4], axis[4], origin[5], axis[5])
 
@@ -230,7 +231,7 @@ def status_generic(model: pin.Model, frame_id: int, q: FloatArray) -> IntArray:
     cos_b = np.einsum("mi,mi->m", upper, fore)
     bit1 = (sin_b > 0) | ((sin_b == 0) & (cos_b > 0))
 
-    bit2 = _wrist_bit(flat[:, chain.q_index[4]])
+    bit2 = _wrist_bit(flat[:, chain.q_index[act[4]]])
     status = bit0 * 1 + bit1 * 2 + bit2 * 4
     return np.where(nan_rows, -1, status).astype(np.int64).reshape(batch)
 

@@ -68,6 +68,10 @@ class _Axes:
 
 def _axes_at_zero(model: pin.Model, frame_id: int) -> _Axes:
     chain = chain_to_frame(model, frame_id)
+    if not np.all(chain.active):
+        # An analytic solver takes q for the joints' own turns; a passive joint on the way (an offset
+        # wrist's second half) turns with another joint, so the numeric solver takes such arms.
+        raise FitError("a passive (<mimic>) joint lies on the chain to the flange")
     if len(chain.joints) != 6 or not np.all(chain.revolute):
         raise FitError(f"needs a chain of six revolute joints to the flange, found {len(chain.joints)} joints "
                        f"({int(np.sum(chain.revolute))} revolute)")
