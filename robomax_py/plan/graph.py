@@ -5,6 +5,7 @@ known free."""
 
 from __future__ import annotations
 
+import itertools
 import logging
 from collections import Counter
 from dataclasses import dataclass
@@ -58,6 +59,18 @@ MAX_BLOCKED_STRAIGHT = 24
 MAX_FAILED_DETOURS = 6
 # States of the coarse probe of a move between two stops that are not near neighbours.
 PROBE_STATES = 9
+# Withdrawing the gun off a flange (`Sequencer._withdrawn_detour`): directions perpendicular to the
+# electrode axis, distances (m; spots lie ~20 mm from the edge the C wraps round, and its jaws
+# reach a little past the electrodes), and exit pairs tried per detour.
+WITHDRAW_DIRECTIONS = 8
+WITHDRAW_M = (0.06, 0.12)
+WITHDRAW_PAIRS = 6
+
+
+def _distinct(path: FloatArray) -> FloatArray:
+    """The polyline without repeated waypoints."""
+    keep = [0] + [k for k in range(1, len(path)) if not np.allclose(path[k], path[k - 1])]
+    return path[keep]
 
 
 def _moves_of(order: tuple[int, ...]) -> set[tuple[int, int]]:
@@ -135,6 +148,7 @@ class Sequencer:
         self.unresolved: Counter[str] = Counter()                                 # move label -> rounds left open
         self.failed_detours: Counter[tuple[int, int]] = Counter()                 # unordered spot pair -> searches
         self.unconnected: set[tuple[int, int]] = set()                            # unordered spot pairs given up
+        self._exit_cache: dict[tuple[int, int], list[FloatArray]] = {}            # (spot, candidate) -> exits
 
     # ------------------------------------------------------------------ knowledge and costs
 
@@ -375,7 +389,7 @@ class Sequencer:
             if not np.isfinite(tour.cost):
                 given_up = ", ".join(f"{self._name(i)} - {self._name(j)}" for i, j in sorted(self.unconnected)[:6])
                 return SequencingOutcome("disconnected", message="no collision-free connection found between some "
-                                         "spots (roadmap exhausted)"
+                                         f"spots (roadmap exhausted): {self._dead_end(tour.order)}"
                                          + (f"; no detour found {MAX_FAILED_DETOURS} times between {given_up}"
                                             if given_up else ""))
             verified = self._verify(tour)
@@ -385,6 +399,17 @@ class Sequencer:
         worst = ", ".join(f"{label} ({n} rounds)" for label, n in self.unresolved.most_common(5))
         return SequencingOutcome("not_converged", message=f"sequencing did not converge in {self.options.max_rounds} "
                                  f"rounds; moves left without a verified connection most often: {worst}")
+
+    def _dead_end(self, order: tuple[int, ...]) -> str:
+        """The first move of an order that no candidate reached so far can make (what an infinite
+        tour cost means), named for the report."""
+        stops = (HOME, *order, HOME)
+        value = np.zeros(1)
+        for prev, nxt in itertools.pairwise(stops):
+            value = np.min(value[:, None] + self.full_cost(prev, nxt), axis=0)
+            if not np.isfinite(value).any():
+                return f"nothing known joins {self._name(prev)} -> {self._name(nxt)} in the best order found"
+        return "every order found has a move without a known connection"
 
     def _verify(self, tour: Tour) -> _TourCheck:
         """Transitions of the tour, complete when every leg is known free; else learn from every leg."""
@@ -459,7 +484,7 @@ class Sequencer:
         where the clamps of the row above block the way up on a stacked flange); then both at once.
         """
         qa, qb = self.q(i)[a], self.q(j)[b]
-        up = invert(np.asarray(self.cell.T_world_base))[:3, :3] @ np.array([0.0, 0.0, 1.0])
+        up = self._up()
         checks = 0
         ends_at = [(qa, i, a), (qb, j, b)]
         back = {idx: self._back_direction(idx, col) for _, idx, col in ends_at if idx != HOME}
@@ -483,19 +508,112 @@ class Sequencer:
                 if len(ends) < 2 or not self.limits.contains(np.array(ends)).all():
                     continue
                 path = np.array([qa, ends[0], ends[1], qb])
-                ok = True
-                for p0, p1 in zip(path[:-1], path[1:]):
-                    if np.allclose(p0, p1):
-                        continue
-                    res = self.world_from(i).check_segment(p0, p1)
-                    checks += res.checks
-                    if not res.free:
-                        ok = False
-                        break
-                if ok:
-                    keep = [0] + [k for k in range(1, 4) if not np.allclose(path[k], path[k - 1])]
-                    wp = path[keep]
+                free, used = self._path_free(i, path)
+                checks += used
+                if free:
+                    wp = _distinct(path)
                     return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits))), checks)
+        self.checks += checks
+        return None
+
+    def _up(self) -> FloatArray:
+        """World up in the robot base frame."""
+        up: FloatArray = invert(np.asarray(self.cell.T_world_base))[:3, :3] @ np.array([0.0, 0.0, 1.0])
+        return up
+
+    def _path_free(self, i: int, path: FloatArray) -> tuple[bool, int]:
+        """Whether every leg of a joint polyline leaving stop i is free (stops at the first blocked
+        one), and the collision checks spent."""
+        checks = 0
+        for p0, p1 in itertools.pairwise(path):
+            if np.allclose(p0, p1):
+                continue
+            res = self.world_from(i).check_segment(p0, p1)
+            checks += res.checks
+            if not res.free:
+                return False, checks
+        return True, checks
+
+    def _moved(self, idx: int, col: int, q: FloatArray, offsets: FloatArray) -> FloatArray:
+        """(k, n) configurations of spot idx's candidate col with its TCP (at q) moved by each of
+        `offsets` (k, 3), base frame, in the candidate's IK column, wrapped towards q; NaN rows
+        where that column has no solution within the limits."""
+        T = np.repeat(fk_tcp(self.robot, q)[None], len(offsets), axis=0)
+        T[:, :3, 3] += offsets
+        table = solve_all(self.robot, T, q_hint=q)
+        column = int(self.spots[idx].column[col])
+        out = q[None, :] + wrap_to_pi(table.q[:, column] - q[None, :])
+        out[~table.valid[:, column]] = np.nan
+        out[~self.limits.contains(out)] = np.nan
+        return out
+
+    def _exits(self, idx: int, col: int) -> list[FloatArray]:
+        """Where the gun can leave spot idx's approach point (candidate col) by a free straight
+        move that takes it off the flange: the TCP moved perpendicular to the electrode axis in
+        WITHDRAW_DIRECTIONS directions by each of WITHDRAW_M (the sheet leaves the C through its
+        mouth only one way; which depends on the tool and the candidate's spin, so every direction
+        is tried), nearest first. Cached per candidate: a spot's candidate joins many pairs."""
+        key = (idx, col)
+        got = self._exit_cache.get(key)
+        if got is not None:
+            return got
+        if idx == HOME:
+            self._exit_cache[key] = [self.home[0]]
+            return self._exit_cache[key]
+        q = self.q(idx)[col]
+        R = fk_tcp(self.robot, q)[:3, :3]
+        angles = 2 * np.pi * np.arange(WITHDRAW_DIRECTIONS) / WITHDRAW_DIRECTIONS
+        dirs = np.cos(angles)[:, None] * R[:, 0][None, :] + np.sin(angles)[:, None] * R[:, 1][None, :]
+        offsets = np.concatenate([w * dirs for w in WITHDRAW_M])
+        moved = self._moved(idx, col, q, offsets)
+        out: list[FloatArray] = []
+        for row in moved:
+            if np.isnan(row).any():
+                continue
+            res = self.world_from(idx).check_segment(q, row)
+            self.checks += res.checks
+            if res.free:
+                out.append(row)
+        self._exit_cache[key] = out
+        return out
+
+    def _withdrawn_detour(self, i: int, a: int, j: int, b: int) -> Detour | None:
+        """Off the flange, (up,) across, (down,) onto the flange: each end leaves its approach point
+        perpendicular to the electrode axis (`_exits`), then the straight move between the two exits,
+        else both exits raised by h (world up) for rising h. This is how the gun is turned over a
+        flange between two faces of a part: the C slid off one edge, turned clear of the part, slid
+        onto the other edge. At most WITHDRAW_PAIRS exit pairs are tried, fastest first."""
+        qa, qb = self.q(i)[a], self.q(j)[b]
+        starts, goals = self._exits(i, a), self._exits(j, b)
+        if not starts or not goals:
+            return None
+        sa, sb = np.array(starts), np.array(goals)
+        sp = 1.0 if self.options.speed is None else self.options.speed
+        leave = np.asarray(ptp_time_estimate(qa[None, :], sa, self.limits, sp))
+        across = np.asarray(ptp_time_estimate(sa[:, None, :], sb[None, :, :], self.limits, sp))
+        arrive = np.asarray(ptp_time_estimate(sb, qb[None, :], self.limits, sp))
+        est = leave[:, None] + across + arrive[None, :]
+        up = self._up()
+        checks = 0
+        pairs = np.argsort(est, axis=None, kind="stable")[:WITHDRAW_PAIRS]
+        for heights in ((0.0,), LIFT_HEIGHTS_M):
+            for flat in pairs:
+                x, y = np.unravel_index(int(flat), est.shape)
+                ea, eb = sa[x], sb[y]
+                for h in heights:
+                    if h == 0.0:
+                        path = np.array([qa, ea, eb, qb])
+                    else:
+                        ra = ea if i == HOME else self._moved(i, a, ea, (h * up)[None])[0]
+                        rb = eb if j == HOME else self._moved(j, b, eb, (h * up)[None])[0]
+                        if np.isnan(ra).any() or np.isnan(rb).any():
+                            continue
+                        path = np.array([qa, ea, ra, rb, eb, qb])
+                    free, used = self._path_free(i, path)
+                    checks += used
+                    if free:
+                        wp = _distinct(path)
+                        return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits))), checks)
         self.checks += checks
         return None
 
@@ -530,7 +648,10 @@ class Sequencer:
 
     def _new_detour(self, i: int, a: int, j: int, b: int) -> None:
         # Lift first: on clamp cells it is found in ~1,000 checks; the roadmap is the general fallback.
-        det = self._lift_detour(i, a, j, b) or self._searched_detour(i, self.q(i)[a], self.q(j)[b])
+        # Where neither finds a way, the gun's C may still hold the sheet at both approach points
+        # (moves between two faces of a part): off the flange first (`_withdrawn_detour`).
+        det = (self._lift_detour(i, a, j, b) or self._searched_detour(i, self.q(i)[a], self.q(j)[b])
+               or self._withdrawn_detour(i, a, j, b))
         if det is None:
             # No way found for this exact pair: make sure the optimiser stops choosing it.
             self.no_way.setdefault((i, j), set()).add((a, b))
