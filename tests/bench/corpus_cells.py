@@ -58,18 +58,20 @@ class Arm:
     home: tuple[float, ...]
     reach: float
     shoulder: float
+    base_width: float                   # m: the riser's top is this much wider
     xacro: str | None = None            # relative to tests/data/rosi: imported with import-urdf
     srdf: str | None = None
 
 
 ARMS = {
-    "kr16": Arm("kr16", "spot_gun_light", (0, -90, 90, 0, 0, 0), 1.45, 0.675),
-    "kr125": Arm("kr125", "spot_gun_c", (0, -90, 90, 0, 0, 0), 2.2, 0.865),
-    "ur10": Arm("ur10", "spot_gun_light", (0, -90, 90, -90, -90, 0), 1.1, 0.128),
-    "irb2400": Arm("irb2400", "spot_gun_light", (0, 0, 0, 0, 30, 0), 1.4, 0.615,
+    "kr16": Arm("kr16", "spot_gun_light", (0, -90, 90, 0, 0, 0), 1.45, 0.675, 0.5),
+    "kr125": Arm("kr125", "spot_gun_c", (0, -90, 90, 0, 0, 0), 2.2, 0.865, 0.8),
+    "ur10": Arm("ur10", "spot_gun_light", (0, -90, 90, -90, -90, 0), 1.1, 0.128, 0.2),
+    "irb2400": Arm("irb2400", "spot_gun_light", (0, 0, 0, 0, 30, 0), 1.4, 0.615, 0.5,
                    "abb_irb2400_support/urdf/irb2400.xacro", "abb_irb2400_moveit_config/config/abb_irb2400.srdf"),
-    "m20ia": Arm("m20ia", "spot_gun_light", (0, 0, 0, 0, 30, 0), 1.6, 0.525, "fanuc_m20ia_support/urdf/m20ia.xacro"),
-    "kr120": Arm("kr120", "spot_gun_c", (0, -90, 90, 0, 30, 0), 2.2, 0.675,
+    "m20ia": Arm("m20ia", "spot_gun_light", (0, 0, 0, 0, 30, 0), 1.6, 0.525, 0.5,
+                 "fanuc_m20ia_support/urdf/m20ia.xacro"),
+    "kr120": Arm("kr120", "spot_gun_c", (0, -90, 90, 0, 30, 0), 2.2, 0.675, 0.8,
                  "kuka_kr120_support/urdf/kr120r2500pro.xacro"),
 }
 
@@ -405,8 +407,10 @@ def place_spots(rng: np.random.Generator, part: Part, n_spots: int, n_seams: int
             s += pitch
         spots = []
         for s in positions:
-            p, d, n, _ = f.at(s)
-            spots.append(Spot("", p, n, d))
+            p, _, n, e = f.at(s)
+            # The seam direction as CAD states the gun's nominal orientation: n x e, so that the
+            # nominal TCP y axis (the side of the gun's C back) points to the edge the C wraps round.
+            spots.append(Spot("", p, n, np.cross(n, e)))
         bounds = np.linspace(0, len(spots), int(seams_per[k]) + 1).round().astype(int)
         for a, b in itertools.pairwise(bounds):
             if b > a:
@@ -497,7 +501,8 @@ def assemble(name: str, arm: Arm, T_world_robot: np.ndarray, riser: float, T_rob
     if riser > 0:
         T_riser = T_world_robot.copy()
         T_riser[:3, 3] += T_world_robot[:3, 2] * riser / 2
-        objects.append({"name": "riser", "box": [0.7, 0.7, round(riser, 4)], "pose": _pose(T_riser)})
+        side = round(1.1 * arm.base_width, 4)
+        objects.append({"name": "riser", "box": [side, side, round(riser, 4)], "pose": _pose(T_riser)})
     seam_dicts = []
     for k, spots in enumerate(seams):
         how = listing or str(rng.choice(["along", "along", "reversed", "by_id"]))
