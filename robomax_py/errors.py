@@ -49,3 +49,8 @@ class ControllerSetupError(ExportError):
         self.key = key
         self.problem = problem
         super().__init__(f"{key}: {problem}")
+
+
+class PreviewError(RobomaxError):
+    """`robomax preview` cannot serve as asked: the host is not an address of this machine, or the
+    port is taken."""

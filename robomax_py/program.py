@@ -342,14 +342,17 @@ Instruction: TypeAlias = PtpMove | LinMove | Spot | Gripper | Wait | WaitFor | C
 class ProgramSetup:
     """What the controller's integrator hands a program (the cell's `robot.controller`), for the
     writers: the position and numeric registers it may use (FANUC), whether a weld calls the
-    program's own `spot_weld` routine ("call") or the controller's process package ("package"), and
+    program's own `spot_weld` routine ("call") or the controller's process package ("package"),
     frames a setup file lists for the integrator to enter by hand (`listed`: FANUC without position
-    registers to set them from). Nothing of it is read back: the statements say what they use."""
+    registers to set them from), and the controller's own names of the numbered frames the program
+    selects, by the name the program refers to them with (`frame_names`: KUKA TOOL_NAME / BASE_NAME,
+    which inline forms show). Nothing of it is read back: the statements say what they use."""
 
     position_registers: tuple[int, ...] = ()
     numeric_registers: tuple[int, ...] = ()
     weld: Literal["call", "package"] = "call"
     listed: tuple[FrameDef, ...] = ()
+    frame_names: tuple[tuple[str, str], ...] = ()
 
 
 @dataclass(frozen=True, slots=True)

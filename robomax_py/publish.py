@@ -80,7 +80,7 @@ class CheckedProgram:
 
 def file_names(name: str, files: dict[str, str]) -> dict[str, str]:
     """Dialect keys (".src" or "_frames.src", after the program's name, or a whole file name such as
-    "spot_weld.ls") -> file names."""
+    "SPOT_WELD.ls") -> file names."""
     return {(f"{name}{key}" if key.startswith((".", "_")) else key): text for key, text in files.items()}
 
 
@@ -111,15 +111,18 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
              name: str, reference: list[PlannedPath]) -> CheckedProgram:
     dialect = DIALECTS[fmt]
     t0 = time.process_time()
+    if name != result.cell:
+        # A baseline program is named apart before the dialect names it its way.
+        planned = dataclasses.replace(planned, program=dataclasses.replace(
+            planned.program, name=planned.program.name + name[len(result.cell):]))
     try:
         adapted = dialect.adapt(planned, robot)
     except ControllerSetupError as exc:
         raise CellFileError(cell.source, exc.key, f"{exc.problem} (--format {fmt})") from None
-    if name != result.cell:
-        adapted = dataclasses.replace(adapted, name=adapted.name + ("_BASELINE" if adapted.name.isupper() else "_baseline"))
     texts = dialect.write(adapted, robot)
     t1 = time.process_time()
-    main = f"{name}{dialect.extensions[0]}"
+    stem = adapted.name if dialect.program_name else name
+    main = f"{stem}{dialect.extensions[0]}"
     try:
         parsed = dialect.parse(texts, main, robot)
     except ProgramError as exc:
@@ -148,7 +151,7 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
             v = report.violations[0]
             raise ExportError(f"{fmt}: the written program's motion is not clean: {v.kind}: {v.detail}"
                               f"{f' (line {v.line} of {main})' if v.line else ''}")
-    return CheckedProgram(fmt, file_names(name, texts), diff, t1 - t0, time.process_time() - t1, report)
+    return CheckedProgram(fmt, file_names(stem, texts), diff, t1 - t0, time.process_time() - t1, report)
 
 
 def _same_program(fmt: str, main: str, adapted: Program, parsed: Parsed) -> None:

@@ -25,7 +25,7 @@ MB = 1024 * 1024
 
 @dataclass(frozen=True, slots=True)
 class FileLimits:
-    """Largest files read, by kind (bytes), and the YAML bounds."""
+    """Largest files read, by kind (bytes), the YAML bounds, and the bounds of a xacro expansion."""
 
     cell: int = 10 * MB
     description: int = 1 * MB          # robot.yaml, tool.yaml, SRDF
@@ -37,6 +37,11 @@ class FileLimits:
     yaml_nodes: int = 1_000_000        # after expanding aliases
     yaml_depth: int = 64               # nested collections
     int_digits: int = 30               # no quantity in a cell needs more
+    urdf_links: int = 1000             # links (and joints) of one URDF; arms have fewer than 50
+    # One xacro expansion (`import-urdf`, run in a process of its own): CPU seconds and address
+    # space. The ROS-Industrial support packages expand in under 0.2 s and 60 MB.
+    xacro_cpu_s: float = 30.0
+    xacro_memory: int = 1024 * MB
 
 
 LIMITS = FileLimits()
@@ -86,8 +91,10 @@ def checked_file(path: Path, limit: int, error: ErrorFactory, what: str, key: st
     return resolved
 
 
-def read_text(path: Path, limit: int, error: ErrorFactory, what: str, key: str | None = None) -> str:
-    """The UTF-8 text of a checked file (`checked_file`); a BOM is dropped."""
+def read_text(path: Path, limit: int, error: ErrorFactory, what: str, key: str | None = None,
+              fallback: str = "") -> str:
+    """The UTF-8 text of a checked file (`checked_file`); a BOM is dropped. fallback: the encoding
+    to read a file in that is not UTF-8 (KRL files are Windows-1252 when written on the controller)."""
     safe = checked_file(path, limit, error, what, key)
     try:
         data = safe.read_bytes()
@@ -98,8 +105,15 @@ def read_text(path: Path, limit: int, error: ErrorFactory, what: str, key: str |
     try:
         return data.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError as exc:
+        if fallback:
+            try:
+                return data.decode(fallback)
+            except UnicodeDecodeError:
+                pass
         line = data[:exc.start].count(b"\n") + 1
-        raise error(path, f"line {line}", f"{what} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start})") from None
+        encodings = "UTF-8" + (f" or {fallback}" if fallback else "")
+        raise error(path, f"line {line}", f"{what} is not {encodings} text (byte 0x{data[exc.start]:02x} at offset "
+                                          f"{exc.start})") from None
 
 
 def printable(text: str, limit: int = 200) -> str:

@@ -68,6 +68,7 @@ class RobotSpec:
     srdf_disabled_links: tuple[tuple[str, str], ...] = ()   # the SRDF's disable_collisions
     package_dirs: tuple[Path, ...] = ()   # folders P with P/NAME the package of the URDF's package://NAME meshes
     loaded: JointLoadLimits | None = None    # joint limits carrying the rated payload (robot.yaml `loaded`)
+    warnings: tuple[str, ...] = ()        # what the checks at load found worth saying (io.robot.check_urdf)
 
 
 @dataclass(frozen=True, slots=True)

@@ -76,16 +76,18 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
     for ext in dialect.extensions:
         sibling = path.with_suffix(ext) if suffix != ext else path
         if sibling == path or sibling.exists():
-            texts[ext] = read_text(sibling, LIMITS.program, ProgramError, "program file")
+            texts[ext] = read_text(sibling, LIMITS.program, ProgramError, "program file",
+                                   fallback=dialect.fallback_encoding)
     main = path.with_suffix(dialect.extensions[0])
     if dialect.extensions[0] not in texts:
         raise ProgramError(main, None, f"{path.name} needs its main file {main.name} beside it")
     for key in dialect.companions:
         # A setup file beside the program (its frames) is what the controller was loaded with;
         # without one, the controller holds the cell's calibrated frames (`controller_frames`).
-        companion = main.with_name(main.stem + key)
-        if companion.exists():
-            texts[key] = read_text(companion, LIMITS.program, ProgramError, "program file")
+        companion = _beside(main, main.stem + key)
+        if companion is not None:
+            texts[key] = read_text(companion, LIMITS.program, ProgramError, "program file",
+                                   fallback=dialect.fallback_encoding)
     from robomax_py.export.rebuild import rebuild
 
     parsed = dialect.parse(texts, str(main), robot)
@@ -95,6 +97,18 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
                         for line, text in parsed.ignored if _is_motion(parsed, line))
     return dataclasses.replace(report, violations=unsimulated + report.violations,
                                ignored=tuple(i for i in parsed.ignored if not _is_motion(parsed, i[0])))
+
+
+def _beside(path: Path, name: str) -> Path | None:
+    """The file `name` in `path`'s folder; on a case-sensitive file system also one whose name
+    differs in case only (a controller's backup writes `home.ls` for the program HOME)."""
+    exact = path.with_name(name)
+    if exact.exists():
+        return exact
+    try:
+        return next((p for p in path.parent.iterdir() if p.name.lower() == name.lower() and p.is_file()), None)
+    except OSError:
+        return None
 
 
 def _is_motion(parsed: Any, line: int) -> bool:

@@ -16,6 +16,8 @@ import yaml
 from typer.testing import CliRunner
 
 from robomax_py.app.cli import EXIT_OK, app
+from robomax_py.export import dialect_for_file
+from robomax_py.export.plan_program import identifier
 
 REPO = Path(__file__).resolve().parents[1]
 CELLS = sorted((REPO / "cells").glob("*.yaml"))
@@ -29,12 +31,18 @@ def test_at_least_three_shipped_cells() -> None:
     assert {p.stem for p in CELLS} >= {"cabin_flange", "frame", "ur10_tray"}
 
 
+def _file(name: str, ext: str) -> str:
+    """A cell's program file: named after the cell, or, for FANUC, after its TP program."""
+    dialect = dialect_for_file(ext)
+    return f"{dialect.program_name(identifier(name)) if dialect and dialect.program_name else name}{ext}"
+
+
 def _plan(cell: Path, out: Path) -> dict[str, object]:
     result = runner.invoke(app, ["plan", str(cell), "-o", str(out), "--format", "all"])
     assert result.exit_code == EXIT_OK, result.output
     name = yaml.safe_load(cell.read_text()).get("name", cell.stem)
     for ext in MAIN_FILES:
-        program = out / f"{name}{ext}"
+        program = out / _file(name, ext)
         assert program.is_file(), f"{program} not written"
         check = runner.invoke(app, ["verify", str(cell), str(program)])
         assert check.exit_code == EXIT_OK, check.output
@@ -48,7 +56,7 @@ def test_shipped_cell_plans_and_verifies(cell: Path, tmp_path: Path, update_gold
     data = _plan(cell, tmp_path)
     name = yaml.safe_load(cell.read_text()).get("name", cell.stem)
     srcl = (tmp_path / f"{name}.srcl").read_bytes()
-    digests = {f"{name}{ext}": hashlib.sha256((tmp_path / f"{name}{ext}").read_bytes()).hexdigest() for ext in HASHED}
+    digests = {_file(name, ext): hashlib.sha256((tmp_path / _file(name, ext)).read_bytes()).hexdigest() for ext in HASHED}
     sums_file = GOLDEN / "SHA256SUMS"
     sums = dict(reversed(line.split("  ")) for line in sums_file.read_text().splitlines() if line)
     if update_golden:

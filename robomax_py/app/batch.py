@@ -325,8 +325,11 @@ def write_outcome_programs(out_dir: Path, outcome: CellOutcome, taken: dict[str,
 
     if outcome.status != PLANNED:
         return outcome
-    # Files every cell writes alike (FANUC's spot_weld.ls) do not belong to one cell.
-    own = [name for name, _ in outcome.programs if name.startswith(outcome.cell)]
+    from robomax_py.export import DIALECTS
+
+    # Files every cell writes alike (FANUC's SPOT_WELD.ls) do not belong to one cell.
+    shared = {name for d in DIALECTS.values() for name in d.shared}
+    own = [name for name, _ in outcome.programs if name not in shared]
     clash = next((taken[name] for name in own if name in taken), None)
     if clash is not None:
         return replace(outcome, status=BAD_INPUT, programs=(), cycle_time=None, detours=None,

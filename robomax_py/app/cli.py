@@ -215,9 +215,12 @@ def _stale_programs(out_dir: Path, name: str) -> list[str]:
     """Program files of an earlier plan of the cell in the output folder."""
     from robomax_py.export import DIALECTS
 
+    from robomax_py.export.plan_program import identifier
+
     suffixes = {".json", ".png", *(e for d in DIALECTS.values() for e in d.extensions)}
+    stems = {name, *(d.program_name(identifier(name)) for d in DIALECTS.values() if d.program_name)}
     try:
-        return sorted(p.name for p in out_dir.iterdir() if p.stem == name and p.suffix in suffixes)
+        return sorted(p.name for p in out_dir.iterdir() if p.stem in stems and p.suffix in suffixes)
     except OSError:
         return []
 
@@ -367,14 +370,21 @@ def preview(
     voxels: Annotated[float | None, typer.Option("--voxels", min=0.005, max=0.5, metavar="PRECISION",
                                                  help="also draw the voxel map of the static objects (blocked leaves) "
                                                       "at this precision limit, m")] = None,
+    host: Annotated[str, typer.Option("--host", help="address to serve the page on (default: this machine only); "
+                                                     "any other makes the cell visible to the network")] = "127.0.0.1",
+    port: Annotated[int | None, typer.Option("--port", min=1, max=65535,
+                                             help="web port (default: the first free one from 7000)")] = None,
 ) -> None:
     """Show the cell in meshcat, animated along a program (serves until Ctrl-C, or writes --html)."""
 
     def run() -> None:
         from robomax_py.app.preview import serve, write_html
         from robomax_py.app.preview_program import home_program, load_program
+        from robomax_py.app.preview_server import LOOPBACK, WILDCARDS, is_loopback
         from robomax_py.io.cell import load_cell, load_cell_robot
 
+        if html is not None and (host != LOOPBACK or port is not None):
+            raise typer.BadParameter("--html writes a file; --host and --port are for serving", param_hint="--host/--port")
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
         shown = home_program(spec) if program is None else load_program(program, spec, robot)
@@ -395,7 +405,16 @@ def preview(
             drawn = f", {content.voxels} blocked voxels" if vmap is not None else ""
             out.print(f"wrote {html} ({content.frames} animation frames, cycle {content.duration:.3f} s{drawn})")
             return
-        serve(spec, robot, shown, lambda url: out.print(f"meshcat preview at {url}  (Ctrl-C to stop)"), voxels=vmap)
+
+        def announce(url: str) -> None:
+            # Said once the server listens, so a host it cannot bind gets only the error.
+            if not is_loopback(host):
+                where = "every interface of this machine" if host.strip("[]") in WILDCARDS else host
+                _warn([(f"--host {host}: the preview listens on {where}; anyone who can reach it on the network "
+                        "can open the page and see the cell (no password)")])
+            out.print(f"meshcat preview at {url}  (Ctrl-C to stop)", soft_wrap=True)
+
+        serve(spec, robot, shown, announce, voxels=vmap, host=host, port=port)
         out.print("preview stopped")
 
     _guarded(run)
@@ -512,10 +531,19 @@ def import_urdf_command(
     brand: Annotated[str | None, typer.Option("--brand", help="kuka | abb | fanuc | ur (default: guessed from the name)")] = None,
     name: Annotated[str | None, typer.Option("--name", help="robot name (default: the folder name)")] = None,
     force: Annotated[bool, typer.Option("--force", help="replace a folder that exists with other content")] = False,
+    xacro_cpu_s: Annotated[float | None, typer.Option("--xacro-cpu-s", min=1, help="CPU seconds the xacro "
+                                                      "expansion may take (default 30)")] = None,
+    xacro_mb: Annotated[int | None, typer.Option("--xacro-mb", min=64, help="memory (MB) the xacro expansion may "
+                                                 "use (default 1024)")] = None,
 ) -> None:
-    """Make a self-contained robot folder from a URDF or xacro: meshes copied, IK fitted and checked."""
+    """Make a self-contained robot folder from a URDF or xacro: meshes copied, IK fitted and checked.
+
+    The package is read as untrusted data: only files below --packages folders and the source's
+    folder, xacro expanded without running Python, in a process bounded in CPU time and memory."""
 
     def run() -> None:
+        import dataclasses
+
         from robomax_py.app.import_urdf import import_urdf
         from robomax_py.errors import RobotModelError
 
@@ -523,8 +551,12 @@ def import_urdf_command(
             raise RobotModelError(None, "--solver", f"expected opw, ur or numeric, got {solver!r}")
         if brand not in (None, "kuka", "abb", "fanuc", "ur"):
             raise RobotModelError(None, "--brand", f"expected kuka, abb, fanuc or ur, got {brand!r}")
+        from robomax_py.safe_files import LIMITS, MB
+
+        limits = dataclasses.replace(LIMITS, xacro_cpu_s=xacro_cpu_s or LIMITS.xacro_cpu_s,
+                                     xacro_memory=LIMITS.xacro_memory if xacro_mb is None else xacro_mb * MB)
         r = import_urdf(source, out_dir, packages or (), name=name, flange=flange, srdf=srdf, solver=solver,
-                        brand=brand, force=force)
+                        brand=brand, force=force, limits=limits)
         _warn(r.warnings)
         what = "unchanged" if r.unchanged else "wrote"
         out.print(f"{what} {r.folder}: robot {r.name}, IK {r.solver} (FK agrees with the URDF within "

@@ -4,33 +4,66 @@ The folder holds the expanded URDF with relative mesh paths, the meshes it names
 when one is given, and a robot.yaml with IK parameters fitted from the URDF and checked against its
 forward kinematics; when the URDF has a ROS-Industrial `base` link (the vendor's base frame), the
 robot.yaml states its pose as `controller.base`, so the folder says which frame Cartesian targets are
-in. It is built in a temporary folder beside the target, loaded back as any robot folder is
-(`robot.load_robot`), and only then moved into place: a failure leaves nothing behind.
+in.
+
+A robot package is untrusted data (downloaded, sent by others):
+
+- files are read only below the `--packages` folders and the source's own folder (real paths,
+  symlinks resolved): xacro includes, `xacro.load_yaml`, `$(find pkg)` and mesh files alike;
+- xacro is expanded by `xacro_sandbox` in a process of its own, bounded in CPU time and memory
+  (`FileLimits.xacro_cpu_s`, `xacro_memory`), with a restricted evaluator instead of Python's eval;
+- each mesh is checked (inside the folders, a mesh file type, within `FileLimits.mesh`) before it
+  is read, and goes to `meshes/collision/...` or `meshes/visual/...`, so a visual mesh never
+  replaces a collision mesh of the same name; every written path is confined to the output folder;
+- the URDF passes `io.robot.check_urdf` (joint limits, collision geometry) before anything is
+  written, and the staged folder is loaded back as any robot folder is (`robot.load_robot`: a
+  non-finite mesh vertex is refused there).
+
+The folder is built in a staging folder beside the target (`_staging`: a name pattern and a marker
+file, so the next import removes one a killed import left, and nothing else) and moved into place
+with one rename (an atomic exchange when it replaces a folder): a failed or killed import leaves the
+old folder or the new one, never a mix, and no other file.
 """
 
 from __future__ import annotations
 
 import hashlib
+import json
 import math
 import os
 import re
 import shutil
+import signal
+import subprocess
 import sys
 import tempfile
 import time
-import types
 import xml.etree.ElementTree as ET
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 
 from robomax_py._typing import FloatArray
+from robomax_py.app import xacro_sandbox
+from robomax_py.app.xacro_sandbox import _package_candidates
 from robomax_py.errors import RobotModelError
-from robomax_py.io.robot import mesh_candidates, package_dirs_for, urdf_base_link
+from robomax_py.io.robot import check_urdf, srdf_disabled_pairs, urdf_base_link
+from robomax_py.safe_files import (
+    LIMITS,
+    MB,
+    FileLimits,
+    checked_file,
+    named_by,
+    printable,
+    read_text,
+)
+from robomax_py.spec import RobotSpec
 from robomax_py.transforms import rpy_from_matrix
 
-MESH_SUFFIXES = (".stl", ".dae", ".obj", ".ply", ".off", ".glb", ".gltf")
+# Mesh files a URDF may name: single-file formats trimesh reads (.gltf is left out: its buffers are
+# further files the import would not copy).
+MESH_SUFFIXES = (".stl", ".dae", ".obj", ".ply", ".off", ".glb")
 _BRAND_PATTERNS = (
     ("kuka", re.compile(r"kuka|(^|[^a-z])kr\s*\d", re.I)),
     ("abb", re.compile(r"abb|irb\s*\d", re.I)),
@@ -61,70 +94,132 @@ def guess_brand(*names: str) -> str:
     return "kuka"
 
 
-@contextmanager
-def _ament_stand_in(roots: Sequence[Path], near: Path) -> Iterator[None]:
-    """xacro's `$(find pkg)` asks ament_index_python; answer from our package search instead."""
-
-    def share(name: str) -> str:
-        for root in roots:
-            if root.name == name and root.is_dir():
-                return str(root)
-            if (root / name).is_dir():
-                return str(root / name)
-        found = package_dirs_for(name, near)
-        if not found:
-            raise LookupError(f"package '{name}' not found (give its folder or a parent with --packages)")
-        return str(found[0] / name)
-
-    packages = types.ModuleType("ament_index_python.packages")
-    packages.get_package_share_directory = share  # type: ignore[attr-defined]
-    top = types.ModuleType("ament_index_python")
-    top.packages = packages  # type: ignore[attr-defined]
-    saved = {k: sys.modules.get(k) for k in ("ament_index_python", "ament_index_python.packages")}
-    sys.modules["ament_index_python"], sys.modules["ament_index_python.packages"] = top, packages
-    try:
-        yield
-    finally:
-        for k, v in saved.items():
-            if v is None:
-                sys.modules.pop(k, None)
-            else:
-                sys.modules[k] = v
+# ------------------------------------------------------------------------------ what may be read
 
 
-def expand(source: Path, packages: Sequence[Path]) -> str:
-    """The URDF text of a .urdf file, or of a .xacro expanded with the xacro package (without ROS)."""
-    if not source.is_file():
-        raise RobotModelError(source, None, "file not found")
+def allowed_folders(source: Path, packages: Sequence[Path]) -> tuple[Path, ...]:
+    """The folders an import may read from: each `--packages` folder and the source's own folder
+    (real paths). Everything the source names (includes, YAML, `$(find pkg)`, meshes) must lie in one."""
+    roots: list[Path] = []
+    for p in packages:
+        real = Path(os.path.realpath(p))
+        if not real.is_dir():
+            raise RobotModelError(None, "--packages", f"{printable(str(p))}: not a folder")
+        roots.append(real)
+    roots.append(Path(os.path.realpath(source)).parent)
+    return tuple(dict.fromkeys(roots))
+
+
+def _inside(path: Path, roots: Sequence[Path]) -> bool:
+    real = os.path.realpath(path)
+    return any(real == str(r) or real.startswith(str(r).rstrip(os.sep) + os.sep) for r in roots)
+
+
+def expand(source: Path, roots: Sequence[Path], limits: FileLimits = LIMITS) -> str:
+    """The URDF text of a .urdf file, or of a .xacro expanded by `xacro_sandbox` in a process of its
+    own: only files below `roots` are read, no Python runs from the file, and the expansion ends
+    after `limits.xacro_cpu_s` CPU seconds or `limits.xacro_memory` bytes with a message."""
     if source.suffix != ".xacro":
-        try:
-            return source.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise RobotModelError(source, None, f"cannot read URDF: {exc}") from None
-    import xacro
+        return read_text(source, limits.urdf, RobotModelError, "URDF")
+    checked_file(source, limits.urdf, RobotModelError, "xacro file")
+    request = {
+        "source": os.path.realpath(source), "roots": [str(r) for r in roots], "parent": os.getpid(),
+        "max_file_bytes": limits.urdf, "max_yaml_bytes": limits.description, "max_output_chars": limits.urdf,
+        "cpu_s": limits.xacro_cpu_s, "memory_bytes": limits.xacro_memory,
+    }
+    seconds = f"xacro expansion exceeds {limits.xacro_cpu_s:g} s of CPU time"
+    memory = f"xacro expansion exceeds {limits.xacro_memory / MB:.0f} MB of memory"
+    # The CPU limit ends a busy child; the wall-clock limit one that waits (with slack for a busy
+    # machine, where a process gets a fraction of a CPU).
+    wall_s = 10 * limits.xacro_cpu_s + 30
+    try:
+        done = subprocess.run([sys.executable, "-I", "-X", "utf8", str(Path(xacro_sandbox.__file__))],
+                              input=json.dumps(request).encode(), capture_output=True, timeout=wall_s,
+                              env={}, check=False)
+    except subprocess.TimeoutExpired:
+        raise RobotModelError(source, None, f"xacro expansion exceeds {wall_s:g} s of waiting "
+                              f"({limits.xacro_cpu_s:g} s of CPU time allowed)") from None
+    if done.returncode in (-signal.SIGXCPU, -signal.SIGKILL):
+        raise RobotModelError(source, None, seconds)
+    try:
+        answer = json.loads(done.stdout)
+    except ValueError:
+        answer = None
+    if done.returncode != 0 or not isinstance(answer, dict):
+        how = (f"signal {signal.Signals(-done.returncode).name}" if done.returncode < 0
+               else f"exit code {done.returncode}")
+        tail = printable(done.stderr.decode("utf-8", "replace").strip().splitlines()[-1]) if done.stderr.strip() else ""
+        raise RobotModelError(source, None, f"xacro expansion ended abnormally ({how}; {memory}?)"
+                              + (f": {tail}" if tail else ""))
+    if "urdf" in answer:
+        return str(answer["urdf"])
+    if answer.get("kind") == "memory":
+        raise RobotModelError(answer.get("file") or source, None, memory)
+    raise RobotModelError(answer.get("file") or source, answer.get("where"), str(answer.get("problem")))
 
-    with _ament_stand_in(packages, source.parent):
-        try:
-            doc = xacro.process_file(str(source))
-            return str(doc.toprettyxml(indent="  "))
-        except Exception as exc:  # xacro raises its own and plain errors (XacroException, KeyError, ...)
-            raise RobotModelError(source, None, f"xacro does not expand: {type(exc).__name__}: {exc}") from None
+
+# ------------------------------------------------------------------------------ meshes
 
 
-def _resolve_mesh(uri: str, source: Path, packages: Sequence[Path]) -> Path | None:
-    """The file a mesh `filename` names: under the --packages folders first, then as any URDF's."""
-    dirs: list[Path] = []
+@dataclass(frozen=True, slots=True)
+class _Mesh:
+    real: Path          # the file read
+    local: str          # where it goes in the robot folder: meshes/<kind>/...
+
+
+def _mesh_file(uri: str, kind: str, where: str, source: Path, roots: Sequence[Path], limits: FileLimits) -> _Mesh | None:
+    """The file a URDF mesh `filename` names, checked before it is read (inside `roots`, a regular
+    file of a mesh type within `limits.mesh`), and its place in the folder; None when not found.
+
+    `package://pkg/rest` is looked for below the allowed folders (the folder named pkg, a child or
+    up to three levels down) and may not leave its package (`..`); file:// and relative paths must
+    lie inside the allowed folders once resolved.
+    """
+    error = named_by(RobotModelError, source, where)
+    if "\x00" in uri or not uri.strip():
+        raise error(None, None, "not a file name")
+    if PurePosixPath(uri).suffix.lower() not in MESH_SUFFIXES:
+        raise error(None, None, f"not a mesh file ({', '.join(MESH_SUFFIXES)})")
     if uri.startswith("package://"):
-        name = uri[len("package://"):].partition("/")[0]
-        dirs = [r.parent if r.name == name else r for r in packages] + package_dirs_for(name, source.parent)
-    return next((c for c in mesh_candidates(uri, source, dirs) if c.is_file()), None)
+        package, _, rest = uri[len("package://"):].partition("/")
+        parts = PurePosixPath(rest).parts
+        if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", package) or package in (".", ".."):
+            raise error(None, None, f"'{printable(package)}' is not a package name")
+        if not parts or rest.startswith("/") or ".." in parts:
+            raise error(None, None, "leaves its package ('..' or an absolute path)")
+        candidates = [Path(folder) / rest for root in roots for folder in _package_candidates(str(root), package)
+                      if os.path.isdir(folder)]
+        local_parts: tuple[str, ...] = (package, *(p for p in parts if p != "."))
+    elif uri.startswith("file://"):
+        candidates, local_parts = [Path(uri[len("file://"):])], ()
+    elif re.match(r"^[A-Za-z][A-Za-z0-9+.-]*://", uri):
+        raise error(None, None, "only package://, file:// and relative paths name mesh files")
+    else:
+        candidates, local_parts = [Path(os.path.realpath(source)).parent / uri], ()
+    for candidate in candidates:
+        if not os.path.lexists(candidate):
+            continue
+        if not _inside(candidate, roots):
+            raise error(None, None, f"{printable(os.path.realpath(candidate))} is outside the package folders given "
+                        "(--packages) and the source's folder")
+        real = checked_file(candidate, limits.mesh, error, f"{kind} mesh")
+        if not local_parts:
+            root = next(r for r in roots if _inside(real, (r,)))
+            local_parts = (root.name, *real.relative_to(root).parts)
+        return _Mesh(real, "/".join(("meshes", kind, *local_parts)))
+    return None
 
 
-def _local_name(uri: str) -> str:
-    """Where a mesh goes inside the folder: meshes/<package>/<path>, or meshes/<file name>."""
-    if uri.startswith("package://"):
-        return "meshes/" + uri[len("package://"):]
-    return "meshes/" + Path(uri).name
+def _confined(stage: Path, local: str) -> Path:
+    """stage/local, refused unless it stays inside the staged folder (no '..', no absolute part)."""
+    parts = PurePosixPath(local).parts
+    if not parts or local.startswith("/") or any(p in ("", ".", "..") for p in parts) or "\x00" in local \
+            or any(len(p.encode("utf-8", "surrogateescape")) > LIMITS.name_chars for p in parts):
+        raise RobotModelError(None, None, f"output path {printable(local)} would leave the robot folder")
+    path = stage.joinpath(*parts)
+    if not _inside(path.parent, (stage,)):
+        raise RobotModelError(None, None, f"output path {printable(local)} would leave the robot folder")
+    return path
 
 
 def _number(v: float) -> str:
@@ -150,12 +245,12 @@ def _robot_yaml(name: str, urdf: str, flange: str, solver: str, params: object, 
     from robomax_py.robot.ik.ur import UrParams
 
     lines = [
-        f"# Imported by `robomax import-urdf` from {source.name}; IK parameters fitted from the URDF's",
+        f"# Imported by `robomax import-urdf` from {printable(source.name)}; IK parameters fitted from the URDF's",
         "# joint origins and axes and checked against its forward kinematics.",
         f"name: {name}",
-        f"description: {name} (imported from {source.name})",
+        f"description: {_yaml_text(f'{name} (imported from {source.name})')}",
         f"urdf: {urdf}",
-        f"flange: {flange}",
+        f"flange: {_yaml_text(flange)}",
         "ik:",
         f"  solver: {solver}",
     ]
@@ -186,12 +281,21 @@ def _robot_yaml(name: str, urdf: str, flange: str, solver: str, params: object, 
     return "\n".join(lines) + "\n"
 
 
+def _yaml_text(text: str) -> str:
+    """A YAML scalar for `text`: as it is when plain, else quoted (a file name may hold ': ', '#' or
+    a line break)."""
+    return text if re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.() -]*", text) and not text.endswith(" ") else json.dumps(text)
+
+
 def _fit(model: object, frame_id: int, solver: str | None) -> tuple[str, object, float]:
     from robomax_py.robot.ik.fit import FitError, fit_opw, fit_ur, fk_agreement
 
     tried: list[str] = []
     for name, fit in (("opw", fit_opw), ("ur", fit_ur)):
         if solver not in (None, name):
+            continue
+        if model.nq != 6:  # type: ignore[attr-defined]
+            tried.append(f"{name}: the URDF has {model.nq} joints, not six")  # type: ignore[attr-defined]
             continue
         try:
             params = fit(model, frame_id)  # type: ignore[arg-type]
@@ -210,105 +314,320 @@ def _fit(model: object, frame_id: int, solver: str | None) -> tuple[str, object,
 def import_urdf(
     source: Path, out: Path, packages: Sequence[Path] = (), *, name: str | None = None, flange: str = "tool0",
     srdf: Path | None = None, solver: str | None = None, brand: str | None = None, force: bool = False,
+    limits: FileLimits = LIMITS,
 ) -> ImportResult:
     """Write the robot folder `out` from `source` (.urdf or .xacro); see the module docstring.
+
+    The source is untrusted data: files are read only below `packages` and the source's folder
+    (`allowed_folders`), xacro runs in a bounded process without evaluating Python (`expand`),
+    meshes are checked before they are read, every written path stays inside `out`, and nothing is
+    written until everything named has been checked.
 
     Raises
     ------
     RobotModelError
-        The source does not expand or parse, a collision mesh is missing, the flange frame is not
-        in the URDF, the chain is not of the requested solver's class, or `out` exists with other
-        content and `force` is not set.
+        The source does not expand or parse or names a file it may not read, a joint's limits or the
+        collision geometry fail `io.robot.check_urdf`, a collision mesh is missing, unreadable or not
+        finite, the flange frame is not in the URDF, the chain is not of the requested solver's
+        class, or `out` exists with other content and `force` is not set.
     """
-    import pinocchio as pin
-
-    from robomax_py.io.robot import load_robot_spec, srdf_disabled_pairs
-    from robomax_py.robot import load_robot
-    from robomax_py.robot.ik.fit import FitError
-
     t0 = time.perf_counter()
-    source = Path(source)
-    packages = tuple(Path(p).resolve() for p in packages)
+    source, out = Path(source), Path(out)
     name = name or out.name
     if name != out.name:
         raise RobotModelError(out, None, f"the folder must be named after the robot (SPEC §1): {name!r}")
-    if not re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", name):
-        raise RobotModelError(out, None, f"robot name {name!r} must be letters, digits, '_', '.', '-'")
-    text = expand(source, packages)
+    if not re.fullmatch(_NAME, name):
+        raise RobotModelError(out, None, f"robot name {printable(name)!r} must be letters, digits, '_', '.', '-'")
+    roots = allowed_folders(source, packages)
+    parent = Path(os.path.abspath(out)).parent
+    clean_stale_staging(parent)
+    text = expand(source, roots, limits)
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:
         raise RobotModelError(source, None, f"not a valid URDF (XML): {exc}") from None
     if root.tag != "robot":
-        raise RobotModelError(source, None, f"not a URDF: the root element is <{root.tag}>, not <robot>")
+        raise RobotModelError(source, None, f"not a URDF: the root element is <{printable(root.tag)}>, not <robot>")
+    warnings = list(check_urdf(root, source))
     T_root_base = urdf_base_link(root, source)
+    meshes, mesh_warnings = _collect_meshes(root, source, roots, limits)
+    warnings.extend(mesh_warnings)
+    srdf_text = None
+    if srdf is not None:
+        srdf_disabled_pairs(Path(srdf), Path(srdf))   # readable, every pair has two links
+        srdf_text = read_text(Path(srdf), limits.description, RobotModelError, "SRDF")
+    urdf_name = f"{name}.urdf"
+    urdf_bytes = ET.tostring(root, encoding="unicode").encode("utf-8") + b"\n"
 
+    # Everything named is checked: build the folder aside, load it back, then move it into place.
+    try:
+        with _staging(parent, name) as stage:
+            for local, real in meshes.items():
+                _copy(real, _confined(stage, local), limits.mesh, source, local)
+            _confined(stage, urdf_name).write_bytes(urdf_bytes)
+            if srdf_text is not None:
+                _confined(stage, f"{name}.srdf").write_text(srdf_text, encoding="utf-8")
+            try:
+                solver_name, fk_error, spec, robot_warnings = _build(
+                    stage, name, urdf_name, flange, solver, brand, source, root, T_root_base,
+                    None if srdf_text is None else f"{name}.srdf")
+            except RobotModelError as exc:
+                raise _unstaged(exc, stage, source) from None
+            warnings.extend(w.replace(str(stage), str(out)) for w in robot_warnings if "limits." in w)
+            unchanged = out.is_dir() and not out.is_symlink() and _digest(out) == _digest(stage)
+            if not unchanged:
+                if os.path.lexists(out) and not force:
+                    raise RobotModelError(out, None, "exists with other content; use --force to replace it")
+                _commit(stage, out)
+    except OSError as exc:
+        raise RobotModelError(out, None, f"cannot write the robot folder: {exc.strerror or exc}") from None
+    return ImportResult(out, name, solver_name, spec.controller.brand, len(meshes), len(spec.srdf_disabled_links),
+                        fk_error, time.perf_counter() - t0, unchanged, tuple(warnings))
+
+
+def _collect_meshes(root: ET.Element, source: Path, roots: Sequence[Path],
+                    limits: FileLimits) -> tuple[dict[str, Path], list[str]]:
+    """The mesh files the links name, checked (`_mesh_file`), by their place in the folder; each
+    `filename` rewritten to that place. Visual and collision meshes go to meshes/visual/ and
+    meshes/collision/, so a visual mesh never stands in for a collision mesh of the same name. A
+    missing visual mesh is shown as the link's collision mesh (a warning)."""
+    meshes: dict[str, Path] = {}
     warnings: list[str] = []
-    files: dict[str, bytes] = {}
-    for link in root.iter("link"):
-        collisions = {m.get("filename") for el in link.iter("collision") for m in el.iter("mesh")}
+    for link in root.findall("link"):
+        link_name = printable(str(link.get("name")))
+        collision_meshes: list[str] = []
         for kind in ("collision", "visual"):
-            for el in list(link.iter(kind)):
+            for el in list(link.findall(kind)):
                 for mesh in el.iter("mesh"):
                     uri = mesh.get("filename") or ""
-                    found = _resolve_mesh(uri, source, packages)
+                    where = f"link {link_name}: {kind} mesh {printable(uri)}"
+                    found = _mesh_file(uri, kind, where, source, roots, limits)
                     if found is None:
                         if kind == "collision":
-                            raise RobotModelError(source, f"link {link.get('name')}: collision mesh", f"{uri} not found")
-                        warnings.append(f"link {link.get('name')}: visual mesh {uri} not found; shown as its collision mesh")
-                        fallback = next(iter(collisions - {None}), None)
-                        if fallback is None:
+                            raise RobotModelError(source, where, "not found in the package folders given "
+                                                  "(--packages) or the source's folder")
+                        warnings.append(f"link {link_name}: visual mesh {printable(uri)} not found; shown as its "
+                                        "collision mesh")
+                        if not collision_meshes:
                             link.remove(el)
                             break
-                        mesh.set("filename", _local_name(fallback))
+                        mesh.set("filename", collision_meshes[0])
                         continue
-                    local = _local_name(uri)
-                    files[local] = found.read_bytes()
-                    mesh.set("filename", local)
-    urdf_name = f"{name}.urdf"
-    files[urdf_name] = ET.tostring(root, encoding="unicode").encode("utf-8") + b"\n"
-
-    with tempfile.TemporaryDirectory(prefix=f".{name}.", dir=_existing_parent(out)) as tmp:
-        stage = Path(tmp) / name
-        for rel, data in files.items():
-            (stage / rel).parent.mkdir(parents=True, exist_ok=True)
-            (stage / rel).write_bytes(data)
-        try:
-            model = pin.buildModelFromUrdf(str(stage / urdf_name))
-        except Exception as exc:  # Pinocchio raises plain errors for bad URDFs
-            raise RobotModelError(source, None, f"cannot parse URDF: {exc}") from None
-        if not model.existFrame(flange):
-            frames = ", ".join(f.name for f in model.frames if f.type == pin.FrameType.BODY)
-            raise RobotModelError(source, "flange", f"the URDF has no frame '{flange}' (links: {frames})")
-        try:
-            solver_name, params, fk_error = _fit(model, int(model.getFrameId(flange)), solver)
-        except FitError as exc:
-            raise RobotModelError(source, "ik.solver", f"not a {solver}-class arm: {exc.problem}") from None
-        srdf_name = None
-        if srdf is not None:
-            srdf_disabled_pairs(Path(srdf), Path(srdf))   # readable, every pair has two links
-            srdf_name = f"{name}.srdf"
-            (stage / srdf_name).write_bytes(Path(srdf).read_bytes())
-        brand = brand or guess_brand(name, source.name, str(root.get("name", "")))
-        (stage / "robot.yaml").write_text(
-            _robot_yaml(name, urdf_name, flange, solver_name, params, brand, srdf_name, source, T_root_base),
-            encoding="utf-8")
-        spec = load_robot_spec(stage / "robot.yaml")
-        robot = load_robot(spec)       # the whole folder loads: meshes, pairs, IK checked against the URDF
-        warnings.extend(w.replace(str(stage), str(out)) for w in robot.warnings if "limits." in w)
-        unchanged = out.is_dir() and _digest(out) == _digest(stage)
-        if not unchanged:
-            if out.exists() and not force:
-                raise RobotModelError(out, None, "exists with other content; use --force to replace it")
-            _replace(stage, out)
-    return ImportResult(out, name, solver_name, brand, sum(1 for f in files if f.startswith("meshes/")),
-                        len(spec.srdf_disabled_links), fk_error, time.perf_counter() - t0, unchanged, tuple(warnings))
+                    if meshes.setdefault(found.local, found.real) != found.real:
+                        raise RobotModelError(source, where, f"{printable(str(found.real))} and "
+                                              f"{printable(str(meshes[found.local]))} would both be {found.local}")
+                    mesh.set("filename", found.local)
+                    if kind == "collision":
+                        collision_meshes.append(found.local)
+        for material in link.iter("material"):
+            for texture in material.findall("texture"):
+                material.remove(texture)
+                warnings.append(f"link {link_name}: texture {printable(str(texture.get('filename')))} not imported")
+    for material in root.findall("material"):
+        for texture in material.findall("texture"):
+            material.remove(texture)
+            warnings.append(f"material {printable(str(material.get('name')))}: texture "
+                            f"{printable(str(texture.get('filename')))} not imported")
+    return meshes, warnings
 
 
-def _existing_parent(out: Path) -> Path:
-    parent = out.resolve().parent
-    parent.mkdir(parents=True, exist_ok=True)
-    return parent
+def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | None, brand: str | None, source: Path,
+           root: ET.Element, T_root_base: FloatArray | None,
+           srdf_name: str | None) -> tuple[str, float, RobotSpec, tuple[str, ...]]:
+    """Fit the IK, write robot.yaml, and load the staged folder back as any robot folder is."""
+    import pinocchio as pin
+
+    from robomax_py.io.robot import load_robot_spec
+    from robomax_py.robot import load_robot
+    from robomax_py.robot.ik.fit import FitError
+
+    try:
+        model = pin.buildModelFromUrdf(str(stage / urdf_name))
+    except Exception as exc:  # Pinocchio raises plain errors for bad URDFs
+        raise RobotModelError(source, None, f"cannot parse URDF: {exc}") from None
+    if not model.existFrame(flange):
+        frames = ", ".join(f.name for f in model.frames if f.type == pin.FrameType.BODY)
+        raise RobotModelError(source, "flange", f"the URDF has no frame '{flange}' (links: {frames})")
+    try:
+        solver_name, params, fk_error = _fit(model, int(model.getFrameId(flange)), solver)
+    except FitError as exc:
+        raise RobotModelError(source, "ik.solver", f"not a {solver}-class arm: {exc.problem}") from None
+    brand = brand or guess_brand(name, source.name, str(root.get("name", "")))
+    _confined(stage, "robot.yaml").write_text(
+        _robot_yaml(name, urdf_name, flange, solver_name, params, brand, srdf_name, source, T_root_base),
+        encoding="utf-8")
+    spec = load_robot_spec(stage / "robot.yaml")
+    robot = load_robot(spec)       # the whole folder loads: meshes, pairs, IK checked against the URDF
+    return solver_name, fk_error, spec, robot.warnings
+
+
+def _unstaged(exc: RobotModelError, stage: Path, source: Path) -> RobotModelError:
+    """An error met loading the staged folder, naming the source and the mesh paths as the URDF
+    names them in the folder rather than the staging folder that is about to vanish."""
+    file = source if exc.file is None or exc.file.startswith(str(stage)) else exc.file
+    return RobotModelError(file, exc.key, exc.problem.replace(str(stage) + os.sep, ""))
+
+
+def _copy(real: Path, dst: Path, limit: int, source: Path, local: str) -> None:
+    """Copy a checked file, never more than `limit` bytes (it may have grown since the check), to a
+    new file (an existing file or link at `dst` is an error, never written through)."""
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    copied = 0
+    with open(real, "rb") as src, open(dst, "xb") as target:
+        while chunk := src.read(1 << 20):
+            copied += len(chunk)
+            if copied > limit:
+                raise RobotModelError(source, local, f"{printable(str(real))} grew beyond {limit / MB:.0f} MB "
+                                      "while it was copied")
+            target.write(chunk)
+
+
+# ------------------------------------------------------------------------------ staging
+
+# A staging folder: `.<robot>.robomax-import-<pid>-<8 random characters>` beside the output folder,
+# holding STAGING_MARKER (its first line MARKER_TEXT, then `out <folder name>`) and the robot folder
+# being built. The next import in that folder removes one whose process has ended (a killed
+# import); nothing else is ever removed.
+STAGING_MARKER = ".robomax-import"
+MARKER_TEXT = "robomax import-urdf staging folder; removed by the next import once its process has ended\n"
+_NAME = r"[A-Za-z0-9_][A-Za-z0-9_.-]*"
+_STAGING = re.compile(rf"\.(?P<name>{_NAME})\.robomax-import-(?P<pid>[0-9]+)-[a-z0-9_]{{8}}")
+
+
+@contextmanager
+def _staging(parent: Path, name: str) -> Iterator[Path]:
+    """A fresh staging folder in `parent` (created if missing); yields the robot folder to build in
+    it. Removed afterwards, and on failure also the parent folders this made."""
+    made = _make_folders(parent)
+    holder: Path | None = None
+    try:
+        holder = Path(tempfile.mkdtemp(prefix=f".{name}.robomax-import-{os.getpid()}-", dir=parent))
+        with open(holder / STAGING_MARKER, "x", encoding="utf-8") as f:
+            f.write(f"{MARKER_TEXT}out {name}\n")
+        stage = Path(os.path.realpath(holder / name))
+        stage.mkdir()
+        yield stage
+    except BaseException:
+        if holder is not None:
+            shutil.rmtree(holder, ignore_errors=True)
+            holder = None
+        for folder in reversed(made):
+            try:
+                folder.rmdir()
+            except OSError:
+                break
+        raise
+    finally:
+        if holder is not None:
+            shutil.rmtree(holder, ignore_errors=True)
+
+
+def _make_folders(folder: Path) -> list[Path]:
+    """mkdir -p `folder`; the folders created, outermost first."""
+    missing = []
+    while not os.path.lexists(folder):
+        missing.append(folder)
+        if folder.parent == folder:
+            break
+        folder = folder.parent
+    made = []
+    for f in reversed(missing):
+        f.mkdir()
+        made.append(f)
+    return made
+
+
+def clean_stale_staging(parent: Path) -> list[Path]:
+    """Remove the staging folders in `parent` left by imports that were killed (their process has
+    ended): recognised by their name (`_STAGING`) and their marker file, or empty (killed before the
+    marker was written). A folder a killed replacement had moved aside (`old`) is put back first
+    when its place is still empty. Returns the folders removed."""
+    removed: list[Path] = []
+    try:
+        entries = list(os.scandir(parent))
+    except OSError:
+        return removed
+    for entry in entries:
+        m = _STAGING.fullmatch(entry.name)
+        if m is None or not entry.is_dir(follow_symlinks=False) or _alive(int(m["pid"])):
+            continue
+        folder = Path(entry.path)
+        out_name = _marked(folder / STAGING_MARKER)
+        if out_name is None:
+            try:
+                folder.rmdir()           # only ever an empty folder
+                removed.append(folder)
+            except OSError:
+                pass
+            continue
+        old, target = folder / "old", parent / out_name
+        if old.is_dir() and not old.is_symlink() and not os.path.lexists(target):
+            try:
+                os.rename(old, target)
+            except OSError:
+                continue             # kept, with the folder it holds, for the user to look at
+        shutil.rmtree(folder, ignore_errors=True)
+        removed.append(folder)
+    return removed
+
+
+def _marked(marker: Path) -> str | None:
+    """The output folder name a staging marker states; None when `marker` is not one."""
+    try:
+        if marker.is_symlink() or not marker.is_file() or marker.stat().st_size > 4096:
+            return None
+        text = marker.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
+    if not text.startswith(MARKER_TEXT):
+        return None
+    m = re.fullmatch(rf"out ({_NAME})\n", text[len(MARKER_TEXT):])
+    return None if m is None else m.group(1)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
+
+def _commit(stage: Path, out: Path) -> None:
+    """Put the staged folder at `out` in one step: a rename, or (replacing a folder) an atomic
+    exchange, so that `out` is the old folder or the new one at every instant. Where the system
+    cannot exchange, the old folder is moved into the staging folder first (a kill between the two
+    renames leaves it there, and the next import puts it back)."""
+    if not os.path.lexists(out):
+        os.rename(stage, out)
+        return
+    if out.is_symlink() or not out.is_dir():
+        raise RobotModelError(out, None, "exists and is not a folder")
+    if _exchange(stage, out):
+        return                       # the old folder is now at `stage`, removed with the staging folder
+    os.rename(out, stage.parent / "old")
+    os.rename(stage, out)
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths atomically (Linux renameat2 RENAME_EXCHANGE); False where unsupported."""
+    import ctypes
+    import errno
+
+    try:
+        renameat2 = ctypes.CDLL(None, use_errno=True).renameat2
+    except (OSError, AttributeError):
+        return False
+    renameat2.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
+    at_fdcwd, rename_exchange = -100, 2
+    if renameat2(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0:
+        return True
+    code = ctypes.get_errno()
+    if code in (errno.ENOSYS, errno.EINVAL, errno.EOPNOTSUPP):
+        return False
+    raise OSError(code, os.strerror(code), str(b))
 
 
 def _digest(folder: Path) -> str:
@@ -316,15 +635,3 @@ def _digest(folder: Path) -> str:
     for path in sorted(p for p in folder.rglob("*") if p.is_file()):
         h.update(str(path.relative_to(folder)).encode() + b"\0" + path.read_bytes() + b"\0")
     return h.hexdigest()
-
-
-def _replace(stage: Path, out: Path) -> None:
-    """Move the staged folder to `out`, the old one (if any) out of the way first, so a reader
-    sees the old folder or the new one, never a mix."""
-    old = None
-    if out.exists():
-        old = out.with_name(f".{out.name}.old-{os.getpid()}")
-        os.replace(out, old)
-    os.replace(stage, out)
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)

@@ -18,7 +18,9 @@ camera looks at (between the robot base and the spots) is the viewer's origin, w
 controls always look at; the floor grid is shifted with it.
 
 `write_html` writes one self-contained page (meshcat's `static_html`, which inlines the viewer's
-three.js bundle and the scene); `serve` keeps a meshcat server running until interrupted.
+three.js bundle and the scene); `serve` keeps a meshcat server running until interrupted. Both
+draw through the preview's own server (`preview_server`: meshcat's bridge bound to 127.0.0.1 unless
+a host is given, its WebSocket opened only to the page's own Origin, nothing served but the viewer).
 """
 
 from __future__ import annotations
@@ -37,7 +39,8 @@ from robomax_py._typing import FloatArray
 from robomax_py.app import palette
 from robomax_py.app.preview_parts import CarriedPart, carried_parts
 from robomax_py.app.preview_program import ShownProgram
-from robomax_py.errors import RobotModelError
+from robomax_py.app.preview_server import LOOPBACK
+from robomax_py.errors import PreviewError, RobotModelError
 from robomax_py.plan.poses import nominal_rotation
 from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.robot.geometry import load_mesh, shape_trimesh
@@ -194,11 +197,25 @@ def write_html(path: Path, cell: CellSpec, robot: RobotModel, program: ShownProg
 
 
 def serve(cell: CellSpec, robot: RobotModel, program: ShownProgram, announce: Callable[[str], None], fps: int = DEFAULT_FPS,
-          voxels: VoxelMap | None = None) -> None:
-    """Start a meshcat server with the preview, announce its URL, and serve until Ctrl-C (then return)."""
+          voxels: VoxelMap | None = None, host: str = LOOPBACK, port: int | None = None) -> None:
+    """Start a meshcat server with the preview, announce its URL, and serve until Ctrl-C (then return).
+
+    Parameters
+    ----------
+    host : str
+        The address (or host name) the web page and its WebSocket are served on; loopback by default.
+        The URL announced is the one bound.
+    port : int, optional
+        The web port; by default the first free one from 7000 (meshcat's habit).
+
+    Raises
+    ------
+    PreviewError
+        The server cannot listen there (address not of this machine, port in use).
+    """
     import time
 
-    vis = _visualizer()
+    vis = _visualizer(host, port)
     try:
         populate(vis, cell, robot, program, fps, voxels)
         announce(vis.url())
@@ -210,15 +227,57 @@ def serve(cell: CellSpec, robot: RobotModel, program: ShownProgram, announce: Ca
         _close(vis)
 
 
-def _visualizer() -> Any:
-    """A meshcat visualizer with its own server; meshcat's own URL banner is not printed."""
+def _visualizer(host: str = LOOPBACK, port: int | None = None) -> Any:
+    """A meshcat visualizer drawing into its own preview server (`preview_server`), which it stops
+    in `_close`; meshcat's own URL banner is not printed."""
     import contextlib
     import io
 
     import meshcat
 
-    with contextlib.redirect_stdout(io.StringIO()):
-        return meshcat.Visualizer()
+    proc, zmq_url = _start_server(host, port)
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):
+            vis = meshcat.Visualizer(zmq_url=zmq_url)
+    except BaseException:
+        _stop(proc)
+        raise
+    vis.window.server_proc = proc
+    return vis
+
+
+def _start_server(host: str, port: int | None) -> tuple[Any, str]:
+    """Start `preview_server` and return the process and its ZMQ URL.
+
+    The server stays in this process group (a Ctrl-C or a signal to the group ends it too) and
+    stops by itself when its stdin, a pipe kept open by this process, closes (this process ended,
+    however). Its stderr goes to the null device: it says what went wrong on stdout.
+    """
+    import os
+    import subprocess
+    import sys
+
+    import robomax_py
+
+    package_root = str(Path(robomax_py.__file__).resolve().parents[1])
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([package_root, *[p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]])
+    args = [sys.executable, "-u", "-m", "robomax_py.app.preview_server", "--host", host]
+    if port is not None:
+        args += ["--port", str(port)]
+    proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env)
+    found: dict[str, str] = {}
+    assert proc.stdout is not None
+    for raw in proc.stdout:                       # ends at end of file: the server exited
+        key, _, value = raw.decode("utf-8", "replace").strip().partition("=")
+        found[key] = value
+        if key in ("web_url", "error"):
+            break
+    proc.stdout.close()
+    if "web_url" not in found or "zmq_url" not in found:
+        _stop(proc)
+        raise PreviewError(found.get("error") or f"the preview server exited (code {proc.returncode}) before listening")
+    return proc, found["zmq_url"]
 
 
 def _present(windows: tuple[tuple[float, float], ...] | None, t: float) -> bool:
@@ -229,8 +288,15 @@ def _present(windows: tuple[tuple[float, float], ...] | None, t: float) -> bool:
 def _close(vis: Any) -> None:
     proc = getattr(vis.window, "server_proc", None)
     if proc is not None:
-        proc.kill()
-        proc.wait()
+        _stop(proc)
+
+
+def _stop(proc: Any) -> None:
+    proc.kill()
+    proc.wait()
+    for pipe in (proc.stdin, proc.stdout):
+        if pipe is not None and not pipe.closed:
+            pipe.close()
 
 
 # --------------------------------------------------------------------------------------------------

@@ -14,7 +14,7 @@ import dataclasses
 from robomax_py.errors import ExportError
 from robomax_py.export import fanuc, krl, rapid, srcl, trajectory_json, urscript
 from robomax_py.export.dialect import Dialect
-from robomax_py.export.plan_program import frame_defs
+from robomax_py.export.plan_program import frame_defs, identifier
 from robomax_py.plan import PlanResult
 from robomax_py.plan.program_frames import cell_program_frames
 from robomax_py.program import FrameDef
@@ -26,10 +26,12 @@ __all__ = ["DIALECTS", "Dialect", "controller_frames", "dialect_for_file", "form
 DIALECTS: dict[str, Dialect] = {
     "srcl": Dialect("srcl", (".srcl",), "", srcl.adapt, srcl.write, srcl.parse),
     "krl": Dialect("krl", (".src", ".dat"), "kuka", krl.adapt, krl.write, krl.parse, krl.frame_name,
-                   (krl.FRAMES_FILE,)),
-    "rapid": Dialect("rapid", (".mod",), "abb", rapid.adapt, rapid.write, rapid.parse, companions=(rapid.FRAMES_FILE,)),
+                   (krl.FRAMES_FILE,), krl.FILE_ENCODING),
+    "rapid": Dialect("rapid", (".mod",), "abb", rapid.adapt, rapid.write, rapid.parse, companions=(rapid.FRAMES_FILE,),
+                     named_frames_only=True),
     "fanuc": Dialect("fanuc", (".ls",), "fanuc", fanuc.adapt, fanuc.write, fanuc.parse, fanuc.frame_name,
-                     (fanuc.FRAMES_FILE,)),
+                     (fanuc.FRAMES_FILE,), program_name=fanuc.program_name,
+                     shared=tuple(f"{name}.ls" for name in fanuc.ROUTINES)),
     "urscript": Dialect("urscript", (".script",), "ur", urscript.adapt, urscript.write, urscript.parse),
 }
 
@@ -37,8 +39,17 @@ DIALECTS: dict[str, Dialect] = {
 def controller_frames(dialect: Dialect, cell: CellSpec) -> tuple[FrameDef, ...]:
     """The frames a controller set up for the cell holds (the integrator has calibrated the cell's
     tool and user frame into it), named as `dialect` refers to them: what a program that selects
-    them without stating their values runs with."""
-    return tuple(dataclasses.replace(f, name=dialect.frame_name(f)) for f in frame_defs(cell_program_frames(cell)))
+    them without stating their values runs with. A dialect whose frames exist only where declared
+    (`Dialect.named_frames_only`, RAPID) finds only those the cell names on the controller: a frame
+    the program neither declares nor finds there is unknown."""
+    frames = frame_defs(cell_program_frames(cell))
+    if dialect.named_frames_only:
+        setup = cell.controller
+        named = {("tool", identifier(setup.tool.name))} if setup.tool is not None and setup.tool.existing else set()
+        if setup.frame is not None and setup.frame.frame.existing:
+            named.add(("base", identifier(setup.frame.frame.name)))
+        frames = tuple(f for f in frames if (f.kind, f.name) in named)
+    return tuple(dataclasses.replace(f, name=dialect.frame_name(f)) for f in frames)
 NATIVE = {"kuka": "krl", "abb": "rapid", "fanuc": "fanuc", "ur": "urscript"}
 
 

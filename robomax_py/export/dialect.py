@@ -91,7 +91,9 @@ def own_name(frame: FrameDef) -> str:
 class Dialect:
     """A controller dialect: its files (the first is the main one; keys starting with "_" are
     companions named `<program>_...`, such as a frames setup file), its brand, both directions,
-    and how it refers to a numbered frame (`frame_name`: e.g. KRL "TOOL_DATA[1]")."""
+    how it refers to a numbered frame (`frame_name`: e.g. KRL "TOOL_DATA[1]"), the encoding its
+    files are read in when they are not UTF-8 (`fallback_encoding`, "" for none), which frames a
+    controller set up for the cell holds (`named_frames_only`), and what its files are named after."""
 
     name: str
     extensions: tuple[str, ...]
@@ -101,6 +103,15 @@ class Dialect:
     parse: Callable[[dict[str, str], str, RobotModel], Parsed]
     frame_name: Callable[[FrameDef], str] = own_name
     companions: tuple[str, ...] = ()
+    fallback_encoding: str = ""
+    # The controller holds only the frames the cell names (`ControllerFrame.existing`), as RAPID
+    # data exist only where a loaded module declares them; otherwise every frame slot it selects.
+    named_frames_only: bool = False
+    # The name the dialect gives a program of a given name (`adapt` names it so), when its files are
+    # named after it rather than after the cell: FANUC, whose programs are named as their files.
+    program_name: Callable[[str], str] | None = None
+    # Whole file names every program of the dialect writes alike (FANUC's default routines).
+    shared: tuple[str, ...] = ()
 
 
 def with_frame_names(program: Program, name_of: Callable[[FrameDef], str]) -> Program:

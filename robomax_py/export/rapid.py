@@ -1,32 +1,95 @@
-r"""ABB RAPID, both directions: one module `<name>.mod`.
+r"""ABB RAPID, both directions: a program module `<name>.mod` and a data module `<name>_frames.mod`.
 
-What a program states, in RAPID's terms (RAPID Reference Manual, data types robtarget,
-jointtarget, speeddata, zonedata, tooldata, wobjdata; instructions MoveAbsJ, MoveL, VelSet, AccSet):
+Sources, cited below by tag:
+- [R3] ABB RAPID Reference Manual, BaseWare OS 3.x ("Basic Characteristics RAPID",
+  https://www.yumpu.com/en/document/view/5679047/basic-characteristics-rapid/<page>): p. 96 (5.1 data
+  scope), 98 (5.3 persistent declaration), 183 (loaddata), 225-226 (tooldata), 233-234 (wobjdata),
+  665 (gundata), 675-676 (SpotL), 699 (SWUSRF).
+- [PS4] ABB Product Specification "RobotWare Options for BaseWare OS 4.0", SpotWare
+  (https://www.easymanua.ls/abb/irb-6650-125-3-2/manual?p=186).
+- [DRV] ros-industrial/abb_driver @ f3068b92 (BSD): rapid/ROS_common.sys:1 `MODULE
+  ROS_common(SYSMODULE)`, :40-43 its PERS declarations; rapid/ROS_motionServer.mod:112-115 writes
+  them ("Sending ... points to MOTION task"), rapid/ROS_motion.mod:82-86 reads them in another
+  task: neither module declares them again.
+- [MSG] ros-industrial/abb_robot_driver_interfaces @ f5d7d117 abb_rapid_msgs/msg/*.msg (ABB's
+  messages citing the "Technical reference manual - RAPID Instructions, Functions and Data types").
+
+What a program states, in RAPID's terms:
 - joint targets as `jointtarget` (deg), Cartesian targets as `robtarget`: [x, y, z] mm, a unit
   quaternion [q1, q2, q3, q4] with q1 = w, confdata [cf1, cf4, cf6, cfx] of the planned
   configuration (SPEC §6), external axes 9E9;
 - every MoveL names its `tooldata` and, when the targets are in a user frame, its `wobjdata`
-  (`\WObj:=`; without it RAPID uses wobj0). With factory settings the robot base frame is the
-  world (the controller knows nothing of the cell), so a robtarget's TCP pose in the robot base
-  frame is the work object's uframe · oframe · target; the robot's placement in the cell is never
-  written. The frames' values are declared in a data module `<name>_frames.mod` (PERS tooldata,
-  PERS wobjdata with oframe identity) that the integrator loads with the program; a tool or work
-  object the cell names (`robot.controller`) exists on the controller and is not declared again;
+  (`\WObj:=`; without it RAPID uses wobj0). The TCP pose in the world is the work object's
+  uframe · oframe · target ([R3] p. 233-234: "The object coordinate system is defined in the user
+  coordinate system", the user frame in the world; [MSG] RobTarget.msg). With factory settings the
+  robot base frame is the world (the controller knows nothing of the cell); the robot's placement
+  in the cell is never written;
 - PTP moves as `MoveAbsJ ... vmax` under `VelSet` (the speed fraction, %) and `AccSet` (which holds
-  for the `MoveL`s after it too, as on the controller); LIN moves as
-  `MoveL` with a `speeddata` whose v_tcp is the planned TCP speed (mm/s, at `VelSet 100`);
+  for the `MoveL`s after it too, as on the controller); LIN moves as `MoveL` with a `speeddata`
+  whose v_tcp is the planned TCP speed (mm/s, at `VelSet 100`);
 - blends as `zonedata` with pzone_tcp the TCP distance (mm) of the planned radius (the other
   zone sizes in the proportions of ABB's predefined zones), `fine` at every stop and weld;
-- a weld as `MoveL ... fine` followed by `spot_weld n, weld_time;  ! seam/name`, with `PROC
-  spot_weld` defined in the module (rest for weld_time; the integrator replaces it);
 - `WaitTime t;` and `WaitDI <signal>, 1;`, the signal named as the controller's I/O configuration
   names it (`robot.controller.inputs`, else the cell's signal name).
 
-The tool's load is not known to robomax: tooldata carries a 1 kg load at the TCP that the
-integrator must replace with the gun's (LoadIdentify). The reader takes the motion subset of any
-module: MoveAbsJ and MoveL with declared or in-place targets, predefined and declared speed and
-zone data, VelSet, AccSet, WaitTime, WaitDI and calls of spot_weld; other motions (MoveJ, MoveC ...)
-are reported as not simulated, everything else as ignored.
+Welds. With `weld: call` (the default, SPEC §6) a weld is `MoveL ... fine` followed by
+`spot_weld n, weld_time;  ! seam/name gun G schedule S`, with `PROC spot_weld` defined in the module
+(rest for weld_time; the integrator replaces it). With `weld: package` it is the spot welding
+option's instruction, which moves to the spot and welds there ([PS4]: SpotL "Move the TCP along a
+linear path and perform a spot welding at the end position"; [R3] p. 675: "The start signal is sent
+to the timer as soon as the robot has reached the end position", a stop point):
+
+    SpotL p4, v_lin1, sd4, gun2, tool1 \WObj:=fixture;  ! flange/s7
+    PERS spotdata sd4 := [4, 1];       (in the program module: the schedule's program number)
+
+The argument list ToPoint, Speed, Spot [\InPos] [\NoConc] [\Retract], Gun, Tool [\WObj] is the
+closest published form found, not ABB's syntax page itself: [R3] p. 676 names the `\Retract`
+switch, p. 699 hands user routines "spot of type spotdata: actual spot given in the
+SpotL-instruction" and "gun of type gundata" in that order, [R3] p. 675 puts "A maximum of four
+discrete gun pressures" in the spot data. The spotdata written is [program number = the spot's
+schedule, pressure level 1] (level 1 exists on every gun: [R3] p. 665, gundata nof_plevels "Number
+of pressure levels (1 - 4)"), the form of public controller backups in the search tool's code index
+(repository not shown there: `PERS spotdata RA696SOLD011:=[1,1];`, the gun opened by
+`OpenHighLift GUN1;`). UNCONFIRMED: the argument order and the spotdata fields of
+RobotWare 6 / OmniCore Spot options (whose spotdata may hold more, such as tip force and plate
+thickness): the integrator completes the declaration to the installed option's record (a RAPID
+aggregate must match its type, so a mismatch should show when the module is loaded, not at the
+weld; not tried on a controller). The gundata is the option's, on the controller, named
+by the cell's gun number (`gun2`, not declared); a tool or work object of that name is refused
+(RAPID names data uniquely). The weld time is the schedule's on the controller: rebuild takes it
+from the cell's spots of that schedule.
+
+The data module. The frames' values are PERS data in `<name>_frames.mod` (tooldata, wobjdata with
+oframe identity); a tool or work object the cell names (`robot.controller`) exists on the
+controller and is not declared again. RAPID data declared at module level without LOCAL is global:
+"The scope of predefined or global program data may include any module" of the task, and "all
+data used must be declared" ([R3] p. 96; [DRV]). Hence the integrator's procedure:
+1. load `<name>_frames.mod` into the same task as `<name>.mod` (compare its values with the
+   calibrated ones first); without it, and without the named data on the controller, the program
+   module refers to undeclared data and cannot run (verify reports such a frame: it then knows
+   only the frames the cell names, never the values of the missing module);
+2. a persistent is one object per name: RAPID updates its declared value whenever the object
+   changes ([R3] p. 96, 98: "if the value of a persistent is updated, this automatically causes
+   the initialisation value of the persistent declaration to be updated"), and a module carrying a
+   persistent of a name already in the task refers to that same object ([DRV]: one persistent
+   written in one task is read in another). Which value then wins, the loaded module's
+   initial value or the one in memory, is UNCONFIRMED from an ABB document: check the frames on the
+   pendant after loading (Program data), and delete a stale module of the same frames first;
+3. the data module is a program module, not `(SYSMODULE)` ([DRV] shows the attribute, but a system
+   module is loaded at start-up from the system parameters and outlives programs; frames the
+   integrator wants kept belong in the controller's own calibration module, named in the cell).
+
+The tool's load is not known to robomax: tooldata carries a point load of 1 kg at the TCP ("If all
+components are defined as being 0 kgm2, the tool is handled as if it were a spot load", [R3]
+p. 226; the centre of gravity of a tool in the wrist coordinate system, p. 183), with a comment:
+replace it with the gun's (LoadIdentify); a wrong load impairs path accuracy (p. 183).
+
+The reader takes the motion subset of any module as the controller executes it: MoveAbsJ (tool,
+`\WObj` and `\TLoad` do not change a joint target), MoveL and SpotL with declared or in-place targets
+in the tool and work object they name (\TLoad changes no path), predefined and declared speed and
+zone data, VelSet, AccSet, WaitTime, WaitDI and calls of spot_weld; a work object held by the robot
+or moved by a mechanical unit (robhold TRUE, ufprog FALSE, ufmec) is reported, not placed; other
+motions (MoveJ, MoveC, SpotJ ...) are reported as not simulated, everything else as ignored.
 """
 
 from __future__ import annotations
@@ -34,6 +97,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+from collections.abc import Sequence
 from functools import lru_cache
 
 from lark import Lark, Token, Tree
@@ -53,6 +117,7 @@ from robomax_py.export.dialect import (
     spot_label,
     tree_numbers,
     with_brand_configs,
+    with_package_welds,
     with_tcp_blends,
 )
 from robomax_py.export.plan_program import identifier
@@ -90,7 +155,8 @@ VMAX_TCP_MM_S = 7000.0
 
 def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     """The program as RAPID states it: ABB confdata, TCP-distance zones, frames by name (those the
-    cell names exist on the controller and are not declared), inputs by signal name."""
+    cell names exist on the controller and are not declared), inputs by signal name, and with
+    `weld: package` every weld as the spot option's SpotL at the end of its approach line."""
     require_six_axes(robot, "RAPID")
     setup = planned.controller
     existing = set()
@@ -112,9 +178,46 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
         out.append(ins)
     # RAPID refers to data by name: the frames carry no slot number.
     frames = tuple(dataclasses.replace(f, number=0) for f in program.frames if (f.kind, f.name) not in existing)
-    program = dataclasses.replace(program, frames=frames, instructions=tuple(out))
+    program = with_package_welds(dataclasses.replace(program, frames=frames, instructions=tuple(out)), "RAPID")
+    _check_weld_data_names(program)
     program = with_brand_configs(program, planned.joints, robot, "abb")
-    return with_tcp_blends(dataclasses.replace(planned, program=program), robot)
+    return with_tcp_blends(dataclasses.replace(planned, program=_without_approach_notes(program)), robot)
+
+
+def gun_data(gun: int) -> str:
+    """The spot option's gundata of gun n on the controller (not declared by the program)."""
+    return f"gun{gun}"
+
+
+def spot_data(schedule: int) -> str:
+    """The spotdata a package weld of `schedule` names (declared in the program module)."""
+    return f"sd{schedule}"
+
+
+def _check_weld_data_names(program: Program) -> None:
+    """A frame named like a gundata or spotdata the welds use: RAPID names data uniquely, and the
+    gundata exists on the controller already."""
+    welds = [i for i in program.instructions if isinstance(i, Spot) and i.package]
+    taken = {gun_data(w.gun).lower(): f"gun {w.gun}'s gundata" for w in welds}
+    taken |= {spot_data(w.schedule).lower(): f"schedule {w.schedule}'s spotdata" for w in welds}
+    names: set[tuple[str, str]] = {(f.kind, f.name) for f in program.frames}
+    names |= {(k, n) for i in program.instructions if isinstance(i, LinMove) for k, n in (("tool", i.tool),
+                                                                                         ("base", i.base))}
+    for kind, name in sorted(names):
+        if name.lower() in taken:
+            key = "robot.controller." + ("tool" if kind == "tool" else "frame") + ".name"
+            raise ControllerSetupError(key, f"{name} is also the name of {taken[name.lower()]} (weld: package); "
+                                            "RAPID names data uniquely: name the frame otherwise")
+
+
+def _without_approach_notes(program: Program) -> Program:
+    """The line to a package weld without its note: its statement (SpotL) carries the weld's."""
+    out = list(program.instructions)
+    for k in range(1, len(out)):
+        ins, before = out[k], out[k - 1]
+        if isinstance(ins, Spot) and ins.package and isinstance(before, LinMove):
+            out[k - 1] = dataclasses.replace(before, comment="")
+    return dataclasses.replace(program, instructions=tuple(out))
 
 
 # ================================================================================== writing
@@ -148,8 +251,10 @@ def _frames_module(program: Program) -> str:
                  "(mm, quaternions [w, x, y, z]; work objects in the robot base frame, which is the world)")
     for f in program.frames:
         if f.kind == "tool":
+            # tload: a 1 kg point load at the TCP (centre of gravity in the wrist frame, no inertia).
             lines.append(f"  PERS tooldata {f.name} := [TRUE, [{_xyz(f.xyz_mm)}, {_q(f.zyx_deg)}], "
-                         "[1, [0, 0, 0.001], [1, 0, 0, 0], 0, 0, 0]];  ! load: replace with the gun's (LoadIdentify)")
+                         f"[1, {_xyz(f.xyz_mm)}, [1, 0, 0, 0], 0, 0, 0]];  "
+                         "! load: 1 kg at the TCP, a placeholder: replace with the gun's (LoadIdentify)")
         else:
             lines.append(f"  PERS wobjdata {f.name} := [FALSE, TRUE, \"\", [{_xyz(f.xyz_mm)}, {_q(f.zyx_deg)}], "
                          "[[0, 0, 0], [1, 0, 0, 0]]];")
@@ -164,10 +269,12 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     joint_tail = _tail(first.tool, "") if first is not None else ", tool0;"
     speeds: dict[float, str] = {}
     zones: dict[float, str] = {}
+    schedules: set[int] = set()
     override = accel = None
     n_point = n_weld = 0
     grips: dict[str, int] = {}
-    for ins in program.instructions:
+    instructions = program.instructions
+    for k, ins in enumerate(instructions):
         if isinstance(ins, Comment):
             body.append(f"    ! {ins.text}" if ins.text else "    !")
             continue
@@ -200,8 +307,25 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
                 name = f"p{n_point}"
                 decl.append(f"  CONST robtarget {name} := [{_xyz(ins.position_mm)}, {_q(ins.zyx_deg)}, "
                             f"{ins.config.replace(',', ', ')}, {_EAX}];")
-                body.append(f"    MoveL {name}, {speeds[ins.speed_mm_s]}, {zone}{_tail(ins.tool, ins.base)}{note}")
+                weld = instructions[k + 1] if k + 1 < len(instructions) else None
+                if isinstance(weld, Spot) and weld.package:
+                    # The spot option's instruction moves to the spot and welds there: always a stop.
+                    if zone != "fine":
+                        raise ExportError(f"{weld.seam}/{weld.name}: a SpotL welds at a stop point; its line flies by")
+                    if weld.schedule not in schedules:
+                        schedules.add(weld.schedule)
+                        decl.append(f"  PERS spotdata {spot_data(weld.schedule)} := [{weld.schedule}, 1];"
+                                    "  ! [program number, pressure level]: check against the spot option's spotdata")
+                    body.append(f"    SpotL {name}, {speeds[ins.speed_mm_s]}, {spot_data(weld.schedule)}, "
+                                f"{gun_data(weld.gun)}{_tail(ins.tool, ins.base)}  ! {weld.seam}/{weld.name}")
+                else:
+                    body.append(f"    MoveL {name}, {speeds[ins.speed_mm_s]}, {zone}{_tail(ins.tool, ins.base)}{note}")
         elif isinstance(ins, Spot):
+            if ins.package:
+                if not (k and isinstance(instructions[k - 1], LinMove)):
+                    raise ExportError(f"{ins.seam}/{ins.name}: RAPID's SpotL welds at the end of a line; the weld "
+                                      "follows no line")
+                continue                                          # written with its line
             n_weld += 1
             body.append(f"    spot_weld {n_weld}, {ins.time_s:.3f};  ! {spot_label(ins)}")
         elif isinstance(ins, Gripper):
@@ -216,9 +340,12 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     lines = ["%%%", "  VERSION:1", "  LANGUAGE:ENGLISH", "%%%", "", f"MODULE {program.name}"]
     lines += [f"  ! {text}" for text in header_lines(program.header)]
     lines.append(f"  ! {_NOTE}: mm, deg, quaternions [w, x, y, z], speeddata mm/s, zonedata mm")
+    if schedules:
+        lines.append("  ! welds: SpotL of the spot welding option with the controller's gundata; the weld time is "
+                     "the schedule's")
     lines += decl
     lines += ["", "  PROC main()", *body, "  ENDPROC"]
-    if n_weld or not grips:
+    if n_weld or not (grips or schedules):
         lines += ["", "  PROC spot_weld(num n, num weld_time)",
                   "    ! default weld: rest for weld_time s; replace with the gun's technology package",
                   "    WaitTime \\InPos, weld_time;", "  ENDPROC"]
@@ -246,7 +373,7 @@ gripper: GRIPPER NUMBER "," NUMBER
 opt: "\\" NAME (":=" value)?
 ?value: NUMBER | NAME | STRING | list | BOOL
 list: "[" [value ("," value)*] "]"
-MOVE.2: /(MoveAbsJ|MoveL)\b/i
+MOVE.2: /(MoveAbsJ|MoveL|SpotL)\b/i
 GRIPPER.2: /(grip|release)\b/i
 BOOL.2: /(TRUE|FALSE)\b/i
 NAME: /[A-Za-z_][A-Za-z0-9_]*/
@@ -256,17 +383,20 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 """
 
 _UNSIMULATED = re.compile(r"^(MoveJ|MoveC|MoveLDO|MoveJDO|MoveLSync|MoveJSync|MoveCSync|MoveExtJ|SearchL|SearchC|"
-                          r"TriggL|TriggJ|TriggC|MoveLRel|MoveAbsJDO|MoveAbsJSync|SpotL|SpotJ)\b", re.I)
-_KNOWN = re.compile(r"^(MoveAbsJ|MoveL|VelSet|AccSet|WaitTime|WaitDI|spot_weld|grip|release)\b", re.I)
+                          r"TriggL|TriggJ|TriggC|MoveLRel|MoveAbsJDO|MoveAbsJSync|SpotJ|SpotML|SpotMJ)\b", re.I)
+_KNOWN = re.compile(r"^(MoveAbsJ|MoveL|SpotL|VelSet|AccSet|WaitTime|WaitDI|spot_weld|grip|release)\b", re.I)
 # Lines that end a statement without ';': routine heads and ends, and control-flow lines.
 _HEADLINE = re.compile(r"^(MODULE|ENDMODULE|(LOCAL\s+)?PROC|ENDPROC|(LOCAL\s+)?FUNC|ENDFUNC|(LOCAL\s+)?TRAP|ENDTRAP)\b", re.I)
 _OPENS = re.compile(r"\b(THEN|DO)\s*$|^(TEST\b.*|ELSE|DEFAULT\s*:|CASE\b.*:)\s*$", re.I)
 _CLOSES = re.compile(r"^(ENDIF|ENDWHILE|ENDFOR|ENDTEST|ELSE)\s*$", re.I)
-# The declarations the motion depends on; others (num, confdata, syncident, arrays ...) are ignored.
-_MOTION_DATA = re.compile(r"^((LOCAL|TASK)\s+)*(CONST|PERS|VAR)\s+(robtarget|jointtarget|speeddata|zonedata|tooldata|wobjdata)\b",
+# The declarations the motion depends on (spotdata: a package weld's schedule); others (num,
+# confdata, syncident, arrays ...) are ignored.
+_MOTION_DATA = re.compile(r"^((LOCAL|TASK)\s+)*(CONST|PERS|VAR)\s+(robtarget|jointtarget|speeddata|zonedata|tooldata|wobjdata|spotdata)\b",
                           re.I)
 _PREDEFINED_SPEED = re.compile(r"^v([0-9]+)$", re.I)
 _PREDEFINED_ZONE = re.compile(r"^z([0-9]+)$", re.I)
+# The spot option's gundata of gun n (`gun_data`); another name leaves the gun unknown (0).
+_GUN_DATA = re.compile(r"^gun([0-9]+)$", re.IGNORECASE)
 
 
 @lru_cache(maxsize=1)
@@ -318,6 +448,7 @@ class _Reader:
         self.override = 100.0
         self.accel = 100.0
         self.depth = 0                        # of IF / WHILE / FOR / TEST blocks
+        self.package_welds = 0
 
     def error(self, line: int, problem: str) -> ProgramError:
         return ProgramError(self.file, f"line {line}", problem)
@@ -412,6 +543,9 @@ class _Reader:
     def move(self, tree: Tree[Token], comment: str, line: int) -> None:
         kind = str(tree.children[0]).lower()
         args = [c for c in tree.children[1:] if not (isinstance(c, Tree) and c.data == "opt")]
+        if kind == "spotl":
+            self.spot_move(tree, args, comment, line)
+            return
         if len(args) < 3:
             raise self.error(line, f"{tree.children[0]} needs a target, a speed and a zone")
         target, speed, zone = args[0], args[1], args[2]
@@ -428,6 +562,11 @@ class _Reader:
         tool = args[3] if len(args) > 3 else None
         if not (isinstance(tool, Token) and tool.type == "NAME"):
             raise self.error(line, "a MoveL names its tooldata after the zone")
+        self.add(self.line_to(tree, target, v, tool, line, comment, flyby_mm), line)
+
+    def line_to(self, tree: Tree[Token], target: object, v: float | None, tool: Token, line: int, comment: str,
+                flyby_mm: float) -> LinMove:
+        """The line to a robtarget with the tool and work object (\\WObj) the statement names."""
         wobj = next((o.children[1] for o in tree.children[1:] if isinstance(o, Tree) and o.data == "opt"
                      and str(o.children[0]).lower() == "wobj" and len(o.children) > 1), None)
         if wobj is not None and not (isinstance(wobj, Token) and wobj.type == "NAME"):
@@ -441,8 +580,27 @@ class _Reader:
         conf = [int(round(c)) for c in tree_numbers(value.children[2], self.file, line)]
         config = "[" + ",".join(str(c) for c in conf) + "]"
         v_tcp = VMAX_TCP_MM_S if v is None else v
-        self.add(LinMove(xyz, zyx, config, v_tcp * self.override / 100.0, comment=comment, flyby_mm=flyby_mm,
-                         accel=self.accel / 100.0, tool=tool_name, base=base_name), line)
+        return LinMove(xyz, zyx, config, v_tcp * self.override / 100.0, comment=comment, flyby_mm=flyby_mm,
+                       accel=self.accel / 100.0, tool=tool_name, base=base_name)
+
+    def spot_move(self, tree: Tree[Token], args: Sequence[object], comment: str, line: int) -> None:
+        """SpotL ToPoint, Speed, Spot, Gun, Tool [\\WObj]: a line to the spot, stopping there (the
+        weld starts at the end position), then the weld of the spotdata's program number with the
+        gun the gundata names (`gun_data`); the comment names the spot."""
+        if len(args) != 5:
+            raise self.error(line, f"SpotL needs ToPoint, Speed, Spot, Gun and Tool, got {len(args)} arguments")
+        target, speed, spot, gun, tool = args
+        if not (isinstance(tool, Token) and tool.type == "NAME" and isinstance(gun, Token) and gun.type == "NAME"):
+            raise self.error(line, "SpotL names its gundata and tooldata")
+        values = tree_numbers(self.resolve(spot, "spotdata", line), self.file, line)
+        if not values or values[0] != int(values[0]) or values[0] < 0:
+            raise self.error(line, f"spotdata {spot}: its first value is the weld program number, got {values[:1]}")
+        match = _GUN_DATA.match(str(gun))
+        self.add(self.line_to(tree, target, self.speed(speed, line), tool, line, "", 0.0), line)
+        self.package_welds += 1
+        named = read_spot_label(comment, self.package_welds, 0.0, self.file, line)
+        self.add(dataclasses.replace(named, gun=int(match.group(1)) if match else 0, schedule=int(values[0]),
+                                     package=True), line)
 
     def frame_ref(self, kind: str, name: str) -> str:
         """A frame named by a move, spelt as declared (RAPID names are case-insensitive)."""

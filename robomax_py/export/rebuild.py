@@ -211,6 +211,7 @@ class _Builder:
             if isinstance(ins, Spot):
                 self._check_interlocks(ins, label)
                 if ins.package:
+                    self._check_schedule(ins, label)
                     ins = dataclasses.replace(ins, time_s=self._schedule_time(ins))
             self._check_action(ins, label)
             self.segments.append(dwell(self.q, ins.time_s, kind="weld", label=label))
@@ -339,6 +340,22 @@ class _Builder:
                                                          "time", self.line))
             return 0.0
         return times.pop()
+
+    def _check_schedule(self, spot: Spot, label: str) -> None:
+        """A process-package weld names the gun and schedule the controller welds with: those of
+        the cell's spot (a weld time alone does not tell a schedule's current from another's)."""
+        from robomax_py.export.plan_program import identifier
+
+        seam = next((s for s in self.cell.seams if identifier(s.name) == spot.seam), None)
+        spec = next((p for p in seam.spots if identifier(p.name) == spot.name), None) if seam else None
+        if spec is None:
+            return
+        process = self.cell.process
+        want = (process.gun, process.schedule_of(spec))
+        if (spot.gun, spot.schedule) != want:
+            self.problems.append(Problem(self.t, "weld", f"{label}: the program welds with gun {spot.gun} schedule "
+                                                         f"{spot.schedule}, the cell with gun {want[0]} schedule "
+                                                         f"{want[1]}", self.line))
 
     def _check_action(self, ins: Spot | Gripper, label: str) -> None:
         """A tending station gets its gripper action, a weld spot a weld."""

@@ -407,6 +407,147 @@ def _joint_origin(joint: ET.Element, urdf: Path) -> FloatArray:
     return pose_matrix(values[0], values[1])
 
 
+# ------------------------------------------------------------------------------ URDF checks
+
+# Joint limits outside these are refused at load as typos or unit mistakes (a velocity of 1e-300 in
+# a URDF passed `check` and ended planning in an overflow): no industrial axis is slower than
+# 0.06 deg/s or faster than 100 rad/s at full speed, no linear axis slower than 0.1 mm/s or faster
+# than 10 m/s; a revolute joint's range stays within 8 turns either way, a prismatic one within 100 m.
+JOINT_VELOCITY_RANGE = {"revolute": (1e-3, 100.0), "continuous": (1e-3, 100.0), "prismatic": (1e-4, 10.0)}
+JOINT_POSITION_BOUND = {"revolute": 16 * math.pi, "prismatic": 100.0}
+_VELOCITY_UNIT = {"revolute": "rad/s", "continuous": "rad/s", "prismatic": "m/s"}
+_SHAPES = ("mesh", "box", "cylinder", "sphere", "capsule")
+
+
+def check_urdf(root: ET.Element, urdf: Path) -> tuple[str, ...]:
+    """The checks every robot's URDF passes at load (`load_robot_spec`, and `import-urdf` before it
+    writes anything): at most LIMITS.urdf_links links and joints; each revolute or prismatic joint
+    with finite limits lower < upper within JOINT_POSITION_BOUND and a velocity within
+    JOINT_VELOCITY_RANGE; collision geometry where the robot moves.
+
+    Collision geometry: a URDF with `<visual>` but no `<collision>` geometry anywhere is refused
+    (nothing could be checked for collisions); one without any geometry (a kinematic model) gets a
+    warning. A moving body (the child link of a movable joint with the links fixed to it) without
+    `<collision>` is refused when it has `<visual>` geometry (a shape that would pass through
+    everything unseen); with no geometry at all it carries nothing (a frame between two joints) and
+    gets a warning.
+
+    Returns
+    -------
+    tuple of str
+        Warnings, each naming the file and the link.
+
+    Raises
+    ------
+    RobotModelError
+        Naming the joint or link and the problem.
+    """
+    links = root.findall("link")
+    joints = root.findall("joint")
+    if max(len(links), len(joints)) > LIMITS.urdf_links:
+        raise RobotModelError(urdf, None, f"{len(links)} links and {len(joints)} joints: more than the "
+                              f"{LIMITS.urdf_links} allowed")
+    for joint in joints:
+        _check_joint_limits(joint, urdf)
+    return _check_collision_geometry(links, joints, urdf)
+
+
+def _urdf_number(element: ET.Element, attr: str, default: float | None, urdf: Path, key: str) -> float:
+    text = element.get(attr)
+    if text is None:
+        if default is None:
+            raise RobotModelError(urdf, key, f"<{element.tag}> needs the attribute {attr}")
+        return default
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise RobotModelError(urdf, key, f"<{element.tag}> {attr}: expected a finite number, got {text!r}")
+    return value
+
+
+def _check_joint_limits(joint: ET.Element, urdf: Path) -> None:
+    kind = joint.get("type", "")
+    if kind not in JOINT_VELOCITY_RANGE:
+        return
+    key = f"joint {joint.get('name')}"
+    limit = joint.find("limit")
+    if limit is None:
+        if kind == "continuous":
+            return
+        raise RobotModelError(urdf, key, f"a {kind} joint needs <limit lower=.. upper=.. velocity=..>")
+    velocity = _urdf_number(limit, "velocity", None, urdf, key)
+    slowest, fastest = JOINT_VELOCITY_RANGE[kind]
+    unit = _VELOCITY_UNIT[kind]
+    if velocity <= 0:
+        raise RobotModelError(urdf, key, f"limit velocity {velocity:g} {unit}: must be > 0")
+    if not slowest <= velocity <= fastest:
+        raise RobotModelError(urdf, key, f"limit velocity {velocity:g} {unit} is outside [{slowest:g}, {fastest:g}] "
+                              f"{unit} (a typo or another unit?)")
+    if kind == "continuous":
+        return
+    lower = _urdf_number(limit, "lower", 0.0, urdf, key)      # the URDF default for both is 0
+    upper = _urdf_number(limit, "upper", 0.0, urdf, key)
+    if lower > upper:
+        raise RobotModelError(urdf, key, f"limit lower {lower:g} > upper {upper:g}")
+    if lower == upper:
+        raise RobotModelError(urdf, key, f"limit lower = upper = {lower:g}: the joint cannot move (make it fixed)")
+    bound = JOINT_POSITION_BOUND[kind]
+    if max(abs(lower), abs(upper)) > bound:
+        raise RobotModelError(urdf, key, f"limits [{lower:g}, {upper:g}] go beyond ±{bound:g} "
+                              f"{'rad' if kind == 'revolute' else 'm'} (a typo or another unit?)")
+
+
+def _has_shape(link: ET.Element, tag: str) -> bool:
+    return any(geometry.find(shape) is not None
+               for el in link.findall(tag) for geometry in el.findall("geometry") for shape in _SHAPES)
+
+
+def _check_collision_geometry(links: list[ET.Element], joints: list[ET.Element], urdf: Path) -> tuple[str, ...]:
+    if not any(_has_shape(link, "collision") for link in links):
+        if any(_has_shape(link, "visual") for link in links):
+            raise RobotModelError(urdf, None, "no <collision> geometry at all, only <visual>: robomax could not check "
+                                  "the robot for collisions (add <collision> elements; the visual meshes will do)")
+        return (f"{urdf}: no geometry at all (a kinematic model): collisions of the arm are not checked",)
+    parent_joint: dict[str, ET.Element] = {}
+    child_of: dict[str, str] = {}
+    for joint in joints:
+        child = joint.find("child")
+        if child is not None and child.get("link"):
+            parent_joint.setdefault(str(child.get("link")), joint)
+            child_of[str(joint.get("name"))] = str(child.get("link"))
+
+    def moved_by(link: str) -> ET.Element | None:
+        """The movable joint nearest above `link` (through fixed joints); None on the root body."""
+        for _ in range(len(joints) + 1):
+            joint = parent_joint.get(link)
+            if joint is None:
+                return None
+            if joint.get("type") != "fixed":
+                return joint
+            parent = joint.find("parent")
+            link = "" if parent is None else str(parent.get("link", ""))
+        return None      # a loop: Pinocchio names it
+
+    bodies: dict[str, list[ET.Element]] = {}
+    for link in links:
+        mover = moved_by(str(link.get("name", "")))
+        if mover is not None:
+            bodies.setdefault(str(mover.get("name")), []).append(link)
+    warnings = []
+    for joint_name, body in bodies.items():
+        if any(_has_shape(link, "collision") for link in body):
+            continue
+        moving = child_of.get(joint_name, str(body[0].get("name")))
+        if any(_has_shape(link, "visual") for link in body):
+            raise RobotModelError(urdf, f"link {moving}", f"moves with joint {joint_name} and has <visual> but no "
+                                  "<collision> geometry: it would pass through everything unseen (add a <collision>)")
+        warnings.append(f"{urdf}: link {moving} moves with joint {joint_name} but has no geometry at all; "
+                        "robomax takes it to carry nothing")
+    return tuple(warnings)
+
+
 # ------------------------------------------------------------------------------ SRDF
 
 
@@ -467,10 +608,12 @@ def load_robot_spec(path: Path) -> RobotSpec:
         raise RobotModelError(path, "limits.loaded", "needs `payload` (kg): the loaded limits hold for the rated payload")
     urdf_text = read_text(urdf, LIMITS.urdf, named_by(RobotModelError, path, "urdf"), f"URDF {urdf}")
     package_dirs = urdf_package_dirs(urdf, path, urdf_text)
+    urdf_root = parse_urdf(urdf_text, urdf)
+    warnings = check_urdf(urdf_root, urdf)
     if ctrl.base is not None:
         T_root_base = pose_matrix(ctrl.base.xyz, [math.radians(a) for a in ctrl.base.rpy])
     else:
-        from_urdf = urdf_base_link(parse_urdf(urdf_text, urdf), urdf)
+        from_urdf = urdf_base_link(urdf_root, urdf)
         T_root_base = np.eye(4) if from_urdf is None else from_urdf
     return RobotSpec(
         name=parsed.name,
@@ -495,6 +638,7 @@ def load_robot_spec(path: Path) -> RobotSpec:
             acceleration=frozen_array(degs_to_rads(limits.loaded.acceleration)),
             jerk=frozen_array(degs_to_rads(limits.loaded.jerk)),
         ),
+        warnings=warnings,
     )
 
 

@@ -22,10 +22,19 @@ CONVEX_VOLUME_RTOL = TOL.convex_volume_rtol
 
 
 def load_mesh(path: Path, scale: np.ndarray | None = None) -> trimesh.Trimesh:
-    """Any format trimesh reads, flattened into one triangle mesh (scene graphs concatenated)."""
-    loaded = trimesh.load(str(path), force="mesh", process=True)
+    """Any format trimesh reads, flattened into one triangle mesh (scene graphs concatenated).
+
+    A vertex that is not finite is an error: trimesh's processing would drop it and the faces using
+    it without a word, and the collision geometry would have holes.
+    """
+    loaded = trimesh.load(str(path), force="mesh", process=False)
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
         raise ValueError("no triangles in file")
+    bad = ~np.isfinite(np.asarray(loaded.vertices)).all(axis=1)
+    if bad.any():
+        raise ValueError(f"{int(bad.sum())} of {len(bad)} vertices are not finite (NaN or infinity), "
+                         f"the first at index {int(np.flatnonzero(bad)[0])}")
+    loaded.process()
     if scale is not None and not np.allclose(scale, 1.0):
         loaded.apply_scale(np.asarray(scale, dtype=float))
     return loaded

@@ -123,7 +123,7 @@ def load_robot(spec: RobotSpec) -> RobotModel:
     jerk = _limit_vector(spec, "jerk", spec.jerk, acceleration / DEFAULT_TIME_TO_FULL_ACCEL_S, n)
 
     package_dirs = [str(spec.urdf.parent), *[str(d) for d in spec.package_dirs]]
-    warnings: list[str] = []
+    warnings: list[str] = list(spec.warnings)
     collision = _build_geometry(model, spec, pin.GeometryType.COLLISION, package_dirs)
     _make_meshes_convex(collision, spec)
     try:
@@ -173,6 +173,9 @@ def checked_ik_params(spec: RobotSpec, model: pin.Model) -> Any:
         return _table_steps(spec, model)
     if spec.ik_solver not in ("opw", "ur"):
         return spec.ik_params
+    if model.nq != 6:
+        raise RobotModelError(spec.source, "ik.solver", f"the {spec.ik_solver} solver is for six joints; the URDF "
+                              f"{spec.urdf.name} has {model.nq} ({', '.join(model.names[1:])}): use numeric or table")
     frame_id = int(model.getFrameId(spec.flange))
     params = spec.ik_params
     origin = "ik.params"

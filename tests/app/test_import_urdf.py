@@ -44,7 +44,7 @@ def arms(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     root = tmp_path_factory.mktemp("robots")
     out = {}
     for name, source in ARMS.items():
-        out[name] = import_urdf(source, root / name, srdf=SRDF.get(name)).folder
+        out[name] = import_urdf(source, root / name, (ROSI,), srdf=SRDF.get(name)).folder
     return out
 
 
@@ -108,14 +108,14 @@ def test_fk_agrees_and_ik_round_trips(arms: dict[str, Path], name: str) -> None:
 
 def test_import_is_idempotent_and_never_overwrites(tmp_path: Path) -> None:
     out = tmp_path / "m20ia"
-    first = import_urdf(ARMS["m20ia"], out)
+    first = import_urdf(ARMS["m20ia"], out, (ROSI,))
     assert not first.unchanged
-    assert import_urdf(ARMS["m20ia"], out).unchanged
+    assert import_urdf(ARMS["m20ia"], out, (ROSI,)).unchanged
     (out / "robot.yaml").write_text((out / "robot.yaml").read_text() + "# edited\n")
     with pytest.raises(RobotModelError, match="--force"):
-        import_urdf(ARMS["m20ia"], out)
+        import_urdf(ARMS["m20ia"], out, (ROSI,))
     assert (out / "robot.yaml").read_text().endswith("# edited\n")
-    assert not import_urdf(ARMS["m20ia"], out, force=True).unchanged
+    assert not import_urdf(ARMS["m20ia"], out, (ROSI,), force=True).unchanged
     assert not (out / "robot.yaml").read_text().endswith("# edited\n")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m20ia"]     # no staging folders left
 
@@ -126,10 +126,11 @@ def test_import_bad_input_leaves_nothing(tmp_path: Path) -> None:
     result = runner.invoke(app, ["import-urdf", str(broken), "-o", str(tmp_path / "out")])
     assert result.exit_code == 2 and "xacro does not expand" in result.output and "broken.xacro" in result.output
     # A chain that is not OPW up to the named frame (the flange at link_4: four joints).
-    result = runner.invoke(app, ["import-urdf", str(ARMS["m20ia"]), "-o", str(tmp_path / "out"),
+    result = runner.invoke(app, ["import-urdf", str(ARMS["m20ia"]), "-o", str(tmp_path / "out"), "--packages", str(ROSI),
                                  "--flange", "link_4", "--solver", "opw"])
     assert result.exit_code == 2 and "six revolute joints" in result.output
-    result = runner.invoke(app, ["import-urdf", str(ARMS["m20ia"]), "-o", str(tmp_path / "out"), "--flange", "nope"])
+    result = runner.invoke(app, ["import-urdf", str(ARMS["m20ia"]), "-o", str(tmp_path / "out"), "--packages", str(ROSI),
+                                 "--flange", "nope"])
     assert result.exit_code == 2 and "no frame 'nope'" in result.output
     assert sorted(p.name for p in tmp_path.iterdir()) == ["broken.xacro"]
 
@@ -302,10 +303,10 @@ def test_flange_in_the_controller_base_is_where_the_vendor_frame_has_it(arms: di
 def test_ur_base_link_is_the_shipped_ur10_base(tmp_path: Path) -> None:
     """The UR10 URDF of example-robot-data has a `base` link turned -180 deg about z from base_link
     (joint base_link-base_fixed_joint): imported, it is the half turn the shipped ur10 states."""
-    from robomax_py.io.robot import shipped_robots_dir
+    from robomax_py.io.robot import package_share_dirs, shipped_robots_dir
 
     shipped = load_robot_spec(shipped_robots_dir() / "ur10" / "robot.yaml")
-    folder = import_urdf(shipped.urdf, tmp_path / "ur10x").folder
+    folder = import_urdf(shipped.urdf, tmp_path / "ur10x", package_share_dirs()).folder
     text = (folder / "robot.yaml").read_text()
     assert "  base: {xyz: [0, 0, 0], rpy: [0, 0, 180]}  # ROS-Industrial's `base` link" in text
     np.testing.assert_allclose(load_robot_spec(folder / "robot.yaml").controller.T_root_base,
@@ -327,15 +328,15 @@ def test_fanuc_targets_are_measured_from_the_world_frame_at_j2_height(arms: dict
     out = tmp_path / "programs"
     result = runner.invoke(app, ["plan", str(cell), "-o", str(out), "--format", "fanuc"])
     assert result.exit_code == 0, result.output
-    program = out / "m20ia_flange.ls"
+    program = out / "M20IA_FLANGE.ls"
     verified = runner.invoke(app, ["verify", str(cell), str(program)])
     assert verified.exit_code == 0, verified.output
     text = program.read_text()
     # The LIN target right before each weld call is the spot's TCP pose.
-    welds = re.findall(r"L P\[(\d+)\][^\n]*FINE ;\n\s*\d+:\s*CALL SPOT_WELD", text)
+    welds = re.findall(r"L P\[(\d+)(?::\w+)?\][^\n]*FINE +;\n\s*\d+:\s*CALL SPOT_WELD", text)
     assert len(welds) == 4
     for k in welds:
-        block = re.search(rf"P\[{k}\]\{{.*?X = (\S+)  mm,\tY = (\S+)  mm,\tZ = (\S+)  mm", text, re.DOTALL)
+        block = re.search(rf"P\[{k}(?::\"\w+\")?\]\{{.*?X = +(\S+)  mm,\tY = +(\S+)  mm,\tZ = +(\S+)  mm", text, re.DOTALL)
         assert block is not None
         x, y, z = (float(v) for v in block.groups())
         assert x == pytest.approx(1050.0, abs=1e-3) and z == pytest.approx(425.0, abs=1e-3)
@@ -469,4 +470,4 @@ def test_cartesian_targets_are_stated_in_the_controller_base(arms: dict[str, Pat
     spots = [np.array([1.6, yy, 1.2]) for yy in (-0.3, -0.1, 0.1, 0.3)]
     assert min(np.linalg.norm(root[:3] - s) for s in spots) < 2e-6
     assert np.linalg.norm(invert(C)[:3, 3]) > 0.1          # the frame really moved the numbers
-    assert "robot_base: BASE FRAME := (POS(100.000, -200.000, 300.000), ORI(90.0000, 0.0000, 0.0000))" in srcl
+    assert "BASE FRAME" not in srcl                          # stated in the controller base itself

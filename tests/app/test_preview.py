@@ -225,8 +225,8 @@ def test_serve_announces_its_url_and_ends_cleanly_on_ctrl_c(planned: tuple[Path,
     servers: list[Any] = []
     make = preview._visualizer
 
-    def visualizer() -> Any:
-        vis = make()
+    def visualizer(*args: Any) -> Any:
+        vis = make(*args)
         servers.append(vis.window.server_proc)
         return vis
 

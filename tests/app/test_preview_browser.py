@@ -1,8 +1,10 @@
-"""The `--html` preview page in a real browser: headless Debian chromium driven by Playwright.
+"""The preview in a real browser: headless Debian chromium driven by Playwright.
 
-The page is opened from disk with the network features of the browser off; the test asserts the
-scene really drew (pixels in the robot's colour inside the canvas), that nothing but the page itself
-and its inline data was requested, and that the console shows no errors.
+The `--html` page is opened from disk with the network features of the browser off; the test asserts
+the scene really drew (pixels in the robot's colour inside the canvas), that nothing but the page
+itself and its inline data was requested, and that the console shows no errors. The served preview
+(`robomax preview CELL`, on loopback) is opened at the URL it prints: the page's WebSocket, which
+carries the browser's own Origin, gets the scene and it draws.
 
 Skips when /usr/bin/chromium (or the playwright package) is missing, unless ROBOMAX_REQUIRE_BROWSER
 is set (CI sets it): then it fails. Playwright never downloads a browser here.
@@ -26,6 +28,7 @@ from robomax_py.app.cli import EXIT_OK, app
 pytestmark = pytest.mark.slow
 
 SmallCell = Callable[..., Path]   # conftest.write_small_cell
+Served = Any                      # tests/app/conftest.Served
 CHROMIUM = Path("/usr/bin/chromium")
 CHROMIUM_ARGS = [
     "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -106,3 +109,48 @@ def test_html_preview_draws_the_robot_offline_without_console_errors(tmp_path: P
     assert fraction > MIN_ROBOT_FRACTION, f"{fraction:.4f} of the canvas in the robot's colour: the scene did not draw"
     # Not a blank canvas: many distinct colours (shaded meshes, grid, path).
     assert len(np.unique(canvas.reshape(-1, 3)[::7], axis=0)) > 200
+
+
+def _draw_in_browser(sync_api: Any, url: str, tmp_path: Path) -> tuple[list[str], list[str], float, int]:
+    """Open `url`, let it draw, and return the console errors, the URLs requested, the fraction of
+    the canvas in the robot's colour and the number of distinct colours (sampled)."""
+    from PIL import Image
+
+    errors: list[str] = []
+    requests: list[str] = []
+    with sync_api.sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=str(CHROMIUM), headless=True, args=CHROMIUM_ARGS)
+        try:
+            page = browser.new_page(viewport=VIEWPORT)
+            page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+            page.on("pageerror", lambda e: errors.append(str(e)))
+            page.on("request", lambda r: requests.append(r.url))
+            page.goto(url)
+            page.wait_for_selector("canvas")
+            page.wait_for_timeout(SETTLE_MS)
+            box = page.locator("canvas").first.bounding_box()
+            shot = page.screenshot()
+        finally:
+            browser.close()
+    assert box is not None and box["width"] > 100 and box["height"] > 100
+    (tmp_path / "screenshot.png").write_bytes(shot)
+    image = np.asarray(Image.open(io.BytesIO(shot)).convert("RGB"))
+    x0, y0 = int(box["x"]), int(box["y"])
+    canvas = image[y0:y0 + int(box["height"]), x0:x0 + int(box["width"])]
+    return errors, requests, float(np.mean(robot_coloured(canvas))), len(np.unique(canvas.reshape(-1, 3)[::7], axis=0))
+
+
+def test_served_preview_draws_the_robot_over_its_websocket(tmp_path: Path, write_small_cell: SmallCell,
+                                                           serve_preview: Callable[..., Served],
+                                                           free_port: Callable[..., int]) -> None:
+    sync_api = _browser_or_skip()
+    cell = write_small_cell(tmp_path, "small_cell")
+    served = serve_preview(cell, "--port", str(free_port()))
+    assert served.url.startswith("http://127.0.0.1:")
+    errors, requests, fraction, colours = _draw_in_browser(sync_api, served.url, tmp_path)
+    assert errors == [], errors
+    origin = served.url.removesuffix("/static/")
+    assert all(u.startswith((origin + "/", "data:")) for u in requests), requests
+    assert fraction > MIN_ROBOT_FRACTION, f"{fraction:.4f} of the canvas in the robot's colour: the scene did not arrive"
+    assert colours > 200
+    assert served.stop()[0] == 0

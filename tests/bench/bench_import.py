@@ -39,7 +39,7 @@ def main() -> None:
         for _ in range(args.runs):
             with tempfile.TemporaryDirectory() as tmp:
                 t0 = time.process_time()
-                folder = import_urdf(source, Path(tmp) / name).folder
+                folder = import_urdf(source, Path(tmp) / name, (ROSI,)).folder
                 cpu.append(time.process_time() - t0)
                 robot = load_robot(load_robot_spec(folder / "robot.yaml"))
         agree = fk_agreement(robot.model, robot.flange_frame_id, robot.ik_params, samples=1000)

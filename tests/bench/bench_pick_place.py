@@ -18,6 +18,8 @@ from pathlib import Path
 
 import yaml
 
+from robomax_py.export.fanuc import program_name
+from robomax_py.export.plan_program import identifier
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions, plan_cell
 from robomax_py.plan.loads import Loads, check_carried_motion
@@ -120,7 +122,8 @@ def generated(folder: Path, out: Path) -> None:
                              capture_output=True, text=True)
         verdicts = []
         for ext in (".json", ".srcl", ".src", ".mod", ".ls", ".script"):
-            program = target / f"{cell.name}{ext}"
+            fanuc = ext == ".ls"       # a TP program's file is named as the program (fanuc.program_name)
+            program = target / f"{program_name(identifier(cell.name)) if fanuc else cell.name}{ext}"
             if run.returncode != 0 or not program.is_file():
                 verdicts.append(f"{ext}: not written")
                 continue

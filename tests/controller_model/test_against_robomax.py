@@ -233,15 +233,18 @@ class Plan:
         return (self.folder / name).read_text(encoding="utf-8")
 
 
-@pytest.fixture(scope="module")
-def plan(tmp_path_factory: pytest.TempPathFactory, write_small_cell: Callable[..., Path]) -> Plan:
-    folder = tmp_path_factory.mktemp("placed_cell")
+def _planned(folder: Path, write_small_cell: Callable[..., Path], formats: str = "all",
+             controller: dict[str, Any] | None = None) -> Plan:
     cell = write_small_cell(folder, name="placed_cell")
     G = _T(PLACEMENT_XYZ_M, (0.0, 0.0, PLACEMENT_YAW_DEG))
     _place_cell(cell, G)
+    if controller is not None:
+        data = yaml.safe_load(cell.read_text())
+        data["robot"]["controller"] = controller
+        cell.write_text(yaml.safe_dump(data, sort_keys=False))
     out = folder / "programs"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
-    done = subprocess.run([sys.executable, "-m", "robomax_py", "plan", str(cell), "-o", str(out), "--format", "all"],
+    done = subprocess.run([sys.executable, "-m", "robomax_py", "plan", str(cell), "-o", str(out), "--format", formats],
                           capture_output=True, text=True, env=env, cwd=folder, check=False)
     assert done.returncode == 0, done.stdout + done.stderr
     data = yaml.safe_load(cell.read_text())
@@ -255,6 +258,11 @@ def plan(tmp_path_factory: pytest.TempPathFactory, write_small_cell: Callable[..
                 np.asarray(trajectory["q"]), order, _load_arm(robot_yaml, tool_yaml, trajectory["joints"]))
 
 
+@pytest.fixture(scope="module")
+def plan(tmp_path_factory: pytest.TempPathFactory, write_small_cell: Callable[..., Path]) -> Plan:
+    return _planned(tmp_path_factory.mktemp("placed_cell"), write_small_cell)
+
+
 def _run(plan: Plan, dialect: str) -> ProgramRun:
     files = sorted(p.name for p in plan.folder.iterdir())
     if dialect == "krl":
@@ -264,10 +272,12 @@ def _run(plan: Plan, dialect: str) -> ProgramRun:
     if dialect == "rapid":
         return run_rapid({f: plan.text(f) for f in files if f.endswith(".mod")})
     if dialect == "fanuc":
-        others = [f for f in files if f.endswith(".ls") and f != f"{plan.name}.ls"]
+        # A TP program is named as its file, in capitals (PLACED_CELL.ls, PLACED_CELL_FRAMES.ls).
+        main = f"{plan.name.upper()}.ls"
+        others = [f for f in files if f.endswith(".ls") and f != main]
         # The cell hands no position registers, so the setup program only lists the frames: the
         # controller holds the integrator's calibrated gun TCP as tool 1 (the default number).
-        return run_fanuc(plan.text(f"{plan.name}.ls"), name=f"{plan.name}.ls",
+        return run_fanuc(plan.text(main), name=main,
                          setup={f: plan.text(f) for f in others if "frames" in f.lower()},
                          called={f: plan.text(f) for f in others if "frames" not in f.lower()},
                          utools={1: plan.arm.T_flange_tcp}, j23_coupling=plan.arm.j23_coupling)
@@ -396,3 +406,21 @@ def test_configuration_names_the_planned_joints(plan: Plan, dialect: str) -> Non
             deg = controller_joints_deg(tuple(np.degrees(q)), plan.arm.j23_coupling)
             if all(-180.0 < deg[i] < 180.0 for i in (0, 3, 4, 5)):   # 0 whichever three axes they count
                 assert config.turns == (0, 0, 0), weld.spot
+
+
+@pytest.mark.slow
+def test_krl_package_welds_call_the_spot_package_at_the_spots(tmp_path: Path,
+                                                               write_small_cell: Callable[..., Path]) -> None:
+    """With `weld: package` each weld is ``USERSPOT(#SPOT,SDATn)``, the KUKA spot package's user
+    routine (ZINK KRC/R1/TP/GripperSpotTech/Spot_User.src), called at rest at its spot."""
+    plan = _planned(tmp_path, write_small_cell, "krl", {"weld": "package"})
+    run = _run(plan, "krl")
+    assert run.clean, run.issues
+    calls = [(k, e) for k, e in enumerate(run.events) if isinstance(e, Call) and e.name.upper() == "USERSPOT"]
+    assert calls[0][1].args == ("#INIT",)               # the SPOTTECH INI fold
+    welds = [(k, e) for k, e in calls if e.args and e.args[0] == "#SPOT"]
+    assert [e.args[1] for _, e in welds] == [f"SDAT{n}" for n in range(1, len(plan.spot_times) + 1)]
+    for (k, _), (name, _) in zip(welds, plan.spot_times, strict=True):
+        motion = run.events[k - 1]
+        assert isinstance(motion, Motion) and motion.stops and motion.T_base_tcp is not None
+        assert np.linalg.norm(plan.world(motion.T_base_tcp)[:3, 3] - plan.spots[name]) <= POS_TOL_M, name

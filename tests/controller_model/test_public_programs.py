@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from controller_model.common import FanucConfig, FloatArray, ProgramRun
+from controller_model.common import FanucConfig, FloatArray, ProgramRun, pose_mm_zyx_deg
 from controller_model.fanuc import run_fanuc
 from controller_model.krl import run_krl
 from controller_model.rapid import run_rapid
@@ -25,10 +25,19 @@ def _text(name: str) -> str:
     return (DATA / name).read_text(encoding="utf-8", errors="replace")
 
 
+def _krl(name: str, **kw: object) -> ProgramRun:
+    """A KRL .src with its .dat (a smartPAD program's points and motion data)."""
+    dat = name.replace(".src", ".dat")
+    return run_krl(_text(name), _text(dat), src_name=name, dat_name=dat, **kw)   # type: ignore[arg-type]
+
+
 READERS: dict[str, Callable[[str], ProgramRun]] = {
     "ros_rsi.src": lambda n: run_krl(_text(n), src_name=n),
+    "style1app1opt1.src": _krl,
+    "spindle_main.src": _krl,
     "Grey_T_ROB1.mod": lambda n: run_rapid({n: _text(n)}),
     "test_4.mod": lambda n: run_rapid({n: _text(n)}),
+    "robodk_Program.mod": lambda n: run_rapid({n: _text(n)}, entry="Main"),
     "ros_movesm.ls": lambda n: run_fanuc(_text(n), name=n),
     "up222.ls": lambda n: run_fanuc(_text(n), name=n),
     "timing_debug.script": lambda n: run_urscript(_text(n), name=n),
@@ -64,6 +73,28 @@ def test_kuka_rsi_program() -> None:
     assert {i.kind for i in run.issues} == {"unsupported"}
 
 
+def test_kuka_inline_form_program_moves_in_base_3() -> None:
+    """KSS 8.3.43 inline forms: the fold of LIN P20 selects FDAT FP20 (TOOL_NO 1, BASE_NO 3, IPO_FRAME
+    #BASE), so its target is the TCP in BASE_DATA[3]; the extTCP folds (IPO_FRAME #TCP) are reported."""
+    base_3 = pose_mm_zyx_deg(1000.0, -500.0, 800.0, 90.0, 0.0, 0.0)
+    tool_1 = pose_mm_zyx_deg(0.0, 0.0, 250.0, 0.0, 0.0, 0.0)
+    run = _krl("style1app1opt1.src", tool_data={1: tool_1}, base_data={3: base_3})
+    p20 = next(m for m in run.motions if m.where.line == 64)           # LIN XP20 C_DIS C_DIS
+    xp20 = pose_mm_zyx_deg(-3850.82104, -108.397034, -435.544800, -178.432037, 0.654220462, -179.967712)
+    assert_allclose(_known(p20.T_base_tcp), base_3 @ xp20, atol=POS_TOL_M)
+    assert_allclose(_known(p20.T_flange_tcp), tool_1, atol=POS_TOL_M)
+    assert p20.blend == "C_DIS C_DIS"
+    external = {i.where.line for i in run.unsupported if "IPO_FRAME #TCP" in i.reason}
+    assert external == {40, 47, 107, 118}                              # the BAS lines of the extTCP folds
+
+
+def test_kuka_inline_form_program_of_kss_8_2() -> None:
+    """Its HOME folds move to the controller's XHOME with FHOME, both in $config.dat, not given here."""
+    run = READERS["spindle_main.src"]("spindle_main.src")
+    undefined = {i.where.line for i in run.issues if i.kind == "undefined"}
+    assert {24, 25, 27} <= undefined                  # FDAT_ACT=Fhome, BAS(#PTP_PARAMS,100), PTP Xhome
+
+
 def test_abb_synchronised_program() -> None:
     run = READERS["Grey_T_ROB1.mod"]("Grey_T_ROB1.mod")
     first, second = run.motions[:2]
@@ -85,6 +116,22 @@ def test_abb_gripper_program() -> None:
     assert_allclose(_known(run.motions[0].T_flange_tcp)[:3, 3], [-0.14418, -0.1544, 0.03477], atol=POS_TOL_M)
     # ConfL \Off, ConfJ \Off, IF, ENDIF, and extax a = 0 (an external axis, if there is one, goes to 0)
     assert _unsupported_lines(run) == {6, 7, 10, 12} | {m.where.line for m in run.motions}
+
+
+def test_abb_program_in_a_work_object() -> None:
+    """RoboDK's module: MoveAbsJ and MoveL with `,\\WObj:=Frame2` (Frame2's uframe 399.855 mm along x,
+    100 mm up, its oframe identity): a target in Frame2 is the user frame's offset plus the target."""
+    run = READERS["robodk_Program.mod"]("robodk_Program.mod")
+    assert [m.statement for m in run.motions] == ["MoveAbsJ"] * 2 + ["MoveL"] * 4
+    in_wobj0, in_frame2 = run.motions[2], run.motions[3]
+    assert_allclose(_known(in_wobj0.T_base_tcp)[:3, 3], [0.018715, 0.147321, 0.458168], atol=POS_TOL_M)
+    assert_allclose(_known(in_frame2.T_base_tcp)[:3, 3], [0.403136, 0.147321, 0.394993], atol=POS_TOL_M)
+    assert_allclose(_known(in_frame2.T_base_user)[:3, 3], [0.399855, 0.0, 0.1], atol=POS_TOL_M)
+    # the tool: TCP at (-30, 0, 40) mm, turned -60 deg about y (q = [cos 30, 0, -sin 30, 0])
+    assert_allclose(_known(in_frame2.T_flange_tcp)[:3, 3], [-0.03, 0.0, 0.04], atol=POS_TOL_M)
+    # ConfL \Off and STOP are outside the subset; the call of Subprog (not in the module) is recorded
+    assert _unsupported_lines(run) == {18, 28}
+    assert [(c.name, c.where.line) for c in run.calls] == [("Subprog", 30)]
 
 
 def test_fanuc_ros_relay_program() -> None:

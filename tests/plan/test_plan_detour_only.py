@@ -15,7 +15,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from conftest import SmallCell
 
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions, resolved_options
@@ -23,6 +22,7 @@ from robomax_py.plan.candidates import SpotCandidates, seam_candidates
 from robomax_py.plan.graph import Sequencer as _Sequencer
 from robomax_py.plan.roadmap import Detour
 from robomax_py.spec import CellSpec
+from tests.conftest import SmallCell
 from robomax_py.world.collision import CollisionWorld, SegmentCheck
 from robomax_py.world.scene import build_scene
 

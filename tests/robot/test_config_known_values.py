@@ -38,7 +38,7 @@ CONFIG_TOL_RAD = math.radians(0.01)
 def rosi(tmp_path_factory: pytest.TempPathFactory) -> dict[str, RobotModel]:
     """The ROS-Industrial arms of tests/data/rosi, imported as `robomax import-urdf` does."""
     root = tmp_path_factory.mktemp("robots")
-    return {name: load_robot(load_robot_spec(import_urdf(source, root / name).folder / "robot.yaml"))
+    return {name: load_robot(load_robot_spec(import_urdf(source, root / name, (ROSI,)).folder / "robot.yaml"))
             for name, source in IMPORTED.items()}
 
 # ------------------------------------------------------------------------------------- FANUC

@@ -52,7 +52,7 @@ def arms(tmp_path_factory: pytest.TempPathFactory) -> dict[str, RobotModel]:
     root = tmp_path_factory.mktemp("robots")
     out = {name: load_robot(load_robot_spec(shipped_robots_dir() / name / "robot.yaml")) for name in ("kr16", "kr125")}
     for name, source in IMPORTED.items():
-        out[name] = load_robot(load_robot_spec(import_urdf(source, root / name).folder / "robot.yaml"))
+        out[name] = load_robot(load_robot_spec(import_urdf(source, root / name, (ROSI,)).folder / "robot.yaml"))
     return out
 
 

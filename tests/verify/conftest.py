@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from robomax_py.export import DIALECTS
+from robomax_py.export.plan_program import identifier
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import plan_cell
 from robomax_py.publish import publish
@@ -32,13 +33,20 @@ class Placed:
     files: dict[str, str]
     name: str
 
+    def stem(self, fmt: str) -> str:
+        """What `fmt`'s files are named after: the cell's name, or the program the dialect names
+        (FANUC: PLACED.ls, PLACED_FRAMES.ls)."""
+        name_of = DIALECTS[fmt].program_name
+        return name_of(identifier(self.name)) if name_of else self.name
+
     def mutant(self, fmt: str, edits: Mapping[str, Edit], tag: str) -> Path:
         """A folder with every file of `fmt`'s program, those named by `edits` (a file name, or a
         suffix after the program's name such as ".dat" or "_frames.src") edited; its main file.
         An edit that changes nothing fails the test: the mutant must differ from the program."""
         folder = self.folder / f"mutant_{fmt}_{tag}"
         folder.mkdir()
-        wanted = {k if not k.startswith((".", "_")) else self.name + k: edit for k, edit in edits.items()}
+        stem = self.stem(fmt)
+        wanted = {k if not k.startswith((".", "_")) else stem + k: edit for k, edit in edits.items()}
         for file, text in self.files.items():
             if file not in wanted:
                 (folder / file).write_text(text)
@@ -47,7 +55,7 @@ class Placed:
             assert new != text, f"the edit of {file} changed nothing"
             (folder / file).write_text(new)
         assert not wanted, f"no such files: {sorted(wanted)}"
-        return folder / f"{self.name}{MAIN[fmt]}"
+        return folder / f"{stem}{MAIN[fmt]}"
 
     def verify(self, fmt: str, edits: Mapping[str, Edit], tag: str) -> VerifyReport:
         return verify_program(self.cell, self.robot, self.mutant(fmt, edits, tag))
@@ -67,6 +75,27 @@ def placed(tmp_path_factory: pytest.TempPathFactory, write_process_cell: Callabl
     for name, text in files.items():
         (folder / name).write_text(text)
     return Placed(folder, path, cell, robot, files, "placed")
+
+
+@pytest.fixture(scope="session")
+def placed_package(tmp_path_factory: pytest.TempPathFactory, write_process_cell: Callable[..., Path]) -> Placed:
+    """The placed process cell with `weld: package`: the welds as the controller's process package
+    states them (FANUC SpotTool+ SPOT[]), gun 2, s7 with schedule 4 (0.5 s), s8 with 7 (0.8 s)."""
+    import yaml
+
+    folder = tmp_path_factory.mktemp("placed_package")
+    path = write_process_cell(folder, name="placed_package")
+    data = yaml.safe_load(path.read_text())
+    data["robot"]["controller"]["weld"] = "package"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    cell = load_cell(path)
+    robot = load_cell_robot(cell)
+    result = plan_cell(cell, robot)
+    assert result.status == "planned", result.message
+    files, _ = publish(result, cell, robot, ("fanuc",))
+    for name, text in files.items():
+        (folder / name).write_text(text)
+    return Placed(folder, path, cell, robot, files, "placed_package")
 
 
 def placement_mm_zyx(cell: CellSpec) -> tuple[list[float], list[float]]:

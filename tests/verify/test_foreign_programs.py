@@ -7,12 +7,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
+from numpy.testing import assert_allclose
+from scipy.spatial.transform import Rotation
 
-from robomax_py.export import dialect_for_file
+from robomax_py.errors import ProgramError
+from robomax_py.export import dialect_for_file, rapid
 from robomax_py.io.cell import load_cell, load_cell_robot
-from robomax_py.program import Comment, LinMove, PtpMove, Wait
+from robomax_py.program import Comment, LinMove, PtpMove, Wait, WaitFor, lin_pose
 from robomax_py.robot import RobotModel
+from robomax_py.safe_files import LIMITS, read_text
 from robomax_py.verify import verify_program
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "programs"
@@ -26,10 +31,14 @@ def kr125() -> tuple[object, RobotModel]:
 
 
 def _read(name: str, robot: RobotModel):  # type: ignore[no-untyped-def]
+    """The program's files (a KRL .src with its .dat) as `verify` reads them."""
     path = DATA / name
     dialect = dialect_for_file(path.suffix)
     assert dialect is not None
-    return dialect.parse({dialect.extensions[0]: path.read_text(encoding="utf-8", errors="replace")}, str(path), robot)
+    texts = {ext: read_text(path.with_suffix(ext), LIMITS.program, ProgramError, "program file",
+                            fallback=dialect.fallback_encoding)
+             for ext in dialect.extensions if path.with_suffix(ext).exists()}
+    return dialect.parse(texts, str(path), robot)
 
 
 def _unsimulated(parsed) -> list[tuple[int, str]]:  # type: ignore[no-untyped-def]
@@ -48,6 +57,35 @@ def test_krl_rsi_program(kr125) -> None:  # type: ignore[no-untyped-def]
     assert moves[0].target_deg == (0.0, -90.0, 90.0, 0.0, 90.0, 0.0)   # PTP {A1 0, A2 -90, ...}
     assert any("RSI_MOVECORR" in text for _, text in _unsimulated(parsed))   # sensor-guided motion
     assert parsed.ignored                                                    # BAS, RSI calls, IF blocks
+
+
+def test_krl_smartpad_program_selects_its_frames_by_fdat(kr125) -> None:  # type: ignore[no-untyped-def]
+    """KSS 8.3.43 inline forms (CRLF): each fold's FDAT selects tool 1 and base 3, so the LIN to P20
+    is relative to BASE_DATA[3]; the folds with IPO_FRAME #TCP (extTCP) are an external TCP."""
+    parsed = _read("style1app1opt1.src", kr125[1])
+    assert parsed.program.name == "style1app1opt1"
+    lins = [(line, i) for i, line in zip(parsed.program.instructions, parsed.lines) if isinstance(i, LinMove)]
+    line, p20 = lins[0]
+    assert line == 64 and p20.position_mm == (-3850.821, -108.397, -435.545)       # LIN XP20 C_DIS C_DIS
+    assert (p20.tool, p20.base) == ("TOOL_DATA[1]", "BASE_DATA[3]")
+    assert p20.speed_mm_s == 2000.0 and p20.flyby_mm == 100.0        # BAS(#CP_PARAMS,2), LCPDAT8 APO_DIST 100
+    assert p20.config == "S010 T100010"                               # S 2, T 34
+    texts = dict(_unsimulated(parsed))
+    assert "external TCP" in texts[41] and "external TCP" in texts[48]       # PTP XP0, LIN XP8
+    assert texts[78] == "not simulated: LIN XP19"                              # inside IF ... ELSE
+    assert WaitFor("NUT_READY", None) in parsed.program.instructions           # WAIT FOR NUT_READY== TRUE
+    assert not [t for _, t in parsed.ignored if "fold" in t]                   # its folds say what they do
+
+
+def test_krl_smartpad_program_of_kss_8_2(kr125) -> None:  # type: ignore[no-untyped-def]
+    """KSS 8.2.19: the HOME fold moves to the controller's global XHOME, the rest loops."""
+    parsed = _read("spindle_main.src", kr125[1])
+    assert parsed.program.name == "Spindle_MAIN"
+    texts = dict(_unsimulated(parsed))
+    assert texts[19].startswith("not simulated: PTP $AXIS_ACT")
+    assert "global data" in texts[27]                                          # PTP Xhome
+    assert texts[60] == "not simulated: PTP Xp1"                               # inside loop ... endloop
+    assert not [i for i in parsed.program.instructions if isinstance(i, (PtpMove, LinMove))]
 
 
 def test_rapid_moveabsj_program(kr125) -> None:  # type: ignore[no-untyped-def]
@@ -70,6 +108,57 @@ def test_rapid_program_with_conditions(kr125) -> None:  # type: ignore[no-untype
     assert 11 in lines                                                      # WaitDI inside IF ... ENDIF
     tool = parsed.program.frames[0]
     assert tool.name == "custom_tool1" and tool.xyz_mm == (-144.18, -154.4, 34.77)
+
+
+def _T(xyz_mm: list[float], q_wxyz: list[float]) -> np.ndarray:
+    """A RAPID pose [[x, y, z], [q1, q2, q3, q4]] (q1 = w) as (4, 4) in metres, by scipy."""
+    w, x, y, z = q_wxyz
+    T = np.eye(4)
+    T[:3, :3] = Rotation.from_quat([x, y, z, w]).as_matrix()
+    T[:3, 3] = np.asarray(xyz_mm) / 1000.0
+    return T
+
+
+def _assert_pose(T: np.ndarray, want: np.ndarray) -> None:
+    assert_allclose(T[:3, 3], want[:3, 3], atol=1e-6)                                 # 1 µm
+    assert Rotation.from_matrix(T[:3, :3].T @ want[:3, :3]).magnitude() < 1e-6
+
+
+def test_rapid_robodk_program_in_its_work_object(kr125) -> None:  # type: ignore[no-untyped-def]
+    """RoboDK's module moves in Frame2 (a user frame 399.855 mm along x, 100 mm up) and once in
+    WObj0: each target lands at uframe · oframe · target, with the tool the statement names."""
+    parsed = _read("robodk_Program.mod", kr125[1])
+    frames = {f.name: f for f in parsed.program.frames}
+    assert set(frames) == {"Tool", "Frame2"}
+    lins = [i for i in parsed.program.instructions if isinstance(i, LinMove)]
+    assert [(lin.tool, lin.base) for lin in lins] == [("Tool", ""), ("Tool", "Frame2"), ("Tool", "Frame2"),
+                                                      ("Tool", "Frame2")]
+    q = [0.0, -0.97969618, 0.0, 0.20048792]
+    _assert_pose(lin_pose(lins[0]), _T([18.715, 147.321, 458.168], q))
+    uframe = _T([399.855, 0.0, 100.0], [1.0, 0.0, 0.0, 0.0])
+    _assert_pose(frames["Frame2"].pose @ lin_pose(lins[1]), uframe @ _T([3.281, 147.321, 294.993], q))
+    _assert_pose(frames["Tool"].pose, _T([-30.0, 0.0, 40.0], [0.86602540, 0.0, -0.5, 0.00000001]))
+    moves = [i for i in parsed.program.instructions if isinstance(i, PtpMove)]
+    assert moves[1].target_deg[4] == -56.1147                                 # `,\\WObj:=` on MoveAbsJ: harmless
+
+
+def test_rapid_calibration_module_as_the_data_module(kr125) -> None:  # type: ignore[no-untyped-def]
+    """SMR1's calibration module (TASK PERS work objects whose oframe is the calibrated one, CRLF)
+    loaded beside a main module: a target in Mandrell lands at uframe · oframe · target."""
+    main = ("MODULE Main\n  PROC main()\n    MoveAbsJ [[0, -30, 30, 0, 60, 0], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]], "
+            "v100, fine, Gripper;\n    MoveL [[100, -50, 20], [0.7071068, 0, 0.7071068, 0], [0, 0, 0, 0], "
+            "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]], v100, fine, Gripper_Sleeve \\WObj:=Mandrell;\n  ENDPROC\nENDMODULE\n")
+    data = (DATA / "smr1_CalibData.mod").read_text(encoding="utf-8")
+    parsed = rapid.parse({".mod": main, rapid.FRAMES_FILE: data}, "Main.mod", kr125[1])
+    frames = {f.name: f for f in parsed.program.frames}
+    assert {"Gripper", "Sleeves", "Mandrell", "Laser", "Gripper_Sleeve"} <= set(frames)
+    (lin,) = [i for i in parsed.program.instructions if isinstance(i, LinMove)]
+    assert (lin.tool, lin.base) == ("Gripper_Sleeve", "Mandrell")
+    uframe = _T([0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0])
+    oframe = _T([2812.88, -226.05, 592.36], [0.27444, 0.27271, 0.64992, 0.65415])    # scipy normalises it
+    target = _T([100.0, -50.0, 20.0], [0.7071068, 0.0, 0.7071068, 0.0])
+    _assert_pose(frames["Mandrell"].pose @ lin_pose(lin), uframe @ oframe @ target)
+    _assert_pose(frames["Gripper_Sleeve"].pose, _T([0.0, 6.4, 1700.0], [1.0, -0.00161, 0.0, 0.0]))
 
 
 def test_fanuc_streaming_program(kr125) -> None:  # type: ignore[no-untyped-def]
@@ -99,12 +188,13 @@ def test_urscript_polyscope_program(kr125) -> None:  # type: ignore[no-untyped-d
     assert len([t for t in texts if "movej(get_inverse_kin" in t]) == 2       # inside while, to an expression
 
 
-@pytest.mark.parametrize("name", ["ros_rsi.src", "Grey_T_ROB1.mod", "test_4.mod", "ros_movesm.ls", "up222.ls",
-                                  "timing_debug.script"])
+@pytest.mark.parametrize("name", ["ros_rsi.src", "style1app1opt1.src", "spindle_main.src", "Grey_T_ROB1.mod",
+                                  "test_4.mod", "ros_movesm.ls", "up222.ls", "timing_debug.script"])
 def test_verify_never_calls_them_clean(kr125, name: str, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
     cell, robot = kr125
     program = tmp_path / name
-    program.write_bytes((DATA / name).read_bytes())
+    for sibling in DATA.glob(f"{Path(name).stem}.*"):        # a KRL .src with its .dat
+        (tmp_path / sibling.name).write_bytes(sibling.read_bytes())
     try:
         report = verify_program(cell, robot, program)
     except Exception as exc:                 # a ProgramError (bad input) is an acceptable answer too

@@ -1,8 +1,14 @@
 """KRL programs written with a convention the controller does not share are rejected by `verify`,
 naming a line: each mutant is the placed process cell's program edited as a mistaken writer would
 have written it (the robot's placement as the base frame, the tool's angles in another rotation
-order, lengths in metres, joint values in radians, the wrist flag flipped, frame selections
-deleted or another tool selected)."""
+order, lengths in metres, joint values in radians, the wrist flag flipped, the folds' FDAT selecting
+tool 1 or base 0, or the lines that select the frames deleted).
+
+What the controller does without them (BAS.SRC, krl.py's docstring): a fold without its FDAT_ACT
+line runs BAS with the FDAT_ACT last assigned, so with every FDAT_ACT line gone the frames are the
+controller's from an earlier run (unknown: the program selects none); a fold without its BAS line
+changes no frame, so with every BAS line gone the INI fold's BAS(#INITMOV) frames stay in force:
+TOOL_DATA[1] and $WORLD."""
 
 from __future__ import annotations
 
@@ -38,7 +44,7 @@ def _tool_in_xyz_order(placed: Placed) -> dict[str, Edit]:
 
 
 def _targets_in_metres(placed: Placed) -> dict[str, Edit]:
-    return {".dat": lambda t: re.sub(r"(E6POS XP\d+=\{X )(-?[\d.]+)(, Y )(-?[\d.]+)(, Z )(-?[\d.]+)",
+    return {".dat": lambda t: re.sub(r"(E6POS XP\d+=\{X )(-?[\d.]+)(,Y )(-?[\d.]+)(,Z )(-?[\d.]+)",
                                      lambda m: "".join([m[1], f"{float(m[2]) / 1000:.6f}", m[3], f"{float(m[4]) / 1000:.6f}",
                                                         m[5], f"{float(m[6]) / 1000:.6f}"]), t)}
 
@@ -48,15 +54,24 @@ def _joints_in_radians(placed: Placed) -> dict[str, Edit]:
 
 
 def _wrist_flag_flipped(placed: Placed) -> dict[str, Edit]:
-    return {".dat": lambda t: re.sub(r"(E6POS XP\d+=\{[^}]*, S )(\d+)", lambda m: m[1] + str(int(m[2]) ^ 4), t, count=1)}
-
-
-def _frames_deleted(placed: Placed) -> dict[str, Edit]:
-    return {".src": lambda t: re.sub(r"^\$(TOOL|BASE) = .*\n", "", t, flags=re.M)}
+    return {".dat": lambda t: re.sub(r"(E6POS XP\d+=\{[^}]*,S )(\d+)", lambda m: m[1] + str(int(m[2]) ^ 4), t, count=1)}
 
 
 def _another_tool(placed: Placed) -> dict[str, Edit]:
-    return {".src": lambda t: t.replace("$TOOL = TOOL_DATA[2]", "$TOOL = TOOL_DATA[1]")}
+    return {".dat": lambda t: t.replace("{TOOL_NO 2,", "{TOOL_NO 1,")}
+
+
+def _robot_base(placed: Placed) -> dict[str, Edit]:
+    """The folds select base 0: the targets, stated in the fixture's frame, are taken in the robot base."""
+    return {".dat": lambda t: t.replace(",BASE_NO 3,", ",BASE_NO 0,")}
+
+
+def _fdat_act_deleted(placed: Placed) -> dict[str, Edit]:
+    return {".src": lambda t: re.sub(r"^FDAT_ACT=.*\n", "", t, flags=re.MULTILINE)}
+
+
+def _bas_deleted(placed: Placed) -> dict[str, Edit]:
+    return {".src": lambda t: re.sub(r"^BAS\(#(PTP|CP)_PARAMS,.*\n", "", t, flags=re.MULTILINE)}
 
 
 MUTANTS = {
@@ -65,8 +80,10 @@ MUTANTS = {
     "targets in metres": _targets_in_metres,
     "joint values in radians": _joints_in_radians,
     "wrist flag flipped": _wrist_flag_flipped,
-    "frame selections deleted": _frames_deleted,
-    "another tool selected": _another_tool,
+    "FDAT selects tool 1": _another_tool,
+    "FDAT selects base 0": _robot_base,
+    "FDAT_ACT lines deleted": _fdat_act_deleted,
+    "BAS lines deleted": _bas_deleted,
 }
 
 

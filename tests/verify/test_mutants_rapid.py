@@ -2,17 +2,32 @@
 naming a line: each mutant is the placed process cell's module edited as a mistaken writer would
 have written it (the robot's placement as the work object's user frame, quaternions in x-y-z-w
 order, the targets' rotations in another order, lengths in metres, joint values in radians, the
-wrist bit of cfx flipped, the work object or the tool left out)."""
+wrist bit of cfx flipped, the work object or the tool left out, the data module not loaded), and,
+with the spot option's SpotL (`weld: package`), welds with another schedule's spotdata, another
+program number or another gun's gundata. The package module is also judged by the controller
+model: every SpotL stops at its spot in the world."""
 
 from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
+from pathlib import Path
 
+import numpy as np
 import pytest
+import yaml
 from scipy.spatial.transform import Rotation
 
 from conftest import Edit, Placed, placement_mm_zyx
+from controller_model.common import Call, Motion
+from controller_model.rapid import run_rapid
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.plan import plan_cell
+from robomax_py.publish import publish
+from robomax_py.verify import verify_program
+
+POS_TOL_M = 1e-4          # 0.1 mm
 
 QUAT = r"\[(-?[\d.]+), (-?[\d.]+), (-?[\d.]+), (-?[\d.]+)\]"
 
@@ -97,3 +112,97 @@ def test_rapid_mutant_is_rejected_with_a_line(placed: Placed, kind: str) -> None
 def test_the_written_rapid_module_is_clean(placed: Placed) -> None:
     report = placed.verify("rapid", {}, "unchanged")
     assert report.clean, report.violations
+
+
+@pytest.mark.slow
+def test_without_the_data_module_a_frame_it_declares_is_unknown(placed: Placed) -> None:
+    """The controller holds only the frames the cell names (the tool gun2); the user frame
+    fixture_plate exists only in the data module: without it the program refers to undeclared
+    data, which verify reports at the first move that uses it."""
+    folder = placed.folder / "mutant_rapid_no_data_module"
+    folder.mkdir()
+    for file, text in placed.files.items():
+        if file != f"{placed.name}_frames.mod":
+            (folder / file).write_text(text)
+    report = verify_program(placed.cell, placed.robot, folder / f"{placed.name}.mod")
+    assert not report.clean
+    assert any("fixture_plate" in v.detail and v.line is not None for v in report.violations), report.violations
+
+
+@pytest.fixture(scope="module")
+def placed_package(tmp_path_factory: pytest.TempPathFactory, write_process_cell: Callable[..., Path]) -> Placed:
+    """The process cell welding with the controller's spot option (`weld: package`); its tool is
+    named tool_gun2, since gun2 is gun 2's gundata on such a controller."""
+    folder = tmp_path_factory.mktemp("placed_package")
+    path = write_process_cell(folder, name="placed_package")
+    data = yaml.safe_load(path.read_text())
+    data["robot"]["controller"]["weld"] = "package"
+    data["robot"]["controller"]["tool"]["name"] = "tool_gun2"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    cell = load_cell(path)
+    robot = load_cell_robot(cell)
+    result = plan_cell(cell, robot)
+    assert result.status == "planned", result.message
+    files, _ = publish(result, cell, robot, ("rapid",))
+    for name, text in files.items():
+        (folder / name).write_text(text)
+    return Placed(folder, path, cell, robot, files, "placed_package")
+
+
+def _first(pattern: str, replacement: str) -> Edit:
+    def edit(t: str) -> str:
+        return re.sub(pattern, replacement, t, count=1, flags=re.MULTILINE)
+    return edit
+
+
+PACKAGE_MUTANTS = {
+    # s7 (schedule 4, 0.5 s) welded with schedule 7's spotdata: longer, and another current program
+    "SpotL with another spotdata": {".mod": _first(r"^(\s*SpotL p\d+, v_lin\d+, )sd4", r"\1sd7")},
+    "spotdata with another program number": {".mod": _first(r"(PERS spotdata sd7 := \[)7,", r"\g<1>4,")},
+    "another gun's gundata": {".mod": _first(r"^(\s*SpotL [^;]*, )gun2,", r"\1gun1,")},
+}
+
+
+@pytest.mark.slow
+def test_the_package_module_welds_with_spotl_and_is_clean(placed_package: Placed) -> None:
+    text = placed_package.files["placed_package.mod"]
+    assert len(re.findall(r"^\s*SpotL p\d+, v_lin\d+, sd(4|7), gun2, tool_gun2 \\WObj:=fixture_plate;  ! flange/s[78]$",
+                          text, re.MULTILINE)) == 2
+    assert "PERS spotdata sd4 := [4, 1];" in text and "PERS spotdata sd7 := [7, 1];" in text
+    assert "spot_weld" not in text and "gundata" not in text.split("PROC main")[0].replace("gundata;", "")
+    report = placed_package.verify("rapid", {}, "unchanged")
+    assert report.clean, report.violations
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", sorted(PACKAGE_MUTANTS))
+def test_rapid_package_mutant_is_rejected_with_a_line(placed_package: Placed, kind: str) -> None:
+    report = placed_package.verify("rapid", PACKAGE_MUTANTS[kind], kind.replace(" ", "_").replace("'", ""))
+    assert not report.clean, kind
+    assert any(v.kind == "weld" and v.line is not None for v in report.violations), report.violations
+
+
+@pytest.mark.slow
+def test_the_controller_model_stops_every_spotl_at_its_spot(placed_package: Placed) -> None:
+    """The independent model runs the package module (the data module beside it, the cell's tool
+    gun on the controller): each SpotL is a stop whose TCP, placed in the world as the cell places
+    the robot, is at a spot of the cell."""
+    tool = placed_package.robot.T_flange_tcp
+    xyz, zyx = (float(v) * 1000.0 for v in tool[:3, 3]), Rotation.from_matrix(tool[:3, :3])
+    x, y, z, w = zyx.as_quat()
+    calibrated = ("MODULE Calibration\n  PERS tooldata tool_gun2 := [TRUE, [[" + ", ".join(f"{v:.6f}" for v in xyz)
+                  + f"], [{w:.12f}, {x:.12f}, {y:.12f}, {z:.12f}]], [1, [0, 0, 1], [1, 0, 0, 0], 0, 0, 0]];\nENDMODULE\n")
+    modules = {n: t for n, t in placed_package.files.items() if n.endswith(".mod")} | {"Calibration.mod": calibrated}
+    run = run_rapid(modules)
+    assert run.clean, run.issues
+    spots = np.asarray([s.xyz for seam in placed_package.cell.seams for s in seam.spots])
+    T_world_base = placed_package.cell.T_world_base @ placed_package.cell.robot.controller.T_root_base
+    welded = []
+    for before, event in zip(run.events, run.events[1:]):
+        if isinstance(event, Call) and event.name == "SpotL":
+            assert isinstance(before, Motion) and before.stops and before.T_base_tcp is not None
+            gaps = np.linalg.norm(spots - (T_world_base @ before.T_base_tcp)[:3, 3], axis=1)
+            assert gaps.min() <= POS_TOL_M, gaps
+            welded.append(int(gaps.argmin()))
+            assert event.args[1] == "gun2"
+    assert sorted(welded) == list(range(len(spots)))

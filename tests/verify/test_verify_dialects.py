@@ -38,6 +38,12 @@ def written(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> dict[
     return {"tmp": tmp, "cell_path": path, "cell": cell, "robot": robot, "files": files}
 
 
+def _stem(fmt: str) -> str:
+    """What the small cell's files of `fmt` are named after (FANUC: the TP program, SMALL_CELL)."""
+    name_of = DIALECTS[fmt].program_name
+    return name_of("small_cell") if name_of else "small_cell"
+
+
 def _edited(written: dict[str, Any], fmt: str, edit: Callable[[str], str], tag: str, *, ext: str | None = None) -> Path:
     """A folder with the program, one of its files edited (the main file, or `ext`); its main file."""
     ext = ext or MAIN[fmt]
@@ -45,12 +51,12 @@ def _edited(written: dict[str, Any], fmt: str, edit: Callable[[str], str], tag: 
     folder.mkdir()
     for name, text in written["files"].items():
         if name.endswith(tuple(DIALECTS[fmt].extensions)):
-            mine = name == f"small_cell{ext}"
+            mine = name == f"{_stem(fmt)}{ext}"
             new = edit(text) if mine else text
             if mine:
                 assert new != text, "the edit changed nothing"
             (folder / name).write_text(new)
-    return folder / f"small_cell{MAIN[fmt]}"
+    return folder / f"{_stem(fmt)}{MAIN[fmt]}"
 
 
 def _verify(written: dict[str, Any], fmt: str, edit: Callable[[str], str], tag: str, *, ext: str | None = None) -> Any:
@@ -63,7 +69,7 @@ def _first(pattern: str, text: str, replace: Callable[[re.Match[str]], str]) -> 
 
 @pytest.mark.parametrize("fmt", sorted(DIALECTS))
 def test_written_programs_verify_clean_from_the_cli(written: dict[str, Any], fmt: str) -> None:
-    result = runner.invoke(app, ["verify", str(written["cell_path"]), str(written["tmp"] / f"small_cell{MAIN[fmt]}")])
+    result = runner.invoke(app, ["verify", str(written["cell_path"]), str(written["tmp"] / f"{_stem(fmt)}{MAIN[fmt]}")])
     assert result.exit_code == EXIT_OK, result.output
     assert "clean" in result.output
 
@@ -82,7 +88,7 @@ def _plus_1mm(value: str) -> str:
 MOVED: dict[str, tuple[str | None, Callable[[str], str]]] = {
     "krl": (".dat", lambda t: _first(r"(E6POS XP\d+=\{X )(-?[\d.]+)", t, lambda m: m[1] + _plus_1mm(m[2]))),
     "rapid": (None, lambda t: _first(r"(robtarget p\d+ := \[\[)(-?[\d.]+)", t, lambda m: m[1] + _plus_1mm(m[2]))),
-    "fanuc": (None, lambda t: _first(r"(X = )(-?[\d.]+)", t, lambda m: m[1] + _plus_1mm(m[2]))),
+    "fanuc": (None, lambda t: _first(r"(X =\s+)(-?[\d.]+)", t, lambda m: m[1] + _plus_1mm(m[2]))),
     "urscript": (None, lambda t: _first(r"(movel\(p\[)(-?[\d.]+)", t, lambda m: m[1] + f"{float(m[2]) + 0.001:.6f}")),
     "srcl": (None, lambda t: _first(r"(MOVE LIN POS\()(-?[\d.]+)", t, lambda m: m[1] + _plus_1mm(m[2]))),
 }
@@ -119,10 +125,17 @@ def test_another_configuration_is_rejected_with_its_line(written: dict[str, Any]
 
 # ------------------------------------------------------------------ a blended weld point
 
+def _krl_cont(fold: re.Match[str]) -> str:
+    """An exact-stop LIN fold made CONT, as the smartPAD's inline form writes it."""
+    text = fold[0].replace(" Vel=", " CONT Vel=", 1).replace("3:, ", "3:C_DIS C_DIS, ", 1)
+    return text[:-len(" \n")] + " C_DIS C_DIS\n"
+
+
 BLENDED: dict[str, Callable[[str], str]] = {
-    "krl": lambda t: _first(r"^(LIN XP\d+)( ; approach)", t, lambda m: m[1] + " C_DIS" + m[2]),
+    "krl": lambda t: re.sub(r"^;FOLD LIN (P\d+) Vel=.*?\nLIN X\1 \n", _krl_cont, t, count=1,
+                             flags=re.MULTILINE | re.DOTALL),
     "rapid": lambda t: _first(r"^(\s*MoveL p\d+, v_lin\d+, )fine", t, lambda m: m[1] + "z10"),
-    "fanuc": lambda t: _first(r"^(\s*\d+:\s+L P\[\d+\] \d+mm/sec )FINE", t, lambda m: m[1] + "CNT50"),
+    "fanuc": lambda t: _first(r"^(\s*\d+:\s*L P\[\d+:\w+\] \d+mm/sec )FINE", t, lambda m: m[1] + "CNT50"),
     "urscript": lambda t: _first(r"^(\s*movel\(.*)r=0\.000000000\)(  # approach)", t, lambda m: m[1] + "r=0.010000000)" + m[2]),
     "srcl": lambda t: _first(r"^(\s*MOVE LIN .* MM/S)( \{ approach \})", t, lambda m: m[1] + " FLYBY 1.0000" + m[2]),
 }
@@ -145,7 +158,7 @@ def _in_metres(pattern: str) -> Callable[[str], str]:
 SCALED: dict[str, tuple[str | None, Callable[[str], str]]] = {
     "krl": (".dat", _in_metres(r"(\b[XYZ] )(-?\d+\.\d{3})(?=,)")),
     "rapid": (None, _in_metres(r"(robtarget p\d+ := \[\[|, )(-?\d+\.\d{3})(?=[,\]])")),
-    "fanuc": (None, _in_metres(r"(\b[XYZ] = )(-?\d+\.\d{3})(?=  mm)")),
+    "fanuc": (None, _in_metres(r"(\b[XYZ] =\s+)(-?\d*\.\d{3})(?=  mm)")),
     "urscript": (None, lambda t: re.sub(r"(movel\(p\[)(-?[\d.]+), (-?[\d.]+), (-?[\d.]+)",
                                         lambda m: m[1] + ", ".join(f"{float(v) * 1000:.3f}" for v in m.groups()[1:]), t)),
 }
