@@ -86,7 +86,8 @@ def import_arms(folder: Path) -> dict[str, Path]:
             continue
         target = folder / arm.name
         if not (target / "robot.yaml").is_file():
-            import_urdf(ROSI / arm.xacro, target, srdf=None if arm.srdf is None else ROSI / arm.srdf, name=arm.name)
+            import_urdf(ROSI / arm.xacro, target, (ROSI,), srdf=None if arm.srdf is None else ROSI / arm.srdf,
+                        name=arm.name)
         out[arm.name] = target / "robot.yaml"
     return out
 
