@@ -304,7 +304,7 @@ class Sequencer:
         for seam in self.cell.seams:
             ids = tuple(range(start, start + len(seam.spots)))
             start += len(seam.spots)
-            blocks.append(SeamBlock(ids, seam.ordered or self.options.baseline))
+            blocks.append(SeamBlock(ids, seam.ordered or self.options.baseline or self.options.given_order))
         return blocks
 
     def probe_pair(self, i: int, j: int) -> tuple[int, int]:
@@ -368,7 +368,7 @@ class Sequencer:
             self.rounds += 1
             # Rounds end when a tour's legs are all known free; the bar shows rounds so far.
             self.progress("sequencing", self.rounds - 1, self.rounds)
-            if self.options.baseline:
+            if self.options.baseline or self.options.given_order:
                 order = tuple(s for b in blocks for s in b.spots)
                 choice, cost = choice_for_order(order, self.full_cost, self.node)
                 tour = Tour(order, choice, cost)

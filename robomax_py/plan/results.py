@@ -29,6 +29,9 @@ class PlanOptions:
     """How to plan; every field has a production default."""
 
     baseline: bool = False           # the published method: given order, nominal orientation, first branch
+    # The spots in the cell file's order, the DP still choosing among every candidate (orientation
+    # sample and branch) with the same detours and timing: paper 003's OptTrag for a given order.
+    given_order: bool = False
     # Speeds; None takes the cell's `planner` values (defaults 1.0, 0.5 m/s, 1.0).
     speed: float | None = None       # global override in (0, 1] of every programmed speed
     tcp_speed: float | None = None   # m/s on approach and retract lines (before the override)

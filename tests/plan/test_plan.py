@@ -186,6 +186,22 @@ def test_ordered_seam_keeps_its_order_and_unordered_may_reorder(tmp_path: Path) 
     assert estimated_cycle_time(cell_f, robot_f, free) <= estimated_cycle_time(cell_o, robot_o, ordered) + COST_TOL_S
 
 
+def test_given_order_keeps_the_file_order_and_chooses_among_every_candidate(tmp_path: Path) -> None:
+    """The published method (given order, the DP over every orientation sample and branch) between
+    the teach-in baseline (nominal orientation, first branch) and the order search."""
+    path = write_cell(tmp_path / "free", [SPOTS[name] for name in ZIGZAG], PANEL_ON_TABLE, ordered=False)
+    cell, robot, optimised = plan_file(path)
+    _, _, published = plan_file(path, PlanOptions(given_order=True))
+    _, _, teach_in = plan_file(path, PlanOptions(baseline=True))
+    for result in (optimised, published, teach_in):
+        assert result.status == "planned", result.message
+    assert [s.name for s in published.spots] == [s.name for s in teach_in.spots] == ZIGZAG
+    assert not published.baseline
+    # Same order, a superset of the candidates: the DP's estimate is no worse.
+    estimate = [estimated_cycle_time(cell, robot, r) for r in (optimised, published, teach_in)]
+    assert estimate[0] <= estimate[1] + COST_TOL_S and estimate[1] <= estimate[2] + COST_TOL_S
+
+
 # ---------------------------------------------------------------------------------------------- 3
 
 
