@@ -1,11 +1,10 @@
 """Cells nobody here laid out (tests/bench/corpus_cells.py): the generator's cells are valid cell
 files within the corpus's ranges; the angle bracket whose cross-face moves turn the gun over a
-flange plans; the corpus bench runs in its quick mode (CI's smoke run)."""
+flange plans."""
 
 from __future__ import annotations
 
 import importlib.util
-import subprocess
 import sys
 from pathlib import Path
 from types import ModuleType
@@ -66,12 +65,3 @@ def test_gun_turns_over_the_flange_between_the_faces_of_a_bracket(corpus: Module
     result = plan_cell(cell, load_cell_robot(cell), PlanOptions())
     assert result.status == "planned", result.message
     assert [s.seam for s in result.spots].count("v") == 5 and result.trajectory is not None
-
-
-@pytest.mark.slow
-def test_corpus_bench_quick_mode_runs(tmp_path: Path) -> None:
-    """The CI smoke run of the corpus bench: a handful of small cells planned and judged."""
-    done = subprocess.run([sys.executable, str(BENCH / "bench_corpus.py"), "--quick", "--jobs", "2",
-                           "--out", str(tmp_path)], capture_output=True, text=True, check=False)
-    assert done.returncode == 0, done.stderr[-2000:]
-    assert "cells 5: planned" in done.stdout and "planning CPU per cell: median" in done.stdout
