@@ -28,6 +28,7 @@ import numpy as np  # noqa: E402
 from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
 from robomax_py.plan import PlanOptions, plan_cell  # noqa: E402
 from robomax_py.plan.graph import Sequencer as _Sequencer
+from robomax_py.plan.results import resolved_options
 from robomax_py.cspace.grid import nearest_cell  # noqa: E402
 from robomax_py.plan.cspace_detour import local_grid  # noqa: E402
 from robomax_py.plan.roadmap import Roadmap  # noqa: E402
@@ -167,26 +168,26 @@ def main() -> None:
                   + (f"path of {length} steps; swept 2 mm check: {'free' if sweep_free else 'BLOCKED'}"
                      if found else "no path") + " (tests: self contact only; objects from the model)")
     rng = np.random.default_rng(cell.planner.seed)
-    seq = _Sequencer.__new__(_Sequencer)  # only for its lift detour, on the same world
-    seq.cell, seq.robot, seq.world, seq.limits, seq.checks = cell, robot, world, robot.limits, 0
-    seq.home = np.asarray(cell.home)[None, :]
     from robomax_py.plan.candidates import seam_candidates
     spots, _ = seam_candidates(cell, robot, world, 0)
-    seq.spots = spots
     i5 = next(k for k, c in enumerate(spots) if c.name == "s5")
     i6 = next(k for k, c in enumerate(spots) if c.name == "s6")
     a5 = int(np.argmin(np.abs(spots[i5].q_app - q5).sum(axis=1)))
     a6 = int(np.argmin(np.abs(spots[i6].q_app - q6).sum(axis=1)))
     t0 = cpu()
+    anchors = np.vstack([cell.home[None, :], *[c.q_app for c in spots]])
+    roadmap = Roadmap(world, robot.limits, anchors, rng, 600, 12, seeds=anchors)
+    roadmap_s = cpu() - t0
+    # A sequencer built as the planner builds it (only its lift detour is used), on the same world.
+    seq = _Sequencer(cell, robot, world, roadmap, spots, resolved_options(cell, PlanOptions()), rng)
+    t0 = cpu()
     lift = seq._lift_detour(i5, a5, i6, a6)
     print(f"{'lift (up, across, down), ours':34s} {(lift.checks if lift else seq.checks):>10,} {cpu() - t0:>9.3f}  "
           f"{'found, ' + str(len(lift.waypoints)) + ' waypoints' if lift else 'none'}")
     t0 = cpu()
-    anchors = np.vstack([cell.home[None, :], *[c.q_app for c in spots]])
-    roadmap = Roadmap(world, robot.limits, anchors, rng, 600, 12, seeds=anchors)
     det = roadmap.query(q5, q6)
     print(f"{'lazy roadmap (600 nodes), ours':34s} {roadmap.sampling_checks + roadmap.edge_checks:>10,} "
-          f"{cpu() - t0:>9.3f}  {'found, ' + str(len(det.waypoints)) + ' waypoints' if det else 'none'}")
+          f"{roadmap_s + cpu() - t0:>9.3f}  {'found, ' + str(len(det.waypoints)) + ' waypoints' if det else 'none'}")
     from robomax_py.plan.cspace_detour import grid_detour as local_map_detour
 
     t0 = cpu()
