@@ -72,6 +72,7 @@ def _sequencer(cell: CellSpec, robot: Any, world: Any, spots: list[SpotCandidate
     seq = _Sequencer(cell, robot, world, _NoRoadmap(), spots, options,  # type: ignore[arg-type]
                      np.random.default_rng(0))
     seq._lift_detour = lambda i, a, j, b: None  # type: ignore[method-assign]   # no way over the "clamp"
+    seq._withdrawn_detour = lambda i, a, j, b: None  # type: ignore[method-assign]   # nor off the flange
     return seq
 
 
