@@ -149,6 +149,7 @@ class Sequencer:
         self.failed_detours: Counter[tuple[int, int]] = Counter()                 # unordered spot pair -> searches
         self.unconnected: set[tuple[int, int]] = set()                            # unordered spot pairs given up
         self._exit_cache: dict[tuple[int, int], list[FloatArray]] = {}            # (spot, candidate) -> exits
+        self._inner: dict[tuple[int, bool], float] = {}                           # (detour, reversed) -> time
 
     # ------------------------------------------------------------------ knowledge and costs
 
@@ -213,11 +214,10 @@ class Sequencer:
         """Time of enter leg + detour v + leave leg between candidates `rows` of i and `cols` of j."""
         if det is _UNUSABLE:
             return np.full((len(rows), len(cols)), np.inf)
-        wp, sp = det.waypoints, self.options.speed * self.options.detour_speed
+        wp, sp = det.waypoints, self._detour_speed()
         enter = ptp_time_estimate(self.q(i)[rows], wp[0][None, :], self.limits, sp)
         leave = ptp_time_estimate(wp[-1][None, :], self.q(j)[cols], self.limits, sp)
-        inner = float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits, sp)))
-        via = enter[:, None] + inner + leave[None, :]
+        via = enter[:, None] + self._inner_time(v, det) + leave[None, :]
         pi, pj = self._positions(i, rows), self._positions(j, cols)
         bad = self.legs_bad.get((i, j), set())
         if len(bad) >= MAX_BLOCKED_LEGS:
@@ -230,6 +230,46 @@ class Sequencer:
             if vv == v and pi[a] >= 0 and pj[b] >= 0:
                 via[pi[a], pj[b]] = np.inf
         return via
+
+    def _detour_speed(self) -> float:
+        """The speed fraction detour moves are estimated at (options resolved from the cell)."""
+        speed, detour = self.options.speed, self.options.detour_speed
+        assert speed is not None and detour is not None
+        return speed * detour
+
+    def _inner_time(self, v: int, det: Detour) -> float:
+        """Estimated time along detour v oriented as `det` (from `vias_for`), cached per direction
+        (the sum taken in the order travelled, as it always was)."""
+        wp = det.waypoints
+        key = (v, not np.array_equal(wp[0], self.detours[v][2].waypoints[0]))
+        got = self._inner.get(key)
+        if got is None:
+            sp = self._detour_speed()
+            got = self._inner[key] = float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits, sp)))
+        return got
+
+    def _pair_via_costs(self, i: int, a: int, j: int, b: int) -> FloatArray:
+        """`_via_costs` of every known detour for one candidate pair (a of i, b of j), at once:
+        `_verify` asks this for every leg of every tour checked."""
+        vias = self.vias_for(i, j)
+        out = np.full(len(vias), np.inf)
+        usable = [v for v, det in enumerate(vias) if det is not _UNUSABLE]
+        if not usable:
+            return out
+        sp = self._detour_speed()
+        enter = ptp_time_estimate(self.q(i)[a][None, :], np.array([vias[v].waypoints[0] for v in usable]),
+                                  self.limits, sp)
+        leave = ptp_time_estimate(np.array([vias[v].waypoints[-1] for v in usable]), self.q(j)[b][None, :],
+                                  self.limits, sp)
+        via = enter + np.array([self._inner_time(v, vias[v]) for v in usable]) + leave
+        bad = self.legs_bad.get((i, j), set())
+        if len(bad) >= MAX_BLOCKED_LEGS:
+            ok = self.legs_ok.get((i, j), set())
+            keep = np.array([(a, b, v) in ok for v in usable])
+        else:
+            keep = np.array([(a, b, v) not in bad for v in usable])
+        out[usable] = np.where(keep, via, np.inf)
+        return out
 
     def _costs(self, i: int, j: int, rows: IntArray, cols: IntArray) -> FloatArray:
         """Estimated move time between candidates `rows` of i and `cols` of j, using what is known
@@ -422,10 +462,8 @@ class Sequencer:
             straight_ok = (min(i, j), max(i, j)) not in self.detour_only and \
                 self.straight.get((i, j), {}).get((a, b), True)
             straight_cost = float(ptp_time_estimate(qa, qb, self.limits, self.options.speed)) if straight_ok else np.inf
-            one_a, one_b = np.array([a]), np.array([b])
-            via_costs = [float(self._via_costs(i, j, v, det, one_a, one_b)[0, 0])
-                         for v, det in enumerate(self.vias_for(i, j))]
-            best_v = int(np.argmin(via_costs)) if via_costs else -1
+            via_costs = self._pair_via_costs(i, a, j, b)
+            best_v = int(np.argmin(via_costs)) if len(via_costs) else -1
             if straight_ok and (best_v < 0 or straight_cost <= via_costs[best_v]):
                 if self._check_straight(i, a, j, b):
                     out.append(Transition("move", np.array([qa, qb]), label))
