@@ -57,6 +57,8 @@ MAX_BLOCKED_STRAIGHT = 24
 # Failed detour searches between two spots after which they count as unconnected (but for
 # detours found at their ends).
 MAX_FAILED_DETOURS = 6
+# Re-choices of the candidates of one order per round (`Sequencer._repair`).
+REPAIRS_PER_ROUND = 40
 # States of the coarse probe of a move between two stops that are not near neighbours.
 PROBE_STATES = 9
 # Withdrawing the gun off a flange (`Sequencer._withdrawn_detour`): directions perpendicular to the
@@ -287,7 +289,7 @@ class Sequencer:
             est = np.full_like(est, np.inf) if usable or unconnected else est * DETOUR_PRIOR
         else:
             known = self.straight.get(key, {})
-            if sum(1 for free in known.values() if not free) >= MAX_BLOCKED_STRAIGHT:
+            if self._verified_straight_only(i, j):
                 # Mostly blocked between these spots: only straight moves known to be free are
                 # offered, or the DP picks a fresh unchecked pair of candidates every round.
                 verified = np.full_like(est, np.inf)
@@ -306,6 +308,14 @@ class Sequencer:
             if pi[a] >= 0 and pj[b] >= 0:
                 est[pi[a], pj[b]] = np.inf
         return est
+
+    def _verified_straight_only(self, i: int, j: int) -> bool:
+        """Whether only straight moves known to be free are offered between spots i and j: many
+        found blocked, or the pair given up (no detour found MAX_FAILED_DETOURS times), where
+        every fresh candidate pair tried would cost another detour search."""
+        known = self.straight.get((i, j), {})
+        return (sum(1 for free in known.values() if not free) >= MAX_BLOCKED_STRAIGHT
+                or (min(i, j), max(i, j)) in self.unconnected)
 
     def cost(self, i: int, j: int) -> FloatArray:
         """`_costs` between the representatives of two spots (what the order search sees), cached."""
@@ -436,9 +446,23 @@ class Sequencer:
             if verified.complete:
                 self.progress("sequencing", self.rounds, self.rounds)
                 return SequencingOutcome("found", tour, verified.transitions)
+            self._repair(tour.order)
         worst = ", ".join(f"{label} ({n} rounds)" for label, n in self.unresolved.most_common(5))
         return SequencingOutcome("not_converged", message=f"sequencing did not converge in {self.options.max_rounds} "
                                  f"rounds; moves left without a verified connection most often: {worst}")
+
+    def _repair(self, order: tuple[int, ...]) -> None:
+        """The candidates of one order re-chosen (the exact DP, cheap next to an order search) and
+        checked again, up to REPAIRS_PER_ROUND times, until every leg is known free or the order
+        has no finite tour. A blocked move between two spots with many near-equal candidates
+        (other wrist turns of one pose, of the same joint time where a big axis sets it) otherwise
+        costs a round per candidate pair: the order search proposes the same order with the next
+        unchecked pair. Nothing is returned from here: the next round's order search weighs what
+        was learnt, and a tour is taken only as a round's optimum."""
+        for _ in range(REPAIRS_PER_ROUND):
+            choice, cost = choice_for_order(order, self.full_cost, self.node)
+            if not np.isfinite(cost) or self._verify(Tour(order, choice, cost)).complete:
+                return
 
     def _dead_end(self, order: tuple[int, ...]) -> str:
         """The first move of an order that no candidate reached so far can make (what an infinite
@@ -459,8 +483,9 @@ class Sequencer:
         for (i, a), (j, b) in zip(stops[:-1], stops[1:]):
             qa, qb = self.q(i)[a], self.q(j)[b]
             label = f"{self._name(i)} -> {self._name(j)}"
+            # As `_costs` offers it: an unchecked straight move is tried only where it is offered.
             straight_ok = (min(i, j), max(i, j)) not in self.detour_only and \
-                self.straight.get((i, j), {}).get((a, b), True)
+                self.straight.get((i, j), {}).get((a, b), not self._verified_straight_only(i, j))
             straight_cost = float(ptp_time_estimate(qa, qb, self.limits, self.options.speed)) if straight_ok else np.inf
             via_costs = self._pair_via_costs(i, a, j, b)
             best_v = int(np.argmin(via_costs)) if len(via_costs) else -1
@@ -751,7 +776,10 @@ class Sequencer:
                 self.checks += res.checks
                 if not res.free:
                     self._record_leg(i, a, j, b, v, False)
-                    self._new_detour(i, a, j, b)
+                    # A pair given up (MAX_FAILED_DETOURS searches found nothing) is not searched
+                    # again for every blocked leg: it keeps the legs known free.
+                    if (min(i, j), max(i, j)) not in self.unconnected:
+                        self._new_detour(i, a, j, b)
                     return None
             self._record_leg(i, a, j, b, v, True)
         path = np.vstack([qa[None, :], wp, qb[None, :]])

@@ -65,3 +65,21 @@ def test_gun_turns_over_the_flange_between_the_faces_of_a_bracket(corpus: Module
     result = plan_cell(cell, load_cell_robot(cell), PlanOptions())
     assert result.status == "planned", result.message
     assert [s.seam for s in result.spots].count("v") == 5 and result.trajectory is not None
+
+
+@pytest.mark.slow
+def test_seams_whose_joining_moves_need_another_arm_configuration_plan(corpus: ModuleType, tmp_path: Path) -> None:
+    """A 40-spot flanged panel on a KR 125-class arm with two clamps, its seams drawn free: the
+    order found welds one seam in another arm configuration than the next, and the straight moves
+    between them swing the gun into the part near their end. Every candidate pair of the two spots
+    costs the same joint time (other wrist turns, other orientations of the grid), so one pair a
+    round was found blocked until the rounds ran out ("sequencing did not converge"); the corpus
+    oracle joins the cell in its given order. Each round now re-chooses the candidates of its order
+    until their moves are known free."""
+    path = corpus.corpus_cell(1, seed=0, max_spots=40).write(tmp_path)
+    cell = load_cell(path)
+    assert sum(len(s.spots) for s in cell.seams) == 40
+    result = plan_cell(cell, load_cell_robot(cell), PlanOptions())
+    assert result.status == "planned", result.message
+    assert result.trajectory is not None and len(result.spots) == 40
+
