@@ -20,8 +20,9 @@ same process, each stage within its CPU limit (the kernel's RLIMIT_CPU):
   collision-free joint path between the approach points of one chosen configuration per spot,
   found by OMPL's RRT-Connect (joint space within the joint limits, each motion checked by the
   collision world's swept check, at most `--oracle-checks` collision queries per query: a count,
-  not a clock) unless the straight move is free. Configurations are chained forward through up to
-  3 per spot per IK branch.
+  not a clock) where no straight move reaches the stop, at most 6 failed queries per stop.
+  Configurations are chained forward: up to 3 per spot per IK branch are tried, each from the 3
+  nearest reached at the previous stop, and the chain goes on from up to 4 reached.
 
 So "feasible by the oracle" is a proof (the chain is a plan in the given order, which every
 seam admits), and "infeasible by the oracle" only means the oracle found no way (for spots
@@ -65,6 +66,8 @@ BRANCH_JUMP_RAD = 0.2        # a joint moving more between line samples: the bra
 PER_BRANCH_KEPT = 12         # free configurations per IK branch and spot the oracle keeps
 PER_BRANCH = 3               # of those, the ones the chain tries per branch (nearest the reached ones)
 SOURCES = 3                  # reached configurations of the previous stop tried per configuration
+KEEP = 4                     # reached configurations per stop the chain goes on from
+RRT_PER_STOP = 6             # failed RRT-Connect queries before a stop is given up
 
 
 # ----------------------------------------------------------------------------------------------
@@ -187,8 +190,7 @@ class Connector:
         return bool(self.world.check_segment(qa, qb).free)
 
     def connect(self, qa: np.ndarray, qb: np.ndarray) -> bool | None:
-        if self.straight_free(qa, qb):
-            return True
+        """Whether RRT-Connect joins qa to qb (the straight move is tried by the caller)."""
         if self.ompl is None:
             return None
         self.rrt_queries += 1
@@ -271,17 +273,25 @@ def oracle(cell: Any, robot: Any, budget: int = 3000, seed: int = 0) -> OracleVe
             idx = np.flatnonzero(branches == b)
             pick.extend(idx[np.argsort(dist[idx], kind="stable")][:PER_BRANCH].tolist())
         pick.sort(key=lambda i: dist[i])
+        sources = {i: np.argsort(np.max(np.abs(src - qs[i]), axis=1), kind="stable")[:SOURCES] for i in pick}
         now: list[np.ndarray] = []
+        # Straight moves suffice on most pairs; a few reached configurations keep the chain open.
         for i in pick:
-            order = np.argsort(np.max(np.abs(src - qs[i]), axis=1), kind="stable")[:SOURCES]
-            for s in order:
-                got = conn.connect(src[s], qs[i])
+            if any(conn.straight_free(src[k], qs[i]) for k in sources[i]):
+                now.append(qs[i])
+                if len(now) >= KEEP:
+                    break
+        # Else RRT-Connect between the nearest pairs, at most RRT_PER_STOP failed queries.
+        failed = 0
+        for i in pick if not now else ():
+            for k in sources[i]:
+                got = conn.connect(src[k], qs[i])
                 if got:
                     now.append(qs[i])
                     break
                 unknown |= got is None
-            # Straight moves suffice on most pairs; a few reached configurations keep the chain open.
-            if len(now) >= 4:
+                failed += 1
+            if len(now) >= KEEP or failed >= RRT_PER_STOP:
                 break
         if not now:
             cpu = time.process_time() - t0
@@ -303,7 +313,11 @@ class _OverCpu(Exception):
     """A stage used up its CPU seconds (SIGXCPU at RLIMIT_CPU's soft limit)."""
 
 
+_OVER = [False]         # set by the handler: the exception may surface wrapped (inside numba code)
+
+
 def _on_xcpu(signum: int, frame: Any) -> None:
+    _OVER[0] = True
     raise _OverCpu
 
 
@@ -316,10 +330,13 @@ def _limited(seconds: float, stage: Any) -> tuple[Any, bool]:
     """stage() within `seconds` more CPU seconds of this process: (its value, True), or (None,
     False) when the kernel's CPU limit stopped it."""
     resource.setrlimit(resource.RLIMIT_CPU, (math.ceil(_cpu_now() + seconds), resource.RLIM_INFINITY))
+    _OVER[0] = False
     try:
         return stage(), True
-    except _OverCpu:
-        return None, False
+    except Exception:
+        if _OVER[0]:
+            return None, False
+        raise
     finally:
         resource.setrlimit(resource.RLIMIT_CPU, (resource.RLIM_INFINITY, resource.RLIM_INFINITY))
 
@@ -441,7 +458,7 @@ def report(rows: list[dict[str, Any]]) -> str:
     feasible = [r for r in rows if verdict[r["cell"]] == "feasible"]
     infeasible = [r for r in rows if verdict[r["cell"]] == "infeasible"]
     unknown = [r for r in rows if verdict[r["cell"]] == "unknown"]
-    missed = [r for r in feasible if r.get("status") != "planned"]
+    missed = [r for r in feasible if r.get("status") not in ("planned", None)]        # None: not planned here
     beyond = [r for r in planned if verdict[r["cell"]] not in ("feasible", "-")]
     cpu = [float(r["cpu"]) for r in rows if r.get("cpu") is not None]
     lines = [(f"cells {len(rows)}: planned {len(planned)}; oracle: feasible {len(feasible)}, infeasible "
