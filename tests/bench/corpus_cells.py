@@ -34,12 +34,13 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import trimesh
 import yaml
 
+Vector = Sequence[float] | np.ndarray
 ROSI = Path(__file__).resolve().parent.parent / "data" / "rosi"
 SHEET_M = 0.003              # two 1.5 mm sheets joined at a flange
 EDGE_M = 0.02                # spot to the flange edge the gun's C wraps over
@@ -96,14 +97,15 @@ def import_arms(folder: Path) -> dict[str, Path]:
 # Geometry in the part's frame P (x away from the robot, z up, origin on the part)
 
 
-def _frame(x: Sequence[float], y: Sequence[float], z: Sequence[float], origin: Sequence[float]) -> np.ndarray:
+def _frame(x: Vector, y: Vector, z: Vector, origin: Vector) -> np.ndarray:
     T = np.eye(4)
     T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = x, y, z, origin
     return T
 
 
 def _box(extents: Sequence[float], T: np.ndarray) -> trimesh.Trimesh:
-    return trimesh.creation.box(extents=list(extents), transform=T)
+    mesh: trimesh.Trimesh = trimesh.creation.box(extents=list(extents), transform=T)
+    return mesh
 
 
 def _aligned_box(lo: Sequence[float], hi: Sequence[float]) -> trimesh.Trimesh:
@@ -142,7 +144,7 @@ def _line(start: Sequence[float], end: Sequence[float], n: Sequence[float], e: S
     return Flange(a, (b - a) / length, np.asarray(n, dtype=float), length, 0.0, np.asarray(e, dtype=float))
 
 
-def _arc(centre: Sequence[float], first: Sequence[float], n: Sequence[float], radius: float, angle: float) -> Flange:
+def _arc(centre: Vector, first: Vector, n: Vector, radius: float, angle: float) -> Flange:
     return Flange(np.asarray(centre, dtype=float), np.asarray(first, dtype=float), np.asarray(n, dtype=float),
                   radius * angle, radius)
 
@@ -493,8 +495,8 @@ def assemble(name: str, arm: Arm, T_world_robot: np.ndarray, riser: float, T_rob
     T_world_part = T_world_robot @ T_robot_part
     T_base = T_world_robot.copy()
     T_base[:3, 3] += T_world_robot[:3, 2] * riser
-    sheet = trimesh.util.concatenate(part.sheets)
-    obstacles = trimesh.util.concatenate(part.fixture + clamps)
+    sheet = cast(trimesh.Trimesh, trimesh.util.concatenate(part.sheets))
+    obstacles = cast(trimesh.Trimesh, trimesh.util.concatenate(part.fixture + clamps))
     objects: list[dict[str, Any]] = [
         {"name": "part", "mesh": f"parts/{name}_part.stl", "workpiece": True, "pose": _pose(T_world_part)},
         {"name": "fixture", "mesh": f"parts/{name}_fixture.stl", "pose": _pose(T_world_part)},
