@@ -1,7 +1,8 @@
 """The planner on the generated corpus, judged by an oracle that is not the planner (not a test):
 
     python tests/bench/bench_corpus.py [--count 200] [--seed 0] [--max-spots 80] [--jobs 2] [--out DIR]
-        [--quick] [--oracle-checks 3000] [--cpu-limit 900] [--no-baselines] [--resume] [--cells CELL.yaml ...]
+        [--quick] [--oracle-checks 3000] [--cpu-limit 900] [--no-baselines | --baselines-every K] [--resume]
+        [--cells CELL.yaml ...]
 
 Cells come from `corpus_cells.py` (written into --out, default a temporary folder), or are given.
 Each cell is planned in a fresh single-threaded process (`plan_cell`, CPU seconds of that process;
@@ -406,7 +407,7 @@ def _child(path: Path, result: Path, args: argparse.Namespace) -> None:
     os._exit(0)          # OMPL's bindings report leaks at interpreter exit; nothing is left to clean
 
 
-def _run(path: Path, folder: Path, args: argparse.Namespace) -> dict[str, Any]:
+def _run(path: Path, folder: Path, args: argparse.Namespace, k: int = 0) -> dict[str, Any]:
     result = folder / f"{path.stem}.result.json"
     if args.resume and result.is_file():
         done: dict[str, Any] = json.loads(result.read_text())
@@ -415,8 +416,9 @@ def _run(path: Path, folder: Path, args: argparse.Namespace) -> dict[str, Any]:
     cmd = [sys.executable, __file__, "--one", str(path), "--result", str(result),
            "--oracle-checks", str(args.oracle_checks), "--oracle-cpu", str(args.oracle_cpu),
            "--cpu-limit", str(args.cpu_limit)]
+    baselines = not args.no_baselines and k % args.baselines_every == 0
     cmd += [flag for flag, on in (("--no-oracle", args.no_oracle), ("--no-plan", args.no_plan),
-                                  ("--no-baselines", args.no_baselines)) if on]
+                                  ("--no-baselines", not baselines)) if on]
     env = {**os.environ, "OMP_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
     result.unlink(missing_ok=True)
     t0 = time.perf_counter()
@@ -541,6 +543,8 @@ def main() -> None:
     ap.add_argument("--no-oracle", action="store_true")
     ap.add_argument("--no-plan", action="store_true")
     ap.add_argument("--no-baselines", action="store_true", help="skip re-planning by the two baselines")
+    ap.add_argument("--baselines-every", type=int, default=1, metavar="K",
+                    help="re-plan by the baselines only every K-th cell (they take about as long as the plan)")
     ap.add_argument("--resume", action="store_true", help="keep the finished results already in --out")
     ap.add_argument("--json", type=Path, default=None, help="write every cell's result here")
     ap.add_argument("--one", type=Path, help=argparse.SUPPRESS)
@@ -562,7 +566,7 @@ def main() -> None:
         results = folder / "results"
         results.mkdir(parents=True, exist_ok=True)
         with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-            rows = list(pool.map(lambda p: _run(p, results, args), cells))
+            rows = list(pool.map(lambda kp: _run(kp[1], results, args, kp[0]), enumerate(cells)))
         if args.json:
             args.json.write_text(json.dumps(rows, indent=1), encoding="utf-8")
         print(report(rows))
