@@ -127,6 +127,9 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
         parsed = dialect.parse(texts, main, robot)
     except ProgramError as exc:
         raise ExportError(f"{fmt}: the written program does not read back: {exc}") from None
+    if parsed.problems:
+        at, kind, detail = parsed.problems[0]
+        raise ExportError(f"{fmt}: the written program is not clean: {kind}: {detail} (line {at} of {main})")
     _same_program(fmt, main, adapted, parsed)
     rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
     if rebuilt.problems or rebuilt.trajectory is None:

@@ -21,6 +21,7 @@ import numpy as np
 from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
 from robomax_py.export.trajectory_json import load_trajectory_file
+from robomax_py.io.files import check_set
 from robomax_py.plan.loads import Loads, check_carried_motion
 from robomax_py.plan.poses import nominal_rotation
 from robomax_py.robot import RobotModel, fk_tcp
@@ -54,6 +55,7 @@ class VerifyReport:
     ignored: tuple[tuple[int, str], ...] = ()     # (line, statement) read but without effect on motion
     clearance: Clearance | None = None            # the smallest distance reached (None: not measured)
     clearance_line: int | None = None             # the program line moving the robot then
+    notes: tuple[str, ...] = ()                   # about the file, not the motion (its plan's set)
 
     @property
     def clean(self) -> bool:
@@ -63,21 +65,58 @@ class VerifyReport:
 def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
     """Verify a trajectory file (.json) or a program of any dialect robomax writes (its motion
     rebuilt from its statements alone)."""
-    from robomax_py.export import DIALECTS, controller_frames, dialect_for_file
+    from robomax_py.export import controller_frames
+    from robomax_py.export.rebuild import rebuild
+    from robomax_py.program import LinMove, PtpMove
+
+    if path.suffix.lower() == ".json":
+        return _with_set(cell, path, (path,), verify_trajectory_file(cell, robot, path))
+    dialect, main, parsed, read = _read_program(robot, path)
+    unsimulated = tuple(Violation(None, "unsupported", f"{text} is not simulated: the program cannot be verified", line)
+                        for line, text in _not_simulated(parsed))
+    stated = tuple(Violation(None, kind, detail, line) for line, kind, detail in parsed.problems)
+    ignored = tuple(i for i in parsed.ignored if not _is_motion(parsed, i[0]))
+    if not any(isinstance(i, (PtpMove, LinMove)) for i in parsed.program.instructions):
+        # No motion runs (the program ends, or jumps past them, before its first motion): it
+        # welds nothing.
+        nowhere = () if stated or unsimulated else (
+            Violation(None, "flow", "no motion of the program runs: it moves the robot nowhere"),)
+        never = tuple(Violation(None, "spot", f"{seam.name}/{spot.name} is never welded")
+                      for seam in cell.seams for spot in seam.spots)
+        return _with_set(cell, path, read,
+                         VerifyReport(str(path), 0, float("nan"), 0, unsimulated + stated + nowhere + never, ignored))
+    rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
+    report = verify_rebuilt(cell, robot, str(path), rebuilt)
+    report = dataclasses.replace(report, violations=unsimulated + stated + report.violations, ignored=ignored)
+    return _with_set(cell, path, read, report)
+
+
+def read_program(robot: RobotModel, path: Path) -> tuple[Any, Path, Any]:
+    """A program's files read as verify reads them: (its `Dialect`, its main file, the `Parsed`
+    program), with the files beside it the dialect reads too (a KRL .dat, the companions, the
+    dialect's shared routines)."""
+    dialect, main, parsed, _ = _read_program(robot, path)
+    return dialect, main, parsed
+
+
+def _read_program(robot: RobotModel, path: Path) -> tuple[Any, Path, Any, tuple[Path, ...]]:
+    """`read_program` and the files of the program's own set it read (its shared routines, which
+    every plan of a folder writes alike, are not among them)."""
+    from robomax_py.export import DIALECTS, dialect_for_file
 
     suffix = path.suffix.lower()
-    if suffix == ".json":
-        return verify_trajectory_file(cell, robot, path)
     dialect = dialect_for_file(suffix)
     if dialect is None:
         known = ", ".join(sorted({e for d in DIALECTS.values() for e in d.extensions}))
         raise ProgramError(path, None, f"expected a trajectory file (.json) or a program ({known})")
     texts = {}
+    read = []
     for ext in dialect.extensions:
         sibling = path.with_suffix(ext) if suffix != ext else path
         if sibling == path or sibling.exists():
             texts[ext] = read_text(sibling, LIMITS.program, ProgramError, "program file",
                                    fallback=dialect.fallback_encoding)
+            read.append(sibling)
     main = path.with_suffix(dialect.extensions[0])
     if dialect.extensions[0] not in texts:
         raise ProgramError(main, None, f"{path.name} needs its main file {main.name} beside it")
@@ -88,15 +127,34 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
         if companion is not None:
             texts[key] = read_text(companion, LIMITS.program, ProgramError, "program file",
                                    fallback=dialect.fallback_encoding)
-    from robomax_py.export.rebuild import rebuild
+            read.append(companion)
+    for name in dialect.shared:
+        # The dialect's routines every program calls alike (FANUC's SPOT_WELD.ls): the reader
+        # checks that the one beside the program does what a weld call is taken to do.
+        routine = _beside(main, name)
+        if routine is not None:
+            texts[name] = read_text(routine, LIMITS.program, ProgramError, "program file",
+                                    fallback=dialect.fallback_encoding)
+    return dialect, main, dialect.parse(texts, str(main), robot), tuple(read)
 
-    parsed = dialect.parse(texts, str(main), robot)
-    rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
-    report = verify_rebuilt(cell, robot, str(path), rebuilt)
-    unsimulated = tuple(Violation(None, "unsupported", f"{text} is not simulated: the program cannot be verified", line)
-                        for line, text in parsed.ignored if _is_motion(parsed, line))
-    return dataclasses.replace(report, violations=unsimulated + report.violations,
-                               ignored=tuple(i for i in parsed.ignored if not _is_motion(parsed, i[0])))
+
+def _with_set(cell: CellSpec, path: Path, read: tuple[Path, ...], report: VerifyReport) -> VerifyReport:
+    """The report with what the manifest of the program's set says: files read (those beside the
+    program, as a controller would be loaded with them) that are not the ones the plan wrote
+    together (a folder mixing plans, or an edited file) are a `set` violation; a
+    program without a manifest is verified as a lone program, and one planned from another
+    version of the cell file is noted (the motion is what verify judges)."""
+    check = check_set(path, read)
+    if check.manifest is None:
+        lone = "no plan's manifest beside it names it: verified as a lone program, not as one plan's set"
+        return dataclasses.replace(report, notes=(*report.notes, lone))
+    found = tuple(Violation(None, "set", m) for m in check.mismatched)
+    notes = report.notes
+    if check.cell_sha256 and check.cell_sha256 != cell.digest:
+        other = (f"planned from another version of the cell file (sha256 {check.cell_sha256[:12]}..., "
+                 f"this one {cell.digest[:12]}...)")
+        notes = (*notes, other)
+    return dataclasses.replace(report, violations=found + report.violations, notes=notes)
 
 
 def _beside(path: Path, name: str) -> Path | None:
@@ -109,6 +167,15 @@ def _beside(path: Path, name: str) -> Path | None:
         return next((p for p in path.parent.iterdir() if p.name.lower() == name.lower() and p.is_file()), None)
     except OSError:
         return None
+
+
+def _not_simulated(parsed: Any) -> list[tuple[int, str]]:
+    """(line, statement and why) of every statement the reader marks as not simulated."""
+    from robomax_py.program import Comment
+
+    mark = "not simulated: "
+    return [(at, ins.text[len(mark):]) for ins, at in zip(parsed.program.instructions, parsed.lines)
+            if isinstance(ins, Comment) and ins.text.startswith(mark)]
 
 
 def _is_motion(parsed: Any, line: int) -> bool:

@@ -109,6 +109,39 @@ def write_small_cell() -> SmallCell:
     return _write_small_cell
 
 
+def _plan_set_state(folder: Path, name: str) -> str | None:
+    """The plan id of the one consistent set of programs `name` in `folder` (None: no set, and no
+    program file of the set's names readable): every file its manifest names has the manifest's
+    sha256, and no other file named as the set's files are can be read. AssertionError otherwise."""
+    import hashlib
+    import json
+    import re
+
+    # The set's own names: the cell's, and FANUC's, named as its TP program (capitals; for short
+    # names such as the tests', `export.fanuc.program_name` without importing the exporters).
+    stems = {name, re.sub(r"[^A-Za-z0-9_]", "_", name).upper()}
+    manifest = folder / f"{name}.manifest.json"
+    readable = {p.name for p in folder.iterdir() if not p.name.startswith(".") and p.exists()
+                and p.name.startswith(tuple(f"{stem}{sep}" for stem in stems for sep in "._"))}
+    if not manifest.exists():
+        assert not readable, f"program files without a manifest: {sorted(readable)}"
+        return None
+    doc = json.loads(manifest.read_text())
+    listed = {f["name"]: f["sha256"] for f in doc["files"]}
+    for file, sha in listed.items():
+        assert hashlib.sha256((folder / file).read_bytes()).hexdigest() == sha, f"{file} is not the manifest's"
+    others = readable - set(listed) - {manifest.name}
+    assert not others, f"files not of the set: {sorted(others)}"
+    return str(doc["plan"])
+
+
+@pytest.fixture(scope="session")
+def plan_set_state() -> Callable[[Path, str], str | None]:
+    """plan_set_state(folder, name): the plan id of the one whole set of programs there (see
+    `_plan_set_state`)."""
+    return _plan_set_state
+
+
 def pytest_addoption(parser: pytest.Parser) -> None:
     parser.addoption("--update-golden", action="store_true", help="rewrite tests/golden/* from current output")
 

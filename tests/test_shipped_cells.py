@@ -37,6 +37,15 @@ def _file(name: str, ext: str) -> str:
     return f"{dialect.program_name(identifier(name)) if dialect and dialect.program_name else name}{ext}"
 
 
+def _verified(cell: Path) -> tuple[str, ...]:
+    """The files `robomax verify` reads back for a cell: the trajectory file, the SRCL program and one
+    controller dialect, a different one for each shipped cell in turn, so that every dialect is
+    verified from disk through the command line. (`plan` has already proven every program it wrote:
+    read back, rebuilt and verified in-process, before writing.)"""
+    dialects = (".src", ".mod", ".ls", ".script")
+    return ".json", ".srcl", dialects[CELLS.index(cell) % len(dialects)]
+
+
 def _plan(cell: Path, out: Path) -> dict[str, object]:
     result = runner.invoke(app, ["plan", str(cell), "-o", str(out), "--format", "all"])
     assert result.exit_code == EXIT_OK, result.output
@@ -44,8 +53,9 @@ def _plan(cell: Path, out: Path) -> dict[str, object]:
     for ext in MAIN_FILES:
         program = out / _file(name, ext)
         assert program.is_file(), f"{program} not written"
-        check = runner.invoke(app, ["verify", str(cell), str(program)])
-        assert check.exit_code == EXIT_OK, check.output
+        if ext in _verified(cell):
+            check = runner.invoke(app, ["verify", str(cell), str(program)])
+            assert check.exit_code == EXIT_OK, check.output
     data: dict[str, object] = json.loads((out / f"{name}.json").read_text())
     return data
 

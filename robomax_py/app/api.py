@@ -57,18 +57,20 @@ def write_programs(cell: LoadedCell, result: PlanResult, out_dir: str | Path, fo
                    stamp: str = "") -> list[Path]:
     """Render the program files of a complete plan (the trajectory file and each of `formats`, as
     `plan --format` takes them), prove each (read back, rebuilt, compared and verified), then
-    write them as one set; the paths written.
+    write them as one set with its manifest, as `plan` does (`io.files.commit_set`); the paths
+    written (the manifest, `<name>.manifest.json`, beside them).
 
     Raises ExportError for a plan that is not complete or a program that does not prove: nothing
     is written then.
     """
-    from robomax_py.export import format_names
-    from robomax_py.io.files import write_programs as write
+    from robomax_py.export import SHARED_FILES, format_names
+    from robomax_py.io.files import commit_set
     from robomax_py.publish import publish
 
     names = format_names(formats, cell.robot.controller.brand)
     files, _ = publish(result, cell.spec, cell.robot, names, stamp=stamp, baseline=result.baseline)
-    return write(Path(out_dir), files)
+    name = result.cell + ("_baseline" if result.baseline else "")
+    return list(commit_set(Path(out_dir), name, files, cell.spec.digest, SHARED_FILES).paths)
 
 
 def verify_program(cell: LoadedCell, path: str | Path) -> VerifyReport:

@@ -69,6 +69,7 @@ class CellOutcome:
     reasons: str = ""                # why it is not planned: failing spots, the file error, the crash
     programs: tuple[tuple[str, str], ...] = ()   # (file name, text) rendered by the worker
     written: tuple[str, ...] = ()    # program files written by the caller
+    cell_sha256: str = ""            # the cell file's digest, named by the programs' manifest
     peak_rss_mb: float | None = None  # peak resident memory of the worker's process so far, MiB (Unix)
 
 
@@ -101,7 +102,7 @@ def plan_cell_file(file: str, baseline: bool) -> CellOutcome:
         return CellOutcome(file, spec.name, INFEASIBLE, seconds, spots=n_spots, reasons=reasons or result.message)
     detours = sum(1 for t in result.transitions if t.kind == "detour")
     return CellOutcome(file, spec.name, PLANNED, seconds, cycle_time=result.cycle_time, spots=n_spots,
-                       detours=detours, programs=programs)
+                       detours=detours, programs=programs, cell_sha256=spec.digest)
 
 
 def run_worker(worker: Worker, file: str, baseline: bool) -> CellOutcome:
@@ -316,26 +317,29 @@ def _first_line(exc: BaseException) -> str:
 
 
 def write_outcome_programs(out_dir: Path, outcome: CellOutcome, taken: dict[str, str]) -> CellOutcome:
-    """Write a planned outcome's programs as `robomax plan` does; the outcome without texts, with paths.
+    """Write a planned outcome's programs as `robomax plan` does (one set with its manifest,
+    `io.files.commit_set`); the outcome without texts, with paths.
 
     `taken` maps program file names already written in this batch to the cell file that wrote them:
     a second cell of the same name would overwrite them, so it becomes `bad input` and writes nothing.
     """
-    from robomax_py.io.files import write_programs
+    from robomax_py.io.files import commit_set
 
     if outcome.status != PLANNED:
         return outcome
-    from robomax_py.export import DIALECTS
+    from robomax_py.export import SHARED_FILES
 
     # Files every cell writes alike (FANUC's SPOT_WELD.ls) do not belong to one cell.
-    shared = {name for d in DIALECTS.values() for name in d.shared}
-    own = [name for name, _ in outcome.programs if name not in shared]
+    own = [name for name, _ in outcome.programs if name not in SHARED_FILES]
     clash = next((taken[name] for name in own if name in taken), None)
     if clash is not None:
         return replace(outcome, status=BAD_INPUT, programs=(), cycle_time=None, detours=None,
                        reasons=f"{outcome.file}: name: cell name '{outcome.cell}' is also that of {clash}; "
                                "its programs would overwrite those")
-    written = write_programs(out_dir, dict(outcome.programs))
+    # The set is named as its trajectory file (publish renders it first): the cell, or <cell>_baseline.
+    name = next((n.removesuffix(".json") for n, _ in outcome.programs if n.endswith(".json")), outcome.cell)
+    committed = commit_set(out_dir, name, dict(outcome.programs), outcome.cell_sha256, SHARED_FILES)
+    written = [*committed.paths, committed.manifest]
     for name in own:
         taken[name] = outcome.file
     return replace(outcome, programs=(), written=tuple(str(p) for p in written))

@@ -6,10 +6,12 @@ Heavy modules are imported inside commands so `robomax --help` stays fast.
 
 from __future__ import annotations
 
+import signal
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated, TypeVar
+from typing import Annotated, Any, TypeVar
 
 import typer
 from rich.console import Console
@@ -154,38 +156,55 @@ def plan(
         import json as _json
         import time
 
-        from robomax_py.app.progress import configure_logging, stage_bars
-        from robomax_py.app.report import plan_report, report_tables
-        from robomax_py.export import format_names
-        from robomax_py.io.cell import load_cell, load_cell_robot
-        from robomax_py.io.files import write_programs
-        from robomax_py.plan import PlanOptions, plan_cell
-        from robomax_py.publish import publish
+        with _signals_deferred():
+            from robomax_py.app.progress import configure_logging, stage_bars
+            from robomax_py.app.report import plan_report, report_tables
+            from robomax_py.export import SHARED_FILES, format_names
+            from robomax_py.io.cell import load_cell, load_cell_robot
+            from robomax_py.io.files import commit_set
+            from robomax_py.plan import PlanOptions, plan_cell
+            from robomax_py.publish import publish
+        _honour_signals()
 
         configure_logging(err, verbose)
         t0 = time.perf_counter()
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
+        _honour_signals()
         _warn(robot.warnings)
         names = format_names(formats, robot.controller.brand)
-        with stage_bars(err, enabled=not verbose) as progress:
+        set_name = spec.name + ("_baseline" if baseline else "")
+        with stage_bars(err, enabled=not verbose) as bars:
+            def progress(stage: str, done: int, total: int) -> None:
+                _honour_signals()
+                bars(stage, done, total)
+
             result = plan_cell(spec, robot, PlanOptions(baseline=baseline, speed=speed), progress)
+        _honour_signals()
         seconds = time.perf_counter() - t0
         written: list[Path] = []
         checked = []
+        removed: tuple[str, ...] = ()
+        unlisted: tuple[str, ...] = ()
         if result.status == "planned":
             from robomax_py.app.chart import cycle_chart, render_png
-            from robomax_py.io.files import write_atomic_bytes
 
             date = datetime.date.today().isoformat() if stamp else ""
             texts, checked = publish(result, spec, robot, names, stamp=date, baseline=baseline)  # all proven before any write
-            png = render_png(cycle_chart(result)) if plot else None
-            written = write_programs(out_dir, texts)
-            if png is not None:
-                path = out_dir / f"{spec.name}{'_baseline' if baseline else ''}.png"
-                write_atomic_bytes(path, png)
-                written.append(path)
+            files: dict[str, str | bytes] = dict(texts)
+            if plot:
+                files[f"{set_name}.png"] = render_png(cycle_chart(result))
+            _honour_signals()                   # nothing is written after an interrupt
+            committed = commit_set(out_dir, set_name, files, spec.digest, SHARED_FILES)
+            _honour_signals()                   # one that came during the commit: the new set is whole
+            written = [*committed.paths, committed.manifest]
+            removed = committed.removed
+            unlisted = committed.unlisted
         report = plan_report(result, seconds, written, robot.defaulted_limits, checked)
+        if result.status == "planned":
+            report["removed"] = [str(out_dir / n) for n in removed]
+            report["not_of_this_plan"] = [str(out_dir / n) for n in _stale_programs(out_dir, set_name)]
+            report["unlisted"] = [str(out_dir / n) for n in unlisted]
         if as_json:
             out.print_json(_json.dumps(report))
         else:
@@ -200,27 +219,38 @@ def plan(
                 r = reach.get((f.seam, f.name))
                 far = f"; {r.out_by_m:.3f} m out of reach at the best orientation" if r and not r.reachable else ""
                 err.print(f"  {f.seam}/{f.name}: {f.reason} ({f.detail}{far})", soft_wrap=True)
-            stale = _stale_programs(out_dir, spec.name + ("_baseline" if baseline else ""))
+            stale = _stale_programs(out_dir, set_name, every=True)
             if stale:
                 err.print(f"[yellow]note:[/] {', '.join(stale)} in {out_dir} are from an earlier plan, not this one "
                           "(nothing was written)", soft_wrap=True)
             return EXIT_INFEASIBLE
+        if report["not_of_this_plan"]:
+            err.print(f"[yellow]note:[/] {', '.join(Path(p).name for p in report['not_of_this_plan'])} in {out_dir} "
+                      "are not of this plan (written by an older robomax or by hand; left as they are)", soft_wrap=True)
+        if unlisted:
+            err.print(f"[yellow]note:[/] {', '.join(unlisted)} in {out_dir}: no plan's set there names it any more "
+                      "(left as it is: it may hold the integrator's routine)", soft_wrap=True)
         return EXIT_OK
 
     code = _guarded(run)
     raise typer.Exit(code)
 
 
-def _stale_programs(out_dir: Path, name: str) -> list[str]:
-    """Program files of an earlier plan of the cell in the output folder."""
+def _stale_programs(out_dir: Path, name: str, every: bool = False) -> list[str]:
+    """Program files of the cell in the output folder that are not of its current set: regular
+    files named as its programs (an older robomax's, or put there by hand; a plan writes its set
+    as links into the set's folder). With `every`, the current set's files too."""
     from robomax_py.export import DIALECTS
-
     from robomax_py.export.plan_program import identifier
+    from robomax_py.io.files import MANIFEST_SUFFIX
 
-    suffixes = {".json", ".png", *(e for d in DIALECTS.values() for e in d.extensions)}
+    # FANUC's files are named as its TP program (capitals), the others' as the cell.
     stems = {name, *(d.program_name(identifier(name)) for d in DIALECTS.values() if d.program_name)}
+    keys = (".json", ".png", MANIFEST_SUFFIX, *(k for d in DIALECTS.values() for k in (*d.extensions, *d.companions)))
+    names = {f"{stem}{key}" for stem in stems for key in keys}
     try:
-        return sorted(p.name for p in out_dir.iterdir() if p.stem in stems and p.suffix in suffixes)
+        return sorted(p.name for p in out_dir.iterdir()
+                      if p.name in names and p.exists() and (every or not p.is_symlink()))
     except OSError:
         return []
 
@@ -252,6 +282,8 @@ def verify(
             out.print(f"  smallest clearance {c.distance_m * 1000:.1f} mm ({at}t = {c.t:.3f} s, {c.between})")
         if report.ignored:
             out.print(f"  {len(report.ignored)} statement(s) read but without effect on the motion (I/O, declarations ...)")
+        for note in report.notes:
+            out.print(f"  note: {note}", soft_wrap=True, markup=False)
         if report.clean:
             done = ("every station's gripper action at rest on its pose" if spec.tending
                     else "every spot welded within tolerance")
@@ -603,21 +635,78 @@ def _library_flags_first(argv: list[str]) -> list[str]:
     return front + rest
 
 
-def _terminate(signum: int, frame: object) -> None:
-    # SIGTERM unwinds like Ctrl-C, so a write in progress removes its temporary file.
+class _Received:
+    """The termination signal this process received (SIGINT or SIGTERM), for `_honour_signals`.
+    Process state by nature: a signal handler has nowhere else to leave it."""
+
+    signum: int | None = None
+
+
+def _on_signal(signum: int, frame: object) -> None:
+    # SIGTERM unwinds like Ctrl-C (KeyboardInterrupt, which the preview ends on), so a write in
+    # progress removes its temporary files; the signal is also kept for `_honour_signals`, since a
+    # dependency that catches BaseException (trimesh, on import and in some mesh functions) can
+    # swallow the exception.
+    _Received.signum = signum
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
     raise SystemExit(128 + signum)
 
 
-def main() -> None:
-    """Console entry point."""
-    import signal
+def _honour_signals() -> None:
+    """End the run as an earlier SIGINT or SIGTERM asked, if its exception was swallowed: called
+    between stages and before anything is written."""
+    if _Received.signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    if _Received.signum is not None:
+        raise SystemExit(128 + _Received.signum)
 
-    signal.signal(signal.SIGTERM, _terminate)
+
+@contextmanager
+def _signals_deferred() -> Iterator[None]:
+    """SIGINT and SIGTERM held while the heavy modules are imported (a few seconds at most): an
+    import that catches BaseException would swallow the interrupt and leave half-imported modules
+    behind. A signal that arrived meanwhile is delivered when the imports are done."""
+    held = {signal.SIGINT, signal.SIGTERM}
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, held)
     try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+
+
+def _unraisable(default: Callable[[Any], object]) -> Callable[[Any], None]:
+    """sys.unraisablehook that keeps quiet about the interrupt raised where Python cannot pass it
+    on (a finaliser, a weakref callback: it prints "Exception ignored" and a traceback, and the run
+    goes on); `_honour_signals` ends the run at the next stage."""
+
+    def hook(unraisable: Any) -> None:         # sys.UnraisableHookArgs
+        if _Received.signum is not None and isinstance(getattr(unraisable, "exc_value", None),
+                                                       (SystemExit, KeyboardInterrupt)):
+            return
+        default(unraisable)
+
+    return hook
+
+
+def main(restore_mask: Iterable[int] | None = None) -> None:
+    """Console entry point. `restore_mask`: the signal mask to set once the handlers are installed
+    (`python -m robomax_py` holds SIGINT and SIGTERM while it imports the command)."""
+    signal.signal(signal.SIGTERM, _on_signal)
+    if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:            # not when started ignoring it (nohup, &)
+        signal.signal(signal.SIGINT, _on_signal)
+    sys.unraisablehook = _unraisable(sys.unraisablehook)
+    try:
+        if restore_mask is not None:
+            signal.pthread_sigmask(signal.SIG_SETMASK, restore_mask)     # a held signal is delivered here
         app(args=_bare_ray_flag(_library_flags_first(sys.argv[1:])))
     except KeyboardInterrupt:
         err.print("interrupted")
         sys.exit(130)
+    except SystemExit as exc:
+        if _Received.signum == signal.SIGTERM and exc.code == 128 + signal.SIGTERM:
+            err.print("terminated")
+        raise
 
 
 if __name__ == "__main__":

@@ -107,6 +107,8 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
                                f"{p['rebuilt_tcp_mm']:.3f} mm, {p['rebuilt_time_ms']:.1f} ms of the plan")
     for f in report["files"]:
         head.add_row("wrote", f)
+    for f in report.get("removed", []):
+        head.add_row("removed", f"{f} (an earlier plan's, not written this time)")
     out: list[Any] = [head]
     if report.get("spots"):
         tending = bool(report.get("tending"))

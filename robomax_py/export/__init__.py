@@ -20,7 +20,7 @@ from robomax_py.plan.program_frames import cell_program_frames
 from robomax_py.program import FrameDef
 from robomax_py.spec import CellSpec
 
-__all__ = ["DIALECTS", "Dialect", "controller_frames", "dialect_for_file", "format_names", "render_trajectory"]
+__all__ = ["DIALECTS", "SHARED_FILES", "Dialect", "controller_frames", "dialect_for_file", "format_names", "render_trajectory"]
 
 # Registry order is the order files are written in (after the trajectory file).
 DIALECTS: dict[str, Dialect] = {
@@ -34,6 +34,8 @@ DIALECTS: dict[str, Dialect] = {
                      shared=tuple(f"{name}.ls" for name in fanuc.ROUTINES)),
     "urscript": Dialect("urscript", (".script",), "ur", urscript.adapt, urscript.write, urscript.parse),
 }
+# Whole file names every program of a dialect writes alike (FANUC's routines): not one cell's files.
+SHARED_FILES: frozenset[str] = frozenset(name for d in DIALECTS.values() for name in d.shared)
 
 
 def controller_frames(dialect: Dialect, cell: CellSpec) -> tuple[FrameDef, ...]:

@@ -73,13 +73,16 @@ class Parsed:
 
     lines[i] is the line (1-based, in the main file) of instruction i; `ignored` are the statements
     (line, text) read but not simulated: the motion is rebuilt without them and verify reports them.
-    brand is whose configuration data the program's Cartesian targets carry.
+    brand is whose configuration data the program's Cartesian targets carry. `problems` are what
+    the statements themselves say is wrong, as the controller executes them, (line, kind, detail):
+    an end that leaves statements unexecuted ("flow"), a speed outside its range ("speed").
     """
 
     program: Program
     lines: tuple[int, ...]
     brand: str
     ignored: tuple[tuple[int, str], ...] = ()
+    problems: tuple[tuple[int, str, str], ...] = ()
 
 
 def own_name(frame: FrameDef) -> str:

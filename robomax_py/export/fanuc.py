@@ -72,6 +72,18 @@ controller, the LS file goes through an ASCII to binary conversion"):
 The reader takes both these files and other writers' (any spacing, LF or CRLF, `/APPL`, position
 comments, continuation lines). Remarks: TP remarks are short; the notes other dialects carry on
 each move are left out.
+
+It follows the program as the controller runs it (`export.flow`): END and ABORT end it, PAUSE
+stops it until it is started again (the verified cycle ends there), JMP LBL[n] continues at
+LBL[n]; a CALL of the frames setup program runs it in place. A CALL of any other program (the
+default routines aside), RUN, conditional jumps and calls (IF ..., SELECT, WAIT ... TIMEOUT,LBL),
+a speed OVERRIDE, waits other than `WAIT t(sec)` and `WAIT DI[k]=ON` (on a register, a flag, an
+expression), and what runs inside IF ... THEN / FOR blocks are reported, never skipped. A
+CALL SPOT_WELD / GRIP / RELEASE is the weld or gripper action it names while the routine shipped
+beside the program (SPOT_WELD.ls ...) does nothing but `WAIT AR[2]`; the time is the call's second
+argument, in s. Linear speeds in mm/sec, cm/min or inch/min are read in their units; a move
+stated by its time (sec, msec) or its orientation speed (deg/sec) is reported; joint speeds in %
+(rebuild reports them above 100 %, and lines above the cell's line speed).
 """
 
 from __future__ import annotations
@@ -100,6 +112,7 @@ from robomax_py.export.dialect import (
     with_package_welds,
     without_comments,
 )
+from robomax_py.export.flow import Flow, Routine, Statement, follow
 from robomax_py.program import (
     NULL_FRAME,
     UNSET_FRAME,
@@ -470,6 +483,13 @@ def _positions(text: str) -> dict[int, tuple[dict[str, float], str, tuple[int, i
     return out
 
 
+def _program_positions(text: str) -> dict[int, tuple[dict[str, float], str, tuple[int, int] | None]]:
+    """The /POS positions of a whole TP program text."""
+    lines = text.splitlines()
+    at = next((i for i, ln in enumerate(lines) if ln.strip() == "/POS"), len(lines))
+    return _positions("\n".join(lines[at + 1:]))
+
+
 def _statements(lines: list[str], start: int, end: int) -> list[tuple[int, str]]:
     """(file line, statement) of the /MN lines start..end-1: a numbered line with its continuation
     lines (`    :  SPOT[...]`), without the closing `;`; a remark's continuations (`!+...`, see
@@ -491,6 +511,92 @@ def _statements(lines: list[str], start: int, end: int) -> list[tuple[int, str]]
         else:
             joined.append((line, "!" + remark if remark is not None else stmt))
     return joined
+
+
+# ------------------------------------------------------------------ control flow
+
+# What TP statements do to the flow: `END` ends the program (a called program returns to its
+# caller), `ABORT` ends it, `PAUSE` stops it until it is started again, `JMP LBL[n]` continues at
+# `LBL[n]`, `CALL NAME[(args)]` runs the program NAME (public TP grammar JTremblayAGT/fanuc-lsp@
+# b0e9a1ea TPLangParser/TPLang/Instructions/TpBranchingInstruction.cs:8-57 (labels, JMP, CALL,
+# IF, SELECT, IF ... THEN / ELSE / ENDIF, END) and TpProgControlInstruction.cs:20-26 (PAUSE,
+# ABORT); RoboDK's R-30iA post writes `PAUSE ;` to "Pause the robot program" and
+# `WAIT ... TIMEOUT, LBL[n]` / `LBL[n] ;`, ros-industrial-attic/robodk_postprocessors@d7e6c1c0
+# Fanuc_R30iA.py:405-410, 474-479). A pause ends the verified cycle (flow.py).
+_LBL = re.compile(r"^LBL\[\s*([0-9]+)\s*(?::[^\]]*)?\]$", re.IGNORECASE)
+_JMP = re.compile(r"^JMP\s+LBL\[\s*([0-9]+)\s*(?::[^\]]*)?\]$", re.IGNORECASE)
+_CALL_ANY = re.compile(r"^CALL\s+([A-Za-z_][A-Za-z0-9_]*)\s*(\((.*)\))?$", re.IGNORECASE)
+# Speeds of a linear move in other units than mm/sec, as mm/s per unit.
+_LINEAR_UNITS = {"mm/sec": 1.0, "cm/min": 10.0 / 60.0, "inch/min": 25.4 / 60.0}
+
+
+def _classify(st: Statement) -> Flow:
+    """What a TP statement does to the flow (`flow.Flow`)."""
+    text = st.text
+    if not text or text.startswith("!"):
+        return Flow()
+    word = text.split()[0].upper()
+    if text.upper() == "END":
+        return Flow("end", "END")
+    if text.upper() == "ABORT":
+        return Flow("end", "ABORT", scope="program")
+    if text.upper() == "PAUSE":
+        return Flow("end", "PAUSE", scope="program", pause=True)
+    jump = _JMP.match(text)
+    if jump:
+        return Flow("goto", jump.group(1))
+    label = _LBL.match(text)
+    if label:
+        return Flow("label", label.group(1))
+    if re.match(r"^IF\b.*\bTHEN$", text, re.IGNORECASE) or word == "FOR":
+        return Flow("open")
+    if word in ("ENDIF", "ENDFOR"):
+        return Flow("close")
+    if word == "ELSE":
+        return Flow()
+    if word in ("IF", "SELECT") or text.startswith("=") or re.match(r"^ELSE\s*,", text, re.IGNORECASE):
+        return Flow("unsupported", why="a conditional jump or call")
+    if re.search(r"\bTIMEOUT\s*,\s*LBL\[", text, re.IGNORECASE):
+        return Flow("unsupported", why="a wait that jumps when it times out")
+    if word == "RUN":
+        return Flow("unsupported", why="a program run beside this one")
+    override = re.match(r"^OVERRIDE\s*=\s*([0-9.]+)\s*%$", text, re.IGNORECASE)
+    if override:
+        return Flow() if float(override.group(1)) == 100.0 else Flow("unsupported", why="a speed override")
+    call = _CALL_ANY.match(text)
+    if call and call.group(1).upper() not in ROUTINES:
+        return Flow("call", call.group(1).upper(), arguments=bool((call.group(3) or "").strip()))
+    return Flow()
+
+
+def _program(text: str, source: str) -> Routine | None:
+    """A TP program text as a routine: its /PROG name and its /MN statements."""
+    lines = text.splitlines()
+    head = next((re.match(r"^/PROG\s+(\S+)", ln) for ln in lines if ln.startswith("/PROG")), None)
+    if head is None:
+        return None
+    mn = next((i for i, ln in enumerate(lines) if ln.strip() == "/MN"), len(lines))
+    pos = next((i for i, ln in enumerate(lines) if ln.strip() == "/POS"), len(lines))
+    body = tuple(Statement(line, stmt, source=source) for line, stmt in _statements(lines, mn + 1, pos))
+    return Routine(head.group(1).upper(), body, (), source)
+
+
+def _not_resting(routine: Routine) -> list[tuple[int, str, str]]:
+    """(line, statement, why) of what a default routine (SPOT_WELD, GRIP, RELEASE) does besides
+    resting for its second argument: remarks and one `WAIT AR[2]` (the routine `write` gives)."""
+    waits = 0
+    out: list[tuple[int, str, str]] = []
+    for st in routine.body:
+        if not st.text or st.text.startswith("!"):
+            continue
+        if re.fullmatch(r"WAIT\s+AR\[\s*2\s*\]", st.text, re.IGNORECASE) and waits == 0:
+            waits += 1
+            continue
+        out.append((st.line, st.text, (f"{routine.name}: a weld or gripper routine that does more than rest its time "
+                                       "(verify takes a call of it for the weld or action it names)")))
+    if waits == 0:
+        out.append((0, routine.name, f"{routine.name}: it does not rest its time (WAIT AR[2])"))
+    return out
 
 
 def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
@@ -557,9 +663,20 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         ignored.append((number, stmt))
         add(Comment(f"not simulated: {stmt}{why}"), number, statement)
 
-    statements = _statements(lines, mn_at + 1, pos_at)
+    main = Routine(head.group(1).upper(), tuple(Statement(line, stmt) for line, stmt in _statements(lines, mn_at + 1, pos_at)))
+    called = [r for r in (_program(texts.get(FRAMES_FILE, ""), FRAMES_FILE),) if r is not None]
+    followed = follow(main, {r.name: r for r in called}, _classify, key=str.upper)
     leading = True                              # remarks before the first statement: the header
-    for s, (number, stmt) in enumerate(statements):
+    for s, step in enumerate(followed.steps):
+        number, stmt = step.line, step.statement.text
+        if step.unsupported:
+            leading = False
+            not_simulated(number, s, stmt, f" ({step.unsupported})")
+            continue
+        if step.conditional and stmt and not stmt.startswith("!"):
+            # Inside IF ... THEN / FOR: whether, or how often, it runs depends on a condition.
+            not_simulated(number, s, stmt)
+            continue
         if stmt.startswith("!"):
             remark = stmt[1:].strip()
             follows = bool(at) and at[-1] == s - 1
@@ -589,17 +706,21 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             cnt = 0 if move.group(5).upper() == "FINE" else int(move.group(6))
             options = move.group(7) or ""
             acc = re.search(r"ACC\s*([0-9]+)", options, re.IGNORECASE)
-            if k not in positions:
-                raise error(number, f"P[{k}] has no position in /POS")
-            fields, config, numbers = positions[k]
+            # A called program's P[k] is in its own /POS.
+            own = positions if step.statement.source == "" else _program_positions(texts.get(step.statement.source, ""))
+            if k not in own:
+                raise error(number, f"P[{k}] has no position in /POS"
+                                    + ("" if step.statement.source == "" else f" of {step.statement.source}"))
+            fields, config, numbers = own[k]
+            if (kind == "J" and unit != "%") or (kind == "L" and unit not in _LINEAR_UNITS):
+                # A move stated by its time (sec, msec) or by its orientation speed (deg/sec).
+                not_simulated(number, s, stmt, f" (a {'joint' if kind == 'J' else 'linear'} move's speed in {unit})")
+                continue
             if kind == "J" and all(f"J{i}" in fields for i in range(1, 7)):
-                if unit != "%":
-                    raise error(number, f"a joint move's speed must be in %, got {unit}")
                 q = _from_controller(tuple(fields[f"J{i}"] for i in range(1, 7)), coupled)
                 add(PtpMove(q, speed / 100, (float(acc.group(1)) if acc else 100.0) / 100, flyby=cnt * CNT_DEG), number, s)
             elif kind == "L" and all(c in fields for c in "XYZWPR"):
-                if unit != "mm/sec":
-                    raise error(number, f"a linear move's speed must be in mm/sec here, got {unit}")
+                speed *= _LINEAR_UNITS[unit]            # mm/sec
                 uf, ut = numbers if numbers is not None else (active["UFRAME"], active["UTOOL"])
                 mismatch = [f"{name} {n} is not the active {name}_NUM {active[name]}"
                             for name, n in (("UFRAME", uf), ("UTOOL", ut))
@@ -644,6 +765,10 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         if wait_di:
             add(WaitFor((wait_di.group(2) or f"DI{wait_di.group(1)}").strip(), int(wait_di.group(1))), number, s)
             continue
+        if re.match(r"^WAIT\b", stmt, re.IGNORECASE):
+            # A wait on a register, a flag, an expression: how long it holds the robot is not known.
+            not_simulated(number, s, stmt, " (a wait other than WAIT t(sec) or WAIT DI[k]=ON)")
+            continue
         selected = _FRAME_NUM.match(stmt)
         if selected:
             active[selected.group(1).upper()] = int(selected.group(2))
@@ -651,10 +776,21 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         if register_or_frame(stmt):
             continue
         ignored.append((number, stmt))
+    for name in ROUTINES:
+        # A default routine shipped beside the program (SPOT_WELD.ls ...), where the program calls it:
+        # reported at the first call, as that is where the program runs it.
+        routine = _program(texts.get(f"{name}.ls", ""), f"{name}.ls")
+        first = next((step.line for step in followed.steps
+                      if re.match(rf"^CALL\s+{name}\b", step.statement.text, re.IGNORECASE)), None)
+        if routine is None or first is None:
+            continue
+        for line, text, why in _not_resting(routine):
+            where_in = f"{name}.ls line {line}: " if line else f"{name}.ls: "
+            not_simulated(first, len(followed.steps), f"{where_in}{text}", f" ({why})")
     # The header's lines as `_header_statements` wrote them (continuations joined), ", " for " | ".
     header = read_header([t.replace(", ", " | ") for t in header_comments])
     return Parsed(Program(head.group(1), header, tuple(frames), tuple(instructions)), tuple(where), "fanuc",
-                  tuple(ignored))
+                  tuple(ignored), tuple(followed.problems))
 
 
 def _frame_ref(kind: str, number: int | None) -> str:

@@ -85,6 +85,17 @@ that disagrees with its statements is noted among the ignored statements: the st
 motions (CIRC, SPTP, *_REL, a PTP to a Cartesian point, a point declared outside the program, an
 external TCP ...) are reported as not simulated, everything else as ignored. Files may have CRLF
 line ends and be Windows-1252 (`FILE_ENCODING`), as KSS writes them.
+
+The reader follows the program as the controller runs it (`export.flow`): RETURN ends the main
+program (returns from a called one), HALT stops it until it is started again (the verified cycle
+ends there), GOTO continues at its jump label; a call of a DEF (or DEFFCT) of the .src or of the
+frames program runs its body in place. A call of any other routine, an interrupt or trigger that
+calls one, and a jump, end or call under a condition or in a loop are reported, never skipped.
+``spot_weld``, ``grip`` and ``release`` are the weld and gripper actions they name while their
+DEF in the .src does nothing but ``WAIT SEC`` of its time parameter (`_not_resting`); the weld
+time is the call's second argument, in s. ``$VEL_AXIS[i]``, ``$ACC_AXIS[i]`` and a PDAT's ACC
+(which ACC_PTP assigns to $ACC_AXIS uncapped under $ADAP_ACC #STEP2) outside 0..100 % are
+reported; ``$VEL.CP`` is in m/s (rebuild compares the lines with the cell's line speed).
 """
 
 from __future__ import annotations
@@ -92,6 +103,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import lru_cache
 
@@ -118,6 +130,7 @@ from robomax_py.export.dialect import (
     with_package_welds,
     with_tcp_blends,
 )
+from robomax_py.export.flow import Flow, Routine, Statement, follow
 from robomax_py.program import (
     NULL_FRAME,
     UNSET_FRAME,
@@ -491,6 +504,7 @@ class _Reader:
         self.instructions: list[Instruction] = []
         self.lines: list[int] = []
         self.ignored: list[tuple[int, str]] = []
+        self.problems: list[tuple[int, str, str]] = []     # (line, kind, detail): see `Parsed`
         self.frames: list[FrameDef] = []       # whose values the program's texts state
         self.tool, self.base = UNSET_FRAME, UNSET_FRAME    # in force: names of frames
         self.external_tcp = False              # $IPO_MODE = #TCP
@@ -682,13 +696,26 @@ class _Reader:
         elif command == "#VEL_PTP" and v is not None:
             self.vel_axis = [min(v, 100.0)] * 6
         elif command == "#ACC_PTP" and v is not None:
-            self.acc_axis = [v] * 6
+            self.acc_axis = [self.percent("BAS(#ACC_PTP)", v, line)] * 6
         elif command == "#VEL_CP" and v is not None:
             self.vel_cp = min(v, DEF_VEL_CP_M_S)
         elif command == "#ACC_CP" and v is not None:
             self.lin_accel = min(v, 100.0) / 100.0
         else:
             self.ignored.append((line, f"BAS({command}{'' if v is None else f',{v}'})"))
+
+    def percent(self, what: str, value: float, line: int) -> float:
+        """An axis speed or acceleration in % of the axis' maximum: $VEL_AXIS[i] and $ACC_AXIS[i]
+        range over 0..100 (KUKA, System Variables for KSS 8.1-8.4, $VEL_AXIS and $ACC_AXIS; the
+        open reference openkuka.github.io/krl/reference/system.variables gives `$ACC_AXIS[] INT[6] %
+        [0,100]`). BAS.SRC caps what it computes (VEL_PTP, NAQIU bas.src 362-376), a program's own
+        assignment is not capped: a value outside the range is reported, and the motion rebuilt at
+        the nearest end of it."""
+        if 0.0 < value <= 100.0:
+            return value
+        self.problems.append((line, "speed", (f"{what} = {value:g} %: an axis' speed or acceleration is 0..100 % "
+                                              "of its maximum")))
+        return min(max(value, 1.0), 100.0)
 
     def ptp_dat(self, line: int) -> None:
         """PTP_DAT: $ACC_AXIS = ACC ($ADAP_ACC #STEP2), $APO.CDIS = APO_DIST with APO_MODE #CDIS
@@ -697,7 +724,8 @@ class _Reader:
         if pdat is None:
             return
         if isinstance(pdat.get("ACC"), float):
-            self.acc_axis = [float(pdat["ACC"])] * 6       # type: ignore[arg-type]
+            # With $ADAP_ACC #STEP2 ACC_PTP assigns the PDAT's ACC to $ACC_AXIS uncapped.
+            self.acc_axis = [self.percent(f"{self.act['PDAT']}.ACC", float(pdat["ACC"]), line)] * 6  # type: ignore[arg-type]
         if pdat.get("APO_MODE") == "#CDIS" and isinstance(pdat.get("APO_DIST"), float):
             self.cdis = float(pdat["APO_DIST"])             # type: ignore[arg-type]
 
@@ -805,7 +833,8 @@ class _Reader:
         elif number is None:
             return
         elif var in ("$VEL_AXIS", "$ACC_AXIS") and index is not None and 1 <= index <= 6:
-            (self.vel_axis if var == "$VEL_AXIS" else self.acc_axis)[index - 1] = number
+            value = self.percent(f"{var}[{index}]", number, line)
+            (self.vel_axis if var == "$VEL_AXIS" else self.acc_axis)[index - 1] = value
             if var == "$ACC_AXIS":
                 # A plain program's convention (robomax's earlier writer): $ACC_AXIS bounds a LIN's axes too.
                 self.lin_accel = min(self.acc_axis) / 100.0
@@ -897,6 +926,120 @@ class _Reader:
         self.add(WaitFor(name, k), line)
 
 
+# ------------------------------------------------------------------ control flow
+
+# Routines and statements (KUKA, KSS 8.3 Operating and Programming Instructions for System
+# Integrators, "Program execution control": GOTO to a jump label `name:` in the same routine,
+# HALT, RETURN; as RoboDK's KRC4 post writes them, ros-industrial-attic/robodk_postprocessors@
+# d7e6c1c0 KUKA_KRC4.py:281-286 `HALT`, 345 and 354 `START_TIMER:` / `GOTO START_TIMER`). HALT stops
+# the program until it is started again (flow.py: a pause ends the verified cycle).
+_DEF_HEAD = re.compile(r"^(?:GLOBAL\s+)?DEF\s+([A-Za-z_][A-Za-z0-9_]*)\s*\((.*)\)\s*$", re.IGNORECASE)
+_DEFFCT_HEAD = re.compile(r"^(?:GLOBAL\s+)?DEFFCT\s+\w+(?:\s*\[[^\]]*\])?\s+([A-Za-z_][A-Za-z0-9_]*)\s*\((.*)\)\s*$",
+                          re.IGNORECASE)
+_ROUTINE_END = re.compile(r"^(END|ENDFCT)$", re.IGNORECASE)
+# Statements of call form that are not calls of a routine: BAS.SRC, the spot package's user
+# routine, the default weld and gripper routines (a weld or gripper action, `_not_resting` checks
+# their bodies) and PULSE (an output pulse).
+_STATEMENT_CALLS = frozenset({"bas", "userspot", "spot_weld", "grip", "release", "pulse"})
+# robomax's default routines that rest for their second argument: a call of one is a weld or a
+# gripper action; the reader takes it for that only while its body does nothing else.
+_REST_ROUTINES = frozenset({"spot_weld", "grip", "release"})
+_INTERRUPT_DECL = re.compile(r"^(GLOBAL\s+)?INTERRUPT\s+DECL\b", re.IGNORECASE)
+
+
+def _routines(text: str, source: str) -> list[Routine]:
+    """The DEF / DEFFCT routines of a .src text, in order (a routine missing its END runs to the
+    end of the text)."""
+    out: list[Routine] = []
+    head: tuple[str, tuple[str, ...]] | None = None
+    body: list[Statement] = []
+    for number, raw in enumerate(text.splitlines(), start=1):
+        stmt, comment = _statement(raw)
+        match = _DEF_HEAD.match(stmt) or _DEFFCT_HEAD.match(stmt)
+        if match and head is None:
+            params = tuple(p.split(":")[0].strip() for p in match.group(2).split(",") if p.strip())
+            head, body = (match.group(1), params), []
+            continue
+        if head is None or stmt.startswith("&"):
+            continue
+        if _ROUTINE_END.match(stmt):
+            out.append(Routine(head[0], tuple(body), head[1], source))
+            head = None
+            continue
+        body.append(Statement(number, stmt, comment, raw, source))
+    if head is not None:
+        out.append(Routine(head[0], tuple(body), head[1], source))
+    return out
+
+
+def _classifier(defined: set[str]) -> Callable[[Statement], Flow]:
+    """What a KRL statement does to the flow (`flow.Flow`); `defined`: the routines the texts
+    define (lower case), whose calls in expressions (a DEFFCT's) run their bodies."""
+    def classify(st: Statement) -> Flow:
+        text = st.text
+        if not text:
+            return Flow()
+        if re.fullmatch(r"RETURN\b.*", text, re.IGNORECASE):
+            return Flow("end", "RETURN")
+        if re.fullmatch(r"HALT", text, re.IGNORECASE):
+            return Flow("end", "HALT", scope="program", pause=True)
+        if re.fullmatch(r"EXIT", text, re.IGNORECASE):
+            return Flow("unsupported", why="EXIT leaves a loop")
+        if re.fullmatch(r"(RESUME|BRAKE(\s+F)?)", text, re.IGNORECASE):
+            return Flow("unsupported", why="an interrupt routine's statement")
+        jump = re.fullmatch(r"GOTO\s+([A-Za-z_][A-Za-z0-9_]*)", text, re.IGNORECASE)
+        if jump:
+            return Flow("goto", jump.group(1))
+        label = re.fullmatch(r"([A-Za-z_][A-Za-z0-9_]*)\s*:", text)
+        if label:
+            return Flow("label", label.group(1))
+        if _BLOCK_START.match(text):
+            return Flow("open")
+        if _BLOCK_END.match(text):
+            return Flow("close")
+        if _INTERRUPT_DECL.match(text) and not _TEMPLATE.match(text):
+            return Flow("unsupported", why="an interrupt: its routine runs whenever its condition holds")
+        if re.match(r"^TRIGGER\b", text, re.IGNORECASE) and re.search(r"\bDO\s+[A-Za-z_]\w*\s*\(", text, re.IGNORECASE):
+            return Flow("unsupported", why="a trigger calls a routine along the path")
+        call = re.fullmatch(r"([A-Za-z_][A-Za-z0-9_]*)\s*\((.*)\)", text)
+        if call:
+            if call.group(1).lower() in _STATEMENT_CALLS:
+                return Flow()
+            return Flow("call", call.group(1), arguments=bool(call.group(2).strip()))
+        assign = re.match(r"^[$A-Za-z_][\w$.\[\], ]*=(?!=)(.*)$", text)
+        if assign:
+            for name, args in re.findall(r"([A-Za-z_][A-Za-z0-9_]*)\s*\(([^()]*)\)", assign.group(1)):
+                if name.lower() in defined:
+                    return Flow("call", name, arguments=bool(args.strip()))
+        return Flow()
+    return classify
+
+
+def _not_resting(routine: Routine) -> list[tuple[int, str, str]]:
+    """(line, statement, why) of what a default routine (spot_weld, grip, release) does besides
+    resting for its second parameter: its declarations, comments and one `WAIT SEC <it>` (the
+    routine `write` gives). A call of it is then a weld or a gripper action of that time;
+    anything else in it (a motion, another time, another unit) is reported."""
+    head = f"{routine.name}: "
+    time = routine.params[1] if len(routine.params) == 2 else None
+    waits = 0
+    out: list[tuple[int, str, str]] = []
+    for st in routine.body:
+        text = st.text
+        if not text or re.fullmatch(r"(DECL\s+)?(INT|REAL)\s+[A-Za-z_]\w*(\s*,\s*[A-Za-z_]\w*)*", text, re.IGNORECASE):
+            continue
+        wait = re.fullmatch(r"WAIT\s+SEC\s+([A-Za-z_]\w*)", text, re.IGNORECASE)
+        if wait and time is not None and wait.group(1).lower() == time.lower() and waits == 0:
+            waits += 1
+            continue
+        out.append((st.line, text, head + "a weld or gripper routine that does more than rest its time (verify takes a "
+                                          "call of it for the weld or action it names)"))
+    if waits == 0:
+        line = routine.body[0].line - 1 if routine.body else 0
+        out.append((line, routine.name, head + "it does not rest its time (WAIT SEC of its second parameter)"))
+    return out
+
+
 def _dat_name(file: str) -> str:
     return re.sub(r"\.src$", ".dat", file, flags=re.IGNORECASE) if file.lower().endswith(".src") else file + " (.dat)"
 
@@ -915,26 +1058,27 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         if match:
             dat_reader.declare(stmt[:match.start(1)] + stmt[match.end(1):] if match[1] else stmt, number)
     reader.data.update(dat_reader.data)
-    src = texts.get(".src", "").splitlines()
-    main_name = ""
-    in_main = False
+    routines = _routines(texts.get(".src", ""), "")
+    if not routines:
+        raise ProgramError(file, None, "no DEF line: not a KRL program")
+    main = routines[0]
+    defined = {r.name.lower(): r for r in [*_routines(texts.get(FRAMES_FILE, ""), FRAMES_FILE), *routines]}
+    followed = follow(main, defined, _classifier(set(defined)))
     folds = 0
     header_comments: list[str] = []
-    for number, raw in enumerate(src, start=1):
-        stmt, comment = _statement(raw)
-        head = re.match(r"^(GLOBAL\s+)?DEF\s+([A-Za-z_][A-Za-z0-9_]*)\s*\(", stmt, re.IGNORECASE)
-        if head:
-            if main_name:
-                break                                   # the main program ends; local routines follow
-            main_name, in_main = head.group(2), True
+    previous: Statement | None = None
+    for step in followed.steps:
+        st, number = step.statement, step.line
+        if previous is not None and (st.source != previous.source or st.line <= previous.line):
+            # A jump or a call: an inline form left open there is not closed by what follows.
+            reader.fold, folds = None, 0
+        previous = st
+        if step.unsupported:
+            reader.unsimulated(st.text, number, step.unsupported)
             continue
-        if not in_main or stmt.startswith("&"):
-            continue
-        if re.match(r"^END\b", stmt, re.IGNORECASE):
-            in_main = False
-            continue
+        stmt, comment = st.text, st.comment
         if not stmt:
-            line = raw.strip()
+            line = st.raw.strip()
             if re.match(r"^;FOLD\b", line, re.IGNORECASE):
                 folds += 1
                 reader.open_fold(line, number, folds)
@@ -949,8 +1093,12 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
                     reader.add(Comment(comment), number)
             continue
         reader.statement(stmt, comment, number)
-    if not main_name:
-        raise ProgramError(file, None, "no DEF line: not a KRL program")
+    for routine in routines[1:]:
+        if routine.name.lower() in _REST_ROUTINES:
+            for at, text, why in _not_resting(routine):
+                reader.unsimulated(text, at, why)
+    reader.problems.extend(followed.problems)
     header = read_header(header_comments)
+    main_name = main.name
     return Parsed(Program(main_name, header, tuple(reader.frames), tuple(reader.instructions)), tuple(reader.lines),
-                  "kuka", tuple(reader.ignored))
+                  "kuka", tuple(reader.ignored), tuple(reader.problems))

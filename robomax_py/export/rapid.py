@@ -90,6 +90,19 @@ in the tool and work object they name (\TLoad changes no path), predefined and d
 zone data, VelSet, AccSet, WaitTime, WaitDI and calls of spot_weld; a work object held by the robot
 or moved by a mechanical unit (robhold TRUE, ufprog FALSE, ufmec) is reported, not placed; other
 motions (MoveJ, MoveC, SpotJ ...) are reported as not simulated, everything else as ignored.
+
+The reader follows `main` as the controller runs it (`export.flow`): RETURN, EXIT and EXITCYCLE
+end it, Stop and Break stop it until it is started again (the verified cycle ends there), GOTO
+continues at its label (a label is a statement of its own: the statement after it on the line, or
+on the next line, is not part of it); a call of a PROC of the module or of the data module runs
+its body in place (its ERROR, BACKWARD and UNDO handlers do not). A call of any other routine
+(instructions that change no motion or flow aside, `_INERT`), a compact IF, WaitUntil, interrupts,
+error handling, calls by name, and a jump, end or call inside IF / WHILE / FOR / TEST are
+reported, never skipped. spot_weld, grip and release are the weld and gripper actions they name
+while their PROC does nothing but ``WaitTime [\\InPos,]`` of its time parameter; the weld time is
+the call's second argument, in s. Speeds: speeddata v_tcp in mm/s (v5000 is 5000 mm/s) times
+VelSet's override, PTP speeds and accelerations as VelSet's and AccSet's percentages (rebuild
+reports them above 100 %, and lines above the cell's line speed).
 """
 
 from __future__ import annotations
@@ -97,7 +110,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from functools import lru_cache
 
 from lark import Lark, Token, Tree
@@ -120,6 +133,7 @@ from robomax_py.export.dialect import (
     with_package_welds,
     with_tcp_blends,
 )
+from robomax_py.export.flow import Flow, Routine, Statement, follow
 from robomax_py.export.plan_program import identifier
 from robomax_py.export.quaternions import quaternion_from_zyx, zyx_from_quaternion
 from robomax_py.program import (
@@ -385,8 +399,13 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 _UNSIMULATED = re.compile(r"^(MoveJ|MoveC|MoveLDO|MoveJDO|MoveLSync|MoveJSync|MoveCSync|MoveExtJ|SearchL|SearchC|"
                           r"TriggL|TriggJ|TriggC|MoveLRel|MoveAbsJDO|MoveAbsJSync|SpotJ|SpotML|SpotMJ)\b", re.I)
 _KNOWN = re.compile(r"^(MoveAbsJ|MoveL|SpotL|VelSet|AccSet|WaitTime|WaitDI|spot_weld|grip|release)\b", re.I)
-# Lines that end a statement without ';': routine heads and ends, and control-flow lines.
-_HEADLINE = re.compile(r"^(MODULE|ENDMODULE|(LOCAL\s+)?PROC|ENDPROC|(LOCAL\s+)?FUNC|ENDFUNC|(LOCAL\s+)?TRAP|ENDTRAP)\b", re.I)
+# Lines that end a statement without ';': routine heads and ends, a routine's handler sections,
+# and control-flow lines.
+_HEADLINE = re.compile(r"^(MODULE|ENDMODULE|(LOCAL\s+)?PROC|ENDPROC|(LOCAL\s+)?FUNC|ENDFUNC|(LOCAL\s+)?TRAP|ENDTRAP|"
+                       r"ERROR|BACKWARD|UNDO)\b", re.I)
+# A label `name:` opening a line (RAPID reference, GOTO: "GOTO next; ... next:"); a statement may
+# follow it on the same line. CASE ...: and DEFAULT: open a TEST's branches instead.
+_LABEL = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*:(?!=)\s*(.*)$")
 _OPENS = re.compile(r"\b(THEN|DO)\s*$|^(TEST\b.*|ELSE|DEFAULT\s*:|CASE\b.*:)\s*$", re.I)
 _CLOSES = re.compile(r"^(ENDIF|ENDWHILE|ENDFOR|ENDTEST|ELSE)\s*$", re.I)
 # The declarations the motion depends on (spotdata: a package weld's schedule); others (num,
@@ -417,6 +436,13 @@ def _statements(text: str) -> list[tuple[int, str, str]]:
             if comment is not None and not pending:
                 out.append((number, "", comment))
             continue
+        label = _LABEL.match(code) if not pending else None
+        if label and label.group(1).upper() not in ("DEFAULT", "CASE"):
+            # A label is a statement of its own: the statement after it is not part of it.
+            out.append((number, f"{label.group(1)}:", comment or "" if not label.group(2).strip() else ""))
+            code = label.group(2)
+            if not code.strip():
+                continue
         if not pending:
             start = number
         pending.append(code)
@@ -649,6 +675,134 @@ class _Reader:
             self.add(read_gripper(str(action).lower(), comment, int(float(n)), float(seconds), self.file, line), line)
 
 
+# ------------------------------------------------------------------ control flow
+
+# What RAPID statements do to the flow (ABB, RAPID Reference Manual, instructions RETURN, EXIT,
+# EXITCYCLE, Stop, Break, GOTO and the labels it jumps to; procedure calls "Name arg, ...;"; the
+# handlers after ERROR / BACKWARD / UNDO run only on an error, a backward step or an undo). Stop
+# and Break stop the program until it is started again (RoboDK's IRC5 post writes `STOP;` to
+# "Pause the robot program", ros-industrial-attic/robodk_postprocessors@d7e6c1c0
+# ABB_RAPID_IRC5.py:381-386); flow.py: a pause ends the verified cycle.
+_PROC_HEAD = re.compile(r"^(?:LOCAL\s+)?PROC\s+([A-Za-z_][A-Za-z0-9_]*)\s*\((.*)\)\s*$", re.IGNORECASE)
+_FUNC_HEAD = re.compile(r"^(?:LOCAL\s+)?(FUNC|TRAP)\s+(?:[A-Za-z_]\w*\s+)?([A-Za-z_][A-Za-z0-9_]*)\b", re.IGNORECASE)
+_HANDLER = re.compile(r"^(ERROR|BACKWARD|UNDO)\b", re.IGNORECASE)
+_BLOCK_OPEN = re.compile(r"^((IF|WHILE|FOR)\b.*\b(THEN|DO)|TEST\b.*)$", re.IGNORECASE)
+_BLOCK_CLOSE = re.compile(r"^(ENDIF|ENDWHILE|ENDFOR|ENDTEST)$", re.IGNORECASE)
+# Instructions that change no motion and no flow: outputs, FlexPendant text, counters and clocks,
+# configuration and singularity handling (the lines keep their configuration in robomax's
+# rebuild, which checks it), the gripped load, the trigger data TriggL uses (TriggL itself is not
+# simulated).
+_INERT = frozenset(s.lower() for s in (
+    "SetDO", "SetAO", "SetGO", "Set", "Reset", "PulseDO", "InvertDO", "TPWrite", "TPErase", "ErrWrite", "Incr", "Decr",
+    "Add", "Clear", "ClkStart", "ClkStop", "ClkReset", "ConfJ", "ConfL", "SingArea", "GripLoad", "TriggIO",
+    "TriggEquip", "TriggInt"))
+# The default routines whose call is a weld or a gripper action (their bodies rest their time).
+_REST_ROUTINES = frozenset({"spot_weld", "grip", "release"})
+
+
+def _params(text: str) -> tuple[str, ...]:
+    """A PROC's parameter names: `num n, num weld_time` -> ("n", "weld_time")."""
+    return tuple(part.split()[-1].lstrip("\\") for part in re.split(r"[,|]", text) if part.split())
+
+
+def _classifier(functions: set[str]) -> Callable[[Statement], Flow]:
+    """What a RAPID statement does to the flow; `functions`: the FUNCs the texts define (lower
+    case), whose calls in expressions run their bodies (not followed: reported)."""
+    def classify(st: Statement) -> Flow:
+        text = st.text
+        if not text:
+            return Flow()
+        word = re.match(r"^%|^[A-Za-z_][A-Za-z0-9_]*", text)
+        first = word.group(0).lower() if word else ""
+        if first == "return":
+            return Flow("end", "RETURN")
+        if first in ("exit", "exitcycle"):
+            return Flow("end", text, scope="program")
+        if first in ("stop", "break"):
+            return Flow("end", text, scope="program", pause=True)
+        if first == "goto":
+            target = re.fullmatch(r"GOTO\s+([A-Za-z_][A-Za-z0-9_]*)", text, re.IGNORECASE)
+            return Flow("goto", target.group(1)) if target else Flow("unsupported", why="a jump to an expression")
+        label = re.fullmatch(r"([A-Za-z_][A-Za-z0-9_]*):", text)
+        if label:
+            return Flow("label", label.group(1))
+        if _BLOCK_OPEN.match(text):
+            return Flow("open")
+        if _BLOCK_CLOSE.match(text):
+            return Flow("close")
+        if first == "if":
+            return Flow("unsupported", why="a statement under a condition (IF without THEN)")
+        if first in ("else", "elseif", "case", "default"):
+            return Flow()
+        if first in ("raise", "retry", "trynext", "callbyvar", "%", "connect", "waituntil", "stopmove", "startmove"):
+            return Flow("unsupported", why={"connect": "an interrupt: its TRAP runs whenever its signal changes",
+                                            "waituntil": "a wait for a condition",
+                                            "stopmove": "the robot waits for StartMove",
+                                            "startmove": "the robot waits for StartMove"}.get(
+                                                first, "error handling or a call by name"))
+        if _MOTION_DATA.match(text) or re.match(r"^((LOCAL|TASK)\s+)*(CONST|PERS|VAR)\b", text, re.IGNORECASE):
+            return Flow()
+        assign = re.match(r"^[A-Za-z_][\w.{}\[\], ]*:=(.*)$", text)
+        if assign:
+            for name in re.findall(r"([A-Za-z_][A-Za-z0-9_]*)\s*\(", assign.group(1)):
+                if name.lower() in functions:
+                    return Flow("unsupported", why=f"a call of {name}, a function of the program (not followed)")
+            return Flow()
+        if _KNOWN.match(text) or _UNSIMULATED.match(text) or first in _INERT:
+            return Flow()
+        rest = text[len(first):].strip()
+        return Flow("call", word.group(0) if word else text, arguments=bool(rest))
+    return classify
+
+
+def _routines(text: str, source: str) -> list[Routine]:
+    """The PROCs of a module text (a FUNC's or TRAP's body is not a procedure), each without its
+    ERROR / BACKWARD / UNDO handler."""
+    out: list[Routine] = []
+    head: tuple[str, tuple[str, ...]] | None = None
+    body: list[Statement] = []
+    handler = False
+    for line, stmt, comment in _statements(text):
+        proc = _PROC_HEAD.match(stmt)
+        if proc:
+            head, body, handler = (proc.group(1), _params(proc.group(2))), [], False
+            continue
+        if re.match(r"^END(PROC|FUNC|TRAP)\b", stmt, re.IGNORECASE):
+            if head is not None:
+                out.append(Routine(head[0], tuple(body), head[1], source))
+            head = None
+            continue
+        if head is None:
+            continue
+        if _HANDLER.match(stmt):
+            handler = True
+        if not handler:
+            body.append(Statement(line, stmt, comment, source=source))
+    return out
+
+
+def _not_resting(routine: Routine) -> list[tuple[int, str, str]]:
+    """(line, statement, why) of what a default routine (spot_weld, grip, release) does besides
+    resting for its second parameter: comments and one `WaitTime [\\InPos,] <it>` (the routine
+    `write` gives); anything else (a motion, another time, another unit) is reported."""
+    time = routine.params[1] if len(routine.params) == 2 else None
+    waits = 0
+    out: list[tuple[int, str, str]] = []
+    for st in routine.body:
+        wait = re.fullmatch(r"WaitTime\s+(\\InPos\s*,\s*)?([A-Za-z_]\w*)", st.text, re.IGNORECASE)
+        if not st.text:
+            continue
+        if wait and time is not None and wait.group(2).lower() == time.lower() and waits == 0:
+            waits += 1
+            continue
+        out.append((st.line, st.text, (f"{routine.name}: a weld or gripper routine that does more than rest its time "
+                                       "(verify takes a call of it for the weld or action it names)")))
+    if waits == 0:
+        line = routine.body[0].line if routine.body else 0
+        out.append((line, routine.name, f"{routine.name}: it does not rest its time (WaitTime of its second parameter)"))
+    return out
+
+
 def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
     """A RAPID module's motion (the `main` procedure, else the first one)."""
     reader = _Reader(file)
@@ -657,38 +811,49 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             reader.statement(stmt, comment, line)
     module = ""
     header_comments: list[str] = []
-    procs: dict[str, list[tuple[int, str, str]]] = {}
-    current: str | None = None
+    in_routine = False
     for line, stmt, comment in _statements(texts.get(".mod", "")):
-        head = re.match(r"^MODULE\s+([A-Za-z_][A-Za-z0-9_]*)", stmt, re.I)
+        head = re.match(r"^MODULE\s+([A-Za-z_][A-Za-z0-9_]*)", stmt, re.IGNORECASE)
         if head:
             module = head.group(1)
             continue
-        proc = re.match(r"^(?:LOCAL\s+)?PROC\s+([A-Za-z_][A-Za-z0-9_]*)", stmt, re.I)
-        if proc:
-            current = proc.group(1).lower()
-            procs[current] = []
+        if _PROC_HEAD.match(stmt) or _FUNC_HEAD.match(stmt):
+            in_routine = True
             continue
-        if re.match(r"^END(PROC|FUNC|TRAP)\b", stmt, re.I):
-            current = None
+        if re.match(r"^END(PROC|FUNC|TRAP)\b", stmt, re.IGNORECASE):
+            in_routine = False
             continue
-        if current is not None:
-            procs[current].append((line, stmt, comment))
-        elif stmt:
+        if in_routine:
+            continue
+        if stmt:
             reader.statement(stmt, comment, line)
         elif is_header_comment(comment) or comment.startswith(_NOTE):
             header_comments.append(comment)
     if not module:
         raise ProgramError(file, None, "no MODULE line: not a RAPID module")
-    main = procs.get("main") or next((body for name, body in procs.items()
-                                      if name not in ("spot_weld", "grip", "release")), None)
+    routines = _routines(texts.get(".mod", ""), "")
+    defined = {r.name.lower(): r for r in [*_routines(texts.get(FRAMES_FILE, ""), FRAMES_FILE), *routines]}
+    main = next((r for r in routines if r.name.lower() == "main"), None) or next(
+        (r for r in routines if r.name.lower() not in _REST_ROUTINES), None)
     if main is None:
         raise ProgramError(file, None, "the module has no PROC main()")
-    for line, stmt, comment in main:
-        if stmt:
-            reader.statement(stmt, comment, line)
+    functions = {m.group(2).lower() for _, stmt, _ in _statements(texts.get(".mod", ""))
+                 for m in [_FUNC_HEAD.match(stmt)] if m}
+    followed = follow(main, defined, _classifier(functions))
+    for step in followed.steps:
+        st, line = step.statement, step.line
+        if step.unsupported:
+            reader.ignored.append((line, st.text))
+            reader.add(Comment(f"not simulated: {st.text} ({step.unsupported})"), line)
+        elif st.text:
+            reader.statement(st.text, st.comment, line)
         else:
-            reader.add(Comment(comment), line)
+            reader.add(Comment(st.comment), line)
+    for routine in routines:
+        if routine.name.lower() in _REST_ROUTINES:
+            for line, text, why in _not_resting(routine):
+                reader.ignored.append((line, text))
+                reader.add(Comment(f"not simulated: {text} ({why})"), line)
     header = read_header(header_comments)
     return Parsed(Program(module, header, tuple(reader.frames), tuple(reader.instructions)), tuple(reader.lines),
-                  "abb", tuple(reader.ignored))
+                  "abb", tuple(reader.ignored), tuple(followed.problems))

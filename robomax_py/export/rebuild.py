@@ -1,5 +1,12 @@
 """A robot program -> the motion it commands, built the way the planner built it (`timing.chain`).
 
+Speeds and weld times are checked as the program states them, in SI units (each reader converts
+its dialect's units): a joint move's speed or acceleration, or a line's acceleration, above 100 % of
+the axes' limits (the robot's); a line faster than the cell's line speed (`planner.tcp_speed`, the
+TCP speed the cell's approach and retract lines are planned with); a weld that takes another time
+than the cell's spot (a time written in ms is a thousand times the cell's). The motion is rebuilt
+with the speeds capped at 100 %, as the program cannot move faster than the axes can.
+
 Semantics (docs/srcl.md, "Motion semantics"): the first PTP is the start; moves are grouped into
 chains at their FLYBY radii; a chain of one PTP is a jerk-limited joint move, every other chain is
 timed by toppra on its blended path with the LIN lines' TCP speeds; SPOT and WAIT hold at rest;
@@ -61,6 +68,10 @@ FRAME_TOL_MM = TOL.frame_tol_mm
 FRAME_TOL_DEG = TOL.frame_tol_deg
 # A target's configuration data may name either side of a boundary the joint is this close to.
 CONFIG_TOL_RAD = math.radians(TOL.config_tol_deg)
+# A line's TCP speed may exceed the cell's line speed by this much (FANUC TP states whole mm/sec).
+TCP_SPEED_TOL_MM_S = 0.5
+# A weld time is the cell's within half the last decimal programs state it with (3 decimals, s).
+WELD_TIME_TOL_S = 0.5e-3 + 1e-9
 
 
 @dataclass(frozen=True, slots=True)
@@ -185,6 +196,7 @@ class _Builder:
 
     def add(self, ins: Any, following: Any, index: int) -> bool:
         if isinstance(ins, (PtpMove, LinMove)):
+            ins = self._check_speeds(ins)
             tool = None
             if isinstance(ins, LinMove):
                 resolved = self._frames_of(ins)
@@ -210,6 +222,8 @@ class _Builder:
             label = f"{ins.seam}/{ins.name}"
             if isinstance(ins, Spot):
                 self._check_interlocks(ins, label)
+                if not ins.package:
+                    self._check_weld_time(ins, label)
                 if ins.package:
                     self._check_schedule(ins, label)
                     ins = dataclasses.replace(ins, time_s=self._schedule_time(ins))
@@ -226,6 +240,47 @@ class _Builder:
         elif isinstance(ins, WaitFor):
             self._wait_for(ins)
         return True
+
+    def _check_speeds(self, ins: PtpMove | LinMove) -> PtpMove | LinMove:
+        """A speed or acceleration above the axes' limits, or a line faster than the cell's line
+        speed, is reported; the move is rebuilt at most at the axes' limits."""
+        what = "joint move" if isinstance(ins, PtpMove) else "line"
+        fractions = {"acceleration": ins.accel}
+        if isinstance(ins, PtpMove):
+            fractions["speed"] = ins.speed
+        over = {k: v for k, v in fractions.items() if v > 1.0 + 1e-9}
+        for k, v in over.items():
+            self.problems.append(Problem(self.t, "speed", f"a {what} at {100.0 * v:.0f} % of the axes' {k}: above 100 %",
+                                         self.line))
+        if isinstance(ins, LinMove):
+            limit_mm_s = 1000.0 * self.cell.planner.tcp_speed
+            if ins.speed_mm_s > limit_mm_s + TCP_SPEED_TOL_MM_S:
+                self.problems.append(Problem(self.t, "speed", f"a line at {ins.speed_mm_s:.1f} mm/s, faster than the "
+                                                              f"cell's line speed {limit_mm_s:.1f} mm/s (planner.tcp_speed)",
+                                             self.line))
+        if not over:
+            return ins
+        if isinstance(ins, PtpMove):
+            return dataclasses.replace(ins, speed=min(ins.speed, 1.0), accel=min(ins.accel, 1.0))
+        return dataclasses.replace(ins, accel=min(ins.accel, 1.0))
+
+    def _check_weld_time(self, spot: Spot, label: str) -> None:
+        """A weld call's time is the cell's weld time of that spot (the weld routine rests or
+        welds that long: another time is another weld)."""
+        from robomax_py.export.plan_program import identifier
+
+        seam = next((s for s in self.cell.seams if identifier(s.name) == spot.seam), None)
+        spec = next((p for p in seam.spots if identifier(p.name) == spot.name), None) if seam else None
+        if spec is None or spec.action is not None:
+            return
+        want = self.cell.process.weld_time_of(spec)
+        if abs(spot.time_s - want) <= WELD_TIME_TOL_S:
+            return
+        hint = ""
+        if want > 0 and abs(spot.time_s / want - 1000.0) < 1.0:
+            hint = " (a thousand times: written in ms?)"
+        self.problems.append(Problem(self.t, "weld", f"{label}: the program welds {spot.time_s:.3f} s, the cell's weld "
+                                                     f"time is {want:.3f} s{hint}", self.line))
 
     def _step(self, ins: PtpMove, following: Any, index: int) -> Step:
         return PtpStep(ptp_target(ins), speed=ins.speed, accel=ins.accel, flyby=math.radians(ins.flyby),

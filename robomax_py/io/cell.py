@@ -10,6 +10,8 @@ import dataclasses
 import hashlib
 import math
 import re
+import stat
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -31,7 +33,7 @@ from robomax_py.io.robot import (
     resolve_robot_file,
     resolve_tool_file,
 )
-from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
+from robomax_py.io.yaml_files import count_items, read_yaml_mapping, validation_error
 from robomax_py.robot.geometry import load_mesh
 from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
 from robomax_py.spec import (
@@ -77,6 +79,25 @@ TENDING_SEAM = "tending"
 PICK_PLACE_SEAM = "transfers"
 # Dynamic windows beyond a day of program time are a typo, and would overflow the time grid.
 MAX_WINDOW_S = 86_400.0
+
+
+@dataclass(frozen=True, slots=True)
+class CellLimits:
+    """The most one cell may ask for (README, "Limits on the files robomax reads"), checked at load
+    before anything is planned: planning time and memory grow with each. A spot costs its seam's
+    orientations x approach samples x IK columns of IK table and its candidates' approach lines;
+    every object adds pairs to every collision check; triangles are held in memory as BVHs."""
+
+    spots: int = 2_000                  # spots of all seams together (a robot welds tens per cycle)
+    objects: int = 1_000                # objects and dynamic objects together
+    orientations: int = 1_000           # per seam: its grid's orientations and its spots' pinned ones
+    mesh_triangles: int = 2_000_000     # one mesh
+    cell_triangles: int = 5_000_000     # every mesh of the cell and its tool together
+
+
+CELL_LIMITS = CellLimits()
+# A tolerance range this narrow is one orientation sample (as `plan.poses.axis_samples` takes it).
+SAME_ORIENTATION_RAD = 1e-9
 
 
 def _printable_name(v: str) -> str:
@@ -409,9 +430,14 @@ def load_cell(path: str | Path) -> CellSpec:
     meshes are read later, by `load_cell_robot`.
     """
     path = Path(path)
-    data = read_yaml_mapping(path, CellFileError, "cell file", LIMITS.cell)
+    text = read_text(path, LIMITS.cell, CellFileError, "cell file")
     # Programs name the exact cell file they were planned from (their header).
-    digest = hashlib.sha256(read_text(path, LIMITS.cell, CellFileError, "cell file").encode("utf-8")).hexdigest()
+    digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    early = count_items(text, (("seams", "*", "spots"), ("objects",), ("dynamic",)))
+    if early is not None:                  # before the guarded reader composes what may be a very long list
+        _refuse_counts(early[("seams", "*", "spots")], early[("objects",)] + early[("dynamic",)], path)
+    data = read_yaml_mapping(path, CellFileError, "cell file", LIMITS.cell)
+    _check_counts(data, path)              # before validating: the data as read, aliases expanded
     version = data.get("robomax")
     if "robomax" in data and version not in SUPPORTED_VERSIONS:
         supported = ", ".join(str(v) for v in SUPPORTED_VERSIONS)
@@ -421,7 +447,10 @@ def load_cell(path: str | Path) -> CellSpec:
     except ValidationError as exc:
         raise validation_error(exc, CellFile, path, CellFileError) from None
     _check_unique_names(parsed, path)
-    machines, doors = _machines(parsed, path)
+    _check_orientations(parsed, path)
+    _check_declared_triangles(parsed, path)
+    triangles: list[int] = []              # of every mesh read, for the cell's total
+    machines, doors = _machines(parsed, path, triangles)
 
     robot_file = checked_file(resolve_robot_file(parsed.robot.model, path), LIMITS.description,
                               named_by(CellFileError, path, "robot.model"), f"unknown robot '{parsed.robot.model}':")
@@ -430,7 +459,14 @@ def load_cell(path: str | Path) -> CellSpec:
     robot_spec = load_robot_spec(robot_file)
     tool_spec = load_tool_spec(tool_file)
     for key, mesh in (("body", tool_spec.body), ("tips", tool_spec.tips)):
-        _check_mesh_readable(mesh, RobotModelError(tool_file, key, f"cannot read mesh {mesh}"))
+        triangles.append(_check_mesh_readable(mesh, RobotModelError(tool_file, key, f"cannot read mesh {mesh}"),
+                                              triangles))
+    objects = tuple(_object(o, path, f"objects[{i}]", triangles) for i, o in enumerate(parsed.objects))
+    dynamic = tuple(_object(o, path, f"dynamic[{i}]", triangles) for i, o in enumerate(parsed.dynamic))
+    parts = _parts(parsed, path, robot_spec, triangles)
+    if sum(triangles) > CELL_LIMITS.cell_triangles:
+        raise CellFileError(path, "objects", f"its meshes and its tool's have {sum(triangles):,} triangles together, "
+                            f"more than the {CELL_LIMITS.cell_triangles:,} a cell may have (cell_triangles)")
 
     cell = CellSpec(
         name=parsed.name or _stem_name(path),
@@ -439,7 +475,7 @@ def load_cell(path: str | Path) -> CellSpec:
         T_world_base=frozen_array(_pose(parsed.robot.base)),
         home=frozen_array(_home(parsed, robot_spec, path)),
         tool=tool_spec,
-        objects=tuple(_object(o, path, f"objects[{i}]") for i, o in enumerate(parsed.objects)),
+        objects=objects,
         seams=_job_seams(parsed, path),
         process=ProcessSpec(
             weld_time=parsed.process.weld_time,
@@ -452,10 +488,10 @@ def load_cell(path: str | Path) -> CellSpec:
         planner=PlannerSpec(seed=parsed.planner.seed, speed=parsed.planner.speed, tcp_speed=parsed.planner.tcp_speed,
                             detour_speed=parsed.planner.detour_speed, detours=parsed.planner.detours,
                             dynamic=parsed.planner.dynamic, max_wait=parsed.planner.max_wait),
-        dynamic=tuple(_object(o, path, f"dynamic[{i}]") for i, o in enumerate(parsed.dynamic)) + doors,
+        dynamic=dynamic + doors,
         digest=digest,
         machines=machines,
-        parts=_parts(parsed, path, robot_spec),
+        parts=parts,
         tcp_limits=_tcp_limits(parsed.pick_place.unloaded) if parsed.pick_place is not None else None,
     )
     return dataclasses.replace(cell, controller=_controller(parsed.robot.controller, cell, path))
@@ -510,7 +546,7 @@ def _tcp_limits(limits: TcpLimitsFile | None) -> TcpLimits | None:
     return None if limits is None else TcpLimits(limits.v, limits.a_T, limits.a_R, limits.j_T, limits.j_R)
 
 
-def _parts(parsed: CellFile, path: Path, robot: RobotSpec) -> tuple[PartSpec, ...]:
+def _parts(parsed: CellFile, path: Path, robot: RobotSpec, triangles: list[int]) -> tuple[PartSpec, ...]:
     """The parts with their held pose in the TCP frame and the supports of the locations they visit."""
     job = parsed.pick_place
     if job is None:
@@ -521,7 +557,7 @@ def _parts(parsed: CellFile, path: Path, robot: RobotSpec) -> tuple[PartSpec, ..
         if robot.payload_kg is not None and part.mass > robot.payload_kg:
             raise CellFileError(path, f"{key}.mass", f"{part.mass:g} kg is above the robot's rated payload "
                                 f"{robot.payload_kg:g} kg ({robot.source})")
-        shape = _object(part, path, key).shape
+        shape = _object(part, path, key, triangles).shape
         at = {t.from_ for t in job.transfers if t.part == part.name} | {t.to for t in job.transfers if t.part == part.name}
         supports = sorted({name for loc in job.locations if loc.name in at for name in loc.support})
         out.append(PartSpec(name=part.name, shape=shape, mass=part.mass,
@@ -642,7 +678,9 @@ def _pose(pose: PoseFile) -> np.ndarray:
     return pose_matrix(pose.xyz, [deg_to_rad(a) for a in pose.rpy])
 
 
-def _object(obj: ObjectFile, path: Path, key: str) -> ObjectSpec:
+def _object(obj: ObjectFile, path: Path, key: str, triangles: list[int]) -> ObjectSpec:
+    """The object's spec; a mesh is read (and refused when unreadable or too large) and its
+    triangles are added to `triangles`."""
     shape: Shape
     if obj.box is not None:
         shape = Box(extents=(obj.box[0], obj.box[1], obj.box[2]))
@@ -656,7 +694,8 @@ def _object(obj: ObjectFile, path: Path, key: str) -> ObjectSpec:
         assert obj.mesh is not None  # guaranteed by ObjectFile._one_shape
         named = path.parent / obj.mesh
         mesh = checked_file(named, LIMITS.mesh, named_by(CellFileError, path, f"{key}.mesh"), f"mesh {named}")
-        _check_mesh_readable(mesh, CellFileError(path, f"{key}.mesh", f"cannot read mesh {mesh}"))
+        triangles.append(_check_mesh_readable(mesh, CellFileError(path, f"{key}.mesh", f"cannot read mesh {mesh}"),
+                                              triangles))
         shape = MeshShape(path=mesh)
     present = None
     if isinstance(obj, DynamicObjectFile):
@@ -690,14 +729,124 @@ def _stem_name(path: Path) -> str:
 
 
 
-def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError) -> None:
+def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError, triangles: list[int]) -> int:
+    """The mesh's triangles, when it reads, has at most `CELL_LIMITS.mesh_triangles` and keeps the
+    cell's meshes read so far (`triangles`) within `CELL_LIMITS.cell_triangles`. What the file
+    states of its size is judged before it is read (reading a mesh of millions of triangles takes
+    seconds)."""
+    limit, total = CELL_LIMITS.mesh_triangles, sum(triangles)
+    declared, exact = _declared_triangles(mesh)
+    more = "" if exact else " or more"
+    if declared > limit:
+        raise type(error)(error.file, error.key, f"mesh {mesh} has {declared:,} triangles{more}, more than the "
+                                                 f"{limit:,} a mesh may have (mesh_triangles)")
+    if total + declared > CELL_LIMITS.cell_triangles:
+        raise type(error)(error.file, error.key, f"mesh {mesh} brings the cell's meshes and its tool's to "
+                                                 f"{total + declared:,} triangles{more}, more than the "
+                                                 f"{CELL_LIMITS.cell_triangles:,} a cell may have (cell_triangles)")
     try:
-        load_mesh(mesh)
+        n = len(load_mesh(mesh).faces)
     except Exception as exc:  # trimesh raises many kinds for unreadable files
         raise type(error)(error.file, error.key, f"{error.problem}: {exc}") from None
+    if n > limit:
+        raise type(error)(error.file, error.key, f"mesh {mesh} has {n:,} triangles, more than the {limit:,} a mesh "
+                                                 "may have (mesh_triangles)")
+    return n
 
 
-def _machines(parsed: CellFile, path: Path) -> tuple[tuple[MachineSpec, ...], tuple[ObjectSpec, ...]]:
+def _declared_triangles(mesh: Path) -> tuple[int, bool]:
+    """As many triangles as the file states before it is read, at least, and whether exactly: a
+    binary STL's count (exact: its size is 84 bytes plus 50 per triangle), a PLY header's faces, an
+    OBJ's face lines (a face is one triangle or more); 0 for other formats or a file that cannot
+    be read, is not a regular file or is larger than LIMITS.mesh (refused when it is checked)."""
+    suffix = mesh.suffix.lower()
+    try:
+        info = mesh.stat()
+        size = info.st_size
+        if not stat.S_ISREG(info.st_mode) or size > LIMITS.mesh:
+            return 0, False
+        if suffix == ".stl":
+            with open(mesh, "rb") as fh:
+                head = fh.read(84)
+            n = int.from_bytes(head[80:84], "little") if len(head) == 84 else 0
+            return (n, True) if size == 84 + 50 * n else (0, False)
+        if suffix == ".ply":
+            with open(mesh, "rb") as fh:
+                header = fh.read(4096).split(b"end_header", 1)[0]
+            found = re.search(rb"^element\s+face\s+(\d{1,12})\s*$", header, re.MULTILINE)
+            return (int(found.group(1)) if found else 0), False
+        if suffix == ".obj":
+            faces, tail = 0, b"\n"             # a face line starts the file or follows a line end
+            with open(mesh, "rb") as fh:
+                while chunk := fh.read(1 << 24):
+                    data = tail + chunk
+                    faces += data.count(b"\nf ") + data.count(b"\nf\t")
+                    tail = data[-2:]
+            return faces, False
+    except OSError:
+        pass
+    return 0, False
+
+
+def _check_declared_triangles(parsed: CellFile, path: Path) -> None:
+    """The cell's meshes within `CELL_LIMITS.cell_triangles` by what their files state
+    (`_declared_triangles`), before any is read: three meshes of 1.9 million triangles each were
+    read, 20 s of CPU, before the third was refused. The tool's meshes and what the files do not
+    state are counted as they are read."""
+    named = [(f"objects[{i}]", o) for i, o in enumerate(parsed.objects)]
+    named += [(f"dynamic[{i}]", o) for i, o in enumerate(parsed.dynamic)]
+    if parsed.tending is not None:
+        named += [(f"tending.machines[{i}].door", m.door) for i, m in enumerate(parsed.tending.machines)]
+    if parsed.pick_place is not None:
+        named += [(f"pick_place.parts[{i}]", p) for i, p in enumerate(parsed.pick_place.parts)]
+    total, exact = 0, True
+    for key, obj in named:
+        if obj.mesh is None:
+            continue
+        n, known = _declared_triangles(path.parent / obj.mesh)
+        total, exact = total + n, exact and known
+        if total > CELL_LIMITS.cell_triangles:
+            raise CellFileError(path, f"{key}.mesh", f"the cell's meshes up to this one have {total:,} triangles"
+                                f"{'' if exact else ' or more'}, more than the {CELL_LIMITS.cell_triangles:,} a "
+                                "cell may have (cell_triangles)")
+
+
+def _check_counts(data: dict[str, Any], path: Path) -> None:
+    """Spots and objects within `CELL_LIMITS`, counted in the file's data before it is validated."""
+    seams = data.get("seams")
+    spots = sum(len(s["spots"]) for s in seams if isinstance(s, dict) and isinstance(s.get("spots"), list)) \
+        if isinstance(seams, list) else 0
+    objects = sum(len(v) for v in (data.get("objects"), data.get("dynamic")) if isinstance(v, list))
+    _refuse_counts(spots, objects, path)
+
+
+def _refuse_counts(spots: int, objects: int, path: Path) -> None:
+    if spots > CELL_LIMITS.spots:
+        raise CellFileError(path, "seams", f"{spots:,} spots, more than the {CELL_LIMITS.spots:,} a cell may have "
+                                           "(spots); split the job into cells")
+    if objects > CELL_LIMITS.objects:
+        raise CellFileError(path, "objects", f"{objects:,} objects and dynamic objects, more than the "
+                                             f"{CELL_LIMITS.objects:,} a cell may have (objects)")
+
+
+def _check_orientations(parsed: CellFile, path: Path) -> None:
+    """Each seam's orientations (its grid's samples, as `plan.poses.orientation_grid` takes them,
+    and its spots' pinned orientations) within `CELL_LIMITS.orientations`: every spot of the seam
+    is solved at every one of them."""
+    for i, seam in enumerate(parsed.seams):
+        tol = seam.tolerance
+        ranges = (2 * deg_to_rad(tol.alpha), 2 * deg_to_rad(tol.beta), deg_to_rad(tol.gamma[1] - tol.gamma[0]))
+        grid = 1
+        for r in ranges:
+            grid *= 1 if seam.grid == 1 or r <= SAME_ORIENTATION_RAD else seam.grid
+        pinned = sum(1 for s in seam.spots if s.alpha is not None and not s.skip)
+        if grid + pinned > CELL_LIMITS.orientations:
+            raise CellFileError(path, f"seams[{i}].grid", f"{grid:,} grid orientations and {pinned:,} pinned ones, "
+                                f"more than the {CELL_LIMITS.orientations:,} a seam may have (orientations): "
+                                "every spot is solved at each")
+
+
+def _machines(parsed: CellFile, path: Path, triangles: list[int]) -> tuple[tuple[MachineSpec, ...], tuple[ObjectSpec, ...]]:
     """Each machine and its door, a dynamic object closed in the schedule's windows."""
     if parsed.tending is None:
         return (), ()
@@ -710,7 +859,7 @@ def _machines(parsed: CellFile, path: Path) -> tuple[tuple[MachineSpec, ...], tu
         if windows[-1][1] > MAX_WINDOW_S:
             raise CellFileError(path, f"tending.machines[{i}].schedule", f"the last machining ends at "
                                 f"{windows[-1][1]:g} s, beyond a day ({MAX_WINDOW_S:g} s) of program time")
-        door = _object(m.door, path, f"tending.machines[{i}].door")
+        door = _object(m.door, path, f"tending.machines[{i}].door", triangles)
         doors.append(ObjectSpec(name=door.name, shape=door.shape, T_world_object=door.T_world_object,
                                 present=windows, door=True))
         machines.append(MachineSpec(m.name, door.name, windows))

@@ -62,8 +62,11 @@ class IkFile(_Strict):
 
 
 def _all_positive(v: list[float]) -> list[float]:
+    # Positive, and neither so small that a duration overflows nor so large that it is a placeholder.
     if any(x <= 0 for x in v):
         raise ValueError(f"every value must be > 0, got {v}")
+    if any(not 1e-3 <= x <= 1e9 for x in v):
+        raise ValueError(f"every value must lie in [1e-3, 1e9] (deg/s, deg/s^2, deg/s^3; m for a prismatic joint), got {v}")
     return v
 
 

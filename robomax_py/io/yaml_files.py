@@ -8,6 +8,7 @@ Shared by `cell_io` and `robot_io`, the only modules that know file keys.
 from __future__ import annotations
 
 import difflib
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -128,6 +129,58 @@ def load_yaml(text: str, path: Path, error: type[_LocatedError], what: str) -> A
         raise error(path, None, "not valid YAML: " + " ".join(str(exc).split())) from None
     except RecursionError:
         raise error(path, None, f"{what}: nested too deeply") from None
+
+
+@dataclass(slots=True)
+class _Open:
+    """A mapping or sequence being read (`count_items`): its key path (None inside a complex key)
+    and, for a mapping, whether its next node is a key and the key of the value being read."""
+
+    is_map: bool
+    path: tuple[str, ...] | None
+    want_key: bool = True
+    key: str | None = None
+
+
+def count_items(text: str, targets: tuple[tuple[str, ...], ...]) -> dict[tuple[str, ...], int] | None:
+    """The items of the sequences at `targets` (key paths; "*" stands for any item of a sequence,
+    e.g. ("seams", "*", "spots")), counted from libyaml's parser events without building the
+    document: a bound checked before the guarded reader composes a long list in Python, which is
+    25 times slower (a cell of 10,002 spots, 1.4 MB: 0.26 s of events, 6.4 s in Python). Aliases
+    count as one item each; a list reached only through an alias is not counted (the reader's own
+    checks see it). None when PyYAML has no libyaml or the text is not valid YAML (the reader
+    then says why)."""
+    if not getattr(yaml, "__with_libyaml__", False):
+        return None
+    counts = dict.fromkeys(targets, 0)
+    stack: list[_Open] = []
+    try:
+        for event in yaml.parse(text, Loader=yaml.CSafeLoader):
+            if isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
+                stack.pop()
+                continue
+            if not isinstance(event, (yaml.NodeEvent, yaml.CollectionStartEvent)):
+                continue                                  # stream and document events
+            parent = stack[-1] if stack else None
+            path: tuple[str, ...] | None = ()
+            if parent is not None and parent.is_map and parent.want_key:
+                parent.want_key = False
+                parent.key = event.value if isinstance(event, yaml.ScalarEvent) else None
+                path = None                               # inside a complex key: nothing counted
+                if not isinstance(event, yaml.CollectionStartEvent):
+                    continue
+            elif parent is not None and parent.is_map:
+                parent.want_key = True
+                path = None if parent.path is None or parent.key is None else (*parent.path, parent.key)
+            elif parent is not None:
+                path = None if parent.path is None else (*parent.path, "*")
+                if parent.path in counts:
+                    counts[parent.path] += 1
+            if isinstance(event, yaml.CollectionStartEvent):
+                stack.append(_Open(isinstance(event, yaml.MappingStartEvent), path))
+    except yaml.YAMLError:
+        return None
+    return counts
 
 
 def read_yaml_mapping(path: Path, error: type[_LocatedError], what: str, limit: int) -> dict[str, Any]:

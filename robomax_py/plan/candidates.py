@@ -15,6 +15,7 @@ from typing import Literal
 import numpy as np
 
 from robomax_py._typing import FloatArray, IntArray
+from robomax_py.errors import CellFileError
 from robomax_py.plan.poses import (
     OrientationGrid,
     approach_poses,
@@ -25,7 +26,13 @@ from robomax_py.plan.poses import (
 from robomax_py.robot import RobotModel, prismatic_mask
 from robomax_py.robot.ik import same_config
 from robomax_py.robot.ik.turns import wrap_to_pi
-from robomax_py.robot.solve import IkTable, config_text, solve_all
+from robomax_py.robot.solve import (
+    IkTable,
+    config_text,
+    ik_columns,
+    ik_table_bytes,
+    solve_all,
+)
 from robomax_py.spec import CellSpec, SeamSpec
 from robomax_py.transforms import invert
 from robomax_py.world.collision import CollisionWorld
@@ -41,6 +48,10 @@ BRANCH_JUMP_RAD = 0.2
 # candidates of a spot by ~16 and the sequencing time with them; 4 keeps every variant of a KUKA-class
 # arm (A4 and A6 beyond +-180 deg: at most 2 x 2).
 MAX_TURN_VARIANTS = 4
+# The most one IK table may take (bytes, `robot.solve.ik_table_bytes`): a seam's spots are solved in
+# batches of this size, and a cell one of whose spots alone would need more is refused. A seam of
+# 10,000 spots was solved as one table of 6.95 GiB.
+IK_TABLE_BUDGET_BYTES = 512 * 2**20
 
 
 RejectionKind = Literal["joint_limit", "approach_branch", "approach_joint_limit", "unreachable", "collision",
@@ -106,33 +117,65 @@ def seam_candidates(
     approach line is checked in (a pick-and-place stop's line carries the part)."""
     seam = cell.seams[seam_index]
     grid = orientation_grid(seam)
+    n_line = approach_samples(cell)
+    per_spot = spot_table_bytes(robot, len(grid.angles), n_line, cell, seam.name)
+    batch = max(1, IK_TABLE_BUDGET_BYTES // max(per_spot, 1))
     T_base_world = invert(np.asarray(cell.T_world_base))
-    T_spot = T_base_world @ spot_poses(seam.spots, grid)                    # (S, m, 4, 4)
-    n_line = max(2, int(np.ceil(cell.process.approach / APPROACH_SAMPLE_M)) + 1)
     fractions = np.linspace(1.0, 0.0, n_line)                               # approach point -> spot
-    T_line = np.stack([approach_poses(T_spot, cell.process.approach * f) for f in fractions], axis=2)
-    table = solve_all(robot, T_line)                                        # (S, m, L, B, n)
     checks = 0
     out: list[SpotCandidates] = []
-    for s in range(len(seam.spots)):
-        result, used = _spot_candidates(robot, world if line_world is None else line_world(s), seam, grid, s, table,
-                                        seam_index)
-        checks += used
-        out.append(_nearest_variants(result, table.branch, np.asarray(cell.home), robot, max_variants))
-        if on_spot is not None:
-            on_spot()
-    return out, CandidateStats(ik_poses=int(np.prod(T_line.shape[:-2])), collision_checks=checks)
+    for first in range(0, len(seam.spots), batch):
+        spots = seam.spots[first:first + batch]
+        T_spot = T_base_world @ spot_poses(spots, grid)                     # (S, m, 4, 4)
+        T_line = np.stack([approach_poses(T_spot, cell.process.approach * f) for f in fractions], axis=2)
+        table = solve_all(robot, T_line)                                    # (S, m, L, B, n)
+        for row in range(len(spots)):
+            s = first + row
+            result, used = _spot_candidates(robot, world if line_world is None else line_world(s), seam, grid, s,
+                                            table, seam_index, row)
+            checks += used
+            out.append(_nearest_variants(result, table.branch, np.asarray(cell.home), robot, max_variants))
+            if on_spot is not None:
+                on_spot()
+        del table, T_line
+    return out, CandidateStats(ik_poses=len(seam.spots) * len(grid.angles) * n_line, collision_checks=checks)
+
+
+def approach_samples(cell: CellSpec) -> int:
+    """L, the TCP poses solved along each approach line (ends included)."""
+    return max(2, int(np.ceil(cell.process.approach / APPROACH_SAMPLE_M)) + 1)
+
+
+def spot_table_bytes(robot: RobotModel, orientations: int, n_line: int, cell: CellSpec, seam: str) -> int:
+    """The IK table memory of one spot of a seam (bytes); CellFileError when it alone exceeds
+    IK_TABLE_BUDGET_BYTES (the cell's seam grid or approach length ask too much of this robot)."""
+    need = ik_table_bytes(robot, orientations * n_line)
+    if need > IK_TABLE_BUDGET_BYTES:
+        raise CellFileError(
+            cell.source, "seams", f"seam {seam}: one spot's IK table would take {need / 2**30:.2f} GiB "
+            f"({orientations:,} orientations x {n_line:,} approach samples x {ik_columns(robot):,} IK columns of "
+            f"{robot.name}), more than the {IK_TABLE_BUDGET_BYTES / 2**30:.2f} GiB one table may take; "
+            "lower the seam's grid or process.approach")
+    return need
+
+
+def check_ik_work(cell: CellSpec, robot: RobotModel) -> None:
+    """Refuse, before planning, a cell one of whose spots' IK tables alone exceeds the budget."""
+    for seam in cell.seams:
+        spot_table_bytes(robot, len(orientation_grid(seam).angles), approach_samples(cell), cell, seam.name)
 
 
 def _spot_candidates(
     robot: RobotModel, world: CollisionWorld, seam: SeamSpec, grid: OrientationGrid,
-    s: int, table: IkTable, seam_index: int,
+    s: int, table: IkTable, seam_index: int, row: int | None = None,
 ) -> tuple[SpotCandidates, int]:
-    q = table.q[s]                             # (m, L, B, n)
-    valid = table.valid[s]                     # (m, L, B)
-    status = table.status[s]
-    turn = table.turn[s]
-    reachable = table.reachable[s]             # a branch exists before limit filtering
+    """Spot s of the seam, row `row` of its batch's IK table (default: row s, a table of the whole seam)."""
+    row = s if row is None else row
+    q = table.q[row]                           # (m, L, B, n)
+    valid = table.valid[row]                   # (m, L, B)
+    status = table.status[row]
+    turn = table.turn[row]
+    reachable = table.reachable[row]           # a branch exists before limit filtering
     limits = robot.limits
     revolute = ~prismatic_mask(robot.model)
     rejected: Counter[Rejection] = Counter()

@@ -16,7 +16,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from robomax_py.plan.candidates import SpotCandidates, seam_candidates
+from robomax_py.plan.candidates import SpotCandidates, check_ik_work, seam_candidates
 from robomax_py.plan.graph import Sequencer
 from robomax_py.plan.loads import Loads, check_carried_motion
 from robomax_py.plan.results import (
@@ -56,6 +56,7 @@ def plan_cell(
 ) -> PlanResult:
     """Plan a cell whose robot (with its tool mounted) is given; `progress` hears of each stage's advance."""
     options = resolved_options(cell, options)
+    check_ik_work(cell, robot)              # before anything large is built
     clock: dict[str, float] = {}
     t0 = time.perf_counter()
     full_world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)

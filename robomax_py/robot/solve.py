@@ -150,6 +150,34 @@ def solve_all(
     )
 
 
+# Bytes `solve_all` may hold for one table column of one pose, per joint value and per flag: the
+# table (q float64; valid, reachable bool; status, turn int64) and, for temporaries (the solver's
+# arrays before the turn variants are expanded, `np.where` copies), as much again.
+_COLUMN_BYTES_PER_JOINT = 2 * 8
+_COLUMN_BYTES_FLAGS = 2 * (1 + 1 + 8 + 8)
+
+
+def ik_columns(robot: RobotModel) -> int:
+    """B, the number of columns `solve_all` returns per pose: branches times turn variants."""
+    model = robot.model
+    params = robot.ik_params
+    if robot.ik_solver in ("opw", "ur"):
+        branches = 8
+    elif isinstance(params, (NumericIkParams, TableIkParams)):
+        branches = 8 if _has_status(model, robot.flange_frame_id) else params.solutions
+    else:
+        branches = 8
+    variants = turn_shifts(np.asarray(robot.limits.lower, dtype=float), np.asarray(robot.limits.upper, dtype=float),
+                           revolute_mask(model))
+    return branches * variants.count
+
+
+def ik_table_bytes(robot: RobotModel, poses: int) -> int:
+    """An estimate (from above) of the memory `solve_all` takes for `poses` TCP poses, bytes."""
+    per_pose = ik_columns(robot) * (int(robot.model.nq) * _COLUMN_BYTES_PER_JOINT + _COLUMN_BYTES_FLAGS)
+    return int(poses) * per_pose
+
+
 def _has_status(model: Any, frame_id: int) -> bool:
     chain = chain_to_frame(model, frame_id)
     return len(chain.joints) >= 5 and bool(np.all(chain.revolute[:5]))

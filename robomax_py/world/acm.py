@@ -17,6 +17,10 @@ Allowed-collision matrix (pairs never checked), deterministic for a given `Colli
   are within `flange_contact_m` of each other in *every* sampled configuration (the gun's mounting
   plate sits on the wrist at the flange). A tool piece that only sometimes touches that link stays
   checked: that contact is the gun swinging into the wrist.
+- "out of reach": robot/tool pieces vs an obstacle piece farther from the arm's first joint than
+  any robot or tool point can ever be, plus the pair's margin (`reach_spheres`, a bound from the
+  joint offsets and the pieces' extents): no configuration can come within the margin of it, so
+  its pairs would only cost every check and every clearance measurement.
 - "never close": self pairs (robot/tool vs robot/tool) that can never touch, *proved*, not guessed.
   First `acm_samples` seeded random configurations (half uniform within the joint limits, half with
   each joint at a limit with probability 1/2): a pair within `acm_margin` (2 cm), or colliding, in
@@ -39,7 +43,7 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.robot import RobotModel
-from robomax_py.world.bounds import KinematicBounds, joint_path
+from robomax_py.world.bounds import KinematicBounds, joint_path, support_points
 from robomax_py.world.prefilter import Prefilter
 from robomax_py.world.scene import Scene, SceneObject
 
@@ -172,7 +176,8 @@ def _pieces(robot: RobotModel, scene: Scene) -> tuple[pin.GeometryModel, list[Pi
     return gm, pieces, obstacles
 
 
-def _classify_pairs(robot: RobotModel, scene: Scene, pieces: list[Piece], obstacles: tuple[Any, ...]) -> _PairRules:
+def _classify_pairs(robot: RobotModel, scene: Scene, pieces: list[Piece], obstacles: tuple[Any, ...],
+                    far: set[int]) -> _PairRules:
     model = robot.model
     flange = model.frames[scene.flange_frame_id]
     rules = _PairRules()
@@ -194,6 +199,8 @@ def _classify_pairs(robot: RobotModel, scene: Scene, pieces: list[Piece], obstac
                 elif rob.joint == 0:
                     disabled.append(DisabledPair(pa.name, pb.name, "fixed base"))
                     base_obstacle.append((a, b))
+                elif (b if pb.kind in OBSTACLE_KINDS else a) in far:
+                    disabled.append(DisabledPair(pa.name, pb.name, "out of reach"))
                 else:
                     obstacle_pairs.append((a, b))
                 continue
@@ -221,7 +228,7 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
     model = robot.model
     gm, pieces, obstacles = _pieces(robot, scene)
     n_geom = len(pieces)
-    rules = _classify_pairs(robot, scene, pieces, obstacles)
+    rules = _classify_pairs(robot, scene, pieces, obstacles, _out_of_reach(model, gm, pieces, max(clearance, 0.0)))
     disabled, obstacle_pairs, self_candidates = rules.disabled, rules.obstacle_pairs, rules.self_candidates
     flange_candidates, base_obstacle = rules.flange_candidates, rules.base_obstacle
 
@@ -299,6 +306,54 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
         layout_contacts=_layout_contacts(gm, pieces, base_obstacle),
         prefilter=Prefilter.of(model, gm, [p.kind in OBSTACLE_KINDS for p in pieces], pair_a, pair_b, pair_margin),
     )
+
+
+# Added to the reach bound before an obstacle is left out: rounding, and GJK's own tolerance.
+OUT_OF_REACH_SLACK_M = 1e-3
+
+
+def reach_spheres(model: pin.Model, gm: pin.GeometryModel, moving: list[bool]) -> list[tuple[FloatArray, float]]:
+    """Spheres (centre in the base frame, m; radius, m) that hold every point of the moving pieces
+    in every configuration within the limits: one per joint attached to the base (the first
+    axis), centred on its origin, with radius the sum of the joint offsets down to each piece,
+    the travel of prismatic joints and the piece's farthest point from its joint (triangle
+    inequality). Empty when a moving piece hangs on no such joint."""
+    bounds = KinematicBounds.of(model)
+    spheres: dict[int, float] = {}
+    for g, is_moving in zip(gm.geometryObjects, moving):
+        j = int(g.parentJoint)
+        if not is_moving or j == 0:
+            continue
+        path = joint_path(model, 0, j)
+        if not path:
+            return []
+        root = path[0]
+        pts = support_points(g.geometry, g.placement.homogeneous)
+        radius = (float(np.max(np.linalg.norm(pts, axis=1))) + float(bounds.travel[root])
+                  + sum(float(np.linalg.norm(model.jointPlacements[m].translation)) + float(bounds.travel[m])
+                        for m in path[1:]))
+        spheres[root] = max(spheres.get(root, 0.0), radius)
+    return [(np.asarray(model.jointPlacements[r].translation, dtype=float), rad) for r, rad in sorted(spheres.items())]
+
+
+def _out_of_reach(model: pin.Model, gm: pin.GeometryModel, pieces: list[Piece], margin: float) -> set[int]:
+    """Obstacle pieces (indices) whose bounding box is farther than reach + margin from the centre
+    of every reach sphere: no robot or tool point can come within the margin of them."""
+    moving = [p.kind in ROBOT_KINDS for p in pieces]
+    spheres = reach_spheres(model, gm, moving)
+    if not spheres:
+        return set()
+    far = set()
+    for k, piece in enumerate(pieces):
+        if piece.kind not in OBSTACLE_KINDS:
+            continue
+        g = gm.geometryObjects[k]
+        pts = support_points(g.geometry, g.placement.homogeneous)
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        if all(float(np.linalg.norm(np.maximum(np.maximum(lo - c, c - hi), 0.0))) > r + margin + OUT_OF_REACH_SLACK_M
+               for c, r in spheres):
+            far.add(k)
+    return far
 
 
 def acm_samples(robot: RobotModel, count: int, seed: int) -> FloatArray:

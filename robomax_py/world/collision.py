@@ -375,6 +375,12 @@ class CollisionWorld:
             return Proximity(distance=math.inf, pair=None)
         return Proximity(distance=float(self._gdata.distanceResults[idx].min_distance), pair=self._contact(idx))
 
+    def active_pairs(self, t: float | None = None) -> BoolArray:
+        """(p,) bool: which enabled pairs count at time t (a dynamic obstacle's pairs only while it is
+        present; None: every obstacle present), in the indexing of `pair_distances`."""
+        self._set_presence(t, t)
+        return np.asarray(self._active, dtype=bool).copy()
+
     def pair_distances(self, q: FloatArray, pairs: IntArray) -> FloatArray:
         """Distances (m) of the enabled pairs `pairs` (indices into `geometry_model.collisionPairs`)
         at q, every dynamic obstacle present; each as `closest` computes it."""

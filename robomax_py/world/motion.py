@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomax_py._typing import FloatArray
+from robomax_py._typing import FloatArray, IntArray
 from robomax_py.robot import JointLimits, RobotModel
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision import CollisionWorld
@@ -83,7 +83,20 @@ def check_motion(
     checks = 0
     limit = 1 if stop_at_first else max_collisions
     collisions: list[Violation] = []
+    rest_end = _rest_ends(q)
+    skip_to = 0
     for i in range(len(t) - 1):
+        if i < skip_to:
+            continue
+        j = int(rest_end[i])
+        if j > i + 1:
+            # A rest (a long weld or wait): one configuration among the obstacles present at any
+            # time of it, checked once; sample by sample only where that finds a collision.
+            res = world.check_segment(q[i], q[i], float(t[i]), float(t[j]))
+            checks += res.checks
+            if res.free:
+                skip_to = j
+                continue
         res = world.check_segment(q[i], q[i + 1], float(t[i]), float(t[i + 1]))
         checks += res.checks
         if res.free:
@@ -103,6 +116,20 @@ def check_motion(
             break
     out.extend(collisions)
     return MotionCheck(tuple(out), checks)
+
+
+def _rest_ends(q: FloatArray) -> IntArray:
+    """For each sample i, the last sample j >= i of the rest it starts: samples i..j all within
+    REST_Q_TOL_RAD of sample i (j = i where the robot moves on)."""
+    n = len(q)
+    out = np.arange(n)
+    if n < 2:
+        return out
+    still = np.abs(np.diff(q, axis=0)).max(axis=1) <= REST_Q_TOL_RAD
+    for i in range(n - 2, -1, -1):
+        if still[i] and float(np.abs(q[int(out[i + 1])] - q[i]).max()) <= REST_Q_TOL_RAD:
+            out[i] = out[i + 1]
+    return out
 
 
 def rate_violations(lim: JointLimits, names: tuple[str, ...], t: FloatArray, q: FloatArray,
@@ -152,16 +179,15 @@ class Clearance:
     between: str
 
 
+# Samples of a rest this close to each other (rad) are one configuration: interpolating a rest
+# moves no point farther than the lever arms (a few m) times this.
+REST_Q_TOL_RAD = 1e-12
+
+
 def min_clearance(world: CollisionWorld, t: FloatArray, q: FloatArray) -> Clearance | None:
     """The smallest distance over the samples of a motion, refined on the steps either side of
     the closest sample (10 sub-steps each); None when no pair is checked."""
-    best_i, best = (0, math.inf) if world.has_dynamic else _closest_sample(world, q)
-    if world.has_dynamic:
-        # Obstacles that come and go change distances without motion: every sample, every pair.
-        for i in range(len(t)):
-            d = world.closest(q[i], float(t[i])).distance
-            if d < best:
-                best_i, best = i, d
+    best_i, best = _closest_sample(world, q, t if world.has_dynamic else None)
     if not math.isfinite(best):
         return None
     best_t, best_q = float(t[best_i]), q[best_i]
@@ -178,14 +204,18 @@ def min_clearance(world: CollisionWorld, t: FloatArray, q: FloatArray) -> Cleara
     return Clearance(float(best), best_t, between)
 
 
-def _closest_sample(world: CollisionWorld, q: FloatArray) -> tuple[int, float]:
-    """The first sample of the least distance over every enabled pair, and that distance (static scene).
+def _closest_sample(world: CollisionWorld, q: FloatArray, t: FloatArray | None = None) -> tuple[int, float]:
+    """The first sample of the least distance over every enabled pair, and that distance.
 
     A pair is computed again only where the motion since it was last computed could have brought
     it below the best so far: no point moves farther than `sweep_length`, so a pair's distance
     shrinks by at most its approach factor times the sweep (1 against a static obstacle, 2 between
     two moving bodies). The answer is the minimum over every pair and sample, exactly as computing
     them all; the closest few pairs are computed at most samples, the rest rarely.
+
+    With `t` (a scene whose obstacles come and go), only the pairs counting at each sample's time
+    are candidates there: a dynamic obstacle stands still while present, so the bound holds for
+    its pairs across its absences too (their distances are geometry, not time).
     """
     n_pairs = world.n_pairs
     if n_pairs == 0 or len(q) == 0:
@@ -195,10 +225,14 @@ def _closest_sample(world: CollisionWorld, q: FloatArray) -> tuple[int, float]:
     everything = np.arange(n_pairs)
     last = world.pair_distances(q[0], everything)              # distance of each pair where last computed
     where = np.repeat(np.asarray(q[:1], dtype=float), n_pairs, axis=0)
-    best_i, best = 0, float(np.min(last))
+    counts = world.active_pairs(float(t[0])) if t is not None else np.ones(n_pairs, dtype=bool)
+    best_i, best = 0, float(np.min(last[counts])) if counts.any() else math.inf
     for i in range(1, len(q)):
         bound = last - factor * (np.abs(q[i] - where) @ lever)
-        due = np.flatnonzero(bound < best)
+        wanted = bound < best
+        if t is not None:
+            wanted &= world.active_pairs(float(t[i]))
+        due = np.flatnonzero(wanted)
         if not len(due):
             continue
         d = world.pair_distances(q[i], due)

@@ -38,6 +38,10 @@ class Served:
         return self.proc.returncode, rest.decode("utf-8", "replace")
 
 
+def _default_interrupt() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _free_port(host: str = "127.0.0.1") -> int:
     with socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET) as probe:
         probe.bind((host, 0))
@@ -73,8 +77,11 @@ def serve_preview(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Callable
         env["PYTHONPATH"] = os.pathsep.join([str(REPO), *[p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]])
         err = tmp_path / f"preview_{len(started)}.err"
         with err.open("wb") as err_out:
+            # Ctrl-C as a terminal delivers it: a shell's background job (and so a test run started
+            # with `&`) inherits SIGINT ignored, and Python then never raises KeyboardInterrupt.
             proc = subprocess.Popen([sys.executable, "-m", "robomax_py", "preview", str(cell), *args],
-                                    stdout=subprocess.PIPE, stderr=err_out, env=env, start_new_session=True)
+                                    stdout=subprocess.PIPE, stderr=err_out, env=env, start_new_session=True,
+                                    preexec_fn=_default_interrupt)
         started.append(proc)
         assert proc.stdout is not None
         for raw in proc.stdout:                # ends when the command exits without a URL

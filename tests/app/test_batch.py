@@ -79,8 +79,9 @@ def test_batch_statuses_in_argument_order_and_exit_2_for_a_bad_file(batch_run: B
 
 
 def test_batch_writes_programs_of_planned_cells_only_and_a_markdown_table(batch_run: Batch) -> None:
-    names = sorted(p.name for p in batch_run.out.iterdir())
-    assert names == ["cell_a.json", "cell_a.srcl", "cell_b.json", "cell_b.srcl", "summary.csv", "summary.md"]
+    names = sorted(p.name for p in batch_run.out.iterdir() if not p.name.startswith("."))
+    assert names == ["cell_a.json", "cell_a.manifest.json", "cell_a.srcl", "cell_b.json", "cell_b.manifest.json",
+                     "cell_b.srcl", "summary.csv", "summary.md"]
     md = (batch_run.out / "summary.md").read_text().splitlines()
     table = [line for line in md if line.startswith("|")]
     assert table[0].split("|")[1:4] == [" cell ", " file ", " status "]
@@ -91,8 +92,10 @@ def test_batch_writes_programs_of_planned_cells_only_and_a_markdown_table(batch_
 def test_batch_programs_equal_plan_programs_byte_for_byte(batch_run: Batch, tmp_path: Path) -> None:
     result = runner.invoke(app, ["plan", batch_run.files[0], "-o", str(tmp_path)])
     assert result.exit_code == EXIT_OK, result.output
-    for ext in (".json", ".srcl"):
+    # The same set, written the same way: its manifest (the cell file's digest, each file's sha256) too.
+    for ext in (".json", ".srcl", ".manifest.json"):
         assert (tmp_path / f"cell_a{ext}").read_bytes() == (batch_run.out / f"cell_a{ext}").read_bytes()
+        assert (batch_run.out / f"cell_a{ext}").is_symlink()
 
 
 def test_missing_cell_file_exits_2_up_front_and_plans_nothing(batch_run: Batch, tmp_path: Path) -> None:

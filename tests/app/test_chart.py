@@ -68,7 +68,8 @@ def test_plan_plot_writes_the_png_beside_the_program(tmp_path: Path, write_small
     out = tmp_path / "programs"
     result = runner.invoke(app, ["plan", str(cell), "-o", str(out), "--plot", "--json"])
     assert result.exit_code == EXIT_OK, result.output
-    assert sorted(p.name for p in out.iterdir()) == ["small_cell.json", "small_cell.png", "small_cell.srcl"]
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
+        "small_cell.json", "small_cell.manifest.json", "small_cell.png", "small_cell.srcl"]
     assert str(out / "small_cell.png") in json.loads(result.output)["files"]
     with Image.open(out / "small_cell.png") as png:
         assert png.format == "PNG" and png.size[0] > 500 and png.size[1] > 150

@@ -76,7 +76,11 @@ def test_plan_small_cell_writes_the_trajectory(tmp_path: Path, write_small_cell:
     result = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
     assert result.exit_code == EXIT_OK, result.output
     check_trajectory_file(out / "small.json", 2, [0, -90, 90, 0, 0, 0], 0.5)
-    assert sorted(p.name for p in out.iterdir()) == ["small.json", "small.srcl"]   # no temporary files left
+    # The set's links and manifest; hidden, its pointer and its one folder (no temporary files left).
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
+        "small.json", "small.manifest.json", "small.srcl"]
+    hidden = sorted(p.name for p in out.iterdir() if p.name.startswith("."))
+    assert len(hidden) == 2 and hidden[0] == ".small.robomax-set", hidden
 
 
 @pytest.mark.slow

@@ -9,6 +9,13 @@ plus `Issue`s: statements outside the modelled subset (``unsupported``), control
 an issue the model goes on with the next statement, as straight-line execution would; a run with
 issues is not a faithful model of the controller and tests must say so.
 
+Flow, in every dialect's model: the run stops at an end of the program or at a pause that waits
+for the operator (`ProgramRun.stopped`); an unconditional jump goes forward to its label in the
+same routine (a jump back repeats what ran, without end: an issue, and the run stops there); a
+call of a routine the texts define, without arguments, runs its body where it is called (a call
+with arguments is recorded as a `Call`, as are calls of routines the texts do not give).
+Conditions are not evaluated: IF, loops and the like stay ``unsupported``.
+
 Units: every matrix is 4x4 in metres; joint values stay in degrees as the controller counts them
 (``joints_deg``); configuration data stays as written.
 
@@ -232,6 +239,10 @@ class ProgramRun:
     events: tuple[Event, ...]
     issues: tuple[Issue, ...]
     j23_coupling: bool = False   # FANUC: joint positions count J3 from the horizontal (see fanuc.py)
+    # Where the program stopped before its last statement: an end (RETURN of the main routine,
+    # EXIT, ABORT, halt()) or a pause that waits for the operator (HALT, Stop, PAUSE), after which
+    # nothing runs in the cycle; None when it ran to its end.
+    stopped: Where | None = None
 
     @property
     def motions(self) -> tuple[Motion, ...]:

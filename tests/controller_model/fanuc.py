@@ -27,8 +27,10 @@ fanuc_joint_streamer_node.cpp 73-74, launch files ``J23_factor`` = 1).
   position's own frames.
 - Motion lines ``J|L P[n] speed FINE|CNTk [ACCk] [SPOT[...]]``; FINE is a stop point. A SpotTool
   ``SPOT[SD=..,P=..,S=..,ED=..]`` option welds at the position: a call after the motion.
-- ``CALL name(args)`` (recorded, not followed; a call of a given program that moves is reported),
-  ``WAIT t(sec)``, ``WAIT DI[k]=ON|OFF``, ``WAIT (DI[k])`` and ``WAIT (!DI[k])``.
+- ``CALL name`` of a program given as `called` runs it (`_Flow`: END, ABORT, PAUSE, JMP LBL[n]
+  too); other calls ``CALL name(args)`` are recorded, not followed (a call of a given program
+  that moves is reported), ``WAIT t(sec)``, ``WAIT DI[k]=ON|OFF``, ``WAIT (DI[k])`` and
+  ``WAIT (!DI[k])``.
 - J2/J3 interaction: on arms whose J3 is measured from the horizontal, J3 as the controller counts
   it is J3_urdf - J2_urdf for the ROS-I URDF convention (J3 turning about -y): the driver sends
   ``J3 - J23_factor·J2`` to the controller with ``J23_factor = 1`` for all but the M-430iA
@@ -134,7 +136,8 @@ def run_fanuc(program: str, *, name: str = "program.ls", setup: Mapping[str, str
         Programs run before on the same controller (e.g. ``<NAME>_FRAMES.ls``): their register and
         frame assignments and frame selections are kept; their motions and calls are issues.
     called : mapping of name to .ls text, optional
-        Other programs on the controller; a CALL of one that moves is reported (calls are not followed).
+        Other programs on the controller; a CALL of one without arguments runs it, a CALL of one
+        that moves with arguments is reported (calls with arguments are not followed).
     uframes, utools : mapping of int to (4, 4) float, optional
         Frames stored on the controller (metres), before the setup programs run. 0 is always the
         identity (world = robot base; faceplate).
@@ -148,15 +151,99 @@ def run_fanuc(program: str, *, name: str = "program.ls", setup: Mapping[str, str
                    uframe_num=uframe_num, utool_num=utool_num)
     for setup_name, text in (setup or {}).items():
         mark = len(state.events)
-        _run(text, setup_name, state, set())
+        _Flow(state, set(), {}).run(text, setup_name)
         for event in state.events[mark:]:
             state.issues.append(Issue(event.where, "unsupported", "", "a setup program may only assign registers "
                                       "and frames"))
         del state.events[mark:]
     moving = {n for n, text in (called or {}).items() if _moves(text)}
     moving |= {_prog_name(text) for text in (called or {}).values() if _moves(text)}
-    _run(program, name, state, moving)
-    return ProgramRun("fanuc", tuple(state.events), tuple(state.issues), j23_coupling=j23_coupling)
+    programs = {_prog_name(text): (n, text) for n, text in (called or {}).items()}
+    flow = _Flow(state, moving, programs)
+    flow.run(program, name)
+    return ProgramRun("fanuc", tuple(state.events), tuple(state.issues), j23_coupling=j23_coupling,
+                      stopped=flow.stopped)
+
+
+class _Stop(Exception):
+    """The program stops: an end, a pause, or a jump that repeats without end."""
+
+
+@dataclass(slots=True)
+class _Flow:
+    """TP program control (public TP grammar JTremblayAGT/fanuc-lsp @ b0e9a1ea TPLangParser/TPLang/
+    Instructions/TpBranchingInstruction.cs 8-57 and TpProgControlInstruction.cs 20-26; RoboDK's
+    R-30iA post, ros-industrial-attic/robodk_postprocessors @ d7e6c1c0 Fanuc_R30iA.py 405-410 and
+    474-479): ``END`` ends the program (a called program returns to its caller), ``ABORT`` ends it,
+    ``PAUSE`` stops it until it is started again; ``JMP LBL[n]`` continues at ``LBL[n]``; ``CALL
+    name`` runs the program name (here: one of `called`, without arguments; the others are
+    recorded)."""
+
+    state: _State
+    moving: set[str]
+    programs: dict[str, tuple[str, str]]          # /PROG name -> (file name, text)
+    stopped: Where | None = None
+
+    def run(self, text: str, source: str) -> None:
+        try:
+            self._program(text, source, [])
+        except _Stop:
+            pass
+
+    def _program(self, text: str, source: str, stack: list[str]) -> None:
+        positions = _positions(text, source)
+        lines = _main_lines(text, source)
+        labels = {m.group(1): i for i, ln in enumerate(lines)
+                  if (m := re.fullmatch(r"LBL\[\s*(\d+)\s*(?::[^\]]*)?\]", ln.code, re.IGNORECASE))}
+        depth = 0                  # of IF ... THEN and FOR: their bodies run straight through, reported
+        i = 0
+        while i < len(lines):
+            line, code = lines[i], lines[i].code
+            if line.number is None:
+                self.state.issue(line, "unsupported", "point logic / nested statement of a motion is not modelled")
+                i += 1
+                continue
+            word = code.upper()
+            if re.match(r"^IF\b.*\bTHEN$|^FOR\b", code, re.IGNORECASE):
+                depth += 1
+            elif word in ("ENDIF", "ENDFOR"):
+                depth = max(0, depth - 1)
+            elif depth and (word in ("END", "ABORT", "PAUSE") or word.startswith("JMP")):
+                self.state.issue(line, "unsupported", "an end or a jump under a condition: conditions are not evaluated")
+                i += 1
+                continue
+            if word == "END" and stack:
+                return
+            if word in ("END", "ABORT", "PAUSE"):
+                self.stopped = line.where
+                raise _Stop
+            jump = re.fullmatch(r"JMP\s+LBL\[\s*(\d+)\s*(?::[^\]]*)?\]", code, re.IGNORECASE)
+            if jump:
+                target = labels.get(jump.group(1))
+                if target is None:
+                    self.state.issue(line, "undefined", f"no LBL[{jump.group(1)}] in the program")
+                elif target <= i:
+                    self.state.issue(line, "unsupported", "a jump back: the statements from its label repeat")
+                    self.stopped = line.where
+                    raise _Stop
+                else:
+                    i = target
+                    continue
+                i += 1
+                continue
+            call = re.fullmatch(r"CALL\s+(\w+)", code, re.IGNORECASE)
+            if call and call.group(1).upper() in self.programs:
+                name = call.group(1).upper()
+                if name in stack or name == _prog_name(text):
+                    self.state.issue(line, "unsupported", f"{call.group(1)} calls itself: without end")
+                    self.stopped = line.where
+                    raise _Stop
+                file, called = self.programs[name]
+                self._program(called, file, [*stack, _prog_name(text)])
+                i += 1
+                continue
+            _execute(line, positions, self.state, self.moving)
+            i += 1
 
 
 def _prog_name(text: str) -> str:
@@ -281,15 +368,6 @@ _INERT = re.compile(r"^(R\[|DO\[|RO\[|GO\[|AO\[|F\[|M\[|TIMER\[|PAYLOAD\[|OVERRI
                     r"MESSAGE\[|JOINT_MAX_SPEED\[|LINEAR_MAX_SPEED\s*=|TIMER_OVERFLOW)", re.IGNORECASE)
 _TARGET_OPTIONS = re.compile(r"^(Offset|Tool_Offset|INC|VOFFSET|Skip|RTCP|COORD|EV|Ind\.EV|PSPD|TIME\s+BEFORE|"
                              r"TIME\s+AFTER|DISTANCE\s+BEFORE)", re.IGNORECASE)
-
-
-def _run(text: str, source: str, state: _State, moving: set[str]) -> None:
-    positions = _positions(text, source)
-    for line in _main_lines(text, source):
-        if line.number is None:
-            state.issue(line, "unsupported", "point logic / nested statement of a motion is not modelled")
-            continue
-        _execute(line, positions, state, moving)
 
 
 def _execute(line: _Line, positions: dict[int, _Position], state: _State, moving: set[str]) -> None:

@@ -32,8 +32,10 @@ KRC/R1/Mada/$machine.dat; CHINA = HugoDanielson/ChinaMilling @ 04c963fe, KSS 8.3
   none = exact stop. A partial aggregate (missing components are taken from the current position)
   is reported.
 - ``WAIT SEC t``; ``WAIT FOR $IN[k]`` (``==TRUE``/``==FALSE``/``NOT``) or a name declared by
-  ``SIGNAL name $IN[k]``. Subroutine calls are recorded (name, args), not followed; a call of a
-  routine given in the texts that moves or changes frames is reported.
+  ``SIGNAL name $IN[k]``. A call of a DEF of the .src without parameters runs its body (`_Flow`:
+  RETURN, HALT, GOTO and jump labels too); other subroutine calls are recorded (name, args), not
+  followed, and a call with arguments of a routine given in the texts that moves or changes
+  frames is reported.
 
 Outside this subset (control flow, relative and spline motions, CIRC, offsets and geometric
 operators, $ROBROOT or $IPO_MODE changes, interrupts other than the template's stop-message
@@ -85,6 +87,8 @@ _UNSUPPORTED_MOTION = re.compile(
     r"^(PTP_REL|LIN_REL|CIRC|CIRC_REL|SPTP|SPTP_REL|SLIN|SLIN_REL|SCIRC|SCIRC_REL|SPL|SPLINE|ENDSPLINE|"
     r"PTP_SPLINE|ENDPTP_SPLINE|TIME_BLOCK|CONST_VEL)\b", re.IGNORECASE)
 _DECL_TYPES = r"INT|REAL|BOOL|CHAR|FRAME|POS|E6POS|AXIS|E6AXIS|FDAT|PDAT|LDAT|LOAD|STRUC|ENUM"
+_OPENS = re.compile(r"^(IF\b.*\bTHEN|WHILE\b.*|FOR\b.*|LOOP|REPEAT|SWITCH\b.*)$", re.IGNORECASE)
+_CLOSES = re.compile(r"^(ENDIF|ENDWHILE|ENDFOR|ENDLOOP|UNTIL\b.*|ENDSWITCH)$", re.IGNORECASE)
 
 
 @dataclass(slots=True)
@@ -159,11 +163,97 @@ def run_krl(src: str, dat: str = "", *, src_name: str = "program.src", dat_name:
         where = Where(src_name, 1)
         state.issues.append(Issue(where, "unsupported", "", "no DEF routine in the .src"))
         return ProgramRun("krl", (), tuple(state.issues))
-    first = next(iter(routines.values()))
-    moving = {name for name, (a, b) in routines.items() if _moves(lines[a + 1:b])}
-    for line in lines[first[0] + 1:first[1]]:
-        _execute(line, state, moving)
-    return ProgramRun("krl", tuple(state.events), tuple(state.issues))
+    first = next(iter(routines))
+    moving = {name for name, (a, b) in routines.items() if _moves(lines[a + 1:b]) and _params(lines[a])}
+    flow = _Flow(lines, routines, state, moving)
+    flow.run(first, [])
+    return ProgramRun("krl", tuple(state.events), tuple(state.issues), stopped=flow.stopped)
+
+
+def _params(head: _Line) -> bool:
+    """Whether a DEF line declares parameters."""
+    m = _DEF_RE.match(head.code)
+    return bool(m and m.group(2).strip())
+
+
+class _Stop(Exception):
+    """The program stops: an end, a pause, or a jump that repeats without end."""
+
+
+@dataclass(slots=True)
+class _Flow:
+    """KSS 8.3 Operating and Programming Instructions for System Integrators, program execution
+    control: ``GOTO label`` continues at ``label:`` in the same routine; ``RETURN`` returns from a
+    subprogram and ends the main program; ``HALT`` stops the program until it is started again
+    (RoboDK's KRC4 post, ros-industrial-attic/robodk_postprocessors @ d7e6c1c0 KUKA_KRC4.py 281-286
+    and 345-354, writes ``HALT`` to pause a program and ``START_TIMER:`` / ``GOTO START_TIMER``); a
+    subprogram call ``name()`` runs the DEF ``name`` of the file."""
+
+    lines: list[_Line]
+    routines: dict[str, tuple[int, int]]
+    state: _State
+    moving: set[str]
+    stopped: Where | None = None
+
+    def run(self, name: str, stack: list[str]) -> None:
+        try:
+            self._body(name, stack)
+        except _Stop:
+            pass
+
+    def _body(self, name: str, stack: list[str]) -> None:
+        a, b = self.routines[name]
+        body = self.lines[a + 1:b]
+        labels = {m.group(1).upper(): i for i, ln in enumerate(body) if (m := re.fullmatch(r"(\w+)\s*:", ln.code))}
+        depth = 0                  # of IF, loops, SWITCH: their bodies run straight through, reported
+        i = 0
+        while i < len(body):
+            line, code = body[i], body[i].code
+            if _OPENS.match(code):
+                depth += 1
+            elif _CLOSES.match(code):
+                depth = max(0, depth - 1)
+            elif depth and re.fullmatch(r"RETURN|HALT|GOTO\s+\w+", code, re.IGNORECASE):
+                self.state.issue(line, "unsupported", "an end or a jump under a condition: conditions are not evaluated")
+                i += 1
+                continue
+            if re.fullmatch(r"RETURN", code, re.IGNORECASE):
+                if stack:
+                    return
+                self.stopped = line.where
+                raise _Stop
+            if re.fullmatch(r"HALT", code, re.IGNORECASE):
+                self.stopped = line.where
+                raise _Stop
+            jump = re.fullmatch(r"GOTO\s+(\w+)", code, re.IGNORECASE)
+            if jump:
+                target = labels.get(jump.group(1).upper())
+                if target is None:
+                    self.state.issue(line, "undefined", f"no jump label {jump.group(1)} in the routine")
+                elif target <= i:
+                    self.state.issue(line, "unsupported", "a jump back: the statements from its label repeat")
+                    self.stopped = line.where
+                    raise _Stop
+                else:
+                    i = target
+                    continue
+                i += 1
+                continue
+            if re.fullmatch(r"\w+\s*:", code):
+                i += 1
+                continue
+            call = _CALL_RE.match(code)
+            callee = call.group(1).upper() if call else ""
+            if call and callee in self.routines and not call.group(2).strip() and not _params(self.lines[self.routines[callee][0]]):
+                if callee in stack or callee == name:
+                    self.state.issue(line, "unsupported", f"{call.group(1)} calls itself: without end")
+                    self.stopped = line.where
+                    raise _Stop
+                self._body(callee, [*stack, name])
+                i += 1
+                continue
+            _execute(line, self.state, self.moving)
+            i += 1
 
 
 # --------------------------------------------------------------------------------------- structure

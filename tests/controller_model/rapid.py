@@ -26,9 +26,10 @@ abb_rapid_msgs/msg/RobTarget.msg, WObjData.msg, ToolData.msg, ConfData.msg).
   along a linear path and perform a spot welding at the end position") are read with ToPoint the
   first and Tool the last positional argument (the exact argument list is UNCONFIRMED): a stop
   motion followed by a call.
-- WaitTime [\InPos,] Time; WaitDI Signal, Value; procedure calls ``Name arg, ...;`` are recorded,
-  not followed (a call of a procedure given in the texts that moves is reported). Data may be
-  declared in any module of the task.
+- WaitTime [\InPos,] Time; WaitDI Signal, Value; a call ``Name;`` of a procedure of the modules
+  without parameters runs it (`_run`: RETURN, EXIT, Stop, GOTO and labels too); other procedure
+  calls ``Name arg, ...;`` are recorded, not followed (a call of a procedure given in the texts
+  that moves is reported). Data may be declared in any module of the task.
 
 Outside this subset (control flow, other motion instructions, offsets such as Offs / RelTool /
 PDispOn, \Conc, \Corr, ConfL/ConfJ \Off, coordinated work objects, stationary tools,
@@ -107,6 +108,7 @@ class _State:
     data: dict[str, _Data]
     signals: dict[str, int]
     procedures: dict[str, list[_Statement]]
+    parameters: dict[str, bool] = field(default_factory=dict)   # procedure -> whether it has any
     events: list[Event] = field(default_factory=list)
     issues: list[Issue] = field(default_factory=list)
 
@@ -141,10 +143,81 @@ def run_rapid(modules: Sequence[str] | Mapping[str, str], *, entry: str = "main"
     if body is None:
         state.issues.append(Issue(Where(next(iter(named), ""), 1), "undefined", "", f"no procedure {entry}"))
         return ProgramRun("rapid", (), tuple(state.issues))
-    moving = {name for name, stmts in state.procedures.items() if _moves(stmts)}
-    for st in body:
+    moving = {name for name, stmts in state.procedures.items() if _moves(stmts) and state.parameters.get(name)}
+    stopped: list[Where] = []
+    try:
+        _run(entry.upper(), [], state, moving, stopped)
+    except _Stop:
+        pass
+    return ProgramRun("rapid", tuple(state.events), tuple(state.issues), stopped=stopped[0] if stopped else None)
+
+
+class _Stop(Exception):
+    """The program stops: an end, a pause, or a jump that repeats without end."""
+
+
+def _run(name: str, stack: list[str], state: _State, moving: set[str], stopped: list[Where]) -> None:
+    """RAPID reference manual, instructions RETURN ("finishes the execution of a routine"; the
+    main routine's ends the program), EXIT and EXITCYCLE (end the program or its cycle), Stop and
+    Break (stop program execution until it is started again; RoboDK's IRC5 post writes ``STOP;``
+    to pause, ros-industrial-attic/robodk_postprocessors @ d7e6c1c0 ABB_RAPID_IRC5.py 381-386),
+    GOTO (continues at a label of the same routine); a procedure call ``Name;`` runs the
+    procedure. A routine's ERROR / BACKWARD / UNDO handler runs only on an error or a backward
+    step: the body ends there."""
+    body = state.procedures[name]
+    end = next((i for i, st in enumerate(body) if re.fullmatch(r"ERROR|BACKWARD|UNDO", st.code, re.IGNORECASE)),
+               len(body))
+    body = body[:end]
+    labels = {st.code[:-1].upper(): i for i, st in enumerate(body) if re.fullmatch(r"\w+:", st.code)}
+    depth = 0                      # of IF, WHILE, FOR, TEST: their bodies run straight through, reported
+    i = 0
+    while i < len(body):
+        st, code = body[i], body[i].code
+        word = code.split(None, 1)[0].upper() if code.split() else ""
+        if re.match(r"^((IF|WHILE|FOR)\b.*\b(THEN|DO)|TEST\b.*)$", code, re.IGNORECASE):
+            depth += 1
+        elif re.fullmatch(r"ENDIF|ENDWHILE|ENDFOR|ENDTEST", code, re.IGNORECASE):
+            depth = max(0, depth - 1)
+        elif depth and word in ("RETURN", "EXIT", "EXITCYCLE", "STOP", "BREAK", "GOTO"):
+            state.issue(st, "unsupported", "an end or a jump under a condition: conditions are not evaluated")
+            i += 1
+            continue
+        if word == "RETURN":
+            if stack:
+                return
+            stopped.append(st.where)
+            raise _Stop
+        if word in ("EXIT", "EXITCYCLE", "STOP", "BREAK"):
+            stopped.append(st.where)
+            raise _Stop
+        jump = re.fullmatch(r"GOTO\s+(\w+)", code, re.IGNORECASE)
+        if jump:
+            target = labels.get(jump.group(1).upper())
+            if target is None:
+                state.issue(st, "undefined", f"no label {jump.group(1)} in the routine")
+            elif target <= i:
+                state.issue(st, "unsupported", "a jump back: the statements from its label repeat")
+                stopped.append(st.where)
+                raise _Stop
+            else:
+                i = target
+                continue
+            i += 1
+            continue
+        if re.fullmatch(r"\w+:", code):
+            i += 1
+            continue
+        callee = code.upper()
+        if re.fullmatch(r"\w+", code) and callee in state.procedures and not state.parameters.get(callee):
+            if callee in stack or callee == name:
+                state.issue(st, "unsupported", f"{code} calls itself: without end")
+                stopped.append(st.where)
+                raise _Stop
+            _run(callee, [*stack, name], state, moving, stopped)
+            i += 1
+            continue
         _execute(st, state, moving)
-    return ProgramRun("rapid", tuple(state.events), tuple(state.issues))
+        i += 1
 
 
 # -------------------------------------------------------------------------------------- structure
@@ -162,6 +235,13 @@ def _statements(text: str, name: str) -> list[_Statement]:
         code = strip_comment(line, "!").strip()
         if not code:
             continue
+        label = re.match(r"^(\w+)\s*:(?!=)\s*(.*)$", code) if not buffer else None
+        if label and label.group(1).upper() not in ("CASE", "DEFAULT"):
+            # A label is a statement of its own (GOTO's target), whatever follows it on the line.
+            out.append(_Statement(Where(name, number), f"{label.group(1)}:", line.strip()))
+            code = label.group(2)
+            if not code:
+                continue
         if not buffer:
             start = number
         buffer = f"{buffer} {code}".strip()
@@ -193,6 +273,7 @@ def _read_module(statements: list[_Statement], state: _State) -> None:
         if m:
             block = m.group(1).upper()
             state.procedures[block] = []
+            state.parameters[block] = bool(m.group(2).strip())
             continue
         if re.match(r"^(?:LOCAL\s+)?(FUNC|TRAP)\b", code, re.IGNORECASE):
             block = ""   # functions and traps are not run (a statement using one is reported where it is)

@@ -1,14 +1,24 @@
 """The programs robomax writes, judged by the controller models.
 
-A small cell (s7 and s8 of the frozen reference cell, grid 3, gamma 0) is moved as a whole by one
-rigid transform -- the robot 1.5 m from the cell origin, turned 30 deg, on a 0.4 m riser -- and
-planned with ``robomax plan --format all``. Each written program is read by its controller model,
-and every weld target (the motion right before the n-th ``spot_weld`` call) is placed in the
-world as the controller places it: cell placement · controller base · the model's TCP in the
-robot base. It must be at the spot (the cell file's xyz) and at the TCP of the trajectory file's
-joints at the spot's arrival (pinocchio FK from the robot's URDF and the tool.yaml tcp). Joint
-targets must lie on the trajectory, and the configuration data must name the planned joints'
-configuration as each vendor defines it (computed here from the arm's geometry).
+Two cells, each planned with ``robomax plan --format all``:
+
+- the small cell (s7 and s8 of the frozen reference cell, grid 3, gamma 0) moved as a whole by one
+  rigid transform -- the robot 1.5 m from the cell origin, turned 30 deg, on a 0.4 m riser -- with
+  the controller's default frames (no user frame: targets in the robot base; the calibrated tool 1);
+- the process cell (tests/conftest.py `write_process_cell`: the robot 1.6 m off the origin, turned
+  30 deg, on a riser tilted 2 deg) with the integrator's numbers: tool 2 named gun2, user frame 3
+  on the fixture plate, position registers 40 and 41 that the FANUC setup program fills before
+  setting UTOOL[2] and UFRAME[3], the clamp and door on inputs 5 and 6.
+
+Each written program is read by its controller model (with its frames setup file, run first on
+the same controller), and every weld target (the motion right before the n-th ``spot_weld`` call)
+is placed in the world as the controller places it: cell placement · controller base · the
+model's TCP in the robot base (the user frame composed in by the model). It must be at the spot
+(the cell file's xyz) and at the TCP of the trajectory file's joints at the spot's arrival
+(pinocchio FK from the robot's URDF and the tool.yaml tcp). The user frame in force must be the
+one the cell names, placed in the world the same way; joint targets must lie on the trajectory,
+and the configuration data must name the planned joints' configuration as each vendor defines it
+(computed here from the arm's geometry).
 
 These caught the robot's placement written as KRL `$BASE` and as the RAPID work object's uframe
 (every weld 1.1 m and 30 deg off) and FANUC's flip letter inverted, all of which the writers'
@@ -18,21 +28,15 @@ own readers had passed.
 from __future__ import annotations
 
 import itertools
-import json
-import math
 import os
 import subprocess
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
-import pinocchio as pin
 import pytest
 import yaml
-from scipy.spatial.transform import Rotation
 
 from controller_model.common import (
     Call,
@@ -43,13 +47,27 @@ from controller_model.common import (
     ProgramRun,
     RapidConfig,
 )
-from controller_model.fanuc import controller_joints_deg, run_fanuc
-from controller_model.krl import run_krl
-from controller_model.rapid import run_rapid
-from controller_model.urscript import run_urscript
-
-REPO = Path(__file__).resolve().parents[2]
-ROBOTS = REPO / "robomax_py" / "robots"
+from controller_model.fanuc import controller_joints_deg
+from controller_model.world import (
+    DIALECTS,
+    REPO,
+    ROBOTS,
+    Plan,
+    T_from,
+    Weld,
+    abb_config,
+    angle_deg,
+    config_mismatch,
+    deviation,
+    fanuc_letters,
+    geometry,
+    kuka_config,
+    load_arm,
+    read_plan,
+    run_program,
+    welds,
+    xyz_rpy,
+)
 
 PLACEMENT_XYZ_M = (1.2, -0.9, 0.4)       # 1.5 m from the cell origin, on a 0.4 m riser
 PLACEMENT_YAW_DEG = 30.0
@@ -58,34 +76,16 @@ ANGLE_TOL_DEG = 0.01
 JOINT_TOL_DEG = 0.01                     # a stop point the trajectory passes through
 BLEND_APPROACH_DEG = 2.0                 # how close the trajectory comes to a blended via point
 
-DIALECTS = ("krl", "rapid", "fanuc", "urscript")
 
 # ------------------------------------------------------------------------------------------ frames
-def _T(xyz: Any = (0.0, 0.0, 0.0), rpy_deg: Any = (0.0, 0.0, 0.0)) -> FloatArray:
-    """(4, 4) from xyz (m) and roll, pitch, yaw (deg) about the fixed x, y, z axes (SPEC §3)."""
-    T = np.eye(4)
-    T[:3, :3] = Rotation.from_euler("xyz", rpy_deg, degrees=True).as_matrix()
-    T[:3, 3] = xyz
-    return T
-
-
-def _xyz_rpy(T: FloatArray) -> dict[str, list[float]]:
-    return {"xyz": [float(v) for v in T[:3, 3]],
-            "rpy": [float(v) for v in Rotation.from_matrix(T[:3, :3]).as_euler("xyz", degrees=True)]}
-
-
-def _angle_deg(R1: FloatArray, R2: FloatArray) -> float:
-    return float(np.degrees(Rotation.from_matrix(R1.T @ R2).magnitude()))
-
-
 def _place_cell(source: Path, G: FloatArray) -> None:
     """Moves the whole cell by G: the robot's base, every object pose, every spot's xyz, normal, direction."""
     data = yaml.safe_load(source.read_text())
     base = data["robot"].get("base", {})
-    data["robot"]["base"] = _xyz_rpy(G @ _T(base.get("xyz", (0, 0, 0)), base.get("rpy", (0, 0, 0))))
+    data["robot"]["base"] = xyz_rpy(G @ T_from(base.get("xyz", (0, 0, 0)), base.get("rpy", (0, 0, 0))))
     for obj in data["objects"]:
         pose = obj.get("pose", {})
-        obj["pose"] = _xyz_rpy(G @ _T(pose.get("xyz", (0, 0, 0)), pose.get("rpy", (0, 0, 0))))
+        obj["pose"] = xyz_rpy(G @ T_from(pose.get("xyz", (0, 0, 0)), pose.get("rpy", (0, 0, 0))))
     for seam in data["seams"]:
         for spot in seam["spots"]:
             spot["xyz"] = [float(v) for v in G[:3, :3] @ np.asarray(spot["xyz"]) + G[:3, 3]]
@@ -94,218 +94,38 @@ def _place_cell(source: Path, G: FloatArray) -> None:
     source.write_text(yaml.safe_dump(data, sort_keys=False))
 
 
-# ------------------------------------------------------------------------------------ the arm (FK)
-@dataclass(frozen=True)
-class Arm:
-    """The robot as its URDF and robot.yaml define it, for FK and configuration geometry."""
-
-    model: Any                 # pin.Model
-    joint_ids: tuple[int, ...]
-    q_index: tuple[int, ...]
-    flange_id: int
-    T_flange_tcp: FloatArray
-    T_root_base: FloatArray    # the controller's robot base frame in the URDF root
-    j23_coupling: bool
-
-    def _q(self, q_urdf: FloatArray) -> FloatArray:
-        q = pin.neutral(self.model)
-        q[list(self.q_index)] = q_urdf
-        return np.asarray(q)
-
-    def tcp(self, q_urdf: FloatArray) -> FloatArray:
-        """(4, 4) TCP in the URDF root."""
-        data = self.model.createData()
-        pin.framesForwardKinematics(self.model, data, self._q(q_urdf))
-        return np.asarray(data.oMf[self.flange_id].homogeneous) @ self.T_flange_tcp
-
-    def axes(self, q_urdf: FloatArray) -> list[tuple[FloatArray, FloatArray]]:
-        """(point on the axis, unit axis direction) of each joint, in the URDF root."""
-        model, data = self.model, self.model.createData()
-        q = self._q(q_urdf)
-        J = pin.computeJointJacobians(model, data, q)
-        out = []
-        for jid in self.joint_ids:
-            v = model.joints[jid].idx_v
-            axis = np.asarray(J[3:, v])
-            out.append((np.asarray(data.oMi[jid].translation), axis / np.linalg.norm(axis)))
-        return out
-
-
-def _load_arm(robot_yaml: Path, tool_yaml: Path, joints: list[str]) -> Arm:
-    robot = yaml.safe_load(robot_yaml.read_text())
-    tool = yaml.safe_load(tool_yaml.read_text())
-    model = pin.buildModelFromUrdf(str(robot_yaml.parent / robot["urdf"]))
-    joint_ids = tuple(model.getJointId(name) for name in joints)
-    controller = robot.get("controller", {})
-    if "base" in controller:
-        T_root_base = _T(controller["base"].get("xyz", (0, 0, 0)), controller["base"].get("rpy", (0, 0, 0)))
-    elif model.existFrame("base"):     # a ROS-Industrial `base` link: the vendor's base frame (SPEC §6)
-        data = model.createData()
-        pin.framesForwardKinematics(model, data, pin.neutral(model))
-        T_root_base = np.asarray(data.oMf[model.getFrameId("base")].homogeneous)
-    else:
-        T_root_base = np.eye(4)
-    tcp = tool["tcp"]
-    return Arm(model, joint_ids, tuple(model.joints[j].idx_q for j in joint_ids), model.getFrameId(robot["flange"]),
-               _T(tcp.get("xyz", (0, 0, 0)), tcp.get("rpy", (0, 0, 0))), T_root_base,
-               bool(controller.get("j23_coupling", False)))
-
-
-@dataclass(frozen=True)
-class Geometry:
-    """Where the wrist point is, as the vendors' configuration definitions need it."""
-
-    wrist_behind_axis1: bool       # KUKA Status bit 0, ABB cfx 'behind axis 1', FANUC B
-    wrist_before_a2_a3_line: bool  # KUKA Status bit 1, ABB cfx 'in front of the lower arm', FANUC U
-
-
-def _closest_point(p1: FloatArray, a1: FloatArray, p2: FloatArray, a2: FloatArray) -> FloatArray:
-    """Midpoint of the closest points of two (non-parallel) lines p + s·a."""
-    w = p1 - p2
-    b, d, e = a1 @ a2, a1 @ w, a2 @ w
-    s = (b * e - d) / (1 - b * b)
-    t = (e - b * d) / (1 - b * b)
-    return np.asarray((p1 + s * a1 + p2 + t * a2) / 2)
-
-
-def _geometry(arm: Arm, q_urdf: FloatArray) -> Geometry:
-    """KUKA's definitions (the Sinumerik copy of KUKA's Status table, vendor_research §1.5): bit 0 is
-    the wrist point (axes 4, 5, 6) at negative x of the A1 coordinate system; bit 1 the wrist point
-    on the A3 >= phi side of the line through the A2 and A3 axes ('elbow up'). ABB cfx and FANUC
-    U/D, T/B use the same geometry (vendor_research §2.3, §3.1)."""
-    (p1, a1), (p2, a2), (p3, _), (p4, a4), (p5, a5), _ = arm.axes(q_urdf)
-    wrist = _closest_point(p4, a4, p5, a5)
-    shoulder = p2 - p1
-    up = a1 if shoulder @ a1 >= 0 else -a1
-    forward = shoulder - (shoulder @ up) * up
-    if np.linalg.norm(forward) < 1e-6:    # no shoulder offset: the plane of the arm
-        forward = np.cross(a2, up) if np.cross(a2, up) @ (p3 - p1) >= 0 else -np.cross(a2, up)
-    forward = forward / np.linalg.norm(forward)
-    behind = float((wrist - p1) @ forward) < 0
-
-    def plane(v: FloatArray) -> tuple[float, float]:
-        return float(v @ forward), float(v @ up)
-
-    (bx, bz), (wx, wz) = plane(p3 - p2), plane(wrist - p2)
-    return Geometry(behind, bx * wz - bz * wx < 0)
-
-
-def kuka_config(arm: Arm, q_urdf: FloatArray) -> KrlConfig:
-    g = _geometry(arm, q_urdf)
-    deg = np.degrees(q_urdf)
-    status = int(g.wrist_behind_axis1) | int(g.wrist_before_a2_a3_line) << 1 | int(deg[4] < 0) << 2
-    return KrlConfig(status, sum(int(v < 0) << i for i, v in enumerate(deg)))
-
-
-def abb_config(arm: Arm, q_urdf: FloatArray) -> RapidConfig:
-    g = _geometry(arm, q_urdf)
-    deg = np.degrees(q_urdf)
-    cfx = 4 * int(g.wrist_behind_axis1) + 2 * int(not g.wrist_before_a2_a3_line) + int(deg[4] < 0)
-    cf1, cf4, cf6 = (math.floor(deg[i] / 90.0) for i in (0, 3, 5))   # the quadrant: floor(angle / 90 deg)
-    return RapidConfig(cf1, cf4, cf6, cfx)
-
-
-def fanuc_letters(arm: Arm, q_urdf: FloatArray) -> tuple[str, str, str]:
-    g = _geometry(arm, q_urdf)
-    j5 = controller_joints_deg(tuple(np.degrees(q_urdf)), arm.j23_coupling)[4]
-    return ("F" if j5 > 0 else "N", "U" if g.wrist_before_a2_a3_line else "D", "B" if g.wrist_behind_axis1 else "T")
-
-
 # -------------------------------------------------------------------------------------- the plan
-@dataclass(frozen=True)
-class Plan:
-    folder: Path
-    name: str
-    G: FloatArray                      # (4, 4) robot base in the world (the cell's robot.base)
-    spots: dict[str, FloatArray]       # spot name -> xyz in the world
-    t: FloatArray
-    q: FloatArray
-    spot_times: list[tuple[str, float]]    # (name, t_arrive) in weld order
-    arm: Arm
-
-    def q_at(self, t: float) -> FloatArray:
-        return np.asarray([np.interp(t, self.t, self.q[:, j]) for j in range(self.q.shape[1])])
-
-    def world(self, T_base_tcp: FloatArray) -> FloatArray:
-        return np.asarray(self.G @ self.arm.T_root_base @ T_base_tcp)
-
-    def text(self, name: str) -> str:
-        return (self.folder / name).read_text(encoding="utf-8")
+CELLS = ("small", "process")
 
 
-def _planned(folder: Path, write_small_cell: Callable[..., Path], formats: str = "all",
-             controller: dict[str, Any] | None = None) -> Plan:
-    cell = write_small_cell(folder, name="placed_cell")
-    G = _T(PLACEMENT_XYZ_M, (0.0, 0.0, PLACEMENT_YAW_DEG))
-    _place_cell(cell, G)
-    if controller is not None:
-        data = yaml.safe_load(cell.read_text())
-        data["robot"]["controller"] = controller
-        cell.write_text(yaml.safe_dump(data, sort_keys=False))
-    out = folder / "programs"
+def _plan_cell(cell: Path, name: str, formats: str = "all") -> Plan:
+    out = cell.parent / "programs"
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
     done = subprocess.run([sys.executable, "-m", "robomax_py", "plan", str(cell), "-o", str(out), "--format", formats],
-                          capture_output=True, text=True, env=env, cwd=folder, check=False)
+                          capture_output=True, text=True, env=env, cwd=cell.parent, check=False)
     assert done.returncode == 0, done.stdout + done.stderr
-    data = yaml.safe_load(cell.read_text())
-    trajectory = json.loads((out / "placed_cell.json").read_text())
-    robot_yaml = ROBOTS / data["robot"]["model"] / "robot.yaml"
-    tool_yaml = ROBOTS / "tools" / data["tool"] / "tool.yaml"
-    base = data["robot"]["base"]
-    spots = {s["name"]: np.asarray(s["xyz"]) for seam in data["seams"] for s in seam["spots"]}
-    order = sorted(((s["name"], float(s["t_arrive"])) for s in trajectory["spots"]), key=lambda s: s[1])
-    return Plan(out, "placed_cell", _T(base["xyz"], base["rpy"]), spots, np.asarray(trajectory["t"]),
-                np.asarray(trajectory["q"]), order, _load_arm(robot_yaml, tool_yaml, trajectory["joints"]))
+    return read_plan(cell, out, name)
 
 
-@pytest.fixture(scope="module")
-def plan(tmp_path_factory: pytest.TempPathFactory, write_small_cell: Callable[..., Path]) -> Plan:
-    return _planned(tmp_path_factory.mktemp("placed_cell"), write_small_cell)
+@pytest.fixture(scope="module", params=CELLS)
+def plan(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory,
+         write_small_cell: Callable[..., Path], write_process_cell: Callable[..., Path]) -> Plan:
+    """The small cell moved off the origin with default frames, or the process cell with the
+    integrator's tool, user frame, registers and inputs; planned, every dialect written."""
+    folder = tmp_path_factory.mktemp(f"{request.param}_cell")
+    if request.param == "small":
+        cell = write_small_cell(folder, name="placed_cell")
+        _place_cell(cell, T_from(PLACEMENT_XYZ_M, (0.0, 0.0, PLACEMENT_YAW_DEG)))
+        return _plan_cell(cell, "placed_cell")
+    return _plan_cell(write_process_cell(folder, name="process_cell"), "process_cell")
 
 
 def _run(plan: Plan, dialect: str) -> ProgramRun:
-    files = sorted(p.name for p in plan.folder.iterdir())
-    if dialect == "krl":
-        setup = {f: plan.text(f) for f in files if f.endswith(".src") and "frames" in f.lower()}
-        return run_krl(plan.text(f"{plan.name}.src"), plan.text(f"{plan.name}.dat"), src_name=f"{plan.name}.src",
-                       dat_name=f"{plan.name}.dat", setup=setup)
-    if dialect == "rapid":
-        return run_rapid({f: plan.text(f) for f in files if f.endswith(".mod")})
-    if dialect == "fanuc":
-        # A TP program is named as its file, in capitals (PLACED_CELL.ls, PLACED_CELL_FRAMES.ls).
-        main = f"{plan.name.upper()}.ls"
-        others = [f for f in files if f.endswith(".ls") and f != main]
-        # The cell hands no position registers, so the setup program only lists the frames: the
-        # controller holds the integrator's calibrated gun TCP as tool 1 (the default number).
-        return run_fanuc(plan.text(main), name=main,
-                         setup={f: plan.text(f) for f in others if "frames" in f.lower()},
-                         called={f: plan.text(f) for f in others if "frames" not in f.lower()},
-                         utools={1: plan.arm.T_flange_tcp}, j23_coupling=plan.arm.j23_coupling)
-    return run_urscript(plan.text(f"{plan.name}.script"), name=f"{plan.name}.script")
-
-
-@dataclass(frozen=True)
-class Weld:
-    spot: str
-    t_arrive: float
-    motion: Motion
+    return run_program(plan, dialect)
 
 
 def _welds(plan: Plan, run: ProgramRun) -> list[Weld]:
-    """The motion right before each ``spot_weld(n, ...)`` call, paired with the n-th spot welded."""
-    welds = []
-    events = run.events
-    for i, event in enumerate(events):
-        if not (isinstance(event, Call) and event.name.lower() == "spot_weld"):
-            continue
-        previous = events[i - 1] if i else None
-        assert isinstance(previous, Motion), f"spot_weld at {event.where} does not follow a motion"
-        assert event.args and isinstance(event.args[0], float), f"spot_weld at {event.where} without its number"
-        n = int(event.args[0])
-        name, t_arrive = plan.spot_times[n - 1]
-        welds.append(Weld(name, t_arrive, previous))
-    assert [w.spot for w in welds] == [s for s, _ in plan.spot_times], "one spot_weld per planned spot, in order"
-    return welds
+    return welds(plan, run)
 
 
 # ----------------------------------------------------------------------------------------- tests
@@ -313,7 +133,7 @@ def test_kuka_home_is_status_2_turn_2() -> None:
     """The configuration geometry on a posture whose KUKA data is known: HOME {A1 0, A2 -90, A3 90,
     A4 0, A5 0, A6 0} is S 'B010', T 'B000010'."""
     robot = ROBOTS / "kr125" / "robot.yaml"
-    arm = _load_arm(robot, ROBOTS / "tools" / "spot_gun_c" / "tool.yaml", [f"joint_a{i}" for i in range(1, 7)])
+    arm = load_arm(robot, ROBOTS / "tools" / "spot_gun_c" / "tool.yaml", [f"joint_a{i}" for i in range(1, 7)])
     assert kuka_config(arm, np.radians([0, -90, 90, 0, 0, 0])) == KrlConfig(2, 2)
     # the arm leaning back over the top puts the wrist point behind A1: bit 0
     assert kuka_config(arm, np.radians([0, -150, 20, 0, 30, 0])).status == 1 | 2
@@ -339,7 +159,7 @@ def test_weld_targets_are_at_the_spots_in_the_world(plan: Plan, dialect: str) ->
         T_planned = plan.G @ plan.arm.tcp(plan.q_at(weld.t_arrive))
         off_spot = np.linalg.norm(T_world[:3, 3] - plan.spots[weld.spot])
         off_plan = np.linalg.norm(T_world[:3, 3] - T_planned[:3, 3])
-        turned = _angle_deg(T_world[:3, :3], T_planned[:3, :3])
+        turned = angle_deg(T_world[:3, :3], T_planned[:3, :3])
         if off_spot > POS_TOL_M or off_plan > POS_TOL_M or turned > ANGLE_TOL_DEG:
             errors.append(f"{weld.spot}: {off_spot * 1e3:.3f} mm from the spot, {off_plan * 1e3:.3f} mm and "
                           f"{turned:.4f} deg from the planned TCP")
@@ -353,7 +173,48 @@ def test_weld_tool_frame_is_the_tools_tcp(plan: Plan, dialect: str) -> None:
         tool = weld.motion.T_flange_tcp
         assert tool is not None, f"{dialect}: no tool frame in force at {weld.spot}"
         assert np.linalg.norm(tool[:3, 3] - plan.arm.T_flange_tcp[:3, 3]) <= POS_TOL_M
-        assert _angle_deg(tool[:3, :3], plan.arm.T_flange_tcp[:3, :3]) <= ANGLE_TOL_DEG
+        assert angle_deg(tool[:3, :3], plan.arm.T_flange_tcp[:3, :3]) <= ANGLE_TOL_DEG
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("dialect", DIALECTS)
+def test_weld_user_frame_is_the_cells(plan: Plan, dialect: str) -> None:
+    """The user frame in force at every weld, placed in the world as the controller places it, is
+    the one the cell names (the fixture plate), or the robot base frame when it names none; URScript
+    commands its targets in the base, so the model reports the identity there and the user frame is
+    judged by the weld positions alone."""
+    want = plan.user_frame_world()
+    for weld in _welds(plan, _run(plan, dialect)):
+        user = weld.motion.T_base_user
+        assert user is not None, f"{dialect}: no user frame in force at {weld.spot}"
+        if dialect == "urscript":
+            continue
+        got = plan.world(user)
+        expected = plan.world(np.eye(4)) if want is None else want
+        off = np.linalg.norm(got[:3, 3] - expected[:3, 3])
+        turned = angle_deg(got[:3, :3], expected[:3, :3])
+        assert off <= POS_TOL_M and turned <= ANGLE_TOL_DEG, \
+            f"{dialect}: user frame at {weld.spot} is {off * 1e3:.3f} mm and {turned:.4f} deg off the cell's"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("dialect", DIALECTS)
+def test_waits_are_for_the_cells_inputs(plan: Plan, dialect: str) -> None:
+    """Every input wait names an input the cell maps: by number (KRL $IN through its SIGNAL, FANUC
+    DI, UR standard digital input) or, in RAPID, by the signal name the cell gives (else the cell's
+    signal name)."""
+    inputs = plan.controller.get("inputs", {})
+    numbers = {v if isinstance(v, int) else v["number"] for v in inputs.values()}
+    names = {(v.get("name") if isinstance(v, dict) else None) or k for k, v in inputs.items()}
+    waits = [w for w in _run(plan, dialect).waits if w.seconds is None]
+    assert bool(waits) == bool(inputs), f"{dialect}: waits {waits} for the cell's inputs {inputs}"
+    for wait in waits:
+        if dialect == "rapid":
+            assert wait.signal in names, f"{dialect}: {wait.signal} at {wait.where} is none of {sorted(names)}"
+        else:
+            assert wait.input_number in numbers, f"{dialect}: input {wait.input_number} at {wait.where} is none " \
+                                                 f"of {sorted(numbers)}"
+        assert wait.state is not False, f"{dialect}: waits for the input to go off at {wait.where}"
 
 
 @pytest.mark.slow
@@ -409,11 +270,83 @@ def test_configuration_names_the_planned_joints(plan: Plan, dialect: str) -> Non
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("dialect", DIALECTS)
+def test_the_gun_lands_where_the_plan_puts_it(plan: Plan, dialect: str) -> None:
+    """The figures the arm bench reports (world.deviation), on these cells: the gun's real TCP at
+    every weld (the flange at target · tool⁻¹ in force) within 0.1 mm and 0.01 deg of the planned
+    TCP and of the spot, joint stop points on the trajectory, configurations as planned."""
+    dev = deviation(plan, dialect)
+    assert not dev.issues, dev.issues
+    assert dev.tcp_mm <= POS_TOL_M * 1e3 and dev.spot_mm <= POS_TOL_M * 1e3, dev
+    assert dev.tcp_deg <= ANGLE_TOL_DEG and dev.joint_deg <= JOINT_TOL_DEG, dev
+    assert dev.via_deg <= BLEND_APPROACH_DEG and not dev.configs, dev
+
+
+def test_a_joint_on_a_boundary_names_both_sides_and_only_there() -> None:
+    """A4 planned at -1e-12 rad (written -0.0 in the trajectory file): the KUKA Turn bit and the ABB
+    quadrant of either side name it; half a degree off the boundary, only its own side does."""
+    robot = ROBOTS / "kr125" / "robot.yaml"
+    arm = load_arm(robot, ROBOTS / "tools" / "spot_gun_c" / "tool.yaml", [f"joint_a{i}" for i in range(1, 7)])
+    on = np.radians([10.0, -80.0, 100.0, 0.0, 40.0, 20.0])
+    on[3] = -1e-12
+    status, turn = kuka_config(arm, on).status, (kuka_config(arm, on).turn or 0) & ~8    # bit 3: A4 < 0
+    for t in (turn, turn | 8):
+        assert config_mismatch(arm, "krl", KrlConfig(status, t), on) is None
+    for cf4 in (-1, 0):
+        assert config_mismatch(arm, "rapid", RapidConfig(0, cf4, 0, abb_config(arm, on).cfx), on) is None
+    off = on.copy()
+    off[3] = np.radians(-0.5)
+    assert config_mismatch(arm, "krl", KrlConfig(status, turn), off) is not None
+    assert config_mismatch(arm, "rapid", RapidConfig(0, 0, 0, abb_config(arm, off).cfx), off) is not None
+
+
+def _serial_arm(folder: Path, joints: list[tuple[tuple[float, float, float], tuple[int, int, int]]]) -> Path:
+    """robot.yaml of a bare six-axis URDF: each joint's origin in its parent (m) and axis."""
+    links = "".join(f'<link name="l{i}"/>' for i in range(7)) + '<link name="tool0"/>'
+    chain = "".join(
+        f'<joint name="j{i + 1}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        f'<origin xyz="{x} {y} {z}"/><axis xyz="{ax} {ay} {az}"/>'
+        f'<limit lower="-6" upper="6" effort="1" velocity="1"/></joint>'
+        for i, ((x, y, z), (ax, ay, az)) in enumerate(joints))
+    chain += '<joint name="flange" type="fixed"><parent link="l6"/><child link="tool0"/></joint>'
+    (folder / "arm.urdf").write_text(f'<robot name="arm">{links}{chain}</robot>')
+    (folder / "robot.yaml").write_text("name: arm\nurdf: arm.urdf\nflange: tool0\n")
+    return folder / "robot.yaml"
+
+
+def test_configuration_geometry_takes_front_and_up_from_the_a1_frame(tmp_path: Path) -> None:
+    """The A1 frame is the robot base turned with A1, not the arm's shape: a ROS-Industrial KUKA URDF
+    (A1 joint at shoulder height turning about -z) at KUKA's HOME is S 'B010'; an arm without a
+    shoulder offset (a Staubli TX60's shape) whose upper arm leans 5 deg back while the forearm
+    reaches forward has its wrist point in front of A1."""
+    tool = ROBOTS / "tools" / "spot_gun_c" / "tool.yaml"
+    (tmp_path / "kuka").mkdir()
+    kuka = _serial_arm(tmp_path / "kuka", [((0, 0, 0.675), (0, 0, -1)), ((0.26, 0, 0), (0, 1, 0)),
+                                           ((0.68, 0, 0), (0, 1, 0)), ((0.67, 0, -0.035), (-1, 0, 0)),
+                                           ((0, 0, 0), (0, 1, 0)), ((0.158, 0, 0), (-1, 0, 0))])
+    arm = load_arm(kuka, tool, [f"j{i}" for i in range(1, 7)])
+    assert kuka_config(arm, np.radians([0, -90, 90, 0, 30, 0])).status == 2
+    assert kuka_config(arm, np.radians([120, -90, 90, 0, 30, 0])).status == 2     # turned with A1
+    (tmp_path / "tx60").mkdir()
+    staubli = _serial_arm(tmp_path / "tx60", [((0, 0, 0.375), (0, 0, 1)), ((0, 0, 0), (0, 1, 0)),
+                                              ((0, 0.02, 0.29), (0, 1, 0)), ((0, 0, 0.31), (0, 0, 1)),
+                                              ((0, 0, 0), (0, 1, 0)), ((0, 0, 0.07), (0, 0, 1))])
+    arm = load_arm(staubli, tool, [f"j{i}" for i in range(1, 7)])
+    assert geometry(arm, np.radians([0, -5, 90, 0, 30, 0])).wrist_behind_axis1 is False
+    assert geometry(arm, np.radians([0, 5, -90, 0, 30, 0])).wrist_behind_axis1 is True
+
+
+@pytest.mark.slow
 def test_krl_package_welds_call_the_spot_package_at_the_spots(tmp_path: Path,
                                                                write_small_cell: Callable[..., Path]) -> None:
     """With `weld: package` each weld is ``USERSPOT(#SPOT,SDATn)``, the KUKA spot package's user
     routine (ZINK KRC/R1/TP/GripperSpotTech/Spot_User.src), called at rest at its spot."""
-    plan = _planned(tmp_path, write_small_cell, "krl", {"weld": "package"})
+    cell = write_small_cell(tmp_path, name="placed_cell")
+    _place_cell(cell, T_from(PLACEMENT_XYZ_M, (0.0, 0.0, PLACEMENT_YAW_DEG)))
+    data = yaml.safe_load(cell.read_text())
+    data["robot"]["controller"] = {"weld": "package"}
+    cell.write_text(yaml.safe_dump(data, sort_keys=False))
+    plan = _plan_cell(cell, "placed_cell", "krl")
     run = _run(plan, "krl")
     assert run.clean, run.issues
     calls = [(k, e) for k, e in enumerate(run.events) if isinstance(e, Call) and e.name.upper() == "USERSPOT"]

@@ -151,15 +151,44 @@ def test_what_may_change_motion_is_reported() -> None:
    8:C P[1]
     :  P[1] 100mm/sec FINE ;
    9:  //L P[1] 100mm/sec FINE ;
-  10:  CALL MOVER ;
+  10:  CALL MOVER(1) ;
   11:  JMP LBL[1] ;
 /POS
 """ + _joint(1, 0, 0, (0, 0, 0, 0, -90, 0)) + "/END\n"
     mover = HEADER.format(name="MOVER") + "   1:J P[1] 100% FINE ;\n/POS\n" + _joint(1, 0, 0, (0,) * 6) + "/END\n"
     run = run_fanuc(program, called={"mover.ls": mover})
+    # the call with an argument is not followed; the jump back to LBL[1] repeats without end
     assert {i.where.line for i in run.unsupported} == {9, 10, 11, 12, 13, 15, 18, 19}
     assert [c.name for c in run.calls] == ["MOVER"]
     assert len(run.motions) == 1     # the L with TB is read (its point logic is reported)
+    assert run.stopped is not None and run.stopped.line == 19
+
+
+def test_the_flow_is_followed() -> None:
+    """A CALL of a given program runs it (its positions its own), JMP LBL[n] skips to LBL[n], END
+    and PAUSE stop the program; a JMP under an IF ... THEN is reported, not taken."""
+    program = HEADER.format(name="FLOW") + """   1:  UFRAME_NUM=0 ;
+   2:  UTOOL_NUM=0 ;
+   3:  CALL MOVER ;
+   4:  JMP LBL[2] ;
+   5:J P[1] 100% FINE ;
+   6:  LBL[2:after] ;
+   7:  IF (DI[1]=ON) THEN ;
+   8:  JMP LBL[3] ;
+   9:  ENDIF ;
+  10:J P[1] 50% FINE ;
+  11:  LBL[3] ;
+  12:  PAUSE ;
+  13:J P[1] 100% FINE ;
+/POS
+""" + _joint(1, 0, 0, (0, 0, 0, 0, -90, 0)) + "/END\n"
+    mover = HEADER.format(name="MOVER") + "   1:J P[1] 100% FINE ;\n   2:  END ;\n   3:J P[1] 100% FINE ;\n/POS\n" \
+        + _joint(1, 0, 0, (10, 0, 0, 0, 0, 0)) + "/END\n"
+    run = run_fanuc(program, called={"mover.ls": mover})
+    assert [(m.where.source, m.joints_deg) for m in run.motions] == [("mover.ls", (10.0, 0.0, 0.0, 0.0, 0.0, 0.0)),
+                                                                      ("program.ls", (0.0, 0.0, 0.0, 0.0, -90.0, 0.0))]
+    assert {i.where.line for i in run.unsupported} == {12, 13, 14}     # IF ... THEN, the JMP under it, ENDIF
+    assert run.stopped is not None and run.stopped.line == 17        # PAUSE
 
 
 def test_j2_j3_coupling_counts_j3_from_the_horizontal() -> None:

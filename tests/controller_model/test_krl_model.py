@@ -204,18 +204,49 @@ CIRC {X 1, Y 1, Z 0}, {X 2, Y 0, Z 0}
 PTP_REL {A1 10}
 LIN XP1:{X 0, Y 0, Z 10, A 0, B 0, C 0}
 $ROBROOT = {X 0, Y 0, Z 100, A 0, B 0, C 0}
-mover()
+mover(1)
 HALT
 END
 
-DEF mover()
+DEF mover(n:IN)
+  INT n
   PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}
 END
 """
     run = run_krl(src)
-    assert {i.where.line for i in run.unsupported} == {4, 6, 7, 8, 9, 10, 11, 12, 13}
+    assert {i.where.line for i in run.unsupported} == {4, 6, 7, 8, 9, 10, 11, 12}
     assert len(run.motions) == 1          # the LIN inside IF is still read, and reported via the IF
     assert [c.name for c in run.calls] == ["mover"]
+    assert run.stopped is not None and run.stopped.line == 13     # HALT: the program waits for a restart
+
+
+def test_the_flow_is_followed() -> None:
+    """A call of a DEF without parameters runs it (its RETURN back to the caller), GOTO skips to
+    its label, RETURN ends the main program; a GOTO under a condition is reported, not taken."""
+    src = """DEF t()
+mover()
+GOTO after
+PTP {A1 1, A2 -90, A3 90, A4 0, A5 0, A6 0}
+after:
+IF $IN[1] THEN
+  GOTO later
+ENDIF
+PTP {A1 2, A2 -90, A3 90, A4 0, A5 0, A6 0}
+later:
+RETURN
+PTP {A1 3, A2 -90, A3 90, A4 0, A5 0, A6 0}
+END
+
+DEF mover()
+  PTP {A1 4, A2 -90, A3 90, A4 0, A5 0, A6 0}
+  RETURN
+  PTP {A1 5, A2 -90, A3 90, A4 0, A5 0, A6 0}
+END
+"""
+    run = run_krl(src)
+    assert [m.joints_deg[0] for m in run.motions if m.joints_deg] == [4.0, 2.0]
+    assert {i.where.line for i in run.unsupported} == {6, 7, 8}     # IF, the GOTO under it, ENDIF
+    assert run.stopped is not None and run.stopped.line == 11
 
 
 def _motion_at(motions: tuple[Motion, ...], line: int) -> Motion:

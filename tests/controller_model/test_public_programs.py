@@ -122,16 +122,22 @@ def test_abb_program_in_a_work_object() -> None:
     """RoboDK's module: MoveAbsJ and MoveL with `,\\WObj:=Frame2` (Frame2's uframe 399.855 mm along x,
     100 mm up, its oframe identity): a target in Frame2 is the user frame's offset plus the target."""
     run = READERS["robodk_Program.mod"]("robodk_Program.mod")
-    assert [m.statement for m in run.motions] == ["MoveAbsJ"] * 2 + ["MoveL"] * 4
+    # STOP (line 28) stops the program until the operator starts it again: the cycle ends there
+    assert run.stopped is not None and run.stopped.line == 28
+    assert [m.statement for m in run.motions] == ["MoveAbsJ"] * 2 + ["MoveL"] * 2
     in_wobj0, in_frame2 = run.motions[2], run.motions[3]
     assert_allclose(_known(in_wobj0.T_base_tcp)[:3, 3], [0.018715, 0.147321, 0.458168], atol=POS_TOL_M)
     assert_allclose(_known(in_frame2.T_base_tcp)[:3, 3], [0.403136, 0.147321, 0.394993], atol=POS_TOL_M)
     assert_allclose(_known(in_frame2.T_base_user)[:3, 3], [0.399855, 0.0, 0.1], atol=POS_TOL_M)
     # the tool: TCP at (-30, 0, 40) mm, turned -60 deg about y (q = [cos 30, 0, -sin 30, 0])
     assert_allclose(_known(in_frame2.T_flange_tcp)[:3, 3], [-0.03, 0.0, 0.04], atol=POS_TOL_M)
-    # ConfL \Off and STOP are outside the subset; the call of Subprog (not in the module) is recorded
-    assert _unsupported_lines(run) == {18, 28}
-    assert [(c.name, c.where.line) for c in run.calls] == [("Subprog", 30)]
+    # ConfL \Off is outside the subset; without the STOP, the call of Subprog (not in the module)
+    # is recorded and the module moves on
+    assert _unsupported_lines(run) == {18}
+    text = _text("robodk_Program.mod").replace("\t\tSTOP;\n", "\t\t! STOP;\n")
+    going = run_rapid({"robodk_Program.mod": text}, entry="Main")
+    assert going.stopped is None and [m.statement for m in going.motions] == ["MoveAbsJ"] * 2 + ["MoveL"] * 4
+    assert [(c.name, c.where.line) for c in going.calls] == [("Subprog", 30)]
 
 
 def test_fanuc_ros_relay_program() -> None:

@@ -99,10 +99,10 @@ def test_what_may_change_motion_is_reported() -> None:
   movel(pose_add(p[0.1, 0, 0, 0, 0, 0], p[0, 0, 0.1, 0, 0, 0]))
   movec(p[0.1, 0, 0, 0, 0, 0], p[0.2, 0, 0, 0, 0, 0])
   movel(target)
-  def mover():
+  def mover(n):
     movej([0, 0, 0, 0, 0, 0])
   end
-  mover()
+  mover(1)
   thread t():
     movel(p[0.1, 0, 0, 0, 0, 0])
   end
@@ -116,6 +116,32 @@ end
     assert by_line == {3: "unsupported", 6: "unsupported", 7: "unsupported", 8: "undefined", 12: "unsupported",
                        16: "unsupported", 17: "unsupported", 18: "unsupported"}
     assert [c.name for c in run.calls] == ["mover"]
+
+
+def test_the_flow_is_followed() -> None:
+    """A call of a function without parameters runs it (its return back to the caller), halt()
+    ends the program; a return under a condition is reported, not taken."""
+    script = """def flow():
+  set_tcp(p[0, 0, 0, 0, 0, 0])
+  def mover():
+    movej([0.1, 0, 0, 0, 0, 0])
+    return
+    movej([0.2, 0, 0, 0, 0, 0])
+  end
+  mover()
+  if get_standard_digital_in(1):
+    return
+  end
+  movej([0.3, 0, 0, 0, 0, 0])
+  halt()
+  movej([0.4, 0, 0, 0, 0, 0])
+end
+"""
+    run = run_urscript(script)
+    firsts = [m.joints_deg[0] for m in run.motions if m.joints_deg]
+    assert_allclose(firsts, [math.degrees(0.1), math.degrees(0.3)])
+    assert {i.where.line for i in run.unsupported} == {9, 10}
+    assert run.stopped is not None and run.stopped.line == 13
 
 
 def test_an_unknown_tcp_is_reported() -> None:
@@ -145,3 +171,28 @@ prog()
     (m,) = run.motions
     assert m.where.line == 3 and m.stops
     assert [(w.input_number, w.state) for w in run.waits] == [(5, True), (6, False)]
+
+
+def test_a_function_that_only_waits_for_its_input_is_that_wait() -> None:
+    """A call of ``def wait_for_signal(n)`` whose body is a wait loop on input n waits for the
+    input the call passes; a function doing more stays a call."""
+    script = """def prog():
+  def wait_for_signal(n):
+    while not get_standard_digital_in(n):
+      sync()
+    end
+  end
+  def wait_and_tell(n):
+    while not get_standard_digital_in(n):
+      sync()
+    end
+    textmsg("in")
+  end
+  wait_for_signal(5)
+  wait_and_tell(6)
+end
+"""
+    run = run_urscript(script)
+    assert run.clean, run.issues
+    assert [(w.input_number, w.state, w.where.line) for w in run.waits] == [(5, True, 13)]
+    assert [(c.name, c.args) for c in run.calls] == [("wait_and_tell", (6.0,))]

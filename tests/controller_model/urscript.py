@@ -19,8 +19,12 @@ rotation vector).
 - ``set_tcp(pose)``: the tool frame (flange to TCP) in force from then on.
   ``pose_trans(p_from, p_from_to)`` = p_from · p_from_to. Pose and joint-vector variables
   (``name = p[...]``, ``global``) hold their value.
-- ``def name(): ... end`` defines a function: a call is recorded (name, args), not followed; a call
-  of a defined function that moves or sets the TCP is reported. ``sleep(t)`` waits t s; a loop
+- ``def name(): ... end`` defines a function: a call ``name()`` runs its body (``return`` leaves
+  it; ``halt()`` and the program's own ``return`` end the program); a call with arguments is
+  recorded (name, args), not followed, and reported when the function moves or sets the TCP. A
+  function whose body is only an input wait on one of its parameters (``def wait_for_signal(n):
+  while not get_standard_digital_in(n): sync() end end``) waits for the input its call passes.
+  ``sleep(t)`` waits t s; a loop
   doing only ``sync()`` / ``sleep`` while a standard digital input is not yet in a state
   (``while not get_standard_digital_in(n):``, ``while (get_standard_digital_in(n) != True):``,
   ...) waits for it.
@@ -86,7 +90,10 @@ class _State:
     tool: FloatArray | None
     variables: dict[str, _Var] = field(default_factory=dict)
     functions: dict[str, list[_Line]] = field(default_factory=dict)
+    parameters: dict[str, list[str]] = field(default_factory=dict)
+    threads: set[str] = field(default_factory=set)               # defined with `thread`: never called
     events: list[Event] = field(default_factory=list)
+    stopped: Where | None = None
     issues: list[Issue] = field(default_factory=list)
 
     def issue(self, line: _Line, kind: IssueKind, reason: str) -> None:
@@ -113,8 +120,19 @@ def run_urscript(script: str, *, name: str = "program.script", tcp: FloatArray |
     lines = [_Line(Where(name, i), strip_comment(raw, "#").strip(), raw) for i, raw in enumerate(script.splitlines(), 1)]
     lines = [ln for ln in lines if ln.code and not ln.code.startswith("$")]   # "$ 2 ..." PolyScope line markers
     state = _State(tool=tcp, variables={k: _Var(pose=v) for k, v in (variables or {}).items()})
-    _block(_program_body(lines), state)
-    return ProgramRun("urscript", tuple(state.events), tuple(state.issues))
+    try:
+        _block(_program_body(lines), state, [])
+    except (_Stop, _Return):
+        pass
+    return ProgramRun("urscript", tuple(state.events), tuple(state.issues), stopped=state.stopped)
+
+
+class _Stop(Exception):
+    """The program stops (halt(), the program's own return, a call without end)."""
+
+
+class _Return(Exception):
+    """`return` in a called function."""
 
 
 def _program_body(lines: list[_Line]) -> list[_Line]:
@@ -184,16 +202,53 @@ def _moves(body: list[_Line]) -> bool:
     return any(re.match(r"^(movej|movel|movep|movec|servoj|speedj|speedl|set_tcp)\s*\(", ln.code) for ln in body)
 
 
-def _block(lines: list[_Line], state: _State) -> None:
+def _block(lines: list[_Line], state: _State, stack: list[str]) -> None:
+    """The URScript Programming Language: ``halt()`` terminates the program, ``return`` leaves a
+    function (the program, when it is the program's own); a call ``name()`` of a function the
+    script defines runs its body (RoboDK's UR post writes ``halt()`` to pause a program,
+    ros-industrial-attic/robodk_postprocessors @ d7e6c1c0 Universal_Robots.py 634-639)."""
+    depth = 0                      # of if, while, for: their bodies run straight through, reported
     i = 0
     while i < len(lines):
         line = lines[i]
         code = line.code
-        definition = re.match(r"^(def|thread)\s+(\w+)\s*\(.*\)\s*:$", code)
+        if re.match(r"^(if|while|for)\b.*:$", code) and _input_wait(code) is None:
+            depth += 1
+        elif code == "end":
+            depth = max(0, depth - 1)
+        elif depth and re.fullmatch(r"halt\(\s*\)|return\b.*", code):
+            state.issue(line, "unsupported", "an end under a condition: conditions are not evaluated")
+            i += 1
+            continue
+        definition = re.match(r"^(def|thread)\s+(\w+)\s*\((.*)\)\s*:$", code)
         if definition:
             end = _block_end(lines, i)
             state.functions[definition.group(2)] = lines[i + 1:end]
+            state.parameters[definition.group(2)] = [a for a in split_top(definition.group(3)) if a]
+            if definition.group(1) == "thread":
+                state.threads.add(definition.group(2))
             i = end + 1
+            continue
+        if re.fullmatch(r"halt\(\s*\)", code):
+            state.stopped = line.where
+            raise _Stop
+        if re.fullmatch(r"return\b.*", code):
+            if stack:
+                raise _Return
+            state.stopped = line.where
+            raise _Stop
+        call = re.fullmatch(r"(\w+)\(\s*\)", code)
+        if (call and call.group(1) in state.functions and not state.parameters.get(call.group(1))
+                and call.group(1) not in state.threads):
+            if call.group(1) in stack:
+                state.issue(line, "unsupported", f"{call.group(1)} calls itself: without end")
+                state.stopped = line.where
+                raise _Stop
+            try:
+                _block(state.functions[call.group(1)], state, [*stack, call.group(1)])
+            except _Return:
+                pass
+            i += 1
             continue
         wait = _input_wait(code)
         if wait is not None:
@@ -243,6 +298,11 @@ def _statement(line: _Line, state: _State) -> None:
             state.issue(line, "unsupported", "sleep with an expression")
         return
     if func in state.functions:
+        waited = _wait_function(state.functions[func], state.parameters.get(func, []), args)
+        if waited is not None:
+            state.events.append(Wait(line.where, signal=f"get_standard_digital_in({waited[0]})",
+                                     input_number=waited[0], state=waited[1]))
+            return
         if _moves(state.functions[func]):
             state.issue(line, "unsupported", f"{func} moves the robot or sets the TCP; calls are not followed")
         state.events.append(Call(line.where, func, tuple(arg_value(a) for a in args)))
@@ -253,6 +313,23 @@ def _statement(line: _Line, state: _State) -> None:
         state.issue(line, "unsupported", "motion function outside the modelled subset (movej, movel)")
         return
     state.issue(line, "unsupported", f"call of {func}, which the model does not know")
+
+
+def _wait_function(body: list[_Line], parameters: list[str], args: list[str]) -> tuple[int, bool] | None:
+    """(input, awaited state) when `body` is only a wait loop on a standard digital input named by a
+    parameter, the call passing its number as a literal; else None."""
+    if not body or len(parameters) != len(args):
+        return None
+    header = re.sub(r"get_standard_digital_in\(\s*(\w+)\s*\)",
+                    lambda m: f"get_standard_digital_in({args[parameters.index(m.group(1))]})"
+                    if m.group(1) in parameters else m.group(0), body[0].code)
+    wait = _input_wait(header)
+    end = _block_end(body, 0)
+    inner = [ln.code for ln in body[1:end]]
+    if wait is None or end != len(body) - 1 or not all(re.fullmatch(r"sync\(\)|sleep\(\s*[\d.]+\s*\)", c)
+                                                       for c in inner):
+        return None
+    return wait
 
 
 def _assign(name: str, expr: str, state: _State) -> None:

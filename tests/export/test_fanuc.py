@@ -152,11 +152,18 @@ def test_motions_with_register_speeds_are_reported(kr125: RobotModel) -> None:
     assert motions == [30, 33, 34, 36, 42, 45, 46, 48]
 
 
+def _unconditional(text: str) -> str:
+    """gratowanie.ls with the IF ... THEN / ENDIF around gripper 1's motions made remarks (inside a
+    condition a motion is reported, not read) and its speed register replaced by a number."""
+    text = text.replace("L P[1] R[26:posuw gratow]mm/sec FINE", "L P[1] 250mm/sec FINE")
+    return text.replace("IF (R[1:stan chwytaka 1]=1) THEN ;", "!if gripper 1 ;").replace("  15:  ENDIF ;", "  15:  !endif ;")
+
+
 def test_a_position_in_user_frame_7_is_read_relative_to_uframe_7(kr125: RobotModel) -> None:
-    """gratowanie.ls with its speed register replaced by a number: P[1] (UF : 7, UT : 1) after
-    UFRAME_NUM=7 / UTOOL_NUM=1 is a LIN in UFRAME[7] with UTOOL[1], the values as exported; the
-    rebuild composes it with the controller's UFRAME[7] (`frame_name`)."""
-    text = (DATA / "gratowanie.ls").read_text().replace("L P[1] R[26:posuw gratow]mm/sec FINE", "L P[1] 250mm/sec FINE")
+    """gratowanie.ls without its first IF, its speed register replaced by a number: P[1] (UF : 7,
+    UT : 1) after UFRAME_NUM=7 / UTOOL_NUM=1 is a LIN in UFRAME[7] with UTOOL[1], the values as
+    exported; the rebuild composes it with the controller's UFRAME[7] (`frame_name`)."""
+    text = _unconditional((DATA / "gratowanie.ls").read_text())
     parsed = _read("gratowanie.ls", kr125, text)
     moves = [i for i in parsed.program.instructions if isinstance(i, LinMove)]
     assert len(moves) == 1
@@ -168,8 +175,24 @@ def test_a_position_in_user_frame_7_is_read_relative_to_uframe_7(kr125: RobotMod
     assert fanuc.frame_name(frame) == move.base
 
 
+def test_linear_speeds_are_read_in_their_units(kr125: RobotModel) -> None:
+    """A linear move's speed in mm/sec, cm/min or inch/min is a TCP speed (mm/s); one stated by the
+    move's time (sec) or its orientation speed (deg/sec) is reported, not guessed."""
+    base = _unconditional((DATA / "gratowanie.ls").read_text())
+    speeds = {}
+    for unit, value in (("mm/sec", "250"), ("cm/min", "1500"), ("inch/min", "590.551")):
+        parsed = _read("gratowanie.ls", kr125, base.replace("L P[1] 250mm/sec FINE", f"L P[1] {value}{unit} FINE"))
+        (move,) = [i for i in parsed.program.instructions if isinstance(i, LinMove)]
+        speeds[unit] = move.speed_mm_s
+    assert speeds["mm/sec"] == speeds["cm/min"] == 250.0 and abs(speeds["inch/min"] - 250.0) < 1e-3
+    for unit in ("sec", "deg/sec"):
+        parsed = _read("gratowanie.ls", kr125, base.replace("L P[1] 250mm/sec FINE", f"L P[1] 2{unit} FINE"))
+        assert not any(isinstance(i, LinMove) for i in parsed.program.instructions)
+        assert any(f"speed in {unit}" in i.text for i in parsed.program.instructions if isinstance(i, Comment))
+
+
 def test_a_position_in_another_user_frame_is_an_alarm(kr125: RobotModel) -> None:
-    text = (DATA / "gratowanie.ls").read_text().replace("L P[1] R[26:posuw gratow]mm/sec FINE", "L P[1] 250mm/sec FINE")
+    text = _unconditional((DATA / "gratowanie.ls").read_text())
     text = text.replace("UF : 7, UT : 1,", "UF : 3, UT : 1,")
     parsed = _read("gratowanie.ls", kr125, text)
     alarms = [i.text for i in parsed.program.instructions if isinstance(i, Comment) and "mismatch" in i.text]

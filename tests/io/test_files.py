@@ -24,7 +24,10 @@ def test_stale_temporary_files_are_removed_by_the_next_writer(tmp_path: Path) ->
     written = write_programs(tmp_path, {"cell.json": "{}\n", "cell.srcl": "x\n"})
     assert [p.name for p in written] == ["cell.json", "cell.srcl"]
     assert not stale.exists()
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["cell.json", "cell.srcl"]
+    # Besides the set's links and manifest, only the set's hidden pointer and folder.
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == [
+        "cell.json", "cell.manifest.json", "cell.srcl"]
+    assert not [p for p in tmp_path.iterdir() if p.name.endswith(TMP_SUFFIX)]
 
 
 def _writer(folder: str, letter: str, rounds: int) -> None:
@@ -67,6 +70,6 @@ def test_plan_killed_mid_run_leaves_no_partial_program(tmp_path: Path, write_sma
                 parse_program(text, program)
     done = subprocess.run([*robomax, "plan", str(cell), "-o", str(out)], capture_output=True, text=True, check=False)
     assert done.returncode == 0, done.stderr
-    names = sorted(p.name for p in out.iterdir())
-    assert names == ["small_cell.json", "small_cell.srcl"], names
+    names = sorted(p.name for p in out.iterdir() if not p.name.startswith("."))
+    assert names == ["small_cell.json", "small_cell.manifest.json", "small_cell.srcl"], names
     assert os.stat(out / "small_cell.json").st_size > 1000

@@ -17,6 +17,7 @@ from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions, plan_cell
 from robomax_py.program import Gripper, Spot, WaitFor
 from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.motion import min_clearance
 from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[2]
@@ -44,8 +45,8 @@ def test_time_aware_tending_against_waiting_at_rest() -> None:
     # Never within the clearance of a door while it is closed (every sample of the dense program).
     doors = CollisionWorld(robot, build_scene(replace(cell, objects=()), robot), 0.0).restricted(self_pairs=False)
     traj = timed.trajectory
-    least = min(doors.closest(q, float(t)).distance for t, q in zip(traj.t, traj.q))
-    assert least >= cell.process.clearance
+    least = min_clearance(doors, traj.t, traj.q)      # every sample's exact minimum, then refined between
+    assert least is not None and least.distance_m >= cell.process.clearance
 
 
 @pytest.mark.slow

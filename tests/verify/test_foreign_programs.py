@@ -126,8 +126,19 @@ def _assert_pose(T: np.ndarray, want: np.ndarray) -> None:
 
 def test_rapid_robodk_program_in_its_work_object(kr125) -> None:  # type: ignore[no-untyped-def]
     """RoboDK's module moves in Frame2 (a user frame 399.855 mm along x, 100 mm up) and once in
-    WObj0: each target lands at uframe · oframe · target, with the tool the statement names."""
-    parsed = _read("robodk_Program.mod", kr125[1])
+    WObj0: each target lands at uframe · oframe · target, with the tool the statement names. Its
+    `STOP;` stops the program until the operator starts it again: the cycle verify checks ends
+    there (reported); without that line (as its comment offers) the call of Subprog, which the
+    module does not define, is reported and the lines after it are read."""
+    stopped = _read("robodk_Program.mod", kr125[1])
+    assert [(line, kind) for line, kind, _ in stopped.problems] == [(28, "flow")]
+    assert sum(isinstance(i, LinMove) for i in stopped.program.instructions) == 2
+    text = (DATA / "robodk_Program.mod").read_text()
+    assert "\t\tSTOP;\n" in text
+    parsed = rapid.parse({".mod": text.replace("\t\tSTOP;\n", "\t\t! STOP;\n")}, "robodk_Program.mod", kr125[1])
+    assert not parsed.problems
+    assert [t for _, t in _unsimulated(parsed)] == [("not simulated: Subprog (a call of Subprog, which neither "
+                                                      "the program nor its companion files define)")]
     frames = {f.name: f for f in parsed.program.frames}
     assert set(frames) == {"Tool", "Frame2"}
     lins = [i for i in parsed.program.instructions if isinstance(i, LinMove)]
@@ -165,7 +176,7 @@ def test_fanuc_streaming_program(kr125) -> None:  # type: ignore[no-untyped-def]
     parsed = _read("ros_movesm.ls", kr125[1])
     texts = [t for _, t in _unsimulated(parsed)]
     assert any("PR[2" in t for t in texts)                                   # J to a position register
-    assert any(t.endswith("JMP LBL[10]") for t in texts)                     # a loop
+    assert any(t.startswith("not simulated: JMP LBL[10] (a jump back") for t in texts)   # a loop
 
 
 def test_fanuc_production_program(kr125) -> None:  # type: ignore[no-untyped-def]

@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
 
 import pytest
 
-from conftest import Edit, Placed, placement_mm_zyx
+from conftest import Edit, Placed, detour_into_the_part, model_execution, placement_mm_zyx, read_execution
+from controller_model.fanuc import run_fanuc
 
 
 def _placement_as_uframe(placed: Placed) -> dict[str, Edit]:
@@ -107,3 +109,110 @@ def test_the_package_weld_program_is_clean_and_welds_with_spot(placed_package: P
     assert "CALL SPOT_WELD" not in text and "SPOT_WELD.ls" not in placed_package.files
     report = placed_package.verify("fanuc", {}, "unchanged")
     assert report.clean, report.violations
+
+
+# ------------------------------------------------------------------ what the controller executes
+# Mutants of the program's flow, speeds and weld times (fanuc.py's docstring, export/flow.py):
+# each is caught with the violation the controller's execution implies; labels and a jump to the
+# statement after one still verify clean.
+
+NL = "\r\n"
+CALL1 = re.compile(r"^(\s*\d+:\s*CALL SPOT_WELD\(1,[\d.]+\) ;\r\n\s*\d+:\s*![^\r\n]*;)(?=\r\n)", re.MULTILINE)
+
+
+def _statement(text: str) -> str:
+    """A /MN line (the reader does not need the lines numbered in order)."""
+    return f"   0:  {text} ;"
+
+
+def _before_frames(text: str) -> dict[str, Edit]:
+    """`text` before the program selects its frames, before any motion."""
+    return {".ls": lambda t: re.sub(r"^(\s*\d+:\s*UFRAME_NUM=)", lambda m: _statement(text) + NL + m[1], t, count=1,
+                                    flags=re.MULTILINE)}
+
+
+def _around_weld1(before: str, after: str) -> dict[str, Edit]:
+    return {".ls": lambda t: CALL1.sub(lambda m: NL.join(x for x in (before and _statement(before), m[1],
+                                                                    after and _statement(after)) if x), t, count=1)}
+
+
+def _before_first_line(text: str) -> Edit:
+    return lambda t: re.sub(r"^(\s*\d+:L P\[)", lambda m: _statement(text) + NL + m[1], t, count=1, flags=re.MULTILINE)
+
+
+def _detour_in_frames_program(placed: Placed) -> Edit:
+    """The frames program moves too: a detour into the part and back, its positions in its /POS."""
+    detour, back = detour_into_the_part(placed)
+
+    def position(k: int, q: list[float]) -> str:
+        values = [f"J{i}={v:>10.4f} deg" for i, v in enumerate(q, start=1)]
+        return NL.join([f"P[{k}]{{", "   GP1:", "\tUF : 0, UT : 0,\t", "\t" + ",\t".join(values[:3]) + ",",
+                        "\t" + ",\t".join(values[3:]), "};"])
+
+    def edit(t: str) -> str:
+        t = t.replace(NL + "/POS" + NL, NL + _statement("J P[1] 100% FINE") + NL + _statement("J P[2] 100% FINE") + NL
+                      + "/POS" + NL + position(1, detour) + NL + position(2, back) + NL, 1)
+        return t
+    return edit
+
+
+FLOW_MUTANTS: dict[str, tuple[Callable[[Placed], dict[str, Edit]], set[str]]] = {
+    "ABORT before the first motion": (lambda p: _before_frames("ABORT"), {"flow"}),
+    "END before the first motion": (lambda p: _before_frames("END"), {"flow"}),
+    "PAUSE before the first motion": (lambda p: _before_frames("PAUSE"), {"flow"}),
+    "END after the first weld": (lambda p: _around_weld1("", "END"), {"flow"}),
+    "JMP over a weld": (lambda p: _around_weld1("JMP LBL[1]", "LBL[1]"), {"spot"}),
+    "JMP back to a label": (lambda p: _around_weld1("LBL[1:again]", "JMP LBL[1]"), {"unsupported"}),
+    "JMP under a condition": (lambda p: _around_weld1("IF R[1]=1,JMP LBL[1]", "LBL[1]"), {"unsupported"}),
+    "colliding move inside the called frames program": (
+        lambda p: {".ls": _before_first_line(f"CALL {p.stem('fanuc')}_FRAMES"), "_FRAMES.ls": _detour_in_frames_program(p)},
+        {"collision"}),
+    "call of an unknown program": (lambda p: {".ls": _before_first_line("CALL MYSTERY")}, {"unsupported"}),
+    "mm/sec three times the line speed": (
+        lambda p: {".ls": lambda t: re.sub(r"(L P\[\d+(?::[^\]]*)?\] )\d+mm/sec",
+                                           lambda m: f"{m[1]}{round(3000 * p.cell.planner.tcp_speed)}mm/sec", t)}, {"speed"}),
+    "cm/min three times the line speed": (
+        lambda p: {".ls": lambda t: re.sub(r"(L P\[\d+(?::[^\]]*)?\] )\d+mm/sec",
+                                           lambda m: f"{m[1]}{round(3 * 6000 * p.cell.planner.tcp_speed)}cm/min", t)},
+        {"speed"}),
+    "J at 300 %": (lambda p: {".ls": lambda t: re.sub(r"(J P\[\d+\] )100%", r"\g<1>300%", t)}, {"speed"}),
+    "weld time in ms": (lambda p: {".ls": lambda t: re.sub(r"(CALL SPOT_WELD\(1,)([\d.]+)",
+                                                            lambda m: f"{m[1]}{1000 * float(m[2]):.3f}", t, count=1)},
+                        {"weld"}),
+    "SPOT_WELD waits another time": (lambda p: {"SPOT_WELD.ls": lambda t: t.replace("WAIT AR[2] ;", "WAIT 500.00(sec) ;")},
+                                     {"unsupported"}),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", sorted(FLOW_MUTANTS))
+def test_fanuc_flow_mutant_is_caught(placed: Placed, kind: str) -> None:
+    edit, expected = FLOW_MUTANTS[kind]
+    report = placed.verify("fanuc", edit(placed), "flow_" + re.sub(r"\W+", "_", kind))
+    assert not report.clean, kind
+    assert expected & {v.kind for v in report.violations}, report.violations
+
+
+@pytest.mark.slow
+def test_fanuc_flow_the_controller_follows_exactly_is_clean(placed: Placed) -> None:
+    """A label with a comment and a JMP to the statement after it change nothing the controller does."""
+    def edit(t: str) -> str:
+        return _before_first_line("LBL[7:approach]")(_before_first_line("JMP LBL[7]")(t))
+    report = placed.verify("fanuc", {".ls": edit}, "flow_followed")
+    assert report.clean, report.violations
+
+
+# The controller model (tests/controller_model, written from the vendors' documents) runs the same
+# mutants: the welds that run, the motions and where the program stops agree with robomax's reading.
+MODEL_CHECKED = ("ABORT before the first motion", "END before the first motion", "PAUSE before the first motion",
+                 "END after the first weld", "JMP over a weld", "colliding move inside the called frames program")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", MODEL_CHECKED)
+def test_fanuc_flow_mutant_reads_as_the_controller_model_runs_it(placed: Placed, kind: str) -> None:
+    edit, _ = FLOW_MUTANTS[kind]
+    main, read = read_execution(placed, "fanuc", edit(placed), "model_" + re.sub(r"\W+", "_", kind))
+    frames = main.with_name(main.stem + "_FRAMES.ls")
+    run = run_fanuc(main.read_text(), name=main.name, called={frames.name: frames.read_text()})
+    assert model_execution(run, "SPOT_WELD") == read

@@ -14,11 +14,13 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
 
 import pytest
 from scipy.spatial.transform import Rotation
 
-from conftest import Edit, Placed, placement_mm_zyx
+from conftest import Edit, Placed, detour_into_the_part, model_execution, placement_mm_zyx, read_execution
+from controller_model.krl import run_krl
 
 FRAME = re.compile(r"\{X (-?[\d.]+), Y (-?[\d.]+), Z (-?[\d.]+), A (-?[\d.]+), B (-?[\d.]+), C (-?[\d.]+)\}")
 
@@ -100,3 +102,105 @@ def test_krl_mutant_is_rejected_with_a_line(placed: Placed, kind: str) -> None:
 def test_the_written_krl_program_is_clean(placed: Placed) -> None:
     report = placed.verify("krl", {}, "unchanged")
     assert report.clean, report.violations
+
+
+# ------------------------------------------------------------------ what the controller executes
+# Mutants of the program's flow, speeds and weld times (krl.py's docstring, export/flow.py): each
+# is caught with the violation the controller's execution implies, and the program with flow it
+# can follow exactly (a label, a jump to the next statement, a call of a routine without motion)
+# still verifies clean.
+
+WELD1 = re.compile(r"^(spot_weld\(1, [\d.]+\).*)$", re.MULTILINE)
+
+
+def _after_ini(statement: str) -> dict[str, Edit]:
+    """`statement` right after the INI fold, before the first motion."""
+    return {".src": lambda t: t.replace(";ENDFOLD (INI)\n", f";ENDFOLD (INI)\n{statement}\n", 1)}
+
+
+def _around_weld1(before: str, after: str) -> dict[str, Edit]:
+    return {".src": lambda t: WELD1.sub(lambda m: f"{before}\n{m[1]}\n{after}".strip("\n"), t, count=1)}
+
+
+def _before_first_line(statement: str) -> Edit:
+    """`statement` before the first LIN's fold (after the joint target the approach starts from)."""
+    return lambda t: t.replace(";FOLD LIN", f"{statement}\n;FOLD LIN", 1)
+
+
+def _axes(q: list[float]) -> str:
+    return "{" + ",".join(f"A{i} {v:.4f}" for i, v in enumerate(q, start=1)) + "}"
+
+
+def _detour_routine(placed: Placed) -> str:
+    detour, back = detour_into_the_part(placed)
+    return f"\nDEF detour( )\n  PTP {_axes(detour)}\n  PTP {_axes(back)}\nEND\n"
+
+
+def _faster_lines(placed: Placed) -> dict[str, Edit]:
+    v = 3.0 * placed.cell.planner.tcp_speed
+    return {".src": lambda t: re.sub(r"^(BAS\(#CP_PARAMS,[\d.]+\)\n)", lambda m: f"{m[1]}$VEL.CP={v:g}\n", t,
+                                     flags=re.MULTILINE)}
+
+
+def _weld_in_ms(placed: Placed) -> dict[str, Edit]:
+    return {".src": lambda t: re.sub(r"^spot_weld\(1, ([\d.]+)\)", lambda m: f"spot_weld(1, {1000 * float(m[1]):.3f})",
+                                     t, count=1, flags=re.MULTILINE)}
+
+
+FLOW_MUTANTS: dict[str, tuple[Callable[[Placed], dict[str, Edit]], set[str]]] = {
+    "RETURN before the first motion": (lambda p: _after_ini("RETURN"), {"flow"}),
+    "HALT before the first motion": (lambda p: _after_ini("HALT"), {"flow"}),
+    "RETURN after the first weld": (lambda p: _around_weld1("", "RETURN"), {"flow"}),
+    "GOTO over a weld": (lambda p: _around_weld1("GOTO skip_weld", "skip_weld:"), {"spot"}),
+    "GOTO back to a label": (lambda p: _around_weld1("again:", "GOTO again"), {"unsupported"}),
+    "GOTO under a condition": (lambda p: _around_weld1("IF $IN[1] THEN\nGOTO skip_weld\nENDIF", "skip_weld:"),
+                               {"unsupported"}),
+    "colliding move inside a called DEF": (
+        lambda p: {".src": lambda t: _before_first_line("detour( )")(t) + _detour_routine(p)}, {"collision"}),
+    "colliding move inside the frames program's DEF": (
+        lambda p: {".src": _before_first_line("detour( )"), "_frames.src": lambda t: t + _detour_routine(p)},
+        {"collision"}),
+    "call of an unknown routine": (lambda p: {".src": _before_first_line("mystery( )")}, {"unsupported"}),
+    "$VEL.CP three times the line speed": (_faster_lines, {"speed"}),
+    "$VEL_AXIS of 300 %": (lambda p: {".src": lambda t: re.sub(r"^(BAS\(#PTP_PARAMS,\d+\)\n)", r"\1$VEL_AXIS[1]=300\n", t,
+                                                                flags=re.MULTILINE)}, {"speed"}),
+    "PDAT ACC of 300 %": (lambda p: {".dat": lambda t: re.sub(r"(DECL PDAT PPDAT\d+=\{VEL [\d.]+,ACC )[\d.]+", r"\g<1>300.000",
+                                                               t)}, {"speed"}),
+    "weld time in ms": (_weld_in_ms, {"weld"}),
+    "spot_weld waits in ms": (lambda p: {".src": lambda t: t.replace("  WAIT SEC weld_time\n", "  WAIT SEC weld_time*1000\n")},
+                              {"unsupported"}),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", sorted(FLOW_MUTANTS))
+def test_krl_flow_mutant_is_caught(placed: Placed, kind: str) -> None:
+    edit, expected = FLOW_MUTANTS[kind]
+    report = placed.verify("krl", edit(placed), "flow_" + re.sub(r"\W+", "_", kind))
+    assert not report.clean, kind
+    assert expected & {v.kind for v in report.violations}, report.violations
+
+
+@pytest.mark.slow
+def test_krl_flow_the_controller_follows_exactly_is_clean(placed: Placed) -> None:
+    """A jump label, a GOTO to the statement after it, and a call of a DEF without motion change
+    nothing the controller does."""
+    edits = {".src": lambda t: _before_first_line("GOTO next\nnext:\nnoop( )")(t)
+             + "\nDEF noop( )\n  ; nothing to do\nEND\n"}
+    report = placed.verify("krl", edits, "flow_followed")
+    assert report.clean, report.violations
+
+
+# The controller model (tests/controller_model, written from the vendors' documents) runs the same
+# mutants: the welds that run, the motions and where the program stops agree with robomax's reading.
+MODEL_CHECKED = ("RETURN before the first motion", "HALT before the first motion", "RETURN after the first weld", "GOTO over a weld",
+                 "colliding move inside a called DEF")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", MODEL_CHECKED)
+def test_krl_flow_mutant_reads_as_the_controller_model_runs_it(placed: Placed, kind: str) -> None:
+    edit, _ = FLOW_MUTANTS[kind]
+    main, read = read_execution(placed, "krl", edit(placed), "model_" + re.sub(r"\W+", "_", kind))
+    run = run_krl(main.read_text(), main.with_suffix(".dat").read_text(), src_name=main.name)
+    assert model_execution(run, "spot_weld") == read

@@ -19,7 +19,7 @@ import pytest
 import yaml
 from scipy.spatial.transform import Rotation
 
-from conftest import Edit, Placed, placement_mm_zyx
+from conftest import Edit, Placed, detour_into_the_part, model_execution, placement_mm_zyx, read_execution
 from controller_model.common import Call, Motion
 from controller_model.rapid import run_rapid
 from robomax_py.io.cell import load_cell, load_cell_robot
@@ -206,3 +206,101 @@ def test_the_controller_model_stops_every_spotl_at_its_spot(placed_package: Plac
             welded.append(int(gaps.argmin()))
             assert event.args[1] == "gun2"
     assert sorted(welded) == list(range(len(spots)))
+
+
+# ------------------------------------------------------------------ what the controller executes
+# Mutants of the module's flow, speeds and weld times (rapid.py's docstring, export/flow.py): each
+# is caught with the violation the controller's execution implies; a module with flow verify can
+# follow exactly (labels, one on the line of the statement it marks, a jump to the next
+# statement, a call of a PROC without motion) still verifies clean.
+
+WELD1 = re.compile(r"^(\s*spot_weld 1, [\d.]+;.*)$", re.MULTILINE)
+
+
+def _first_in_main(statement: str) -> dict[str, Edit]:
+    return {".mod": lambda t: t.replace("PROC main()\n", f"PROC main()\n    {statement}\n", 1)}
+
+
+def _around_weld1(before: str, after: str) -> dict[str, Edit]:
+    return {".mod": lambda t: WELD1.sub(lambda m: "\n".join(x for x in (before, m[1], after) if x), t, count=1)}
+
+
+def _before_first_line(statement: str) -> Edit:
+    return lambda t: re.sub(r"^(\s*MoveL )", lambda m: f"    {statement}\n{m[1]}", t, count=1, flags=re.MULTILINE)
+
+
+def _detour_proc(placed: Placed) -> str:
+    detour, back = detour_into_the_part(placed)
+    eax = "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]"
+    moves = "".join(f"    MoveAbsJ [[{', '.join(f'{v:.4f}' for v in q)}], {eax}], vmax, fine, tool0;\n" for q in (detour, back))
+    return f"  PROC detour()\n{moves}  ENDPROC\n"
+
+
+def _with_proc(proc: str) -> Edit:
+    return lambda t: t.replace("ENDMODULE", proc + "ENDMODULE", 1)
+
+
+def _faster_speeddata(placed: Placed) -> dict[str, Edit]:
+    v = 3000.0 * placed.cell.planner.tcp_speed
+    return {".mod": lambda t: re.sub(r"(speeddata v_lin1 := \[)[\d.]+", lambda m: f"{m[1]}{v:.3f}", t)}
+
+
+FLOW_MUTANTS: dict[str, tuple[Callable[[Placed], dict[str, Edit]], set[str]]] = {
+    "RETURN before the first motion": (lambda p: _first_in_main("RETURN;"), {"flow"}),
+    "Stop before the first motion": (lambda p: _first_in_main("Stop;"), {"flow"}),
+    "EXIT after the first weld": (lambda p: _around_weld1("", "    EXIT;"), {"flow"}),
+    "GOTO over a weld": (lambda p: _around_weld1("    GOTO skip_weld;", "  skip_weld:"), {"spot"}),
+    "GOTO back to a label": (lambda p: _around_weld1("  again:", "    GOTO again;"), {"unsupported"}),
+    "GOTO under a compact IF": (lambda p: _around_weld1("    IF DInput(diClamp1Closed) = 1 GOTO skip_weld;", "  skip_weld:"),
+                                {"unsupported"}),
+    "colliding move inside a called PROC": (
+        lambda p: {".mod": lambda t: _with_proc(_detour_proc(p))(_before_first_line("detour;")(t))}, {"collision"}),
+    "colliding move inside the data module's PROC": (
+        lambda p: {".mod": _before_first_line("detour;"), "_frames.mod": _with_proc(_detour_proc(p))}, {"collision"}),
+    "call of an unknown routine": (lambda p: {".mod": _before_first_line("mystery;")}, {"unsupported"}),
+    "speeddata three times the line speed": (_faster_speeddata, {"speed"}),
+    "v5000 on a line": (lambda p: {".mod": lambda t: re.sub(r"(MoveL p\d+, )v_lin\d+", r"\1v5000", t, count=1)}, {"speed"}),
+    "VelSet 300 %": (lambda p: {".mod": lambda t: re.sub(r"VelSet [\d.]+,", "VelSet 300,", t, count=1)}, {"speed"}),
+    "AccSet 300 %": (lambda p: {".mod": lambda t: re.sub(r"AccSet [\d.]+,", "AccSet 300,", t, count=1)}, {"speed"}),
+    "weld time in ms": (lambda p: {".mod": lambda t: re.sub(r"(spot_weld 1, )([\d.]+)", lambda m: f"{m[1]}{1000 * float(m[2]):.3f}",
+                                                             t, count=1)}, {"weld"}),
+    "spot_weld waits in ms": (lambda p: {".mod": lambda t: t.replace("WaitTime \\InPos, weld_time;",
+                                                                      "WaitTime \\InPos, weld_time * 1000;")}, {"unsupported"}),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", sorted(FLOW_MUTANTS))
+def test_rapid_flow_mutant_is_caught(placed: Placed, kind: str) -> None:
+    edit, expected = FLOW_MUTANTS[kind]
+    report = placed.verify("rapid", edit(placed), "flow_" + re.sub(r"\W+", "_", kind))
+    assert not report.clean, kind
+    assert expected & {v.kind for v in report.violations}, report.violations
+
+
+@pytest.mark.slow
+def test_rapid_flow_the_controller_follows_exactly_is_clean(placed: Placed) -> None:
+    """A label on its own line before the first weld (it swallowed the weld once), one on the
+    line of the statement it marks, a GOTO to the statement after it and a call of a PROC without
+    motion change nothing the controller does."""
+    def edit(t: str) -> str:
+        t = WELD1.sub(lambda m: "  before_weld:\n" + m[1], t, count=1)
+        t = _before_first_line("GOTO next;\n  next: noop;")(t)
+        return _with_proc("  PROC noop()\n    ! nothing to do\n  ENDPROC\n")(t)
+    report = placed.verify("rapid", {".mod": edit}, "flow_followed")
+    assert report.clean, report.violations
+
+
+# The controller model (tests/controller_model, written from the vendors' documents) runs the same
+# mutants: the welds that run, the motions and where the program stops agree with robomax's reading.
+MODEL_CHECKED = ("RETURN before the first motion", "Stop before the first motion", "EXIT after the first weld", "GOTO over a weld",
+                 "colliding move inside a called PROC", "colliding move inside the data module's PROC")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", MODEL_CHECKED)
+def test_rapid_flow_mutant_reads_as_the_controller_model_runs_it(placed: Placed, kind: str) -> None:
+    edit, _ = FLOW_MUTANTS[kind]
+    main, read = read_execution(placed, "rapid", edit(placed), "model_" + re.sub(r"\W+", "_", kind))
+    run = run_rapid({p.name: p.read_text() for p in (main, main.with_name(main.stem + "_frames.mod"))})
+    assert model_execution(run, "spot_weld") == read

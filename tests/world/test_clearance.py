@@ -40,3 +40,35 @@ def test_skipping_finds_the_brute_force_minimum(world: tuple[CollisionWorld, np.
     assert i == int(np.argmin(brute))
     report = min_clearance(w, np.arange(len(q)) * 0.01, q)
     assert report is not None and report.distance_m <= d
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_with_obstacles_that_come_and_go_the_minimum_is_the_brute_force_one(reference_cell_path: Path, seed: int) -> None:
+    """A box that is present only in two windows, placed where the walk passes: the per-pair skipping
+    counts each pair only while it exists and still gives exactly the sample-by-sample minimum."""
+    import dataclasses
+
+    from robomax_py.robot.model import fk_flange
+    from robomax_py.spec import Box, ObjectSpec
+    from robomax_py.transforms import pose_matrix
+
+    cell = load_cell(reference_cell_path)
+    robot = load_cell_robot(cell)
+    rng = np.random.default_rng(seed)
+    home = np.asarray(cell.home)
+    goal = np.array([0.0, -0.35, 0.55, 0.0, 0.6, 0.0]) + rng.uniform(-0.3, 0.3, 6)
+    steps = np.linspace(0.0, 1.0, 120)[:, None]
+    q = home + steps * (goal - home) + rng.normal(0.0, 0.002, (120, 6))
+    t = np.arange(len(q)) * 0.01
+    near = np.asarray(fk_flange(robot, q[70]))[:3, 3] + rng.uniform(-0.1, 0.1, 3) + [0.0, 0.0, 0.25]
+    box = ObjectSpec("door", Box((0.3, 0.3, 0.05)), np.asarray(cell.T_world_base) @ pose_matrix(near, [0.0, 0.0, 0.0]),
+                     present=((0.3, 0.6), (0.9, 1.0)))
+    cell = dataclasses.replace(cell, dynamic=(box,))
+    w = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+    assert w.has_dynamic
+    brute = [w.closest(qi, float(ti)).distance for qi, ti in zip(q, t, strict=True)]
+    i, d = _closest_sample(w, q, t)
+    assert d == min(brute)
+    assert i == int(np.argmin(brute))
+    report = min_clearance(w, t, q)
+    assert report is not None and report.distance_m <= d
