@@ -157,7 +157,7 @@ def plan_cell(
         rounds=sequencer.rounds, dp_evaluations=sequencer.dp_evaluations, seconds=clock,
     )
     return PlanResult(cell.name, robot.name, "planned", "planned", spots=tuple(plans), transitions=tuple(transitions),
-                      trajectory=trajectory, stats=stats, baseline=options.baseline, joint_names=robot.joint_names,
+                      trajectory=trajectory, stats=stats, baseline=options.method != "optimised", joint_names=robot.joint_names,
                       tool=cell.tool.name, T_flange_tcp=np.asarray(robot.T_flange_tcp),
                       T_world_base=np.asarray(cell.T_world_base),
                       T_root_controller=np.asarray(cell.robot.controller.T_root_base), controller=cell.controller,
