@@ -2,8 +2,9 @@
 
     python tests/bench/bench_plan.py [CELL] [--runs 5]
 
-Reports medians over the runs of: planning time (one core), cycle time of the optimiser vs the
-baseline (the published method's choices, same timing layer, same run), collision checks spent;
+Reports medians over the runs of: planning time (one core), cycle time of the optimiser vs both
+baselines (the published method and teach-in, `plan.METHODS`; same timing layer, same run),
+collision checks spent;
 and the detour table: the published method built a configuration-space map over the first three
 axes at resolution r and searched it (their figures for r = 20 / 50 / 100: 8,000 tests in 0.3 s,
 25,000 in 22.3 s, 1,000,000 in 122.2 s on a 3 GHz CPU). We rebuild that map for the same detour
@@ -26,7 +27,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.plan import PlanOptions, plan_cell  # noqa: E402
+from robomax_py.plan import PlanOptions, method_options, plan_cell  # noqa: E402
 from robomax_py.plan.graph import Sequencer as _Sequencer
 from robomax_py.plan.results import resolved_options
 from robomax_py.cspace.grid import nearest_cell  # noqa: E402
@@ -114,12 +115,11 @@ def main() -> None:
     rows: dict[str, list[float]] = collections.defaultdict(list)
     last = {}
     for _ in range(args.runs):
-        for baseline in (False, True):
+        for tag in ("optimised", "published", "teach-in"):
             t0 = cpu()
-            result = plan_cell(cell, robot, PlanOptions(baseline=baseline))
+            result = plan_cell(cell, robot, method_options(tag))
             seconds = cpu() - t0
             assert result.status == "planned", result.message
-            tag = "baseline" if baseline else "optimised"
             st = result.stats
             assert st is not None
             rows[f"{tag} planning s"].append(seconds)
@@ -133,8 +133,10 @@ def main() -> None:
     print(f"{'quantity':40s} {'median':>12s} {'min':>12s} {'max':>12s}")
     for name, values in rows.items():
         print(f"{name:40s} {statistics.median(values):12.3f} {min(values):12.3f} {max(values):12.3f}")
-    opt, base = statistics.median(rows["optimised cycle s"]), statistics.median(rows["baseline cycle s"])
-    print(f"cycle time optimised / baseline = {opt / base:.4f}  ({100 * (1 - opt / base):.1f} % shorter)")
+    opt = statistics.median(rows["optimised cycle s"])
+    for tag in ("published", "teach-in"):
+        base = statistics.median(rows[f"{tag} cycle s"])
+        print(f"cycle time optimised / {tag} = {opt / base:.4f}  ({100 * (1 - opt / base):.1f} % shorter)")
 
     # Detour table: around clamp 1, between the optimiser's configurations at s5 and s6.
     res = last["optimised"]

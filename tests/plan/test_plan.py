@@ -309,3 +309,36 @@ def test_optimiser_beats_baseline_on_reference_cell() -> None:
     assert baseline.status == "planned", baseline.message
     assert baseline.baseline and not optimised.baseline
     assert optimised.cycle_time < baseline.cycle_time
+
+
+def test_a_blended_timing_that_fails_its_check_is_replaced_by_the_unblended_one(
+    tmp_path: Path, write_small_cell: Any, monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Two generated cells (a KR 120 frame and flange) failed with 'the timed program failed its own
+    check: collision: tool_body vs part' at a fly-by blend, though the same tour timed without
+    blends is free. Here the check of every blended timing is made to fail."""
+    import robomax_py.plan.pipeline as pipeline
+
+    cell = load_cell(write_small_cell(tmp_path, "small"))
+    robot = load_cell_robot(cell)
+    real = pipeline.verify_trajectory
+    seen: list[bool] = []
+
+    def check(world: Any, robot: Any, traj: Any, *args: Any, **kwargs: Any) -> Any:
+        got = real(world, robot, traj, *args, **kwargs)
+        seen.append(got.clean)
+        if len(seen) == 1:                          # the blended timing: as if it grazed an object
+            return type(got)((_violation(traj),), got.checks)
+        return got
+
+    monkeypatch.setattr(pipeline, "verify_trajectory", check)
+    result = plan_cell(cell, robot, PlanOptions())
+    assert result.status == "planned", result.message
+    assert len(seen) == 2 and result.options.blend is False
+    assert verify_trajectory(world_of(cell, robot), robot, result.trajectory).clean  # type: ignore[arg-type]
+
+
+def _violation(traj: Any) -> Any:
+    from robomax_py.world.motion import Violation
+
+    return Violation(float(traj.t[1]), "collision", "tool_body vs part (made up)")
