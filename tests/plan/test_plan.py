@@ -317,7 +317,7 @@ def test_a_blended_timing_that_fails_its_check_is_replaced_by_the_unblended_one(
     """Two generated cells (a KR 120 frame and flange) failed with 'the timed program failed its own
     check: collision: tool_body vs part' at a fly-by blend, though the same tour timed without
     blends is free. Here the check of every blended timing is made to fail."""
-    import robomax_py.plan.pipeline as pipeline
+    from robomax_py.plan import pipeline
 
     cell = load_cell(write_small_cell(tmp_path, "small"))
     robot = load_cell_robot(cell)
