@@ -35,7 +35,7 @@ from robomax_py.export import (
 from robomax_py.export.dialect import Parsed, PlannedProgram
 from robomax_py.export.plan_program import planned_program
 from robomax_py.export.rebuild import rebuild
-from robomax_py.plan import PlanResult
+from robomax_py.plan import PlanResult, method_suffix
 from robomax_py.program import LinMove, Program, lin_pose
 from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.spec import CellSpec
@@ -90,16 +90,17 @@ def file_names(name: str, files: dict[str, str]) -> dict[str, str]:
 
 
 def publish(result: PlanResult, cell: CellSpec, robot: RobotModel, formats: tuple[str, ...], *,
-            stamp: str = "", baseline: bool = False) -> tuple[dict[str, str], list[CheckedProgram]]:
+            stamp: str = "", method: str = "optimised") -> tuple[dict[str, str], list[CheckedProgram]]:
     """Every file of a planned result (the trajectory file first, then each format's files), all
     proven; ExportError when any is not.
 
-    baseline : name the files `<cell>_baseline.*`, so that a baseline run never replaces the
-        optimised program.
+    method : the plan's method; a baseline's files are named `<cell>_published.*` or
+        `<cell>_teach_in.*` (`method_suffix`), so that a baseline run never replaces the optimised
+        program.
     """
     for fmt in formats:                          # before any dialect is proven: one clear message
         require_calibration(fmt, robot)
-    name = result.cell + ("_baseline" if baseline else "")
+    name = result.cell + method_suffix(method)
     files = {f"{name}.json": render_trajectory(result)}
     planned = planned_program(result, cell.digest, stamp)
     checked = []

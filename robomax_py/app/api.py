@@ -50,7 +50,7 @@ def load_cell(path: str | Path) -> LoadedCell:
 
 
 def plan_cell(cell: LoadedCell, options: PlanOptions | None = None, **overrides: object) -> PlanResult:
-    """Plan a loaded cell. `overrides` are `PlanOptions` fields (e.g. ``baseline=True``)."""
+    """Plan a loaded cell. `overrides` are `PlanOptions` fields (e.g. ``given_order=True``, the published method)."""
     from robomax_py.plan import plan_cell as plan
 
     opts = dataclasses.replace(options or PlanOptions(), **overrides)  # type: ignore[arg-type]
@@ -75,13 +75,14 @@ def write_programs(cell: LoadedCell, result: PlanResult, out_dir: str | Path, fo
 
     from robomax_py.export import SHARED_FILES, choose_formats
     from robomax_py.io.files import commit_set
+    from robomax_py.plan import method_suffix
     from robomax_py.publish import publish
 
     chosen = choose_formats(formats, cell.robot)
     for skipped in chosen.skipped:
         warnings.warn(skipped.message, FormatSkippedWarning, stacklevel=2)
-    files, _ = publish(result, cell.spec, cell.robot, chosen.names, stamp=stamp, baseline=result.baseline)
-    name = result.cell + ("_baseline" if result.baseline else "")
+    files, _ = publish(result, cell.spec, cell.robot, chosen.names, stamp=stamp, method=result.method)
+    name = result.cell + method_suffix(result.method)
     return list(commit_set(Path(out_dir), name, files, cell.spec.digest, SHARED_FILES).paths)
 
 

@@ -52,7 +52,7 @@ class BatchOptions:
 
     jobs: int                        # cells planned at the same time (processes or Ray tasks)
     timeout: float | None = None     # s of wall time per cell from its start; None: no limit
-    baseline: bool = False           # plan with PlanOptions(baseline=True)
+    method: str = "optimised"       # or a baseline: "published", "teach-in" (plan.METHODS)
 
 
 @dataclass(frozen=True, slots=True)
@@ -73,25 +73,25 @@ class CellOutcome:
     peak_rss_mb: float | None = None  # peak resident memory of the worker's process so far, MiB (Unix)
 
 
-Worker = Callable[[str, bool], CellOutcome]
+Worker = Callable[[str, str], CellOutcome]
 Context = ForkServerContext | SpawnContext
 # Called in the caller's process as each cell finishes (index, outcome); returns the outcome to keep.
 OnDone = Callable[[int, CellOutcome], CellOutcome]
 
 
-def plan_cell_file(file: str, baseline: bool) -> CellOutcome:
+def plan_cell_file(file: str, method: str) -> CellOutcome:
     """The worker: load a cell file, plan it and render its programs (no file is written here)."""
     from robomax_py.errors import RobomaxError
     from robomax_py.io.cell import load_cell, load_cell_robot
-    from robomax_py.plan import PlanOptions, plan_cell
+    from robomax_py.plan import method_options, plan_cell
     from robomax_py.publish import publish
 
     t0 = time.perf_counter()
     try:
         spec = load_cell(file)
         robot = load_cell_robot(spec)
-        result = plan_cell(spec, robot, PlanOptions(baseline=baseline))
-        programs = (tuple(publish(result, spec, robot, ("srcl",), baseline=baseline)[0].items())
+        result = plan_cell(spec, robot, method_options(method))
+        programs = (tuple(publish(result, spec, robot, ("srcl",), method=method)[0].items())
                     if result.status == PLANNED else ())
     except RobomaxError as exc:
         return CellOutcome(file, Path(file).stem, BAD_INPUT, time.perf_counter() - t0, reasons=str(exc))
@@ -105,11 +105,11 @@ def plan_cell_file(file: str, baseline: bool) -> CellOutcome:
                        detours=detours, programs=programs, cell_sha256=spec.digest)
 
 
-def run_worker(worker: Worker, file: str, baseline: bool) -> CellOutcome:
+def run_worker(worker: Worker, file: str, method: str) -> CellOutcome:
     """Run a worker; an exception escaping it (a bug, not a user's mistake) becomes a `crashed` outcome."""
     t0 = time.perf_counter()
     try:
-        outcome = worker(file, baseline)
+        outcome = worker(file, method)
     except Exception as exc:  # noqa: BLE001 - reported per cell; the batch goes on
         where = traceback.extract_tb(exc.__traceback__)[-1]
         detail = f"{type(exc).__name__}: {exc} (at {Path(where.filename).name}:{where.lineno})"
@@ -127,9 +127,9 @@ def _peak_rss_mb() -> float | None:
     return peak / 1024 / 1024 if sys.platform == "darwin" else peak / 1024   # bytes on macOS, KiB on Linux
 
 
-def _child_main(conn: multiprocessing.connection.Connection, worker: Worker, file: str, baseline: bool) -> None:
+def _child_main(conn: multiprocessing.connection.Connection, worker: Worker, file: str, method: str) -> None:
     """Entry point of a cell's process: send the outcome back, then exit."""
-    outcome = run_worker(worker, file, baseline)
+    outcome = run_worker(worker, file, method)
     conn.send(outcome)
     conn.close()
 
@@ -176,7 +176,7 @@ def run_local(
             while pending and len(running) < max(1, options.jobs):
                 i, file = pending.popleft()
                 receiver, sender = ctx.Pipe(duplex=False)
-                process = ctx.Process(target=_child_main, args=(sender, worker, file, options.baseline),
+                process = ctx.Process(target=_child_main, args=(sender, worker, file, options.method),
                                       name=f"robomax-batch-{i}", daemon=True)
                 process.start()
                 sender.close()             # the child holds the only sending end: EOF when it dies
@@ -275,7 +275,7 @@ def run_ray(
             while pending or running:
                 while pending and len(running) < max(1, options.jobs):
                     i, file = pending.popleft()
-                    ref = remote.remote(worker, str(Path(file).resolve()), options.baseline)
+                    ref = remote.remote(worker, str(Path(file).resolve()), options.method)
                     running[ref] = (i, time.monotonic())
                 wait_s = None
                 if options.timeout is not None:
@@ -336,7 +336,7 @@ def write_outcome_programs(out_dir: Path, outcome: CellOutcome, taken: dict[str,
         return replace(outcome, status=BAD_INPUT, programs=(), cycle_time=None, detours=None,
                        reasons=f"{outcome.file}: name: cell name '{outcome.cell}' is also that of {clash}; "
                                "its programs would overwrite those")
-    # The set is named as its trajectory file (publish renders it first): the cell, or <cell>_baseline.
+    # The set is named as its trajectory file (publish renders it first): the cell, or <cell>_published / <cell>_teach_in.
     name = next((n.removesuffix(".json") for n, _ in outcome.programs if n.endswith(".json")), outcome.cell)
     committed = commit_set(out_dir, name, dict(outcome.programs), outcome.cell_sha256, SHARED_FILES)
     written = [*committed.paths, committed.manifest]

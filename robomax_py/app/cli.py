@@ -142,7 +142,7 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")]) -> Non
 def plan(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
     out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder")] = Path("programs"),
-    baseline: Annotated[bool, typer.Option("--baseline", help="the published method: given order, nominal orientation, first branch; writes <name>_baseline.*")] = False,
+    baseline: Annotated[str | None, typer.Option("--baseline", metavar="published|teach-in", help="plan a baseline instead and write <name>_published.* or <name>_teach_in.*: published = the published method (paper 003: the cell's spot order, the DP over every orientation sample and IK branch, the same detours and timing), teach-in = the cell's order, nominal orientation, first branch")] = None,
     as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable report instead of tables")] = False,
     speed: Annotated[float | None, typer.Option("--speed", min=0.01, max=1.0, help="override of every programmed speed, fraction in (0, 1] (default: the cell's planner.speed, else 1)")] = None,
     verbose: Annotated[bool, typer.Option("-v", "--verbose", help="debug logging: stage sizes, counts and times")] = False,
@@ -151,6 +151,7 @@ def plan(
     stamp: Annotated[bool, typer.Option("--stamp", help="write the date into each program's header (otherwise the same cell gives the same bytes)")] = False,
 ) -> None:
     """Plan a cell and write its program files (only when the plan is complete and every program proven)."""
+    method = _method(baseline)
 
     def run() -> int:
         import datetime
@@ -163,7 +164,12 @@ def plan(
             from robomax_py.export import SHARED_FILES, choose_formats
             from robomax_py.io.cell import load_cell, load_cell_robot
             from robomax_py.io.files import commit_set
-            from robomax_py.plan import PlanOptions, plan_cell
+            from robomax_py.plan import (
+                PlanOptions,
+                method_options,
+                method_suffix,
+                plan_cell,
+            )
             from robomax_py.publish import publish
         _honour_signals()
 
@@ -176,13 +182,13 @@ def plan(
         chosen = choose_formats(formats, robot)
         names = chosen.names
         _warn([s.message for s in chosen.skipped])
-        set_name = spec.name + ("_baseline" if baseline else "")
+        set_name = spec.name + method_suffix(method)
         with stage_bars(err, enabled=not verbose) as bars:
             def progress(stage: str, done: int, total: int) -> None:
                 _honour_signals()
                 bars(stage, done, total)
 
-            result = plan_cell(spec, robot, PlanOptions(baseline=baseline, speed=speed), progress)
+            result = plan_cell(spec, robot, method_options(method, PlanOptions(speed=speed)), progress)
         _honour_signals()
         seconds = time.perf_counter() - t0
         written: list[Path] = []
@@ -193,7 +199,7 @@ def plan(
             from robomax_py.app.chart import cycle_chart, render_png
 
             date = datetime.date.today().isoformat() if stamp else ""
-            texts, checked = publish(result, spec, robot, names, stamp=date, baseline=baseline)  # all proven before any write
+            texts, checked = publish(result, spec, robot, names, stamp=date, method=method)  # all proven before any write
             files: dict[str, str | bytes] = dict(texts)
             if plot:
                 files[f"{set_name}.png"] = render_png(cycle_chart(result))
@@ -237,6 +243,15 @@ def plan(
 
     code = _guarded(run)
     raise typer.Exit(code)
+
+
+def _method(baseline: str | None) -> str:
+    """The planning method `--baseline` names (None: the optimiser); a usage error otherwise."""
+    if baseline is None:
+        return "optimised"
+    if baseline not in ("published", "teach-in"):
+        raise typer.BadParameter(f"expected published or teach-in, got {baseline!r}", param_hint="--baseline")
+    return baseline
 
 
 def _stale_programs(out_dir: Path, name: str, every: bool = False) -> list[str]:
@@ -463,13 +478,14 @@ def batch(
     timeout: Annotated[float | None, typer.Option("--timeout", min=0.0, help="seconds per cell before its worker is killed")] = None,
     ray_address: Annotated[str | None, typer.Option("--ray", metavar="[ADDRESS]",
                                                     help="plan on Ray: a local Ray without ADDRESS (or with `local`), else the cluster at ADDRESS")] = None,
-    baseline: Annotated[bool, typer.Option("--baseline", help="the published method: given order, nominal orientation, first branch")] = False,
+    baseline: Annotated[str | None, typer.Option("--baseline", metavar="published|teach-in", help="plan every cell by a baseline instead (see plan --baseline)")] = None,
 ) -> None:
     """Plan many cells in parallel (one process per cell); write their programs and a summary table.
 
     Exit 0 all planned; 3 some infeasible, timed out or crashed; 2 a cell file is bad (reported in its
     row, the others still plan) or does not exist (nothing is planned).
     """
+    method = _method(baseline)
 
     def run() -> int:
         import os
@@ -504,7 +520,7 @@ def batch(
             except ImportError:
                 err.print("[bold red]error:[/] --ray needs Ray: pip install 'robomax-py[ray]'", soft_wrap=True)
                 return EXIT_BAD_INPUT
-        options = BatchOptions(jobs=jobs or os.cpu_count() or 1, timeout=timeout, baseline=baseline)
+        options = BatchOptions(jobs=jobs or os.cpu_count() or 1, timeout=timeout, method=method)
         where = f"Ray ({address or 'local'})" if use_ray else f"{options.jobs} process(es)"
         with Progress(TextColumn("planning"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                       console=err, transient=False) as progress:

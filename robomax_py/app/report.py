@@ -25,7 +25,7 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
     passed over for want of the robot file's data (`export.SkippedFormat`)."""
     report: dict[str, Any] = {
         "cell": result.cell, "robot": result.robot, "status": result.status, "message": result.message,
-        "method": "baseline" if result.baseline else "optimised", "planning_seconds": round(seconds, 3),
+        "method": result.method, "planning_seconds": round(seconds, 3),
         "failures": [{"seam": f.seam, "spot": f.name, "reason": f.reason, "detail": f.detail} for f in result.failures],
         "files": [str(p) for p in written],
         "defaulted_limits": list(defaulted_limits),

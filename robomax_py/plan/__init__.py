@@ -4,6 +4,7 @@ junction (`tour_timing`, `junction`, `waiting`), checked (`pipeline`) -> a `Plan
 
 from robomax_py.plan.pipeline import plan_cell, verify_trajectory
 from robomax_py.plan.results import (
+    METHODS,
     PlanOptions,
     PlanResult,
     PlanStats,
@@ -11,11 +12,13 @@ from robomax_py.plan.results import (
     SpotFailure,
     SpotPlan,
     Transition,
+    method_options,
+    method_suffix,
     resolved_options,
 )
 from robomax_py.plan.tour_timing import weld_end
 
 __all__ = [
-    "PlanOptions", "PlanResult", "PlanStats", "Progress", "SpotFailure", "SpotPlan", "Transition",
-    "plan_cell", "resolved_options", "verify_trajectory", "weld_end",
+    "METHODS", "PlanOptions", "PlanResult", "PlanStats", "Progress", "SpotFailure", "SpotPlan", "Transition",
+    "method_options", "method_suffix", "plan_cell", "resolved_options", "verify_trajectory", "weld_end",
 ]

@@ -5,6 +5,7 @@ known free."""
 
 from __future__ import annotations
 
+import itertools
 import logging
 from collections import Counter
 from dataclasses import dataclass
@@ -56,8 +57,22 @@ MAX_BLOCKED_STRAIGHT = 24
 # Failed detour searches between two spots after which they count as unconnected (but for
 # detours found at their ends).
 MAX_FAILED_DETOURS = 6
+# Re-choices of the candidates of one order per round (`Sequencer._repair`).
+REPAIRS_PER_ROUND = 40
 # States of the coarse probe of a move between two stops that are not near neighbours.
 PROBE_STATES = 9
+# Withdrawing the gun off a flange (`Sequencer._withdrawn_detour`): directions perpendicular to the
+# electrode axis, distances (m; spots lie ~20 mm from the edge the C wraps round, and its jaws
+# reach a little past the electrodes), and exit pairs tried per detour.
+WITHDRAW_DIRECTIONS = 8
+WITHDRAW_M = (0.06, 0.12)
+WITHDRAW_PAIRS = 6
+
+
+def _distinct(path: FloatArray) -> FloatArray:
+    """The polyline without repeated waypoints."""
+    keep = [0] + [k for k in range(1, len(path)) if not np.allclose(path[k], path[k - 1])]
+    return path[keep]
 
 
 def _moves_of(order: tuple[int, ...]) -> set[tuple[int, int]]:
@@ -135,6 +150,8 @@ class Sequencer:
         self.unresolved: Counter[str] = Counter()                                 # move label -> rounds left open
         self.failed_detours: Counter[tuple[int, int]] = Counter()                 # unordered spot pair -> searches
         self.unconnected: set[tuple[int, int]] = set()                            # unordered spot pairs given up
+        self._exit_cache: dict[tuple[int, int], list[FloatArray]] = {}            # (spot, candidate) -> exits
+        self._inner: dict[tuple[int, bool], float] = {}                           # (detour, reversed) -> time
 
     # ------------------------------------------------------------------ knowledge and costs
 
@@ -199,11 +216,10 @@ class Sequencer:
         """Time of enter leg + detour v + leave leg between candidates `rows` of i and `cols` of j."""
         if det is _UNUSABLE:
             return np.full((len(rows), len(cols)), np.inf)
-        wp, sp = det.waypoints, self.options.speed * self.options.detour_speed
+        wp, sp = det.waypoints, self._detour_speed()
         enter = ptp_time_estimate(self.q(i)[rows], wp[0][None, :], self.limits, sp)
         leave = ptp_time_estimate(wp[-1][None, :], self.q(j)[cols], self.limits, sp)
-        inner = float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits, sp)))
-        via = enter[:, None] + inner + leave[None, :]
+        via = enter[:, None] + self._inner_time(v, det) + leave[None, :]
         pi, pj = self._positions(i, rows), self._positions(j, cols)
         bad = self.legs_bad.get((i, j), set())
         if len(bad) >= MAX_BLOCKED_LEGS:
@@ -216,6 +232,46 @@ class Sequencer:
             if vv == v and pi[a] >= 0 and pj[b] >= 0:
                 via[pi[a], pj[b]] = np.inf
         return via
+
+    def _detour_speed(self) -> float:
+        """The speed fraction detour moves are estimated at (options resolved from the cell)."""
+        speed, detour = self.options.speed, self.options.detour_speed
+        assert speed is not None and detour is not None
+        return speed * detour
+
+    def _inner_time(self, v: int, det: Detour) -> float:
+        """Estimated time along detour v oriented as `det` (from `vias_for`), cached per direction
+        (the sum taken in the order travelled, as it always was)."""
+        wp = det.waypoints
+        key = (v, not np.array_equal(wp[0], self.detours[v][2].waypoints[0]))
+        got = self._inner.get(key)
+        if got is None:
+            sp = self._detour_speed()
+            got = self._inner[key] = float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits, sp)))
+        return got
+
+    def _pair_via_costs(self, i: int, a: int, j: int, b: int) -> FloatArray:
+        """`_via_costs` of every known detour for one candidate pair (a of i, b of j), at once:
+        `_verify` asks this for every leg of every tour checked."""
+        vias = self.vias_for(i, j)
+        out = np.full(len(vias), np.inf)
+        usable = [v for v, det in enumerate(vias) if det is not _UNUSABLE]
+        if not usable:
+            return out
+        sp = self._detour_speed()
+        enter = ptp_time_estimate(self.q(i)[a][None, :], np.array([vias[v].waypoints[0] for v in usable]),
+                                  self.limits, sp)
+        leave = ptp_time_estimate(np.array([vias[v].waypoints[-1] for v in usable]), self.q(j)[b][None, :],
+                                  self.limits, sp)
+        via = enter + np.array([self._inner_time(v, vias[v]) for v in usable]) + leave
+        bad = self.legs_bad.get((i, j), set())
+        if len(bad) >= MAX_BLOCKED_LEGS:
+            ok = self.legs_ok.get((i, j), set())
+            keep = np.array([(a, b, v) in ok for v in usable])
+        else:
+            keep = np.array([(a, b, v) not in bad for v in usable])
+        out[usable] = np.where(keep, via, np.inf)
+        return out
 
     def _costs(self, i: int, j: int, rows: IntArray, cols: IntArray) -> FloatArray:
         """Estimated move time between candidates `rows` of i and `cols` of j, using what is known
@@ -233,7 +289,7 @@ class Sequencer:
             est = np.full_like(est, np.inf) if usable or unconnected else est * DETOUR_PRIOR
         else:
             known = self.straight.get(key, {})
-            if sum(1 for free in known.values() if not free) >= MAX_BLOCKED_STRAIGHT:
+            if self._verified_straight_only(i, j):
                 # Mostly blocked between these spots: only straight moves known to be free are
                 # offered, or the DP picks a fresh unchecked pair of candidates every round.
                 verified = np.full_like(est, np.inf)
@@ -252,6 +308,14 @@ class Sequencer:
             if pi[a] >= 0 and pj[b] >= 0:
                 est[pi[a], pj[b]] = np.inf
         return est
+
+    def _verified_straight_only(self, i: int, j: int) -> bool:
+        """Whether only straight moves known to be free are offered between spots i and j: many
+        found blocked, or the pair given up (no detour found MAX_FAILED_DETOURS times), where
+        every fresh candidate pair tried would cost another detour search."""
+        known = self.straight.get((i, j), {})
+        return (sum(1 for free in known.values() if not free) >= MAX_BLOCKED_STRAIGHT
+                or (min(i, j), max(i, j)) in self.unconnected)
 
     def cost(self, i: int, j: int) -> FloatArray:
         """`_costs` between the representatives of two spots (what the order search sees), cached."""
@@ -290,7 +354,7 @@ class Sequencer:
         for seam in self.cell.seams:
             ids = tuple(range(start, start + len(seam.spots)))
             start += len(seam.spots)
-            blocks.append(SeamBlock(ids, seam.ordered or self.options.baseline))
+            blocks.append(SeamBlock(ids, seam.ordered or self.options.baseline or self.options.given_order))
         return blocks
 
     def probe_pair(self, i: int, j: int) -> tuple[int, int]:
@@ -354,7 +418,7 @@ class Sequencer:
             self.rounds += 1
             # Rounds end when a tour's legs are all known free; the bar shows rounds so far.
             self.progress("sequencing", self.rounds - 1, self.rounds)
-            if self.options.baseline:
+            if self.options.baseline or self.options.given_order:
                 order = tuple(s for b in blocks for s in b.spots)
                 choice, cost = choice_for_order(order, self.full_cost, self.node)
                 tour = Tour(order, choice, cost)
@@ -375,16 +439,41 @@ class Sequencer:
             if not np.isfinite(tour.cost):
                 given_up = ", ".join(f"{self._name(i)} - {self._name(j)}" for i, j in sorted(self.unconnected)[:6])
                 return SequencingOutcome("disconnected", message="no collision-free connection found between some "
-                                         "spots (roadmap exhausted)"
+                                         f"spots (roadmap exhausted): {self._dead_end(tour.order)}"
                                          + (f"; no detour found {MAX_FAILED_DETOURS} times between {given_up}"
                                             if given_up else ""))
             verified = self._verify(tour)
             if verified.complete:
                 self.progress("sequencing", self.rounds, self.rounds)
                 return SequencingOutcome("found", tour, verified.transitions)
+            self._repair(tour.order)
         worst = ", ".join(f"{label} ({n} rounds)" for label, n in self.unresolved.most_common(5))
         return SequencingOutcome("not_converged", message=f"sequencing did not converge in {self.options.max_rounds} "
                                  f"rounds; moves left without a verified connection most often: {worst}")
+
+    def _repair(self, order: tuple[int, ...]) -> None:
+        """The candidates of one order re-chosen (the exact DP, cheap next to an order search) and
+        checked again, up to REPAIRS_PER_ROUND times, until every leg is known free or the order
+        has no finite tour. A blocked move between two spots with many near-equal candidates
+        (other wrist turns of one pose, of the same joint time where a big axis sets it) otherwise
+        costs a round per candidate pair: the order search proposes the same order with the next
+        unchecked pair. Nothing is returned from here: the next round's order search weighs what
+        was learnt, and a tour is taken only as a round's optimum."""
+        for _ in range(REPAIRS_PER_ROUND):
+            choice, cost = choice_for_order(order, self.full_cost, self.node)
+            if not np.isfinite(cost) or self._verify(Tour(order, choice, cost)).complete:
+                return
+
+    def _dead_end(self, order: tuple[int, ...]) -> str:
+        """The first move of an order that no candidate reached so far can make (what an infinite
+        tour cost means), named for the report."""
+        stops = (HOME, *order, HOME)
+        value = np.zeros(1)
+        for prev, nxt in itertools.pairwise(stops):
+            value = np.min(value[:, None] + self.full_cost(prev, nxt), axis=0)
+            if not np.isfinite(value).any():
+                return f"nothing known joins {self._name(prev)} -> {self._name(nxt)} in the best order found"
+        return "every order found has a move without a known connection"
 
     def _verify(self, tour: Tour) -> _TourCheck:
         """Transitions of the tour, complete when every leg is known free; else learn from every leg."""
@@ -394,13 +483,12 @@ class Sequencer:
         for (i, a), (j, b) in zip(stops[:-1], stops[1:]):
             qa, qb = self.q(i)[a], self.q(j)[b]
             label = f"{self._name(i)} -> {self._name(j)}"
+            # As `_costs` offers it: an unchecked straight move is tried only where it is offered.
             straight_ok = (min(i, j), max(i, j)) not in self.detour_only and \
-                self.straight.get((i, j), {}).get((a, b), True)
+                self.straight.get((i, j), {}).get((a, b), not self._verified_straight_only(i, j))
             straight_cost = float(ptp_time_estimate(qa, qb, self.limits, self.options.speed)) if straight_ok else np.inf
-            one_a, one_b = np.array([a]), np.array([b])
-            via_costs = [float(self._via_costs(i, j, v, det, one_a, one_b)[0, 0])
-                         for v, det in enumerate(self.vias_for(i, j))]
-            best_v = int(np.argmin(via_costs)) if via_costs else -1
+            via_costs = self._pair_via_costs(i, a, j, b)
+            best_v = int(np.argmin(via_costs)) if len(via_costs) else -1
             if straight_ok and (best_v < 0 or straight_cost <= via_costs[best_v]):
                 if self._check_straight(i, a, j, b):
                     out.append(Transition("move", np.array([qa, qb]), label))
@@ -459,7 +547,7 @@ class Sequencer:
         where the clamps of the row above block the way up on a stacked flange); then both at once.
         """
         qa, qb = self.q(i)[a], self.q(j)[b]
-        up = invert(np.asarray(self.cell.T_world_base))[:3, :3] @ np.array([0.0, 0.0, 1.0])
+        up = self._up()
         checks = 0
         ends_at = [(qa, i, a), (qb, j, b)]
         back = {idx: self._back_direction(idx, col) for _, idx, col in ends_at if idx != HOME}
@@ -483,19 +571,112 @@ class Sequencer:
                 if len(ends) < 2 or not self.limits.contains(np.array(ends)).all():
                     continue
                 path = np.array([qa, ends[0], ends[1], qb])
-                ok = True
-                for p0, p1 in zip(path[:-1], path[1:]):
-                    if np.allclose(p0, p1):
-                        continue
-                    res = self.world_from(i).check_segment(p0, p1)
-                    checks += res.checks
-                    if not res.free:
-                        ok = False
-                        break
-                if ok:
-                    keep = [0] + [k for k in range(1, 4) if not np.allclose(path[k], path[k - 1])]
-                    wp = path[keep]
+                free, used = self._path_free(i, path)
+                checks += used
+                if free:
+                    wp = _distinct(path)
                     return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits))), checks)
+        self.checks += checks
+        return None
+
+    def _up(self) -> FloatArray:
+        """World up in the robot base frame."""
+        up: FloatArray = invert(np.asarray(self.cell.T_world_base))[:3, :3] @ np.array([0.0, 0.0, 1.0])
+        return up
+
+    def _path_free(self, i: int, path: FloatArray) -> tuple[bool, int]:
+        """Whether every leg of a joint polyline leaving stop i is free (stops at the first blocked
+        one), and the collision checks spent."""
+        checks = 0
+        for p0, p1 in itertools.pairwise(path):
+            if np.allclose(p0, p1):
+                continue
+            res = self.world_from(i).check_segment(p0, p1)
+            checks += res.checks
+            if not res.free:
+                return False, checks
+        return True, checks
+
+    def _moved(self, idx: int, col: int, q: FloatArray, offsets: FloatArray) -> FloatArray:
+        """(k, n) configurations of spot idx's candidate col with its TCP (at q) moved by each of
+        `offsets` (k, 3), base frame, in the candidate's IK column, wrapped towards q; NaN rows
+        where that column has no solution within the limits."""
+        T = np.repeat(fk_tcp(self.robot, q)[None], len(offsets), axis=0)
+        T[:, :3, 3] += offsets
+        table = solve_all(self.robot, T, q_hint=q)
+        column = int(self.spots[idx].column[col])
+        out = q[None, :] + wrap_to_pi(table.q[:, column] - q[None, :])
+        out[~table.valid[:, column]] = np.nan
+        out[~self.limits.contains(out)] = np.nan
+        return out
+
+    def _exits(self, idx: int, col: int) -> list[FloatArray]:
+        """Where the gun can leave spot idx's approach point (candidate col) by a free straight
+        move that takes it off the flange: the TCP moved perpendicular to the electrode axis in
+        WITHDRAW_DIRECTIONS directions by each of WITHDRAW_M (the sheet leaves the C through its
+        mouth only one way; which depends on the tool and the candidate's spin, so every direction
+        is tried), nearest first. Cached per candidate: a spot's candidate joins many pairs."""
+        key = (idx, col)
+        got = self._exit_cache.get(key)
+        if got is not None:
+            return got
+        if idx == HOME:
+            self._exit_cache[key] = [self.home[0]]
+            return self._exit_cache[key]
+        q = self.q(idx)[col]
+        R = fk_tcp(self.robot, q)[:3, :3]
+        angles = 2 * np.pi * np.arange(WITHDRAW_DIRECTIONS) / WITHDRAW_DIRECTIONS
+        dirs = np.cos(angles)[:, None] * R[:, 0][None, :] + np.sin(angles)[:, None] * R[:, 1][None, :]
+        offsets = np.concatenate([w * dirs for w in WITHDRAW_M])
+        moved = self._moved(idx, col, q, offsets)
+        out: list[FloatArray] = []
+        for row in moved:
+            if np.isnan(row).any():
+                continue
+            res = self.world_from(idx).check_segment(q, row)
+            self.checks += res.checks
+            if res.free:
+                out.append(row)
+        self._exit_cache[key] = out
+        return out
+
+    def _withdrawn_detour(self, i: int, a: int, j: int, b: int) -> Detour | None:
+        """Off the flange, (up,) across, (down,) onto the flange: each end leaves its approach point
+        perpendicular to the electrode axis (`_exits`), then the straight move between the two exits,
+        else both exits raised by h (world up) for rising h. This is how the gun is turned over a
+        flange between two faces of a part: the C slid off one edge, turned clear of the part, slid
+        onto the other edge. At most WITHDRAW_PAIRS exit pairs are tried, fastest first."""
+        qa, qb = self.q(i)[a], self.q(j)[b]
+        starts, goals = self._exits(i, a), self._exits(j, b)
+        if not starts or not goals:
+            return None
+        sa, sb = np.array(starts), np.array(goals)
+        sp = 1.0 if self.options.speed is None else self.options.speed
+        leave = np.asarray(ptp_time_estimate(qa[None, :], sa, self.limits, sp))
+        across = np.asarray(ptp_time_estimate(sa[:, None, :], sb[None, :, :], self.limits, sp))
+        arrive = np.asarray(ptp_time_estimate(sb, qb[None, :], self.limits, sp))
+        est = leave[:, None] + across + arrive[None, :]
+        up = self._up()
+        checks = 0
+        pairs = np.argsort(est, axis=None, kind="stable")[:WITHDRAW_PAIRS]
+        for heights in ((0.0,), LIFT_HEIGHTS_M):
+            for flat in pairs:
+                x, y = np.unravel_index(int(flat), est.shape)
+                ea, eb = sa[x], sb[y]
+                for h in heights:
+                    if h == 0.0:
+                        path = np.array([qa, ea, eb, qb])
+                    else:
+                        ra = ea if i == HOME else self._moved(i, a, ea, (h * up)[None])[0]
+                        rb = eb if j == HOME else self._moved(j, b, eb, (h * up)[None])[0]
+                        if np.isnan(ra).any() or np.isnan(rb).any():
+                            continue
+                        path = np.array([qa, ea, ra, rb, eb, qb])
+                    free, used = self._path_free(i, path)
+                    checks += used
+                    if free:
+                        wp = _distinct(path)
+                        return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits))), checks)
         self.checks += checks
         return None
 
@@ -530,7 +711,10 @@ class Sequencer:
 
     def _new_detour(self, i: int, a: int, j: int, b: int) -> None:
         # Lift first: on clamp cells it is found in ~1,000 checks; the roadmap is the general fallback.
-        det = self._lift_detour(i, a, j, b) or self._searched_detour(i, self.q(i)[a], self.q(j)[b])
+        # Where neither finds a way, the gun's C may still hold the sheet at both approach points
+        # (moves between two faces of a part): off the flange first (`_withdrawn_detour`).
+        det = (self._lift_detour(i, a, j, b) or self._searched_detour(i, self.q(i)[a], self.q(j)[b])
+               or self._withdrawn_detour(i, a, j, b))
         if det is None:
             # No way found for this exact pair: make sure the optimiser stops choosing it.
             self.no_way.setdefault((i, j), set()).add((a, b))
@@ -592,7 +776,10 @@ class Sequencer:
                 self.checks += res.checks
                 if not res.free:
                     self._record_leg(i, a, j, b, v, False)
-                    self._new_detour(i, a, j, b)
+                    # A pair given up (MAX_FAILED_DETOURS searches found nothing) is not searched
+                    # again for every blocked leg: it keeps the legs known free.
+                    if (min(i, j), max(i, j)) not in self.unconnected:
+                        self._new_detour(i, a, j, b)
                     return None
             self._record_leg(i, a, j, b, v, True)
         path = np.vstack([qa[None, :], wp, qb[None, :]])

@@ -28,7 +28,12 @@ def _no_progress(stage: str, done: int, total: int) -> None:
 class PlanOptions:
     """How to plan; every field has a production default."""
 
-    baseline: bool = False           # the published method: given order, nominal orientation, first branch
+    # Teach-in, the baseline an integrator programs by hand: the cell file's order, the nominal
+    # orientation where feasible, the first feasible branch.
+    baseline: bool = False
+    # The spots in the cell file's order, the DP still choosing among every candidate (orientation
+    # sample and branch) with the same detours and timing: paper 003's OptTrag for a given order.
+    given_order: bool = False
     # Speeds; None takes the cell's `planner` values (defaults 1.0, 0.5 m/s, 1.0).
     speed: float | None = None       # global override in (0, 1] of every programmed speed
     tcp_speed: float | None = None   # m/s on approach and retract lines (before the override)
@@ -44,6 +49,28 @@ class PlanOptions:
     probe_neighbours: int = 6        # nearest spots per spot whose straight move is probed up front
     jerk_limited: bool = True        # PTP moves and detour legs with ruckig; False: toppra (vel/acc only)
     blend: bool = True               # fly by detour corners and approach points on checked G2 blends where faster
+
+    @property
+    def method(self) -> str:
+        """"optimised", or the baseline these options plan: "published" or "teach-in" (`METHODS`)."""
+        return "teach-in" if self.baseline else "published" if self.given_order else "optimised"
+
+
+# The methods `plan --baseline` and the benchmarks compare, each as the options that plan it (every
+# one with the same candidates, detours and timing): the optimiser; the published method (paper 003's
+# planner for the given order: the DP over every orientation sample and IK branch); teach-in.
+METHODS: dict[str, dict[str, bool]] = {"optimised": {}, "published": {"given_order": True}, "teach-in": {"baseline": True}}
+
+
+def method_options(method: str, options: PlanOptions | None = None) -> PlanOptions:
+    """`options` (default: the defaults) set to plan by `method`, a key of `METHODS`."""
+    return replace(options or PlanOptions(), **METHODS[method])
+
+
+def method_suffix(method: str) -> str:
+    """What a baseline's files add to the cell's name ("_published", "_teach_in"), so that a
+    baseline never replaces the optimised program; "" for the optimised plan."""
+    return "" if method == "optimised" else "_" + method.replace("-", "_")
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -132,7 +159,7 @@ class PlanResult:
     transitions: tuple[Transition, ...] = ()
     trajectory: Trajectory | None = None
     stats: PlanStats | None = None
-    baseline: bool = False
+    baseline: bool = False           # planned by a baseline method (`options.method` says which)
     joint_names: tuple[str, ...] = ()
     tool: str = ""
     T_flange_tcp: FloatArray | None = None   # (4, 4)
@@ -148,6 +175,10 @@ class PlanResult:
     def tending(self) -> bool:
         """Whether the stops are gripper actions at tending stations rather than welds."""
         return any(s.action is not None for s in self.spots)
+
+    @property
+    def method(self) -> str:
+        return self.options.method
 
     @property
     def cycle_time(self) -> float:

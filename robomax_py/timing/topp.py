@@ -237,6 +237,9 @@ def _toppra_sd_squared(
     path: GeometricPath, s_grid: FloatArray, lim: KinematicLimits, speed_limit: PathSpeedLimit | None
 ) -> FloatArray:
     """(N + 1,) squared path speeds x = sd^2 at the grid points, rest to rest."""
+    from robomax_py._lazy import defer
+
+    defer("matplotlib.pyplot")      # toppra.algorithm imports it for its plots, which we never draw
     import toppra.algorithm as algo
     import toppra.constraint as constraint
 

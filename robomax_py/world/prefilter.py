@@ -151,7 +151,11 @@ class Prefilter:
         Returns (offsets (k + 1,), pairs): configuration i's pairs are pairs[offsets[i]:offsets[i + 1]],
         in pair order.
         """
-        counts, pairs = _uncleared(np.ascontiguousarray(qs, dtype=np.float64), self.floats, self.ints, active)
+        # Always a read-only view: numba compiles one specialisation per array type, and a writable
+        # and a read-only batch are two (each about half the kernel's compile time on a first plan).
+        batch = np.ascontiguousarray(qs, dtype=np.float64).view()
+        batch.flags.writeable = False
+        counts, pairs = _uncleared(batch, self.floats, self.ints, active)
         return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), pairs
 
     def joint_placements(self, q: FloatArray) -> tuple[FloatArray, FloatArray]:

@@ -116,7 +116,7 @@ def test_timeout_is_reported_the_worker_killed_and_exit_3(batch_run: Batch, tmp_
     assert sorted(p.name for p in out.iterdir()) == ["summary.csv", "summary.md"]
 
 
-def fake_worker(file: str, baseline: bool) -> CellOutcome:
+def fake_worker(file: str, method: str) -> CellOutcome:
     """Test worker (imported by name in each cell's process): dies as the file's stem says, else 'plans'."""
     stem = Path(file).stem
     if stem == "exits":

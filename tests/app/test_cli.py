@@ -97,6 +97,18 @@ def test_plan_small_cell_writes_the_trajectory(tmp_path: Path, write_small_cell:
     assert len(hidden) == 2 and hidden[0] == ".small.robomax-set", hidden
 
 
+def test_plan_baseline_names_its_method_and_files(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    cell = write_small_cell(tmp_path, "small")
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["plan", str(cell), "-o", str(out), "--baseline", "teach-in", "--json"])
+    assert result.exit_code == EXIT_OK, result.output
+    assert json.loads(result.stdout)["method"] == "teach-in"
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
+        "small_teach_in.json", "small_teach_in.manifest.json", "small_teach_in.srcl"]
+    result = runner.invoke(app, ["plan", str(cell), "-o", str(out), "--baseline", "nominal"])
+    assert result.exit_code == EXIT_BAD_INPUT and "published or teach-in" in result.output
+
+
 @pytest.mark.slow
 def test_plan_reference_cell_twice_is_byte_identical(tmp_path: Path, reference_cell_path: Path) -> None:
     outputs = []

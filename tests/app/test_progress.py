@@ -6,6 +6,8 @@ import io
 import logging
 from pathlib import Path
 
+import numpy as np
+
 import pytest
 from rich.console import Console
 
@@ -65,7 +67,7 @@ def test_verbose_logs_the_stages(tmp_path: Path, write_small_cell: SmallCell) ->
         assert needle in text
 
 
-def test_lower_bound_is_below_the_cycle_and_sums_rest_to_rest_moves(
+def test_lower_bound_is_below_the_cycle_and_counts_rests_and_the_lines(
     planned: tuple[PlanResult, list[tuple[str, int, int]]],
 ) -> None:
     result, _ = planned
@@ -75,6 +77,10 @@ def test_lower_bound_is_below_the_cycle_and_sums_rest_to_rest_moves(
     spots = result.spots
     first = float(ptp_time_estimate(result.home[None], spots[0].q_spot[None], robot_limits, straight=False)[0])
     assert bound >= first + result.weld_time * len(spots)
+    # Half of every approach and of every retract line at the line speed (the halves at the sheet).
+    lines = sum(float(np.linalg.norm(s.T_app[:3, 3] - s.T_spot[:3, 3])) for s in spots)
+    line_speed = result.options.tcp_speed * result.options.speed
+    assert bound >= result.weld_time * len(spots) + lines / line_speed - 1e-9
 
 
 def test_bench_command_prints_one_table(tmp_path: Path, write_small_cell: SmallCell) -> None:

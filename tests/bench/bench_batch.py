@@ -88,7 +88,8 @@ def main() -> None:
             walls[name].append(wall)
             rss[name].extend(o.peak_rss_mb for o in outcomes if o.peak_rss_mb is not None)
             statuses[name] = Counter(o.status for o in outcomes)
-            programs = {p.name: p.read_bytes() for p in sorted(out.iterdir()) if not p.name.startswith("summary")}
+            programs = {p.name: p.read_bytes() for p in sorted(out.iterdir())          # the sets' files, not their
+                    if not p.name.startswith(("summary", "."))}                  # hidden folders
             if not reference:
                 reference = programs
             same = "same programs" if programs == reference else "PROGRAMS DIFFER"

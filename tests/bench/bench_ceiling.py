@@ -1,4 +1,5 @@
-"""How much shorter than the baseline can a plan of a cell get? Leg by leg (a script, not a test).
+"""How much shorter than teach-in (the baseline here: `PlanOptions(baseline=True)`, the cell's
+order, nominal orientation, first branch) can a plan of a cell get? Leg by leg (a script, not a test).
 
     python tests/bench/bench_ceiling.py [CELL] [--pairs 40]
 

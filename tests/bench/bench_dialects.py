@@ -18,7 +18,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from robomax_py.export import DIALECTS
+from robomax_py.export import DIALECTS, SHARED_FILES
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import plan_cell
 from robomax_py.publish import publish
@@ -53,7 +53,10 @@ def main() -> None:
                     prove.append(checked.check_seconds)
                     for name, text in files.items():
                         (Path(tmp) / name).write_text(text)
-                    main_file = Path(tmp) / f"{result.cell}{DIALECTS[fmt].extensions[0]}"
+                    # The main program: a dialect that names programs its way (FANUC) names it so.
+                    ext = DIALECTS[fmt].extensions[0]
+                    main_file = Path(tmp) / next(n for n in checked.files if n.endswith(ext)
+                                                 and not n.endswith("_frames" + ext) and n not in SHARED_FILES)
                     t0 = time.process_time()
                     report = verify_program(cell, robot, main_file)
                     verify.append(time.process_time() - t0)

@@ -1,7 +1,7 @@
 """Pick and place: planning CPU and cycle of the shipped cell (10 transfers), the same cell with
 the parts' limits ignored, and growing numbers of transfers.
 
-    python tests/bench/bench_pick_place.py [--repeat 3] [--sizes 2,5,10,20]
+    python tests/bench/bench_pick_place.py [--repeat 3] [--sizes 2,5,10,20] [--quick]
 
 CPU is `time.process_time` of `plan_cell` (one process, one core), the median of the repeats.
 "With limits ignored" plans the same cell with massless parts without TCP limits: its motion is
@@ -39,6 +39,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--sizes", default="2,5,10,20")
     ap.add_argument("--out", type=Path, default=Path("/tmp/bench_pick_place"))
+    ap.add_argument("--quick", action="store_true", help="the shipped cell once, nothing else (smoke run)")
     ap.add_argument("--generated", type=Path, default=None,
                     help="plan and verify every cell in this folder (tests/bench/pick_place_cells.py) instead")
     args = ap.parse_args()
@@ -49,7 +50,7 @@ def main() -> None:
     cell = load_cell(CELL)
     robot = load_cell_robot(cell)
     cpu, results = [], []
-    for _ in range(args.repeat):
+    for _ in range(1 if args.quick else args.repeat):
         t0 = time.process_time()
         results.append(plan_cell(cell, robot, PlanOptions()))
         cpu.append(time.process_time() - t0)
@@ -63,6 +64,8 @@ def main() -> None:
     print(f"shipped cell, 10 transfers: {result.status}, cycle {result.cycle_time:.3f} s, planning CPU median "
           f"{statistics.median(cpu):.2f} s ({', '.join(f'{c:.2f}' for c in cpu)}), carried moves {len(carried)} "
           f"({sum(t.kind == 'detour' for t in carried)} detours), carried check {'clean' if check.clean else check.violations}")
+    if args.quick:
+        return
     print("| limits applied | cycle |")
     print("|---|---|")
     for label, variant in (

@@ -114,9 +114,10 @@ def test_stamp_only_when_asked(small: dict[str, Any]) -> None:
 
 
 def test_baseline_files_are_named_apart(small: dict[str, Any]) -> None:
-    files, _ = publish(small["result"], small["cell"], small["robot"], ("srcl", "krl"), baseline=True)
-    assert sorted(files) == ["small_cell_baseline.dat", "small_cell_baseline.json", "small_cell_baseline.src",
-                             "small_cell_baseline.srcl", "small_cell_baseline_frames.src"]
+    for method, suffix in (("published", "_published"), ("teach-in", "_teach_in")):
+        files, _ = publish(small["result"], small["cell"], small["robot"], ("srcl", "krl"), method=method)
+        name = "small_cell" + suffix
+        assert sorted(files) == [f"{name}.dat", f"{name}.json", f"{name}.src", f"{name}.srcl", f"{name}_frames.src"]
 
 
 @pytest.mark.parametrize(("name", "ident"), [("door-L 2", "door_L_2"), ("7up", "_7up"), ("s1", "s1")])

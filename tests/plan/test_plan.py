@@ -186,6 +186,22 @@ def test_ordered_seam_keeps_its_order_and_unordered_may_reorder(tmp_path: Path) 
     assert estimated_cycle_time(cell_f, robot_f, free) <= estimated_cycle_time(cell_o, robot_o, ordered) + COST_TOL_S
 
 
+def test_given_order_keeps_the_file_order_and_chooses_among_every_candidate(tmp_path: Path) -> None:
+    """The published method (given order, the DP over every orientation sample and branch) between
+    the teach-in baseline (nominal orientation, first branch) and the order search."""
+    path = write_cell(tmp_path / "free", [SPOTS[name] for name in ZIGZAG], PANEL_ON_TABLE, ordered=False)
+    cell, robot, optimised = plan_file(path)
+    _, _, published = plan_file(path, PlanOptions(given_order=True))
+    _, _, teach_in = plan_file(path, PlanOptions(baseline=True))
+    for result in (optimised, published, teach_in):
+        assert result.status == "planned", result.message
+    assert [s.name for s in published.spots] == [s.name for s in teach_in.spots] == ZIGZAG
+    assert not published.baseline
+    # Same order, a superset of the candidates: the DP's estimate is no worse.
+    estimate = [estimated_cycle_time(cell, robot, r) for r in (optimised, published, teach_in)]
+    assert estimate[0] <= estimate[1] + COST_TOL_S and estimate[1] <= estimate[2] + COST_TOL_S
+
+
 # ---------------------------------------------------------------------------------------------- 3
 
 
@@ -293,3 +309,36 @@ def test_optimiser_beats_baseline_on_reference_cell() -> None:
     assert baseline.status == "planned", baseline.message
     assert baseline.baseline and not optimised.baseline
     assert optimised.cycle_time < baseline.cycle_time
+
+
+def test_a_blended_timing_that_fails_its_check_is_replaced_by_the_unblended_one(
+    tmp_path: Path, write_small_cell: Any, monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Two generated cells (a KR 120 frame and flange) failed with 'the timed program failed its own
+    check: collision: tool_body vs part' at a fly-by blend, though the same tour timed without
+    blends is free. Here the check of every blended timing is made to fail."""
+    from robomax_py.plan import pipeline
+
+    cell = load_cell(write_small_cell(tmp_path, "small"))
+    robot = load_cell_robot(cell)
+    real = pipeline.verify_trajectory
+    seen: list[bool] = []
+
+    def check(world: Any, robot: Any, traj: Any, *args: Any, **kwargs: Any) -> Any:
+        got = real(world, robot, traj, *args, **kwargs)
+        seen.append(got.clean)
+        if len(seen) == 1:                          # the blended timing: as if it grazed an object
+            return type(got)((_violation(traj),), got.checks)
+        return got
+
+    monkeypatch.setattr(pipeline, "verify_trajectory", check)
+    result = plan_cell(cell, robot, PlanOptions())
+    assert result.status == "planned", result.message
+    assert len(seen) == 2 and result.options.blend is False
+    assert verify_trajectory(world_of(cell, robot), robot, result.trajectory).clean  # type: ignore[arg-type]
+
+
+def _violation(traj: Any) -> Any:
+    from robomax_py.world.motion import Violation
+
+    return Violation(float(traj.t[1]), "collision", "tool_body vs part (made up)")

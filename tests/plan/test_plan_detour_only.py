@@ -15,16 +15,17 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 
 from robomax_py.io.cell import load_cell, load_cell_robot
-from robomax_py.plan import PlanOptions, resolved_options
+from robomax_py.plan import PlanOptions, graph, resolved_options
 from robomax_py.plan.candidates import SpotCandidates, seam_candidates
 from robomax_py.plan.graph import Sequencer as _Sequencer
 from robomax_py.plan.roadmap import Detour
 from robomax_py.spec import CellSpec
-from tests.conftest import SmallCell
 from robomax_py.world.collision import CollisionWorld, SegmentCheck
 from robomax_py.world.scene import build_scene
+from tests.conftest import SmallCell
 
 JOINT_TOL_RAD = 1e-12
 
@@ -72,6 +73,7 @@ def _sequencer(cell: CellSpec, robot: Any, world: Any, spots: list[SpotCandidate
     seq = _Sequencer(cell, robot, world, _NoRoadmap(), spots, options,  # type: ignore[arg-type]
                      np.random.default_rng(0))
     seq._lift_detour = lambda i, a, j, b: None  # type: ignore[method-assign]   # no way over the "clamp"
+    seq._withdrawn_detour = lambda i, a, j, b: None  # type: ignore[method-assign]   # nor off the flange
     return seq
 
 
@@ -94,14 +96,28 @@ def test_blocked_first_probe_with_free_alternative_plans_straight(tmp_path: Path
     assert seq.rounds < 10
 
 
-def test_non_convergence_names_the_moves(tmp_path: Path, write_small_cell: SmallCell) -> None:
-    """If the loop still runs out of rounds, the message names the moves left open."""
+def test_non_convergence_names_the_moves(tmp_path: Path, write_small_cell: SmallCell,
+                                        monkeypatch: pytest.MonkeyPatch) -> None:
+    """If the loop still runs out of rounds, the message names the moves left open (rounds without
+    the repairs of one order between them, which would otherwise settle this cell within a round)."""
+    monkeypatch.setattr(graph, "REPAIRS_PER_ROUND", 0)
     cell, robot, world, spots = _setup(tmp_path, write_small_cell)
     seq = _sequencer(cell, robot, _BlockEverything(world), spots, 2)
     outcome = seq.run()
     assert outcome.status == "not_converged" and outcome.tour is None
     assert "did not converge in 2 rounds" in outcome.message
     assert "home -> s7" in outcome.message or "home -> s8" in outcome.message, outcome.message
+
+
+def test_nothing_free_is_disconnected_with_the_move_named(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    """Every move blocked, no detour: within a few rounds the cell is reported disconnected, naming
+    the move nothing joins (the repairs of one order use up its candidate pairs)."""
+    cell, robot, world, spots = _setup(tmp_path, write_small_cell)
+    seq = _sequencer(cell, robot, _BlockEverything(world), spots, 80)
+    outcome = seq.run()
+    assert outcome.status == "disconnected" and outcome.tour is None, outcome.message
+    assert "nothing known joins home -> s" in outcome.message, outcome.message
+    assert seq.rounds <= 3
 
 
 class _BlockEverything:
