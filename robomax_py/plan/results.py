@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 from robomax_py._typing import FloatArray
 from robomax_py.plan.waiting import WaitPlan
@@ -59,7 +60,7 @@ class PlanOptions:
 # The methods `plan --baseline` and the benchmarks compare, each as the options that plan it (every
 # one with the same candidates, detours and timing): the optimiser; the published method (paper 003's
 # planner for the given order: the DP over every orientation sample and IK branch); teach-in.
-METHODS: dict[str, dict[str, bool]] = {"optimised": {}, "published": {"given_order": True}, "teach-in": {"baseline": True}}
+METHODS: dict[str, dict[str, Any]] = {"optimised": {}, "published": {"given_order": True}, "teach-in": {"baseline": True}}
 
 
 def method_options(method: str, options: PlanOptions | None = None) -> PlanOptions:

@@ -196,7 +196,7 @@ def test_given_order_keeps_the_file_order_and_chooses_among_every_candidate(tmp_
     for result in (optimised, published, teach_in):
         assert result.status == "planned", result.message
     assert [s.name for s in published.spots] == [s.name for s in teach_in.spots] == ZIGZAG
-    assert not published.baseline
+    assert (published.method, teach_in.method, optimised.method) == ("published", "teach-in", "optimised")
     # Same order, a superset of the candidates: the DP's estimate is no worse.
     estimate = [estimated_cycle_time(cell, robot, r) for r in (optimised, published, teach_in)]
     assert estimate[0] <= estimate[1] + COST_TOL_S and estimate[1] <= estimate[2] + COST_TOL_S
