@@ -85,6 +85,22 @@ class Parsed:
     problems: tuple[tuple[int, str, str], ...] = ()
 
 
+
+def controller_identifier(name: str, *, upper: bool, max_chars: int, reserved: Sequence[str] = ()) -> str:
+    """A cell's name as a program name a controller takes: letters of one case, digits and `_`, a
+    letter first (`P` put in front otherwise), at most `max_chars`; a name one of the dialect's own
+    routines has gets `_PROG` (`_prog`) after it.
+
+    >>> controller_identifier("door-L 2", upper=True, max_chars=8), controller_identifier("7up", upper=False, max_chars=15)
+    ('DOOR_L_2', 'p7up')
+    """
+    letters, first, suffix = ("A-Z", "P", "_PROG") if upper else ("a-z", "p", "_prog")
+    ident = re.sub(f"[^{letters}0-9_]", "_", name.upper() if upper else name.lower()) or first
+    if not re.match(f"[{letters}]", ident):
+        ident = first + ident
+    ident = ident[:max_chars]
+    return ident + suffix if ident in reserved else ident
+
 def own_name(frame: FrameDef) -> str:
     """A frame's name as the program states it, for dialects that refer to frames by name."""
     return frame.name

@@ -55,6 +55,7 @@ from robomax_py.errors import ControllerSetupError, ExportError, ProgramError
 from robomax_py.export.dialect import (
     Parsed,
     PlannedProgram,
+    controller_identifier,
     header_lines,
     numbered_frames,
     numbered_inputs,
@@ -103,11 +104,7 @@ def frame_name(frame: FrameDef) -> str:
 
 def program_name(name: str) -> str:
     """The job a cell's program becomes: capitals, digits and `_`, a letter first, at most NAME_CHARS."""
-    ident = re.sub(r"[^A-Z0-9_]", "_", name.upper()) or "P"
-    if not "A" <= ident[0] <= "Z":
-        ident = "P" + ident
-    ident = ident[:NAME_CHARS]
-    return ident + "_PROG" if ident in ROUTINES else ident
+    return controller_identifier(name, upper=True, max_chars=NAME_CHARS, reserved=tuple(ROUTINES))
 
 
 def _number(name: str) -> int:

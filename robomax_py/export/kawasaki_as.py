@@ -48,6 +48,7 @@ from robomax_py.errors import ControllerSetupError, ExportError, ProgramError
 from robomax_py.export.dialect import (
     Parsed,
     PlannedProgram,
+    controller_identifier,
     gripper_label,
     header_lines,
     numbered_inputs,
@@ -146,11 +147,7 @@ def frame_name(frame: FrameDef) -> str:
 
 
 def _program_name(name: str) -> str:
-    ident = re.sub(r"[^a-z0-9_]", "_", name.lower()) or "p"
-    if not "a" <= ident[0] <= "z":
-        ident = "p" + ident
-    ident = ident[:15]                # AS names: at most 15 characters
-    return ident + "_prog" if ident in ROUTINES else ident
+    return controller_identifier(name, upper=False, max_chars=15, reserved=tuple(ROUTINES))    # AS names: 15 characters
 
 
 def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
