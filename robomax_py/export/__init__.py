@@ -89,7 +89,7 @@ def _requested(spec: str, brand: str, robot_file: object) -> tuple[set[str], set
     every: set[str] = set()
     for part in (p.strip().lower() for p in spec.split(",")):
         if part == "all":
-            every.update(DIALECTS)
+            every.update(name for name, d in DIALECTS.items() if d.in_all)
         elif part == "native":
             native = native_dialect(brand)
             if native is None:

@@ -142,6 +142,8 @@ class Dialect:
     # controller's calibration data a program counts in (INFORM's encoder pulses per degree). A
     # dialect asked for by name on such a robot is an error; `--format all` passes it over and says so.
     needs: Callable[[RobotModel], tuple[tuple[str, str], ...]] = needs_nothing
+    # Whether `--format all` takes it in (a dialect left out is written only when named).
+    in_all: bool = True
 
 
 def with_frame_names(program: Program, name_of: Callable[[FrameDef], str]) -> Program:

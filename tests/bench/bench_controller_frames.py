@@ -374,7 +374,7 @@ def panel_cell(name: str, robot_yaml: Path, shape: ArmShape, arm: str, seed: int
 
 # --------------------------------------------------------------------------------------- one arm
 def bench_arm(name: str, brand: str, source: str, srdf: str, args: argparse.Namespace, tmp: Path) -> Row:
-    from robomax_py.export import DIALECTS as WRITERS
+    from robomax_py.export import choose_formats
     from robomax_py.io.cell import load_cell, load_cell_robot
     from robomax_py.io.robot import load_robot_spec
     from robomax_py.plan import plan_cell
@@ -415,7 +415,8 @@ def bench_arm(name: str, brand: str, source: str, srdf: str, args: argparse.Name
             row.plan_cpu_s = cpu() - t0
             row.planned = f"{result.status}: {one_line(Exception(result.message), 120)}"
             return row
-        files, _ = publish(result, cell, load_cell_robot(cell), tuple(WRITERS))
+        robot = load_cell_robot(cell)
+        files, _ = publish(result, cell, robot, choose_formats("all", robot).names)
     except RobomaxError as exc:
         row.plan_cpu_s = cpu() - t0
         row.planned = f"failed: {one_line(exc)}"

@@ -18,7 +18,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from robomax_py.export import DIALECTS, SHARED_FILES
+from robomax_py.export import DIALECTS, SHARED_FILES, choose_formats
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import plan_cell
 from robomax_py.publish import publish
@@ -44,7 +44,7 @@ def main() -> None:
             continue
         rows = {}
         with tempfile.TemporaryDirectory() as tmp:
-            for fmt in DIALECTS:
+            for fmt in choose_formats("all", robot).names:
                 write, prove, verify = [], [], []
                 checked = None
                 for _ in range(args.runs):

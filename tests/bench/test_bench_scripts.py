@@ -1,7 +1,7 @@
 """Every benchmark script in tests/bench runs in CI at its smallest (a smoke run: the script must
 finish with exit 0; no figure or timing is asserted), so that none rots while the code it measures
-changes. The corpus and arm benches have their own smoke tests (test_bench_corpus.py,
-tests/controller_model/test_arm_bench.py).
+changes. The corpus, family and arm benches have their own smoke tests (test_bench_corpus.py,
+test_bench_family.py, tests/controller_model/test_arm_bench.py).
 
 Each script runs in its own process as a user runs it, on the small 2-spot test cell where it
 takes a cell; the reference cell where the script is about that cell."""
@@ -39,7 +39,7 @@ SMOKE: dict[str, list[str]] = {
     "bench_timing.py": [SMALL, "--runs", "1"],
     "bench_voxels.py": [SMALL],
 }
-OWN_TESTS = {"bench_corpus.py", "bench_controller_frames.py"}
+OWN_TESTS = {"bench_corpus.py", "bench_controller_frames.py", "bench_family.py"}
 
 
 def test_every_bench_script_has_a_smoke_run() -> None:

@@ -35,7 +35,7 @@ def written(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> dict[
     robot = load_cell_robot(cell)
     result = plan_cell(cell, robot)
     assert result.status == "planned", result.message
-    chosen = choose_formats("all", robot)
+    chosen = choose_formats("all,as", robot)            # AS only when named
     assert sorted(chosen.names) == WRITTEN and [k.format for k in chosen.skipped] == ["inform"]
     files, _ = publish(result, cell, robot, chosen.names)
     for name, text in files.items():
@@ -69,7 +69,7 @@ def _verify(written: dict[str, Any], fmt: str, edit: Callable[[str], str], tag: 
 
 
 def _first(pattern: str, text: str, replace: Callable[[re.Match[str]], str]) -> str:
-    return re.sub(pattern, replace, text, count=1, flags=re.M)
+    return re.sub(pattern, replace, text, count=1, flags=re.MULTILINE)
 
 
 @pytest.mark.parametrize("fmt", WRITTEN)
@@ -178,7 +178,7 @@ def test_lengths_in_another_unit_are_rejected(written: dict[str, Any], fmt: str)
 
 
 def test_a_quaternion_that_is_not_unit_is_bad_input_with_its_line(written: dict[str, Any]) -> None:
-    edit: Callable[[str], str] = lambda t: _first(r"(robtarget p\d+ := \[\[[^\]]*\], \[)(-?[\d.]+)", t,  # noqa: E731
+    edit: Callable[[str], str] = lambda t: _first(r"(robtarget p\d+ := \[\[[^\]]*\], \[)(-?[\d.]+)", t,
                                                   lambda m: m[1] + f"{float(m[2]) + 0.1:.9f}")
     program = _edited(written, "rapid", edit, "quaternion")
     with pytest.raises(ProgramError, match=r"line \d+.*not unit"):
