@@ -9,8 +9,7 @@ from __future__ import annotations
 import re
 import signal
 import sys
-from collections.abc import Callable, Iterable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
@@ -19,6 +18,7 @@ from rich.console import Console
 from rich.table import Table
 
 from robomax_py.errors import RobomaxError
+from robomax_py.io.files import signals_held
 
 EXIT_OK = 0
 EXIT_VIOLATIONS = 1
@@ -158,7 +158,10 @@ def plan(
         import json as _json
         import time
 
-        with _signals_deferred():
+        # SIGINT and SIGTERM held while the heavy modules are imported (a few seconds at most): an
+        # import that catches BaseException would swallow the interrupt and leave half-imported
+        # modules behind. A signal that arrived meanwhile is delivered when the imports are done.
+        with signals_held():
             from robomax_py.app.progress import configure_logging, stage_bars
             from robomax_py.app.report import plan_report, report_tables
             from robomax_py.export import SHARED_FILES, choose_formats
@@ -690,19 +693,6 @@ def _honour_signals() -> None:
         raise KeyboardInterrupt
     if _Received.signum is not None:
         raise SystemExit(128 + _Received.signum)
-
-
-@contextmanager
-def _signals_deferred() -> Iterator[None]:
-    """SIGINT and SIGTERM held while the heavy modules are imported (a few seconds at most): an
-    import that catches BaseException would swallow the interrupt and leave half-imported modules
-    behind. A signal that arrived meanwhile is delivered when the imports are done."""
-    held = {signal.SIGINT, signal.SIGTERM}
-    before = signal.pthread_sigmask(signal.SIG_BLOCK, held)
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def _unraisable(default: Callable[[Any], object]) -> Callable[[Any], None]:

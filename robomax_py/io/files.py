@@ -190,7 +190,7 @@ def _switch(out_dir: Path, name: str, own: dict[str, bytes], plan: str) -> tuple
     else:
         folder = _stage(out_dir, name, plan, own)
     try:
-        with _signals_held():
+        with signals_held():
             if folder is not None and current is None:
                 # First set in this folder: an empty one becomes current, so that links made
                 # before the switch read as absent files, as the folder had them.
@@ -348,8 +348,9 @@ def _umask() -> int:
 
 
 @contextmanager
-def _signals_held() -> Iterator[None]:
-    """SIGINT and SIGTERM held for the few renames of a switch (milliseconds), so an interrupt
+def signals_held() -> Iterator[None]:
+    """SIGINT and SIGTERM held (blocked in the main thread, delivered when the block ends) for a
+    step that must not be cut: here the few renames of a switch (milliseconds), so an interrupt
     ends the run after the set is whole and the previous one's files are gone, not between."""
     if threading.current_thread() is not threading.main_thread():
         yield
