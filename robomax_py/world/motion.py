@@ -191,14 +191,24 @@ def min_clearance(world: CollisionWorld, t: FloatArray, q: FloatArray) -> Cleara
     if not math.isfinite(best):
         return None
     best_t, best_q = float(t[best_i]), q[best_i]
+    # Sub-steps either side of the closest sample: a pair is computed only where its distance at
+    # that sample, less the most the motion since could take off it (`_closest_sample`'s bound),
+    # is below the best so far, so the answer is the minimum over every pair, as `closest` gives.
+    lever, factor = world.lever_arms, world.pair_approach_factors()
+    at_best = world.pair_distances(q[best_i], np.arange(world.n_pairs))
     for k in (best_i - 1, best_i):
         if 0 <= k < len(t) - 1:
             for s in np.linspace(0.0, 1.0, MIN_CLEARANCE_SUBSTEPS + 1)[1:-1]:
                 qs = q[k] + s * (q[k + 1] - q[k])
                 ts = float(t[k] + s * (t[k + 1] - t[k]))
-                d = world.closest(qs, ts).distance
-                if d < best:
-                    best, best_t, best_q = d, ts, qs
+                wanted = at_best - factor * (np.abs(qs - q[best_i]) @ lever) < best
+                if world.has_dynamic:
+                    wanted &= world.active_pairs(ts)
+                due = np.flatnonzero(wanted)
+                if len(due):
+                    d = float(np.min(world.pair_distances(qs, due)))
+                    if d < best:
+                        best, best_t, best_q = d, ts, qs
     pair = world.closest(best_q, best_t).pair
     between = f"{pair.body_a} and {pair.body_b}" if pair is not None else "?"
     return Clearance(float(best), best_t, between)

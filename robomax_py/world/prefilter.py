@@ -26,6 +26,7 @@ world keeps coal's broad phase for every query.
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Any
 
@@ -72,24 +73,19 @@ class Prefilter:
         obb_axes = np.tile(np.eye(3), (n_geom, 1, 1))
         obb_half = np.full((n_geom, 3), np.inf)
         points_of: list[FloatArray | None] = []
-        chunks: list[list[FloatArray]] = []                  # per piece: a tree of point sets covering an obstacle
-        skips: list[list[int]] = []
+        bounds_of: list[_PieceBounds | None] = []
         for g, obj in enumerate(gm.geometryObjects):
             piece_joint[g] = int(obj.parentJoint)
-            placed = support_points(obj.geometry, obj.placement.homogeneous)
-            if not np.isfinite(placed).all():
+            piece = _piece_bounds(obj.geometry, obj.placement.homogeneous, bool(obstacle[g]))
+            bounds_of.append(piece)
+            if piece is None:
                 points_of.append(None)
-                chunks.append([])
-                skips.append([])
                 continue                                      # unbounded shape: never cleared
-            points_of.append(placed)
-            nodes, skip = _mesh_chunks(obj.geometry, placed) if obstacle[g] else ([], [])
-            chunks.append(nodes)
-            skips.append(skip)
+            points_of.append(piece.placed)
             if obstacle[g]:
-                box_lo[g], box_hi[g] = placed.min(axis=0), placed.max(axis=0)
-            centre[g], radius[g] = _enclosing_sphere(placed)
-            obb_centre[g], obb_axes[g], obb_half[g] = _enclosing_box(placed)
+                box_lo[g], box_hi[g] = piece.placed.min(axis=0), piece.placed.max(axis=0)
+            centre[g], radius[g] = piece.sphere
+            obb_centre[g], obb_axes[g], obb_half[g] = piece.box
         is_obs = np.asarray(obstacle, dtype=bool)
         pa, pb = np.asarray(pair_a, dtype=np.int64), np.asarray(pair_b, dtype=np.int64)
         swap = is_obs[pa]                                     # the robot piece first
@@ -121,6 +117,8 @@ class Prefilter:
         group_joint = np.array(joints, dtype=np.int64)
 
         # Obstacle chunks: an unbounded obstacle has none, and is never cleared.
+        chunks = [piece.chunks if piece is not None else [] for piece in bounds_of]
+        skips = [piece.skip if piece is not None else [] for piece in bounds_of]
         flat = [c for piece in chunks for c in piece]
         ch_end = np.cumsum([len(c) for c in chunks]).astype(np.int64)
         ch_start = ch_end - np.array([len(c) for c in chunks], dtype=np.int64)
@@ -128,8 +126,8 @@ class Prefilter:
         for g in range(n_geom):
             if is_obs[g] and points_of[g] is None:
                 ch_start[g] = ch_end[g] = -1
-        spheres = [_enclosing_sphere(c) for c in flat]
-        boxes = [_enclosing_box(c) for c in flat]
+        spheres = [s for piece in bounds_of if piece is not None for s in piece.chunk_spheres]
+        boxes = [b for piece in bounds_of if piece is not None for b in piece.chunk_boxes]
         ch_centre = np.array([c for c, _ in spheres]).reshape(-1, 3)
         ch_radius = np.array([r for _, r in spheres], dtype=float)
         ch_box_c = np.array([b[0] for b in boxes]).reshape(-1, 3)
@@ -161,6 +159,47 @@ class Prefilter:
     def joint_placements(self, q: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(J, 3, 3) rotations and (J, 3) translations of every joint frame at q (as Pinocchio's oMi)."""
         return _placements(np.ascontiguousarray(q, dtype=np.float64), self.floats, self.ints)  # type: ignore[no-any-return]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class _PieceBounds:
+    """One piece's enclosing volumes at its placement in its joint (or the base) frame."""
+
+    geometry: Any                # held, so that no other piece takes its id while the entry lives
+    placed: FloatArray           # its support points
+    sphere: tuple[FloatArray, float]
+    box: tuple[FloatArray, FloatArray, FloatArray]
+    chunks: list[FloatArray]     # an obstacle's chunk tree (`_mesh_chunks`); none for a robot piece
+    skip: list[int]
+    chunk_spheres: list[tuple[FloatArray, float]]
+    chunk_boxes: list[tuple[FloatArray, FloatArray, FloatArray]]
+
+
+# Worlds of one process share their pieces' coal geometry (the robot's link geometry and a cell's
+# meshes are loaded once: robot.model, world.scene), and a piece's volumes depend only on its
+# geometry and placement, so each is computed once: a verify or a batch builds the same world many
+# times, and these volumes were the most of a world's build. Bounded; the oldest entries go first.
+_BOUNDS: OrderedDict[tuple[int, bytes, bool], _PieceBounds] = OrderedDict()
+_BOUNDS_SIZE = 4096
+
+
+def _piece_bounds(geom: Any, placement: FloatArray, obstacle: bool) -> _PieceBounds | None:
+    """The volumes of a piece `geom` at `placement`; None for an unbounded shape."""
+    key = (id(geom), np.asarray(placement, dtype=float).tobytes(), obstacle)
+    hit = _BOUNDS.get(key)
+    if hit is not None and hit.geometry is geom:
+        _BOUNDS.move_to_end(key)
+        return hit
+    placed = support_points(geom, placement)
+    if not np.isfinite(placed).all():
+        return None
+    nodes, skip = _mesh_chunks(geom, placed) if obstacle else ([], [])
+    entry = _PieceBounds(geom, placed, _enclosing_sphere(placed), _enclosing_box(placed), nodes, skip,
+                         [_enclosing_sphere(c) for c in nodes], [_enclosing_box(c) for c in nodes])
+    _BOUNDS[key] = entry
+    while len(_BOUNDS) > _BOUNDS_SIZE:
+        _BOUNDS.popitem(last=False)
+    return entry
 
 
 def _enclosing_box(points: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:

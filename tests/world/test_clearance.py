@@ -3,7 +3,8 @@
 On the reference cell (kr125 with the C-gun, clamps, the cabin panel as a mesh) a seeded random
 joint walk is sampled; the smallest distance over every sample computed pair by pair with
 `CollisionWorld.closest` must equal what `min_clearance` reports before its refinement step, to the
-bit, and the refined value can only be lower.
+bit; the refined value is the brute-force minimum over the sub-steps either side of that sample
+(every pair computed with `closest`), also to the bit.
 """
 
 from __future__ import annotations
@@ -15,8 +16,22 @@ import pytest
 
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.world.collision import CollisionWorld
-from robomax_py.world.motion import _closest_sample, min_clearance
+from robomax_py.world.motion import (
+    MIN_CLEARANCE_SUBSTEPS,
+    _closest_sample,
+    min_clearance,
+)
 from robomax_py.world.scene import build_scene
+
+
+def _brute_refined(w: CollisionWorld, t: np.ndarray, q: np.ndarray, i: int, d: float) -> float:
+    """The sample's minimum lowered by every pair's distance at the sub-steps of the steps either side."""
+    best = d
+    for k in (i - 1, i):
+        if 0 <= k < len(t) - 1:
+            for s in np.linspace(0.0, 1.0, MIN_CLEARANCE_SUBSTEPS + 1)[1:-1]:
+                best = min(best, w.closest(q[k] + s * (q[k + 1] - q[k]), float(t[k] + s * (t[k + 1] - t[k]))).distance)
+    return best
 
 
 @pytest.fixture(scope="module")
@@ -38,8 +53,9 @@ def test_skipping_finds_the_brute_force_minimum(world: tuple[CollisionWorld, np.
     i, d = _closest_sample(w, q)
     assert d == min(brute)
     assert i == int(np.argmin(brute))
-    report = min_clearance(w, np.arange(len(q)) * 0.01, q)
-    assert report is not None and report.distance_m <= d
+    t = np.arange(len(q)) * 0.01
+    report = min_clearance(w, t, q)
+    assert report is not None and report.distance_m == _brute_refined(w, t, q, i, d)
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -71,4 +87,4 @@ def test_with_obstacles_that_come_and_go_the_minimum_is_the_brute_force_one(refe
     assert d == min(brute)
     assert i == int(np.argmin(brute))
     report = min_clearance(w, t, q)
-    assert report is not None and report.distance_m <= d
+    assert report is not None and report.distance_m == _brute_refined(w, t, q, i, d)

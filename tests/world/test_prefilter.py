@@ -135,3 +135,33 @@ def test_answers_are_the_same_with_and_without_the_filter(
     mine, theirs = world.check_path(path), plain.check_path(path)
     assert (mine.free, mine.checks, mine.states, mine.s_contact) == \
         (theirs.free, theirs.checks, theirs.states, theirs.s_contact)
+
+
+def test_a_pieces_volumes_are_reused_only_for_the_same_geometry_at_the_same_placement(
+        reference: tuple[CellSpec, RobotModel, CollisionWorld]) -> None:
+    """The per-piece volumes are kept per process; a rebuilt world's filter is the fresh one, and a
+    piece moved or replaced gets volumes of its own."""
+    from robomax_py.world import prefilter
+    from robomax_py.world.acm import OBSTACLE_KINDS
+
+    _, _, world = reference
+    s = world._s
+    obstacle = [p.kind in OBSTACLE_KINDS for p in s.pieces]
+    args = (s.model, s.geom_model, obstacle, s.pair_a, s.pair_b, s.pair_margin)
+    prefilter._BOUNDS.clear()
+    fresh = Prefilter.of(*args)
+    reused = Prefilter.of(*args)
+    assert fresh is not None and reused is not None
+    np.testing.assert_array_equal(fresh.floats, reused.floats)
+    np.testing.assert_array_equal(fresh.ints, reused.ints)
+
+    gm = s.geom_model.copy()
+    g = next(k for k, o in enumerate(obstacle) if o)
+    moved = gm.geometryObjects[g]
+    moved.placement = pin.SE3(np.eye(3), np.asarray(moved.placement.translation) + [0.5, 0.0, 0.0])
+    shifted = Prefilter.of(s.model, gm, *args[2:])
+    prefilter._BOUNDS.clear()
+    shifted_fresh = Prefilter.of(s.model, gm, *args[2:])
+    assert shifted is not None and shifted_fresh is not None
+    np.testing.assert_array_equal(shifted.floats, shifted_fresh.floats)
+    assert not np.array_equal(shifted.floats, fresh.floats)
