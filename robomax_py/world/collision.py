@@ -483,6 +483,8 @@ class CollisionWorld:
             return SegmentCheck(True, len(order), m + 1, int(tests), None)
         start = float(t0) if t0 is not None else 0.0
         span = float(t1) - start if t1 is not None else 0.0
+        if self._pf is not None:
+            return self._scan_timed(states, fractions, order, m, start, span)
         for k, step in enumerate(order):
             if timed:
                 ta = start + max(step - 1, 0) / m * span
@@ -547,6 +549,28 @@ class CollisionWorld:
             if pin.computeCollision(gm, gd, p):
                 return False, n + 1
         return True, len(pairs)
+
+    def _scan_timed(self, states: FloatArray, fractions: FloatArray, order: IntArray, m: int, start: float,
+                    span: float) -> SegmentCheck:
+        """`_scan` where dynamic obstacles come and go: state k (of `order`) counts the obstacles
+        present during the time between its neighbouring steps, so the states are scanned in runs
+        that share one presence, each with the pairs active then, stopping at the first collision."""
+        windows = [(start + max(int(step) - 1, 0) / m * span, start + min(int(step) + 1, m) / m * span) for step in order]
+        dynamic = [self._s.obstacles[int(i)] for i in self._s.dynamic_ids]
+        presence = [tuple(_present_during(o, min(a, b), max(a, b)) for o in dynamic) for a, b in windows]
+        tests, k0 = 0, 0
+        while k0 < len(order):
+            k1 = k0 + 1
+            while k1 < len(order) and presence[k1] == presence[k0]:
+                k1 += 1
+            a, b = windows[k0]
+            self._set_presence(min(a, b), max(a, b))
+            res = self._scan(states[k0:k1], fractions[k0:k1], m + 1)
+            tests += res.narrow_phase_tests
+            if not res.free:
+                return SegmentCheck(False, k0 + res.checks, m + 1, tests, res.s_contact)
+            k0 = k1
+        return SegmentCheck(True, len(order), m + 1, tests, None)
 
     def _scan(self, states: FloatArray, fractions: FloatArray, n_states: int) -> SegmentCheck:
         """Check `states` in the given order, stopping at the first collision (pre-filter on)."""
