@@ -34,6 +34,7 @@ SMOKE: dict[str, list[str]] = {
     "bench_pick_place.py": ["--quick", "--out", OUT],
     "bench_plan.py": ["--runs", "1", "--resolutions", "20"],
     "bench_scale.py": ["--sizes", "8", "--families", "open", "--runs", "1"],
+    "bench_startup.py": [SMALL, "--runs", "1"],
     "bench_table_ik.py": [],
     "bench_tending.py": ["--cycles", "1"],
     "bench_timing.py": [SMALL, "--runs", "1"],

@@ -1,0 +1,66 @@
+"""`robomax plan` as a user runs it: one process from start to exit, its CPU (user + sys, of the
+process and any it waits for), on the cell of the README's quick start unless given another.
+
+    python tests/bench/bench_startup.py [CELL] [--runs 3]
+
+Cold is the first plan after an install: empty caches (a fresh ROBOMAX_CACHE and NUMBA_CACHE_DIR,
+so numba compiles every kernel the plan calls; a set NUMBA_CACHE_DIR is searched before the
+numba files next to the sources). Warm is the next plan with the caches the cold one left.
+Each run has its own cache folder and output folder. The figures are medians over --runs; the
+ratio cold / warm is of the same run, so a busy machine shifts both alike. The split of a warm
+run (imports, the command's own work) comes from `python -X importtime` and a profile.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+QUICK_START_CELL = REPO / "cells" / "cabin_flange.yaml"
+
+
+def plan_cpu(cell: Path, cache: Path, out: Path) -> float:
+    """CPU seconds (user + sys) of one `python -m robomax_py plan cell --out out` with its caches in
+    `cache`; raises when the command fails."""
+    env = {**os.environ,
+           "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]),
+           "ROBOMAX_CACHE": str(cache / "robomax"), "NUMBA_CACHE_DIR": str(cache / "numba"),
+           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    done = subprocess.run([sys.executable, "-m", "robomax_py", "plan", str(cell), "--out", str(out)],
+                          capture_output=True, text=True, env=env, check=False)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if done.returncode != 0:
+        raise SystemExit(f"robomax plan {cell} failed ({done.returncode}):\n{done.stderr[-3000:]}")
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("cell", nargs="?", type=Path, default=QUICK_START_CELL)
+    ap.add_argument("--runs", type=int, default=3)
+    args = ap.parse_args()
+    cold, warm, ratio = [], [], []
+    for _ in range(args.runs):
+        with tempfile.TemporaryDirectory() as tmp:
+            root = Path(tmp)
+            c = plan_cpu(args.cell, root / "cache", root / "out_cold")
+            w = plan_cpu(args.cell, root / "cache", root / "out_warm")
+        cold.append(c)
+        warm.append(w)
+        ratio.append(c / w)
+    print(f"robomax plan {args.cell.name}: process CPU s (user + sys), median of {args.runs}")
+    print(f"{'cold (empty caches)':>22} {statistics.median(cold):8.2f}")
+    print(f"{'warm':>22} {statistics.median(warm):8.2f}")
+    print(f"{'cold / warm':>22} {statistics.median(ratio):8.2f}")
+
+
+if __name__ == "__main__":
+    main()
