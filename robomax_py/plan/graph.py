@@ -19,6 +19,7 @@ from robomax_py.plan.cspace_detour import grid_detour
 from robomax_py.plan.loads import Loads
 from robomax_py.plan.results import PlanOptions, Progress, Transition, _no_progress
 from robomax_py.plan.roadmap import Detour, Roadmap
+from robomax_py.plan.rrt_detour import rrt_detour
 from robomax_py.plan.sequence import (
     EXACT_ORDERS,
     HOME,
@@ -67,6 +68,11 @@ PROBE_STATES = 9
 WITHDRAW_DIRECTIONS = 8
 WITHDRAW_M = (0.06, 0.12)
 WITHDRAW_PAIRS = 6
+# An order whose best tour has a move no reached candidate can make (`Sequencer._open_dead_end`):
+# straight moves checked from the reached candidates of that move, then detour searches (the
+# random trees of `rrt_detour` the last resort), before the cell is called disconnected.
+DEAD_END_STRAIGHT = 48
+DEAD_END_DETOURS = 3
 
 
 def _distinct(path: FloatArray) -> FloatArray:
@@ -314,8 +320,12 @@ class Sequencer:
         found blocked, or the pair given up (no detour found MAX_FAILED_DETOURS times), where
         every fresh candidate pair tried would cost another detour search."""
         known = self.straight.get((i, j), {})
-        return (sum(1 for free in known.values() if not free) >= MAX_BLOCKED_STRAIGHT
-                or (min(i, j), max(i, j)) in self.unconnected)
+        blocked = sum(1 for free in known.values() if not free)
+        # Given up on detours, yet most straight moves checked are free: the failed searches were
+        # for candidate pairs the gun cannot join without turning (two spins on one flange), not a
+        # wall between the spots, and the next unchecked straight move is as likely free as not.
+        return (blocked >= MAX_BLOCKED_STRAIGHT
+                or ((min(i, j), max(i, j)) in self.unconnected and blocked >= len(known) - blocked))
 
     def cost(self, i: int, j: int) -> FloatArray:
         """`_costs` between the representatives of two spots (what the order search sees), cached."""
@@ -436,6 +446,8 @@ class Sequencer:
                 self._full = {key: m for key, m in self._full.items() if key in moves}
                 choice, cost = choice_for_order(found.order, self.full_cost, self.node)
                 tour = Tour(found.order, choice, cost)
+            if not np.isfinite(tour.cost) and self._open_dead_end(tour.order):
+                continue
             if not np.isfinite(tour.cost):
                 given_up = ", ".join(f"{self._name(i)} - {self._name(j)}" for i, j in sorted(self.unconnected)[:6])
                 return SequencingOutcome("disconnected", message="no collision-free connection found between some "
@@ -463,6 +475,61 @@ class Sequencer:
             choice, cost = choice_for_order(order, self.full_cost, self.node)
             if not np.isfinite(cost) or self._verify(Tour(order, choice, cost)).complete:
                 return
+
+    def _open_dead_end(self, order: tuple[int, ...]) -> bool:
+        """Whether something new joins the first move of `order` that no reached candidate can make
+        (the tour's cost is infinite there): a free straight move from a candidate the tour reaches
+        before that move, else a detour found from one (cheapest reached first).
+
+        What is known can leave such a move with no offer at all while the two spots do connect:
+        candidate pairs whose detours all failed (two spins of the gun on one flange, where it must
+        slide off to turn) mark the spots unconnected, after which only straight moves known free
+        are offered, and those join candidates the rest of the tour does not reach; or detours found
+        for neighbouring pairs whose legs are blocked stand in for the detour this pair never got.
+        The moves checked here start where the tour actually is, as a forward chain would."""
+        stops = (HOME, *order, HOME)
+        value = np.zeros(1)
+        for prev, nxt in itertools.pairwise(stops):
+            step = np.min(value[:, None] + self.full_cost(prev, nxt), axis=0)
+            if np.isfinite(step).any():
+                value = step
+                continue
+            reached = np.flatnonzero(np.isfinite(value))
+            est = self.estimate(prev, nxt)[reached] + value[reached][:, None]
+            ranked = [(int(reached[r]), int(b)) for r, b in
+                      zip(*np.unravel_index(np.argsort(est, axis=None, kind="stable"), est.shape))]
+            known = self.straight.get((prev, nxt), {})
+            banned = self.no_way.get((prev, nxt), set())
+            tried = 0
+            for a, b in ranked:
+                if tried >= DEAD_END_STRAIGHT:
+                    break
+                if (a, b) in known or (a, b) in banned:
+                    continue
+                res = self.world_from(prev).check_segment(self.q(prev)[a], self.q(nxt)[b])
+                self.checks += res.checks
+                self._record_straight(prev, a, nxt, b, res.free)
+                tried += 1
+                if res.free:
+                    log.debug("dead end %s -> %s opened by a straight move", self._name(prev), self._name(nxt))
+                    self.detour_only.discard((min(prev, nxt), max(prev, nxt)))
+                    return True
+            found = len(self.detours)
+            searched = 0
+            for a, b in ranked:
+                if searched >= DEAD_END_DETOURS:
+                    break
+                if (a, b) in banned:
+                    continue
+                self._new_detour(prev, a, nxt, b, last_resort=True)
+                searched += 1
+                if len(self.detours) > found:
+                    log.debug("dead end %s -> %s opened by a detour", self._name(prev), self._name(nxt))
+                    return True
+            log.debug("dead end %s -> %s: %d reached candidates, %d straight moves and %d detour searches "
+                      "found nothing", self._name(prev), self._name(nxt), len(reached), tried, searched)
+            return False
+        return False
 
     def _dead_end(self, order: tuple[int, ...]) -> str:
         """The first move of an order that no candidate reached so far can make (what an infinite
@@ -709,12 +776,18 @@ class Sequencer:
         norm = float(np.linalg.norm(d))
         return d / norm if norm > 0 else np.zeros(3)
 
-    def _new_detour(self, i: int, a: int, j: int, b: int) -> None:
+    def _new_detour(self, i: int, a: int, j: int, b: int, last_resort: bool = False) -> None:
         # Lift first: on clamp cells it is found in ~1,000 checks; the roadmap is the general fallback.
         # Where neither finds a way, the gun's C may still hold the sheet at both approach points
         # (moves between two faces of a part): off the flange first (`_withdrawn_detour`).
         det = (self._lift_detour(i, a, j, b) or self._searched_detour(i, self.q(i)[a], self.q(j)[b])
                or self._withdrawn_detour(i, a, j, b))
+        if det is None and last_resort:
+            # A tour with no other way on (`_open_dead_end`): trees grown between the two ends find
+            # narrow ways out that the shared roadmap samples too thinly (a few CPU seconds at most).
+            det, spent = rrt_detour(self.world_from(i), self.limits, self.q(i)[a], self.q(j)[b], self.rng)
+            if det is None:
+                self.checks += spent
         if det is None:
             # No way found for this exact pair: make sure the optimiser stops choosing it.
             self.no_way.setdefault((i, j), set()).add((a, b))
