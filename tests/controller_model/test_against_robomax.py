@@ -20,6 +20,10 @@ one the cell names, placed in the world the same way; joint targets must lie on 
 and the configuration data must name the planned joints' configuration as each vendor defines it
 (computed here from the arm's geometry).
 
+Kawasaki AS programs (every dialect but INFORM, which these test arms cannot have: their
+robot.yaml states no encoder pulses) are judged the same way; AS joint values carry the
+configuration, its transformation values none.
+
 These caught the robot's placement written as KRL `$BASE` and as the RAPID work object's uframe
 (every weld 1.1 m and 30 deg off) and FANUC's flip letter inverted, all of which the writers'
 own readers had passed.

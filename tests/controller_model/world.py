@@ -39,14 +39,15 @@ from .common import (
     RapidConfig,
 )
 from .fanuc import controller_joints_deg, run_fanuc
+from .kawasaki_as import run_as
 from .krl import run_krl
 from .rapid import run_rapid
 from .urscript import run_urscript
 
 REPO = Path(__file__).resolve().parents[2]
 ROBOTS = REPO / "robomax_py" / "robots"
-DIALECTS = ("krl", "rapid", "fanuc", "urscript")
-MAIN_FILE = {"krl": ".src", "rapid": ".mod", "fanuc": ".ls", "urscript": ".script"}
+DIALECTS = ("krl", "rapid", "fanuc", "urscript", "as")
+MAIN_FILE = {"krl": ".src", "rapid": ".mod", "fanuc": ".ls", "urscript": ".script", "as": ".as"}
 
 
 # ------------------------------------------------------------------------------------------ frames
@@ -239,7 +240,7 @@ def _quadrants(value: float) -> set[int]:
 
 def config_mismatch(arm: Arm, dialect: str, config: object, q_urdf: FloatArray) -> str | None:
     """Why the configuration data written does not name the planned joints' configuration as the
-    vendor defines it (None when it does; URScript targets carry none). A joint within
+    vendor defines it (None when it does; URScript and AS transformation values carry none). A joint within
     BOUNDARY_DEG of a sign or quadrant boundary is accepted on either side."""
     deg = np.degrees(q_urdf)
     if dialect == "krl":
@@ -392,6 +393,9 @@ def run_program(plan: Plan, dialect: str) -> ProgramRun:
                          setup={f: plan.text(f) for f in others if "frames" in f.lower()},
                          called={f: plan.text(f) for f in others if "frames" not in f.lower()},
                          utools=utools, uframes=uframes, j23_coupling=plan.arm.j23_coupling)
+    if dialect == "as":
+        # The program and its weld routine in one file; its tool and base values stated in it.
+        return run_as(plan.text(f"{plan.name}.as"), name=f"{plan.name}.as")
     return run_urscript(plan.text(f"{plan.name}.script"), name=f"{plan.name}.script")
 
 
