@@ -39,6 +39,7 @@ from .common import (
     RapidConfig,
 )
 from .fanuc import controller_joints_deg, run_fanuc
+from .inform import run_inform
 from .kawasaki_as import run_as
 from .krl import run_krl
 from .rapid import run_rapid
@@ -46,8 +47,9 @@ from .urscript import run_urscript
 
 REPO = Path(__file__).resolve().parents[2]
 ROBOTS = REPO / "robomax_py" / "robots"
-DIALECTS = ("krl", "rapid", "fanuc", "urscript", "as")
-MAIN_FILE = {"krl": ".src", "rapid": ".mod", "fanuc": ".ls", "urscript": ".script", "as": ".as"}
+DIALECTS = ("krl", "rapid", "fanuc", "urscript", "as", "inform")
+MAIN_FILE = {"krl": ".src", "rapid": ".mod", "fanuc": ".ls", "urscript": ".script", "as": ".as",
+             "inform": ".jbi"}
 
 
 # ------------------------------------------------------------------------------------------ frames
@@ -85,6 +87,7 @@ class Arm:
     T_flange_tcp: FloatArray
     T_root_base: FloatArray    # the controller's robot base frame in the URDF root
     j23_coupling: bool
+    pulses_per_degree: tuple[float, ...] = ()     # Yaskawa: robot.yaml controller.pulses_per_degree
 
     def _q(self, q_urdf: FloatArray) -> FloatArray:
         q = pin.neutral(self.model)
@@ -149,7 +152,8 @@ def load_arm(robot_yaml: Path, tool_yaml: Path, joints: list[str]) -> Arm:
     else:
         T_root_base = np.eye(4)
     return Arm(model, joint_ids, tuple(model.joints[j].idx_q for j in joint_ids), model.getFrameId(robot["flange"]),
-               _pose(tool["tcp"]), T_root_base, bool(controller.get("j23_coupling", False)))
+               _pose(tool["tcp"]), T_root_base, bool(controller.get("j23_coupling", False)),
+               tuple(float(v) for v in controller.get("pulses_per_degree") or ()))
 
 
 # --------------------------------------------------------------------------- configuration data
@@ -375,6 +379,18 @@ def fanuc_held(plan: Plan) -> tuple[dict[int, FloatArray], dict[int, FloatArray]
     return utools, uframes
 
 
+def inform_held(plan: Plan) -> tuple[dict[int, FloatArray], dict[int, FloatArray]]:
+    """(tools, user frames) a Yaskawa controller calibrated for the cell holds: a job names them
+    by number only. The cell's tool (tool 1 unless it names one) and user frame (in the robot base)."""
+    tools = {int((plan.controller.get("tool") or {}).get("number", 1)): plan.arm.T_flange_tcp}
+    users = {}
+    frame = plan.controller.get("frame")
+    world = plan.user_frame_world()
+    if frame is not None and world is not None:
+        users[int(frame.get("number", 1))] = np.linalg.inv(plan.world(np.eye(4))) @ world
+    return tools, users
+
+
 def run_program(plan: Plan, dialect: str) -> ProgramRun:
     """The dialect's controller model run on the plan's program, after its frames setup file."""
     files = sorted(p.name for p in plan.folder.iterdir())
@@ -393,6 +409,14 @@ def run_program(plan: Plan, dialect: str) -> ProgramRun:
                          setup={f: plan.text(f) for f in others if "frames" in f.lower()},
                          called={f: plan.text(f) for f in others if "frames" not in f.lower()},
                          utools=utools, uframes=uframes, j23_coupling=plan.arm.j23_coupling)
+    if dialect == "inform":
+        # A job is named in capitals (PROCESS_CELL.JBI); its weld job SPOTWELD is called, not run.
+        job = next((f for f in files if f.lower() == f"{plan.name}.jbi"), None)
+        if job is None:          # none written: the robot file states no pulses per degree
+            raise FileNotFoundError(f"{plan.folder / plan.name}.jbi")
+        tools, users = inform_held(plan)
+        return run_inform(plan.text(job), name=job, pulses_per_degree=plan.arm.pulses_per_degree,
+                          tools=tools, users=users)
     if dialect == "as":
         # The program and its weld routine in one file; its tool and base values stated in it.
         return run_as(plan.text(f"{plan.name}.as"), name=f"{plan.name}.as")
@@ -407,11 +431,12 @@ class Weld:
 
 
 def welds(plan: Plan, run: ProgramRun) -> list[Weld]:
-    """The motion right before each ``spot_weld(n, ...)`` call, paired with the n-th spot welded."""
+    """The motion right before each ``spot_weld(n, ...)`` call (INFORM: ``CALL JOB:SPOTWELD ARGF n``),
+    paired with the n-th spot welded."""
     out = []
     events = run.events
     for i, event in enumerate(events):
-        if not (isinstance(event, Call) and event.name.lower() == "spot_weld"):
+        if not (isinstance(event, Call) and event.name.lower() in ("spot_weld", "spotweld")):
             continue
         previous = events[i - 1] if i else None
         assert isinstance(previous, Motion), f"spot_weld at {event.where} does not follow a motion"
@@ -520,4 +545,5 @@ def deviation(plan: Plan, dialect: str) -> Deviation:
 
 
 def main_file(plan: Plan, dialect: str) -> Path:
-    return plan.folder / f"{plan.name}{MAIN_FILE[dialect]}"
+    want = f"{plan.name}{MAIN_FILE[dialect]}"
+    return next((p for p in plan.folder.iterdir() if p.name.lower() == want.lower()), plan.folder / want)
