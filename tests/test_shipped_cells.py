@@ -62,7 +62,7 @@ def _plan(cell: Path, out: Path) -> dict[str, object]:
     text = " ".join(result.output.split())
     assert "robot.yaml: controller.pulses_per_degree is not given: no inform program written" in text, text
     assert not list(out.glob("*.jbi")) and not list(out.glob("*.JBI"))
-    assert not list(out.glob("*.as"))                     # AS is written only when named
+    assert (out / f"{name}.as").is_file()
     for ext in MAIN_FILES:
         program = out / _file(name, ext)
         assert program.is_file(), f"{program} not written"

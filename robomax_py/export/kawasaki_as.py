@@ -10,7 +10,11 @@ examples/Kawasaki.pg):
   the configuration, turns included; linear moves `LMOVE TRANS(x, y, z, o, a, t)`, mm and the
   Euler angles O, A, T in deg with R = Rz(O)·Ry(A)·Rz(T) (z, y', z''; RoboDK robomath
   Adept_2_Pose, RoboDK/RoboDK-API@84099bba Python/robodk/robomath.py:815-835, and Roboception's
-  "Kawasaki XYZ-OAT format" page agree), 3 and 4 decimals. A transformation location carries no
+  "Kawasaki XYZ-OAT format" page agree), mm with 3 decimals and O, A, T with 5. RoboDK's post
+  writes 4 (Kawasaki.py:55), too few: the ZYX angles (4 decimals) turned into OAT rounded to 4
+  come back changed by up to 1e-4 deg, beyond verify's orientation tolerance of 1e-6 rad
+  (5.7e-5 deg) for a spot the planner put at its tolerance's edge; rounded to 5 (at most 3e-7
+  rad off) they come back as written away from ZYX's gimbal lock (|B| < 60 deg). A transformation location carries no
   configuration: along a straight line the arm keeps its own (the configuration instructions
   LEFTY ... DWRIST act on the next joint-interpolated motion), so LMOVE targets state none
   (`robot.ik.config.kawasaki_config` names the branch for SRCL);
@@ -23,7 +27,12 @@ examples/Kawasaki.pg):
   the cell's frame numbers;
 - per motion (no ALWAYS: "applies to the next motion only"): `SPEED <%>` (joint moves, whole % of
   the maximum, 1 decimal) or `SPEED <v> MM/S` (linear, 1 decimal), and `ACCURACY <mm>`: a fly-by
-  as the planned blend's TCP distance (1 decimal), and `ACCURACY 1 FINE` at every stop;
+  as the planned blend's TCP distance (1 decimal), and `ACCURACY 1 FINE` at every stop; a motion
+  slower to accelerate than the axes allow (a part in the gripper: robot.yaml `limits.loaded`)
+  `ACCEL <%>` and `DECEL <%>` (1 decimal), the share of the maximum acceleration and deceleration
+  the next motion uses (RoboDK's post writes the same statement, robodk_postprocessors@d7e6c1c0
+  Kawasaki.py:163-167; without it the controller accelerates at 100 % and every later event comes
+  early);
 - a weld (`weld: call`) as the stop, then `CALL spot_weld(n, weld_time) ; seam/name gun G
   schedule S`, `.PROGRAM spot_weld(n, t)` resting `TWAIT t`; grippers `CALL grip(n, t)` /
   `CALL release(n, t)` alike; `weld: package` has no AS form here;
@@ -81,7 +90,7 @@ __all__ = ["adapt", "frame_name", "matrix_from_oat", "oat_from_matrix", "oat_fro
            "zyx_from_oat"]
 
 INPUT_BASE = 1000            # external input k is signal 1000 + k
-ANGLE_DECIMALS = 4
+ANGLE_DECIMALS = 5
 EXT = ".as"
 ROUTINES = ("spot_weld", "grip", "release")
 
@@ -161,15 +170,20 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     out: list[Instruction] = []
     for ins in program.instructions:
         if isinstance(ins, PtpMove):
-            ins = dataclasses.replace(ins, speed=max(0.001, round(ins.speed * 100, 1) / 100), accel=1.0,
+            ins = dataclasses.replace(ins, speed=max(0.001, round(ins.speed * 100, 1) / 100), accel=_accel(ins.accel),
                                       flyby_mm=round(ins.flyby_mm, 1))
         elif isinstance(ins, LinMove):
             ins = dataclasses.replace(ins, zyx_deg=zyx_from_oat(oat_from_zyx(ins.zyx_deg)), config="",
-                                      speed_mm_s=max(0.1, round(ins.speed_mm_s, 1)), accel=1.0,
+                                      speed_mm_s=max(0.1, round(ins.speed_mm_s, 1)), accel=_accel(ins.accel),
                                       flyby_mm=round(ins.flyby_mm, 1))
         out.append(ins)
     frames = tuple(dataclasses.replace(f, zyx_deg=zyx_from_oat(oat_from_zyx(f.zyx_deg))) for f in program.frames)
     return dataclasses.replace(program, name=_program_name(program.name), frames=frames, instructions=tuple(out))
+
+
+def _accel(fraction: float) -> float:
+    """An acceleration share as ACCEL states it: % with 1 decimal, 0.1 to 100."""
+    return max(0.1, min(100.0, round(fraction * 100, 1))) / 100
 
 
 # ================================================================================== writing
@@ -193,6 +207,8 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     for ins in program.instructions:
         if isinstance(ins, (PtpMove, LinMove)):
             accuracy = f"ACCURACY {_num(ins.flyby_mm, 1)}" if ins.flyby_mm > 0 else "ACCURACY 1 FINE"
+            if ins.accel < 1.0:
+                body += [f"ACCEL {_num(ins.accel * 100, 1)}", f"DECEL {_num(ins.accel * 100, 1)}"]
             if isinstance(ins, PtpMove):
                 body += [f"SPEED {_num(ins.speed * 100, 1)}", accuracy,
                          "JMOVE #[" + ",".join(_num(v, 4) for v in ins.target_deg) + "]"]
@@ -232,6 +248,7 @@ _TRANS = re.compile(rf"^TRANS\s*\(\s*({_NUM}(?:\s*,\s*{_NUM}){{5}})\s*\)$", re.I
 _JOINTS = re.compile(rf"^#\[\s*({_NUM}(?:\s*,\s*{_NUM})*)\s*\]$")
 _POINT = re.compile(r"^POINT\s+([A-Za-z_][A-Za-z0-9_.]*)\s*=\s*(.+)$", re.IGNORECASE)
 _SPEED = re.compile(rf"^SPEED\s+({_NUM})\s*(MM/S|MM/MIN|S)?\s*(ALWAYS)?$", re.IGNORECASE)
+_ACCEL = re.compile(rf"^(ACCEL|DECEL)\s+({_NUM})\s*(ALWAYS)?$", re.IGNORECASE)
 _ACCURACY = re.compile(rf"^ACCURACY\s+({_NUM})\s*(FINE)?\s*(ALWAYS)?$", re.IGNORECASE)
 _CALL = re.compile(rf"^CALL\s+(spot_weld|grip|release)\s*\(\s*([0-9]+)\s*,\s*({_NUM})\s*\)$", re.IGNORECASE)
 _SWAIT = re.compile(r"^(?:SWAIT\s+([0-9]+)|WAIT\s+SIG\s*\(\s*([0-9]+)\s*\))$", re.IGNORECASE)
@@ -272,6 +289,8 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
     always: dict[str, float] = {}
     accuracy: tuple[float, bool] | None = None
     accuracy_always: tuple[float, bool] = (1.0, False)
+    accel: dict[str, float] = {}                  # ACCEL / DECEL for the next motion, in %
+    accel_always: dict[str, float] = {}
     leading = True
 
     def error(line: int, problem: str) -> ProgramError:
@@ -305,6 +324,11 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         match = re.search(r"([0-9]+)$", label)
         frames[label] = FrameDef(label, "tool" if kind == "tool" else "base", xyz, zyx, int(match.group(1)) if match else 0)
         return label
+
+    def share() -> float:
+        """robomax's one acceleration share of a motion: the smaller of ACCEL and DECEL."""
+        values = [accel.get(k, accel_always.get(k, 100.0)) for k in ("ACCEL", "DECEL")]
+        return min(values) / 100
 
     def blend() -> float:
         acc = accuracy if accuracy is not None else accuracy_always
@@ -351,6 +375,14 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             else:
                 accuracy = value2
             continue
+        ac = _ACCEL.match(stmt)
+        if ac:
+            value3 = float(ac.group(2))
+            if not 0.0 < value3 <= 100.0:
+                problems.append((number, "speed", f"{stmt}: an acceleration is 0.01 to 100 %"))
+                value3 = min(max(value3, 0.01), 100.0)
+            (accel_always if ac.group(3) else accel)[ac.group(1).upper()] = value3
+            continue
         if stmt.upper().startswith("JMOVE"):
             target = stmt[5:].strip()
             joints = _JOINTS.match(target)
@@ -361,10 +393,11 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
                 q = _numbers(joints.group(1))
                 if len(q) < 6:
                     raise error(number, f"a joint location of {len(q)} axes")
-                add(PtpMove(q[:6], pct / 100, 1.0, flyby_mm=blend()), number)
+                add(PtpMove(q[:6], pct / 100, share(), flyby_mm=blend()), number)
             speed.pop("%", None)
             speed.pop("mm/s", None)
             accuracy = None
+            accel.clear()
             continue
         if stmt.upper().startswith("LMOVE"):
             _, (xyz, zyx) = location(stmt[5:], number)
@@ -372,10 +405,11 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             if v is None:
                 not_simulated(number, stmt, " (a linear speed in % of the maximum)")
             else:
-                add(LinMove(xyz, zyx, "", v, flyby_mm=blend(), tool=tool, base=base), number)
+                add(LinMove(xyz, zyx, "", v, flyby_mm=blend(), accel=share(), tool=tool, base=base), number)
             speed.pop("%", None)
             speed.pop("mm/s", None)
             accuracy = None
+            accel.clear()
             continue
         call = _CALL.match(stmt)
         if call:

@@ -25,10 +25,7 @@ INFORM = Dialect("inform", (".jbi",), "yaskawa", inform.adapt, inform.write, inf
                  program_name=inform.program_name, shared=tuple(f"{name}{inform.EXT}" for name in inform.ROUTINES),
                  needs=inform.needs)
 AS = Dialect("as", (".as", ".pg"), "kawasaki", kawasaki_as.adapt, kawasaki_as.write, kawasaki_as.parse,
-             kawasaki_as.frame_name, any_extension=True,
-             # Written only when named: its proof still refuses the programs of the pick-and-place and
-             # UR10 shipped cells (a wait timed differently; an orientation at the tolerance's edge).
-             in_all=False)
+             kawasaki_as.frame_name, any_extension=True)
 
 # In the order files are written (after the trajectory file).
 SHIPPED: tuple[Dialect, ...] = (SRCL, KRL, RAPID, FANUC, URSCRIPT, INFORM, AS)

@@ -37,9 +37,8 @@ StateOf = Callable[[Path, str], "str | None"]
 ENV = {**os.environ, "COLUMNS": "400"}
 NAME = "small_cell"
 # What `plan --format all` writes for the small cell (the set's own files and FANUC's shared routine).
-# No INFORM job: the test arm's robot.yaml states no encoder pulses per degree; no AS program: `all`
-# leaves AS out (written only when named).
-ALL_FILES = ("SMALL_CELL.ls", "SMALL_CELL_FRAMES.ls", "SPOT_WELD.ls", "small_cell.dat",
+# No INFORM job: the test arm's robot.yaml states no encoder pulses per degree.
+ALL_FILES = ("SMALL_CELL.ls", "SMALL_CELL_FRAMES.ls", "SPOT_WELD.ls", "small_cell.as", "small_cell.dat",
              "small_cell.json", "small_cell.mod", "small_cell.script", "small_cell.src", "small_cell.srcl",
              "small_cell_frames.mod", "small_cell_frames.src")
 # Kill instants, CPU seconds of the child: log-uniform over a whole run of the small cell with
@@ -224,7 +223,7 @@ def test_dialects_not_written_again_are_removed_and_reported(sets: Sets, tmp_pat
     report = json.loads(done.stdout)
     removed = sorted(Path(p).name for p in report["removed"])
     # FANUC's program and its setup companion are named as the TP program: the set's all the same.
-    assert removed == ["SMALL_CELL.ls", "SMALL_CELL_FRAMES.ls", "small_cell.dat", "small_cell.mod",
+    assert removed == ["SMALL_CELL.ls", "SMALL_CELL_FRAMES.ls", "small_cell.as", "small_cell.dat", "small_cell.mod",
                        "small_cell.script", "small_cell.src", "small_cell_frames.mod", "small_cell_frames.src"]
     assert [Path(p).name for p in report["unlisted"]] == ["SPOT_WELD.ls"]
     assert "SPOT_WELD.ls" in done.stderr and "no plan's set there names it" in done.stderr

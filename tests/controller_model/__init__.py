@@ -11,6 +11,9 @@ never from robomax_py's export, program, verify or configuration code, which it 
 - `rapid`    ABB RAPID modules: TCP = wobj uframe · oframe · target, tooldata tframe
 - `fanuc`    FANUC TP .ls: TCP = UFRAME[UF] · position, UF/UT alarms, J2/J3 coupling
 - `urscript` URScript: poses in the UR Base frame, set_tcp, pose_trans
+- `kawasaki_as` Kawasaki AS: TCP = BASE · transformation (X, Y, Z, O, A, T; Rz·Ry·Rz), TOOL
+- `inform`   Yaskawa INFORM jobs: pulse positions, rectangular positions in the base or USER n with
+             TOOL n (the controller's frames, given by the caller)
 
 Each reads program text(s) and returns a `common.ProgramRun`: every motion statement in execution
 order with its target as the controller composes it (TCP in the controller's robot base frame,

@@ -20,6 +20,11 @@ one the cell names, placed in the world the same way; joint targets must lie on 
 and the configuration data must name the planned joints' configuration as each vendor defines it
 (computed here from the arm's geometry).
 
+Kawasaki AS and Yaskawa INFORM programs are judged the same way; for INFORM, whose joint
+positions count encoder pulses, the test arm's robot.yaml is copied with the pulses per degree a
+controller would state (`_with_pulses`). AS joint values carry the configuration, its
+transformation values none; INFORM's RCONF is not judged here.
+
 These caught the robot's placement written as KRL `$BASE` and as the RAPID work object's uframe
 (every weld 1.1 m and 30 deg off) and FANUC's flip letter inverted, all of which the writers'
 own readers had passed.
@@ -96,6 +101,26 @@ def _place_cell(source: Path, G: FloatArray) -> None:
 
 # -------------------------------------------------------------------------------------- the plan
 CELLS = ("small", "process")
+PULSES_PER_DEGREE = [1194.7, 1194.7, 1194.7, 853.3, 853.3, 512.0]   # tests/conftest.py TEST_PULSES_PER_DEGREE
+
+
+def _with_pulses(cell: Path) -> None:
+    """The cell's robot as a robot file beside the cell (the library's, its other files linked)
+    that states the controller's encoder pulses per degree, so that `--format all` writes INFORM."""
+    from controller_model.world import _reference
+
+    data = yaml.safe_load(cell.read_text())
+    source = _reference(cell, data["robot"]["model"], ROBOTS, "robot.yaml")
+    folder = cell.parent / "robots_with_pulses" / source.parent.name      # a robot folder is named as the robot
+    folder.mkdir(parents=True)
+    for item in source.parent.iterdir():
+        if item.name != "robot.yaml":
+            (folder / item.name).symlink_to(item)
+    robot = yaml.safe_load(source.read_text())
+    robot["controller"] = {**(robot.get("controller") or {}), "pulses_per_degree": PULSES_PER_DEGREE}
+    (folder / "robot.yaml").write_text(yaml.safe_dump(robot, sort_keys=False))
+    data["robot"]["model"] = str(folder / "robot.yaml")
+    cell.write_text(yaml.safe_dump(data, sort_keys=False))
 
 
 def _plan_cell(cell: Path, name: str, formats: str = "all") -> Plan:
@@ -116,8 +141,11 @@ def plan(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactor
     if request.param == "small":
         cell = write_small_cell(folder, name="placed_cell")
         _place_cell(cell, T_from(PLACEMENT_XYZ_M, (0.0, 0.0, PLACEMENT_YAW_DEG)))
+        _with_pulses(cell)
         return _plan_cell(cell, "placed_cell")
-    return _plan_cell(write_process_cell(folder, name="process_cell"), "process_cell")
+    cell = write_process_cell(folder, name="process_cell")
+    _with_pulses(cell)
+    return _plan_cell(cell, "process_cell")
 
 
 def _run(plan: Plan, dialect: str) -> ProgramRun:

@@ -39,14 +39,17 @@ from .common import (
     RapidConfig,
 )
 from .fanuc import controller_joints_deg, run_fanuc
+from .inform import run_inform
+from .kawasaki_as import run_as
 from .krl import run_krl
 from .rapid import run_rapid
 from .urscript import run_urscript
 
 REPO = Path(__file__).resolve().parents[2]
 ROBOTS = REPO / "robomax_py" / "robots"
-DIALECTS = ("krl", "rapid", "fanuc", "urscript")
-MAIN_FILE = {"krl": ".src", "rapid": ".mod", "fanuc": ".ls", "urscript": ".script"}
+DIALECTS = ("krl", "rapid", "fanuc", "urscript", "as", "inform")
+MAIN_FILE = {"krl": ".src", "rapid": ".mod", "fanuc": ".ls", "urscript": ".script", "as": ".as",
+             "inform": ".jbi"}
 
 
 # ------------------------------------------------------------------------------------------ frames
@@ -84,6 +87,7 @@ class Arm:
     T_flange_tcp: FloatArray
     T_root_base: FloatArray    # the controller's robot base frame in the URDF root
     j23_coupling: bool
+    pulses_per_degree: tuple[float, ...] = ()     # Yaskawa: robot.yaml controller.pulses_per_degree
 
     def _q(self, q_urdf: FloatArray) -> FloatArray:
         q = pin.neutral(self.model)
@@ -148,7 +152,8 @@ def load_arm(robot_yaml: Path, tool_yaml: Path, joints: list[str]) -> Arm:
     else:
         T_root_base = np.eye(4)
     return Arm(model, joint_ids, tuple(model.joints[j].idx_q for j in joint_ids), model.getFrameId(robot["flange"]),
-               _pose(tool["tcp"]), T_root_base, bool(controller.get("j23_coupling", False)))
+               _pose(tool["tcp"]), T_root_base, bool(controller.get("j23_coupling", False)),
+               tuple(float(v) for v in controller.get("pulses_per_degree") or ()))
 
 
 # --------------------------------------------------------------------------- configuration data
@@ -239,7 +244,7 @@ def _quadrants(value: float) -> set[int]:
 
 def config_mismatch(arm: Arm, dialect: str, config: object, q_urdf: FloatArray) -> str | None:
     """Why the configuration data written does not name the planned joints' configuration as the
-    vendor defines it (None when it does; URScript targets carry none). A joint within
+    vendor defines it (None when it does; URScript and AS transformation values carry none). A joint within
     BOUNDARY_DEG of a sign or quadrant boundary is accepted on either side."""
     deg = np.degrees(q_urdf)
     if dialect == "krl":
@@ -374,6 +379,18 @@ def fanuc_held(plan: Plan) -> tuple[dict[int, FloatArray], dict[int, FloatArray]
     return utools, uframes
 
 
+def inform_held(plan: Plan) -> tuple[dict[int, FloatArray], dict[int, FloatArray]]:
+    """(tools, user frames) a Yaskawa controller calibrated for the cell holds: a job names them
+    by number only. The cell's tool (tool 1 unless it names one) and user frame (in the robot base)."""
+    tools = {int((plan.controller.get("tool") or {}).get("number", 1)): plan.arm.T_flange_tcp}
+    users = {}
+    frame = plan.controller.get("frame")
+    world = plan.user_frame_world()
+    if frame is not None and world is not None:
+        users[int(frame.get("number", 1))] = np.linalg.inv(plan.world(np.eye(4))) @ world
+    return tools, users
+
+
 def run_program(plan: Plan, dialect: str) -> ProgramRun:
     """The dialect's controller model run on the plan's program, after its frames setup file."""
     files = sorted(p.name for p in plan.folder.iterdir())
@@ -392,6 +409,17 @@ def run_program(plan: Plan, dialect: str) -> ProgramRun:
                          setup={f: plan.text(f) for f in others if "frames" in f.lower()},
                          called={f: plan.text(f) for f in others if "frames" not in f.lower()},
                          utools=utools, uframes=uframes, j23_coupling=plan.arm.j23_coupling)
+    if dialect == "inform":
+        # A job is named in capitals (PROCESS_CELL.JBI); its weld job SPOTWELD is called, not run.
+        job = next((f for f in files if f.lower() == f"{plan.name}.jbi"), None)
+        if job is None:          # none written: the robot file states no pulses per degree
+            raise FileNotFoundError(f"{plan.folder / plan.name}.jbi")
+        tools, users = inform_held(plan)
+        return run_inform(plan.text(job), name=job, pulses_per_degree=plan.arm.pulses_per_degree,
+                          tools=tools, users=users)
+    if dialect == "as":
+        # The program and its weld routine in one file; its tool and base values stated in it.
+        return run_as(plan.text(f"{plan.name}.as"), name=f"{plan.name}.as")
     return run_urscript(plan.text(f"{plan.name}.script"), name=f"{plan.name}.script")
 
 
@@ -403,11 +431,12 @@ class Weld:
 
 
 def welds(plan: Plan, run: ProgramRun) -> list[Weld]:
-    """The motion right before each ``spot_weld(n, ...)`` call, paired with the n-th spot welded."""
+    """The motion right before each ``spot_weld(n, ...)`` call (INFORM: ``CALL JOB:SPOTWELD ARGF n``),
+    paired with the n-th spot welded."""
     out = []
     events = run.events
     for i, event in enumerate(events):
-        if not (isinstance(event, Call) and event.name.lower() == "spot_weld"):
+        if not (isinstance(event, Call) and event.name.lower() in ("spot_weld", "spotweld")):
             continue
         previous = events[i - 1] if i else None
         assert isinstance(previous, Motion), f"spot_weld at {event.where} does not follow a motion"
@@ -516,4 +545,5 @@ def deviation(plan: Plan, dialect: str) -> Deviation:
 
 
 def main_file(plan: Plan, dialect: str) -> Path:
-    return plan.folder / f"{plan.name}{MAIN_FILE[dialect]}"
+    want = f"{plan.name}{MAIN_FILE[dialect]}"
+    return next((p for p in plan.folder.iterdir() if p.name.lower() == want.lower()), plan.folder / want)

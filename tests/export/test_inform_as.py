@@ -39,13 +39,38 @@ def test_oat_is_intrinsic_zyz(o: float, a: float, t: float) -> None:
 @settings(max_examples=50, deadline=None)
 @given(angle, st.floats(-89.0, 89.0), angle)
 def test_zyx_to_oat_and_back_is_the_same_rotation(a: float, b: float, c: float) -> None:
-    """A LIN's ZYX angles written as OAT and read back name the same rotation (within the 4
-    decimals written)."""
-    R = lin_pose(LinMove((0, 0, 0), (a, b, c)))[:3, :3]
-    oat = kawasaki_as.oat_from_zyx((a, b, c))
-    np.testing.assert_allclose(Rotation.from_euler("ZYZ", oat, degrees=True).as_matrix(), R, atol=5e-6)
-    zyx = kawasaki_as.zyx_from_oat(oat)
-    np.testing.assert_allclose(Rotation.from_euler("ZYX", zyx, degrees=True).as_matrix(), R, atol=5e-6)
+    """A LIN's ZYX angles written as OAT name the same rotation within 3e-7 rad (three angles
+    rounded to 1e-5 deg), well inside verify's orientation tolerance (1e-6 rad), so that a spot the
+    planner put at its tolerance's edge stays inside it; away from ZYX's gimbal lock (|B| < 60 deg)
+    they read back as the very ZYX angles written."""
+    zyx = LinMove((0, 0, 0), (a, b, c)).zyx_deg            # the program's values (4 decimals)
+    R = lin_pose(LinMove((0, 0, 0), zyx))[:3, :3]
+    oat = kawasaki_as.oat_from_zyx(zyx)
+    off = Rotation.from_euler("ZYZ", oat, degrees=True) * Rotation.from_matrix(R).inv()
+    assert off.magnitude() < 3e-7
+    back = kawasaki_as.zyx_from_oat(oat)
+    np.testing.assert_allclose(Rotation.from_euler("ZYX", back, degrees=True).as_matrix(), R, atol=5e-7)
+    if abs(zyx[1]) < 60:
+        assert LinMove((0, 0, 0), back).zyx_deg == zyx
+
+
+def test_as_states_each_motions_acceleration(robot6) -> None:  # type: ignore[no-untyped-def]
+    """A motion slower to accelerate (a part in the gripper) is written with ACCEL and DECEL for
+    that motion only; the reader takes the smaller share, and ALWAYS for every later motion."""
+    from robomax_py.program import Header, Program
+
+    header = Header("c", "kr16", "gun", 1.0, tuple(f"a{i}" for i in range(6)))
+    moves = (PtpMove((10, -80, 90, 5, 40, 0), 0.5, 0.36), LinMove((100, 20, 30), (0, 0, 0), "", 250.0, accel=0.42,
+                                                                   tool="", base=""),
+             PtpMove((0, -90, 90, 0, 30, 0), 1.0))
+    files = kawasaki_as.write(Program("c", header, (), moves), robot6)
+    assert "ACCEL 36.0\r\n  DECEL 36.0\r\n" in files[".as"] and files[".as"].count("ACCEL ") == 2
+    got = kawasaki_as.parse(files, "x", robot6).program.instructions
+    assert [m.accel for m in got] == [0.36, 0.42, 1.0]      # type: ignore[union-attr]
+    text = (".PROGRAM p()\r\n  ACCEL 80 ALWAYS\r\n  DECEL 50\r\n  JMOVE #[0,0,0,0,0,0]\r\n"
+            "  JMOVE #[1,0,0,0,0,0]\r\n.END\r\n")
+    got = kawasaki_as.parse({".as": text}, "p.as", robot6).program.instructions
+    assert [m.accel for m in got] == [0.5, 0.8]             # type: ignore[union-attr]
 
 
 def _rconf_by_table(q_deg: list[float], overhead: bool, elbow: bool) -> str:
@@ -178,7 +203,7 @@ def test_all_passes_over_inform_for_an_arm_without_pulse_counts(robot6) -> None:
 
     bare = dataclasses.replace(robot6, controller=dataclasses.replace(robot6.controller, pulses_per_degree=()))
     chosen = export.choose_formats("all", bare)
-    assert chosen.names == ("srcl", "krl", "rapid", "fanuc", "urscript")          # AS only when named
+    assert chosen.names == ("srcl", "krl", "rapid", "fanuc", "urscript", "as")
     assert [(k.format, k.robot_file, k.key) for k in chosen.skipped] == [
         ("inform", str(bare.source), "controller.pulses_per_degree")]
     message = chosen.skipped[0].message
@@ -192,8 +217,7 @@ def test_all_passes_over_inform_for_an_arm_without_pulse_counts(robot6) -> None:
     with pytest.raises(ExportError, match="controller.pulses_per_degree"):
         export.choose_formats("native", yaskawa)
     full = export.choose_formats("all", robot6)
-    assert full.names == tuple(n for n in export.DIALECTS if n != "as") and full.skipped == ()
-    assert export.choose_formats("all,as", robot6).names == tuple(export.DIALECTS)
+    assert full.names == tuple(export.DIALECTS) and full.skipped == ()
     assert export.choose_formats("srcl", bare) == export.FormatChoice(("srcl",))
 
 

@@ -35,7 +35,7 @@ def written(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> dict[
     robot = load_cell_robot(cell)
     result = plan_cell(cell, robot)
     assert result.status == "planned", result.message
-    chosen = choose_formats("all,as", robot)            # AS only when named
+    chosen = choose_formats("all", robot)
     assert sorted(chosen.names) == WRITTEN and [k.format for k in chosen.skipped] == ["inform"]
     files, _ = publish(result, cell, robot, chosen.names)
     for name, text in files.items():
