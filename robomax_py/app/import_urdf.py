@@ -288,6 +288,10 @@ def _robot_yaml(name: str, urdf: str, flange: str, solver: str, params: object, 
             lines.append(f"    {key}: {_number(getattr(params, key))}")
         lines.append(f"    offsets: [{', '.join(_number(math.degrees(o)) for o in params.offsets)}]")
         lines.append(f"    sign_corrections: [{', '.join(str(s) for s in params.sign_corrections)}]")
+        if params.base_xy != (0.0, 0.0):
+            lines.append(f"    base_xy: [{', '.join(_number(v) for v in params.base_xy)}]  # axis 1 in the root frame")
+        if params.flange_xy != (0.0, 0.0):
+            lines.append(f"    flange_xy: [{', '.join(_number(v) for v in params.flange_xy)}]  # flange off axis 6")
     elif isinstance(params, UrParams):
         lines.append("  params:")
         for key in ("d1", "a2", "a3", "d4", "d5", "d6"):
