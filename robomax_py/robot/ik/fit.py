@@ -200,9 +200,9 @@ def fit_opw(model: pin.Model, frame_id: int) -> OpwParams:
 
     signs = (s1, s2, s3, s4, s5, s6)
     offsets = tuple(_wrap(-t) for t in (th1, th2, th23 - th2, th4, th5, th6))
-    fitted = _opw_lengths(model, frame_id, signs, offsets, base_xy)
-    return OpwParams(*fitted[:7], offsets=offsets, sign_corrections=signs,  # type: ignore[arg-type]
-                     base_xy=base_xy, flange_xy=(fitted[7], fitted[8]))
+    a1, a2, b, c1, c2, c3, c4, fx, fy = _opw_lengths(model, frame_id, signs, offsets, base_xy)
+    return OpwParams(a1, a2, b, c1, c2, c3, c4, offsets=offsets, sign_corrections=signs,  # type: ignore[arg-type]
+                     base_xy=base_xy, flange_xy=(fx, fy))
 
 
 def _opw_lengths(model: pin.Model, frame_id: int, signs: tuple[int, ...], offsets: tuple[float, ...],
