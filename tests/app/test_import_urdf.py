@@ -151,6 +151,20 @@ def test_fall_back_to_numeric_ik_says_why_and_what_it_costs(tmp_path: Path) -> N
     assert asked.solver == "numeric" and not [w for w in asked.warnings if w.startswith("IK falls back")]
 
 
+def test_import_warns_where_the_controllers_joint_convention_is_not_known(tmp_path: Path) -> None:
+    """KUKA URDFs that follow KUKA's axis directions and zero (kr120) and FANUC (driver passes the
+    values through but for the J2/J3 linkage, j23_coupling) are known; the KR 210 L150's A1 turns
+    about +z with A2 = 0 upright (kuka_experimental issue 98) and ABB is not checked: warnings."""
+    def convention(name: str) -> list[str]:
+        result = import_urdf(ARMS[name], tmp_path / name, (ROSI,), srdf=SRDF.get(name))
+        return [w for w in result.warnings if "joint directions and zeros taken from the URDF" in w]
+
+    assert convention("kr120r2500pro") == [] and convention("m20ia") == []
+    assert convention("irb2400") and "controller.joint_signs" in convention("irb2400")[0]
+    [kr210] = convention("kr210l150")
+    assert "differ from KUKA's" in kr210
+
+
 def test_import_is_idempotent_and_never_overwrites(tmp_path: Path) -> None:
     out = tmp_path / "m20ia"
     first = import_urdf(ARMS["m20ia"], out, (ROSI,))
