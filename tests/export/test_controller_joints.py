@@ -20,10 +20,13 @@ from robomax_py.plan import plan_cell
 from robomax_py.publish import publish
 from robomax_py.robot import load_robot
 from robomax_py.verify import verify_program
+from tests.conftest import with_pulses
 
 SIGNS = (-1.0, 1.0, -1.0, -1.0, 1.0, -1.0)
-ZEROS_DEG = (10.0, -90.0, 90.0, 0.0, 5.0, 30.0)
-FORMATS = ("srcl", "krl", "rapid", "urscript")
+# Whole numbers of the test's INFORM pulses (tests/conftest.py), as an encoder's zero is: the home
+# then stays exactly the home in pulses.
+ZEROS_DEG = (10.0, -90.0, 90.0, 0.0, 0.0, 30.0)
+FORMATS = ("srcl", "krl", "rapid", "urscript", "fanuc", "inform", "as")
 
 
 def _numbers(text: str) -> list[float]:
@@ -34,7 +37,7 @@ def _numbers(text: str) -> list[float]:
 def written(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> dict[str, Any]:  # type: ignore[no-untyped-def]
     folder = tmp_path_factory.mktemp("conventions")
     cell = load_cell(write_small_cell(folder))
-    plain = load_cell_robot(cell)
+    plain = with_pulses(load_cell_robot(cell))           # INFORM counts joint positions in pulses
     robot = dataclasses.replace(plain, controller=dataclasses.replace(
         plain.controller, joint_signs=SIGNS, joint_zeros=tuple(math.radians(z) for z in ZEROS_DEG)))
     result = plan_cell(cell, robot)
@@ -65,12 +68,15 @@ def test_joint_targets_are_the_controllers_values(written: dict[str, Any]) -> No
            for m in re.findall(r"DECL E6AXIS XP\d+=\{([^}]*)\}", files[f"{name}.dat"])]
     rapid = [_numbers(m) for m in re.findall(r"CONST jointtarget jt\d+ := \[\[([^\]]*)\]", files[f"{name}.mod"])]
     ur = [[math.degrees(v) for v in _numbers(m)] for m in re.findall(r"movej\(\[([^\]]*)\]", files[f"{name}.script"])]
-    for got in (krl, rapid, ur):
+    fanuc_text = next(t for f, t in files.items() if f.endswith(".ls") and f.upper().startswith(name.upper()))
+    fanuc = [[float(v) for v in re.findall(r"J\d=\s*(-?\d*\.\d+) deg", block)]
+             for block in re.findall(r"P\[\d+[^\]]*\]\{(.*?)\};", fanuc_text, re.DOTALL) if "J1=" in block]
+    for got in (krl, rapid, ur, fanuc):
         assert len(got) == len(urdf)
         for g, u in zip(got, urdf):
             assert g == pytest.approx(_expected(u), abs=1e-4)
     # The home (URDF 0, -90, 90, 0, 0, 0) as this controller counts it.
-    assert krl[0] == pytest.approx([10, -180, 0, 0, 5, 30], abs=1e-4)
+    assert krl[0] == pytest.approx([10, -180, 0, 0, 0, 30], abs=1e-4)
 
 
 def test_srcl_keeps_the_urdf_values_and_the_plain_robot_is_unchanged(written: dict[str, Any]) -> None:
@@ -82,9 +88,11 @@ def test_srcl_keeps_the_urdf_values_and_the_plain_robot_is_unchanged(written: di
     assert lins[0] == lins[1]
 
 
-@pytest.mark.parametrize("ext", [".src", ".mod", ".script"])
+@pytest.mark.parametrize("ext", [".src", ".mod", ".script", ".ls", ".jbi", ".as"])
 def test_verify_rebuilds_the_plan_from_the_controllers_values(written: dict[str, Any], ext: str) -> None:
-    report = verify_program(written["cell"], written["robot"], written["folder"] / f"{written['name']}{ext}")
+    # FANUC and INFORM name the file after the program (capitals).
+    [main] = [f for f in written["files"] if f.lower() == f"{written['name']}{ext}"]
+    report = verify_program(written["cell"], written["robot"], written["folder"] / main)
     assert report.clean, report.violations[:3]
 
 
