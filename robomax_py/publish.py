@@ -32,7 +32,7 @@ from robomax_py.export import (
     render_trajectory,
     require_calibration,
 )
-from robomax_py.export.dialect import Parsed, PlannedProgram
+from robomax_py.export.dialect import Parsed, PlannedProgram, in_controller_joints
 from robomax_py.export.plan_program import planned_program
 from robomax_py.export.rebuild import rebuild
 from robomax_py.plan import PlanResult, method_suffix
@@ -124,6 +124,8 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
         planned = dataclasses.replace(planned, program=dataclasses.replace(
             planned.program, name=planned.program.name + name[len(result.cell):]))
     try:
+        if dialect.brand:
+            planned = dataclasses.replace(planned, program=in_controller_joints(planned.program, robot))
         adapted = dialect.adapt(planned, robot)
     except ControllerSetupError as exc:
         raise CellFileError(cell.source, exc.key, f"{exc.problem} (--format {fmt})") from None
@@ -139,7 +141,8 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
         at, kind, detail = parsed.problems[0]
         raise ExportError(f"{fmt}: the written program is not clean: {kind}: {detail} (line {at} of {main})")
     _same_program(fmt, main, adapted, parsed)
-    rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
+    read = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
+    rebuilt = rebuild(read, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
     if rebuilt.problems or rebuilt.trajectory is None:
         p = rebuilt.problems[0] if rebuilt.problems else None
         where = f"line {p.line}: " if p and p.line else ""

@@ -52,6 +52,10 @@ class ControllerSpec:
     T_root_base: FloatArray = field(default_factory=_identity)   # (4, 4) controller base in the URDF root
     # Yaskawa: encoder pulses per degree of each axis, as INFORM counts joint positions; () unknown.
     pulses_per_degree: tuple[float, ...] = ()
+    # The controller's joint value = joint_signs[i] * q[i] + joint_zeros[i] (rad), for the joint
+    # targets of controller programs; () = the URDF's own (+1, 0) for every joint.
+    joint_signs: tuple[float, ...] = ()
+    joint_zeros: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -67,6 +67,7 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
     """Verify a trajectory file (.json) or a program of any dialect robomax writes (its motion
     rebuilt from its statements alone)."""
     from robomax_py.export import controller_frames
+    from robomax_py.export.dialect import in_controller_joints
     from robomax_py.export.rebuild import rebuild
     from robomax_py.program import LinMove, PtpMove
 
@@ -86,7 +87,9 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
                       for seam in cell.seams for spot in seam.spots)
         return _with_set(cell, path, read,
                          VerifyReport(str(path), 0, float("nan"), 0, unsimulated + stated + nowhere + never, ignored))
-    rebuilt = rebuild(parsed.program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
+    # A controller's joint targets count its joints its way (robot.yaml controller.joint_signs/zeros).
+    joint_program = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
+    rebuilt = rebuild(joint_program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
     report = verify_rebuilt(cell, robot, str(path), rebuilt)
     report = dataclasses.replace(report, violations=unsimulated + stated + report.violations, ignored=ignored)
     return _with_set(cell, path, read, report)

@@ -288,6 +288,10 @@ def _robot_yaml(name: str, urdf: str, flange: str, solver: str, params: object, 
             lines.append(f"    {key}: {_number(getattr(params, key))}")
         lines.append(f"    offsets: [{', '.join(_number(math.degrees(o)) for o in params.offsets)}]")
         lines.append(f"    sign_corrections: [{', '.join(str(s) for s in params.sign_corrections)}]")
+        if params.base_xy != (0.0, 0.0):
+            lines.append(f"    base_xy: [{', '.join(_number(v) for v in params.base_xy)}]  # axis 1 in the root frame")
+        if params.flange_xy != (0.0, 0.0):
+            lines.append(f"    flange_xy: [{', '.join(_number(v) for v in params.flange_xy)}]  # flange off axis 6")
     elif isinstance(params, UrParams):
         lines.append("  params:")
         for key in ("d1", "a2", "a3", "d4", "d5", "d6"):
@@ -315,7 +319,59 @@ def _yaml_text(text: str) -> str:
     return text if re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.() -]*", text) and not text.endswith(" ") else json.dumps(text)
 
 
-def _fit(model: object, frame_id: int, solver: str | None) -> tuple[str, object, float]:
+# What the numeric solver costs, for the warning when the fit falls back to it. Measured once on
+# ROS-Industrial's KR 210 L150 planning a four-spot flange cell (tests/app/test_import_urdf.py's
+# `_flange_cell`), one thread, warm: 6.6 s CPU with numeric IK against 1.4 to 2.1 s with the fitted
+# OPW solver.
+NUMERIC_COST = ("planning several times slower (about 4x CPU on a KR 210 L150 cell), and the IK branches of each "
+                "pose found by sampling from random starts, not enumerated, so a branch can be missed")
+
+
+CONVENTION_UNKNOWN = ("joint directions and zeros taken from the URDF; check them against the controller's axis "
+                      "display (robot.yaml controller.joint_signs, controller.joint_zeros_deg)")
+# KUKA's own axis directions in its base frame at A1..A6 = 0 (KSS: A1 turns about -z, A4 and A6
+# about -x; A2 = 0 with the upper arm horizontal, forward), which the ROS-Industrial KUKA URDFs
+# follow so that their joint values are the controller's: kuka_rsi_hw_interface passes the
+# controller's axis values through unchanged (ros-industrial/kuka_experimental@e78bbd15
+# kuka_rsi_hw_interface/src/kuka_hardware_interface.cpp:109, `joint_position_[i] = DEG2RAD *
+# rsi_state_.positions[i]`; kuka_kr120_support/urdf/kr120r2500pro_macro.xacro:156-196). Not all do:
+# kuka_kr210_support's kr210l150 (A1 about +z, A2 = 0 upright) is kuka_experimental issue 98,
+# "kr210: update xacro to comply with actual kinematic chain".
+_KUKA_AXES = ((0, 0, -1), (0, 1, 0), (0, 1, 0), (-1, 0, 0), (0, 1, 0), (-1, 0, 0))
+
+
+def _convention_warning(model: object, frame_id: int, brand: str, T_root_base: FloatArray | None) -> str | None:
+    """None when the URDF's joint values are known to be the controller's, else the warning.
+
+    FANUC: ROS-Industrial's fanuc_driver exchanges the URDF's joint values with the controller
+    unchanged but for the J2/J3 linkage (ros-industrial/fanuc@8fee5e30
+    fanuc_driver/include/fanuc_driver/fanuc_utils.h:55-71, `J3_out = J3_in + j23_factor * J2_in`),
+    which `controller.j23_coupling` states. KUKA: checked against KUKA's axis directions and zero
+    (`_KUKA_AXES`). Other brands: not known here."""
+    import numpy as np
+
+    from robomax_py.robot.ik._chain import joint_axes_at_zero
+
+    if brand == "fanuc":
+        return None
+    if brand != "kuka" or model.nq != 6:  # type: ignore[attr-defined]
+        return CONVENTION_UNKNOWN
+    try:
+        axes = joint_axes_at_zero(model, frame_id)
+    except Exception:  # noqa: BLE001 - a chain the check cannot read is simply not known to match
+        return CONVENTION_UNKNOWN
+    R = np.eye(3) if T_root_base is None else np.asarray(T_root_base)[:3, :3]
+    u = axes.u @ R                                      # directions in the controller's base frame
+    upper = (axes.p[2] - axes.p[1]) @ R                 # J2 -> J3 at zero: horizontal and forward on KUKA
+    matches = len(u) == 6 and all(float(a @ np.asarray(e)) > 1 - 1e-6 for a, e in zip(u, _KUKA_AXES)) \
+        and upper[0] > 0 and abs(upper[2]) < 0.2 * upper[0]
+    return None if matches else (f"the URDF's joint axes or zero differ from KUKA's (A1 about -z, A4 and A6 about -x, "
+                                 f"A2 = 0 with the upper arm horizontal): {CONVENTION_UNKNOWN}")
+
+
+def _fit(model: object, frame_id: int, solver: str | None) -> tuple[str, object, float, str | None]:
+    """(solver, parameters, FK error in m, warning): the warning says why the closed forms were not
+    taken and what that costs, whenever the fit fell back to numeric IK (None otherwise)."""
     from robomax_py.robot.ik.fit import FitError, fit_opw, fit_ur, fk_agreement
 
     tried: list[str] = []
@@ -332,10 +388,13 @@ def _fit(model: object, frame_id: int, solver: str | None) -> tuple[str, object,
             continue
         agreement = fk_agreement(model, frame_id, params)  # type: ignore[arg-type]
         if agreement.ok:
-            return name, params, agreement.position_m
+            return name, params, agreement.position_m, None
         tried.append(f"{name}: fitted parameters disagree with the URDF by {agreement.position_m * 1000:.3f} mm")
-    if solver in (None, "numeric"):
-        return "numeric", None, 0.0
+    if solver == "numeric":
+        return "numeric", None, 0.0, None
+    if solver is None:
+        return "numeric", None, 0.0, (f"IK falls back to the numeric solver: no closed form fits ({'; '.join(tried)}); "
+                                      f"this costs {NUMERIC_COST}")
     raise FitError("; ".join(tried))
 
 
@@ -404,6 +463,7 @@ def import_urdf(
                     None if srdf_text is None else f"{name}.srdf")
             except RobotModelError as exc:
                 raise _unstaged(exc, stage, source, urdf_name) from None
+            warnings.extend(w for w in robot_warnings if w.startswith(("IK falls back", "joint directions", "the URDF's joint axes")))
             warnings.extend(w.replace(str(stage), str(out)) for w in robot_warnings if "limits." in w)
             warnings.extend(_named_srdf(w, stage, source, urdf_name, srdf) for w in robot_warnings if ": srdf: " in w)
             unchanged = out.is_dir() and not out.is_symlink() and _digest(out) == _digest(stage)
@@ -481,7 +541,7 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
         frames = ", ".join(f.name for f in model.frames if f.type == pin.FrameType.BODY)
         raise RobotModelError(source, "flange", f"the URDF has no frame '{flange}' (links: {frames})")
     try:
-        solver_name, params, fk_error = _fit(model, int(model.getFrameId(flange)), solver)
+        solver_name, params, fk_error, fallback = _fit(model, int(model.getFrameId(flange)), solver)
     except FitError as exc:
         raise RobotModelError(source, "ik.solver", f"not a {solver}-class arm: {exc.problem}") from None
     # The file's folders too: ROS-Industrial packages name the maker (motoman_gp180_support/urdf/...).
@@ -491,7 +551,9 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
         encoding="utf-8")
     spec = load_robot_spec(stage / "robot.yaml")
     robot = load_robot(spec)       # the whole folder loads: meshes, pairs, IK checked against the URDF
-    return solver_name, fk_error, spec, robot.warnings
+    notes = tuple(n for n in (fallback, _convention_warning(model, int(model.getFrameId(flange)), brand, T_root_base))
+                  if n is not None)
+    return solver_name, fk_error, spec, (*notes, *robot.warnings)
 
 
 def _unstaged(exc: RobotModelError, stage: Path, source: Path, urdf_name: str) -> RobotModelError:

@@ -323,6 +323,32 @@ def with_brand_configs(program: Program, joints: Sequence[FloatArray], robot: Ro
     return dataclasses.replace(program, instructions=tuple(out))
 
 
+def in_controller_joints(program: Program, robot: RobotModel, inverse: bool = False) -> Program:
+    """The program's joint targets as the controller counts its joints (robot.yaml
+    `controller.joint_signs`, `controller.joint_zeros_deg`): controller = sign * URDF + zero, in
+    degrees; `inverse` takes them back to the URDF's. The one place controller dialects' joint
+    values are converted: publishing applies it before a dialect adapts the plan (so every dialect
+    writes, rounds and reads back controller values) and its inverse before the motion is rebuilt
+    from what was read, as `verify` does. Without the keys the program is returned as it is."""
+    c = robot.controller
+    if not c.joint_signs and not c.joint_zeros:
+        return program
+    n = robot.dof
+    signs = c.joint_signs or (1.0,) * n
+    zeros = tuple(math.degrees(z) for z in c.joint_zeros) or (0.0,) * n
+
+    def convert(values: tuple[float, ...]) -> tuple[float, ...]:
+        if len(values) != n:
+            return values               # rebuild reports the wrong axis count
+        if inverse:
+            return tuple((v - z) * s for v, s, z in zip(values, signs, zeros))
+        return tuple(s * v + z for v, s, z in zip(values, signs, zeros))
+
+    out = tuple(dataclasses.replace(i, target_deg=convert(i.target_deg)) if isinstance(i, PtpMove) else i
+                for i in program.instructions)
+    return dataclasses.replace(program, instructions=out)
+
+
 def without_comments(program: Program) -> Program:
     """The program without its comment lines and move notes (for dialects that cannot carry them)."""
     kept = tuple(dataclasses.replace(i, comment="") if isinstance(i, (PtpMove, LinMove)) else i

@@ -5,7 +5,10 @@ the file (converted to radians here):
 
 opw
     a1, a2, b, c1, c2, c3, c4 (m, required; c2 > 0 and (a2, c3) not both 0);
-    offsets (deg, 6, default all 0); sign_corrections (6 values of +1 or -1, default all +1).
+    offsets (deg, 6, default all 0); sign_corrections (6 values of +1 or -1, default all +1);
+    base_xy (m, 2, default [0, 0]): where axis 1 meets the xy plane of the URDF root frame, a fixed
+    translation in front of the chain (the root frame need not lie on axis 1); flange_xy (m, 2,
+    default [0, 0]): the flange origin's offset from axis 6, along the flange frame's x and y.
     Conventions of the opw_kinematics reference implementation (see `opw`).
 ur
     d1, a2, a3, d4, d5, d6 (m, required; Universal Robots' DH table, a2 and a3 non-zero, negative for
@@ -58,7 +61,7 @@ def params_from_mapping(solver: str, params: Mapping[str, Any]) -> OpwParams | U
     if not isinstance(params, Mapping):
         raise RobotModelError(None, "ik.params", f"expected a mapping of parameters, got {type(params).__name__}")
     if solver == "opw":
-        allowed: tuple[str, ...] = (*_OPW_LENGTHS, "offsets", "sign_corrections")
+        allowed: tuple[str, ...] = (*_OPW_LENGTHS, "offsets", "sign_corrections", "base_xy", "flange_xy")
     elif solver == "ur":
         allowed = (*_UR_LENGTHS, *_UR_POSES)
     elif solver == "table":
@@ -84,10 +87,13 @@ def params_from_mapping(solver: str, params: Mapping[str, Any]) -> OpwParams | U
                 raise RobotModelError(None, "ik.params.sign_corrections", f"entry {i} must be +1 or -1, got {s:g}")
         o = [math.radians(v) for v in offsets_deg]
         g = [int(v) for v in signs]
+        bx, by = _vector(params, "base_xy", 2, (0.0, 0.0))
+        fx, fy = _vector(params, "flange_xy", 2, (0.0, 0.0))
         return OpwParams(
             a1=a1, a2=a2, b=b, c1=c1, c2=c2, c3=c3, c4=c4,
             offsets=(o[0], o[1], o[2], o[3], o[4], o[5]),
             sign_corrections=(g[0], g[1], g[2], g[3], g[4], g[5]),
+            base_xy=(bx, by), flange_xy=(fx, fy),
         )
     if solver == "ur":
         d1, a2, a3, d4, d5, d6 = (_number(params, k) for k in _UR_LENGTHS)

@@ -115,6 +115,24 @@ class ControllerFile(_Strict):
             raise ValueError("expected 6 non-zero numbers (negative where the axis counts the other way)")
         return v
     base: PoseFile | None = None              # None: the URDF's `base` link, else identity
+    # Each joint's direction and zero as the controller counts it: controller value (deg) =
+    # joint_signs[i] * URDF value (deg) + joint_zeros_deg[i]. None: the URDF's own (signs +1, zeros 0).
+    joint_signs: list[int] | None = None
+    joint_zeros_deg: list[float] | None = None
+
+    @field_validator("joint_signs")
+    @classmethod
+    def _signs(cls, v: list[int] | None) -> list[int] | None:
+        if v is not None and (not v or any(isinstance(x, bool) or x not in (1, -1) for x in v)):
+            raise ValueError("expected one +1 or -1 per joint")
+        return v
+
+    @field_validator("joint_zeros_deg")
+    @classmethod
+    def _zeros(cls, v: list[float] | None) -> list[float] | None:
+        if v is not None and (not v or any(not math.isfinite(x) for x in v)):
+            raise ValueError("expected one finite number (deg) per joint")
+        return v
 
 
 class CollisionFile(_Strict):
@@ -647,6 +665,8 @@ def load_robot_spec(path: Path) -> RobotSpec:
         controller=ControllerSpec(
             brand=ctrl.brand, j23_coupling=ctrl.j23_coupling,
             pulses_per_degree=tuple(ctrl.pulses_per_degree or ()),
+            joint_signs=tuple(float(s) for s in ctrl.joint_signs or ()),
+            joint_zeros=tuple(math.radians(z) for z in ctrl.joint_zeros_deg or ()),
             T_root_base=frozen_array(T_root_base),
         ),
         disabled_links=disabled,

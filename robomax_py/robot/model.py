@@ -227,6 +227,9 @@ def load_robot(spec: RobotSpec) -> RobotModel:
     limits = JointLimits(lower=frozen_array(lower), upper=frozen_array(upper), velocity=frozen_array(velocity),
                          acceleration=frozen_array(acceleration), jerk=frozen_array(jerk))
     loaded = _loaded_limits(spec, limits)
+    for key, given in (("joint_signs", spec.controller.joint_signs), ("joint_zeros_deg", spec.controller.joint_zeros)):
+        if given and len(given) != n:
+            raise RobotModelError(spec.source, f"controller.{key}", f"expected {n} values (one per joint), got {len(given)}")
     defaulted = tuple(k for k, v in (("acceleration", spec.acceleration), ("jerk", spec.jerk)) if v is None)
     if defaulted:
         warnings.append(

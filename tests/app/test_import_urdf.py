@@ -32,6 +32,8 @@ ARMS = {
     "irb2400": ROSI / "abb_irb2400_support/urdf/irb2400.xacro",
     "m20ia": ROSI / "fanuc_m20ia_support/urdf/m20ia.xacro",
     "kr120r2500pro": ROSI / "kuka_kr120_support/urdf/kr120r2500pro.xacro",
+    # Axis 1 2.6 mm off base_link's origin, tool0 0.24 mm off axis 6: fixed offsets around the OPW chain.
+    "kr210l150": ROSI / "kuka_kr210_support/urdf/kr210l150.xacro",
 }
 SRDF = {"irb2400": ROSI / "abb_irb2400_moveit_config/config/abb_irb2400.srdf"}
 # Round trips of a correct closed-form solver are at float64 round-off; 1e-9 m leaves room.
@@ -60,7 +62,7 @@ def test_import_writes_a_self_contained_folder(arms: dict[str, Path]) -> None:
         assert all((folder / m).is_file() for m in ("robot.yaml", f"{name}.urdf"))
         assert list((folder / "meshes").rglob("*.stl"))
         spec = load_robot_spec(folder / "robot.yaml")
-        assert spec.controller.brand == {"irb2400": "abb", "m20ia": "fanuc", "kr120r2500pro": "kuka"}[name]
+        assert spec.controller.brand == {"irb2400": "abb", "m20ia": "fanuc", "kr120r2500pro": "kuka", "kr210l150": "kuka"}[name]
         robot = load_robot(spec)
         # The test copies have no visual meshes: the collision meshes stand in, with a warning.
         assert robot.visual_model.ngeoms == robot.collision_model.ngeoms
@@ -104,6 +106,63 @@ def test_fk_agrees_and_ik_round_trips(arms: dict[str, Path], name: str) -> None:
         assert wrapped.min() < 1e-6
 
     round_trip()
+
+
+def test_offsets_off_the_axes_are_fitted_exactly(arms: dict[str, Path]) -> None:
+    """kuka_kr210_support/urdf/kr210l150_macro.xacro: joint_a1 at xyz -0.00262 0.00097586 0.33099 in
+    base_link (axis z), link_6-flange at xyz 0.0375 0 -0.00023924 (axis 6 along x, tool0 = flange
+    turned 90 deg about y, so 0.24 mm along tool0's x)."""
+    robot = load_robot(load_robot_spec(arms["kr210l150"] / "robot.yaml"))
+    assert robot.ik_solver == "opw"
+    params = fit_opw(robot.model, robot.flange_frame_id)
+    assert params.base_xy == pytest.approx((-0.00262, 0.00097586), abs=1e-12)
+    assert params.flange_xy == pytest.approx((0.00023924, 0.0), abs=1e-12)
+    assert fk_agreement(robot.model, robot.flange_frame_id, params).position_m < 1e-12
+    # As written to robot.yaml (9 decimals) the parameters still agree within the round-trip bound.
+    assert fk_agreement(robot.model, robot.flange_frame_id, robot.ik_params).position_m < ROUND_TRIP_M
+    assert _params(arms["kr210l150"])["base_xy"] == [-0.00262, 0.00097586]
+    # The arms on their axes write no offset keys.
+    assert not {"base_xy", "flange_xy"} & set(_params(arms["kr120r2500pro"]))
+
+
+def _non_opw_urdf(path: Path) -> Path:
+    """Six revolute joints whose axes 2 and 3 are perpendicular (neither OPW nor UR), no meshes."""
+    axes = ["0 0 1", "0 1 0", "1 0 0", "1 0 0", "0 1 0", "1 0 0"]
+    origins = ["0 0 0.4", "0.1 0 0.3", "0 0 0.6", "0.5 0 0", "0.2 0 0", "0.1 0 0"]
+    links = "".join(f'<link name="l{i}"/>' for i in range(7))
+    joints = "".join(
+        f'<joint name="j{i + 1}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        f'<origin xyz="{o}"/><axis xyz="{a}"/><limit lower="-3" upper="3" effort="1" velocity="2"/></joint>'
+        for i, (a, o) in enumerate(zip(axes, origins)))
+    path.write_text(f'<robot name="odd6">{links}{joints}<link name="tool0"/><joint name="j_t" type="fixed">'
+                    f'<parent link="l6"/><child link="tool0"/><origin xyz="0.05 0 0" rpy="0 1.5707963267948966 0"/>'
+                    f'</joint></robot>')
+    return path
+
+
+def test_fall_back_to_numeric_ik_says_why_and_what_it_costs(tmp_path: Path) -> None:
+    result = import_urdf(_non_opw_urdf(tmp_path / "odd6.urdf"), tmp_path / "odd6")
+    assert result.solver == "numeric"
+    [warning] = [w for w in result.warnings if w.startswith("IK falls back to the numeric solver")]
+    assert "opw: axes 2 and 3 must be parallel" in warning and "ur: axes 2 and 3 must be parallel" in warning
+    assert "slower" in warning and "sampling" in warning
+    # Asked for, numeric IK is no fall-back: no warning.
+    asked = import_urdf(tmp_path / "odd6.urdf", tmp_path / "odd6n", solver="numeric")
+    assert asked.solver == "numeric" and not [w for w in asked.warnings if w.startswith("IK falls back")]
+
+
+def test_import_warns_where_the_controllers_joint_convention_is_not_known(tmp_path: Path) -> None:
+    """KUKA URDFs that follow KUKA's axis directions and zero (kr120) and FANUC (driver passes the
+    values through but for the J2/J3 linkage, j23_coupling) are known; the KR 210 L150's A1 turns
+    about +z with A2 = 0 upright (kuka_experimental issue 98) and ABB is not checked: warnings."""
+    def convention(name: str) -> list[str]:
+        result = import_urdf(ARMS[name], tmp_path / name, (ROSI,), srdf=SRDF.get(name))
+        return [w for w in result.warnings if "joint directions and zeros taken from the URDF" in w]
+
+    assert convention("kr120r2500pro") == [] and convention("m20ia") == []
+    assert convention("irb2400") and "controller.joint_signs" in convention("irb2400")[0]
+    [kr210] = convention("kr210l150")
+    assert "differ from KUKA's" in kr210
 
 
 def test_import_is_idempotent_and_never_overwrites(tmp_path: Path) -> None:
@@ -200,6 +259,7 @@ MACROS = {
     "irb2400": ROSI / "abb_irb2400_support/urdf/irb2400_macro.xacro",
     "m20ia": ROSI / "fanuc_m20ia_support/urdf/m20ia_macro.xacro",
     "kr120r2500pro": ROSI / "kuka_kr120_support/urdf/kr120r2500pro_macro.xacro",
+    "kr210l150": ROSI / "kuka_kr210_support/urdf/kr210l150_macro.xacro",
 }
 BASE_TOL_M = 1e-9       # robot.yaml states the base in m and deg with 9 decimals
 
@@ -400,6 +460,7 @@ def _plan_and_verify(cell: Path, out: Path) -> None:
     ("irb2400", "spot_gun_light", 1.05, 0.95, "[0, 0, 0, 0, 30, 0]"),
     ("m20ia", "spot_gun_light", 1.05, 0.95, "[0, 0, 0, 0, 30, 0]"),
     ("kr120r2500pro", "spot_gun_c", 1.6, 1.2, "[0, -90, 90, 0, 30, 0]"),   # KUKA: A2 = -90 is upright
+    ("kr210l150", "spot_gun_c", 1.6, 1.2, "[0, 0, 0, 0, 30, 0]"),          # this URDF's zero is upright
 ])
 def test_each_arm_plans_and_verifies(arms: dict[str, Path], tmp_path: Path, name: str, tool: str, x: float, z: float,
                                      home: str) -> None:

@@ -123,20 +123,24 @@ def _urdf_fk(model: pin.Model, frame_id: int, qs: FloatArray) -> FloatArray:
 
 def fit_opw(model: pin.Model, frame_id: int) -> OpwParams:
     """OPW parameters of a URDF chain (root frame = the OPW base frame up to a yaw, absorbed in the
-    joint-1 offset; a vertical offset is absorbed in c1).
+    joint-1 offset, a vertical offset, absorbed in c1, and a horizontal one, kept as `base_xy`).
 
     Raises
     ------
     FitError
-        The chain is not an ortho-parallel arm with a spherical wrist whose axis 1 is the root's z
-        line, or its flange z axis is not along axis 6.
+        The chain is not an ortho-parallel arm with a spherical wrist whose axis 1 is parallel to the
+        root's z axis, or its flange z axis is not along axis 6.
     """
     ax = _axes_at_zero(model, frame_id)
-    u, p = ax.u, ax.p
+    u = ax.u
     ez = np.array([0.0, 0.0, 1.0])
     _require_parallel(u[0], ez, "axis 1 and the root frame's z axis")
-    if np.hypot(p[0, 0] - u[0, 0] / u[0, 2] * p[0, 2], p[0, 1] - u[0, 1] / u[0, 2] * p[0, 2]) > STRUCTURE_TOL:
-        raise FitError("axis 1 must pass through the root frame's origin")
+    # Axis 1 off the root origin is a fixed translation in front of the chain, not another class of
+    # arm: the chain is fitted in the root frame moved (in x, y only, so the z conventions stay) to
+    # the foot of axis 1, and the translation travels with the parameters as `base_xy`.
+    foot = ax.p[0] - ax.p[0, 2] / u[0, 2] * u[0]
+    base_xy = (0.0, 0.0) if np.hypot(foot[0], foot[1]) < 1e-12 else (float(foot[0]), float(foot[1]))
+    p = ax.p - np.array([base_xy[0], base_xy[1], 0.0])
     s1 = 1 if u[0] @ ez > 0 else -1
     _require_perpendicular(u[1], ez, "axes 1 and 2")
     _require_parallel(u[1], u[2], "axes 2 and 3")
@@ -196,14 +200,19 @@ def fit_opw(model: pin.Model, frame_id: int) -> OpwParams:
 
     signs = (s1, s2, s3, s4, s5, s6)
     offsets = tuple(_wrap(-t) for t in (th1, th2, th23 - th2, th4, th5, th6))
-    lengths = _opw_lengths(model, frame_id, signs, offsets)
-    return OpwParams(*lengths, offsets=offsets, sign_corrections=signs)  # type: ignore[arg-type]
+    a1, a2, b, c1, c2, c3, c4, fx, fy = _opw_lengths(model, frame_id, signs, offsets, base_xy)
+    return OpwParams(a1, a2, b, c1, c2, c3, c4, offsets=offsets, sign_corrections=signs,  # type: ignore[arg-type]
+                     base_xy=base_xy, flange_xy=(fx, fy))
 
 
-def _opw_lengths(model: pin.Model, frame_id: int, signs: tuple[int, ...], offsets: tuple[float, ...]) -> tuple[float, ...]:
-    """a1, a2, b, c1, c2, c3, c4 by least squares: the flange position is linear in them."""
+def _opw_lengths(model: pin.Model, frame_id: int, signs: tuple[int, ...], offsets: tuple[float, ...],
+                 base_xy: tuple[float, float]) -> tuple[float, ...]:
+    """a1, a2, b, c1, c2, c3, c4 and the flange offset from axis 6 (x, y in the flange frame) by least
+    squares: the flange position (less `base_xy`) is linear in them."""
     qs = _random_q(model, FIT_SAMPLES, seed=1)
     T = _urdf_fk(model, frame_id, qs)
+    T[:, 0, 3] -= base_xy[0]
+    T[:, 1, 3] -= base_xy[1]
     th = qs * np.asarray(signs) - np.asarray(offsets)
     rows, rhs = [], []
     zero = OpwParams(0, 0, 0, 0, 1, 0, 0, offsets=offsets, sign_corrections=signs)  # type: ignore[arg-type]
@@ -219,6 +228,8 @@ def _opw_lengths(model: pin.Model, frame_id: int, signs: tuple[int, ...], offset
             Rz1 @ [np.sin(t2), 0.0, np.cos(t2)],              # c2
             Rz1 @ [np.sin(t23), 0.0, np.cos(t23)],            # c3
             R[k][:, 2],                                       # c4
+            R[k][:, 0],                                       # flange x off axis 6
+            R[k][:, 1],                                       # flange y off axis 6
         ]
         rows.append(np.stack(cols, axis=1))
         rhs.append(T[k, :3, 3])

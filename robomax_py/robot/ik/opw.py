@@ -22,7 +22,14 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True, slots=True)
 class OpwParams:
-    """Seven lengths (m), six joint offsets (rad) and six axis signs (+1 or -1)."""
+    """Seven lengths (m), six joint offsets (rad), six axis signs (+1 or -1), base and flange offsets (m).
+
+    Two fixed translations around the paper's chain, for URDFs whose frames are not on the axes
+    (ROS-Industrial's KR 210 L150: axis 1 2.6 mm off the root origin, tool0 0.24 mm off axis 6):
+    `base_xy` is where axis 1 meets the robot base frame's xy plane (the paper's axis 1 is the base z
+    axis); `flange_xy` is the flange origin's offset from axis 6 along the flange's own x and y. FK
+    adds them, IK takes them off the target first.
+    """
 
     a1: float
     a2: float
@@ -33,6 +40,8 @@ class OpwParams:
     c4: float
     offsets: tuple[float, float, float, float, float, float] = (0.0,) * 6
     sign_corrections: tuple[int, int, int, int, int, int] = (1,) * 6
+    base_xy: tuple[float, float] = (0.0, 0.0)
+    flange_xy: tuple[float, float] = (0.0, 0.0)
 
 
 def to_paper_angles(params: OpwParams, q: FloatArray) -> FloatArray:
@@ -78,7 +87,9 @@ def opw_fk(params: OpwParams, q: FloatArray) -> FloatArray:
 
     T = np.zeros(th.shape[:-1] + (4, 4))
     T[..., :3, :3] = R
-    T[..., :3, 3] = wrist + params.c4 * R[..., :, 2]
+    T[..., :3, 3] = wrist + params.c4 * R[..., :, 2] + params.flange_xy[0] * R[..., :, 0] + params.flange_xy[1] * R[..., :, 1]
+    T[..., 0, 3] += params.base_xy[0]
+    T[..., 1, 3] += params.base_xy[1]
     T[..., 3, 3] = 1.0
     return T
 
@@ -123,7 +134,7 @@ def opw_pin_model(
     z, y = np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])
     wrist_set_back = 0.2
     joints = [
-        (z, _rot_z(np.asarray(th0[0])), (0.0, 0.0, 0.0)),
+        (z, _rot_z(np.asarray(th0[0])), (params.base_xy[0], params.base_xy[1], 0.0)),
         (y, _rot_y(np.asarray(th0[1])), (params.a1, 0.0, params.c1)),
         (y, _rot_y(np.asarray(th0[2])), (0.0, params.b, params.c2)),
         (z, _rot_z(np.asarray(th0[3])), (params.a2, 0.0, params.c3 - wrist_set_back)),
@@ -134,7 +145,7 @@ def opw_pin_model(
     for i, (axis, rot, xyz) in enumerate(joints):
         placement = pin.SE3(np.asarray(rot), np.array(xyz, dtype=float))
         parent = model.addJoint(parent, pin.JointModelRevoluteUnaligned(sign[i] * axis), placement, f"joint_{i + 1}")
-    model.addFrame(pin.Frame(flange, parent, pin.SE3(np.eye(3), np.array([0.0, 0.0, params.c4])), pin.FrameType.OP_FRAME))
+    model.addFrame(pin.Frame(flange, parent, pin.SE3(np.eye(3), np.array([params.flange_xy[0], params.flange_xy[1], params.c4])), pin.FrameType.OP_FRAME))
     model.lowerPositionLimit = np.full(6, -2 * np.pi) if lower is None else np.asarray(lower, dtype=float)
     model.upperPositionLimit = np.full(6, 2 * np.pi) if upper is None else np.asarray(upper, dtype=float)
     return model
@@ -201,10 +212,12 @@ def opw_ik(
         hint1, hint4 = th_hint[:, 0], th_hint[:, 3]
 
     R = T[:, :3, :3]
-    # Wrist centre C = flange position - c4 * approach axis.
-    cx = T[:, 0, 3] - p.c4 * R[:, 0, 2]
-    cy = T[:, 1, 3] - p.c4 * R[:, 1, 2]
-    cz = T[:, 2, 3] - p.c4 * R[:, 2, 2]
+    # Wrist centre C = flange position - c4 * approach axis (less the flange offset), in the frame
+    # whose origin is on axis 1.
+    fx, fy = p.flange_xy
+    cx = T[:, 0, 3] - p.base_xy[0] - p.c4 * R[:, 0, 2] - fx * R[:, 0, 0] - fy * R[:, 0, 1]
+    cy = T[:, 1, 3] - p.base_xy[1] - p.c4 * R[:, 1, 2] - fx * R[:, 1, 0] - fy * R[:, 1, 1]
+    cz = T[:, 2, 3] - p.c4 * R[:, 2, 2] - fx * R[:, 2, 0] - fy * R[:, 2, 1]
 
     # theta1: the wrist centre, seen in the frame turned by theta1, sits at (+-s, b).
     r2 = cx * cx + cy * cy
