@@ -93,7 +93,10 @@ def rrt_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: F
 
     path = None
     while path is None and segments < budget:
-        # A fresh pair of trees per try, its random numbers drawn from `rng`.
+        # A fresh pair of trees per try, its random numbers drawn from `rng`: OMPL seeds each new
+        # generator (the planner's, the sampler's) from one process-wide sequence, which setSeed
+        # restarts even after the first seeds were handed out (OMPL logs a complaint, silenced
+        # above). The plan runs in one thread, so no other search draws from that sequence meanwhile.
         ou.RNG.setSeed(int(rng.integers(1, 2**31)))
         setup = og.SimpleSetup(si)
         setup.setStartAndGoalStates(start, goal)
