@@ -1,17 +1,18 @@
-"""A detour by bidirectional rapidly-exploring random trees (RRT-Connect) in joint space.
+"""A detour by bidirectional rapidly-exploring random trees (OMPL's RRT-Connect) in joint space.
 
 The last resort between two configurations that the lift, the roadmap, the local A1-A3 map and
 sliding the gun off a flange all failed to join: a narrow way out of a flange or bracket, where
 the gun must turn about its electrode axis, lies in a corridor the shared roadmap samples too
-thinly and the local map (the wrist interpolated along A1-A3) cannot express. Two trees grow from
-the ends, within the joint limits, each extension a swept-checked straight move of at most `step`
-(time-scaled joint distance); the search stops after `budget` swept checks (a count, not a clock).
-The path found is shortened greedily.
+thinly and the local map (the wrist interpolated along A1-A3) cannot express. OMPL's RRT-Connect
+grows two trees from the ends, within the joint limits, each extension a swept-checked straight
+move of at most `STEP_FRACTION` of the joint box's diagonal in time-scaled joint distance; the
+search stops after `budget` swept checks (a count, not a clock). The path found is shortened
+greedily.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -24,7 +25,8 @@ from robomax_py.world.collision import CollisionWorld
 
 # Swept checks (tree extensions and connections) per search, and per pair of trees: the trees are
 # grown afresh after TRY_BUDGET checks (trees that missed a narrow way out early mostly keep
-# missing it, their nodes crowding the open space).
+# missing it, their nodes crowding the open space). OMPL tests its termination condition between
+# iterations, not within a connect run, so a try may overrun its share by one connect run.
 BUDGET = 2400
 TRY_BUDGET = 100
 # Longest tree edge, as a share of the joint-limit box's diagonal (time-scaled). OMPL's default
@@ -36,11 +38,26 @@ STEP_FRACTION = 0.05
 def rrt_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: FloatArray,
                rng: np.random.Generator, budget: int = BUDGET) -> tuple[Detour | None, int]:
     """A swept-checked detour from qa to qb (None when the trees have not met within `budget`
-    swept checks), and the collision checks spent."""
+    swept checks), and the collision checks spent.
+
+    OMPL's random numbers come from a process-wide seed, set here from `rng` before the search,
+    so the same planner state gives the same detour.
+    """
+    from ompl import base as ob
+    from ompl import geometric as og
+    from ompl import util as ou
+
+    ou.setLogLevel(ou.LOG_NONE)
     qa, qb = np.asarray(qa, dtype=float), np.asarray(qb, dtype=float)
+    dof = len(qa)
+    # OMPL's real vector space measures plain Euclidean distance: the trees live in joint
+    # coordinates divided by each joint's velocity limit, so distance there is joint time, as in
+    # the roadmap and the move-time estimates.
+    scale = 1.0 / np.asarray(limits.velocity, dtype=float)
     lo, hi = np.asarray(limits.lower, dtype=float), np.asarray(limits.upper, dtype=float)
-    scale = 1.0 / np.asarray(limits.velocity, dtype=float)          # distance ~ joint time
     step = STEP_FRACTION * float(np.linalg.norm((hi - lo) * scale))
+    # Ends within the joint tolerance but just outside the limits would be refused as start or goal.
+    lo, hi = np.minimum(lo, np.minimum(qa, qb)), np.maximum(hi, np.maximum(qa, qb))
     checks = 0
     segments = 0
 
@@ -51,67 +68,62 @@ def rrt_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: F
         segments += 1
         return bool(res.free)
 
-    def toward(p: FloatArray, target: FloatArray) -> FloatArray:
-        d = float(np.linalg.norm((target - p) * scale))
-        return target if d <= step else p + (target - p) * (step / d)
+    def joints(state: Any) -> FloatArray:
+        return np.array([state[k] for k in range(dof)]) / scale
+
+    def state_free(state: Any) -> bool:
+        nonlocal checks
+        checks += 1
+        return bool(world.is_free(joints(state)))
+
+    space = ob.RealVectorStateSpace(dof)
+    bounds = ob.RealVectorBounds(dof)
+    for k in range(dof):
+        bounds.setLow(k, float(lo[k] * scale[k]))
+        bounds.setHigh(k, float(hi[k] * scale[k]))
+    space.setBounds(bounds)
+    si = ob.SpaceInformation(space)
+    si.setStateValidityChecker(state_free)
+    validator = _swept_validator(ob, si, lambda s1, s2: free(joints(s1), joints(s2)))
+    si.setMotionValidator(validator)
+    si.setup()
+    start, goal = space.allocState(), space.allocState()
+    for k in range(dof):
+        start[k], goal[k] = float(qa[k] * scale[k]), float(qb[k] * scale[k])
 
     path = None
     while path is None and segments < budget:
-        path = _try(qa, qb, lo, hi, scale, rng, free, toward, min(budget, segments + TRY_BUDGET), lambda: segments)
+        # A fresh pair of trees per try, its random numbers drawn from `rng`: OMPL seeds each new
+        # generator (the planner's, the sampler's) from one process-wide sequence, which setSeed
+        # restarts even after the first seeds were handed out (OMPL logs a complaint, silenced
+        # above). The plan runs in one thread, so no other search draws from that sequence meanwhile.
+        ou.RNG.setSeed(int(rng.integers(1, 2**31)))
+        setup = og.SimpleSetup(si)
+        setup.setStartAndGoalStates(start, goal)
+        planner = og.RRTConnect(si)
+        planner.setRange(step)
+        setup.setPlanner(planner)
+        stop = min(budget, segments + TRY_BUDGET)
+        solved = setup.solve(ob.PlannerTerminationCondition(lambda stop=stop: segments >= stop))
+        if solved and setup.haveExactSolutionPath():
+            found = setup.getSolutionPath()
+            path = np.array([joints(found.getState(i)) for i in range(found.getStateCount())])
     if path is None:
         return None, checks
-    found = path
-    keep = greedy_shortcut(len(found), lambda i, j: free(found[i], found[j]))
+    # The ends exactly as given, not as scaled and scaled back (a rounding apart).
+    path[0], path[-1] = qa, qb
+    joined = path
+    keep = greedy_shortcut(len(joined), lambda i, j: free(joined[i], joined[j]))
     assert keep is not None                              # neighbours were checked as tree edges
-    wp = found[keep]
+    wp = joined[keep]
     return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], limits))), checks), checks
 
 
-def _try(qa: FloatArray, qb: FloatArray, lo: FloatArray, hi: FloatArray, scale: FloatArray,
-         rng: np.random.Generator, free: Callable[[FloatArray, FloatArray], bool],
-         toward: Callable[[FloatArray, FloatArray], FloatArray], stop: int,
-         spent: Callable[[], int]) -> FloatArray | None:
-    """One pair of trees grown from qa and qb until they meet (the path, (m, n)) or `spent()`
-    reaches `stop` (None)."""
-    # Each tree: nodes (list of arrays) and parent indices.
-    trees: list[tuple[list[FloatArray], list[int]]] = [([qa], [-1]), ([qb], [-1])]
-    grow = 0
-    while spent() < stop:
-        nodes, parents = trees[grow]
-        other_nodes, other_parents = trees[1 - grow]
-        target = rng.uniform(lo, hi)
-        near = int(np.argmin(np.linalg.norm((np.array(nodes) - target) * scale, axis=1)))
-        new = toward(nodes[near], target)
-        if free(nodes[near], new):
-            nodes.append(new)
-            parents.append(near)
-            # Connect: the other tree grows straight towards the new node until blocked or there.
-            k = int(np.argmin(np.linalg.norm((np.array(other_nodes) - new) * scale, axis=1)))
-            while spent() < stop:
-                nxt = toward(other_nodes[k], new)
-                if not free(other_nodes[k], nxt):
-                    break
-                other_nodes.append(nxt)
-                other_parents.append(k)
-                k = len(other_nodes) - 1
-                if nxt is new:
-                    return _joined(trees, grow, len(nodes) - 1, k)
-        grow = 1 - grow
-    return None
+def _swept_validator(ob: Any, si: Any, motion_free: Any) -> Any:
+    """An OMPL motion validator whose every motion is the collision world's swept check."""
 
+    class Swept(ob.MotionValidator):  # type: ignore[misc]
+        def checkMotion(self, s1: Any, s2: Any) -> bool:          # OMPL's name
+            return bool(motion_free(s1, s2))
 
-def _branch(nodes: list[FloatArray], parents: list[int], k: int) -> list[FloatArray]:
-    out = []
-    while k >= 0:
-        out.append(nodes[k])
-        k = parents[k]
-    return out                                     # from node k back to the tree's root
-
-
-def _joined(trees: list[tuple[list[FloatArray], list[int]]], grow: int, k_grow: int, k_other: int) -> FloatArray:
-    """The path from qa (tree 0's root) to qb (tree 1's root) through the two meeting nodes."""
-    a = _branch(*trees[grow], k_grow)
-    b = _branch(*trees[1 - grow], k_other)
-    start_side, goal_side = (a, b) if grow == 0 else (b, a)
-    # The meeting node is the last of both branches' heads: keep it once.
-    return np.array([*start_side[::-1], *goal_side[1:]])
+    return Swept(si)
