@@ -723,6 +723,14 @@ def main(restore_mask: Iterable[int] | None = None) -> None:
     except KeyboardInterrupt:
         err.print("interrupted")
         sys.exit(130)
+    except Exception:
+        if _Received.signum is None:
+            raise
+        # The signal's exception raised inside compiled code comes out as another error: numba's
+        # dispatcher reports a KeyboardInterrupt raised while its kernel ran as "SystemError: ...
+        # returned a result with an exception set". The run ends as the signal asked all the same.
+        err.print("interrupted" if _Received.signum == signal.SIGINT else "terminated")
+        sys.exit(128 + _Received.signum)
     except SystemExit as exc:
         if _Received.signum == signal.SIGTERM and exc.code == 128 + signal.SIGTERM:
             err.print("terminated")
