@@ -35,7 +35,7 @@ nominal orientation, first branch, `PlanOptions(baseline=True)`).
 Printed: cells planned, feasible and infeasible by the oracle, every cell the oracle connects but
 the planner does not (with the planner's reason), planning CPU per cell (median, 90th percentile,
 max), the cycle against the rest-to-rest lower bound (`robomax bench`'s) and against both
-baselines, per family, and a row per cell. `--quick`: a handful of small cells, as CI runs it;
+baselines, per family, and a row per cell. `--quick`: two small cells, as CI runs it;
 without OMPL installed, the oracle only tries straight moves and reports a pair it cannot join
 straight as unknown.
 """
@@ -535,7 +535,7 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--out", type=Path, default=None, help="corpus folder (default: a temporary one)")
     ap.add_argument("--cells", type=Path, nargs="*", default=None, help="plan these cells instead")
-    ap.add_argument("--quick", action="store_true", help="a handful of small cells (CI's smoke run)")
+    ap.add_argument("--quick", action="store_true", help="two small cells (CI's smoke run)")
     ap.add_argument("--oracle-checks", type=int, default=3000,
                     help="collision queries per RRT-Connect query (states and swept motions)")
     ap.add_argument("--oracle-cpu", type=int, default=600, help="CPU s for the oracle per cell")
