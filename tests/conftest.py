@@ -12,8 +12,7 @@ import pytest
 import yaml
 
 REPO = Path(__file__).resolve().parents[1]
-SHARED = REPO.parent / "shared"
-REFERENCE_CELL = SHARED / "cells" / "reference" / "cabin_flange.yaml"
+REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
 # The small test cell's source: a frozen copy of the reference cell (shipped cells may change).
 SHIPPED_CELL = REPO / "tests" / "data" / "flange_cell" / "cabin_flange.yaml"
 
@@ -198,9 +197,8 @@ def rng() -> np.random.Generator:
 
 @pytest.fixture(scope="session")
 def reference_cell_path() -> Path:
-    """The contract's reference cell (../shared beside the clone, as in CI)."""
-    if not REFERENCE_CELL.is_file():
-        pytest.skip(f"reference cell not found at {REFERENCE_CELL} (shared/ must sit beside the clone)")
+    """The contract's reference cell (a copy kept in tests/data/reference)."""
+    assert REFERENCE_CELL.is_file(), f"{REFERENCE_CELL} is missing from the checkout"
     return REFERENCE_CELL
 
 

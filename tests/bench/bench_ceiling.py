@@ -51,7 +51,7 @@ from robomax_py.world.collision import CollisionWorld  # noqa: E402
 from robomax_py.world.scene import build_scene  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
-REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
+REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
 TARGET_SAVING = 0.15      # issue 4: cycle time >= 15 % shorter than the baseline
 
 

@@ -33,7 +33,7 @@ from robomax_py.world.collision import CollisionWorld  # noqa: E402
 from robomax_py.world.scene import build_scene  # noqa: E402
 
 RUNS = 5
-REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
+REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
 SEGMENT_MAX_DEG = 10.0          # random short segments: each joint moves by at most this
 
 

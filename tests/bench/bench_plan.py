@@ -37,7 +37,7 @@ from robomax_py.world.collision import CollisionWorld  # noqa: E402
 from robomax_py.world.scene import build_scene  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
-REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
+REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
 PUBLISHED = {20: (8_000, 0.3), 50: (25_000, 22.3), 100: (1_000_000, 122.2)}
 
 

@@ -24,7 +24,7 @@ from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
 from robomax_py.plan import PlanOptions, plan_cell  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
-REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
+REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
 VARIANTS = {
     "(a) toppra vel/acc": PlanOptions(jerk_limited=False, blend=False),
     "(b) jerk-limited": PlanOptions(jerk_limited=True, blend=False),

@@ -24,7 +24,7 @@ from robomax_py.world.scene import build_scene  # noqa: E402
 from robomax_py.world.voxels import build_voxels  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
-CELLS = [REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml", *sorted((REPO / "cells").glob("*.yaml"))]
+CELLS = [REPO / "tests" / "data" / "reference" / "cabin_flange.yaml", *sorted((REPO / "cells").glob("*.yaml"))]
 LO, HI = np.array([-3.2, -3.2, -0.5]), np.array([3.2, 3.2, 2.9])
 
 

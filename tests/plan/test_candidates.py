@@ -63,7 +63,7 @@ def _scan(robot, world, q, valid, reachable):  # type: ignore[no-untyped-def]
 
 
 @pytest.mark.parametrize("cell_path, spot", [
-    (REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml", 0),   # limits on the line
+    (REPO / "tests" / "data" / "reference" / "cabin_flange.yaml", 0),   # limits on the line
     (REPO / "cells" / "ur10_tray.yaml", 0),                                      # blocked lines, turns
 ])
 def test_filter_equals_a_plain_scan(cell_path: Path, spot: int) -> None:

@@ -22,7 +22,7 @@ from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[2]
-REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
+REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
 
 
 @pytest.fixture(scope="module")

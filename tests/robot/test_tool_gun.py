@@ -25,7 +25,7 @@ GUN_DIR = REPO / "robomax_py" / "robots" / "tools" / "spot_gun_c"
 # the contract's shared/ folder beside the clone (as in CI).
 CELL_CANDIDATES = (
     REPO / "tests" / "data" / "flange_cell" / "cabin_flange.yaml",
-    REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml",
+    REPO / "tests" / "data" / "reference" / "cabin_flange.yaml",
 )
 CONVEX_REL_TOL = 1e-6
 MIN_GAP_M = 0.06  # open stroke: a 30 mm approach from either side

@@ -49,7 +49,7 @@ from robomax_py.world.collision import (
 from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[2]
-REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
+REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
 PANEL = REFERENCE_CELL.parent / "parts" / "cabin_panel.stl"
 
 # The clearance boundary is tested this far on either side; coal decides it to ~1e-9 m.

@@ -24,7 +24,7 @@ from robomax_py.world.prefilter import SLACK_M, Prefilter
 from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[2]
-REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
+REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
 FK_TOL = 1e-12                        # m and rotation-matrix entries: products of six rotations
 LIBRARY = ["kr125", "kr16", "ur10"]
 ROSI = REPO / "tests" / "data" / "rosi"

@@ -40,7 +40,7 @@ from robomax_py.world.scene import (
 )
 
 REPO = Path(__file__).resolve().parents[2]
-REFERENCE_CELL = REPO.parent / "shared" / "cells" / "reference" / "cabin_flange.yaml"
+REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
 POSE_ATOL = 1e-12  # pose products of a few 4x4 float64 matrices
 
 
