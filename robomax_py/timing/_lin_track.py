@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -23,8 +22,11 @@ ZERO_LENGTH_M = 1e-9
 # Orientation error allowed halfway between samples, rad.
 LIN_PATH_TOL_RAD = TOL.lin_path_tol_rad
 
-# (robot, T_base_tcp (..., 4, 4)) -> table with q (..., B, n) and valid (..., B); robomax_py.robot.ik.solve_all.
-IkSolver = Callable[[RobotModel, FloatArray], Any]
+class IkSolver(Protocol):
+    """(robot, T_base_tcp (..., 4, 4), q_hint) -> table with q (..., B, n) and valid (..., B), as
+    `robomax_py.robot.solve.solve_all` (a seeded solver starts from `q_hint` first)."""
+
+    def __call__(self, robot: RobotModel, T_base_tcp: FloatArray, q_hint: FloatArray | None = None, /) -> Any: ...
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -73,9 +75,18 @@ class Tracker:
         self._solve = solve
         self._revolute = ~prismatic_mask(robot.model)
 
-    def solve(self, u: FloatArray) -> Any:
-        """The IK table at line fractions u (k,)."""
-        return self._solve(self.robot, self.line.poses(u))
+    def solve(self, u: FloatArray, q_hint: FloatArray | None = None) -> Any:
+        """The IK table at line fractions u (k,); `q_hint` seeds a numeric solver first."""
+        if q_hint is None:
+            return self._solve(self.robot, self.line.poses(u))
+        return self._solve(self.robot, self.line.poses(u), q_hint)
+
+    @property
+    def seeded(self) -> bool:
+        """Whether the solver searches from seeds (numeric, table): its table at a pose holds the
+        solutions its seeds reached, so the continuation of a motion may be missing from it and is
+        found by seeding the solver at the configuration just before."""
+        return self.robot.ik_solver in ("numeric", "table")
 
     def column(self, table: Any, row: int) -> FloatArray | None:
         """The start column's solution at this row, or None where it is not valid."""

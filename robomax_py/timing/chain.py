@@ -267,7 +267,10 @@ def column_of(robot: RobotModel, q: FloatArray, ik: IkSolver | None = None) -> i
 
     solve = ik if ik is not None else _default_ik()
     q = np.asarray(q, dtype=float).reshape(-1)
-    table = solve(robot, fk_tcp(robot, q)[None])
+    # A seeded solver (numeric, table) holds the solutions its seeds reached: seeded at q itself,
+    # q is found (its solution comes first); a closed form finds every branch without it.
+    seeded = robot.ik_solver in ("numeric", "table")
+    table = solve(robot, fk_tcp(robot, q)[None], q) if seeded else solve(robot, fk_tcp(robot, q)[None])
     sols = np.asarray(table.q)[0]
     valid = np.asarray(table.valid)[0]
     revolute = ~prismatic_mask(robot.model)

@@ -158,7 +158,8 @@ def lin_path(
     """
     line = Line.between(T_start, T_end)
     tracker = Tracker(robot, ik if ik is not None else _default_ik(), line, branch_index, max_joint_step)
-    first = tracker.solve(np.zeros(1))
+    seed = np.asarray(q_start, dtype=float).reshape(-1) if q_start is not None and tracker.seeded else None
+    first = tracker.solve(np.zeros(1), seed)
     if q_start is not None:
         q0 = np.asarray(q_start, dtype=float).reshape(-1)
         near = tracker.nearest(first, 0, q0)
@@ -214,6 +215,8 @@ def _follow(tracker: Tracker, grid: FloatArray, q0: FloatArray) -> tuple[FloatAr
         u_b, row = todo[0]
         sol, r = (table, row) if row >= 0 else (tracker.solve(np.array([u_b])), 0)
         q_b = tracker.follow(sol, r, qs[-1])
+        if q_b is None and tracker.seeded:
+            q_b = tracker.follow(tracker.solve(np.array([u_b]), qs[-1]), 0, qs[-1])
         if q_b is not None:
             if np.any(q_b < lower) or np.any(q_b > upper):
                 return _failed(line, "joint_limit", "the line leaves the joint limits", u_b, us, qs)

@@ -190,3 +190,38 @@ def test_params_from_mapping_numeric() -> None:
         with pytest.raises(RobotModelError) as info:
             params_from_mapping("numeric", bad)
         assert info.value.key == key
+
+
+def test_a_line_from_a_configuration_the_seeds_miss_is_followed(rng: np.random.Generator) -> None:
+    """A seeded solver's table holds the solutions its seeds reached. A motion that starts (or goes
+    on) in a configuration missing from it is still followed: the solver is seeded at the
+    configuration itself. With one random seed per pose, most configurations of an eight-branch arm
+    are missing from the plain table; column_of and a short LIN line from each still work, and the
+    line's samples solve their poses on the line."""
+    from robomax_py.timing.chain import column_of
+    from robomax_py.timing.lin import lin_path
+
+    model = opw_pin_model(KR16_LIKE, KR_LOWER, KR_UPPER)
+    n = model.nq
+    limits = JointLimits(KR_LOWER, KR_UPPER, np.ones(n), np.ones(n), np.ones(n))
+    robot = RobotModel(
+        "kr", Path("kr"), model, pin.GeometryModel(), pin.GeometryModel(), tuple(model.names[1:]),
+        model.getFrameId("flange"), limits, "numeric", NumericIkParams(seeds=1, solutions=8), np.eye(4),
+    )
+    missed = 0
+    for q in rng.uniform(np.asarray(KR_LOWER) * 0.8, np.asarray(KR_UPPER) * 0.8, size=(12, 6)):
+        T0 = opw_fk(KR16_LIKE, q[None])[0]
+        plain = solve_all(robot, T0[None])
+        found = plain.valid[0] & np.all(np.abs(wrapped_diff(plain.q[0], q)) < 1e-6, axis=-1)
+        missed += not found.any()
+        k = column_of(robot, q)
+        T1 = T0.copy()
+        T1[:3, 3] += [0.0, 0.0, 0.01]                        # 10 mm up
+        lp = lin_path(robot, T0, T1, k, q_start=q)
+        if not lp.ok:
+            assert lp.reason in ("joint_limit", "unreachable", "discontinuous"), lp.detail
+            continue
+        assert np.max(np.abs(wrapped_diff(lp.q[0], q))) < 1e-6
+        T_got = opw_fk(KR16_LIKE, np.asarray(lp.q))
+        assert np.abs(T_got[:, :2, 3] - T0[:2, 3]).max() < 1e-5 and np.abs(T_got[:, :3, :3] - T0[:3, :3]).max() < 1e-5
+    assert missed >= 3                                       # the case arose
