@@ -23,6 +23,11 @@ class _LocatedError(RobomaxError):
         parts = [p for p in (self.file, key) if p]
         super().__init__(": ".join([*parts, problem]))
 
+    def __reduce__(self) -> tuple[type, tuple[str | None, str | None, str]]:
+        # Rebuilt from its parts (an exception pickles its message alone by default, which this
+        # constructor does not take): a process pool or a Ray worker passes it back whole.
+        return type(self), (self.file, self.key, self.problem)
+
 
 class CellFileError(_LocatedError):
     """A cell file (or a file it names) is malformed."""
@@ -49,6 +54,9 @@ class ControllerSetupError(ExportError):
         self.key = key
         self.problem = problem
         super().__init__(f"{key}: {problem}")
+
+    def __reduce__(self) -> tuple[type, tuple[str, str]]:
+        return type(self), (self.key, self.problem)
 
 
 class PreviewError(RobomaxError):

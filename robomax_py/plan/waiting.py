@@ -61,6 +61,9 @@ class Trapped(WaitingError):
         super().__init__(message)
         self.obstacle, self.window_end, self.door = obstacle, window_end, door
 
+    def __reduce__(self) -> tuple[type, tuple[str, str, float, bool]]:
+        return type(self), (str(self), self.obstacle, self.window_end, self.door)
+
 
 def clear_wait(t: float, windows: Sequence[tuple[float, float]]) -> float:
     """Seconds `WAIT FOR <name>_clear` holds at time t: 0 when the obstacle is absent."""

@@ -39,7 +39,11 @@ class LinMoveError(TimingError):
         self.reason = reason
         self.index = index
         self.fraction = fraction
+        self.detail = detail
         super().__init__(f"LIN move {reason} at {100.0 * fraction:.1f} % of the line (sample {index}): {detail}")
+
+    def __reduce__(self) -> tuple[type, tuple[str, int, float, str]]:
+        return type(self), (self.reason, self.index, self.fraction, self.detail)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
