@@ -242,7 +242,12 @@ def main() -> None:
 
 def _bench_job(job: tuple[str, str, str, Path | None, int]) -> FamilyRow:
     name, source, srdf, packages, seed = job
-    return bench_arm(name, source, srdf, packages, seed)
+    try:
+        return bench_arm(name, source, srdf, packages, seed)
+    except Exception as exc:  # noqa: BLE001 -- one arm's failure is a row of the table, not the end of the run
+        row = FamilyRow(name, source.split(":")[-1].split("/")[0])
+        row.imported = f"crashed: {type(exc).__name__}: {one_line(exc, 100)}"
+        return row
 
 
 if __name__ == "__main__":
