@@ -43,6 +43,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import argparse
 import math
+import re
 import sys
 import tempfile
 import time
@@ -159,6 +160,13 @@ def _located(given: str, packages: Path | None) -> Path | None:
     return packages / given if packages else None
 
 
+# Values for launch arguments a support package's launch file requires without a default, as a user
+# gives them (`--xacro-arg NAME:=VALUE`): Motoman's `controller` picks the joint-velocity file of
+# the controller generation (motoman_*_support/launch/load_*.launch: "dx100, dx200"); DX200 is the
+# newer of the two the ES family's files name.
+LAUNCH_CHOICES = {"controller": "dx200"}
+
+
 def import_arm(name: str, source: str, srdf: str, packages: Path | None, library: Path, row: Row) -> Path | None:
     """robot.yaml of the arm: a shipped folder, or `import-urdf` of the source (with the SRDF's
     disabled pairs when one is given) into `library`.
@@ -182,11 +190,18 @@ def import_arm(name: str, source: str, srdf: str, packages: Path | None, library
         srdf_path = None
     roots = [ROSI] if kind == "rosi" else [packages] if packages else []
     added: list[tuple[str, str]] = []
+    xacro_args: dict[str, str] = {}
     t0 = cpu()
-    for _ in range(4):
+    for _ in range(5):
         try:
-            result = import_urdf(path, library / name, roots, srdf=srdf_path, force=True)
+            result = import_urdf(path, library / name, roots, srdf=srdf_path, force=True, xacro_args=xacro_args)
         except (RobomaxError, LookupError) as exc:
+            # A launch argument the package's launch file requires and does not default (Motoman's
+            # `controller`, which picks the joint-velocity file): given as a user would give it.
+            needed = re.search(r"the launch argument (\w+) has no default", str(exc))
+            if needed and needed[1] in LAUNCH_CHOICES and needed[1] not in xacro_args:
+                xacro_args[needed[1]] = LAUNCH_CHOICES[needed[1]]
+                continue
             row.import_cpu_s = cpu() - t0
             row.imported = f"failed: {one_line(exc)}"
             return None
@@ -202,7 +217,8 @@ def import_arm(name: str, source: str, srdf: str, packages: Path | None, library
         srdf_path = with_disabled_pairs(srdf_path, added, library / f"{name}_always.srdf", name)
     row.import_cpu_s = cpu() - t0
     row.imported = "ok" + (" (SRDF)" if srdf and srdf_path else "") + \
-        (f" (+ always touching: {', '.join('/'.join(p) for p in added)})" if added else "")
+        (f" (+ always touching: {', '.join('/'.join(p) for p in added)})" if added else "") + \
+        "".join(f" (--xacro-arg {k}:={v})" for k, v in xacro_args.items())
     return result.folder / "robot.yaml"
 
 

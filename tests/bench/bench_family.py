@@ -11,7 +11,9 @@ HEAD <pkg> | tar -x -C DIR`): each `<pkg>/urdf/<arm>.xacro` that is not a macro 
 (`*_macro.xacro`, `common_*`), with the MoveIt SRDF of the arm where a `*_moveit_config` package
 holds one named after it. Quick mode (CI) runs the arms kept in tests/data/rosi.
 
-For every arm: `import-urdf` exactly as the README says (no --xacro-arg, the brand guessed), the IK
+For every arm: `import-urdf` exactly as the README says (the brand guessed; no --xacro-arg but a
+launch argument the package requires without a default, given as a user would:
+bench_controller_frames.LAUNCH_CHOICES, named in the import column), the IK
 solver chosen and the fit's largest FK difference to the URDF, then the seeded panel cell of
 bench_controller_frames (its `arm_shape`, `panel_cell`, `free_home`: four spots on a sheet in front
 of the arm, user frame, tool number) planned and its programs written in the robot's native dialect
