@@ -32,7 +32,12 @@ from robomax_py.export import (
     render_trajectory,
     require_calibration,
 )
-from robomax_py.export.dialect import Parsed, PlannedProgram, in_controller_joints
+from robomax_py.export.dialect import (
+    Parsed,
+    PlannedProgram,
+    in_controller_joints,
+    in_controller_terms,
+)
 from robomax_py.export.plan_program import planned_program
 from robomax_py.export.rebuild import rebuild
 from robomax_py.plan import PlanResult, method_suffix
@@ -125,7 +130,7 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
             planned.program, name=planned.program.name + name[len(result.cell):]))
     try:
         if dialect.brand:
-            planned = dataclasses.replace(planned, program=in_controller_joints(planned.program, robot))
+            planned = in_controller_terms(planned, robot)
         adapted = dialect.adapt(planned, robot)
     except ControllerSetupError as exc:
         raise CellFileError(cell.source, exc.key, f"{exc.problem} (--format {fmt})") from None
@@ -142,7 +147,8 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
         raise ExportError(f"{fmt}: the written program is not clean: {kind}: {detail} (line {at} of {main})")
     _same_program(fmt, main, adapted, parsed)
     read = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
-    rebuilt = rebuild(read, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
+    rebuilt = rebuild(read, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
+                      controller=bool(dialect.brand))
     if rebuilt.problems or rebuilt.trajectory is None:
         p = rebuilt.problems[0] if rebuilt.problems else None
         where = f"line {p.line}: " if p and p.line else ""

@@ -89,7 +89,8 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
                          VerifyReport(str(path), 0, float("nan"), 0, unsimulated + stated + nowhere + never, ignored))
     # A controller's joint targets count its joints its way (robot.yaml controller.joint_signs/zeros).
     joint_program = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
-    rebuilt = rebuild(joint_program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell))
+    rebuilt = rebuild(joint_program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
+                      controller=bool(dialect.brand))
     report = verify_rebuilt(cell, robot, str(path), rebuilt)
     report = dataclasses.replace(report, violations=unsimulated + stated + report.violations, ignored=ignored)
     return _with_set(cell, path, read, report)
@@ -297,9 +298,17 @@ def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> lis
         written = entry.get("config")
         if written is not None:
             brand = str(entry.get("brand", robot.controller.brand))
-            nearby = config_texts_near(robot, qs[0], brand, math.radians(TOL.config_tol_deg))
-            actual = brand_text_of(robot, qs[0], brand)
-            if spot.config is not None and brand == robot.controller.brand and not same_config(spot.config, str(written)):
+            counted = bool(entry.get("controller", False))
+            tol = math.radians(TOL.config_tol_deg)
+            nearby = config_texts_near(robot, qs[0], brand, tol, counted)
+            actual = brand_text_of(robot, qs[0], brand, counted)
+            # A pinned configuration is the planner's (URDF joint values, `solve.config_text`); a
+            # controller program states its own from the controller's values of the same joints.
+            recounted = counted and bool(robot.controller.joint_signs or robot.controller.joint_zeros)
+            pinned_ok = spot.config is None or brand != robot.controller.brand or (
+                any(same_config(spot.config, t) for t in config_texts_near(robot, qs[0], brand, tol)) if recounted
+                else same_config(spot.config, str(written)))
+            if not pinned_ok:
                 out.append(Violation(t0, "spot", f"{label}: configuration {written}, pinned {spot.config}"))
             if not any(same_config(str(written), text) for text in nearby):
                 out.append(Violation(t0, "spot", f"{label}: configuration written as {written}, robot is in {actual}"))

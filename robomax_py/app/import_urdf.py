@@ -265,7 +265,7 @@ def _base_yaml(T_root_base: FloatArray) -> str:
 
 
 def _robot_yaml(name: str, urdf: str, flange: str, solver: str, params: object, brand: str, srdf: str | None,
-                source: Path, T_root_base: FloatArray | None) -> str:
+                source: Path, T_root_base: FloatArray | None, convention: Convention | None = None) -> str:
     """The robot.yaml text. `T_root_base` (4, 4), metres: the URDF's ROS-Industrial `base` link in
     its root frame (`io.robot.urdf_base_link`), written as `controller.base`; None when the URDF has
     none (a UR arm then gets the UR controller's base, `base_link` turned 180 deg about z)."""
@@ -308,6 +308,9 @@ def _robot_yaml(name: str, urdf: str, flange: str, solver: str, params: object, 
         lines.append(f"  base: {_base_yaml(T_root_base)}  # ROS-Industrial's `base` link: the vendor's base frame")
     elif brand == "ur":
         lines.append("  base: {rpy: [0, 0, 180]}  # the UR controller's base: base_link turned 180 deg about z")
+    if convention is not None and convention.signs:
+        lines.append(f"  joint_signs: [{', '.join(str(v) for v in convention.signs)}]  # derived from the URDF's axes")
+        lines.append(f"  joint_zeros_deg: [{', '.join(_number(v) for v in convention.zeros_deg)}]")
     if srdf is not None:
         lines.append(f"srdf: {srdf}")
     return "\n".join(lines) + "\n"
@@ -330,43 +333,180 @@ NUMERIC_COST = ("planning several times slower (about 4x CPU on a KR 210 L150 ce
 CONVENTION_UNKNOWN = ("joint directions and zeros taken from the URDF; check them against the controller's axis "
                       "display (robot.yaml controller.joint_signs, controller.joint_zeros_deg)")
 # KUKA's own axis directions in its base frame at A1..A6 = 0 (KSS: A1 turns about -z, A4 and A6
-# about -x; A2 = 0 with the upper arm horizontal, forward), which the ROS-Industrial KUKA URDFs
-# follow so that their joint values are the controller's: kuka_rsi_hw_interface passes the
-# controller's axis values through unchanged (ros-industrial/kuka_experimental@e78bbd15
+# about -x; A2 = 0 with the upper arm horizontal, forward; A3 = 0 with the forearm in line with
+# it, so that the mastering position A2 = -90, A3 = 90 deg has the upper arm upright and the
+# forearm horizontal), which the ROS-Industrial KUKA URDFs follow so that their joint values are
+# the controller's: kuka_rsi_hw_interface passes the controller's axis values through unchanged
+# (ros-industrial/kuka_experimental@e78bbd15
 # kuka_rsi_hw_interface/src/kuka_hardware_interface.cpp:109, `joint_position_[i] = DEG2RAD *
 # rsi_state_.positions[i]`; kuka_kr120_support/urdf/kr120r2500pro_macro.xacro:156-196). Not all do:
 # kuka_kr210_support's kr210l150 (A1 about +z, A2 = 0 upright) is kuka_experimental issue 98,
 # "kr210: update xacro to comply with actual kinematic chain".
 _KUKA_AXES = ((0, 0, -1), (0, 1, 0), (0, 1, 0), (-1, 0, 0), (0, 1, 0), (-1, 0, 0))
+# ROS-Industrial's tool0 (z out of the flange, REP 199) at KUKA's zero: x pointing down
+# (kr120r2500pro_macro.xacro, flange-tool0 rpy 0 90 0 on a flange whose frame is the base's at zero).
+_KUKA_TOOL0_X = (0.0, 0.0, -1.0)
+# How far (deg) the URDF's upper arm, forearm or front may lie from a quarter turn at its zero: the
+# ROS-Industrial meshes' origins are a few degrees off (the KR 210 L150's A2 origin is 6 deg off x).
+_QUARTER_TOL_DEG = 15.0
+# abb_driver exchanges joint values with the controller in degrees <-> radians only
+# (ros-industrial/abb_driver@f3068b92d9f5550992143f775d110b946ef04551 rapid/ROS_messages.sys:131-145,
+# `message.joints := rad2deg_robjoint(message.joints)`, and :155-175; rapid/ROS_stateServer.mod:64-70,
+# `joints := CJointT(); message.joints := joints.robax`; rapid/ROS_motion.mod:56-66, `target.robax :=
+# trajectory{current_index}.joint_pos; MoveAbsJ target`), except on arms whose support package sets
+# `J23_coupled` (src/abb_utils.cpp:52, `points_out->at(2) += J23_factor * points_out->at(1)`: the
+# controller's J3 = J3 + J2 of the URDF; ros-industrial/abb@77db19bd: IRB 2400, 4400, 5400), which
+# robot.yaml cannot state for ABB.
+_J23 = re.compile(r'<arg\s+name="J23_coupled"\s+default="(true|false)"')
+_LAUNCH_BYTES = 65536
 
 
-def _convention_warning(model: object, frame_id: int, brand: str, T_root_base: FloatArray | None) -> str | None:
-    """None when the URDF's joint values are known to be the controller's, else the warning.
+@dataclass(frozen=True, slots=True)
+class Convention:
+    """What the import knows of how the controller counts the URDF's joints: the robot.yaml keys
+    (`signs`, `zeros_deg`; empty for the URDF's own count) and the note it gives, if any."""
+
+    signs: tuple[int, ...] = ()
+    zeros_deg: tuple[float, ...] = ()
+    note: str | None = None
+
+
+def _quarter(angle: float) -> float | None:
+    """The multiple of 90 deg an angle (deg) lies within _QUARTER_TOL_DEG of, in (-180, 180]."""
+    q = 90.0 * round(angle / 90.0)
+    if abs(angle - q) > _QUARTER_TOL_DEG:
+        return None
+    q = (q + 180.0) % 360.0 - 180.0
+    return 180.0 if q == -180.0 else q + 0.0
+
+
+def _kuka_counting(axes: object, R: FloatArray) -> tuple[tuple[int, ...], tuple[float, ...]] | None:
+    """KUKA's joint_signs and joint_zeros_deg for a URDF (controller = sign * URDF + zero), derived
+    from its joint axes and flange at q = 0 in the controller's base frame, or None when they are
+    not quarter turns and axis flips of KUKA's (`_KUKA_AXES`).
+
+    At the URDF's zero the controller's A1 is where the arm faces (A2's origin off A1), A2 the angle
+    of the upper arm (A2 -> A3 origins) from the horizontal about +y, A2 + A3 that of the forearm
+    (along axis 4, away from A3), A4 = A5 = 0 (the wrist straight: axis 6 in line with axis 4), A6
+    the turn of ROS-Industrial's tool0 from its place at KUKA's zero (`_KUKA_TOOL0_X`). The signs
+    are then those of the URDF's axes against KUKA's turned into that posture. A4 + 180, -A5,
+    A6 + 180 give the same flange pose: the URDF's zero is taken to have A4 = 0, as ROS-Industrial
+    models the arm at the mastering position."""
+    import numpy as np
+
+    from robomax_py.transforms import rot_y, rot_z
+
+    u = np.asarray(axes.u) @ R                                    # type: ignore[attr-defined]
+    p = np.asarray(axes.p) @ R                                    # type: ignore[attr-defined]
+    x_tool = np.asarray(axes.T_flange)[:3, 0] @ R                 # type: ignore[attr-defined]
+    if len(u) != 6 or abs(float(u[5] @ u[3])) < 1 - 1e-6:
+        return None
+    front = p[1] - p[0]
+    a1 = _quarter(-math.degrees(math.atan2(front[1], front[0])))
+    if a1 is None or math.hypot(front[0], front[1]) < 1e-3:
+        return None
+    Rz = rot_z(-math.radians(a1))                                  # KUKA's A1 turns about -z
+    upper = Rz.T @ (p[2] - p[1])
+    a2 = _quarter(math.degrees(math.atan2(-upper[2], upper[0])))
+    w = Rz.T @ (u[3] * np.sign(float((p[4] - p[2]) @ u[3]) or 1.0))
+    a23 = _quarter(math.degrees(math.atan2(-w[2], w[0])))
+    if a2 is None or a23 is None:
+        return None
+    R_arm = Rz @ rot_y(math.radians(a23))                          # the forearm's turn at the URDF's zero
+    want = [Rz @ np.asarray(e, dtype=float) for e in _KUKA_AXES[:3]] + \
+        [R_arm @ np.asarray(e, dtype=float) for e in _KUKA_AXES[3:]]
+    dots = [float(a @ e) for a, e in zip(u, want)]
+    if any(abs(d) < 1 - 1e-6 for d in dots):
+        return None
+    e6 = want[5]                                                   # KUKA's A6 axis in that posture
+    ref = R_arm @ np.asarray(_KUKA_TOOL0_X)
+    if abs(float(x_tool @ e6)) > 1e-6:
+        return None
+    a6 = math.degrees(math.atan2(float(np.cross(ref, x_tool) @ e6), float(ref @ x_tool)))
+    if abs(a6 - 90.0 * round(a6 / 90.0)) > 1e-4:
+        return None
+    a6_quarter = _quarter(a6)
+    a3 = (a23 - a2 + 180.0) % 360.0 - 180.0
+    if a6_quarter is None:
+        return None
+    signs = tuple(1 if d > 0 else -1 for d in dots)
+    return signs, (a1, a2, 180.0 if a3 == -180.0 else a3 + 0.0, 0.0, 0.0, a6_quarter)
+
+
+def _abb_coupling(source: Path, roots: Sequence[Path]) -> tuple[bool, Path] | None:
+    """Whether the URDF's ROS-Industrial support package has abb_driver couple J3 with J2 (a
+    launch file's `J23_coupled` default, the package's folder above `urdf/`), with that file;
+    None when no readable launch file of the package says."""
+    package = source.resolve().parent.parent
+    launch = package / "launch"
+    if not launch.is_dir() or not _inside(launch, roots):
+        return None
+    found = None
+    for path in sorted(launch.glob("*.launch")):
+        if not path.is_file() or not _inside(path, roots):
+            continue
+        with open(path, "rb") as f:
+            match = _J23.search(f.read(_LAUNCH_BYTES).decode("utf-8", "replace"))
+        if match:
+            if match[1] == "true":
+                return True, path
+            found = (False, path)
+    return found
+
+
+def _convention(model: object, frame_id: int, brand: str, T_root_base: FloatArray | None,
+                source: Path | None = None, roots: Sequence[Path] = ()) -> Convention:
+    """How the controller counts the URDF's joints, as far as it is known (`Convention`).
 
     FANUC: ROS-Industrial's fanuc_driver exchanges the URDF's joint values with the controller
     unchanged but for the J2/J3 linkage (ros-industrial/fanuc@8fee5e30
     fanuc_driver/include/fanuc_driver/fanuc_utils.h:55-71, `J3_out = J3_in + j23_factor * J2_in`),
-    which `controller.j23_coupling` states. KUKA: checked against KUKA's axis directions and zero
-    (`_KUKA_AXES`). Other brands: not known here."""
+    which `controller.j23_coupling` states. ABB: abb_driver passes the values unchanged but on arms
+    whose support package couples J2 and J3 (`_J23`). UR: Universal_Robots_ROS_Driver takes the
+    controller's `actual_q` (rad) as the joint positions and sends its commands as they are
+    (UniversalRobots/Universal_Robots_ROS_Driver@66510fde40df294631bd22899677375d0b190d4e
+    ur_robot_driver/src/hardware_interface.cpp:526, `readData(data_pkg, "actual_q",
+    joint_positions_)`, and :714, `writeJointCommand(joint_position_command_, ...MODE_SERVOJ`) for
+    ur_description's URDFs. KUKA: KUKA's axis directions and zero (`_KUKA_AXES`) against the
+    URDF's; where they differ by axis flips and quarter turns the keys are derived
+    (`_kuka_counting`). Other brands: not known here."""
     import numpy as np
 
     from robomax_py.robot.ik._chain import joint_axes_at_zero
 
-    if brand == "fanuc":
-        return None
+    if brand in ("fanuc", "ur"):
+        return Convention()
+    if brand == "abb":
+        coupled = _abb_coupling(source, roots) if source is not None else None
+        if coupled is None:
+            return Convention(note="abb_driver passes joint values unchanged except on arms whose J3 it couples with "
+                                   "J2 (its J23_coupled: IRB 2400, 4400, 5400), and no launch file of the URDF's support "
+                                   f"package says which: {CONVENTION_UNKNOWN}")
+        if coupled[0]:
+            return Convention(note=f"abb_driver couples J3 with J2 for this arm (J23_coupled in {coupled[1].name}): the "
+                                   "controller's J3 is the URDF's J3 + J2, which robot.yaml does not state for ABB; "
+                                   f"{CONVENTION_UNKNOWN}")
+        return Convention()
     if brand != "kuka" or model.nq != 6:  # type: ignore[attr-defined]
-        return CONVENTION_UNKNOWN
+        return Convention(note=CONVENTION_UNKNOWN)
     try:
         axes = joint_axes_at_zero(model, frame_id)
     except Exception:  # noqa: BLE001 - a chain the check cannot read is simply not known to match
-        return CONVENTION_UNKNOWN
+        return Convention(note=CONVENTION_UNKNOWN)
     R = np.eye(3) if T_root_base is None else np.asarray(T_root_base)[:3, :3]
-    u = axes.u @ R                                      # directions in the controller's base frame
-    upper = (axes.p[2] - axes.p[1]) @ R                 # J2 -> J3 at zero: horizontal and forward on KUKA
-    matches = len(u) == 6 and all(float(a @ np.asarray(e)) > 1 - 1e-6 for a, e in zip(u, _KUKA_AXES)) \
-        and upper[0] > 0 and abs(upper[2]) < 0.2 * upper[0]
-    return None if matches else (f"the URDF's joint axes or zero differ from KUKA's (A1 about -z, A4 and A6 about -x, "
-                                 f"A2 = 0 with the upper arm horizontal): {CONVENTION_UNKNOWN}")
+    derived = _kuka_counting(axes, R)
+    if derived is None:
+        return Convention(note=f"the URDF's joint axes or zero differ from KUKA's (A1 about -z, A4 and A6 about -x, "
+                               f"A2 = 0 with the upper arm horizontal): {CONVENTION_UNKNOWN}")
+    signs, zeros = derived
+    if all(s == 1 for s in signs) and not any(zeros):
+        return Convention()
+    return Convention(signs, zeros, (
+        f"the URDF's joint axes differ from KUKA's (A1 about -z, A4 and A6 about -x, A2 = 0 with the upper arm "
+        f"horizontal; cf. kuka_experimental issue 98): controller.joint_signs [{', '.join(map(str, signs))}] and "
+        f"joint_zeros_deg [{', '.join(_number(z) for z in zeros)}] derived from the axes at the URDF's zero, taken to be KUKA's mastering "
+        "position with A4 = 0 (A4 + 180, -A5, A6 + 180 reach the same flange pose): check them against the axis "
+        "display"))
 
 
 def _fit(model: object, frame_id: int, solver: str | None) -> tuple[str, object, float, str | None]:
@@ -460,10 +600,10 @@ def import_urdf(
             try:
                 solver_name, fk_error, spec, robot_warnings = _build(
                     stage, name, urdf_name, flange, solver, brand, source, root, T_root_base,
-                    None if srdf_text is None else f"{name}.srdf")
+                    None if srdf_text is None else f"{name}.srdf", roots)
             except RobotModelError as exc:
                 raise _unstaged(exc, stage, source, urdf_name) from None
-            warnings.extend(w for w in robot_warnings if w.startswith(("IK falls back", "joint directions", "the URDF's joint axes")))
+            warnings.extend(w for w in robot_warnings if w.startswith(("IK falls back", "joint directions", "the URDF's joint axes", "abb_driver")))
             warnings.extend(w.replace(str(stage), str(out)) for w in robot_warnings if "limits." in w)
             warnings.extend(_named_srdf(w, stage, source, urdf_name, srdf) for w in robot_warnings if ": srdf: " in w)
             unchanged = out.is_dir() and not out.is_symlink() and _digest(out) == _digest(stage)
@@ -525,7 +665,7 @@ def _collect_meshes(root: ET.Element, source: Path, roots: Sequence[Path],
 
 def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | None, brand: str | None, source: Path,
            root: ET.Element, T_root_base: FloatArray | None,
-           srdf_name: str | None) -> tuple[str, float, RobotSpec, tuple[str, ...]]:
+           srdf_name: str | None, roots: Sequence[Path] = ()) -> tuple[str, float, RobotSpec, tuple[str, ...]]:
     """Fit the IK, write robot.yaml, and load the staged folder back as any robot folder is."""
     import pinocchio as pin
 
@@ -546,13 +686,13 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
         raise RobotModelError(source, "ik.solver", f"not a {solver}-class arm: {exc.problem}") from None
     # The file's folders too: ROS-Industrial packages name the maker (motoman_gp180_support/urdf/...).
     brand = brand or guess_brand(name, *source.parts[-4:], str(root.get("name", "")))
+    convention = _convention(model, int(model.getFrameId(flange)), brand, T_root_base, source, roots)
     _confined(stage, "robot.yaml").write_text(
-        _robot_yaml(name, urdf_name, flange, solver_name, params, brand, srdf_name, source, T_root_base),
+        _robot_yaml(name, urdf_name, flange, solver_name, params, brand, srdf_name, source, T_root_base, convention),
         encoding="utf-8")
     spec = load_robot_spec(stage / "robot.yaml")
     robot = load_robot(spec)       # the whole folder loads: meshes, pairs, IK checked against the URDF
-    notes = tuple(n for n in (fallback, _convention_warning(model, int(model.getFrameId(flange)), brand, T_root_base))
-                  if n is not None)
+    notes = tuple(n for n in (fallback, convention.note) if n is not None)
     return solver_name, fk_error, spec, (*notes, *robot.warnings)
 
 

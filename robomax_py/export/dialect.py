@@ -44,6 +44,8 @@ __all__ = [
     "Parsed",
     "PlannedProgram",
     "header_lines",
+    "in_controller_joints",
+    "in_controller_terms",
     "is_header_comment",
     "read_header",
     "spot_label",
@@ -311,16 +313,36 @@ def with_tcp_blends(planned: PlannedProgram, robot: RobotModel) -> Program:
 
 
 def with_brand_configs(program: Program, joints: Sequence[FloatArray], robot: RobotModel, brand: str) -> Program:
-    """Every Cartesian target's configuration data in `brand`'s terms (SPEC §6); the robot's own
-    brand keeps the data the planner wrote (taken from the unrounded joints)."""
+    """Every Cartesian target's configuration data in `brand`'s terms (SPEC §6), from the joints as
+    the controller counts them; the robot's own brand keeps the data the program has (the
+    planner's, in the controller's terms since `in_controller_terms`, taken from the unrounded
+    joints)."""
     if brand == robot.controller.brand:
         return program
+    return _configs_of(program, joints, robot, brand)
+
+
+def _configs_of(program: Program, joints: Sequence[FloatArray], robot: RobotModel, brand: str) -> Program:
     out: list[Instruction] = []
     for ins, q in zip(program.instructions, joints):
         if isinstance(ins, LinMove):
-            ins = dataclasses.replace(ins, config=brand_text_of(robot, q, brand))
+            ins = dataclasses.replace(ins, config=brand_text_of(robot, q, brand, controller=True))
         out.append(ins)
     return dataclasses.replace(program, instructions=tuple(out))
+
+
+def in_controller_terms(planned: PlannedProgram, robot: RobotModel) -> PlannedProgram:
+    """The plan as a controller program states it: its joint targets as the controller counts its
+    joints (`in_controller_joints`) and its Cartesian targets' configuration data computed from
+    those joint values (turn bits, wrist bit, quadrants, turn numbers: `solve.brand_text_of` with
+    `controller`), in the robot's brand; a dialect of another brand restates them from the same
+    values (`with_brand_configs`). The one conversion point of what publishing writes; the joints
+    (`planned.joints`) stay the URDF's. Without the keys the plan is returned as it is."""
+    c = robot.controller
+    if not c.joint_signs and not c.joint_zeros:
+        return planned
+    program = in_controller_joints(planned.program, robot)
+    return dataclasses.replace(planned, program=_configs_of(program, planned.joints, robot, c.brand))
 
 
 def in_controller_joints(program: Program, robot: RobotModel, inverse: bool = False) -> Program:

@@ -113,7 +113,7 @@ class Rebuilt:
 
 def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | str,
             lines: tuple[int, ...] | None = None, brand: str | None = None,
-            stored: tuple[FrameDef, ...] = ()) -> Rebuilt:
+            stored: tuple[FrameDef, ...] = (), controller: bool = False) -> Rebuilt:
     """Rebuild the motion; ProgramError when the program is not for this cell's robot.
 
     lines : the program line of each instruction (as the parser read them), for messages.
@@ -124,6 +124,11 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
         is composed as the controller composes it: the controller's base, the user frame in force,
         the target; the arm follows it with the tool in force (the program's, which the cell's
         gun then carries wherever that puts it).
+    controller : the program is a controller's (a dialect of a brand): its configuration data count
+        the joints as the controller does (robot.yaml `controller.joint_signs` / `joint_zeros_deg`),
+        so the configuration a LIN ends in is stated from the controller's values of the joints the
+        arm reaches (`solve.brand_text_of`) before it is compared with the written one. The
+        program's joint targets are the URDF's here (`dialect.in_controller_joints` inverse).
     A program that does not name its robot (a header with robot "" and no joints, as
     programs written by others) is taken to be for the cell's robot, joints in URDF order.
     """
@@ -132,7 +137,8 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
         raise ProgramError(file, "ROBOT", f"program is for robot {header.robot!r}, the cell uses {robot.name!r}")
     if header.joints and tuple(header.joints) != tuple(robot.joint_names):
         raise ProgramError(file, "AXES", f"expected {list(robot.joint_names)}, got {list(header.joints)}")
-    builder = _Builder(cell, robot, brand or robot.controller.brand, {**_by_name(stored), **_by_name(program.frames)})
+    builder = _Builder(cell, robot, brand or robot.controller.brand, {**_by_name(stored), **_by_name(program.frames)},
+                       controller)
     numbered = [(ins, None if lines is None else lines[i]) for i, ins in enumerate(program.instructions)]
     moves = [(ins, line) for ins, line in numbered if not isinstance(ins, Comment)]
     if not moves or not isinstance(moves[0][0], PtpMove):
@@ -172,8 +178,9 @@ def _by_name(frames: tuple[FrameDef, ...]) -> dict[tuple[str, str], FrameDef]:
 
 class _Builder:
     def __init__(self, cell: CellSpec, robot: RobotModel, brand: str,
-                 frames: dict[tuple[str, str], FrameDef]) -> None:
+                 frames: dict[tuple[str, str], FrameDef], controller: bool = False) -> None:
         self.cell, self.robot, self.brand = cell, robot, brand
+        self.controller = controller                       # configuration data in the controller's joint values
         self.frames = frames
         self.reported: set[tuple[str, str]] = set()        # frames whose difference is reported
         self.tools: list[FloatArray | None] = []           # of the pending steps: the tool of each LIN
@@ -232,7 +239,7 @@ class _Builder:
             config = self.last_config or self.config_text(self.q)
             self.spots.append({"seam": ins.seam, "name": ins.name, "t_arrive": self.t,
                                "t_leave": self.t + ins.time_s, "config": config, "line": self.line,
-                               "brand": self.brand})
+                               "brand": self.brand, "controller": self.controller})
             self.spans.append(Span(self.t, self.t + ins.time_s, self.line))
             self.t += ins.time_s
         elif isinstance(ins, Wait):
@@ -353,7 +360,8 @@ class _Builder:
                 if idx == k:
                     actual = self.config_text(path.targets[k])
                     self.last_config = actual
-                    nearby = config_texts_near(self.robot, path.targets[k], self.brand, CONFIG_TOL_RAD)
+                    nearby = config_texts_near(self.robot, path.targets[k], self.brand, CONFIG_TOL_RAD,
+                                               self.controller)
                     if written and not any(same_config(written, text) for text in nearby):
                         self.problems.append(Problem(t_end, "config", f"LIN ends in {actual}, the program says {written}",
                                                      lines[k]))
@@ -374,7 +382,7 @@ class _Builder:
 
     def config_text(self, q: FloatArray) -> str:
         """The configuration data, in the program's brand, of joint values q."""
-        return brand_text_of(self.robot, q, self.brand)
+        return brand_text_of(self.robot, q, self.brand, self.controller)
 
     def _hold(self, seconds: float, label: str) -> None:
         if seconds > 0:

@@ -211,26 +211,59 @@ def config_text(robot: RobotModel, q: FloatArray) -> str:
     return brand_text_of(robot, q, robot.controller.brand)
 
 
-def brand_text_of(robot: RobotModel, q: FloatArray, brand: str) -> str:
-    """The configuration data `brand`'s controller writes for q (n,), rad."""
+def controller_values(robot: RobotModel, q: FloatArray, inverse: bool = False) -> FloatArray:
+    """URDF joint values q (..., n), rad, as the controller counts its joints (robot.yaml
+    `controller.joint_signs`, `controller.joint_zeros_deg`): sign * q + zero; `inverse` the other
+    way. Without the keys q itself."""
+    q = np.asarray(q, dtype=float)
+    c = robot.controller
+    if not c.joint_signs and not c.joint_zeros:
+        return q
+    n = q.shape[-1]
+    signs = np.asarray(c.joint_signs or (1.0,) * n, dtype=float)
+    zeros = np.asarray(c.joint_zeros or (0.0,) * n, dtype=float)
+    if signs.shape[0] != n or zeros.shape[0] != n:
+        return q
+    out: FloatArray = (q - zeros) * signs if inverse else signs * q + zeros
+    return out
+
+
+def brand_text_of(robot: RobotModel, q: FloatArray, brand: str, controller: bool = False) -> str:
+    """The configuration data `brand`'s controller writes for q (n,), rad.
+
+    controller: the data as a controller program states it, from the joint values as the controller
+    counts them (`controller_values`): the turn bits, the wrist bit (A5 < 0), ABB's quadrants, FANUC's
+    flip and turn numbers, Yaskawa's R/T/S halves. The shoulder and elbow bits are geometric (where
+    the wrist point lies, SPEC §6) and do not depend on how the joints are counted. Without it (SRCL,
+    the trajectory file, the planner) the URDF's joint values, as those state them."""
+    q = np.asarray(q, dtype=float)
     ind = config_of(robot, q)
-    return brand_text(brand, ind.status, ind.turn, np.asarray(q, dtype=float))
+    q_c = controller_values(robot, q) if controller else q
+    if q_c is q:
+        return brand_text(brand, ind.status, ind.turn, q)
+    status = ind.status
+    if len(q_c) >= 5 and status >= 0:
+        status = (status & 3) | (4 if np.mod(q_c[4], 2.0 * np.pi) >= np.pi else 0)
+    return brand_text(brand, status, int(turn_bits(q_c)), q_c)
 
 
-def config_texts_near(robot: RobotModel, q: FloatArray, brand: str, tol_rad: float) -> set[str]:
+def config_texts_near(robot: RobotModel, q: FloatArray, brand: str, tol_rad: float, controller: bool = False) -> set[str]:
     """The configuration data of `brand` for q and for q with each joint that lies within tol_rad
     of a boundary the data changes at (0 and multiples of 90 deg: turn signs, ABB quadrants,
     FANUC turns at 180 deg) moved to either side: a target written with one of them names the
-    branch q is in, as far as the program's decimals can tell (SPEC §6: within 0.01 deg)."""
+    branch q is in, as far as the program's decimals can tell (SPEC §6: within 0.01 deg).
+    controller: as `brand_text_of`; the boundaries are then those of the controller's joint values."""
     q = np.asarray(q, dtype=float)
+    q_c = controller_values(robot, q) if controller else q
     quarter = np.pi / 2.0
-    near = [j for j in range(len(q)) if abs(q[j] - quarter * round(q[j] / quarter)) <= tol_rad]
+    near = [j for j in range(len(q_c)) if abs(q_c[j] - quarter * round(q_c[j] / quarter)) <= tol_rad]
     texts = set()
     for mask in range(1 << len(near)):
         for sign in (1.0, -1.0):
-            p = q.copy()
+            p = q_c.copy()
             for bit, j in enumerate(near):
                 if mask >> bit & 1:
-                    p[j] = quarter * round(q[j] / quarter) + sign * 2.0 * tol_rad
-            texts.add(brand_text_of(robot, p, brand))
+                    p[j] = quarter * round(q_c[j] / quarter) + sign * 2.0 * tol_rad
+            p_urdf = controller_values(robot, p, inverse=True) if controller else p
+            texts.add(brand_text_of(robot, p_urdf, brand, controller))
     return texts

@@ -152,17 +152,59 @@ def test_fall_back_to_numeric_ik_says_why_and_what_it_costs(tmp_path: Path) -> N
 
 
 def test_import_warns_where_the_controllers_joint_convention_is_not_known(tmp_path: Path) -> None:
-    """KUKA URDFs that follow KUKA's axis directions and zero (kr120) and FANUC (driver passes the
-    values through but for the J2/J3 linkage, j23_coupling) are known; the KR 210 L150's A1 turns
-    about +z with A2 = 0 upright (kuka_experimental issue 98) and ABB is not checked: warnings."""
-    def convention(name: str) -> list[str]:
-        result = import_urdf(ARMS[name], tmp_path / name, (ROSI,), srdf=SRDF.get(name))
-        return [w for w in result.warnings if "joint directions and zeros taken from the URDF" in w]
+    """KUKA URDFs that follow KUKA's axis directions and zero (kr120), FANUC (driver passes the
+    values through but for the J2/J3 linkage, j23_coupling) and ABB arms whose support package
+    leaves J2 and J3 uncoupled (abb_driver passes the values through: irb6640) are known; the
+    IRB 2400's abb_driver couples J3 with J2 (its launch file's J23_coupled), which robot.yaml does
+    not state for ABB: a warning. The KR 210 L150 (A1 about +z, A2 = 0 upright, kuka_experimental
+    issue 98) gets its keys derived, and says so."""
+    irb6640 = ROSI / "abb_irb6640_support/urdf/irb6640_185_280.xacro"
+    srdf6640 = ROSI / "abb_irb6640_moveit_config/config/abb_irb6640_185_280.srdf"
 
-    assert convention("kr120r2500pro") == [] and convention("m20ia") == []
-    assert convention("irb2400") and "controller.joint_signs" in convention("irb2400")[0]
+    def convention(name: str) -> list[str]:
+        source, srdf = (irb6640, srdf6640) if name == "irb6640" else (ARMS[name], SRDF.get(name))
+        result = import_urdf(source, tmp_path / name, (ROSI,), srdf=srdf)
+        return [w for w in result.warnings if "controller.joint_signs" in w]
+
+    assert convention("kr120r2500pro") == [] and convention("m20ia") == [] and convention("irb6640") == []
+    [irb2400] = convention("irb2400")
+    assert "J23_coupled" in irb2400 and "joint directions and zeros taken from the URDF" in irb2400
     [kr210] = convention("kr210l150")
-    assert "differ from KUKA's" in kr210
+    assert "differ from KUKA's" in kr210 and "derived from the axes" in kr210 and "issue 98" in kr210
+    assert "joint_signs" not in (tmp_path / "kr120r2500pro" / "robot.yaml").read_text()
+
+
+def _axis_origins(robot, q):  # type: ignore[no-untyped-def]
+    import pinocchio as pin
+
+    data = robot.model.createData()
+    pin.forwardKinematics(robot.model, data, np.asarray(q, dtype=float))
+    return [data.oMi[j].translation.copy() for j in range(1, 7)]
+
+
+def test_kr210_keys_count_its_joints_as_kuka_does(arms: dict[str, Path]) -> None:
+    """The derived keys make the KR 210 L150's controller values those of the kr120, whose URDF
+    counts as KUKA does: at the same controller values both flanges point the same way, and the
+    upper arm stands upright at KUKA's mastering position A2 = -90, A3 = 90 deg (both arms' axes
+    lie on the base axes, so the flange orientations agree exactly; the KR 210 L150's link origins
+    are a few mm off its axes, issue 98). What the flange cannot tell (A4 + 180, -A5, A6 + 180) the
+    derivation takes from the URDF's zero as the mastering position."""
+    kr210 = load_robot(load_robot_spec(arms["kr210l150"] / "robot.yaml"))
+    kr120 = load_robot(load_robot_spec(arms["kr120r2500pro"] / "robot.yaml"))
+    signs = np.asarray(kr210.controller.joint_signs)
+    zeros = np.asarray(kr210.controller.joint_zeros)
+    assert list(signs) == [-1, 1, 1, -1, 1, -1]
+    assert np.degrees(zeros) == pytest.approx([0, -90, 90, 0, 0, 0])
+    rng = np.random.default_rng(7)
+    controller_deg = [[0, -90, 90, 0, 0, 0], [30, -60, 100, 45, 20, -70], [-120, -100, 40, -150, -60, 160]]
+    controller_deg += [list(rng.uniform(-120, 120, 6)) for _ in range(3)]
+    for c in np.radians(controller_deg):
+        q210 = (c - zeros) * signs              # the keys' definition: controller = sign * URDF + zero
+        R210, R120 = fk_flange(kr210, q210)[:3, :3], fk_flange(kr120, c)[:3, :3]
+        assert R210 == pytest.approx(R120, abs=1e-9)
+    p = _axis_origins(kr210, (np.radians([0, -90, 90, 0, 0, 0]) - zeros) * signs)
+    upper = (p[2] - p[1]) / np.linalg.norm(p[2] - p[1])
+    assert upper[2] > 0.99                      # A2 = -90 deg: upright, as KUKA documents its mastering position
 
 
 def test_import_is_idempotent_and_never_overwrites(tmp_path: Path) -> None:

@@ -21,6 +21,11 @@ joint-5 origin lies there, as usual, that origin). Arms without a spherical wris
 parallel to axis 3) use the intersection of axes 5 and 6 for bit 0 and of axes 4 and 5 for bit 1, so
 that the bits split the eight IK branches as they do for spherical wrists; see `status_generic`.
 
+Joint values here are those the caller passes: the URDF's for the planner, SRCL and the trajectory
+file; the controller's (robot.yaml `controller.joint_signs`, `controller.joint_zeros_deg`) for the
+configuration data of controller programs (`solve.brand_text_of` with `controller`). S bits 0 and 1
+are where the wrist point lies and do not depend on how the joints are counted.
+
 String form `S110 T010011`: three status bits then six turn bits, each written most significant
 first, like KRL's 'B110' binary literals (leftmost = bit 2 resp. bit 5 = A6).
 
