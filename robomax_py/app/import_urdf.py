@@ -292,6 +292,9 @@ def _robot_yaml(name: str, urdf: str, flange: str, solver: str, params: object, 
             lines.append(f"    base_xy: [{', '.join(_number(v) for v in params.base_xy)}]  # axis 1 in the root frame")
         if params.flange_xy != (0.0, 0.0):
             lines.append(f"    flange_xy: [{', '.join(_number(v) for v in params.flange_xy)}]  # flange off axis 6")
+        if params.flange_rpy != (0.0, 0.0, 0.0):
+            lines.append(f"    flange_rpy: [{', '.join(_number(math.degrees(v)) for v in params.flange_rpy)}]"
+                         "  # the URDF flange in the paper's (z along axis 6)")
     elif isinstance(params, UrParams):
         lines.append("  params:")
         for key in ("d1", "a2", "a3", "d4", "d5", "d6"):
