@@ -59,6 +59,7 @@ from robomax_py.safe_files import (
     read_text,
 )
 from robomax_py.spec import RobotSpec
+from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.transforms import rpy_from_matrix
 
 # Mesh files a URDF may name: single-file formats trimesh reads (.gltf is left out: its buffers are
@@ -292,6 +293,9 @@ def _robot_yaml(name: str, urdf: str, flange: str, solver: str, params: object, 
             lines.append(f"    base_xy: [{', '.join(_number(v) for v in params.base_xy)}]  # axis 1 in the root frame")
         if params.flange_xy != (0.0, 0.0):
             lines.append(f"    flange_xy: [{', '.join(_number(v) for v in params.flange_xy)}]  # flange off axis 6")
+        if params.flange_rpy != (0.0, 0.0, 0.0):
+            lines.append(f"    flange_rpy: [{', '.join(_number(math.degrees(v)) for v in params.flange_rpy)}]"
+                         "  # the URDF flange in the paper's (z along axis 6)")
     elif isinstance(params, UrParams):
         lines.append("  params:")
         for key in ("d1", "a2", "a3", "d4", "d5", "d6"):
@@ -509,6 +513,38 @@ def _convention(model: object, frame_id: int, brand: str, T_root_base: FloatArra
         "display"))
 
 
+# The vendors' mounting flange (ISO 9409-1) has z out of the flange along the last axis, and so does
+# ROS-Industrial's `tool0` (REP 199, "Coordinate Frames for Serial Industrial Manipulators", as the
+# support packages cite it: ros-industrial/kuka_experimental@e78bbd15
+# kuka_kr120_support/urdf/kr120r2500pro_macro.xacro:146 "Following REP199, this frame shall be use to
+# attach EEF", :217-220 tool0 = flange turned 90 deg about y, z along axis 6;
+# ros-industrial/abb@77db19bd abb_irb2400_support/urdf/irb2400_macro.xacro:164-167 likewise, after
+# its CHANGELOG's "corrects tool0 to match robot controller"). Not every package does:
+# abb_irb4400_support's irb4400l_30_243 publishes tool0 = link_6's frame, x along axis 6.
+FLANGE_Z_WARNING = ("the flange frame '{flange}' has its z axis {angle:.1f} deg off the last joint's axis: not the "
+                    "vendor's mounting flange convention (z out of the flange along the last axis, as "
+                    "ROS-Industrial's tool0 has it, REP 199). Tools mount on this frame as published, so a "
+                    "tool's z (its working direction) points along this frame's z; choose another frame with "
+                    "--flange or fix the URDF's flange joint")
+
+
+def _flange_z_warning(model: object, frame_id: int, flange: str) -> str | None:
+    """The warning when the flange frame's z axis is not along the last joint's axis (either way), else None."""
+    import numpy as np
+
+    from robomax_py.robot.ik._chain import joint_axes_at_zero
+
+    try:
+        axes = joint_axes_at_zero(model, frame_id)
+    except Exception:  # noqa: BLE001 - a chain the check cannot read: nothing to say about its flange
+        return None
+    if len(axes.u) == 0:
+        return None
+    cos = abs(float(axes.u[-1] @ axes.T_flange[:3, 2]))
+    angle = float(np.degrees(np.arccos(min(cos, 1.0))))
+    return None if cos >= math.cos(TOL.structure_tol) else FLANGE_Z_WARNING.format(flange=flange, angle=angle)
+
+
 def _fit(model: object, frame_id: int, solver: str | None) -> tuple[str, object, float, str | None]:
     """(solver, parameters, FK error in m, warning): the warning says why the closed forms were not
     taken and what that costs, whenever the fit fell back to numeric IK (None otherwise)."""
@@ -603,7 +639,8 @@ def import_urdf(
                     None if srdf_text is None else f"{name}.srdf", roots)
             except RobotModelError as exc:
                 raise _unstaged(exc, stage, source, urdf_name) from None
-            warnings.extend(w for w in robot_warnings if w.startswith(("IK falls back", "joint directions", "the URDF's joint axes", "abb_driver")))
+            warnings.extend(w for w in robot_warnings if w.startswith(
+                ("IK falls back", "the flange frame", "joint directions", "the URDF's joint axes", "abb_driver")))
             warnings.extend(w.replace(str(stage), str(out)) for w in robot_warnings if "limits." in w)
             warnings.extend(_named_srdf(w, stage, source, urdf_name, srdf) for w in robot_warnings if ": srdf: " in w)
             unchanged = out.is_dir() and not out.is_symlink() and _digest(out) == _digest(stage)
@@ -692,7 +729,8 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
         encoding="utf-8")
     spec = load_robot_spec(stage / "robot.yaml")
     robot = load_robot(spec)       # the whole folder loads: meshes, pairs, IK checked against the URDF
-    notes = tuple(n for n in (fallback, convention.note) if n is not None)
+            warnings.extend(w for w in robot_warnings if w.startswith(
+                ("IK falls back", "the flange frame", "joint directions", "the URDF's joint axes", "abb_driver")))
     return solver_name, fk_error, spec, (*notes, *robot.warnings)
 
 

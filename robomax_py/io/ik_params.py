@@ -8,7 +8,9 @@ opw
     offsets (deg, 6, default all 0); sign_corrections (6 values of +1 or -1, default all +1);
     base_xy (m, 2, default [0, 0]): where axis 1 meets the xy plane of the URDF root frame, a fixed
     translation in front of the chain (the root frame need not lie on axis 1); flange_xy (m, 2,
-    default [0, 0]): the flange origin's offset from axis 6, along the flange frame's x and y.
+    default [0, 0]): the flange origin's offset from axis 6, along the paper's flange x and y;
+    flange_rpy (deg, 3, default [0, 0, 0]): the URDF flange frame's roll, pitch, yaw in the paper's
+    flange frame (z along axis 6), for a flange whose z is not along axis 6.
     Conventions of the opw_kinematics reference implementation (see `opw`).
 ur
     d1, a2, a3, d4, d5, d6 (m, required; Universal Robots' DH table, a2 and a3 non-zero, negative for
@@ -61,7 +63,7 @@ def params_from_mapping(solver: str, params: Mapping[str, Any]) -> OpwParams | U
     if not isinstance(params, Mapping):
         raise RobotModelError(None, "ik.params", f"expected a mapping of parameters, got {type(params).__name__}")
     if solver == "opw":
-        allowed: tuple[str, ...] = (*_OPW_LENGTHS, "offsets", "sign_corrections", "base_xy", "flange_xy")
+        allowed: tuple[str, ...] = (*_OPW_LENGTHS, "offsets", "sign_corrections", "base_xy", "flange_xy", "flange_rpy")
     elif solver == "ur":
         allowed = (*_UR_LENGTHS, *_UR_POSES)
     elif solver == "table":
@@ -89,11 +91,12 @@ def params_from_mapping(solver: str, params: Mapping[str, Any]) -> OpwParams | U
         g = [int(v) for v in signs]
         bx, by = _vector(params, "base_xy", 2, (0.0, 0.0))
         fx, fy = _vector(params, "flange_xy", 2, (0.0, 0.0))
+        fr, fp, fw = (math.radians(v) for v in _vector(params, "flange_rpy", 3, (0.0, 0.0, 0.0)))
         return OpwParams(
             a1=a1, a2=a2, b=b, c1=c1, c2=c2, c3=c3, c4=c4,
             offsets=(o[0], o[1], o[2], o[3], o[4], o[5]),
             sign_corrections=(g[0], g[1], g[2], g[3], g[4], g[5]),
-            base_xy=(bx, by), flange_xy=(fx, fy),
+            base_xy=(bx, by), flange_xy=(fx, fy), flange_rpy=(fr, fp, fw),
         )
     if solver == "ur":
         d1, a2, a3, d4, d5, d6 = (_number(params, k) for k in _UR_LENGTHS)

@@ -122,7 +122,58 @@ def test_offsets_off_the_axes_are_fitted_exactly(arms: dict[str, Path]) -> None:
     assert fk_agreement(robot.model, robot.flange_frame_id, robot.ik_params).position_m < ROUND_TRIP_M
     assert _params(arms["kr210l150"])["base_xy"] == [-0.00262, 0.00097586]
     # The arms on their axes write no offset keys.
-    assert not {"base_xy", "flange_xy"} & set(_params(arms["kr120r2500pro"]))
+    assert not {"base_xy", "flange_xy", "flange_rpy"} & set(_params(arms["kr120r2500pro"]))
+    # Nor does any arm whose tool0 has z along axis 6 write a flange rotation.
+    assert not any("flange_rpy" in _params(folder) for folder in arms.values())
+
+
+def _irb4400_like_urdf(path: Path, tool0_xyz: str, tool0_rpy: str) -> Path:
+    """The joints of abb_irb4400_support/urdf/irb4400l_30_243_macro.xacro (axis 6 along link_6's x),
+    no meshes, with tool0 placed on link_6 as given; that package publishes xyz "0.14 0 0", rpy "0 0 0"."""
+    joints = [("0 0 0", "0 0 1", -2.87979, 2.87979), ("0.2 0 0.68", "0 1 0", -1.2217, 1.658),
+              ("0 0 0.89", "0 1 0", -1.0472, 1.1345), ("1.38 0 0.15", "1 0 0", -3.49, 3.49),
+              ("0 0 0", "0 1 0", -2.0944, 2.0944), ("0 0 0", "1 0 0", -6.9813, 6.9813)]
+    links = "".join(f'<link name="link_{i}"/>' for i in range(7))
+    body = "".join(
+        f'<joint name="joint_{i + 1}" type="revolute"><parent link="link_{i}"/><child link="link_{i + 1}"/>'
+        f'<origin xyz="{xyz}"/><axis xyz="{axis}"/><limit lower="{lo}" upper="{hi}" effort="1" velocity="2"/></joint>'
+        for i, (xyz, axis, lo, hi) in enumerate(joints))
+    path.write_text(f'<robot name="irb4400_like">{links}{body}<link name="tool0"/><joint name="joint_6-tool0" '
+                    f'type="fixed"><parent link="link_6"/><child link="tool0"/><origin xyz="{tool0_xyz}" '
+                    f'rpy="{tool0_rpy}"/></joint></robot>')
+    return path
+
+
+@pytest.mark.parametrize(("xyz", "rpy"), [("0.14 0 0", "0 0 0"), ("0.14 0.003 -0.002", "0.4 -0.7 1.1")])
+def test_flange_turned_against_axis_6_fits_opw_with_a_flange_rotation(tmp_path: Path, xyz: str, rpy: str) -> None:
+    """A tool0 whose z is not along axis 6 (irb4400l_30_243 as published, and a tilted one off the
+    axis): OPW with `flange_rpy`, exact against the URDF, written and read back, IK reproducing the
+    URDF's flange poses; and the import says the frame is not the mounting-flange convention."""
+    result = import_urdf(_irb4400_like_urdf(tmp_path / "irb4400_like.urdf", xyz, rpy), tmp_path / "irb4400_like")
+    assert result.solver == "opw"
+    [warning] = [w for w in result.warnings if w.startswith("the flange frame 'tool0' has its z axis")]
+    assert "REP 199" in warning and "--flange" in warning and "fix the URDF" in warning
+    assert len(_params(result.folder)["flange_rpy"]) == 3  # type: ignore[arg-type]
+
+    robot = load_robot(load_robot_spec(result.folder / "robot.yaml"))
+    assert robot.ik_solver == "opw"
+    fitted = fit_opw(robot.model, robot.flange_frame_id)
+    exact = fk_agreement(robot.model, robot.flange_frame_id, fitted)
+    assert exact.position_m < 1e-12 and exact.rotation_rad < 1e-12
+    read_back = fk_agreement(robot.model, robot.flange_frame_id, robot.ik_params)
+    assert read_back.position_m < ROUND_TRIP_M and read_back.rotation_rad < ROUND_TRIP_M
+
+    rng = np.random.default_rng(4)
+    qs = robot.limits.lower + rng.uniform(0.02, 0.98, (40, 6)) * (robot.limits.upper - robot.limits.lower)
+    for q in qs[np.abs(np.sin(qs[:, 4])) > 1e-3]:
+        T = fk_flange(robot, q)                       # Pinocchio on the URDF
+        table = solve_all(robot, T)
+        sols = table.q[table.valid]
+        assert len(sols)
+        T_sols = fk_flange(robot, sols)
+        assert np.abs(T_sols[:, :3, 3] - T[:3, 3]).max() < ROUND_TRIP_M
+        assert np.abs(T_sols[:, :3, :3] - T[:3, :3]).max() < ROUND_TRIP_M
+        assert np.abs(np.angle(np.exp(1j * (sols - q)))).max(axis=1).min() < 1e-6
 
 
 def _non_opw_urdf(path: Path) -> Path:
@@ -164,6 +215,8 @@ def test_import_warns_where_the_controllers_joint_convention_is_not_known(tmp_pa
     def convention(name: str) -> list[str]:
         source, srdf = (irb6640, srdf6640) if name == "irb6640" else (ARMS[name], SRDF.get(name))
         result = import_urdf(source, tmp_path / name, (ROSI,), srdf=srdf)
+        # Their tool0 has z along axis 6: no flange warning.
+        assert not [w for w in result.warnings if w.startswith("the flange frame")]
         return [w for w in result.warnings if "controller.joint_signs" in w]
 
     assert convention("kr120r2500pro") == [] and convention("m20ia") == [] and convention("irb6640") == []

@@ -41,7 +41,12 @@ LATERAL = OpwParams(
     a1=0.150, a2=0.080, b=0.070, c1=0.500, c2=0.600, c3=0.700, c4=0.100,
     offsets=(0.1, 0.2, -0.3, 0.4, 0.0, 0.6),
 )
-PARAM_SETS = {"kr6_r700": KR6_R700, "irb2400": IRB2400, "lateral_b": LATERAL}
+# A flange frame off axis 6 and turned against it (a URDF whose flange z is not along axis 6).
+TURNED_FLANGE = OpwParams(
+    a1=0.200, a2=-0.150, b=0.0, c1=0.680, c2=0.890, c3=1.380, c4=0.140,
+    offsets=(0.0, 0.0, -np.pi / 2, 0.0, 0.0, -np.pi / 2), flange_xy=(0.004, -0.003), flange_rpy=(0.3, -1.2, 2.0),
+)
+PARAM_SETS = {"kr6_r700": KR6_R700, "irb2400": IRB2400, "lateral_b": LATERAL, "turned_flange": TURNED_FLANGE}
 N_RANDOM = 2000
 
 
@@ -268,6 +273,10 @@ def test_params_from_mapping_converts_degrees() -> None:
     defaults = params_from_mapping("opw", {k: v for k, v in KR6_YAML.items() if k in "a1 a2 b c1 c2 c3 c4".split()})
     assert isinstance(defaults, OpwParams)
     assert defaults.offsets == (0.0,) * 6 and defaults.sign_corrections == (1,) * 6
+    assert defaults.flange_rpy == (0.0, 0.0, 0.0)
+    turned = params_from_mapping("opw", {**KR6_YAML, "flange_rpy": [0, -90, 45]})
+    assert isinstance(turned, OpwParams)
+    assert_allclose(turned.flange_rpy, (0.0, -np.pi / 2, np.pi / 4), atol=1e-15)
 
 
 @pytest.mark.parametrize(
@@ -281,6 +290,7 @@ def test_params_from_mapping_converts_degrees() -> None:
         ({"offsets": 5}, "ik.params.offsets", "list of 6"),
         ({"sign_corrections": [1, 1, 1, 1, 1, 2]}, "ik.params.sign_corrections", "+1 or -1"),
         ({"b": True}, "ik.params.b", "finite number"),
+        ({"flange_rpy": [0, 90]}, "ik.params.flange_rpy", "expected 3 values"),
     ],
 )
 def test_params_from_mapping_rejects(change: dict[str, object], key: str, words: str) -> None:
@@ -307,3 +317,16 @@ def test_regression_wrap_boundary() -> None:
     """Found by hypothesis: a joint landing a hair above pi wrapped to exactly -pi, outside (-pi, pi]."""
     sols, valid = opw_ik(IRB2400, opw_fk(IRB2400, np.array([0.0, 0.0, 0.5, np.pi, 1.5, 0.0])))
     assert np.all((sols[valid] > -np.pi) & (sols[valid] <= np.pi))
+
+
+def test_flange_rpy_turns_the_flange_about_its_origin(rng: np.random.Generator) -> None:
+    """flange_rpy only turns the frame: same origin, T = T_paper * R(flange_rpy)."""
+    from dataclasses import replace
+
+    from robomax_py.transforms import rpy_matrix
+
+    q = rng.uniform(-np.pi, np.pi, (50, 6))
+    paper = opw_fk(replace(TURNED_FLANGE, flange_rpy=(0.0, 0.0, 0.0)), q)
+    turned = opw_fk(TURNED_FLANGE, q)
+    assert_allclose(turned[:, :3, 3], paper[:, :3, 3], atol=1e-15)
+    assert_allclose(turned[:, :3, :3], paper[:, :3, :3] @ rpy_matrix(*TURNED_FLANGE.flange_rpy), atol=1e-14)

@@ -129,7 +129,7 @@ def fit_opw(model: pin.Model, frame_id: int) -> OpwParams:
     ------
     FitError
         The chain is not an ortho-parallel arm with a spherical wrist whose axis 1 is parallel to the
-        root's z axis, or its flange z axis is not along axis 6.
+        root's z axis. A flange frame turned against axis 6 is kept as `flange_rpy` (`_paper_flange`).
     """
     ax = _axes_at_zero(model, frame_id)
     u = ax.u
@@ -156,7 +156,7 @@ def fit_opw(model: pin.Model, frame_id: int) -> OpwParams:
     if np.linalg.norm(c45 - c56) > STRUCTURE_TOL:
         raise FitError("the wrist axes must meet in one point")
     wrist = c45
-    _require_parallel(ax.R_flange[:, 2], u[5], "the flange z axis and axis 6")
+    R_flange, flange_rpy = _paper_flange(ax.R_flange, ax.p_flange - np.array([base_xy[0], base_xy[1], 0.0]) - wrist, u[5])
 
     # The paper's x axis at q = 0: from axis 1 towards axis 2 (a1), else towards the wrist, else root x.
     foot2 = closest_on_line(p[1], u[1], np.zeros(3), ez)
@@ -189,11 +189,11 @@ def fit_opw(model: pin.Model, frame_id: int) -> OpwParams:
     options = [(1, float(np.arctan2(-u5c[0], u5c[1]))), (-1, float(np.arctan2(u5c[0], -u5c[1])))]
     s5, th4 = min(options, key=lambda o: abs(o[1]))
     R_4 = R_c @ rot_z(th4)
-    zf = R_4.T @ ax.R_flange[:, 2]
+    zf = R_4.T @ R_flange[:, 2]
     th5 = float(np.arctan2(zf[0], zf[2]))
     R_5 = R_4 @ rot_y(th5)
-    s6 = 1 if u[5] @ ax.R_flange[:, 2] > 0 else -1
-    M = R_5.T @ ax.R_flange
+    s6 = 1 if u[5] @ R_flange[:, 2] > 0 else -1
+    M = R_5.T @ R_flange
     th6 = float(np.arctan2(M[1, 0], M[0, 0]))
     if np.linalg.norm(M - rot_z(th6)) > STRUCTURE_TOL:
         raise FitError("the flange frame is not a rotation about axis 6 of the wrist")
@@ -202,13 +202,41 @@ def fit_opw(model: pin.Model, frame_id: int) -> OpwParams:
     offsets = tuple(_wrap(-t) for t in (th1, th2, th23 - th2, th4, th5, th6))
     a1, a2, b, c1, c2, c3, c4, fx, fy = _opw_lengths(model, frame_id, signs, offsets, base_xy)
     return OpwParams(a1, a2, b, c1, c2, c3, c4, offsets=offsets, sign_corrections=signs,  # type: ignore[arg-type]
-                     base_xy=base_xy, flange_xy=(fx, fy))
+                     base_xy=base_xy, flange_xy=(fx, fy), flange_rpy=flange_rpy)
+
+
+def _paper_flange(R_urdf: FloatArray, wrist_to_flange: FloatArray,
+                  u6: FloatArray) -> tuple[FloatArray, tuple[float, float, float]]:
+    """The paper's flange rotation at q = 0 (3, 3) and `flange_rpy` (rad) turning it into the URDF's.
+
+    A URDF flange whose z axis is along axis 6 (either way) is the paper's flange: rpy zero, the
+    parameters as they always were. Otherwise (ROS-Industrial's irb4400l_30_243: tool0 = link_6's
+    frame, x along axis 6) the paper's flange frame is chosen as: z along axis 6, pointing away from
+    the wrist centre (along the URDF flange's z side of it when the flange origin is at the wrist);
+    x the URDF flange's x axis projected on the plane normal to z (its y axis when x is along axis 6).
+    The choice is canonical up to a turn about axis 6, which the joint-6 offset would absorb anyway;
+    this one keeps the paper's x nearest the URDF's. The URDF flange = paper flange * R(flange_rpy).
+    """
+    if _angle_between_lines(R_urdf[:, 2], u6) <= STRUCTURE_TOL:
+        return R_urdf, (0.0, 0.0, 0.0)
+    along = float(wrist_to_flange @ u6)
+    side = along if abs(along) > 1e-9 else float(R_urdf[:, 2] @ u6)
+    z = u6 if side >= 0 else -u6
+    for v in (R_urdf[:, 0], R_urdf[:, 1]):
+        h = v - (v @ z) * z
+        if np.linalg.norm(h) > 1e-6:
+            break
+    x = h / np.linalg.norm(h)
+    R_paper = np.stack([x, np.cross(z, x), z], axis=1)
+    rpy = rpy_from_matrix(R_paper.T @ R_urdf)
+    return R_paper, (float(rpy[0]), float(rpy[1]), float(rpy[2]))
 
 
 def _opw_lengths(model: pin.Model, frame_id: int, signs: tuple[int, ...], offsets: tuple[float, ...],
                  base_xy: tuple[float, float]) -> tuple[float, ...]:
-    """a1, a2, b, c1, c2, c3, c4 and the flange offset from axis 6 (x, y in the flange frame) by least
-    squares: the flange position (less `base_xy`) is linear in them."""
+    """a1, a2, b, c1, c2, c3, c4 and the flange offset from axis 6 (x, y in the paper's flange frame)
+    by least squares: the flange position (less `base_xy`) is linear in them (`flange_rpy` turns the
+    frame about its origin, so it does not enter)."""
     qs = _random_q(model, FIT_SAMPLES, seed=1)
     T = _urdf_fk(model, frame_id, qs)
     T[:, 0, 3] -= base_xy[0]

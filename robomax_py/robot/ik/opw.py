@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from robomax_py._typing import BoolArray, FloatArray
+from robomax_py.transforms import rpy_matrix
 
 if TYPE_CHECKING:
     import pinocchio as pin
@@ -22,13 +23,20 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True, slots=True)
 class OpwParams:
-    """Seven lengths (m), six joint offsets (rad), six axis signs (+1 or -1), base and flange offsets (m).
+    """Seven lengths (m), six joint offsets (rad), six axis signs (+1 or -1), base and flange offsets (m)
+    and a fixed flange rotation (rad).
 
     Two fixed translations around the paper's chain, for URDFs whose frames are not on the axes
     (ROS-Industrial's KR 210 L150: axis 1 2.6 mm off the root origin, tool0 0.24 mm off axis 6):
     `base_xy` is where axis 1 meets the robot base frame's xy plane (the paper's axis 1 is the base z
-    axis); `flange_xy` is the flange origin's offset from axis 6 along the flange's own x and y. FK
-    adds them, IK takes them off the target first.
+    axis); `flange_xy` is the flange origin's offset from axis 6 along the paper's flange x and y.
+    FK adds them, IK takes them off the target first.
+
+    `flange_rpy` (roll, pitch, yaw about fixed x, y, z, as URDF's rpy) turns the paper's flange frame
+    (z along axis 6) into the robot's flange frame, for URDFs whose flange z is not along axis 6
+    (ROS-Industrial's abb_irb4400_support irb4400l_30_243: tool0 = link_6's frame, x along axis 6):
+    T_base_flange = T_base_paper_flange * R(flange_rpy), same origin. Zero for a flange with z
+    along axis 6.
     """
 
     a1: float
@@ -42,6 +50,12 @@ class OpwParams:
     sign_corrections: tuple[int, int, int, int, int, int] = (1,) * 6
     base_xy: tuple[float, float] = (0.0, 0.0)
     flange_xy: tuple[float, float] = (0.0, 0.0)
+    flange_rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+def flange_rotation(params: OpwParams) -> FloatArray:
+    """R(flange_rpy), (3, 3): the robot's flange frame in the paper's flange frame."""
+    return rpy_matrix(*params.flange_rpy)
 
 
 def to_paper_angles(params: OpwParams, q: FloatArray) -> FloatArray:
@@ -91,6 +105,8 @@ def opw_fk(params: OpwParams, q: FloatArray) -> FloatArray:
     T[..., 0, 3] += params.base_xy[0]
     T[..., 1, 3] += params.base_xy[1]
     T[..., 3, 3] = 1.0
+    if params.flange_rpy != (0.0, 0.0, 0.0):
+        T[..., :3, :3] = R @ flange_rotation(params)
     return T
 
 
@@ -145,7 +161,7 @@ def opw_pin_model(
     for i, (axis, rot, xyz) in enumerate(joints):
         placement = pin.SE3(np.asarray(rot), np.array(xyz, dtype=float))
         parent = model.addJoint(parent, pin.JointModelRevoluteUnaligned(sign[i] * axis), placement, f"joint_{i + 1}")
-    model.addFrame(pin.Frame(flange, parent, pin.SE3(np.eye(3), np.array([params.flange_xy[0], params.flange_xy[1], params.c4])), pin.FrameType.OP_FRAME))
+    model.addFrame(pin.Frame(flange, parent, pin.SE3(flange_rotation(params), np.array([params.flange_xy[0], params.flange_xy[1], params.c4])), pin.FrameType.OP_FRAME))
     model.lowerPositionLimit = np.full(6, -2 * np.pi) if lower is None else np.asarray(lower, dtype=float)
     model.upperPositionLimit = np.full(6, 2 * np.pi) if upper is None else np.asarray(upper, dtype=float)
     return model
@@ -212,6 +228,8 @@ def opw_ik(
         hint1, hint4 = th_hint[:, 0], th_hint[:, 3]
 
     R = T[:, :3, :3]
+    if p.flange_rpy != (0.0, 0.0, 0.0):
+        R = R @ flange_rotation(p).T        # the paper's flange frame: z along axis 6
     # Wrist centre C = flange position - c4 * approach axis (less the flange offset), in the frame
     # whose origin is on axis 1.
     fx, fy = p.flange_xy
