@@ -37,7 +37,7 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
 sys.path.insert(0, str(HERE))
 
-from corpus_cells import scaled_cell  # noqa: E402
+from corpus_cells import scaled_cell
 from scale_cells import FAMILIES, write_scale_cell  # noqa: E402
 
 CHILD = r"""
