@@ -218,26 +218,41 @@ class Sequencer:
                 out.append(_UNUSABLE)
         return out
 
-    def _via_costs(self, i: int, j: int, v: int, det: Detour, rows: IntArray, cols: IntArray) -> FloatArray:
-        """Time of enter leg + detour v + leave leg between candidates `rows` of i and `cols` of j."""
-        if det is _UNUSABLE:
-            return np.full((len(rows), len(cols)), np.inf)
-        wp, sp = det.waypoints, self._detour_speed()
-        enter = ptp_time_estimate(self.q(i)[rows], wp[0][None, :], self.limits, sp)
-        leave = ptp_time_estimate(wp[-1][None, :], self.q(j)[cols], self.limits, sp)
-        via = enter[:, None] + self._inner_time(v, det) + leave[None, :]
-        pi, pj = self._positions(i, rows), self._positions(j, cols)
+    def _via_costs(self, i: int, j: int, vias: list[Detour], rows: IntArray, cols: IntArray, pi: IntArray,
+                   pj: IntArray) -> FloatArray:
+        """Least time of enter leg + detour + leave leg over the usable detours `vias` (from
+        `vias_for`) between candidates `rows` of i and `cols` of j (positions `pi`, `pj`), inf where
+        none. The enter and leave legs of every detour are estimated in one call each: per detour,
+        two calls on a few rows cost numpy's overhead many times the arithmetic, and a spot beside
+        clamps collects dozens of detours."""
+        out = np.full((len(rows), len(cols)), np.inf)
+        usable = [v for v, det in enumerate(vias) if det is not _UNUSABLE]
+        if not usable:
+            return out
+        sp = self._detour_speed()
+        starts = np.array([vias[v].waypoints[0] for v in usable])
+        ends = np.array([vias[v].waypoints[-1] for v in usable])
+        enter = ptp_time_estimate(self.q(i)[rows][:, None, :], starts[None, :, :], self.limits, sp)   # rows x vias
+        leave = ptp_time_estimate(ends[:, None, :], self.q(j)[cols][None, :, :], self.limits, sp)     # vias x cols
         bad = self.legs_bad.get((i, j), set())
-        if len(bad) >= MAX_BLOCKED_LEGS:
-            verified = np.full_like(via, np.inf)
-            for a, b, vv in self.legs_ok.get((i, j), ()):
-                if vv == v and pi[a] >= 0 and pj[b] >= 0:
-                    verified[pi[a], pj[b]] = via[pi[a], pj[b]]
-            return verified
-        for a, b, vv in bad:
-            if vv == v and pi[a] >= 0 and pj[b] >= 0:
-                via[pi[a], pj[b]] = np.inf
-        return via
+        verified_only = len(bad) >= MAX_BLOCKED_LEGS
+        marks: dict[int, list[tuple[int, int]]] = {}
+        for a, b, vv in (self.legs_ok.get((i, j), ()) if verified_only else bad):
+            if pi[a] >= 0 and pj[b] >= 0:
+                marks.setdefault(vv, []).append((int(pi[a]), int(pj[b])))
+        for k, v in enumerate(usable):
+            via = enter[:, k, None] + self._inner_time(v, vias[v]) + leave[k][None, :]
+            cells = marks.get(v, ())
+            if verified_only:
+                verified = np.full_like(via, np.inf)
+                for r, c in cells:
+                    verified[r, c] = via[r, c]
+                via = verified
+            else:
+                for r, c in cells:
+                    via[r, c] = np.inf
+            out = np.minimum(out, via)
+        return out
 
     def _detour_speed(self) -> float:
         """The speed fraction detour moves are estimated at (options resolved from the cell)."""
@@ -307,9 +322,7 @@ class Sequencer:
                 for (a, b), free in known.items():
                     if not free and pi[a] >= 0 and pj[b] >= 0:
                         est[pi[a], pj[b]] = np.inf
-        for v, det in enumerate(vias):
-            if det is not _UNUSABLE:
-                est = np.minimum(est, self._via_costs(i, j, v, det, rows, cols))
+        est = np.minimum(est, self._via_costs(i, j, vias, rows, cols, pi, pj))
         for a, b in self.no_way.get(key, ()):
             if pi[a] >= 0 and pj[b] >= 0:
                 est[pi[a], pj[b]] = np.inf

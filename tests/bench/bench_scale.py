@@ -3,9 +3,11 @@
     python tests/bench/bench_scale.py [--sizes 8,15,30,60,120,240] [--families open,clamped,interleaved]
                                       [--runs 1] [--against DIR] [--against-max 30] [--timeout 1800]
     python tests/bench/bench_scale.py --cells CELL... [--runs 3] [--against DIR]
+    python tests/bench/bench_scale.py --corpus frame,panel [--sizes 30,60,120,240] [--no-baseline]
 
 Cells come from `scale_cells.py` (seeded, one KR 125 with the C-gun, N spots on flange rows, three
-families). Each plan runs in a fresh process (so peak memory is the plan's own and nothing is
+families), or with `--corpus FAMILIES` from `corpus_cells.scaled_cell` (four fixtures holding one
+corpus part each round a KR 125, N / 4 spots per part; shapes the planner was not tuned on). Each plan runs in a fresh process (so peak memory is the plan's own and nothing is
 warm), one thread. Per family and N it prints the median over the runs of: CPU seconds of the plan
 (imports and cell loading excluded) and its split into candidates, sequencing, timing and the
 rest (world, roadmap, verify, clearance), each stage's share of the process's wall clock
@@ -35,6 +37,7 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[1]
 sys.path.insert(0, str(HERE))
 
+from corpus_cells import scaled_cell
 from scale_cells import FAMILIES, write_scale_cell  # noqa: E402
 
 CHILD = r"""
@@ -138,6 +141,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="8,15,30,60,120,240")
     ap.add_argument("--families", default=",".join(FAMILIES))
+    ap.add_argument("--corpus", default=None,
+                    help="corpus families (e.g. frame,panel): cells from corpus_cells.scaled_cell instead")
+    ap.add_argument("--no-baseline", action="store_true", help="skip planning the published baseline")
     ap.add_argument("--runs", type=int, default=1)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--against", type=Path, default=None, help="a tree holding another robomax_py to compare")
@@ -156,7 +162,8 @@ def main() -> None:
         saved: dict[str, dict] = {}
         for cell in args.cells:
             cell = cell.resolve()
-            rows = [run_child(cell, REPO, baseline=(k == 0), timeout=args.timeout) for k in range(args.runs)]
+            rows = [run_child(cell, REPO, baseline=(k == 0 and not args.no_baseline), timeout=args.timeout)
+                    for k in range(args.runs)]
             old = [run_child(cell, args.against, baseline=False, timeout=args.timeout)
                    for _ in range(args.runs)] if args.against else []
             label = f"{cell.parent.name}/{cell.stem}"       # two folders may hold cells of one name
@@ -166,15 +173,19 @@ def main() -> None:
                 args.json.write_text(json.dumps(saved, indent=1), encoding="utf-8")
         return
     sizes = [int(x) for x in args.sizes.split(",")]
-    families = args.families.split(",")
+    families = (args.corpus or args.families).split(",")
     everything: dict[str, dict] = {}
     with tempfile.TemporaryDirectory() as tmp:
         print(HEADER, flush=True)
         for family in families:
             points = []
             for n in sizes:
-                cell = write_scale_cell(Path(tmp), family, n, args.seed)
-                rows = [run_child(cell, REPO, baseline=(k == 0), timeout=args.timeout) for k in range(args.runs)]
+                if args.corpus:
+                    cell = scaled_cell(family, n, args.seed).write(Path(tmp) / f"{family}_{n}")
+                else:
+                    cell = write_scale_cell(Path(tmp), family, n, args.seed)
+                rows = [run_child(cell, REPO, baseline=(k == 0 and not args.no_baseline), timeout=args.timeout)
+                        for k in range(args.runs)]
                 old = [run_child(cell, args.against, baseline=False, timeout=args.timeout)
                        for _ in range(args.runs)] if args.against and n <= args.against_max else []
                 everything[f"{family}/{n}"] = {"new": rows, "old": old}

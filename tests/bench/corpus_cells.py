@@ -163,12 +163,13 @@ class Part:
     notes: dict[str, Any] = field(default_factory=dict)
 
 
-def panel(rng: np.random.Generator, size: float) -> Part:
-    """A horizontal sheet lying on a table with upturned flanges (40-60 mm) along 1-3 edges."""
+def panel(rng: np.random.Generator, size: float, all_flanges: bool = False) -> Part:
+    """A horizontal sheet lying on a table with upturned flanges (40-60 mm) along 1-3 edges (all
+    three with `all_flanges`)."""
     w, depth = size * rng.uniform(0.8, 1.2), size * rng.uniform(0.45, 0.75)
     hf = rng.uniform(0.04, 0.06)
     sheets = [_aligned_box((-depth / 2, -w / 2, -SHEET_M), (depth / 2, w / 2, 0))]
-    edges = ["front"] + [e for e in ("left", "right") if rng.random() < 0.5]
+    edges = ["front"] + [e for e in ("left", "right") if rng.random() < 0.5 or all_flanges]
     flanges = []
     z = hf - EDGE_M
     for e in edges:
@@ -235,9 +236,10 @@ def box(rng: np.random.Generator, size: float) -> Part:
                 math.hypot(depth / 2 + rim, w / 2 + rim))
 
 
-def frame(rng: np.random.Generator, size: float) -> Part:
+def frame(rng: np.random.Generator, size: float, all_flanges: bool = False) -> Part:
     """A rectangular frame of four flanged rails (like cells/frame.yaml) on a table: each rail's
-    upturned 40 mm flange on its outer edge; the rear rail's flange faces away from the robot."""
+    upturned 40 mm flange on its outer edge; the rear rail's flange faces away from the robot.
+    Spots on 1-4 of the flanges (all four with `all_flanges`)."""
     w, depth, rail, hf = size * rng.uniform(0.8, 1.2), size * rng.uniform(0.6, 0.9), 0.08, 0.045
     sheets: list[trimesh.Trimesh] = []
     flanges: list[Flange] = []
@@ -258,6 +260,8 @@ def frame(rng: np.random.Generator, size: float) -> Part:
         ys = y0 + sy * SHEET_M / 2
         flanges.append(_line((-depth / 2 + rail + 0.04, ys, z), (depth / 2 - rail - 0.04, ys, z), (0, sy, 0), (0, 0, 1)))
     keep = sorted(rng.permutation(4)[:int(rng.integers(1, 5))])
+    if all_flanges:
+        keep = [0, 1, 2, 3]
     fixture = [_aligned_box((sx * depth / 2 - 0.04 - sx * 0.0, -w / 2 + 0.02, -0.7),
                             (sx * depth / 2 + 0.04 - sx * 0.08, w / 2 - 0.02, -SHEET_M)) for sx in (-1, 1)]
     fixture = [_aligned_box((min(b.bounds[0][0], b.bounds[1][0]), b.bounds[0][1], -0.7),
@@ -352,23 +356,24 @@ class Spot:
 
 
 def place_spots(rng: np.random.Generator, part: Part, n_spots: int, n_seams: int,
-                n_clamps: int) -> tuple[list[list[Spot]], list[trimesh.Trimesh], int]:
+                n_clamps: int, min_pitch: float = MIN_PITCH_M) -> tuple[list[list[Spot]], list[trimesh.Trimesh], int]:
     """Spots along the part's flanges (seams never cross flanges; a long flange may hold several
-    seams), with clamp gaps: the seams in their natural order along the flanges, the clamps'
-    boxes and how many clamps there are (fewer than asked where a flange has no room)."""
+    seams), with clamp gaps, no closer than `min_pitch`: the seams in their natural order along the
+    flanges, the clamps' boxes and how many clamps there are (fewer than asked where a flange has
+    no room)."""
     flanges = part.flanges
     order = rng.permutation(len(flanges)).tolist()
     used = max(1, min(len(flanges), n_seams, n_spots // 2))
     # Enough flanges for the spots at the closest pitch (a seam never crosses flanges).
-    while used < len(flanges) and sum(int(flanges[k].length / MIN_PITCH_M) + 1 for k in order[:used]) < n_spots:
+    while used < len(flanges) and sum(int(flanges[k].length / min_pitch) + 1 for k in order[:used]) < n_spots:
         used += 1
     pick = sorted(order[:used])
     lengths = np.array([flanges[k].length for k in pick])
     clamps_per = np.zeros(used, dtype=int)
     for _ in range(n_clamps):
         clamps_per[int(rng.integers(used))] += 1
-    clamps_per = np.minimum(clamps_per, ((lengths - MIN_PITCH_M) / CLAMP_GAP_M).astype(int))
-    caps = ((lengths - clamps_per * CLAMP_GAP_M) / MIN_PITCH_M).astype(int) + 1
+    clamps_per = np.minimum(clamps_per, ((lengths - min_pitch) / CLAMP_GAP_M).astype(int))
+    caps = ((lengths - clamps_per * CLAMP_GAP_M) / min_pitch).astype(int) + 1
     # Spots per flange in proportion to its length, at least 2, at most what it holds.
     counts = np.minimum(caps, np.maximum(2, np.floor(lengths / lengths.sum() * n_spots))).astype(int)
     while counts.sum() < n_spots and (counts < caps).any():
@@ -390,8 +395,8 @@ def place_spots(rng: np.random.Generator, part: Part, n_spots: int, n_seams: int
         gap = CLAMP_GAP_M
         room = f.length - nc * gap
         pitch = min(0.08, room / max(1, count - 1)) if count > 1 else 0.0
-        if count > 1 and pitch < MIN_PITCH_M:             # too many: shorten to what fits
-            count = max(2, int(room / MIN_PITCH_M) + 1)
+        if count > 1 and pitch < min_pitch:               # too many: shorten to what fits
+            count = max(2, int(room / min_pitch) + 1)
             pitch = room / (count - 1)
             nc = min(nc, count - 1)
         span = pitch * (count - 1) + nc * gap
@@ -421,9 +426,9 @@ def place_spots(rng: np.random.Generator, part: Part, n_spots: int, n_seams: int
     return seams, clamps, placed
 
 
-def capacity(part: Part) -> int:
-    """Spots the part's flanges hold at the closest pitch."""
-    return sum(int(f.length / MIN_PITCH_M) + 1 for f in part.flanges)
+def capacity(part: Part, min_pitch: float = MIN_PITCH_M) -> int:
+    """Spots the part's flanges hold at `min_pitch`."""
+    return sum(int(f.length / min_pitch) + 1 for f in part.flanges)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -579,6 +584,65 @@ def _translation(x: float, y: float, z: float) -> np.ndarray:
     T = np.eye(4)
     T[:3, 3] = x, y, z
     return T
+
+
+SCALED_ARM = "kr125"
+SCALED_STATIONS = (-135.0, -45.0, 45.0, 135.0)     # deg: bearings of the fixtures round the robot
+SCALED_MAX_SPOTS = 240                             # the part is sized for this many spots
+
+
+def scaled_cell(family: str, n_spots: int, seed: int = 0) -> GeneratedCell:
+    """A cell of `n_spots` spots on four copies of one corpus part (`family`), each in its own
+    fixture at a bearing of SCALED_STATIONS round one KR 125 with the C-gun (as a welding cell with
+    several fixtures), n_spots / 4 spots per part. The arm, the part's shape and size, the
+    stations' distance and height and the riser are drawn from `seed` alone, so the cells of one
+    family and seed differ only in their spots (their placement, clamps and seam listing are then
+    drawn for each N as `corpus_cell` draws them). The part is sized for SCALED_MAX_SPOTS / 4 spots
+    (every flange used); where its flanges are too short at the corpus's closest pitch, the pitch
+    shrinks (not below 20 mm, a common minimum for two 1.5 mm sheets) rather than the part outgrowing
+    the arm's reach."""
+    family_index = FAMILIES.index(family)
+    rng = np.random.default_rng([seed, 1000 + family_index])
+    arm = ARMS[SCALED_ARM]
+    n_seams = int(rng.integers(1, 7))
+    n_clamps = int(rng.choice([0, 0, 1, 2, 3, 4, 6]))
+    per_part_max = -(-SCALED_MAX_SPOTS // len(SCALED_STATIONS))
+    builder = BUILDERS[family]
+    build = (lambda size: builder(rng, size, all_flanges=True)) if family in ("panel", "frame") \
+        else (lambda size: builder(rng, size))
+    size = arm.reach * rng.uniform(0.35, 0.45)
+    part = build(size)
+    for _ in range(6):          # the corpus's growth, capped so that four stations keep apart
+        if capacity(part) >= per_part_max + 3 * n_clamps:
+            break
+        size = min(size * 1.25, arm.reach * 0.5)
+        part = build(size)
+    riser = float(rng.choice([0.3, 0.5, 0.7])) if rng.random() < 0.35 else 0.0
+    dist = rng.uniform(0.45, 0.55) * arm.reach + 0.35 * part.extent
+    height = max(0.35, riser + arm.shoulder + rng.uniform(-0.45, 0.1) * arm.reach * 0.6)
+    T_world_robot = _translation(rng.uniform(-2.5, 2.5), rng.uniform(-2.5, 2.5), 0.0) @ _rz(rng.uniform(-180, 180))
+    usable = sum(f.length for f in part.flanges) - n_clamps * CLAMP_GAP_M
+    min_pitch = max(0.02, min(MIN_PITCH_M, usable / (per_part_max + 1)))
+    # Everything N changes is drawn after this point.
+    sheets: list[trimesh.Trimesh] = []
+    fixture: list[trimesh.Trimesh] = []
+    clamps: list[trimesh.Trimesh] = []
+    seams: list[list[Spot]] = []
+    placed = 0
+    counts = [n_spots // len(SCALED_STATIONS) + (k < n_spots % len(SCALED_STATIONS)) for k in range(len(SCALED_STATIONS))]
+    for bearing, count in zip(SCALED_STATIONS, counts, strict=True):
+        T = _rz(bearing) @ _translation(dist, 0.0, height)
+        sheets += [m.copy().apply_transform(T) for m in part.sheets]
+        fixture += [m.copy().apply_transform(T) for m in part.fixture]
+        station_seams, station_clamps, k = place_spots(rng, part, count, n_seams, n_clamps, min_pitch)
+        clamps += [m.apply_transform(T) for m in station_clamps]
+        placed += k
+        R = T[:3, :3]
+        seams += [[Spot("", (T @ np.r_[s.xyz, 1.0])[:3], R @ s.normal, R @ s.direction) for s in seam]
+                  for seam in station_seams]
+    cell_part = Part(part.kind, sheets, fixture, [], part.z_support, part.extent)
+    name = f"scaled_{family}_{sum(len(s) for s in seams)}_s{seed}"
+    return assemble(name, arm, T_world_robot, riser, np.eye(4), cell_part, seams, clamps, rng, n_clamps=placed)
 
 
 def bracket_regression_cell() -> GeneratedCell:

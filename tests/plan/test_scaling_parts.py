@@ -105,3 +105,58 @@ def test_probe_checks_near_pairs_in_full_and_far_pairs_coarsely(reference: tuple
         a, b = seq.probe_pair(i, j)
         assert seq.straight[(i, j)][(a, b)] is True
     assert PROBE_STATES >= 3
+
+
+def _via_costs_one_by_one(seq: Sequencer, i: int, j: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """The detour prices as they were computed before the legs were batched: two estimates per
+    detour, its blocked (or, past MAX_BLOCKED_LEGS, its verified) legs marked, the least kept."""
+    from robomax_py.plan.graph import _UNUSABLE, MAX_BLOCKED_LEGS
+    from robomax_py.timing import ptp_time_estimate
+
+    out = np.full((len(rows), len(cols)), np.inf)
+    pi, pj = seq._positions(i, rows), seq._positions(j, cols)
+    bad = seq.legs_bad.get((i, j), set())
+    sp = seq._detour_speed()
+    for v, det in enumerate(seq.vias_for(i, j)):
+        if det is _UNUSABLE:
+            continue
+        enter = ptp_time_estimate(seq.q(i)[rows], det.waypoints[0][None, :], seq.limits, sp)
+        leave = ptp_time_estimate(det.waypoints[-1][None, :], seq.q(j)[cols], seq.limits, sp)
+        via = enter[:, None] + seq._inner_time(v, det) + leave[None, :]
+        if len(bad) >= MAX_BLOCKED_LEGS:
+            verified = np.full_like(via, np.inf)
+            for a, b, vv in seq.legs_ok.get((i, j), ()):
+                if vv == v and pi[a] >= 0 and pj[b] >= 0:
+                    verified[pi[a], pj[b]] = via[pi[a], pj[b]]
+            via = verified
+        else:
+            for a, b, vv in bad:
+                if vv == v and pi[a] >= 0 and pj[b] >= 0:
+                    via[pi[a], pj[b]] = np.inf
+        out = np.minimum(out, via)
+    return out
+
+
+@pytest.mark.slow
+def test_detour_prices_batched_equal_one_by_one(reference: tuple[Any, Any, CollisionWorld, list[Any]]) -> None:
+    from robomax_py.plan.graph import MAX_BLOCKED_LEGS
+    from robomax_py.plan.roadmap import Detour
+
+    cell, robot, world, spots = reference
+    seq = Sequencer(cell, robot, world, None, spots, resolved_options(cell, PlanOptions()), np.random.default_rng(0))
+    rng = np.random.default_rng(7)
+    i, j = 0, 1
+    # Detours between i and j both ways, leaving i, reaching j, reaching i (used reversed) and
+    # between other spots (not usable from i to j).
+    for di, dj in [(i, j), (j, i), (i, 2), (3, j), (2, i), (2, 3), (j, 4)]:
+        seq.detours.append((di, dj, Detour(rng.uniform(-2.0, 2.0, (4, 6)), 1.0, 10)))
+    rows, cols = np.arange(len(seq.q(i))), seq._rows(j)
+    pi, pj = seq._positions(i, rows), seq._positions(j, cols)
+    assert np.isfinite(_via_costs_one_by_one(seq, i, j, rows, cols)).all()
+    for count in (0, MAX_BLOCKED_LEGS - 1, MAX_BLOCKED_LEGS + 2):
+        seq.legs_bad[(i, j)] = {(int(rng.integers(len(rows))), int(cols[rng.integers(len(cols))]), int(rng.integers(7)))
+                                for _ in range(count)}
+        seq.legs_ok[(i, j)] = {(int(rng.integers(len(rows))), int(cols[rng.integers(len(cols))]), int(rng.integers(7)))
+                               for _ in range(5)}
+        got = seq._via_costs(i, j, seq.vias_for(i, j), rows, cols, pi, pj)
+        assert np.array_equal(got, _via_costs_one_by_one(seq, i, j, rows, cols))     # bit for bit
