@@ -166,9 +166,9 @@ def plan_cell(
 
 
 # The file's order is timed only when the published method's estimate of it is at most this
-# fraction above the searched tour's. Wherever the file's order timed shorter and its estimate was
-# logged (six cells: five of the generated corpus and cells/cabin_flange.yaml), that estimate was
-# 0.5-3.3 % below the searched tour's (the search ranks orders on a few representative candidates per spot, the exact DP then
+# fraction above the searched tour's. Wherever the file's order timed shorter (seven cells: six of
+# the generated corpus and cells/cabin_flange.yaml), that estimate was 0.5-4.2 % below the searched
+# tour's (the search ranks orders on a few representative candidates per spot, the exact DP then
 # chooses among all); on cells/ur10_tray.yaml one 2.9 % above timed 3.1 % longer. Timing and
 # checking a tour costs about a third of a plan.
 GIVEN_ORDER_MARGIN = 0.01
