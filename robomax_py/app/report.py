@@ -45,6 +45,13 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
     for phase in result.trajectory.phases:
         split[phase.kind] = split.get(phase.kind, 0.0) + float(phase.t_end - phase.t_start)
     report["cycle_time"] = round(result.cycle_time, 4)
+    if result.order is not None:
+        o = result.order
+        report["order"] = {
+            "kept": o.kept, "note": o.note, "line": o.describe(),
+            "searched_cycle": None if o.searched_cycle is None else round(o.searched_cycle, 4),
+            "given_cycle": None if o.given_cycle is None else round(o.given_cycle, 4),
+        }
     if result.clearance is not None:
         c = result.clearance
         report["clearance"] = {"mm": round(c.distance_m * 1000, 3), "t": round(c.t, 4), "between": c.between}
@@ -87,6 +94,8 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
         word = {"weld": "grip/release"} if report.get("tending") else {}
         split = ", ".join(f"{word.get(k, k)} {v:.2f}" for k, v in report["split"].items() if v > 0)
         head.add_row("cycle time", f"{report['cycle_time']:.2f} s  ({split})")
+        if "order" in report:
+            head.add_row("order", report["order"]["line"])
         detours = ", ".join(f"{d['between']} ({d['checks_to_find']} checks)" for d in report["detours"])
         head.add_row("detours", detours or "none")
         carried = [c for c in report.get("carried", []) if c["part"]]

@@ -5,6 +5,7 @@ junction (`tour_timing`, `junction`, `waiting`), checked (`pipeline`) -> a `Plan
 from robomax_py.plan.pipeline import plan_cell, verify_trajectory
 from robomax_py.plan.results import (
     METHODS,
+    OrderChoice,
     PlanOptions,
     PlanResult,
     PlanStats,
@@ -19,6 +20,7 @@ from robomax_py.plan.results import (
 from robomax_py.plan.tour_timing import weld_end
 
 __all__ = [
-    "METHODS", "PlanOptions", "PlanResult", "PlanStats", "Progress", "SpotFailure", "SpotPlan", "Transition",
+    "METHODS", "OrderChoice", "PlanOptions", "PlanResult", "PlanStats", "Progress", "SpotFailure", "SpotPlan",
+    "Transition",
     "method_options", "method_suffix", "plan_cell", "resolved_options", "verify_trajectory", "weld_end",
 ]

@@ -5,10 +5,11 @@ known free."""
 
 from __future__ import annotations
 
+import copy
 import itertools
 import logging
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -158,6 +159,10 @@ class Sequencer:
         self.unconnected: set[tuple[int, int]] = set()                            # unordered spot pairs given up
         self._exit_cache: dict[tuple[int, int], list[FloatArray]] = {}            # (spot, candidate) -> exits
         self._inner: dict[tuple[int, bool], float] = {}                           # (detour, reversed) -> time
+        # What `_probe_pairs` learnt (straight moves, detour-only pairs, checks) and the generator as
+        # it was before any round: a sequencer of the given order starts from them (`given_order`).
+        self._probed: tuple[dict[tuple[int, int], dict[tuple[int, int], bool]], set[tuple[int, int]], int] | None = None
+        self._rng_at_start = copy.deepcopy(rng)
 
     # ------------------------------------------------------------------ knowledge and costs
 
@@ -435,7 +440,9 @@ class Sequencer:
     def run(self) -> SequencingOutcome:
         """The best tour whose every leg is known free, or why there is none (a status, not None)."""
         blocks = self._blocks()
-        self._probe_pairs()
+        if self._probed is None:
+            self._probe_pairs()
+            self._probed = ({k: dict(v) for k, v in self.straight.items()}, set(self.detour_only), self.checks)
         previous: tuple[tuple[int, ...], ...] = ()
         for _ in range(self.options.max_rounds):
             self.rounds += 1
@@ -475,6 +482,23 @@ class Sequencer:
         worst = ", ".join(f"{label} ({n} rounds)" for label, n in self.unresolved.most_common(5))
         return SequencingOutcome("not_converged", message=f"sequencing did not converge in {self.options.max_rounds} "
                                  f"rounds; moves left without a verified connection most often: {worst}")
+
+    def given_order(self) -> Sequencer:
+        """A sequencer of the cell file's order (the published method, `PlanOptions.given_order`)
+        that starts where a fresh one would after its probe, so that its tour is the one the
+        published method plans: the probe is a function of the candidates alone and is copied, not
+        repeated; the random generator starts as this sequencer's did. Call after `run`."""
+        assert self._probed is not None, "run() first"
+        other = Sequencer(self.cell, self.robot, self.world, self.roadmap.fresh(), self.spots,
+                          replace(self.options, given_order=True), copy.deepcopy(self._rng_at_start),
+                          loads=self.loads)
+        straight, detour_only, _ = self._probed
+        other.straight = {k: dict(v) for k, v in straight.items()}
+        other.detour_only = set(detour_only)
+        other._probed = (straight, detour_only, 0)
+        # Roadmaps built for held parts are seeded by the cell alone; their checked edges are shared.
+        other._roadmaps.update({part: r.fresh() for part, r in self._roadmaps.items() if part is not None})
+        return other
 
     def _repair(self, order: tuple[int, ...]) -> None:
         """The candidates of one order re-chosen (the exact DP, cheap next to an order search) and

@@ -137,6 +137,28 @@ class Transition:
 
 
 @dataclass(frozen=True, slots=True)
+class OrderChoice:
+    """Which spot order an optimised plan kept: the searched one, or the cell file's own order
+    planned by the published method (the DP over every candidate, same detours and timing), kept
+    where its timed cycle is shorter. `given_cycle` is None where the file's order was not timed;
+    `note` then says why."""
+
+    kept: str                        # "searched" | "given"
+    searched_cycle: float | None     # s; None where the searched tour failed its timing or check
+    given_cycle: float | None        # s
+    note: str = ""
+
+    def describe(self) -> str:
+        """One line: "searched (x s, kept) / as given (y s)" and, where it was not timed, why."""
+        def part(name: str, cycle: float | None, kept: bool) -> str:
+            what = "not timed" if cycle is None else f"{cycle:.3f} s"
+            return f"{name} ({what}{', kept' if kept else ''})"
+        line = (part("searched", self.searched_cycle, self.kept == "searched") + " / "
+                + part("as given", self.given_cycle, self.kept == "given"))
+        return line + (f": {self.note}" if self.note else "")
+
+
+@dataclass(frozen=True, slots=True)
 class PlanStats:
     candidates: int
     candidate_checks: int
@@ -171,6 +193,7 @@ class PlanResult:
     options: PlanOptions = PlanOptions()
     weld_time: float = 0.0
     clearance: Clearance | None = None       # the smallest distance the planned motion keeps, and where
+    order: OrderChoice | None = None         # optimised plans: the searched order or the file's, and why
 
     @property
     def tending(self) -> bool:

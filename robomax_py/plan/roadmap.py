@@ -10,6 +10,7 @@ move). Every collision check is counted.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -100,7 +101,19 @@ class Roadmap:
         self._edge_index = {(int(u), int(v)): e for e, (u, v) in enumerate(self._pairs)}
         self._edge_blocked = np.zeros(len(self._pairs), dtype=bool)
         self._edge_free: dict[tuple[int, int], bool] = {}
+        # Every edge's check result, shared with `fresh` copies (which do not know them yet).
+        self._checked: dict[tuple[int, int], bool] = {}
         self.edge_checks = 0
+
+    def fresh(self) -> Roadmap:
+        """This roadmap as it was built, before any edge was known: its queries find what a new
+        roadmap's would (a query gives up after MAX_BLOCKED_PER_QUERY blocked edges it meets, so what
+        is known changes what is found). Edges checked by either are not checked again."""
+        other = copy.copy(self)
+        other._edge_blocked = np.zeros(len(self._pairs), dtype=bool)
+        other._edge_free = {}
+        other.edge_checks = 0
+        return other
 
     def __len__(self) -> int:
         return len(self.nodes)
@@ -123,11 +136,16 @@ class Roadmap:
         known = self._edge_free.get(key)
         if known is not None:
             return known, 0
-        res = self._world.check_segment(self.nodes[u], self.nodes[v])
-        self._edge_free[key] = res.free
-        if not res.free:
+        checked = self._checked.get(key)
+        used = 0
+        if checked is None:
+            res = self._world.check_segment(self.nodes[u], self.nodes[v])
+            checked = self._checked[key] = res.free
+            used = res.checks
+        self._edge_free[key] = checked
+        if not checked:
             self._edge_blocked[self._edge_index[key]] = True
-        return res.free, res.checks
+        return checked, used
 
     def nearest(self, q: FloatArray, k: int | None = None) -> list[int]:
         """The k (default: the roadmap's k) nodes nearest q in the time-scaled metric."""

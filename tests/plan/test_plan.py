@@ -200,6 +200,10 @@ def test_given_order_keeps_the_file_order_and_chooses_among_every_candidate(tmp_
     # Same order, a superset of the candidates: the DP's estimate is no worse.
     estimate = [estimated_cycle_time(cell, robot, r) for r in (optimised, published, teach_in)]
     assert estimate[0] <= estimate[1] + COST_TOL_S and estimate[1] <= estimate[2] + COST_TOL_S
+    # The optimiser weighs the file's order as the published method plans it and keeps the shorter.
+    assert optimised.cycle_time <= published.cycle_time + 1e-9
+    assert optimised.order is not None and published.order is None and teach_in.order is None
+    assert optimised.order.kept in ("searched", "given") and optimised.order.describe().startswith("searched (")
 
 
 # ---------------------------------------------------------------------------------------------- 3

@@ -96,3 +96,28 @@ def test_first_checked_path_is_the_shortest() -> None:
                 dist[v] = d + w
                 heapq.heappush(heap, (d + w, v))
     assert length(path) == pytest.approx(dist[-2], rel=1e-12)
+
+
+def test_a_fresh_copy_finds_what_a_new_roadmap_finds_without_checking_edges_again() -> None:
+    """`Roadmap.fresh`: the published method planned beside the search starts from the roadmap as
+    built. Queries that another roadmap's knowledge would change (blocked edges already dropped)
+    give the same detours as a newly built roadmap, and edges checked before are not checked again."""
+    start, goal = np.array([-0.9, 0.1, 0, 0, 0, 0]), np.array([0.9, -0.1, 0, 0, 0, 0])
+    other_start, other_goal = np.array([0, -0.9, 0.2, 0, 0, 0]), np.array([0, 0.9, -0.2, 0, 0, 0])
+
+    def build(world: BallWorld) -> Roadmap:
+        return Roadmap(world, LIMITS, np.array([start, goal, other_start, other_goal]), np.random.default_rng(5),
+                       n_nodes=300, k=8)  # type: ignore[arg-type]
+
+    used = build(BallWorld())
+    first = used.query(other_start, other_goal)
+    assert first is not None
+    fresh_world, new_world = BallWorld(), BallWorld()
+    fresh = used.fresh()
+    fresh._world = fresh_world  # type: ignore[assignment]   # count what the copy checks
+    new = build(new_world)
+    for a, b in ((start, goal), (other_start, other_goal)):
+        got, want = fresh.query(a, b), new.query(a, b)
+        assert got is not None and want is not None
+        assert np.array_equal(got.waypoints, want.waypoints)
+    assert fresh_world.segments < new_world.segments
