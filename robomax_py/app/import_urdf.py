@@ -729,8 +729,8 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
         encoding="utf-8")
     spec = load_robot_spec(stage / "robot.yaml")
     robot = load_robot(spec)       # the whole folder loads: meshes, pairs, IK checked against the URDF
-            warnings.extend(w for w in robot_warnings if w.startswith(
-                ("IK falls back", "the flange frame", "joint directions", "the URDF's joint axes", "abb_driver")))
+    flange_z = _flange_z_warning(model, int(model.getFrameId(flange)), flange)
+    notes = tuple(n for n in (fallback, flange_z, convention.note) if n is not None)
     return solver_name, fk_error, spec, (*notes, *robot.warnings)
 
 

@@ -191,10 +191,12 @@ def import_arm(name: str, source: str, srdf: str, packages: Path | None, library
     roots = [ROSI] if kind == "rosi" else [packages] if packages else []
     added: list[tuple[str, str]] = []
     xacro_args: dict[str, str] = {}
+    flange = "tool0"
     t0 = cpu()
     for _ in range(5):
         try:
-            result = import_urdf(path, library / name, roots, srdf=srdf_path, force=True, xacro_args=xacro_args)
+            result = import_urdf(path, library / name, roots, srdf=srdf_path, force=True, xacro_args=xacro_args,
+                                 flange=flange)
         except (RobomaxError, LookupError) as exc:
             # A launch argument the package's launch file requires and does not default (Motoman's
             # `controller`, which picks the joint-velocity file): given as a user would give it.
@@ -202,6 +204,15 @@ def import_arm(name: str, source: str, srdf: str, packages: Path | None, library
             if needed and needed[1] in LAUNCH_CHOICES and needed[1] not in xacro_args:
                 xacro_args[needed[1]] = LAUNCH_CHOICES[needed[1]]
                 continue
+            # No `tool0` (older Motoman packages end their chain at link_t): the chain's last link,
+            # as a user names it with --flange.
+            links = re.search(r"the URDF has no frame 'tool0' \(links: ([^)]*)\)", str(exc))
+            if links and flange == "tool0":
+                names = [n.strip() for n in links[1].split(",") if n.strip() and not n.strip().endswith("…")]
+                tips = [n for n in names if re.fullmatch(r"link_(\d+_)?t", n)]
+                if tips:
+                    flange = tips[0]
+                    continue
             row.import_cpu_s = cpu() - t0
             row.imported = f"failed: {one_line(exc)}"
             return None
@@ -218,7 +229,8 @@ def import_arm(name: str, source: str, srdf: str, packages: Path | None, library
     row.import_cpu_s = cpu() - t0
     row.imported = "ok" + (" (SRDF)" if srdf and srdf_path else "") + \
         (f" (+ always touching: {', '.join('/'.join(p) for p in added)})" if added else "") + \
-        "".join(f" (--xacro-arg {k}:={v})" for k, v in xacro_args.items())
+        "".join(f" (--xacro-arg {k}:={v})" for k, v in xacro_args.items()) + \
+        (f" (--flange {flange})" if flange != "tool0" else "")
     return result.folder / "robot.yaml"
 
 
@@ -227,12 +239,17 @@ def always_in_contact(robot_yaml: Path, scratch: Path) -> tuple[str, str] | None
     from collections import Counter
 
     from robomax_py.io.cell import load_cell, load_cell_robot
+    from robomax_py.io.robot import load_robot_spec
+    from robomax_py.robot import load_robot
     from robomax_py.world.collision import KIND_LINK, CollisionWorld
     from robomax_py.world.scene import build_scene
 
+    # Home inside the limits for any number of joints (zero where the limits allow it).
+    arm = load_robot(load_robot_spec(robot_yaml))
+    home = np.degrees(np.clip(0.0, arm.limits.lower, arm.limits.upper)).round(6).tolist()
     cell_path = scratch / "_self_check.yaml"
     cell_path.write_text(yaml.safe_dump({
-        "robomax": 1, "robot": {"model": str(robot_yaml), "home": [0.0] * 6}, "tool": "spot_gun_light",
+        "robomax": 1, "robot": {"model": str(robot_yaml), "home": home}, "tool": "spot_gun_light",
         "objects": [], "seams": [{"name": "a", "spots": [{"name": "s", "xyz": [1, 0, 1], "normal": [-1, 0, 0],
                                                           "direction": [0, 1, 0]}]}],
         "process": {"weld_time": 0.3, "approach": 0.03, "clearance": 0.0}}), encoding="utf-8")
