@@ -370,18 +370,12 @@ def fanuc_held(plan: Plan) -> tuple[dict[int, FloatArray], dict[int, FloatArray]
     the robot base frame) into the controller."""
     if (plan.controller.get("registers") or {}).get("position"):
         return {}, {}
-    utools = {int((plan.controller.get("tool") or {}).get("number", 1)): plan.arm.T_flange_tcp}
-    uframes = {}
-    frame = plan.controller.get("frame")
-    world = plan.user_frame_world()
-    if frame is not None and world is not None:
-        uframes[int(frame.get("number", 1))] = np.linalg.inv(plan.world(np.eye(4))) @ world
-    return utools, uframes
+    return calibrated_frames(plan)
 
 
-def inform_held(plan: Plan) -> tuple[dict[int, FloatArray], dict[int, FloatArray]]:
-    """(tools, user frames) a Yaskawa controller calibrated for the cell holds: a job names them
-    by number only. The cell's tool (tool 1 unless it names one) and user frame (in the robot base)."""
+def calibrated_frames(plan: Plan) -> tuple[dict[int, FloatArray], dict[int, FloatArray]]:
+    """(tools, user frames) by number that an integrator calibrated into a controller for the cell:
+    the cell's tool (number 1 unless the cell names one) and its user frame (in the robot base)."""
     tools = {int((plan.controller.get("tool") or {}).get("number", 1)): plan.arm.T_flange_tcp}
     users = {}
     frame = plan.controller.get("frame")
@@ -389,6 +383,12 @@ def inform_held(plan: Plan) -> tuple[dict[int, FloatArray], dict[int, FloatArray
     if frame is not None and world is not None:
         users[int(frame.get("number", 1))] = np.linalg.inv(plan.world(np.eye(4))) @ world
     return tools, users
+
+
+def inform_held(plan: Plan) -> tuple[dict[int, FloatArray], dict[int, FloatArray]]:
+    """(tools, user frames) a Yaskawa controller calibrated for the cell holds: a job names them
+    by number only."""
+    return calibrated_frames(plan)
 
 
 def run_program(plan: Plan, dialect: str) -> ProgramRun:
