@@ -260,8 +260,9 @@ def always_in_contact(robot_yaml: Path, scratch: Path) -> tuple[str, str] | None
     # no two links of an arm touch unless their hulls always do.
     rng = np.random.default_rng(0)
     qs = rng.uniform(robot.limits.lower, robot.limits.upper, size=(60, robot.dof))
-    qs[:, 1:3] = rng.uniform(-np.radians(30), np.radians(30), size=(60, 2))
-    qs[:, 4] = rng.choice([-1.0, 1.0], size=60) * rng.uniform(np.radians(30), np.radians(90), size=60)
+    if robot.dof >= 5:                    # an arm; a positioner's few axes are taken as drawn
+        qs[:, 1:3] = rng.uniform(-np.radians(30), np.radians(30), size=(60, 2))
+        qs[:, 4] = rng.choice([-1.0, 1.0], size=60) * rng.uniform(np.radians(30), np.radians(90), size=60)
     qs = np.clip(qs, robot.limits.lower, robot.limits.upper)
     seen: Counter[tuple[str, str]] = Counter()
     for q in qs:
