@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
@@ -309,6 +309,7 @@ def _curvature(path: GeometricPath, s: np.ndarray) -> np.ndarray:
     b=st.lists(st.floats(-2, 2), min_size=3, max_size=3).map(np.array),
     radius=st.floats(0.01, 1.0),
 )
+@example(a=np.array([0.09375, 0.0, 0.0]), c=np.zeros(3), b=np.array([-1.0, 0.0, 0.0]), radius=1.0)   # straight through
 def test_blend_corner_is_g2_and_within_radius(a: np.ndarray, c: np.ndarray, b: np.ndarray, radius: float) -> None:
     len_in, len_out = np.linalg.norm(c - a), np.linalg.norm(b - c)
     if min(len_in, len_out) < 0.05:
@@ -329,7 +330,10 @@ def test_blend_corner_is_g2_and_within_radius(a: np.ndarray, c: np.ndarray, b: n
     s = np.linspace(0, h, 2001)
     k = _curvature(path, s)
     dk = np.abs(np.diff(k))
-    assert dk.max() <= CURVATURE_STEP_FACTOR * (s[1] - s[0]) * np.max(np.abs(np.gradient(k, s)))
+    # Plus round-off: on a straight-through corner the curvature is 0 and its samples are noise of
+    # the join check's size (JOIN_CURVATURE_RTOL / radius), not a jump.
+    assert dk.max() <= CURVATURE_STEP_FACTOR * (s[1] - s[0]) * np.max(np.abs(np.gradient(k, s))) \
+        + JOIN_CURVATURE_RTOL / corner.radius
     # Within the radius of the corner.
     assert np.max(np.linalg.norm(path(s) - c, axis=1)) <= corner.radius * (1 + RADIUS_RTOL)
 
