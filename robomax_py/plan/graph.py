@@ -361,6 +361,16 @@ class Sequencer:
             got = self._full[key] = self._costs(i, j, np.arange(len(self.q(i))), np.arange(len(self.q(j))))
         return got
 
+    def _try_straight(self, i: int, a: int, j: int, b: int) -> bool:
+        """Check the straight move from candidate a of i to b of j, count and record it; a free one
+        takes the pair off the detour-only list."""
+        res = self.world_from(i).check_segment(self.q(i)[a], self.q(j)[b])
+        self.checks += res.checks
+        self._record_straight(i, a, j, b, res.free)
+        if res.free:
+            self.detour_only.discard((min(i, j), max(i, j)))
+        return bool(res.free)
+
     def _record_straight(self, i: int, a: int, j: int, b: int, free: bool) -> None:
         self.straight.setdefault((i, j), {})[(a, b)] = free
         if self._load(i) == self._load(j):       # else the way back is checked in another world
@@ -543,13 +553,9 @@ class Sequencer:
                     break
                 if (a, b) in known or (a, b) in banned:
                     continue
-                res = self.world_from(prev).check_segment(self.q(prev)[a], self.q(nxt)[b])
-                self.checks += res.checks
-                self._record_straight(prev, a, nxt, b, res.free)
                 tried += 1
-                if res.free:
+                if self._try_straight(prev, a, nxt, b):
                     log.debug("dead end %s -> %s opened by a straight move", self._name(prev), self._name(nxt))
-                    self.detour_only.discard((min(prev, nxt), max(prev, nxt)))
                     return True
             found = len(self.detours)
             searched = 0
@@ -865,12 +871,8 @@ class Sequencer:
             a, b = (int(x) for x in np.unravel_index(int(flat), est.shape))
             if (a, b) in known or (a, b) in banned or not np.isfinite(est[a, b]):
                 continue
-            res = self.world_from(i).check_segment(self.q(i)[a], self.q(j)[b])
-            self.checks += res.checks
-            self._record_straight(i, a, j, b, res.free)
             tried += 1
-            if res.free:
-                self.detour_only.discard((min(i, j), max(i, j)))
+            if self._try_straight(i, a, j, b):
                 self._forget(i, j)
                 return True
         return False
