@@ -470,7 +470,8 @@ def pose_mm_zyx(T: FloatArray) -> tuple[tuple[float, ...], tuple[float, ...]]:
 
 def ptp_target(move: PtpMove) -> FloatArray:
     """The joint target a PTP move states, rad."""
-    return np.deg2rad(np.asarray(move.target_deg, dtype=float))
+    target: FloatArray = np.deg2rad(np.asarray(move.target_deg, dtype=float))
+    return target
 
 
 def lin_pose(move: LinMove) -> FloatArray:

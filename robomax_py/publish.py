@@ -195,14 +195,14 @@ def _same(a: object, b: object) -> bool:
         return True
     if type(a) is not type(b) or not dataclasses.is_dataclass(a):
         return False
-    fields = {f.name for f in dataclasses.fields(a)}     # type: ignore[arg-type]
+    fields = {f.name for f in dataclasses.fields(a)}
     if "zyx_deg" not in fields:
         return False
     rest = [f for f in fields if f != "zyx_deg"]
     if any(getattr(a, f) != getattr(b, f) for f in rest):
         return False
-    Ra = lin_pose(LinMove((0.0, 0.0, 0.0), a.zyx_deg))[:3, :3]   # type: ignore[attr-defined]
-    Rb = lin_pose(LinMove((0.0, 0.0, 0.0), b.zyx_deg))[:3, :3]   # type: ignore[attr-defined]
+    Ra = lin_pose(LinMove((0.0, 0.0, 0.0), getattr(a, "zyx_deg")))[:3, :3]
+    Rb = lin_pose(LinMove((0.0, 0.0, 0.0), getattr(b, "zyx_deg")))[:3, :3]
     angle = math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(Ra.T @ Rb) - 1.0) / 2.0))))
     return angle <= TOL.readback_angle_deg
 
@@ -272,11 +272,13 @@ def _same_samples(a: Trajectory, b: Trajectory) -> bool:
 def _to_polyline(points: FloatArray, path: FloatArray) -> FloatArray:
     """Distance of each point (m, d) from the polyline through path (k, d)."""
     if len(path) < 2:
-        return np.linalg.norm(points - path[:1], axis=1)
+        ends: FloatArray = np.linalg.norm(points - path[:1], axis=1)
+        return ends
     p0, p1 = path[:-1], path[1:]
     d = p1 - p0
     dd = np.maximum((d * d).sum(axis=1), 1e-30)
     rel = points[:, None, :] - p0[None, :, :]
     s = np.clip((rel * d[None]).sum(axis=2) / dd[None], 0.0, 1.0)
     closest = p0[None] + s[..., None] * d[None]
-    return np.linalg.norm(points[:, None, :] - closest, axis=2).min(axis=1)
+    nearest: FloatArray = np.linalg.norm(points[:, None, :] - closest, axis=2).min(axis=1)
+    return nearest

@@ -60,7 +60,8 @@ def rotation_angle(R_a: FloatArray, R_b: FloatArray) -> FloatArray:
     cos = (np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0
     # arccos is ill-conditioned near 0; the skew part gives the small angles accurately.
     skew = np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], -1)
-    return np.arctan2(np.linalg.norm(skew, axis=-1) / 2.0, cos)
+    angle: FloatArray = np.arctan2(np.linalg.norm(skew, axis=-1) / 2.0, cos)
+    return angle
 
 
 def closest_on_line(p: FloatArray, a: FloatArray, p_ref: FloatArray, a_ref: FloatArray) -> FloatArray:

@@ -19,11 +19,13 @@ def rad_to_deg(value_rad: float) -> float:
 
 
 def degs_to_rads(values_deg: Sequence[float] | FloatArray) -> FloatArray:
-    return np.radians(np.asarray(values_deg, dtype=float))
+    out: FloatArray = np.radians(np.asarray(values_deg, dtype=float))
+    return out
 
 
 def rads_to_degs(values_rad: Sequence[float] | FloatArray) -> FloatArray:
-    return np.degrees(np.asarray(values_rad, dtype=float))
+    out: FloatArray = np.degrees(np.asarray(values_rad, dtype=float))
+    return out
 
 
 def m_to_mm(value_m: float) -> float:

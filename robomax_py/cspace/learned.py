@@ -365,7 +365,7 @@ def _fit(distances: FloatArray, targets: FloatArray, settings: TrainingSettings,
         err = (np.abs(F @ weights - targets) / scale).max(axis=1)
         error = float(err.max())
         if error <= settings.tolerance_steps or len(chosen) == n:
-            return centres, weights, error
+            return centres, np.asarray(weights, dtype=float), error
         err[idx] = -1.0                  # a neuron where the fit is worst, among distances without one
         chosen.add(int(np.argmax(err)))
 

@@ -38,7 +38,8 @@ def surface_points(scene: Scene, spacing: float) -> FloatArray:
             mesh = _piece_mesh(geom)
             if mesh is None:
                 continue
-            vertices, _ = trimesh.remesh.subdivide_to_size(mesh.vertices, mesh.faces, max_edge=spacing)
+            vertices, _ = trimesh.remesh.subdivide_to_size(  # type: ignore[no-untyped-call]
+                mesh.vertices, mesh.faces, max_edge=spacing)
             out.append(np.asarray(vertices) @ T[:3, :3].T + T[:3, 3])
     if not out:
         return np.zeros((0, 3))
@@ -52,4 +53,5 @@ def _piece_mesh(geom: coal.CollisionGeometry) -> trimesh.Trimesh | None:
     pts = support_points(geom)
     if not np.isfinite(pts).all():
         return None                       # an unbounded shape (a plane) has no surface to sample
-    return trimesh.convex.convex_hull(pts)
+    hull: trimesh.Trimesh = trimesh.convex.convex_hull(pts)
+    return hull

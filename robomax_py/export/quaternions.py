@@ -16,7 +16,8 @@ __all__ = ["quaternion_from_zyx", "rotvec_from_zyx", "zyx_from_matrix", "zyx_fro
 
 def _matrix(zyx_deg: tuple[float, ...]) -> np.ndarray:
     a, b, c = zyx_deg
-    return Rotation.from_euler("ZYX", [a, b, c], degrees=True).as_matrix()
+    matrix: np.ndarray = Rotation.from_euler("ZYX", [a, b, c], degrees=True).as_matrix()
+    return matrix
 
 
 def zyx_from_matrix(R: np.ndarray) -> tuple[float, float, float]:

@@ -656,23 +656,23 @@ class _Reader:
         if tree.data == "move":
             self.move(tree, comment, line)
         elif tree.data == "velset":
-            self.override = float(tree.children[0])
+            self.override = float(str(tree.children[0]))
         elif tree.data == "accset":
-            self.accel = float(tree.children[0])
+            self.accel = float(str(tree.children[0]))
         elif tree.data == "waittime":
-            self.add(Wait(float(tree.children[-1])), line)
+            self.add(Wait(float(str(tree.children[-1]))), line)
         elif tree.data == "waitdi":
-            if float(tree.children[1]) != 1.0:
+            if float(str(tree.children[1])) != 1.0:
                 self.ignored.append((line, text))
                 self.add(Comment(f"not simulated: {text} (waits for the input to be 0)"), line)
             else:
                 self.add(WaitFor(str(tree.children[0])), line)
         elif tree.data == "weld":
-            n, seconds = (float(t) for t in tree.children)
+            n, seconds = (float(str(t)) for t in tree.children)
             self.add(read_spot_label(comment, int(n), seconds, self.file, line), line)
         elif tree.data == "gripper":
-            action, n, seconds = tree.children
-            self.add(read_gripper(str(action).lower(), comment, int(float(n)), float(seconds), self.file, line), line)
+            action, number, held_s = (str(t) for t in tree.children)
+            self.add(read_gripper(action.lower(), comment, int(float(number)), float(held_s), self.file, line), line)
 
 
 # ------------------------------------------------------------------ control flow

@@ -17,6 +17,7 @@ import re
 from collections.abc import Iterable
 from functools import lru_cache
 from pathlib import Path
+from typing import Literal
 
 from lark import Lark, Token, Tree
 from lark.exceptions import (
@@ -405,7 +406,7 @@ def _end_position(text: str) -> tuple[int, int]:
 
 def _describe(parser: Lark, text: str, exc: UnexpectedInput) -> tuple[int, int, str]:
     if isinstance(exc, UnexpectedCharacters):
-        char = text[exc.pos_in_stream]
+        char = text[exc.pos_in_stream] if exc.pos_in_stream is not None else ""
         if char == "{":
             problem = "unterminated comment: '{' has no '}' on the same line (comments are one line, no nested braces)"
         elif char == "'":
@@ -533,7 +534,8 @@ class _Builder:
             (name,) = self.tokens(node, "IDENT")
             if any(f.name == str(name) for f in frames):
                 raise self.error(name.line, name.column, f"frame {str(name)!r} is already defined")
-            kind = "tool" if any(isinstance(c, Tree) and c.data == "tool_kind" for c in node.children) else "base"
+            kind: Literal["tool", "base"] = \
+                "tool" if any(isinstance(c, Tree) and c.data == "tool_kind" for c in node.children) else "base"
             number = [t for t in node.children if isinstance(t, Token) and t.type == "NUMBER"]
             frame = FrameDef(
                 str(name), kind, self.triple(self.subtree(node, "pos")), self.triple(self.subtree(node, "ori")),
@@ -569,7 +571,7 @@ class _Builder:
         if tree.data == "gripper":
             name, seam = self.tokens(tree, "IDENT")
             (seconds,) = self.tokens(tree, "NUMBER")
-            action = "grip" if self.tokens(tree, "GRIP") else "release"
+            action: Literal["grip", "release"] = "grip" if self.tokens(tree, "GRIP") else "release"
             return Gripper(action, str(name), str(seam), self.number(seconds))
         if tree.data == "wait":
             (seconds,) = self.tokens(tree, "NUMBER")

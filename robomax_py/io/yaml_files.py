@@ -26,14 +26,14 @@ class _GuardedLoader(yaml.SafeLoader):
         super().__init__(stream)
         self._depth = 0
 
-    def compose_node(self, parent: Any, index: Any) -> Any:  # type: ignore[override]
+    def compose_node(self, parent: Any, index: Any) -> Any:
         self._depth += 1
         try:
             if self._depth > LIMITS.yaml_depth:
-                mark = self.peek_event().start_mark
+                mark = self.peek_event().start_mark  # type: ignore[no-untyped-call]
                 raise yaml.constructor.ConstructorError(
                     None, None, f"nested more than {LIMITS.yaml_depth} levels deep", mark)
-            return super().compose_node(parent, index)  # type: ignore[no-untyped-call]
+            return super().compose_node(parent, index)
         finally:
             self._depth -= 1
 
@@ -44,7 +44,7 @@ def _construct_mapping(loader: _GuardedLoader, node: yaml.MappingNode, deep: boo
         mark = key_node.start_mark
         if not isinstance(key_node, yaml.ScalarNode):
             raise yaml.constructor.ConstructorError(None, None, "a key must be plain text, not a list or mapping", mark)
-        key = loader.construct_object(key_node, deep=deep)  # type: ignore[no-untyped-call]
+        key = loader.construct_object(key_node, deep=deep)
         if not isinstance(key, str):
             raise yaml.constructor.ConstructorError(
                 None, None, f"key {key_node.value!r} must be text (it reads as {type(key).__name__}; quote it)", mark)
@@ -59,7 +59,7 @@ def _construct_int(loader: _GuardedLoader, node: yaml.ScalarNode) -> int:
     if digits > LIMITS.int_digits:
         raise yaml.constructor.ConstructorError(
             None, None, f"integer of {digits} digits (at most {LIMITS.int_digits})", node.start_mark)
-    return int(loader.construct_yaml_int(node))  # type: ignore[no-untyped-call]
+    return int(loader.construct_yaml_int(node))
 
 
 _GuardedLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)

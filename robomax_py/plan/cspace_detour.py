@@ -42,7 +42,10 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
     checks = len(configs)
     start, goal = (nearest_cell(axes, q) for q in (qa, qb))
     r = resolution
-    flat = lambda ijk: (ijk[0] * r + ijk[1]) * r + ijk[2]  # noqa: E731 - index arithmetic, used twice
+
+    def flat(ijk: tuple[int, ...]) -> int:
+        return (ijk[0] * r + ijk[1]) * r + ijk[2]
+
     if not (free[flat(start)] and free[flat(goal)]):
         return None, checks
     # Edges between free neighbouring cells, weighted by the straight move's time estimate.

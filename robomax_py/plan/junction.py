@@ -174,8 +174,8 @@ def time_junction(
                     break                  # smaller junction radii only pass the corner more slowly
     if best is None:
         best = exact_motion()
-    used = extended if best_rj > 0 and extended is not None else Extension()
-    return Junction(best[2], best_rj, best_rd, checks, used)
+    extension = extended if best_rj > 0 and extended is not None else Extension()
+    return Junction(best[2], best_rj, best_rd, checks, extension)
 
 
 def time_junction_at(

@@ -9,6 +9,8 @@ at i, until a release.
 
 from __future__ import annotations
 
+from typing import Any
+
 import dataclasses
 import math
 from dataclasses import dataclass
@@ -146,7 +148,9 @@ class LoadOverrides:
 
 def tcp_block_peaks(robot: RobotModel, segments: list[Segment]) -> TcpPeaks:
     """The TCP peaks of segments run end to end (each starts where the one before ends)."""
-    ts, qs, t0 = [], [], 0.0
+    ts: list[FloatArray] = []
+    qs: list[FloatArray] = []
+    t0 = 0.0
     for seg in (seg for seg in segments if len(seg.t) > 1):
         first = 0 if not ts else 1
         ts.append(np.asarray(seg.t[first:]) + t0)
@@ -175,7 +179,7 @@ class Hold:
     release: SpotSpec | None
 
 
-def holds(cell: CellSpec, spots: list[dict]) -> list[Hold]:
+def holds(cell: CellSpec, spots: list[dict[str, Any]]) -> list[Hold]:
     """Every hold of a written motion, from its spot entries (`seam`, `name`, `t_arrive`,
     `t_leave`, as a trajectory file gives them): from the arrival at a grip to the departure from
     the release that follows it. The part is in the gripper while it closes: the checks take it as
@@ -198,7 +202,7 @@ def holds(cell: CellSpec, spots: list[dict]) -> list[Hold]:
 
 def check_carried_motion(
     cell: CellSpec, robot: RobotModel, empty: CollisionWorld, worlds: dict[str, CollisionWorld], t: FloatArray,
-    q: FloatArray, spots: list[dict], stop_at_first: bool = False, velocity_rtol: float = TOL.velocity_rtol,
+    q: FloatArray, spots: list[dict[str, Any]], stop_at_first: bool = False, velocity_rtol: float = TOL.velocity_rtol,
 ) -> MotionCheck:
     """`world.motion.check_motion` hold by hold: while a part is held, with it in the gripper and
     within the joint limits for its mass and the part's TCP limits (speed, tangential and radial
@@ -228,8 +232,8 @@ def _runs(t: FloatArray, spans: list[Hold]) -> list[tuple[int, int, Hold | None]
     """(first, last, hold) sample runs of constant load; a run starts on the last sample of the one before."""
     held: list[Hold | None] = [None] * len(t)
     for h in spans:
-        for i in np.flatnonzero((t >= h.t_start - 1e-9) & (t <= h.t_end + 1e-9)):
-            held[int(i)] = h
+        for n in np.flatnonzero((t >= h.t_start - 1e-9) & (t <= h.t_end + 1e-9)).tolist():
+            held[n] = h
     runs: list[tuple[int, int, Hold | None]] = []
     start = 0
     for i in range(1, len(t) + 1):

@@ -176,6 +176,7 @@ class Roadmap:
             if path is None:
                 return None
             bad = None
+            known: bool | None
             for u, v in zip(path[:-1], path[1:]):
                 key = (min(u, v), max(u, v))
                 if u >= 0 and v >= 0:

@@ -117,7 +117,8 @@ class _BoundTable:
                 x, y = divmod(code, self.size + 1)
                 self.table[x, y] = self.costs.lower_bound(self._id(x), self._id(y))
             values = self.table[a, b]
-        return values.sum(axis=1)
+        total: FloatArray = values.sum(axis=1)
+        return total
 
 
 def best_choice(order: Sequence[int], costs: _Costs) -> tuple[tuple[int, ...], float]:
@@ -165,9 +166,11 @@ class _PrefixCost:
     def _layer(self, order: tuple[int, ...], k: int, value: FloatArray | None) -> FloatArray:
         node = self.costs.node[order[k]]
         if k == 0:
-            return self.costs(HOME, order[0])[0] + node
+            first: FloatArray = self.costs(HOME, order[0])[0] + node
+            return first
         assert value is not None
-        return np.min(value[:, None] + self.costs(order[k - 1], order[k]), axis=0) + node
+        layer: FloatArray = np.min(value[:, None] + self.costs(order[k - 1], order[k]), axis=0) + node
+        return layer
 
     def __call__(self, order: tuple[int, ...]) -> float:
         if not order:

@@ -36,7 +36,7 @@ def load_mesh(path: Path, scale: np.ndarray | None = None) -> trimesh.Trimesh:
                          f"the first at index {int(np.flatnonzero(bad)[0])}")
     loaded.process()
     if scale is not None and not np.allclose(scale, 1.0):
-        loaded.apply_scale(np.asarray(scale, dtype=float))
+        loaded.apply_scale(np.asarray(scale, dtype=float))  # type: ignore[no-untyped-call]
     return loaded
 
 
@@ -63,7 +63,7 @@ def is_convex_piece(piece: trimesh.Trimesh) -> bool:
     if not piece.is_watertight or piece.volume <= 0:
         return False
     hull_volume = piece.convex_hull.volume
-    return abs(hull_volume - piece.volume) <= CONVEX_VOLUME_RTOL * hull_volume + 1e-12
+    return bool(abs(hull_volume - piece.volume) <= CONVEX_VOLUME_RTOL * hull_volume + 1e-12)
 
 
 def mesh_collision_shapes(mesh: trimesh.Trimesh) -> list[coal.CollisionGeometry]:
@@ -90,11 +90,14 @@ def primitive_shape(shape: Shape) -> coal.CollisionGeometry:
 def shape_trimesh(shape: Shape) -> trimesh.Trimesh:
     """A triangle mesh of any shape in its local frame (for previews and exact-answer tests)."""
     if isinstance(shape, Box):
-        return trimesh.creation.box(extents=shape.extents)
+        made: trimesh.Trimesh = trimesh.creation.box(extents=shape.extents)
+        return made
     if isinstance(shape, Cylinder):
-        return trimesh.creation.cylinder(radius=shape.radius, height=shape.length, sections=48)
+        cylinder: trimesh.Trimesh = trimesh.creation.cylinder(radius=shape.radius, height=shape.length, sections=48)
+        return cylinder
     if isinstance(shape, Sphere):
-        return trimesh.creation.icosphere(subdivisions=3, radius=shape.radius)
+        sphere: trimesh.Trimesh = trimesh.creation.icosphere(subdivisions=3, radius=shape.radius)
+        return sphere
     if isinstance(shape, Capsule):
         return trimesh.creation.capsule(height=shape.length, radius=shape.radius, count=[48, 24])
     if isinstance(shape, MeshShape):

@@ -39,7 +39,8 @@ class JointLimits:
     def contains(self, q: FloatArray, tol: float = 0.0) -> np.ndarray:
         """(..., n) -> (...) bool: every joint within [lower - tol, upper + tol]."""
         q = np.asarray(q)
-        return np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=-1)
+        inside: np.ndarray = np.all((q >= self.lower - tol) & (q <= self.upper + tol), axis=-1)
+        return inside
 
 
 @dataclass(frozen=True, slots=True, eq=False)

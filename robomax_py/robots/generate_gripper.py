@@ -93,11 +93,13 @@ def tool_yaml(g: Gripper) -> str:
 def generate(out: Path) -> list[Path]:
     """Write the gripper's files under ``out`` (the ``robots/`` folder layout); returns them in order."""
     body, tips = shells(GRIPPER)
-    return G.write_tool(out, NAME, body, tips, tool_yaml(GRIPPER))
+    written: list[Path] = G.write_tool(out, NAME, body, tips, tool_yaml(GRIPPER))
+    return written
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    return G.script_main(generate, __doc__, HERE, argv)
+    code: int = G.script_main(generate, __doc__, HERE, argv)
+    return code
 
 
 if __name__ == "__main__":

@@ -238,9 +238,10 @@ def blend_chain(paths: Sequence[GeometricPath], radii: Sequence[float]) -> Blend
             parts.append(piece)
             s += piece.length
         ranges[k] = (start, s)
-        if k < m - 1 and joins[k] is not None:
-            parts.append(joins[k])
-            s += joins[k].length
+        join = joins[k] if k < m - 1 else None
+        if join is not None:
+            parts.append(join)
+            s += join.length
     return BlendedChain(concatenate_paths(parts), frozen_array(ranges), frozen_array(used))
 
 

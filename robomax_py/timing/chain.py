@@ -153,7 +153,7 @@ def chain_path(
     if not moving:
         raise TimingError("the chain does not move")
     radii_in = [radii_by_step[k] for k in moving[:-1]]
-    blended = blend_chain([pieces[k] for k in moving], radii_in)
+    blended = blend_chain([p for p in pieces if p is not None], radii_in)
     m = len(steps)
     ranges = np.zeros((m, 2))
     radii = np.zeros(max(m - 1, 0))

@@ -32,7 +32,8 @@ def toppra_time(path: BezierPath, limits: TcpLimits, samples: int = 600) -> floa
 
     def cap(x: np.ndarray) -> np.ndarray:
         kappa = np.abs(np.interp(x, s_tab, k_tab))
-        return np.minimum(limits.v, np.sqrt(limits.a_R / np.maximum(kappa, 1e-12)))
+        capped: np.ndarray = np.minimum(limits.v, np.sqrt(limits.a_R / np.maximum(kappa, 1e-12)))
+        return capped
 
     return float(time_path(geometric, lim, path_speed_limit=cap).t[-1])
 

@@ -471,11 +471,11 @@ def _prove_never_close(
     data = model.createData()
     lower, upper = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
     margin = options.acm_proof_margin
-    for path, members in groups.items():
-        idx = [int(model.joints[k].idx_q) for k in path]
+    for chain, members in groups.items():
+        idx = [int(model.joints[k].idx_q) for k in chain]
         m = len(idx)
         # L[p][k]: m per rad (plain floats: this loop is Python-bound, numpy per box costs more).
-        L = [[bounds.piece_lever(k, gm.geometryObjects[hi]) for k in path] for _, _, hi in members]
+        L = [[bounds.piece_lever(k, gm.geometryObjects[hi]) for k in chain] for _, _, hi in members]
         tmp = pin.GeometryModel()
         for g in gm.geometryObjects:
             tmp.addGeometryObject(pin.GeometryObject(g))
@@ -488,7 +488,7 @@ def _prove_never_close(
         # A revolute joint repeats its poses every 2 pi: one period covers a wider range.
         half0 = [
             float(upper[i] - lower[i]) / 2 if bounds.prismatic[k] else min(float(upper[i] - lower[i]) / 2, math.pi)
-            for i, k in zip(idx, path)
+            for i, k in zip(idx, chain)
         ]
         stack = [(centre0, half0, list(range(len(members))))]
         evaluations = 0

@@ -30,7 +30,8 @@ def support_points(geom: coal.CollisionGeometry, pose: FloatArray | None = None)
     if pose is None:
         return pts
     T = np.asarray(pose, dtype=float)
-    return pts @ T[:3, :3].T + T[:3, 3]
+    placed: FloatArray = pts @ T[:3, :3].T + T[:3, 3]
+    return placed
 
 
 def triangles(geom: coal.BVHModelBase) -> np.ndarray:

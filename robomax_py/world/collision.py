@@ -345,8 +345,8 @@ class CollisionWorld:
             offsets, pairs = self._pf.uncleared(qs, self._active)
             left = np.diff(offsets)
             out[:] = left == 0
-            for i in np.flatnonzero(left):
-                out[i] = self._exact(qs[i], pairs[offsets[i]:offsets[i + 1]])[0]
+            for n in np.flatnonzero(left).tolist():
+                out[n] = self._exact(qs[n], pairs[offsets[n]:offsets[n + 1]])[0]
         elif self._manager is not None:
             model, data, manager, callback = s.model, self._data, self._manager, self._callback
             for i in range(len(qs)):

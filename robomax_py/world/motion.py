@@ -153,7 +153,7 @@ def rate_violations(lim: JointLimits, names: tuple[str, ...], t: FloatArray, q: 
 
 def _runs(mask: np.ndarray) -> list[tuple[int, int, int]]:
     """(column, first row, last row) of every run of True down the columns of a (k, n) mask."""
-    out = []
+    out: list[tuple[int, int, int]] = []
     for j in range(mask.shape[1]):
         rows = np.flatnonzero(mask[:, j])
         if not len(rows):

@@ -99,13 +99,15 @@ class Prefilter:
         g_radius = np.full(len(joints), np.inf)
         for j in joints:
             members = [points_of[g] for g in range(n_geom) if not is_obs[g] and piece_joint[g] == j]
-            if all(m is not None for m in members):
-                g_centre[group_of[j]], g_radius[group_of[j]] = _enclosing_sphere(np.concatenate(members))
+            present = [m for m in members if m is not None]
+            if len(present) == len(members):
+                g_centre[group_of[j]], g_radius[group_of[j]] = _enclosing_sphere(np.concatenate(present))
         # Blocks: (group, obstacle piece) or (group, group), each with its pairs.
         blocks: dict[tuple[int, int, int], list[int]] = {}
         for k, (a, b) in enumerate(zip(robot_side, other)):
             ga = group_of[int(piece_joint[a])]
-            key = (0, ga, int(b)) if is_obs[b] else (1, *sorted((ga, group_of[int(piece_joint[b])])))
+            gb = group_of[int(piece_joint[b])]
+            key = (0, ga, int(b)) if is_obs[b] else (1, min(ga, gb), max(ga, gb))
             blocks.setdefault(key, []).append(k)
         keys = list(blocks)
         block_kind = np.array([key[0] for key in keys], dtype=np.int64)

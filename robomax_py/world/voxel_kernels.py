@@ -149,4 +149,4 @@ def _tri_box(c: np.ndarray, h: float, tri: np.ndarray) -> bool:
     nz = e0[0] * e1[1] - e0[1] * e1[0]
     d = nx * v0[0] + ny * v0[1] + nz * v0[2]
     r = h * (abs(nx) + abs(ny) + abs(nz)) + SAT_SLACK_M
-    return abs(d) <= r
+    return bool(abs(d) <= r)

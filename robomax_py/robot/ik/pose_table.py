@@ -131,4 +131,4 @@ def _load(path: Path) -> TableIk | None:
 
 def _store(path: Path, table: TableIk) -> None:
     # An unwritable cache: the table is built again next time.
-    store_arrays(path, {"q": table.q, "x": table.x, "grid_size": np.int64(table.grid_size)})
+    store_arrays(path, {"q": table.q, "x": table.x, "grid_size": np.asarray(table.grid_size, dtype=np.int64)})

@@ -161,9 +161,9 @@ def route(table: TableIk, start: int, goal: int, k: int, edge_free: Callable[[Fl
         keys = [e for e in pairs if known.get(e) is not False]
         if not keys:
             return None
-        a = np.array([e[0] for e in keys])
-        b = np.array([e[1] for e in keys])
-        graph = csr_matrix((np.array([pairs[e] for e in keys]), (a, b)), shape=(n, n))
+        src = np.array([e[0] for e in keys])
+        dst = np.array([e[1] for e in keys])
+        graph = csr_matrix((np.array([pairs[e] for e in keys]), (src, dst)), shape=(n, n))
         d, pred = dijkstra(graph, directed=False, indices=start, return_predecessors=True)
         if not math.isfinite(d[goal]):
             return None
