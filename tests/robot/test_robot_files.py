@@ -94,23 +94,6 @@ def test_robot_yaml_has_exactly_the_spec_keys(name: str) -> None:
 
 
 @pytest.mark.parametrize("name", ARMS)
-def test_urdf_fk_equals_opw_fk(name: str) -> None:
-    import pinocchio as pin
-
-    model = _model(name)
-    data = model.createData()
-    frame = model.getFrameId("tool0")
-    params = _opw_params(name)
-    assert model.nq == 6
-    assert [model.names[i] for i in range(1, 7)] == [f"joint_a{i}" for i in range(1, 7)]
-    rng = np.random.default_rng(20240611)
-    for _ in range(200):
-        q = rng.uniform(model.lowerPositionLimit, model.upperPositionLimit)
-        pin.framesForwardKinematics(model, data, q)
-        np.testing.assert_allclose(data.oMf[frame].homogeneous, opw_fk(params, q), rtol=0.0, atol=FK_ATOL)
-
-
-@pytest.mark.parametrize("name", ARMS)
 def test_home_is_within_limits_and_points_forward(name: str) -> None:
     model = _model(name)
     home = np.radians(HOME_DEG)

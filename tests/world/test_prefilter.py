@@ -1,6 +1,6 @@
 """robomax_py.world.prefilter: the bounding-volume pre-filter before coal's exact test.
 
-What must hold: its forward kinematics is Pinocchio's (to 1e-12, rounding of six 3x3 products); a
+What must hold (its forward kinematics is Pinocchio's: tests/robot/test_forward_kinematics.py): a
 pair it clears is farther apart than its margin by coal's own distance (it may never clear a pair
 coal would call colliding); and every query of a world gives the same answers with the filter as
 without it (verdicts, the state a segment stops at, the contact named).
@@ -13,11 +13,8 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
 
-from robomax_py.io.robot import load_robot_spec
-from robomax_py.robot import RobotModel, load_robot
+from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.prefilter import SLACK_M, Prefilter
@@ -25,19 +22,8 @@ from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[2]
 REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
-FK_TOL = 1e-12                        # m and rotation-matrix entries: products of six rotations
-LIBRARY = ["kr125", "kr16", "ur10"]
-ROSI = REPO / "tests" / "data" / "rosi"
 
 
-def _robots() -> list[RobotModel]:
-    out = [load_robot(load_robot_spec(REPO / "robomax_py" / "robots" / name / "robot.yaml")) for name in LIBRARY]
-    for yaml in sorted(ROSI.glob("*/robot.yaml")):
-        out.append(load_robot(load_robot_spec(yaml)))
-    return out
-
-
-ROBOTS = _robots()
 
 
 @pytest.fixture(scope="module")
@@ -49,24 +35,6 @@ def reference() -> tuple[CellSpec, RobotModel, CollisionWorld]:
     cell = load_cell(REFERENCE_CELL)
     robot = load_cell_robot(cell)
     return cell, robot, CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
-
-
-@pytest.mark.parametrize("robot", ROBOTS, ids=[r.name for r in ROBOTS])
-@settings(max_examples=60, deadline=None)
-@given(u=st.lists(st.floats(0.0, 1.0), min_size=6, max_size=6))
-def test_forward_kinematics_is_pinocchios(robot: RobotModel, u: list[float]) -> None:
-    model = robot.model
-    lo, hi = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
-    q = lo + np.asarray(u[: model.nq]) * (hi - lo)
-    filt = Prefilter.of(model, robot.collision_model, [False] * robot.collision_model.ngeoms,
-                        np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0))
-    assert filt is not None
-    rot, trans = filt.joint_placements(q)
-    data = model.createData()
-    pin.forwardKinematics(model, data, q)
-    for j in range(model.njoints):
-        np.testing.assert_allclose(rot[j], data.oMi[j].rotation, atol=FK_TOL, rtol=0)
-        np.testing.assert_allclose(trans[j], data.oMi[j].translation, atol=FK_TOL, rtol=0)
 
 
 def test_no_filter_for_a_joint_it_does_not_model() -> None:
