@@ -1,4 +1,4 @@
-"""The only exceptions the package raises.
+"""The only exceptions the package raises, and its one warning category.
 
 A user's mistake becomes one of these, carrying a message that names the file, the key path and the
 problem; the CLI prints that message and exits 2. Anything else escaping is a bug in robomax_py.
@@ -62,3 +62,9 @@ class ControllerSetupError(ExportError):
 class PreviewError(RobomaxError):
     """`robomax preview` cannot serve as asked: the host is not an address of this machine, or the
     port is taken."""
+
+
+class RobomaxWarning(UserWarning):
+    """What the user should know that does not stop the work: a robot file's limits defaulted from its
+    URDF, a dialect passed over. The CLI prints these as `warning:` lines; the Python API issues them
+    with `warnings.warn`, so `warnings.simplefilter("error", RobomaxWarning)` makes them fatal."""

@@ -2,35 +2,57 @@
 
     import robomax_py as rm
     cell = rm.load_cell("cells/cabin_flange.yaml")
-    result = rm.plan_cell(cell)
-    files = rm.write_programs(cell, result, "programs", formats="srcl,krl")
-    report = rm.verify_program(cell, files[-1])
+    result = rm.plan_cell(cell, rm.PlanOptions(speed=0.8), progress=lambda e: print(e.stage, e.done, e.total))
+    written = rm.write_programs(cell, result, "programs", formats=["srcl", "krl"])
+    report = rm.verify_program(cell, written.by_dialect["krl"][0])
 
 Bad input raises a `RobomaxError` (file, key and problem in its message); infeasibility is a
-result (`PlanResult.status`), not an exception.
+result (`PlanResult.status`, a `PlanStatus`), not an exception. What the CLI prints as `warning:`
+lines is issued here with `warnings.warn` as a `RobomaxWarning`; the planner's stage log (what
+`robomax plan -v` shows) goes to the `logging` logger "robomax_py" at DEBUG level.
 """
 
 from __future__ import annotations
 
-import dataclasses
+import warnings
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
+from typing import Any, cast, overload
 
-from robomax_py.plan import PlanOptions, PlanResult
+from robomax_py.errors import ExportError, RobomaxWarning
+from robomax_py.plan import (
+    FailureReason,
+    PlanOptions,
+    PlanResult,
+    PlanStage,
+    PlanStatus,
+    SpotFailure,
+    SpotPlan,
+    Transition,
+    TransitionKind,
+)
+from robomax_py.plan.results import STAGE_LABELS
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.verify import VerifyReport
+from robomax_py.world.motion import Violation
 
-__all__ = ["FormatSkippedWarning", "LoadedCell", "load_cell", "plan_cell", "verify_program", "write_programs"]
+__all__ = [
+    "FailureReason", "FormatSkippedWarning", "LoadedCell", "PlanOptions", "PlanResult", "PlanStage", "PlanStatus",
+    "ProgressEvent", "RobomaxWarning", "SpotFailure", "SpotPlan", "Transition", "TransitionKind", "VerifyReport",
+    "Violation", "WrittenPrograms", "load_cell", "plan_cell", "verify_program", "write_programs",
+]
 
 
-class FormatSkippedWarning(UserWarning):
-    """`write_programs(formats="all")` passed over a dialect the robot file lacks data for."""
+class FormatSkippedWarning(RobomaxWarning):
+    """`write_programs(formats=["all"])` passed over a dialect the robot file lacks data for."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)
 class LoadedCell:
-    """A checked cell file and its robot with the tool mounted, ready to plan or verify against."""
+    """A checked cell and its robot with the tool mounted, ready to plan or verify against."""
 
     spec: CellSpec
     robot: RobotModel
@@ -40,54 +62,155 @@ class LoadedCell:
         return self.spec.name
 
 
-def load_cell(path: str | Path) -> LoadedCell:
-    """Read and check a cell file (SPEC §3) and build its robot (URDF, meshes, IK checked)."""
+@dataclass(frozen=True, slots=True)
+class ProgressEvent:
+    """One step of a long planning stage, as `plan_cell(progress=...)` is told of it.
+
+    `stage` runs through "candidates", "sequencing", "timing", "verify" in that order; within a
+    stage `done` never goes back and ends equal to `total`. `total` may grow while a stage runs
+    (sequencing rounds are added as repairs need them).
+    """
+
+    stage: PlanStage
+    done: int
+    total: int
+
+    @property
+    def label(self) -> str:
+        """What the stage does, in a few words (as the CLI's progress bar names it)."""
+        return STAGE_LABELS.get(self.stage, self.stage)
+
+    @property
+    def fraction(self) -> float:
+        """done / total in [0, 1] (1 for an empty stage)."""
+        return 1.0 if self.total <= 0 else min(1.0, self.done / self.total)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class WrittenPrograms(Sequence[Path]):
+    """The files `write_programs` wrote, by dialect.
+
+    `by_dialect` maps each dialect written ("srcl", "krl", ...) to its files, main program first
+    (KRL: `.src`, then `.dat` and the frames setup); `trajectory` is the trajectory file
+    (`<name>.json`) every set holds; `manifest` lists the set. As a sequence it is every file
+    written (not the manifest): the trajectory file, then each dialect's in the order asked.
+    """
+
+    paths: tuple[Path, ...]
+    by_dialect: Mapping[str, tuple[Path, ...]]
+    trajectory: Path
+    manifest: Path
+
+    @overload
+    def __getitem__(self, index: int) -> Path: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> Sequence[Path]: ...
+
+    def __getitem__(self, index: int | slice) -> Path | Sequence[Path]:
+        return self.paths[index]
+
+    def __len__(self) -> int:
+        return len(self.paths)
+
+    def __iter__(self) -> Iterator[Path]:
+        return iter(self.paths)
+
+
+def load_cell(source: str | Path | Mapping[str, Any], *, base_dir: str | Path | None = None) -> LoadedCell:
+    """Read and check a cell (SPEC §3) and build its robot (URDF, meshes, IK checked).
+
+    `source` is a cell file, or a mapping holding what a cell file's YAML parses to (built in
+    code; checked as the file would be, errors naming "<mapping>" as the file; `name` required).
+    A mapping's relative paths (meshes, a robot or tool file) are relative to `base_dir`, by
+    default the current directory; a file's are relative to its folder, and `base_dir` is refused.
+
+    What the robot's loading fell back on (limits not given in robot.yaml and derived from the
+    URDF, visual meshes not read) is issued as a `RobomaxWarning`.
+    """
+    from robomax_py.io.cell import cell_from_mapping, load_cell_robot
     from robomax_py.io.cell import load_cell as load_spec
-    from robomax_py.io.cell import load_cell_robot
 
-    spec = load_spec(Path(path))
-    return LoadedCell(spec, load_cell_robot(spec))
+    if isinstance(source, Mapping):
+        spec = cell_from_mapping(source, Path.cwd() if base_dir is None else Path(base_dir))
+    elif base_dir is not None:
+        raise TypeError("load_cell: base_dir is for a cell given as a mapping; a cell file's paths are relative "
+                        "to its own folder")
+    else:
+        spec = load_spec(Path(source))
+    robot: RobotModel = load_cell_robot(spec)
+    for line in robot.warnings:
+        warnings.warn(line, RobomaxWarning, stacklevel=2)
+    return LoadedCell(spec, robot)
 
 
-def plan_cell(cell: LoadedCell, options: PlanOptions | None = None, **overrides: object) -> PlanResult:
-    """Plan a loaded cell. `overrides` are `PlanOptions` fields (e.g. ``given_order=True``, the published method)."""
+def plan_cell(cell: LoadedCell, options: PlanOptions | None = None, *,
+              progress: Callable[[ProgressEvent], None] | None = None) -> PlanResult:
+    """Plan a loaded cell with `options` (default `PlanOptions()`, as `robomax plan` plans).
+
+    `progress`, when given, is called with a `ProgressEvent` as each long stage advances; an
+    exception it raises stops the planning and propagates (a way to cancel).
+    """
     from robomax_py.plan import plan_cell as plan
 
-    opts = dataclasses.replace(options or PlanOptions(), **overrides)  # type: ignore[arg-type]
-    return plan(cell.spec, cell.robot, opts)
+    if progress is None:
+        return plan(cell.spec, cell.robot, options or PlanOptions())
+    report = progress
+
+    def on_stage(stage: str, done: int, total: int) -> None:
+        report(ProgressEvent(cast(PlanStage, stage), done, total))
+
+    return plan(cell.spec, cell.robot, options or PlanOptions(), on_stage)
 
 
-def write_programs(cell: LoadedCell, result: PlanResult, out_dir: str | Path, formats: str = "srcl",
-                   stamp: str = "") -> list[Path]:
-    """Render the program files of a complete plan (the trajectory file and each of `formats`, as
-    `plan --format` takes them), prove each (read back, rebuilt, compared and verified), then
-    write them as one set with its manifest, as `plan` does (`io.files.commit_set`); the paths
-    written (the manifest, `<name>.manifest.json`, beside them).
+def write_programs(cell: LoadedCell, result: PlanResult, out_dir: str | Path,
+                   formats: Sequence[str] = ("srcl",), stamp: str = "") -> WrittenPrograms:
+    """Render the program files of a complete plan (the trajectory file and each dialect of
+    `formats`), prove each (read back, rebuilt, compared and verified), then write them as one set
+    with its manifest, as `robomax plan` does; what was written, by dialect.
 
-    `all` is every dialect the robot file has the data for: one it lacks a key for (INFORM without
-    `controller.pulses_per_degree`) is passed over with a `FormatSkippedWarning` naming the file,
-    the key and the dialect.
+    `formats` names dialects as `plan --format` does, one per item: "srcl", "krl", "rapid",
+    "fanuc", "urscript", "inform", "as", "native" (the robot's controller brand) or "all" (every
+    dialect the robot file has the data for; one it lacks a key for, e.g. INFORM without
+    `controller.pulses_per_degree`, is passed over with a `FormatSkippedWarning` naming the file,
+    the key and the dialect). A comma-separated string ("srcl,krl") is still accepted but
+    deprecated (DeprecationWarning).
 
     Raises ExportError for a plan that is not complete, a dialect named that the robot file lacks
     data for, or a program that does not prove: nothing is written then.
     """
-    import warnings
-
     from robomax_py.export import SHARED_FILES, choose_formats
-    from robomax_py.io.files import commit_set
+    from robomax_py.io.files import MANIFEST_SUFFIX, commit_set
     from robomax_py.plan import method_suffix
     from robomax_py.publish import publish
 
-    chosen = choose_formats(formats, cell.robot)
+    if isinstance(formats, str):
+        warnings.warn("write_programs(formats=...) as a comma-separated string is deprecated; pass a sequence, "
+                      f"e.g. formats={[f.strip() for f in formats.split(',') if f.strip()]!r}",
+                      DeprecationWarning, stacklevel=2)
+        asked = formats
+    else:
+        if not formats or any(not isinstance(f, str) or not f.strip() or "," in f for f in formats):
+            raise ExportError(f"formats: expected one dialect name per item (e.g. ['srcl', 'krl']), got {formats!r}")
+        asked = ",".join(formats)
+    chosen = choose_formats(asked, cell.robot)
     for skipped in chosen.skipped:
         warnings.warn(skipped.message, FormatSkippedWarning, stacklevel=2)
-    files, _ = publish(result, cell.spec, cell.robot, chosen.names, stamp=stamp, method=result.method)
+    files, checked = publish(result, cell.spec, cell.robot, chosen.names, stamp=stamp, method=result.method)
     name = result.cell + method_suffix(result.method)
-    return list(commit_set(Path(out_dir), name, files, cell.spec.digest, SHARED_FILES).paths)
+    out = Path(out_dir)
+    paths = tuple(commit_set(out, name, files, cell.spec.digest, SHARED_FILES).paths)
+    return WrittenPrograms(
+        paths=paths,
+        by_dialect=MappingProxyType({one.format: tuple(out / n for n in one.files) for one in checked}),
+        trajectory=out / f"{name}.json",
+        manifest=out / f"{name}{MANIFEST_SUFFIX}",
+    )
 
 
 def verify_program(cell: LoadedCell, path: str | Path) -> VerifyReport:
-    """Re-simulate a program file (.srcl rebuilt from its statements, or .json) against the cell."""
+    """Re-simulate a program file (any dialect robomax writes, rebuilt from its statements, or a
+    trajectory .json) against the cell; its `violations` are empty (`clean`) when it holds."""
     from robomax_py.verify import verify_program as verify
 
     return verify(cell.spec, cell.robot, Path(path))

@@ -18,13 +18,7 @@ from rich.progress import (
 )
 
 from robomax_py.plan import Progress as PlanProgress
-
-STAGE_LABELS = {
-    "candidates": "candidates (IK x orientation grid)",
-    "sequencing": "sequencing rounds",
-    "timing": "timing moves",
-    "verify": "final check",
-}
+from robomax_py.plan.results import STAGE_LABELS
 
 
 @contextmanager

@@ -8,9 +8,11 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import json
 import math
 import re
 import stat
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -437,6 +439,64 @@ def load_cell(path: str | Path) -> CellSpec:
     if early is not None:                  # before the guarded reader composes what may be a very long list
         _refuse_counts(early[("seams", "*", "spots")], early[("objects",)] + early[("dynamic",)], path)
     data = read_yaml_mapping(path, CellFileError, "cell file", LIMITS.cell)
+    return _cell_from_data(data, path, digest)
+
+
+# The file a cell given as a mapping is named as in messages (there is none).
+MAPPING_FILE = "<mapping>"
+
+
+def cell_from_mapping(data: Mapping[str, Any], base_dir: str | Path) -> CellSpec:
+    """A cell given as a mapping (built in code, or read from elsewhere), checked as its file would be.
+
+    `data` holds what a cell file's YAML would parse to (degrees and millimetres as in the file;
+    tuples and numpy arrays are taken as lists); relative paths in it (meshes, a robot or tool
+    file) are relative to `base_dir`. A CellFileError names the file as "<mapping>". `name` is
+    required (there is no file stem to default to); `source` is `base_dir/<mapping>` and `digest`
+    the SHA-256 of the mapping as canonical JSON (keys sorted).
+    """
+    plain = _plain(data, "", 0)
+    if not isinstance(plain, dict):
+        raise CellFileError(MAPPING_FILE, None, f"expected a mapping of keys, got {type(data).__name__}")
+    if plain.get("name") is None:
+        raise CellFileError(MAPPING_FILE, "name", "required for a cell given as a mapping (its programs are named "
+                                                  "after it)")
+    digest = hashlib.sha256(json.dumps(plain, sort_keys=True, separators=(",", ":")).encode("utf-8")).hexdigest()
+    stand_in = Path(base_dir) / MAPPING_FILE   # so that relative paths resolve against base_dir
+    try:
+        return _cell_from_data(plain, stand_in, digest)
+    except (CellFileError, RobotModelError) as exc:
+        if exc.file != str(stand_in):
+            raise
+        raise type(exc)(MAPPING_FILE, exc.key, exc.problem) from None
+
+
+def _plain(value: object, key: str, depth: int) -> Any:
+    """`value` as the YAML reader would give it: dicts with string keys, lists, scalars."""
+    if depth > LIMITS.yaml_depth:
+        raise CellFileError(MAPPING_FILE, key or None, f"nested more than {LIMITS.yaml_depth} levels deep")
+    if isinstance(value, Mapping):
+        out: dict[str, Any] = {}
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise CellFileError(MAPPING_FILE, key or None, f"key {k!r} is not a string")
+            out[k] = _plain(v, f"{key}.{k}" if key else k, depth + 1)
+        return out
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, list | tuple):
+        return [_plain(v, f"{key}[{i}]", depth + 1) for i, v in enumerate(value)]
+    if isinstance(value, np.generic):
+        return value.item()
+    if value is None or isinstance(value, str | bool | int | float):
+        return value
+    raise CellFileError(MAPPING_FILE, key or None, f"expected plain data (mappings, lists, numbers, strings), "
+                                                   f"got {type(value).__name__}")
+
+
+def _cell_from_data(data: dict[str, Any], path: Path, digest: str) -> CellSpec:
+    """The checked cell of a cell file's parsed YAML; `path` names it in messages and anchors its relative
+    paths."""
     _check_counts(data, path)              # before validating: the data as read, aliases expanded
     version = data.get("robomax")
     if "robomax" in data and version not in SUPPORTED_VERSIONS:

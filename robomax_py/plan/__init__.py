@@ -5,14 +5,18 @@ junction (`tour_timing`, `junction`, `waiting`), checked (`pipeline`) -> a `Plan
 from robomax_py.plan.pipeline import plan_cell, verify_trajectory
 from robomax_py.plan.results import (
     METHODS,
+    FailureReason,
     OrderChoice,
     PlanOptions,
     PlanResult,
+    PlanStage,
     PlanStats,
+    PlanStatus,
     Progress,
     SpotFailure,
     SpotPlan,
     Transition,
+    TransitionKind,
     method_options,
     method_suffix,
     resolved_options,
@@ -20,7 +24,7 @@ from robomax_py.plan.results import (
 from robomax_py.plan.tour_timing import weld_end
 
 __all__ = [
-    "METHODS", "OrderChoice", "PlanOptions", "PlanResult", "PlanStats", "Progress", "SpotFailure", "SpotPlan",
-    "Transition",
+    "METHODS", "FailureReason", "OrderChoice", "PlanOptions", "PlanResult", "PlanStage", "PlanStats", "PlanStatus",
+    "Progress", "SpotFailure", "SpotPlan", "Transition", "TransitionKind",
     "method_options", "method_suffix", "plan_cell", "resolved_options", "verify_trajectory", "weld_end",
 ]

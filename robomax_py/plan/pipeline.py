@@ -21,6 +21,7 @@ from robomax_py.plan.candidates import SpotCandidates, check_ik_work, seam_candi
 from robomax_py.plan.graph import Sequencer
 from robomax_py.plan.loads import Loads, check_carried_motion
 from robomax_py.plan.results import (
+    FailureReason,
     OrderChoice,
     PlanOptions,
     PlanResult,
@@ -328,15 +329,17 @@ def _failure(cell: CellSpec, c: SpotCandidates) -> SpotFailure:
     if not c.rejected:
         return SpotFailure(seam, c.name, "unreachable", "no IK solution at any orientation")
     groups: Counter[str] = Counter()
-    for reason, n in c.rejected.items():
-        groups[reason.kind] += n
-    order = ("approach_blocked", "collision", "approach_branch", "approach_joint_limit", "joint_limit", "unreachable",
-             "pinned_config", "pinned_orientation")
-    for reason in order:
-        if groups.get(reason):
+    for rejection, n in c.rejected.items():
+        groups[rejection.kind] += n
+    # Most telling first; the approach's own kinds are reported as the spot's (`FailureReason`).
+    order: tuple[tuple[str, FailureReason], ...] = (
+        ("approach_blocked", "approach_blocked"), ("collision", "collision"), ("approach_branch", "approach_blocked"),
+        ("approach_joint_limit", "joint_limit"), ("joint_limit", "joint_limit"), ("unreachable", "unreachable"),
+        ("pinned_config", "pinned_config"), ("pinned_orientation", "pinned_orientation"))
+    for kind, reason in order:
+        if groups.get(kind):
             detail = ", ".join(f"{k} x{v}" for k, v in c.rejected.most_common(4))
-            label = {"approach_branch": "approach_blocked", "approach_joint_limit": "joint_limit"}.get(reason, reason)
-            return SpotFailure(seam, c.name, label, detail)
+            return SpotFailure(seam, c.name, reason, detail)
     return SpotFailure(seam, c.name, "unreachable", "no IK solution at any orientation")
 
 

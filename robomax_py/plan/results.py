@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, Literal
 
 from robomax_py._typing import FloatArray
 from robomax_py.plan.waiting import WaitPlan
@@ -13,6 +13,30 @@ from robomax_py.timing import (
     Trajectory,
 )
 from robomax_py.world.motion import Clearance
+
+PlanStatus = Literal["planned", "infeasible"]
+"""`PlanResult.status`: "planned" (every spot, a checked trajectory) or "infeasible" (`message` says why)."""
+
+TransitionKind = Literal["move", "detour"]
+"""`Transition.kind`: a straight joint move between two stops, or a detour through via points."""
+
+FailureReason = Literal["unreachable", "joint_limit", "collision", "approach_blocked", "pinned_config",
+                        "pinned_orientation"]
+"""`SpotFailure.reason`, the dominant reason a spot has no candidate: no IK solution at any allowed
+orientation; every solution beyond a joint limit (at the spot or the approach point); in collision;
+the approach line blocked or leaving the spot's IK branch; no solution in the pinned configuration;
+none at the pinned orientation."""
+
+PlanStage = Literal["candidates", "sequencing", "timing", "verify"]
+"""The stages a `Progress` callback is told about, in the order they run."""
+
+STAGE_LABELS: dict[str, str] = {
+    "candidates": "candidates (IK x orientation grid)",
+    "sequencing": "sequencing rounds",
+    "timing": "timing moves",
+    "verify": "final check",
+}
+"""What each stage does, in a few words (the CLI's progress bars, `ProgressEvent.label`)."""
 
 Progress = Callable[[str, int, int], None]
 """progress(stage, done, total): called as a long stage advances ("candidates", "sequencing",
@@ -27,29 +51,53 @@ def _no_progress(stage: str, done: int, total: int) -> None:
 
 @dataclass(frozen=True, slots=True)
 class PlanOptions:
-    """How to plan; every field has a production default."""
+    """How to plan; every field has a production default, so `PlanOptions()` plans as `robomax plan`.
 
-    # Teach-in, the baseline an integrator programs by hand: the cell file's order, the nominal
-    # orientation where feasible, the first feasible branch.
+    Build one with the fields to change, e.g. ``PlanOptions(given_order=True, speed=0.5)``, or
+    derive one with `dataclasses.replace`. Fields:
+
+    - `baseline`: plan teach-in, the baseline an integrator programs by hand: the cell file's spot
+      order, the nominal orientation where feasible, the first feasible IK branch.
+    - `given_order`: the published method: the spots in the cell file's order, the DP still choosing
+      among every candidate (orientation sample and IK branch), with the same detours and timing.
+    - `speed`: global override in (0, 1] of every programmed speed (`plan --speed`); None takes the
+      cell's `planner.speed` (default 1.0).
+    - `tcp_speed`: m/s on approach and retract lines, before the override; None takes the cell's
+      `planner.tcp_speed` (default 0.5).
+    - `detour_speed`: speed fraction of detour moves, before the override; None takes the cell's
+      `planner.detour_speed` (default 1.0).
+    - `detours`: where detours are searched: "roadmap", "cspace" (the local A1-A3 map) or "both";
+      None takes the cell's `planner.detours`.
+    - `dynamic`: how dynamic objects are planned around: "timed" (time-aware moves) or "rest"
+      (waits at rest); None takes the cell's `planner.dynamic`.
+    - `roadmap_nodes`, `roadmap_k`: size of the detour roadmap and the neighbours each node is
+      joined to.
+    - `straight_tries`: blocked straight moves between two spots before that pair takes detours only.
+    - `max_rounds`: sequencing rounds (optimise, verify, repair) before giving up.
+    - `max_evaluations`: DP evaluations per sequencing round.
+    - `order_candidates`: candidates per spot the order search sees (the exact DP then uses all).
+    - `probe_neighbours`: nearest spots per spot whose straight move is probed up front.
+    - `jerk_limited`: PTP moves and detour legs timed jerk-limited (ruckig); False: toppra
+      (velocity and acceleration limits only).
+    - `blend`: fly by detour corners and approach points on checked G2 blends where that is faster.
+    """
+
     baseline: bool = False
-    # The spots in the cell file's order, the DP still choosing among every candidate (orientation
-    # sample and branch) with the same detours and timing: paper 003's OptTrag for a given order.
     given_order: bool = False
-    # Speeds; None takes the cell's `planner` values (defaults 1.0, 0.5 m/s, 1.0).
-    speed: float | None = None       # global override in (0, 1] of every programmed speed
-    tcp_speed: float | None = None   # m/s on approach and retract lines (before the override)
-    detour_speed: float | None = None  # speed fraction of detour moves (before the override)
-    detours: str | None = None       # "roadmap", "cspace" or "both"; None takes the cell's planner.detours
-    dynamic: str | None = None       # "timed" or "rest"; None takes the cell's planner.dynamic
+    speed: float | None = None
+    tcp_speed: float | None = None
+    detour_speed: float | None = None
+    detours: str | None = None
+    dynamic: str | None = None
     roadmap_nodes: int = 600
     roadmap_k: int = 12
-    straight_tries: int = 12         # blocked straight moves between two spots before detours only
-    max_rounds: int = 80             # sequencing rounds (optimise, verify, repair)
-    max_evaluations: int = 400       # DP evaluations per sequencing round
-    order_candidates: int = 32       # candidates per spot the order search sees (exact DP then uses all)
-    probe_neighbours: int = 6        # nearest spots per spot whose straight move is probed up front
-    jerk_limited: bool = True        # PTP moves and detour legs with ruckig; False: toppra (vel/acc only)
-    blend: bool = True               # fly by detour corners and approach points on checked G2 blends where faster
+    straight_tries: int = 12
+    max_rounds: int = 80
+    max_evaluations: int = 400
+    order_candidates: int = 32
+    probe_neighbours: int = 6
+    jerk_limited: bool = True
+    blend: bool = True
 
     @property
     def method(self) -> str:
@@ -100,7 +148,7 @@ class SpotPlan:
 class SpotFailure:
     seam: str
     name: str
-    reason: str                      # unreachable | joint_limit | collision | approach_blocked
+    reason: FailureReason
     detail: str
 
 
@@ -116,7 +164,7 @@ class Stage:
 class Transition:
     """The joint path between two stops (home or an approach point); kind 'move' or 'detour'."""
 
-    kind: str
+    kind: TransitionKind
     waypoints: FloatArray            # (m, n), both ends included
     label: str
     checks: int = 0                  # collision checks spent finding this detour (0 for a straight move)
@@ -175,7 +223,7 @@ class PlanStats:
 class PlanResult:
     cell: str
     robot: str
-    status: str                      # "planned" | "infeasible"
+    status: PlanStatus
     message: str
     spots: tuple[SpotPlan, ...] = ()
     failures: tuple[SpotFailure, ...] = ()

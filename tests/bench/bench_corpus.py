@@ -386,7 +386,7 @@ def run_one(path: Path, args: argparse.Namespace, save: Any = lambda data: None)
     if planned and not args.no_baselines:
         for name, overrides in BASELINES.items():
             t0 = time.process_time()
-            base, done = _limited(args.cpu_limit, lambda o=overrides: rm.plan_cell(cell, **o))
+            base, done = _limited(args.cpu_limit, lambda o=overrides: rm.plan_cell(cell, rm.PlanOptions(**o)))
             got: dict[str, Any] = {"cpu": round(time.process_time() - t0, 3)}
             if not done:
                 got.update(status="cpu_limit")
