@@ -134,14 +134,15 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
         emit(spot.q_spot, lin(spot.T_spot, spot.config, _lin_mm_s(trans, lin_mm_s), comment="approach",
                               accel=trans.accel), act)
         after = transitions[k + 1] if k + 1 < len(transitions) else None
-        extended = after is not None and after.retract_T is not None and after.retract_q is not None
-        T_retract = after.retract_T if extended else spot.T_app                              # type: ignore[union-attr]
+        # The retract ends where the next move's extended retract does, else at the approach point.
+        T_retract, q_end = spot.T_app, spot.q_app
+        if after is not None and after.retract_T is not None and after.retract_q is not None:
+            T_retract, q_end = after.retract_T, after.retract_q
         if k + 1 < len(result.spots) and result.spots[k + 1].interlocks:
             emit(spot.q_spot, *_interlocks(result.spots[k + 1].interlocks, setup))
-        if k + 1 < len(transitions) and transitions[k + 1].wait is not None:
-            emit(spot.q_spot, *_wait(transitions[k + 1].wait, setup))
-        retract_radius = transitions[k + 1].flyby_radius if k + 1 < len(transitions) else 0.0
-        q_end = after.retract_q if extended else spot.q_app                                  # type: ignore[union-attr]
+        if after is not None and after.wait is not None:
+            emit(spot.q_spot, *_wait(after.wait, setup))
+        retract_radius = after.flyby_radius if after is not None else 0.0
         emit(q_end, lin(T_retract, spot.config_app, lin_mm_s if after is None else _lin_mm_s(after, lin_mm_s),
                         flyby=math.degrees(retract_radius), comment="retract", accel=1.0 if after is None else after.accel))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,

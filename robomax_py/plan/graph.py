@@ -18,7 +18,7 @@ from robomax_py._typing import FloatArray, IntArray
 from robomax_py.plan.candidates import SpotCandidates
 from robomax_py.plan.cspace_detour import grid_detour
 from robomax_py.plan.loads import Loads
-from robomax_py.plan.results import PlanOptions, Progress, Transition, _no_progress
+from robomax_py.plan.results import Progress, ResolvedOptions, Transition, _no_progress
 from robomax_py.plan.roadmap import Detour, Roadmap
 from robomax_py.plan.rrt_detour import rrt_detour
 from robomax_py.plan.sequence import (
@@ -125,7 +125,7 @@ class Sequencer:
 
     def __init__(
         self, cell: CellSpec, robot: RobotModel, world: CollisionWorld, roadmap: Roadmap,
-        spots: list[SpotCandidates], options: PlanOptions, rng: np.random.Generator,
+        spots: list[SpotCandidates], options: ResolvedOptions, rng: np.random.Generator,
         progress: Progress = _no_progress, loads: Loads | None = None,
     ) -> None:
         self.cell, self.robot, self.world, self.roadmap = cell, robot, world, roadmap

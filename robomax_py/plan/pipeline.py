@@ -27,6 +27,7 @@ from robomax_py.plan.results import (
     PlanResult,
     PlanStats,
     Progress,
+    ResolvedOptions,
     SpotFailure,
     SpotPlan,
     Transition,
@@ -58,7 +59,10 @@ def plan_cell(
     cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOptions(), progress: Progress = _no_progress,
 ) -> PlanResult:
     """Plan a cell whose robot (with its tool mounted) is given; `progress` hears of each stage's advance."""
-    options = resolved_options(cell, options)
+    return _plan(cell, robot, resolved_options(cell, options), progress)
+
+
+def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress: Progress) -> PlanResult:
     check_ik_work(cell, robot)              # before anything large is built
     clock: dict[str, float] = {}
     t0 = time.perf_counter()
@@ -151,14 +155,14 @@ def plan_cell(
     clearance = min_clearance(full_world, trajectory.t, trajectory.q)
     clock["clearance"] = time.perf_counter() - t0
 
-    stats = PlanStats(
+    plan_stats = PlanStats(
         candidates=sum(len(c) for c in spots), candidate_checks=candidate_checks,
         sequencing_checks=sequencer.checks + given_checks, roadmap_checks=roadmap.sampling_checks + roadmap.edge_checks,
         verify_checks=verify_checks, detours=sum(1 for t in transitions if t.kind == "detour"),
         rounds=sequencer.rounds, dp_evaluations=sequencer.dp_evaluations, seconds=clock,
     )
     return PlanResult(cell.name, robot.name, "planned", "planned", spots=tuple(plans), transitions=tuple(transitions),
-                      trajectory=trajectory, stats=stats, baseline=options.method != "optimised", joint_names=robot.joint_names,
+                      trajectory=trajectory, stats=plan_stats, baseline=options.method != "optimised", joint_names=robot.joint_names,
                       tool=cell.tool.name, T_flange_tcp=np.asarray(robot.T_flange_tcp),
                       T_world_base=np.asarray(cell.T_world_base),
                       T_root_controller=np.asarray(cell.robot.controller.T_root_base), controller=cell.controller,
@@ -189,14 +193,14 @@ class _Timed:
     trajectory: Trajectory | None
     plans: list[SpotPlan]
     transitions: list[Transition]
-    options: PlanOptions
+    options: ResolvedOptions
     verify_checks: int
     verify_seconds: float
     failure: str | None = None
 
 
 def _time_and_check(cell: CellSpec, robot: RobotModel, world: CollisionWorld, full_world: CollisionWorld,
-                    spots: list[SpotCandidates], tour: Tour, found: Sequence[Transition], options: PlanOptions,
+                    spots: list[SpotCandidates], tour: Tour, found: Sequence[Transition], options: ResolvedOptions,
                     progress: Progress, roadmap: Roadmap, loads: Loads | None) -> _Timed:
     """The tour timed (fly-by blends, else stopping at every corner where a blend fails the check)
     and the first timing that passes the plan's own check."""
@@ -249,7 +253,7 @@ def _time_and_check(cell: CellSpec, robot: RobotModel, world: CollisionWorld, fu
 
 def _given_order(sequencer: Sequencer, tour: Tour, searched: _Timed, cell: CellSpec, robot: RobotModel,
                  world: CollisionWorld, full_world: CollisionWorld, spots: list[SpotCandidates],
-                 options: PlanOptions, loads: Loads | None) -> tuple[OrderChoice, _Timed | None, int]:
+                 options: ResolvedOptions, loads: Loads | None) -> tuple[OrderChoice, _Timed | None, int]:
     """The cell file's order planned by the published method beside the searched tour: which of
     the two is kept (the shorter clean cycle; the searched one on a tie), the given tour's timing
     where it was timed, and the collision checks its sequencing took.
@@ -290,7 +294,7 @@ def _given_order(sequencer: Sequencer, tour: Tour, searched: _Timed, cell: CellS
 
 
 def _timed_tours(cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots: list[SpotCandidates], tour: Tour,
-                 transitions: list[Transition], options: PlanOptions, progress: Progress,
+                 transitions: list[Transition], options: ResolvedOptions, progress: Progress,
                  roadmap: Roadmap, loads: Loads | None = None) -> list[tuple[Trajectory, list[SpotPlan], list[Transition]]]:
     """The tour timed, best first. With dynamic objects planned in time (`planner.dynamic: timed`)
     it is also timed waiting at rest, shorter first: the time-aware choice is made junction by

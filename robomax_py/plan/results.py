@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any, Literal
 
 from robomax_py._typing import FloatArray
@@ -105,6 +105,19 @@ class PlanOptions:
         return "teach-in" if self.baseline else "published" if self.given_order else "optimised"
 
 
+@dataclass(frozen=True, slots=True)
+class ResolvedOptions(PlanOptions):
+    """Options with every value the cell may supply filled in (`resolved_options`): what the planner
+    and the program writer work with, so a speed is always a number there. The defaults are the
+    cell file's (`planner` section)."""
+
+    speed: float = 1.0
+    tcp_speed: float = 0.5
+    detour_speed: float = 1.0
+    detours: str = "both"
+    dynamic: str = "timed"
+
+
 # The methods `plan --baseline` and the benchmarks compare, each as the options that plan it (every
 # one with the same candidates, detours and timing): the optimiser; the published method (paper 003's
 # planner for the given order: the DP over every orientation sample and IK branch); teach-in.
@@ -141,7 +154,7 @@ class SpotPlan:
     gun: int = 1
     schedule: int = 1
     interlocks: tuple[str, ...] = ()  # clamp signals the program waits for before moving to this spot
-    action: str | None = None        # tending stations: "grip" or "release" instead of a weld
+    action: Literal["grip", "release"] | None = None   # tending stations: a gripper action instead of a weld
 
 
 @dataclass(frozen=True, slots=True)
@@ -238,7 +251,7 @@ class PlanResult:
     T_root_controller: FloatArray | None = None   # (4, 4) the controller's base in the URDF root frame
     controller: ControllerSetup = field(default_factory=ControllerSetup)   # the cell's `robot.controller`: frames, inputs, weld style
     home: FloatArray | None = None
-    options: PlanOptions = PlanOptions()
+    options: ResolvedOptions = ResolvedOptions()
     weld_time: float = 0.0
     clearance: Clearance | None = None       # the smallest distance the planned motion keeps, and where
     order: OrderChoice | None = None         # optimised plans: the searched order or the file's, and why
@@ -257,16 +270,17 @@ class PlanResult:
         return float("nan") if self.trajectory is None else self.trajectory.duration
 
 
-def resolved_options(cell: CellSpec, options: PlanOptions) -> PlanOptions:
+def resolved_options(cell: CellSpec, options: PlanOptions) -> ResolvedOptions:
     """The options with every speed left None taken from the cell's `planner` section."""
     p = cell.planner
-    return replace(
-        options,
-        speed=p.speed if options.speed is None else options.speed,
-        tcp_speed=p.tcp_speed if options.tcp_speed is None else options.tcp_speed,
-        detour_speed=p.detour_speed if options.detour_speed is None else options.detour_speed,
-        detours=p.detours if options.detours is None else options.detours,
-        dynamic=p.dynamic if options.dynamic is None else options.dynamic,
-    )
+    given = {f.name: getattr(options, f.name) for f in fields(PlanOptions)}
+    return ResolvedOptions(**{
+        **given,
+        "speed": p.speed if options.speed is None else options.speed,
+        "tcp_speed": p.tcp_speed if options.tcp_speed is None else options.tcp_speed,
+        "detour_speed": p.detour_speed if options.detour_speed is None else options.detour_speed,
+        "detours": p.detours if options.detours is None else options.detours,
+        "dynamic": p.dynamic if options.dynamic is None else options.dynamic,
+    })
 
 

@@ -32,8 +32,8 @@ from robomax_py.plan.poses import (
 )
 from robomax_py.plan.program_frames import cell_program_frames
 from robomax_py.plan.results import (
-    PlanOptions,
     Progress,
+    ResolvedOptions,
     SpotPlan,
     Transition,
     _no_progress,
@@ -81,7 +81,7 @@ from robomax_py.world.scene import build_scene, clamps_near
 
 def time_tour(
     cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots: list[SpotCandidates], tour: Tour,
-    transitions: list[Transition], options: PlanOptions, progress: Progress = _no_progress,
+    transitions: list[Transition], options: ResolvedOptions, progress: Progress = _no_progress,
     roadmap: Roadmap | None = None, loads: Loads | None = None,
 ) -> tuple[Trajectory, list[SpotPlan], list[Transition]]:
     """Junction by junction (retract, move or detour, approach; `junction.time_junction`) and dwells.
@@ -120,6 +120,7 @@ def time_tour(
         junction = timed(load)
         tcp_limits = tcp_limits_after(cell, part)
         for _ in range(MAX_TCP_RETIMES if tcp_limits is not None else 0):
+            assert tcp_limits is not None
             slower = load.slowed(tcp_block_peaks(robot, junction.segments), tcp_limits)
             if slower is None:
                 break
@@ -158,9 +159,10 @@ def time_tour(
         q_spot = np.asarray(traj.q[phase.i_start], dtype=float)
         # Each target states its own configuration: on ABB and FANUC arms J2 is often near 0 at
         # the spot and changes sign over the approach line (issue 14).
+        q_retract = retract_q[k]
         plans.append(SpotPlan(seam.name, c.name, c.angles[a], config_text(robot, c.q_spot[a]), q_spot,
                               as_written_joints(c.q_app[a]), float(phase.t_start), float(phase.t_end), T_spot, T_app,
-                              config_text(robot, retract_q[k] if retract_q[k] is not None else c.q_app[a]),
+                              config_text(robot, q_retract if q_retract is not None else c.q_app[a]),
                               weld_times[k], cell.process.gun,
                               cell.process.schedule_of(spec_of[k]), waits_for[k], spec_of[k].action))
     return traj, plans, timed
@@ -223,7 +225,7 @@ def _tcp_space(cell: CellSpec, robot: RobotModel) -> TcpSpace:
 
 def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, roadmap: Roadmap | None,
                   blocks: list[list[Segment]], timed: list[Transition], ends: list[WeldEnd], weld_times: list[float],
-                  options: PlanOptions, retime: Callable[[int, FloatArray], tuple[list[Segment], Transition]],
+                  options: ResolvedOptions, retime: Callable[[int, FloatArray], tuple[list[Segment], Transition]],
                   ) -> tuple[list[list[Segment]], list[Transition]]:
     """The blocks in time order with their waits for the dynamic obstacles: at rest before a blocked
     junction (`planner.dynamic: rest`), or the time-aware junction (`timed_moves`) where it
@@ -279,7 +281,7 @@ def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, road
     return out_blocks, out_timed
 
 
-def _next_block(ctx: JunctionContext | None, options: PlanOptions, dynamic_world: CollisionWorld,
+def _next_block(ctx: JunctionContext | None, options: ResolvedOptions, dynamic_world: CollisionWorld,
                 windows: dict[str, tuple[tuple[float, float], ...]], doors: frozenset[str], k: int, t: float,
                 block: list[Segment], trans: Transition, ends: list[WeldEnd], weld_times: list[float],
                 ) -> tuple[list[Segment], Transition] | WaitingError:
