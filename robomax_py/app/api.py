@@ -41,7 +41,7 @@ class LoadedCell:
 
 
 def load_cell(path: str | Path) -> LoadedCell:
-    """Read and check a cell file (SPEC §3) and build its robot (URDF, meshes, IK checked)."""
+    """Read and check a cell file (docs/cell-files.md, "A cell file") and build its robot (URDF, meshes, IK checked)."""
     from robomax_py.io.cell import load_cell as load_spec
     from robomax_py.io.cell import load_cell_robot
 
