@@ -12,13 +12,14 @@ import os
 import subprocess
 import sys
 from pathlib import Path
+from types import ModuleType
 
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 
 
-def _gen_schema():  # type: ignore[no-untyped-def]
+def _gen_schema() -> ModuleType:
     spec = importlib.util.spec_from_file_location("gen_schema", REPO / "docs" / "gen_schema.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
