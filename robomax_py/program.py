@@ -137,7 +137,7 @@ class Header:
 
 @dataclass(frozen=True, slots=True)
 class FrameDef:
-    """A tool or user frame whose value the program's files state (SPEC §6).
+    """A tool or user frame whose value the program's files state (docs/cell-files.md, "Controller programs").
 
     Attributes
     ----------
@@ -503,7 +503,7 @@ def _identity(T: FloatArray) -> bool:
 
 def to_frame(T_root_frame: FloatArray, T: FloatArray) -> FloatArray:
     """A pose given in the URDF root frame, expressed in another frame (the controller's base,
-    SPEC §6). An exactly identity frame returns T itself: no floating-point touch, so programs of
+    docs/cell-files.md, "Controller programs"). An exactly identity frame returns T itself: no floating-point touch, so programs of
     robots without `controller.base` stay byte for byte what they were."""
     if _identity(T_root_frame):
         return np.asarray(T, dtype=float)

@@ -23,7 +23,7 @@ def frozen_array(values: Any) -> FloatArray:
 
 
 Brand = Literal["kuka", "abb", "fanuc", "ur", "yaskawa", "kawasaki", "staubli", "comau", "nachi"]
-# Every controller brand robot.yaml may name (SPEC §6); a brand whose dialect robomax lacks
+# Every controller brand robot.yaml may name (docs/cell-files.md, "Controller programs"); a brand whose dialect robomax lacks
 # (Stäubli VAL 3, Comau PDL2, Nachi FD) gets no native program.
 BRANDS: tuple[str, ...] = ("kuka", "abb", "fanuc", "ur", "yaskawa", "kawasaki", "staubli", "comau", "nachi")
 
@@ -45,7 +45,7 @@ def _identity() -> FloatArray:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class ControllerSpec:
-    """The robot's controller (SPEC §6): whose configuration data programs carry, and its frames."""
+    """The robot's controller (docs/cell-files.md, "Controller programs"): whose configuration data programs carry, and its frames."""
 
     brand: Brand = "kuka"
     j23_coupling: bool = False        # FANUC: J3 as the controller counts it = J3 - J2 of the URDF
@@ -82,7 +82,7 @@ class RobotSpec:
 
 @dataclass(frozen=True, slots=True)
 class ControllerFrame:
-    """A frame as the robot's controller stores it (SPEC §6, cell key `robot.controller`).
+    """A frame as the robot's controller stores it (docs/cell-files.md, "Controller programs", cell key `robot.controller`).
 
     number : int
         Its slot: KUKA TOOL_DATA[n] / BASE_DATA[n], FANUC UTOOL[n] / UFRAME[n].

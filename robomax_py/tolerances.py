@@ -17,7 +17,7 @@ class Tolerances:
     # (issue 14): far below any process tolerance, far above round-off of a correct parameter set.
     ik_fit_m: float = 1e-6
     ik_fit_rad: float = 1e-6
-    # SPEC §5: the TCP is at the spot within 0.1 mm.
+    # docs/cell-files.md, "The trajectory file": the TCP is at the spot within 0.1 mm.
     spot_pos_m: float = 1e-4
     # Largest motion of any robot or tool point between two checked states of a swept move.
     sweep_step_m: float = 0.002
@@ -74,7 +74,7 @@ class Tolerances:
     # ZYX angles near B = ±90 deg can come back as other angles of the same rotation.
     readback_angle_deg: float = 1e-4
     # Configuration data names a branch as far as the joints are this far from where it changes
-    # (SPEC §6: re-solving a target in its configuration gives the planned joints within 0.01 deg).
+    # (docs/cell-files.md, "Controller programs": re-solving a target in its configuration gives the planned joints within 0.01 deg).
     config_tol_deg: float = 0.01
     # Over the approach distance the TCP stays on the electrode axis within this (m): the LIN
     # lines follow it to 1e-5 m (lin_path_tol_m); blends start beyond it.

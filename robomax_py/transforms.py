@@ -23,7 +23,7 @@ def rot_z(a: float) -> FloatArray:
 
 
 def rpy_matrix(roll: float, pitch: float, yaw: float) -> FloatArray:
-    """R = Rz(yaw) Ry(pitch) Rx(roll): fixed-axis X, Y, Z rotations (SPEC §3)."""
+    """R = Rz(yaw) Ry(pitch) Rx(roll): fixed-axis X, Y, Z rotations (docs/cell-files.md, "A cell file")."""
     return rot_z(yaw) @ rot_y(pitch) @ rot_x(roll)
 
 

@@ -1,6 +1,6 @@
 """Re-simulate a written program against its cell and report every violation (no printing).
 
-A trajectory file (SPEC §5) is checked on its own samples, the motion between samples taken as
+A trajectory file (docs/cell-files.md, "The trajectory file") is checked on its own samples, the motion between samples taken as
 linear in joint space: joint position, velocity and acceleration limits; collisions with static
 objects, dynamic objects inside their windows and the robot itself, swept between samples with the
 collision world's 2 mm bound; start and end at home; every spot of the cell welded once, at rest

@@ -118,7 +118,7 @@ class WrittenPrograms(Sequence[Path]):
 
 
 def load_cell(source: str | Path | Mapping[str, Any], *, base_dir: str | Path | None = None) -> LoadedCell:
-    """Read and check a cell (SPEC §3) and build its robot (URDF, meshes, IK checked).
+    """Read and check a cell (docs/cell-files.md, "A cell file") and build its robot (URDF, meshes, IK checked).
 
     `source` is a cell file, or a mapping holding what a cell file's YAML parses to (built in
     code; checked as the file would be, errors naming "<mapping>" as the file; `name` required).

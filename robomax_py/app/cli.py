@@ -1,4 +1,4 @@
-"""The `robomax` command: exit codes and messages per SPEC §4.
+"""The `robomax` command: exit codes and messages per docs/cell-files.md, "Commands and exit codes".
 
 A RobomaxError (a user's mistake) becomes one line on stderr and exit code 2, never a traceback.
 Heavy modules are imported inside commands so `robomax --help` stays fast.

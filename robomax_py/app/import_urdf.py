@@ -599,7 +599,7 @@ def import_urdf(
     source, out = Path(source), Path(out)
     name = name or out.name
     if name != out.name:
-        raise RobotModelError(out, None, f"the folder must be named after the robot (SPEC §1): {name!r}")
+        raise RobotModelError(out, None, f"the folder must be named after the robot (docs/cell-files.md, 'The robot folder'): {name!r}")
     if not re.fullmatch(_NAME, name):
         raise RobotModelError(out, None, f"robot name {printable(name)!r} must be letters, digits, '_', '.', '-'")
     roots = allowed_folders(source, packages)

@@ -222,7 +222,7 @@ def serve(cell: CellSpec, robot: RobotModel, program: ShownProgram, announce: Ca
         while True:
             time.sleep(3600)
     except KeyboardInterrupt:
-        return                               # Ctrl-C is how a preview ends (SPEC §4: exit 0)
+        return                               # Ctrl-C is how a preview ends (docs/cell-files.md, "Commands and exit codes": exit 0)
     finally:
         _close(vis)
 
@@ -403,7 +403,7 @@ def _link_nodes(robot: RobotModel) -> list[_LinkNode]:
 
 
 def _coal_shape(geom: Any) -> Shape | None:
-    """The SPEC shape of a coal primitive, or None for other geometry."""
+    """The cell-file shape of a coal primitive, or None for other geometry."""
     import coal
 
     if isinstance(geom, coal.Box):

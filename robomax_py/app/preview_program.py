@@ -4,7 +4,7 @@
 
 - `.srcl`: parsed and rebuilt (`rebuild.rebuild`, the motion `verify` checks); the phases are the
   rebuilt segments' kinds, and a PTP run the program comments as a detour is drawn as "detour".
-- `.json` (SPEC §5): the file holds samples and spots, not phases, so phases are recovered:
+- `.json` (docs/cell-files.md, "The trajectory file"): the file holds samples and spots, not phases, so phases are recovered:
   "weld" during each spot's [t_arrive, t_leave]; "approach" / "retract" while the TCP is within the
   approach distance of the spot just before / after it; "wait" where the robot stands still outside
   welds; the remaining motion is "move", or "detour" where it strays from the straight joint-space
@@ -63,7 +63,7 @@ class ShownProgram:
     t : (k,) float
         Sample times, s, strictly increasing, starting at 0.
     q : (k, n) float
-        Joint values, rad (m for prismatic joints); linear between samples (SPEC §5).
+        Joint values, rad (m for prismatic joints); linear between samples (docs/cell-files.md, "The trajectory file").
     phases : tuple of Phase
         Contiguous, in time order, covering [t[0], t[-1]]; empty for a single sample.
     spots : tuple of ShownSpot

@@ -4,7 +4,7 @@ deterministic, fixed float formats), and program files -> what `robomax verify` 
 `plan_program` turns a plan into the dialect-free `Program` (`planned_program`); each dialect
 module owns its adapter, writer and reader (`srcl`, `krl`, `rapid`, `fanuc`, `urscript`,
 `inform`, `kawasaki_as`; `dialect` holds what they share), registered as entry points of the group
-`robomax_py.dialects` (`shipped`; other packages add dialects the same way); `trajectory_json` is the sampled trajectory file (SPEC §5);
+`robomax_py.dialects` (`shipped`; other packages add dialects the same way); `trajectory_json` is the sampled trajectory file (docs/cell-files.md, "The trajectory file");
 `rebuild` turns a parsed program back into motion.
 """
 
@@ -109,7 +109,7 @@ def _requested(spec: str, brand: str, robot_file: object) -> tuple[set[str], set
 
 
 def format_names(spec: str, brand: str, robot_file: object = None) -> tuple[str, ...]:
-    """`--format` LIST (SPEC §6): names, `all` or `native` (the robot's brand), comma-separated,
+    """`--format` LIST (docs/cell-files.md, "Controller programs"): names, `all` or `native` (the robot's brand), comma-separated,
     in registry order without repeats; ExportError for an unknown name, and for `native` when the
     robot's brand has no dialect (naming the robot file and its key, never another brand's).
     What the robot lacks for a dialect is not looked at here (`choose_formats`)."""
@@ -175,7 +175,7 @@ def dialect_for_file(suffix: str) -> Dialect | None:
 
 
 def render_trajectory(result: PlanResult) -> str:
-    """The trajectory file (SPEC §5) of a planned result."""
+    """The trajectory file (docs/cell-files.md, "The trajectory file") of a planned result."""
     if result.status != "planned" or result.trajectory is None:
         raise ExportError(f"cell {result.cell} is not planned: {result.message}")
     return trajectory_json.render(result)

@@ -1,4 +1,4 @@
-"""What the controller dialects share (SPEC §6): the program a plan becomes before a dialect
+"""What the controller dialects share (docs/cell-files.md, "Controller programs"): the program a plan becomes before a dialect
 states it, the header every program carries, and the conversions of blends and configuration
 data into the terms of a controller brand.
 
@@ -257,7 +257,7 @@ _LABEL = re.compile(r"^(?P<seam>[^/\s]+)/(?P<name>[^/\s]+)(?: gun (?P<gun>[0-9]+
 
 
 def spot_label(spot: Spot) -> str:
-    """`seam/name gun G schedule S`, the comment a weld call carries (SPEC §6: `seam/name` first)."""
+    """`seam/name gun G schedule S`, the comment a weld call carries (docs/cell-files.md, "Controller programs": `seam/name` first)."""
     return f"{spot.seam}/{spot.name} gun {spot.gun} schedule {spot.schedule}"
 
 
@@ -313,7 +313,7 @@ def with_tcp_blends(planned: PlannedProgram, robot: RobotModel) -> Program:
 
 
 def with_brand_configs(program: Program, joints: Sequence[FloatArray], robot: RobotModel, brand: str) -> Program:
-    """Every Cartesian target's configuration data in `brand`'s terms (SPEC §6), from the joints as
+    """Every Cartesian target's configuration data in `brand`'s terms (docs/cell-files.md, "Controller programs"), from the joints as
     the controller counts them; the robot's own brand keeps the data the program has (the
     planner's, in the controller's terms since `in_controller_terms`, taken from the unrounded
     joints)."""

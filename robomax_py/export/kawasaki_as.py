@@ -22,7 +22,7 @@ examples/Kawasaki.pg):
   `BASE <name>` / `BASE NULL`. AS's BASE is "the base coordinates relative to the null base
   coordinates": the null base is the robot's own base frame, and every transformation location is
   relative to the base coordinates. AS has no user frame besides it, so BASE is the program's user
-  frame of SPEC §6: the cell's user frame in the robot base frame, or NULL (the robot base frame
+  frame of docs/cell-files.md, "Controller programs": the cell's user frame in the robot base frame, or NULL (the robot base frame
   itself); the robot's placement in the cell is never written. Names `tool<n>` / `base<n>` after
   the cell's frame numbers;
 - per motion (no ALWAYS: "applies to the next motion only"): `SPEED <%>` (joint moves, whole % of

@@ -17,7 +17,7 @@ What a program states, in KRL's own terms:
   ``LIN XP2 C_DIS C_DIS``; an exact stop has no CONT, ``3:, `` and the statement ends in a space
   (``PTP XP1 ``). The .dat declares per point ``DECL E6AXIS XPn`` (joint target, deg) or
   ``DECL E6POS XPn`` (X, Y, Z mm; A, B, C deg with R = Rz(A)·Ry(B)·Rx(C); S and T the KUKA Status
-  and Turn of the planned configuration, SPEC §6), its ``DECL FDAT FPn`` and its own ``DECL PDAT
+  and Turn of the planned configuration, docs/cell-files.md, "Controller programs"), its ``DECL FDAT FPn`` and its own ``DECL PDAT
   PPDATk`` / ``DECL LDAT LCPDATk`` with the full KSS 8.3 field lists (CHINA amm_periphery.dat 53-55,
   64; STRUCs NAQIU KRC/R1/System/$config.dat 57-59), as the smartPAD gives every point its own data.
 - Frames are selected by each fold's FDAT: TOOL_NO t and BASE_NO b of the controller's TOOL_DATA[t]

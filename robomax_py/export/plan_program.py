@@ -73,7 +73,7 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
         raise ExportError(f"cell {result.cell} has no complete plan to export")
     opts = result.options
     setup = result.controller
-    # Cartesian targets are stated in the program's user frame (SPEC §6): by default the
+    # Cartesian targets are stated in the program's user frame (docs/cell-files.md, "Controller programs"): by default the
     # controller's robot base frame itself; never the robot's placement in the cell.
     C = np.eye(4) if result.T_root_controller is None else result.T_root_controller
     given = program_frames(result.tool, result.T_flange_tcp, result.T_world_base, C, setup)

@@ -17,7 +17,7 @@ Sources, cited below by tag:
 What a program states, in RAPID's terms:
 - joint targets as `jointtarget` (deg), Cartesian targets as `robtarget`: [x, y, z] mm, a unit
   quaternion [q1, q2, q3, q4] with q1 = w, confdata [cf1, cf4, cf6, cfx] of the planned
-  configuration (SPEC §6), external axes 9E9;
+  configuration (docs/cell-files.md, "Controller programs"), external axes 9E9;
 - every MoveL names its `tooldata` and, when the targets are in a user frame, its `wobjdata`
   (`\WObj:=`; without it RAPID uses wobj0). The TCP pose in the world is the work object's
   uframe · oframe · target ([R3] p. 233-234: "The object coordinate system is defined in the user
@@ -32,7 +32,7 @@ What a program states, in RAPID's terms:
 - `WaitTime t;` and `WaitDI <signal>, 1;`, the signal named as the controller's I/O configuration
   names it (`robot.controller.inputs`, else the cell's signal name).
 
-Welds. With `weld: call` (the default, SPEC §6) a weld is `MoveL ... fine` followed by
+Welds. With `weld: call` (the default, docs/cell-files.md, "Controller programs") a weld is `MoveL ... fine` followed by
 `spot_weld n, weld_time;  ! seam/name gun G schedule S`, with `PROC spot_weld` defined in the module
 (rest for weld_time; the integrator replaces it). With `weld: package` it is the spot welding
 option's instruction, which moves to the spot and welds there ([PS4]: SpotL "Move the TCP along a

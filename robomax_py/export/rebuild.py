@@ -94,7 +94,7 @@ class Span:
 @dataclass(slots=True)
 class Rebuilt:
     """The motion of a program: a trajectory (None when it could not be built to the end), the
-    spots it welds (as SPEC §5 `spots` entries) and what was wrong on the way."""
+    spots it welds (as the trajectory file's `spots` entries) and what was wrong on the way."""
 
     trajectory: Trajectory | None
     spots: list[dict[str, Any]] = field(default_factory=list)
@@ -117,7 +117,7 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
     """Rebuild the motion; ProgramError when the program is not for this cell's robot.
 
     lines : the program line of each instruction (as the parser read them), for messages.
-    brand : whose configuration data the program's Cartesian targets carry (SPEC §6);
+    brand : whose configuration data the program's Cartesian targets carry (docs/cell-files.md, "Controller programs");
         None: the robot's controller brand.
     stored : the frames the controller holds without the program stating them (the cell's tool
         and user frame, calibrated on the controller under the dialect's names). A LIN's target

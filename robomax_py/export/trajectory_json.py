@@ -1,4 +1,4 @@
-"""SPEC §5 trajectory file, both directions: a plan -> text (`render`) and a file -> checked data
+"""The trajectory file (docs/cell-files.md), both directions: a plan -> text (`render`) and a file -> checked data
 (`load_trajectory_file`): dense joint samples, spots with arrive/leave times, angles and indicators.
 
 Numbers are written with fixed decimals (t: 1 µs, q: 1e-9 rad) so that the same plan gives the same
@@ -60,7 +60,7 @@ def _deg(rad: float) -> str:
 
 
 def load_trajectory_file(path: Path, robot: RobotModel) -> dict[str, Any]:
-    """Read and check the structure of a SPEC §5 file; ProgramError names what is wrong."""
+    """Read and check the structure of a trajectory file (docs/cell-files.md); ProgramError names what is wrong."""
     text = read_text(path, LIMITS.program, ProgramError, "program file")
     try:
         data = json.loads(text)

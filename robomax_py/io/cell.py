@@ -1,4 +1,4 @@
-"""Cell files (SPEC §3) -> checked CellSpec in SI units.
+"""Cell files (docs/cell-files.md, "A cell file") -> checked CellSpec in SI units.
 
 The only module that knows cell-file keys. Every user mistake becomes one CellFileError naming the
 file, the key path (e.g. `seams[0].spots[3].normal`) and the problem; nothing here prints.
@@ -85,7 +85,7 @@ MAX_WINDOW_S = 86_400.0
 
 @dataclass(frozen=True, slots=True)
 class CellLimits:
-    """The most one cell may ask for (README, "Limits on the files robomax reads"), checked at load
+    """The most one cell may ask for (docs/limits.md), checked at load
     before anything is planned: planning time and memory grow with each. A spot costs its seam's
     orientations x approach samples x IK columns of IK table and its candidates' approach lines;
     every object adds pairs to every collision check; triangles are held in memory as BVHs."""
@@ -181,7 +181,7 @@ class RegistersFile(_Strict):
 
 
 class RobotControllerFile(_Strict):
-    """The integrator's numbers on the robot's controller (README, "Controller programs")."""
+    """The integrator's numbers on the robot's controller (docs/cell-extensions.md, "The integrator's numbers")."""
 
     tool: ControllerFrameFile | None = None
     frame: UserFrameFile | None = None
@@ -218,7 +218,7 @@ class ObjectFile(_Strict):
     mesh: Reference | None = None
     pose: PoseFile = PoseFile()
     workpiece: bool = False
-    signal: Name | None = None          # extension: clamp interlock input (README, cell file extensions)
+    signal: Name | None = None          # extension: clamp interlock input (docs/cell-extensions.md)
 
     @model_validator(mode="after")
     def _one_shape(self) -> ObjectFile:
@@ -274,7 +274,7 @@ class SpotFile(_Strict):
     xyz: Vec3
     normal: Vec3
     direction: Vec3
-    # Extensions (README, cell file extensions): per-spot process and pinned choices.
+    # Extensions (docs/cell-extensions.md): per-spot process and pinned choices.
     weld_time: NonNegative | None = None
     schedule: Annotated[int, Field(ge=1, le=9999)] | None = None
     alpha: Angle | None = None
@@ -304,7 +304,7 @@ class ProcessFile(_Strict):
     weld_time: NonNegative = 0.5
     approach: NonNegative = 0.03
     clearance: NonNegative = 0.0
-    # Extensions (README, cell file extensions).
+    # Extensions (docs/cell-extensions.md).
     gun: Annotated[int, Field(ge=1, le=99)] = 1
     schedule: Annotated[int, Field(ge=1, le=9999)] = 1
     interlock_distance: Annotated[float, Field(ge=0, le=10, allow_inf_nan=False)] = 0.2
@@ -312,7 +312,7 @@ class ProcessFile(_Strict):
 
 class PlannerFile(_Strict):
     seed: Annotated[int, Field(ge=0)] = 0
-    # Extensions of SPEC §3 (README, "Cell file extensions"): speeds the program states per move.
+    # Extensions (docs/cell-extensions.md): speeds the program states per move.
     speed: Annotated[float, Field(gt=0, le=1)] = 1.0
     tcp_speed: Annotated[float, Field(gt=0, le=2)] = 0.5
     detour_speed: Annotated[float, Field(gt=0, le=1)] = 1.0
@@ -321,7 +321,7 @@ class PlannerFile(_Strict):
     max_wait: Annotated[float, Field(gt=0, le=MAX_WINDOW_S, allow_inf_nan=False)] = 600.0
 
 
-# Tending cells (README, "Machine tending"): stations visited in a fixed order per cycle, machines
+# Tending cells (docs/cell-extensions.md, "Machine tending"): stations visited in a fixed order per cycle, machines
 # whose doors are closed while they machine, on a fixed schedule.
 
 
@@ -367,7 +367,7 @@ class TendingFile(_Strict):
     sequence: Annotated[list[Name], Field(min_length=1)] | None = None   # one cycle; default: the stations
 
 
-# Pick-and-place cells (README, "Pick and place"): parts carried from location to location, each
+# Pick-and-place cells (docs/cell-extensions.md, "Pick and place"): parts carried from location to location, each
 # transfer a grip and a release; while held, a part moves with the TCP and is checked for collisions.
 
 

@@ -1,4 +1,4 @@
-"""robot.yaml and tool.yaml (SPEC §1, §2) -> checked RobotSpec / ToolSpec.
+"""robot.yaml and tool.yaml (docs/cell-files.md, "The robot folder" and "The tool folder") -> checked RobotSpec / ToolSpec.
 
 Owns the keys of those two files. A robot or tool is named either by folder name (looked up in the
 robot library path: `--robots` folders, then `ROBOMAX_ROBOTS`, then the shipped library) or by a
@@ -95,7 +95,7 @@ class LimitsFile(_Strict):
 
 
 class ControllerFile(_Strict):
-    """SPEC §6: the controller's brand (its configuration data and native dialect) and base frame.
+    """docs/cell-files.md, "Controller programs": the controller's brand (its configuration data and native dialect) and base frame.
 
     `base` is the controller's base frame in the URDF root frame. Absent, it is the pose of the
     URDF's ROS-Industrial `base` link when fixed joints alone attach that link to the root
@@ -145,7 +145,7 @@ class RobotFile(_Strict):
     flange: str
     ik: IkFile
     limits: LimitsFile = LimitsFile()
-    # Extensions to SPEC §1, all optional.
+    # Extensions of docs/cell-files.md, "The robot folder", all optional.
     controller: ControllerFile = ControllerFile()
     collision: CollisionFile = CollisionFile()
     srdf: str | None = None                   # MoveIt SRDF whose disable_collisions are honoured

@@ -1,4 +1,4 @@
-"""Seams x orientation grid -> candidate TCP poses (SPEC §3 "Spot frame and tolerance angles").
+"""Seams x orientation grid -> candidate TCP poses (docs/cell-files.md, "Seams and spots").
 
 For a spot with outward normal n and seam direction d the nominal TCP frame has z = -n (the electrode
 closes into the sheet), x = d orthogonal to n, y = z x x. A candidate orientation is

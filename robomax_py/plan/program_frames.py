@@ -1,4 +1,4 @@
-"""The frames a cell's programs state their targets in (SPEC §6), as the programs state them.
+"""The frames a cell's programs state their targets in (docs/cell-files.md, "Controller programs"), as the programs state them.
 
 A controller with factory settings knows nothing of the cell: its robot base frame is the robot's
 own (robot.yaml `controller.base` in the URDF root frame), never the robot's placement in the cell.

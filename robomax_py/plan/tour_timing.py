@@ -195,7 +195,7 @@ def weld_end(cell: CellSpec, c: SpotCandidates, a: int, grids: list[OrientationG
     grids: `orientation_grid` of every seam of the cell."""
     seam = cell.seams[c.seam_index]
     T_world = spot_poses((seam.spots[c.spot_index],), grids[c.seam_index])[0, c.orient[a]]
-    # Rounded as the program states them: in its user frame (SPEC §6).
+    # Rounded as the program states them: in its user frame (docs/cell-files.md, "Controller programs").
     frames = cell_program_frames(cell)
     T_spot = frames.written(invert(np.asarray(cell.T_world_base)) @ T_world)
     T_app = frames.written(approach_poses(T_spot, cell.process.approach))

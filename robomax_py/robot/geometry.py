@@ -75,7 +75,7 @@ def mesh_collision_shapes(mesh: trimesh.Trimesh) -> list[coal.CollisionGeometry]
 
 
 def primitive_shape(shape: Shape) -> coal.CollisionGeometry:
-    """coal geometry of a SPEC §3 primitive, centred on its local frame, axis z."""
+    """coal geometry of a cell-file primitive (docs/cell-files.md), centred on its local frame, axis z."""
     if isinstance(shape, Box):
         return coal.Box(*shape.extents)
     if isinstance(shape, Cylinder):

@@ -19,7 +19,7 @@ from robomax_py.robot.geometry import convex_hull_shape, load_mesh
 from robomax_py.spec import ControllerSpec, RobotSpec, frozen_array
 from robomax_py.tolerances import DEFAULT as TOL
 
-# When robot.yaml gives no acceleration or jerk limits (SPEC §1 makes them optional) we derive them
+# When robot.yaml gives no acceleration or jerk limits (docs/cell-files.md, "The robot folder" makes them optional) we derive them
 # from the URDF velocity: full speed in 0.4 s, full acceleration in 0.1 s. Conservative for
 # industrial arms (data sheets imply 0.2-0.5 s to full speed), documented in the plan report.
 DEFAULT_TIME_TO_FULL_SPEED_S = 0.4

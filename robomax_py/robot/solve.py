@@ -234,7 +234,7 @@ def brand_text_of(robot: RobotModel, q: FloatArray, brand: str, controller: bool
     controller: the data as a controller program states it, from the joint values as the controller
     counts them (`controller_values`): the turn bits, the wrist bit (A5 < 0), ABB's quadrants, FANUC's
     flip and turn numbers, Yaskawa's R/T/S halves. The shoulder and elbow bits are geometric (where
-    the wrist point lies, SPEC §6) and do not depend on how the joints are counted. Without it (SRCL,
+    the wrist point lies, docs/cell-files.md, "Controller programs") and do not depend on how the joints are counted. Without it (SRCL,
     the trajectory file, the planner) the URDF's joint values, as those state them."""
     q = np.asarray(q, dtype=float)
     ind = config_of(robot, q)
@@ -251,7 +251,7 @@ def config_texts_near(robot: RobotModel, q: FloatArray, brand: str, tol_rad: flo
     """The configuration data of `brand` for q and for q with each joint that lies within tol_rad
     of a boundary the data changes at (0 and multiples of 90 deg: turn signs, ABB quadrants,
     FANUC turns at 180 deg) moved to either side: a target written with one of them names the
-    branch q is in, as far as the program's decimals can tell (SPEC §6: within 0.01 deg).
+    branch q is in, as far as the program's decimals can tell (docs/cell-files.md, "Controller programs": within 0.01 deg).
     controller: as `brand_text_of`; the boundaries are then those of the controller's joint values."""
     q = np.asarray(q, dtype=float)
     q_c = controller_values(robot, q) if controller else q

@@ -3,7 +3,7 @@
 Module map:
 
 - `estimate`    closed-form minimum times (trapezoid, double-S), vectorised for ranking
-- `trajectory`  Segment / Trajectory / Phase, dwell, concatenate, resample (SPEC §5 grid)
+- `trajectory`  Segment / Trajectory / Phase, dwell, concatenate, resample (docs/cell-files.md, "The trajectory file" grid)
 - `ptp`         jerk-limited state-to-state moves with ruckig (offline, no waypoints)
 - `paths`       GeometricPath: joint paths as Bézier pieces (lines, splines), sampling, restriction
 - `blend`       quintic G2 corner blends and fly-by joins between paths

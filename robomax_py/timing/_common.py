@@ -12,9 +12,9 @@ from robomax_py.robot import JointLimits
 from robomax_py.tolerances import DEFAULT as TOL
 
 # Sample period of the segments this package builds (s). 4 ms is a common controller interpolation
-# cycle (and the SPEC example's); `resample` turns a trajectory into the file's <= 10 ms grid.
+# cycle (and the trajectory file example's in docs/cell-files.md); `resample` turns a trajectory into the file's <= 10 ms grid.
 DEFAULT_DT_S = 0.004
-# SPEC §5: trajectory samples at most this far apart (s).
+# docs/cell-files.md, "The trajectory file": trajectory samples at most this far apart (s).
 SPEC_MAX_DT_S = 0.010
 # Relative slack for boundary velocities given by a caller (rounding of values read off another move).
 BOUNDARY_VEL_RTOL = TOL.boundary_vel_rtol

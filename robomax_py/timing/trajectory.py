@@ -2,7 +2,7 @@
 
 Both hold samples (t, q, qd, qdd), not solver objects, so they pickle to worker processes and stay
 immutable. Segments are sampled densely (`DEFAULT_DT_S`); `resample` produces the trajectory file's
-grid (SPEC §5: strictly increasing t, at most 10 ms apart) with every phase boundary on a sample, so a
+grid (docs/cell-files.md, "The trajectory file": strictly increasing t, at most 10 ms apart) with every phase boundary on a sample, so a
 spot's arrive and leave times are exact sample times.
 """
 
@@ -131,7 +131,7 @@ class Trajectory:
 
     @property
     def duration(self) -> float:
-        """Seconds from the first to the last sample (the SPEC's cycle_time)."""
+        """Seconds from the first to the last sample (the trajectory file's cycle_time)."""
         return float(self.t[-1] - self.t[0])
 
     @property

@@ -13,7 +13,7 @@ from robomax_py.robot import JointLimits, RobotModel
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision import CollisionWorld
 
-# Finite differences of 10 ms samples: velocity is exact for the linear interpolation the SPEC
+# Finite differences of 10 ms samples: velocity is exact for the linear interpolation the trajectory file
 # prescribes; acceleration from second differences of a jerk-limited profile overshoots the
 # sampled peak slightly, hence the larger slack.
 VELOCITY_RTOL = TOL.velocity_rtol

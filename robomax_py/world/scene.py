@@ -6,7 +6,7 @@ Built once per cell; read-only afterwards (the coal geometries are shared, never
 
 How each shape becomes collision geometry
 -----------------------------------------
-- Box, cylinder, sphere, capsule: the exact coal primitive (SPEC §3: centred, axis z).
+- Box, cylinder, sphere, capsule: the exact coal primitive (docs/cell-files.md, "A cell file": centred, axis z).
 - Mesh (obstacle, workpiece or tool): `geometry.mesh_collision_shapes`: when *every* connected piece
   of the mesh is a closed convex shell, one coal convex polytope per piece (exact, and fast GJK);
   otherwise the whole mesh stays one exact triangle BVH (OBBRSS). Sheet-metal parts such as the
@@ -103,7 +103,7 @@ class SceneObject:
 class ToolGeometry:
     """The mounted tool: body and electrode-tip pieces in the flange frame, metres.
 
-    The body collides with everything; the tips may touch workpieces (SPEC §2).
+    The body collides with everything; the tips may touch workpieces (docs/cell-files.md, "The tool folder").
     """
 
     name: str
@@ -216,7 +216,7 @@ def build_scene(cell: CellSpec, robot: RobotModel, held: PartSpec | None = None)
 
 
 def shape_pieces(shape: Shape, file: Path | None = None, key: str | None = None) -> tuple[tuple[coal.CollisionGeometry, ...], str]:
-    """coal pieces of one SPEC §3 shape in its own frame, and how it is represented.
+    """coal pieces of one cell-file shape (docs/cell-files.md) in its own frame, and how it is represented.
 
     Raises CellFileError(file, key, problem) when a mesh cannot be read.
     """

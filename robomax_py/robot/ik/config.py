@@ -7,7 +7,7 @@ operating and programming instructions for system integrators ("Status", "Turn")
 
 - S bit 0 (overhead): the wrist point has x < 0 in the A1 coordinate system (the base frame turned
   with axis 1). 0 = basic area, 1 = overhead area.
-- S bit 1 (elbow): the wrist point lies in front of the line through the A2 and A3 axes (SPEC §6,
+- S bit 1 (elbow): the wrist point lies in front of the line through the A2 and A3 axes (docs/cell-files.md, "Controller programs",
   the KUKA-compatible definition of Beckhoff's TF5200 manual), seen in the arm plane turned with
   A1, whichever way the URDF turns A3. On KUKA arms this is KUKA's A3 >= phi, phi the A3 value of
   the stretched arm (forearm in line with the upper arm, measured at the wrist point), taken
@@ -38,7 +38,7 @@ Functions and Data types, data type confdata, robot configuration data for 6-axi
   not S bit 1; ABB's lower arm is the link from axis 2 to axis 3) + (axis 5 negative = S bit 2):
   the manual's 0..7 table.
 
-FANUC configuration string `F|N U|D T|B, t4, t5, t6` (SPEC §6):
+FANUC configuration string `F|N U|D T|B, t4, t5, t6` (docs/cell-files.md, "Controller programs"):
 
 - F (flip) when J5 >= 0, N when J5 < 0, J5 as the controller counts it, within its turn (the
   turn number t5 holds whole turns). FANUC's flip is not KUKA's 'A5 < 0' bit: the RoboDK FANUC
@@ -170,7 +170,7 @@ def status_opw(params: OpwParams, q: FloatArray) -> IntArray:
         0..7 as defined in the module docstring; -1 for rows containing NaN. The A1 frame is the
         link-1 frame: the paper's frame turned by theta1, x towards the arm's front (the a1 offset),
         which splits the shoulder branches exactly also when b != 0. The elbow
-        bit is geometric (SPEC §6): the wrist point in front of the line through the A2 and A3
+        bit is geometric (docs/cell-files.md, "Controller programs"): the wrist point in front of the line through the A2 and A3
         axes, whichever way the URDF's axis 3 turns (ROS-Industrial FANUC arms turn it about -y).
     """
     q = np.asarray(q, dtype=float)
@@ -224,7 +224,7 @@ def status_generic(model: pin.Model, frame_id: int, q: FloatArray) -> IntArray:
     bit0 = np.einsum("mi,mi->m", wrist_56 - origin[0], x1) < 0
 
     # The arm plane's normal from the A1 frame (up x front), not from axis 3 as the URDF turns it:
-    # the elbow bit is geometric (SPEC §6), the same on arms whose axis 3 points the other way.
+    # the elbow bit is geometric (docs/cell-files.md, "Controller programs"), the same on arms whose axis 3 points the other way.
     up = np.where((axis[0][:, 2] >= 0)[:, None], axis[0], -axis[0])
     a3 = np.cross(up, x1)
     a3 = a3 / np.maximum(np.linalg.norm(a3, axis=1, keepdims=True), 1e-300)
@@ -244,7 +244,7 @@ def status_generic(model: pin.Model, frame_id: int, q: FloatArray) -> IntArray:
 # ------------------------------------------------------------------ the controllers' own words
 
 def brand_text(brand: str, status: int, turn: int, q: FloatArray) -> str:
-    """The configuration data a `brand`'s controller writes for joint values q (6,), rad (SPEC §6).
+    """The configuration data a `brand`'s controller writes for joint values q (6,), rad (docs/cell-files.md, "Controller programs").
 
     kuka: Status and Turn, `S110 T010011` (KUKA System Software 8.x manual, "Status" and "Turn").
     abb: robtarget confdata `[cf1,cf4,cf6,cfx]`: quadrants floor(q / 90 deg) of axes 1, 4, 6 and
