@@ -176,8 +176,7 @@ def test_status_distinct_over_branches_in_solve_all(rng: np.random.Generator) ->
 def test_against_robot_urdf_if_present(rng: np.random.Generator) -> None:
     yaml = pytest.importorskip("yaml")
     folder = REPO / "robomax_py" / "robots" / "kr16"
-    if not (folder / "kr16.urdf").is_file() or not (folder / "robot.yaml").is_file():
-        pytest.skip("robots/kr16 not written yet")
+    assert (folder / "kr16.urdf").is_file() and (folder / "robot.yaml").is_file(), "robots/kr16 is shipped with the repository"
     spec = yaml.safe_load((folder / "robot.yaml").read_text())
     params = params_from_mapping("opw", spec["ik"]["params"])
     assert isinstance(params, OpwParams)

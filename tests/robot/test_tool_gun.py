@@ -21,8 +21,7 @@ import yaml
 
 REPO = Path(__file__).resolve().parents[2]
 GUN_DIR = REPO / "robomax_py" / "robots" / "tools" / "spot_gun_c"
-# The reference cell: its frozen copy in tests/data (cells/cabin_flange.yaml is now our own cell), else
-# the contract's shared/ folder beside the clone (as in CI).
+# The reference cell: its frozen copies in tests/data (cells/cabin_flange.yaml is now our own cell).
 CELL_CANDIDATES = (
     REPO / "tests" / "data" / "flange_cell" / "cabin_flange.yaml",
     REPO / "tests" / "data" / "reference" / "cabin_flange.yaml",
@@ -231,8 +230,7 @@ def test_gun_clear_of_the_wrist(robot: str, a5_deg: float) -> None:
 
 def test_gun_welds_every_reference_spot_without_body_contact() -> None:
     cell_path = next((p for p in CELL_CANDIDATES if p.is_file()), None)
-    if cell_path is None:
-        pytest.skip("reference cell cabin_flange.yaml not found (shared/ must sit beside the clone)")
+    assert cell_path is not None, "the reference cell (tests/data/reference) is shipped with the repository"
     with open(cell_path, encoding="utf-8") as fh:
         cell = yaml.safe_load(fh)
     workpieces, others = _cell_objects(cell_path, cell)

@@ -152,8 +152,8 @@ def ur10_cell_world(ur10: RobotModel, gun: ToolSpec) -> CollisionWorld:
 
 @pytest.fixture(scope="module")
 def reference() -> tuple[CellSpec, RobotModel, CollisionWorld]:
-    if not REFERENCE_CELL.is_file() or not (REPO / "robomax_py" / "robots" / "kr125" / "robot.yaml").is_file():
-        pytest.skip("reference cell or robots/kr125 not available")
+    assert REFERENCE_CELL.is_file() and (REPO / "robomax_py" / "robots" / "kr125" / "robot.yaml").is_file(), \
+        "the reference cell (tests/data/reference) and robots/kr125 are shipped with the repository"
     from robomax_py.io.cell import load_cell, load_cell_robot
 
     cell = load_cell(REFERENCE_CELL)
@@ -163,8 +163,7 @@ def reference() -> tuple[CellSpec, RobotModel, CollisionWorld]:
 
 def library_robot(name: str) -> RobotModel:
     path = REPO / "robomax_py" / "robots" / name / "robot.yaml"
-    if not path.is_file():
-        pytest.skip(f"robots/{name} not available")
+    assert path.is_file(), f"robots/{name} is shipped with the repository"
     return load_robot(load_robot_spec(path))
 
 

@@ -168,8 +168,8 @@ def test_meshes_convex_shells_become_pieces_open_sheets_stay_exact(
 
 
 def test_reference_panel_stays_exact_and_gun_is_convex_pieces() -> None:
-    if not REFERENCE_CELL.is_file() or not (REPO / "robomax_py" / "robots" / "kr125" / "robot.yaml").is_file():
-        pytest.skip("reference cell or robots/kr125 not available")
+    assert REFERENCE_CELL.is_file() and (REPO / "robomax_py" / "robots" / "kr125" / "robot.yaml").is_file(), \
+        "the reference cell (tests/data/reference) and robots/kr125 are shipped with the repository"
     from robomax_py.io.cell import load_cell, load_cell_robot
 
     cell = load_cell(REFERENCE_CELL)
