@@ -19,7 +19,12 @@ from typer.testing import CliRunner
 
 from robomax_py._version import __version__
 from robomax_py.app.cli import EXIT_BAD_INPUT, EXIT_CODES, EXIT_OK, app, json_schema
-from robomax_py.app.examples import copy_examples, default_bench_cell, example_files, examples_dir
+from robomax_py.app.examples import (
+    copy_examples,
+    default_bench_cell,
+    example_files,
+    examples_dir,
+)
 from robomax_py.errors import OutputError
 from robomax_py.io.cell import load_cell
 
