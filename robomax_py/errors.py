@@ -37,6 +37,11 @@ class RobotModelError(_LocatedError):
     """A robot.yaml, tool.yaml, URDF or mesh cannot be used."""
 
 
+class OutputError(_LocatedError):
+    """A command's output cannot be written as asked: a file there holds something else (and
+    --force was not given), or the folder cannot be written."""
+
+
 class ProgramError(_LocatedError):
     """A robot program file cannot be parsed; `key` holds 'line L, column C'."""
 

@@ -12,6 +12,7 @@ from robomax_py.errors import (
     CellFileError,
     ControllerSetupError,
     ExportError,
+    OutputError,
     ProgramError,
     RobotModelError,
 )
@@ -23,6 +24,7 @@ ERRORS = [
     CellFileError("cells/a.yaml", "robot.home", "expected six joint values"),
     RobotModelError(None, None, "no such robot"),
     ProgramError("p.src", "line 3, column 1", "unknown statement"),
+    OutputError("ex/frame.yaml", None, "exists with other content; use --force to replace it"),
     ControllerSetupError("robot.controller.tool.number", "must be 1..16"),
     ExportError("no dialect"),
     FitError("axes 2 and 3 must be parallel"),

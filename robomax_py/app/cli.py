@@ -2,6 +2,14 @@
 
 A RobomaxError (a user's mistake) becomes one line on stderr and exit code 2, never a traceback.
 Heavy modules are imported inside commands so `robomax --help` stays fast.
+
+Every command takes --json: one JSON object on stdout instead of tables, its first keys `schema`
+("robomax.cli.<command>/<version>", the version raised when a key changes meaning or goes) and `ok`
+(true exactly when the exit code is 0). A bad input still exits non-zero: the object is then
+{"schema", "ok": false, "error": {"file", "key", "message"}} and the human message goes to stderr
+as without --json. Warnings and progress always go to stderr. A command line the parser rejects
+(unknown option, missing argument) gets the usage message and exit 2 without JSON: the command
+never ran.
 """
 
 from __future__ import annotations
@@ -16,7 +24,9 @@ from typing import Annotated, Any, TypeVar
 import typer
 from rich.console import Console
 from rich.table import Table
+from typer.core import TyperCommand, TyperGroup
 
+from robomax_py._version import __version__
 from robomax_py.errors import RobomaxError
 from robomax_py.io.files import signals_held
 
@@ -24,12 +34,99 @@ EXIT_OK = 0
 EXIT_VIOLATIONS = 1
 EXIT_BAD_INPUT = 2
 EXIT_INFEASIBLE = 3
+EXIT_INTERRUPTED = 130                  # 128 + SIGINT
+EXIT_TERMINATED = 143                   # 128 + SIGTERM
 
-app = typer.Typer(add_completion=False, no_args_is_help=True, help="Offline programming for spot-welding robot cells.")
+# The one table of exit codes, shown under every command's help.
+EXIT_CODES = (
+    (EXIT_OK, "done: valid, planned, clean"),
+    (EXIT_VIOLATIONS, "verify found violations"),
+    (EXIT_BAD_INPUT, "bad input: a file (named with its key) or the command line is wrong"),
+    (EXIT_INFEASIBLE, "infeasible: a spot left unplanned (batch: or a cell timed out or crashed)"),
+    (EXIT_INTERRUPTED, "interrupted (Ctrl-C)"),
+    (EXIT_TERMINATED, "terminated (SIGTERM)"),
+)
+JSON_VERSION = 1
+# "\b" keeps the lines as they are in the help (click's and typer's formatters rewrap otherwise).
+EPILOG = "\b\nExit codes:\n" + "\n".join(f"  {code:>3}  {what}" for code, what in EXIT_CODES) + (
+    f"\n\b\n--json: one object on stdout, {{\"schema\": \"robomax.cli.<command>/{JSON_VERSION}\", \"ok\": ...}}; "
+    "on bad input {\"ok\": false, \"error\": {\"file\", \"key\", \"message\"}}")
+HELP_OPTIONS = {"help_option_names": ["-h", "--help"]}
+
+
+def json_schema(command: str) -> str:
+    """The `schema` value of a command's --json output."""
+    return f"robomax.cli.{command}/{JSON_VERSION}"
+
+
+def _untyped_flags(params: list[Any]) -> list[Any]:
+    """A flag takes no value: typer from 0.2x shows its type (`<bool>`) in the help unless it has a
+    metavar, so flags get an empty one (no effect with older typer, which shows none)."""
+    for param in params:
+        if getattr(param, "is_flag", False) and param.metavar is None:
+            param.metavar = ""
+    return params
+
+
+class _Command(TyperCommand):
+    """A command whose help shows no `<bool>` and names its arguments as the usage line does
+    (CELL, [PROGRAM], CELLS...), not `{cell}`."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        for param in self.params:
+            if param.param_type_name == "argument" and param.metavar is None and param.name:
+                param.metavar = param.name.upper()
+
+    def get_params(self, ctx: Any) -> list[Any]:
+        return _untyped_flags(super().get_params(ctx))
+
+    def collect_usage_pieces(self, ctx: Any) -> list[str]:
+        pieces = [self.options_metavar] if self.options_metavar else []
+        for param in self.get_params(ctx):
+            if param.param_type_name != "argument":
+                pieces.extend(param.get_usage_pieces(ctx))
+                continue
+            name = str(param.metavar or param.name).upper()
+            name = name if param.required else f"[{name}]"
+            pieces.append(name + ("..." if param.nargs != 1 else ""))
+        return pieces
+
+
+class _Group(TyperGroup):
+    def get_params(self, ctx: Any) -> list[Any]:
+        return _untyped_flags(super().get_params(ctx))
+
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, cls=_Group, context_settings=HELP_OPTIONS,
+                  epilog=EPILOG, help="Offline programming for spot-welding robot cells.")
 out = Console(highlight=False)
 err = Console(stderr=True, highlight=False)
 
+
+def _command(name: str | None = None) -> Callable[[Callable[..., T]], Callable[..., T]]:
+    """`app.command` with the conventions every command shares: -h, the exit-code epilog, clean help."""
+    return app.command(name, cls=_Command, epilog=EPILOG)
+
+
+JsonFlag = Annotated[bool, typer.Option("--json", help="print one JSON object on stdout instead of tables "
+                                                       "(see below)")]
+
+
+def _print_json(command: str, ok: bool, payload: dict[str, Any]) -> None:
+    """A command's --json output: `schema` and `ok` first, then the command's own keys."""
+    import json
+
+    out.print_json(json.dumps({"schema": json_schema(command), "ok": ok, **payload}))
+
+
 T = TypeVar("T")
+
+
+def _print_version(wanted: bool) -> None:
+    if wanted:
+        out.print(f"robomax_py {__version__}", markup=False, highlight=False)
+        raise typer.Exit(EXIT_OK)
 
 
 @app.callback()
@@ -38,6 +135,8 @@ def _library(
         "--robots", metavar="DIR",
         help="a robot library folder searched before ROBOMAX_ROBOTS and the shipped library (repeatable; "
              "any command takes it, before or after the command name)")] = None,
+    version: Annotated[bool, typer.Option("--version", is_eager=True, callback=_print_version,
+                                          help="print the version and exit")] = False,
 ) -> None:
     """Offline programming for spot-welding robot cells."""
     if robots_dirs:
@@ -62,23 +161,57 @@ def _warn(lines: tuple[str, ...] | list[str]) -> None:
         err.print(f"[yellow]warning:[/] {escape(line)}", soft_wrap=True, highlight=False)
 
 
-def _guarded(action: Callable[[], T]) -> T:
-    """Run a command body; a RobomaxError becomes one message and exit code 2."""
+def _guarded(action: Callable[[], T], json_command: str | None = None) -> T:
+    """Run a command body; a RobomaxError becomes one message on stderr and exit code 2 (with
+    `json_command`, the --json error object on stdout as well)."""
     try:
         return action()
     except RobomaxError as exc:
-        err.print(f"[bold red]error:[/] {exc}", markup=True, soft_wrap=True)
+        from rich.markup import escape
+
+        err.print(f"[bold red]error:[/] {escape(str(exc))}", markup=True, soft_wrap=True)
+        if json_command is not None:
+            _print_json(json_command, False, {"error": {
+                "file": getattr(exc, "file", None), "key": getattr(exc, "key", None), "message": str(exc)}})
         raise typer.Exit(EXIT_BAD_INPUT) from None
 
 
-@app.command()
-def robots() -> None:
+def _num(value: float | None) -> float | None:
+    """A number for JSON (a numpy scalar as a float)."""
+    return None if value is None else float(value)
+
+
+def _json_failure(command: str, as_json: bool, file: str | None, message: str) -> int:
+    """A bad input found by the command itself (not a RobomaxError): the message on stderr, the
+    error object on stdout with --json; exit code 2."""
+    from rich.markup import escape
+
+    err.print(f"[bold red]error:[/] {escape(message)}", soft_wrap=True)
+    if as_json:
+        _print_json(command, False, {"error": {"file": file, "key": None, "message": message}})
+    return EXIT_BAD_INPUT
+
+
+@_command()
+def robots(as_json: JsonFlag = False) -> None:
     """List the robot and tool library: axes, reach, IK solver, tool TCP."""
 
     def run() -> None:
         from robomax_py.app.library import list_robots, list_tools
         from robomax_py.io.robot import robot_library
 
+        if as_json:
+            found, tools_found = list_robots(), list_tools()
+            _warn([f"robot {r.name}: {s} is hidden by {r.source}" for r in found for s in r.shadowed])
+            _warn([f"tool {t.name}: {s} is hidden by {t.source}" for t in tools_found for s in t.shadowed])
+            _print_json("robots", True, {
+                "library": [str(d) for d in robot_library()],
+                "robots": [{"name": r.name, "axes": r.axes, "reach_m": round(r.reach_m, 6), "payload_kg": r.payload_kg,
+                            "ik": r.ik_solver, "controller": r.brand, "source": str(r.source),
+                            "description": r.description} for r in found],
+                "tools": [{"name": t.name, "tcp_xyz_m": [round(v, 6) for v in t.tcp_xyz_m],
+                           "tcp_distance_m": round(t.tcp_distance_m, 6), "source": str(t.source)} for t in tools_found]})
+            return
         out.print("library path: " + "  ".join(str(d) for d in robot_library()), soft_wrap=True)
         table = Table(title="Robots", title_justify="left")
         for col in ("name", "axes", "flange reach (m)", "payload (kg)", "IK", "controller", "from", "description"):
@@ -98,11 +231,11 @@ def robots() -> None:
             _warn([f"tool {t.name}: {s} is hidden by {t.source}" for s in t.shadowed])
         out.print(tools)
 
-    _guarded(run)
+    _guarded(run, "robots" if as_json else None)
 
 
-@app.command()
-def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")]) -> None:
+@_command()
+def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_json: JsonFlag = False) -> None:
     """Validate a cell (and its robot, tool and meshes) and print a summary."""
 
     def run() -> None:
@@ -114,7 +247,8 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")]) -> Non
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
         _warn(robot.warnings)
-        out.print(cell_summary(spec, robot))
+        if not as_json:
+            out.print(cell_summary(spec, robot))
         reach = reach_report(spec, robot)
         far = [r for r in reach if not r.reachable]
         stop = "station" if spec.tending else "spot"          # gripper actions (tending, pick and place)
@@ -124,8 +258,8 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")]) -> Non
             raise CellFileError(cell, worst.key, f"{stop} {worst.seam}/{worst.name} is out of {robot.name}'s reach by "
                                 f"{worst.out_by_m:.3f} m at every allowed orientation (shoulder to wrist "
                                 f"{worst.distance_m:.3f} m, the arm reaches {worst.reach_m:.3f} m){others}")
-        if reach:
-            tight = min(reach, key=lambda r: -r.out_by_m)
+        tight = min(reach, key=lambda r: -r.out_by_m) if reach else None
+        if tight is not None and not as_json:
             out.print(f"reach: all {len(reach)} {stop}s within reach (least margin {-tight.out_by_m * 1000:.0f} mm "
                       f"at {tight.seam}/{tight.name})")
         at_home, always = self_contacts(robot, spec.home)
@@ -133,17 +267,27 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")]) -> Non
                f"[{a}, {b}] to collision.disable in {robot.source}" for a, b in at_home])
         _warn([f"{robot.name}: links {a} and {b} touch in every sampled configuration; add [{a}, {b}] "
                f"to collision.disable in {robot.source} (or give its SRDF as srdf:)" for a, b in always])
+        if as_json:
+            _print_json("check", True, {
+                "cell": str(cell), "name": spec.name, "robot": robot.name, "tool": spec.tool.name,
+                "seams": [{"name": seam.name, "spots": len(seam.spots), "ordered": seam.ordered} for seam in spec.seams],
+                "objects": [obj.name for obj in (*spec.objects, *spec.dynamic)],
+                "reach": None if tight is None else {
+                    stop + "s": len(reach), "least_margin_m": round(-tight.out_by_m, 6), "at": f"{tight.seam}/{tight.name}"},
+                "self_contacts_at_home": [list(p) for p in at_home],
+                "self_contacts_always": [list(p) for p in always]})
+            return
         out.print(f"[green]ok[/]: {cell} is a valid cell")
 
-    _guarded(run)
+    _guarded(run, "check" if as_json else None)
 
 
-@app.command()
+@_command()
 def plan(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
     out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder")] = Path("programs"),
     baseline: Annotated[str | None, typer.Option("--baseline", metavar="published|teach-in", help="plan a baseline instead and write <name>_published.* or <name>_teach_in.*: published = the published method (paper 003: the cell's spot order, the DP over every orientation sample and IK branch, the same detours and timing), teach-in = the cell's order, nominal orientation, first branch")] = None,
-    as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable report instead of tables")] = False,
+    as_json: JsonFlag = False,
     speed: Annotated[float | None, typer.Option("--speed", min=0.01, max=1.0, help="override of every programmed speed, fraction in (0, 1] (default: the cell's planner.speed, else 1)")] = None,
     verbose: Annotated[bool, typer.Option("-v", "--verbose", help="debug logging: stage sizes, counts and times")] = False,
     plot: Annotated[bool, typer.Option("--plot", help="also write DIR/<name>.png: a cycle-time Gantt chart, one row per spot")] = False,
@@ -155,7 +299,6 @@ def plan(
 
     def run() -> int:
         import datetime
-        import json as _json
         import time
 
         # SIGINT and SIGTERM held while the heavy modules are imported (a few seconds at most): an
@@ -218,7 +361,7 @@ def plan(
             report["not_of_this_plan"] = [str(out_dir / n) for n in _stale_programs(out_dir, set_name)]
             report["unlisted"] = [str(out_dir / n) for n in unlisted]
         if as_json:
-            out.print_json(_json.dumps(report))
+            _print_json("plan", result.status == "planned", report)
         else:
             for renderable in report_tables(report):
                 out.print(renderable)
@@ -244,7 +387,7 @@ def plan(
                       "(left as it is: it may hold the integrator's routine)", soft_wrap=True)
         return EXIT_OK
 
-    code = _guarded(run)
+    code = _guarded(run, "plan" if as_json else None)
     raise typer.Exit(code)
 
 
@@ -276,10 +419,11 @@ def _stale_programs(out_dir: Path, name: str, every: bool = False) -> list[str]:
         return []
 
 
-@app.command()
+@_command()
 def verify(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
     program: Annotated[Path, typer.Argument(help="a program (.srcl, .src, .mod, .ls, .script: the motion rebuilt from its statements) or a trajectory file (.json)")],
+    as_json: JsonFlag = False,
 ) -> None:
     """Re-simulate a program against the cell; report collisions, limit and tolerance violations."""
 
@@ -290,6 +434,17 @@ def verify(
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
         report = verify_program(spec, robot, program)
+        if as_json:
+            c = report.clearance
+            _print_json("verify", report.clean, {
+                "cell": str(cell), "program": str(program), "clean": report.clean, "samples": report.samples,
+                "cycle_time": round(report.cycle_time, 4), "collision_checks": report.collision_checks,
+                "violations": [{"kind": v.kind, "line": v.line, "t": _num(v.t), "t_end": _num(v.t_end), "detail": v.detail}
+                               for v in report.violations],
+                "clearance": None if c is None else {"mm": round(c.distance_m * 1000, 3), "t": round(c.t, 4),
+                                                     "between": c.between, "line": report.clearance_line},
+                "ignored_statements": len(report.ignored), "notes": list(report.notes)})
+            return EXIT_OK if report.clean else EXIT_VIOLATIONS
         out.print(f"{program}: {report.samples} samples, cycle {report.cycle_time:.3f} s, "
                   f"{report.collision_checks} collision checks")
         for v in report.violations:
@@ -313,15 +468,17 @@ def verify(
         out.print(f"[red]{len(report.violations)} violation(s)[/]")
         return EXIT_VIOLATIONS
 
-    code = _guarded(run)
+    code = _guarded(run, "verify" if as_json else None)
     raise typer.Exit(code)
 
 
-@app.command()
+@_command()
 def bench(
-    cell: Annotated[Path, typer.Argument(help="cell to plan (default: the shipped cabin_flange cell)")] = Path("cells/cabin_flange.yaml"),
+    cell: Annotated[Path | None, typer.Argument(help="cell to plan (default: the cabin_flange example shipped "
+                                                     "with the package)", show_default=False)] = None,
     runs: Annotated[int, typer.Option("--runs", min=1, help="planning runs (median)")] = 3,
     quick: Annotated[bool, typer.Option("--quick", help="smaller IK and collision batches")] = False,
+    as_json: JsonFlag = False,
 ) -> None:
     """Measure this machine: IK/s, collision checks/s, planning time, cycle vs baseline vs lower bound."""
 
@@ -329,12 +486,19 @@ def bench(
         from rich.status import Status
 
         from robomax_py.app.bench import run_bench
+        from robomax_py.app.examples import default_bench_cell
         from robomax_py.io.cell import load_cell, load_cell_robot
 
-        spec = load_cell(cell)
+        path = default_bench_cell() if cell is None else cell
+        spec = load_cell(path)
         robot = load_cell_robot(spec)
         with Status("", console=err) as status:
             rows = run_bench(spec, robot, runs=runs, quick=quick, on_step=lambda s: status.update(f"measuring {s}"))
+        if as_json:
+            _print_json("bench", True, {"cell": str(path), "name": spec.name, "robot": robot.name, "runs": runs,
+                                        "quick": quick, "figures": [{"name": r.name, "value": float(r.value), "unit": r.unit,
+                                                                     "note": r.note} for r in rows]})
+            return
         table = Table(title=f"robomax bench: {spec.name} ({robot.name}), one process", title_justify="left")
         for col, justify in (("figure", "left"), ("value", "right"), ("unit", "left"), ("note", "left")):
             table.add_column(col, justify=justify)  # type: ignore[arg-type]
@@ -343,17 +507,17 @@ def bench(
             table.add_row(r.name, value, r.unit, r.note)
         out.print(table)
 
-    _guarded(run)
+    _guarded(run, "bench" if as_json else None)
 
 
-@app.command()
+@_command()
 def cspace(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
     wrist: Annotated[str, typer.Option("--wrist", help="A4-A6 held at home, or at a spot's nominal-orientation IK (spot or seam/spot)")] = "home",
     resolution: Annotated[int, typer.Option("--resolution", help="samples per axis of A1-A3 (4..400)")] = 50,
     plot: Annotated[Path | None, typer.Option("--plot", help="write a PNG of the blocked cells here")] = None,
     jobs: Annotated[int, typer.Option("-j", "--jobs", min=0, help="processes (0: the cores this process may use)")] = 0,
-    as_json: Annotated[bool, typer.Option("--json", help="print a machine-readable summary")] = False,
+    as_json: JsonFlag = False,
     learned: Annotated[bool, typer.Option("--learned", help="also the map of the learned point model (trained once per robot, tool and wrist, then cached), compared with the exact one cell by cell")] = False,
     spacing: Annotated[float, typer.Option("--spacing", min=0.005, max=1.0, help="m between the object surface points of the learned map")] = 0.1,
     program: Annotated[Path | None, typer.Option("--program", help="with --plot: draw this trajectory file's A1-A3 path (a .json from plan) over the map")] = None,
@@ -364,8 +528,6 @@ def cspace(
     (and with --learned, from the learned point model too)."""
 
     def run() -> None:
-        import json as _json
-
         import numpy as np
 
         from robomax_py.app.cspace_view import map_png, map_summary, spot_wrist
@@ -405,17 +567,17 @@ def cspace(
             write_atomic_bytes(plot, png)
             summary["plot"] = str(plot)
         if as_json:
-            out.print_json(_json.dumps(summary))
+            _print_json("cspace", True, summary)
             return
         table = Table(show_header=False, box=None)
         for key, value in summary.items():
             table.add_row(key, f"{value:,}" if isinstance(value, int) else str(value))
         out.print(table)
 
-    _guarded(run)
+    _guarded(run, "cspace" if as_json else None)
 
 
-@app.command()
+@_command()
 def preview(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
     program: Annotated[Path | None, typer.Argument(help="program written by plan (.json or .srcl); without it the robot stands at home")] = None,
@@ -427,6 +589,8 @@ def preview(
                                                      "any other makes the cell visible to the network")] = "127.0.0.1",
     port: Annotated[int | None, typer.Option("--port", min=1, max=65535,
                                              help="web port (default: the first free one from 7000)")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="print one JSON object on stdout (see below): with --html "
+                                                         "the page written, else the URL served, once it listens")] = False,
 ) -> None:
     """Show the cell in meshcat, animated along a program (serves until Ctrl-C, or writes --html)."""
 
@@ -453,8 +617,14 @@ def preview(
 
             lo = np.array([-HALF_WIDTH_M, -HALF_WIDTH_M, -0.5])
             vmap = build_voxels(build_scene(replace(spec, dynamic=()), robot), lo, lo + 2 * HALF_WIDTH_M, voxels)
+        shown_files = {"cell": str(cell), "program": None if program is None else str(program)}
         if html is not None:
             content = write_html(html, spec, robot, shown, voxels=vmap)
+            if as_json:
+                _print_json("preview", True, {**shown_files, "url": None, "files": [str(html)],
+                                              "frames": content.frames, "duration": round(content.duration, 4),
+                                              "voxels": content.voxels if vmap is not None else None})
+                return
             drawn = f", {content.voxels} blocked voxels" if vmap is not None else ""
             out.print(f"wrote {html} ({content.frames} animation frames, cycle {content.duration:.3f} s{drawn})")
             return
@@ -465,15 +635,19 @@ def preview(
                 where = "every interface of this machine" if host.strip("[]") in WILDCARDS else host
                 _warn([(f"--host {host}: the preview listens on {where}; anyone who can reach it on the network "
                         "can open the page and see the cell (no password)")])
+            if as_json:                         # one object, flushed now: the page is served until Ctrl-C
+                _print_json("preview", True, {**shown_files, "url": url, "files": []})
+                err.print("serving (Ctrl-C to stop)")
+                return
             out.print(f"meshcat preview at {url}  (Ctrl-C to stop)", soft_wrap=True)
 
         serve(spec, robot, shown, announce, voxels=vmap, host=host, port=port)
-        out.print("preview stopped")
+        (err if as_json else out).print("preview stopped")
 
-    _guarded(run)
+    _guarded(run, "preview" if as_json else None)
 
 
-@app.command()
+@_command()
 def batch(
     cells: Annotated[list[Path], typer.Argument(help="cell files (YAML)")],
     jobs: Annotated[int | None, typer.Option("-j", "--jobs", min=1, help="cells planned at once (default: the number of CPUs)")] = None,
@@ -482,6 +656,7 @@ def batch(
     ray_address: Annotated[str | None, typer.Option("--ray", metavar="[ADDRESS]",
                                                     help="plan on Ray: a local Ray without ADDRESS (or with `local`), else the cluster at ADDRESS")] = None,
     baseline: Annotated[str | None, typer.Option("--baseline", metavar="published|teach-in", help="plan every cell by a baseline instead (see plan --baseline)")] = None,
+    as_json: JsonFlag = False,
 ) -> None:
     """Plan many cells in parallel (one process per cell); write their programs and a summary table.
 
@@ -516,13 +691,16 @@ def batch(
         if missing:
             for f in missing:
                 err.print(f"[bold red]error:[/] {f}: cell file not found", soft_wrap=True)
+            if as_json:
+                more = f" ({len(missing) - 1} more)" if len(missing) > 1 else ""
+                _print_json("batch", False, {"error": {"file": missing[0], "key": None,
+                                                       "message": f"{missing[0]}: cell file not found{more}"}})
             return EXIT_BAD_INPUT
         if use_ray:
             try:
                 import ray  # noqa: F401
             except ImportError:
-                err.print("[bold red]error:[/] --ray needs Ray: pip install 'robomax-py[ray]'", soft_wrap=True)
-                return EXIT_BAD_INPUT
+                return _json_failure("batch", as_json, None, "--ray needs Ray: pip install 'robomax-py[ray]'")
         options = BatchOptions(jobs=jobs or os.cpu_count() or 1, timeout=timeout, method=method)
         where = f"Ray ({address or 'local'})" if use_ray else f"{options.jobs} process(es)"
         with Progress(TextColumn("planning"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
@@ -539,6 +717,15 @@ def batch(
                 return o
 
             outcomes = run_batch(files, out_dir, options, use_ray=use_ray, ray_address=address, on_done=done)
+        code = (EXIT_OK if all(o.status == PLANNED for o in outcomes) else
+                EXIT_BAD_INPUT if any(o.status == BAD_INPUT for o in outcomes) else EXIT_INFEASIBLE)
+        if as_json:
+            _print_json("batch", code == EXIT_OK, {
+                "out": str(out_dir), "summary": [str(out_dir / "summary.csv"), str(out_dir / "summary.md")],
+                "cells": [{"cell": o.cell, "file": o.file, "status": o.status, "cycle_time": _num(o.cycle_time),
+                           "seconds": round(o.seconds, 3), "spots": o.spots, "detours": o.detours,
+                           "reasons": o.reasons, "written": list(o.written)} for o in outcomes]})
+            return code
         table = Table(title=f"batch: {out_dir / 'summary.md'}", title_justify="left")
         for col in ("cell", "status", "cycle (s)", "planning (s)", "spots", "detours"):
             table.add_column(col)
@@ -547,20 +734,19 @@ def batch(
                           f"{o.seconds:.1f}", "" if o.spots is None else str(o.spots),
                           "" if o.detours is None else str(o.detours))
         out.print(table)
-        if all(o.status == PLANNED for o in outcomes):
-            return EXIT_OK
-        return EXIT_BAD_INPUT if any(o.status == BAD_INPUT for o in outcomes) else EXIT_INFEASIBLE
+        return code
 
-    code = _guarded(run)
+    code = _guarded(run, "batch" if as_json else None)
     raise typer.Exit(code)
 
 
-@app.command()
+@_command()
 def variants(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
     n: Annotated[int, typer.Option("--n", "-n", min=1, help="number of variants")] = 20,
     seed: Annotated[int, typer.Option("--seed", min=0, help="seed: the same seed writes the same files")] = 0,
     out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder")] = Path("variants"),
+    as_json: JsonFlag = False,
 ) -> None:
     """Write seeded perturbed copies of a cell (clamps ±15 mm, part ±5 mm / ±1°, spot order of free seams)."""
 
@@ -568,12 +754,16 @@ def variants(
         from robomax_py.io.variants import write_variants
 
         made = write_variants(cell, n, seed, out_dir)
+        if as_json:
+            _print_json("variants", True, {"cell": str(cell), "seed": seed, "out": str(out_dir),
+                                           "files": [str(v.path) for v in made]})
+            return
         out.print(f"wrote {len(made)} variant(s) of {cell}: {made[0].path} ... {made[-1].path}")
 
-    _guarded(run)
+    _guarded(run, "variants" if as_json else None)
 
 
-@app.command("import-urdf")
+@_command("import-urdf")
 def import_urdf_command(
     source: Annotated[Path, typer.Argument(help=".urdf or .xacro file (xacro is expanded without ROS)")],
     out_dir: Annotated[Path, typer.Option("-o", "--out", help="the robot folder to write, e.g. robots/irb2400")],
@@ -592,6 +782,7 @@ def import_urdf_command(
     xacro_arg: Annotated[list[str] | None, typer.Option("--xacro-arg", metavar="NAME:=VALUE",
                          help="a xacro argument (repeatable); unset ones take the value the package's "
                               "launch/load_<robot>.launch passes, else the file's default")] = None,
+    as_json: JsonFlag = False,
 ) -> None:
     """Make a self-contained robot folder from a URDF or xacro: meshes copied, IK fitted and checked.
 
@@ -623,12 +814,43 @@ def import_urdf_command(
         r = import_urdf(source, out_dir, packages or (), name=name, flange=flange, srdf=srdf, solver=solver,
                         brand=brand, force=force, limits=limits, xacro_args=xacro_args)
         _warn(r.warnings)
+        if as_json:
+            _print_json("import-urdf", True, {
+                "folder": str(r.folder), "name": r.name, "solver": r.solver, "fk_error_m": float(r.fk_error_m),
+                "brand": r.brand, "meshes": r.meshes, "disabled_pairs": r.disabled_pairs,
+                "seconds": round(r.seconds, 3), "unchanged": r.unchanged, "warnings": list(r.warnings)})
+            return
         what = "unchanged" if r.unchanged else "wrote"
         out.print(f"{what} {r.folder}: robot {r.name}, IK {r.solver} (FK agrees with the URDF within "
                   f"{r.fk_error_m:.1e} m), controller {r.brand}, {r.meshes} meshes, {r.disabled_pairs} disabled "
                   f"pairs from the SRDF ({r.seconds:.1f} s)")
 
-    _guarded(run)
+    _guarded(run, "import-urdf" if as_json else None)
+
+
+@_command()
+def examples(
+    folder: Annotated[Path, typer.Argument(help="folder to copy the example cells into (made if missing)")],
+    force: Annotated[bool, typer.Option("--force", help="replace files there that hold something else")] = False,
+    as_json: JsonFlag = False,
+) -> None:
+    """Copy the example cells shipped with the package (and the part meshes they name) into a folder."""
+
+    def run() -> None:
+        from robomax_py.app.examples import copy_examples
+
+        done = copy_examples(folder, force=force)
+        if as_json:
+            _print_json("examples", True, {"folder": str(folder), "written": [str(p) for p in done.written],
+                                           "unchanged": [str(p) for p in done.unchanged]})
+            return
+        cells = sorted(p.name for p in (*done.written, *done.unchanged) if p.suffix == ".yaml")
+        same = f", {len(done.unchanged)} already there" if done.unchanged else ""
+        out.print(f"wrote {len(done.written)} file(s) to {folder}{same}: {', '.join(cells)}", soft_wrap=True)
+        if cells:
+            out.print(f"try: robomax check {folder / cells[0]}", soft_wrap=True)
+
+    _guarded(run, "examples" if as_json else None)
 
 
 RAY_LOCAL = "local"
