@@ -1,8 +1,8 @@
 """robomax_py: offline programming for spot-welding robot cells.
 
-The public API (`load_cell`, `plan_cell`, `write_programs`, `verify_program`, `LoadedCell`;
-see `robomax_py.app.api`) is imported on first use, so `import robomax_py` and `robomax --help`
-stay fast.
+The public API (`load_cell`, `plan_cell`, `write_programs`, `verify_program`, `LoadedCell`,
+`CellWarning`; see `robomax_py.app.api`) is imported on first use, so `import robomax_py` and
+`robomax --help` stay fast.
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from robomax_py.errors import (
 
 if TYPE_CHECKING:
     from robomax_py.app.api import (
+        CellWarning,
         LoadedCell,
         load_cell,
         plan_cell,
@@ -28,10 +29,11 @@ if TYPE_CHECKING:
 
 from robomax_py._version import __version__  # noqa: E402
 
-_API = ("LoadedCell", "load_cell", "plan_cell", "verify_program", "write_programs")
+_API = ("CellWarning", "LoadedCell", "load_cell", "plan_cell", "verify_program", "write_programs")
 
 __all__ = [
-    "CellFileError", "ExportError", "LoadedCell", "ProgramError", "RobomaxError", "RobotModelError", "__version__",
+    "CellFileError", "CellWarning", "ExportError", "LoadedCell", "ProgramError", "RobomaxError", "RobotModelError",
+    "__version__",
     "load_cell", "plan_cell", "verify_program", "write_programs",
 ]
 

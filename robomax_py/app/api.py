@@ -21,7 +21,13 @@ from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.verify import VerifyReport
 
-__all__ = ["FormatSkippedWarning", "LoadedCell", "load_cell", "plan_cell", "verify_program", "write_programs"]
+__all__ = ["CellWarning", "FormatSkippedWarning", "LoadedCell", "load_cell", "plan_cell", "verify_program", "write_programs"]
+
+
+class CellWarning(UserWarning):
+    """A cell file that loads but probably holds a mistake (`CellSpec.notices`): lengths that look
+    like millimetres, a spot inside an object, a home pose in radians, zero clearance to the part.
+    The message is the notice's 'file: key: message'."""
 
 
 class FormatSkippedWarning(UserWarning):
@@ -41,11 +47,20 @@ class LoadedCell:
 
 
 def load_cell(path: str | Path) -> LoadedCell:
-    """Read and check a cell file (SPEC §3) and build its robot (URDF, meshes, IK checked)."""
+    """Read and check a cell file (SPEC §3) and build its robot (URDF, meshes, IK checked).
+
+    What is valid but probably a mistake is reported through Python's `warnings` module, one
+    `CellWarning` per notice (also kept in ``cell.spec.notices`` as `Notice(file, key, message)`);
+    ``warnings.simplefilter("error", rm.CellWarning)`` makes them errors.
+    """
+    import warnings
+
     from robomax_py.io.cell import load_cell as load_spec
     from robomax_py.io.cell import load_cell_robot
 
     spec = load_spec(Path(path))
+    for notice in spec.notices:
+        warnings.warn(str(notice), CellWarning, stacklevel=2)
     return LoadedCell(spec, load_cell_robot(spec))
 
 
