@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -31,8 +31,10 @@ from robomax_py.spec import (
     Sphere,
 )
 
-if TYPE_CHECKING:
-    from robomax_py.io.cell import CellFile, ObjectFile
+# `io.cell`'s schema objects (CellFile, ObjectFile), typed loosely here: `io.cell` imports this
+# module, and the package keeps no import cycle, not even one for type checking.
+CellFile = Any
+ObjectFile = Any
 
 # No robot reaches 50 m: the largest industrial arms reach about 4 m and a cell on a track or under
 # a gantry spans tens of metres at most. A coordinate beyond 50 m in a metres file is far outside any
