@@ -76,13 +76,11 @@ def lint_cell(parsed: CellFile, cell: CellSpec, path: Path) -> tuple[Notice, ...
     """
     file = str(path)
     meshes: dict[Path, Any] = {}
-    out: list[Notice] = []
-    out += _millimetre_positions(parsed, file)
-    out += _process_lengths(parsed, file)
-    out += _oversized_objects(parsed, cell, file, meshes)
-    out += _home_in_radians(parsed, cell, file)
-    out += _zero_clearance(parsed, cell, file)
-    out += _spots_and_objects(parsed, cell, file, meshes)
+    units = _millimetre_positions(parsed, file) + _oversized_objects(parsed, cell, file, meshes)
+    out = [*units, *_process_lengths(parsed, file), *_home_in_radians(parsed, cell, file),
+           *_zero_clearance(parsed, cell, file)]
+    if not units:                   # in millimetres, every spot is off every surface: one mistake, named above
+        out += _spots_and_objects(parsed, cell, file, meshes)
     return tuple(out)
 
 

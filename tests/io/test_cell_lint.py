@@ -83,6 +83,7 @@ def test_a_cell_in_millimetres_is_named(tmp_path: Path) -> None:
     size = _only(path, "objects[0].box")
     assert "table: it measures 1800 m across, larger than any workshop (100 m)" in size.message
     assert "also 10 more objects over 100 m" in size.message
+    assert [n.key for n in _notices(path)] == ["objects[0].pose.xyz", "objects[0].box", "process.clearance"]
 
 
 def test_a_700_m_table_is_named(tmp_path: Path) -> None:
