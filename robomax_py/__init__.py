@@ -33,7 +33,8 @@ Errors and warnings
     RobomaxError      base of every error raised on purpose (CellFileError, RobotModelError,
                       ProgramError, ExportError), its message naming file, key and problem
     RobomaxWarning    what the CLI prints as `warning:` (defaulted robot limits, a dialect passed
-                      over: FormatSkippedWarning), issued with `warnings.warn`
+                      over: FormatSkippedWarning; a cell that is probably wrong: CellWarning),
+                      issued with `warnings.warn`
 
 The planner's stage log goes to the `logging` logger "robomax_py" at DEBUG level.
 """
@@ -53,6 +54,7 @@ from robomax_py.errors import (
 
 if TYPE_CHECKING:
     from robomax_py.app.api import (
+        CellWarning,
         FailureReason,
         FormatSkippedWarning,
         LoadedCell,
@@ -78,13 +80,13 @@ from robomax_py._version import __version__  # noqa: E402
 
 # Names served from robomax_py.app.api on first use (it imports the planner: numpy, Pinocchio, ...).
 _API = (
-    "FailureReason", "FormatSkippedWarning", "LoadedCell", "PlanOptions", "PlanResult", "PlanStage", "PlanStatus",
+    "CellWarning", "FailureReason", "FormatSkippedWarning", "LoadedCell", "PlanOptions", "PlanResult", "PlanStage", "PlanStatus",
     "ProgressEvent", "SpotFailure", "SpotPlan", "Transition", "TransitionKind", "VerifyReport", "Violation",
     "WrittenPrograms", "load_cell", "plan_cell", "verify_program", "write_programs",
 )
 
 __all__ = [
-    "CellFileError", "ExportError", "FailureReason", "FormatSkippedWarning", "LoadedCell", "PlanOptions", "PlanResult",
+    "CellFileError", "CellWarning", "ExportError", "FailureReason", "FormatSkippedWarning", "LoadedCell", "PlanOptions", "PlanResult",
     "PlanStage", "PlanStatus", "ProgramError", "ProgressEvent", "RobomaxError", "RobomaxWarning", "RobotModelError",
     "SpotFailure", "SpotPlan", "Transition", "TransitionKind", "VerifyReport", "Violation", "WrittenPrograms",
     "__version__", "load_cell", "plan_cell", "verify_program", "write_programs",

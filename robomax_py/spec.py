@@ -301,6 +301,20 @@ class PartSpec:
     supports: tuple[str, ...] = ()            # objects it rests on at its locations
 
 
+@dataclass(frozen=True, slots=True)
+class Notice:
+    """What in a cell file is valid but probably a mistake (lengths that look like millimetres, a
+    spot inside an object, ...): the file, the key path and the message. A warning, never an error:
+    the cell still loads and plans."""
+
+    file: str
+    key: str
+    message: str
+
+    def __str__(self) -> str:
+        return f"{self.file}: {self.key}: {self.message}"
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class CellSpec:
     name: str
@@ -319,6 +333,7 @@ class CellSpec:
     parts: tuple[PartSpec, ...] = ()          # pick-and-place cells: the parts moved
     tcp_limits: TcpLimits | None = None       # pick-and-place cells: TCP limits without a part
     controller: ControllerSetup = field(default_factory=ControllerSetup)   # the integrator's numbers
+    notices: tuple[Notice, ...] = ()          # probable mistakes found at load (`io.cell_lint`)
 
     @property
     def signals(self) -> tuple[str, ...]:

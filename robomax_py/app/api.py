@@ -40,10 +40,16 @@ from robomax_py.verify import VerifyReport
 from robomax_py.world.motion import Violation
 
 __all__ = [
-    "FailureReason", "FormatSkippedWarning", "LoadedCell", "PlanOptions", "PlanResult", "PlanStage", "PlanStatus",
+    "CellWarning", "FailureReason", "FormatSkippedWarning", "LoadedCell", "PlanOptions", "PlanResult", "PlanStage", "PlanStatus",
     "ProgressEvent", "RobomaxWarning", "SpotFailure", "SpotPlan", "Transition", "TransitionKind", "VerifyReport",
     "Violation", "WrittenPrograms", "load_cell", "plan_cell", "verify_program", "write_programs",
 ]
+
+
+class CellWarning(RobomaxWarning):
+    """A cell file that loads but probably holds a mistake (`CellSpec.notices`): lengths that look
+    like millimetres, a spot inside an object, a home pose in radians, zero clearance to the part.
+    The message is the notice's 'file: key: message'."""
 
 
 class FormatSkippedWarning(RobomaxWarning):
@@ -126,7 +132,10 @@ def load_cell(source: str | Path | Mapping[str, Any], *, base_dir: str | Path | 
     default the current directory; a file's are relative to its folder, and `base_dir` is refused.
 
     What the robot's loading fell back on (limits not given in robot.yaml and derived from the
-    URDF, visual meshes not read) is issued as a `RobomaxWarning`.
+    URDF, visual meshes not read) is issued as a `RobomaxWarning`. What is valid but probably a
+    mistake in the cell is issued as a `CellWarning` (a `RobomaxWarning`), one per notice (also kept
+    in ``cell.spec.notices`` as `Notice(file, key, message)`); ``warnings.simplefilter("error",
+    rm.RobomaxWarning)`` makes them errors.
     """
     from robomax_py.io.cell import cell_from_mapping, load_cell_robot
     from robomax_py.io.cell import load_cell as load_spec
@@ -138,6 +147,8 @@ def load_cell(source: str | Path | Mapping[str, Any], *, base_dir: str | Path | 
                         "to its own folder")
     else:
         spec = load_spec(Path(source))
+    for notice in spec.notices:
+        warnings.warn(str(notice), CellWarning, stacklevel=2)
     robot: RobotModel = load_cell_robot(spec)
     for line in robot.warnings:
         warnings.warn(line, RobomaxWarning, stacklevel=2)

@@ -245,6 +245,7 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
         from robomax_py.plan.reach import reach_report, self_contacts
 
         spec = load_cell(cell)
+        _warn([str(n) for n in spec.notices])   # probable mistakes: warnings, the cell is still valid
         robot = load_cell_robot(spec)
         _warn(robot.warnings)
         if not as_json:
@@ -322,6 +323,7 @@ def plan(
         configure_logging(err, verbose)
         t0 = time.perf_counter()
         spec = load_cell(cell)
+        _warn([str(n) for n in spec.notices])
         robot = load_cell_robot(spec)
         _honour_signals()
         _warn(robot.warnings)
@@ -356,6 +358,7 @@ def plan(
             removed = committed.removed
             unlisted = committed.unlisted
         report = plan_report(result, seconds, written, robot.defaulted_limits, checked, chosen.skipped)
+        report["warnings"] = [{"file": n.file, "key": n.key, "message": n.message} for n in spec.notices]
         if result.status == "planned":
             report["removed"] = [str(out_dir / n) for n in removed]
             report["not_of_this_plan"] = [str(out_dir / n) for n in _stale_programs(out_dir, set_name)]

@@ -12,10 +12,10 @@ import json
 import math
 import re
 import stat
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, TypeVar
 
 import numpy as np
 from pydantic import (
@@ -29,13 +29,20 @@ from pydantic import (
 )
 
 from robomax_py.errors import CellFileError, RobotModelError
+from robomax_py.io.cell_lint import library_hint, lint_cell
 from robomax_py.io.robot import (
     load_robot_spec,
     load_tool_spec,
     resolve_robot_file,
     resolve_tool_file,
 )
-from robomax_py.io.yaml_files import count_items, read_yaml_mapping, validation_error
+from robomax_py.io.yaml_files import (
+    MAX_LISTED_PROBLEMS,
+    count_items,
+    read_yaml_mapping,
+    several,
+    validation_error,
+)
 from robomax_py.robot.geometry import load_mesh
 from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
 from robomax_py.spec import (
@@ -64,6 +71,7 @@ from robomax_py.spec import (
 from robomax_py.transforms import invert, pose_matrix
 from robomax_py.units import deg_to_rad
 
+T = TypeVar("T")
 SUPPORTED_VERSIONS = (1,)
 # A direction this close to parallel with the normal (sine of the angle) leaves no seam direction.
 MIN_DIRECTION_SINE = 1e-3
@@ -506,24 +514,37 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str) -> CellSpec:
         parsed = CellFile.model_validate(data)
     except ValidationError as exc:
         raise validation_error(exc, CellFile, path, CellFileError) from None
-    _check_unique_names(parsed, path)
-    _check_orientations(parsed, path)
-    _check_declared_triangles(parsed, path)
+    # Independent checks each run, and their errors are reported together (up to MAX_LISTED_PROBLEMS);
+    # a check that needs what an earlier one refused waits until those are fixed.
+    problems = _Problems(path)
+    problems.attempt(_check_unique_names, parsed, path)
+    jobs_ok = not problems.found           # one job, named uniquely: its seams can be built
+    problems.attempt(_check_orientations, parsed, path)
+    problems.attempt(_check_declared_triangles, parsed, path)
     triangles: list[int] = []              # of every mesh read, for the cell's total
-    machines, doors = _machines(parsed, path, triangles)
-
-    robot_file = checked_file(resolve_robot_file(parsed.robot.model, path), LIMITS.description,
-                              named_by(CellFileError, path, "robot.model"), f"unknown robot '{parsed.robot.model}':")
-    tool_file = checked_file(resolve_tool_file(parsed.tool, path), LIMITS.description,
-                             named_by(CellFileError, path, "tool"), f"unknown tool '{parsed.tool}':")
+    machines, doors = problems.attempt(_machines, parsed, path, triangles) or ((), ())
+    seams = problems.attempt(_job_seams, parsed, path, problems) if jobs_ok else None
+    robot_file = problems.attempt(checked_file, resolve_robot_file(parsed.robot.model, path), LIMITS.description,
+                                  named_by(CellFileError, path, "robot.model"),
+                                  f"unknown robot '{parsed.robot.model}'{library_hint(parsed.robot.model, 'robot')}:")
+    tool_file = problems.attempt(checked_file, resolve_tool_file(parsed.tool, path), LIMITS.description,
+                                 named_by(CellFileError, path, "tool"),
+                                 f"unknown tool '{parsed.tool}'{library_hint(parsed.tool, 'tool')}:")
+    if parsed.name is None:
+        problems.attempt(_stem_name, path)
+    problems.raise_found()
+    assert robot_file is not None and tool_file is not None and seams is not None   # else raised above
     robot_spec = load_robot_spec(robot_file)
     tool_spec = load_tool_spec(tool_file)
     for key, mesh in (("body", tool_spec.body), ("tips", tool_spec.tips)):
         triangles.append(_check_mesh_readable(mesh, RobotModelError(tool_file, key, f"cannot read mesh {mesh}"),
                                               triangles))
-    objects = tuple(_object(o, path, f"objects[{i}]", triangles) for i, o in enumerate(parsed.objects))
-    dynamic = tuple(_object(o, path, f"dynamic[{i}]", triangles) for i, o in enumerate(parsed.dynamic))
-    parts = _parts(parsed, path, robot_spec, triangles)
+    objects = tuple(problems.attempt(_object, o, path, f"objects[{i}]", triangles) for i, o in enumerate(parsed.objects))
+    dynamic = tuple(problems.attempt(_object, o, path, f"dynamic[{i}]", triangles) for i, o in enumerate(parsed.dynamic))
+    parts = problems.attempt(_parts, parsed, path, robot_spec, triangles)
+    home = problems.attempt(_home, parsed, robot_spec, path)
+    problems.raise_found()
+    assert parts is not None and home is not None
     if sum(triangles) > CELL_LIMITS.cell_triangles:
         raise CellFileError(path, "objects", f"its meshes and its tool's have {sum(triangles):,} triangles together, "
                             f"more than the {CELL_LIMITS.cell_triangles:,} a cell may have (cell_triangles)")
@@ -533,10 +554,10 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str) -> CellSpec:
         source=path.resolve(),
         robot=robot_spec,
         T_world_base=frozen_array(_pose(parsed.robot.base)),
-        home=frozen_array(_home(parsed, robot_spec, path)),
+        home=frozen_array(home),
         tool=tool_spec,
-        objects=objects,
-        seams=_job_seams(parsed, path),
+        objects=tuple(o for o in objects if o is not None),
+        seams=seams,
         process=ProcessSpec(
             weld_time=parsed.process.weld_time,
             approach=parsed.process.approach,
@@ -548,13 +569,14 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str) -> CellSpec:
         planner=PlannerSpec(seed=parsed.planner.seed, speed=parsed.planner.speed, tcp_speed=parsed.planner.tcp_speed,
                             detour_speed=parsed.planner.detour_speed, detours=parsed.planner.detours,
                             dynamic=parsed.planner.dynamic, max_wait=parsed.planner.max_wait),
-        dynamic=dynamic + doors,
+        dynamic=tuple(o for o in dynamic if o is not None) + doors,
         digest=digest,
         machines=machines,
         parts=parts,
         tcp_limits=_tcp_limits(parsed.pick_place.unloaded) if parsed.pick_place is not None else None,
     )
-    return dataclasses.replace(cell, controller=_controller(parsed.robot.controller, cell, path))
+    cell = dataclasses.replace(cell, controller=_controller(parsed.robot.controller, cell, path))
+    return dataclasses.replace(cell, notices=lint_cell(parsed, cell, path))
 
 
 def _controller(ctrl: RobotControllerFile, cell: CellSpec, path: Path) -> ControllerSetup:
@@ -594,12 +616,35 @@ def _controller(ctrl: RobotControllerFile, cell: CellSpec, path: Path) -> Contro
                            numeric_registers=tuple(ctrl.registers.numeric), inputs=tuple(inputs), weld=ctrl.weld)
 
 
-def _job_seams(parsed: CellFile, path: Path) -> tuple[SeamSpec, ...]:
+def _job_seams(parsed: CellFile, path: Path, problems: _Problems) -> tuple[SeamSpec, ...]:
     if parsed.tending is not None:
         return _tending_seams(parsed, path)
     if parsed.pick_place is not None:
         return _pick_place_seams(parsed.pick_place, {o.name for o in parsed.objects}, path)
-    return _seams(parsed, path)
+    return _seams(parsed, path, problems)
+
+
+class _Problems:
+    """The CellFileErrors of a cell file's independent checks, raised together as one (`several`)."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.found: list[CellFileError] = []
+
+    def attempt(self, check: Callable[..., T], *args: Any) -> T | None:
+        """`check(*args)`, or None when it refuses the file (its error kept; raised at once when
+        MAX_LISTED_PROBLEMS are kept: the rest of the file is not looked at)."""
+        try:
+            return check(*args)
+        except CellFileError as exc:
+            self.found.append(exc)
+            if len(self.found) >= MAX_LISTED_PROBLEMS:
+                raise several(list(self.found), self.path, more=True) from None
+            return None
+
+    def raise_found(self) -> None:
+        if self.found:
+            raise several(list(self.found), self.path)
 
 
 def _tcp_limits(limits: TcpLimitsFile | None) -> TcpLimits | None:
@@ -960,38 +1005,25 @@ def _tending_seams(parsed: CellFile, path: Path) -> tuple[SeamSpec, ...]:
                      spots=tuple(spots)),)
 
 
-def _seams(parsed: CellFile, path: Path) -> tuple[SeamSpec, ...]:
+def _seams(parsed: CellFile, path: Path, problems: _Problems) -> tuple[SeamSpec, ...]:
     """The seams with their spots to weld: spots marked `skip` are left out, and so is a seam
-    left without spots; a cell left without any is an error."""
-    seams = tuple(s for s in (_seam(s, path, f"seams[{i}]") for i, s in enumerate(parsed.seams)) if s.spots)
-    if not seams:
+    left without spots; a cell left without any is an error. Every seam is checked (`problems`
+    keeps each refusal)."""
+    before = len(problems.found)
+    checked = [_seam(s, path, f"seams[{i}]", problems) for i, s in enumerate(parsed.seams)]
+    seams = tuple(s for s in checked if s.spots)
+    if not seams and len(problems.found) == before:     # not when spots were refused: those are the problem
         raise CellFileError(path, "seams", "every spot is marked skip: nothing to weld")
     return seams
 
 
-def _seam(seam: SeamFile, path: Path, key: str) -> SeamSpec:
+def _seam(seam: SeamFile, path: Path, key: str, problems: _Problems) -> SeamSpec:
     spots = []
-    tol = seam.tolerance
     for j, spot in enumerate(seam.spots):
-        spot_key = f"{key}.spots[{j}]"
-        if spot.skip:
-            continue
-        normal = _unit(spot.normal, path, f"{spot_key}.normal")
-        direction = _unit(spot.direction, path, f"{spot_key}.direction")
-        along = direction - np.dot(direction, normal) * normal
-        if np.linalg.norm(along) < MIN_DIRECTION_SINE:
-            raise CellFileError(path, f"{spot_key}.direction", f"parallel to the normal {spot.normal}: no seam direction")
-        angles = None
-        if spot.alpha is not None and spot.beta is not None and spot.gamma is not None:
-            angles = (deg_to_rad(spot.alpha), deg_to_rad(spot.beta), deg_to_rad(spot.gamma))
-            _check_pinned(spot, tol, path, spot_key)
-        spots.append(SpotSpec(
-            name=spot.name,
-            xyz=frozen_array(spot.xyz),
-            normal=frozen_array(normal),
-            direction=frozen_array(along / np.linalg.norm(along)),
-            weld_time=spot.weld_time, schedule=spot.schedule, angles=angles, config=spot.config,
-        ))
+        checked = None if spot.skip else problems.attempt(_spot, spot, seam.tolerance, path, f"{key}.spots[{j}]")
+        if checked is not None:
+            spots.append(checked)
+    tol = seam.tolerance
     return SeamSpec(
         name=seam.name,
         ordered=seam.ordered,
@@ -1000,6 +1032,25 @@ def _seam(seam: SeamFile, path: Path, key: str) -> SeamSpec:
         gamma_range=(deg_to_rad(tol.gamma[0]), deg_to_rad(tol.gamma[1])),
         grid=seam.grid,
         spots=tuple(spots),
+    )
+
+
+def _spot(spot: SpotFile, tol: ToleranceFile, path: Path, spot_key: str) -> SpotSpec:
+    normal = _unit(spot.normal, path, f"{spot_key}.normal")
+    direction = _unit(spot.direction, path, f"{spot_key}.direction")
+    along = direction - np.dot(direction, normal) * normal
+    if np.linalg.norm(along) < MIN_DIRECTION_SINE:
+        raise CellFileError(path, f"{spot_key}.direction", f"parallel to the normal {spot.normal}: no seam direction")
+    angles = None
+    if spot.alpha is not None and spot.beta is not None and spot.gamma is not None:
+        angles = (deg_to_rad(spot.alpha), deg_to_rad(spot.beta), deg_to_rad(spot.gamma))
+        _check_pinned(spot, tol, path, spot_key)
+    return SpotSpec(
+        name=spot.name,
+        xyz=frozen_array(spot.xyz),
+        normal=frozen_array(normal),
+        direction=frozen_array(along / np.linalg.norm(along)),
+        weld_time=spot.weld_time, schedule=spot.schedule, angles=angles, config=spot.config,
     )
 
 

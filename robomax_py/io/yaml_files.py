@@ -200,29 +200,69 @@ def key_path(loc: tuple[int | str, ...]) -> str:
     return out
 
 
+# At most this many independent problems of one file are listed in one error: enough to fix a file
+# in one pass, few enough to read (a list of 2,000 spots all wrong the same way is one mistake).
+MAX_LISTED_PROBLEMS = 20
+
+
 def validation_error(
     exc: ValidationError, schema: type[BaseModel], path: Path, error: type[_LocatedError]
 ) -> _LocatedError:
-    """The first schema violation as one located error, with a 'did you mean' for unknown keys."""
-    first = exc.errors(include_url=False)[0]
-    # Pydantic appends the union member or validator name ('function-after[...]') to locations; drop it.
-    loc = tuple(p for p in first["loc"] if not (isinstance(p, str) and "[" in p))
-    kind = first["type"]
+    """The schema violations as one located error, with a 'did you mean' for unknown keys: the
+    error itself when there is one, else every one (up to MAX_LISTED_PROBLEMS) on its own line. A
+    value that fits no member of a union is reported once, at its own key."""
+    found: list[_LocatedError] = []
+    seen: list[tuple[int | str, ...]] = []
+    for err in exc.errors(include_url=False):
+        # Pydantic appends the union member or validator name ('function-after[...]') to locations; drop it.
+        loc = tuple(p for p in err["loc"] if not (isinstance(p, str) and "[" in p))
+        value = _value_loc(loc)
+        if any(value[:len(s)] == s or s[:len(value)] == value for s in seen):
+            continue                     # the same value, seen through another member of a union
+        seen.append(value)
+        found.append(error(path, key_path(loc) or None, _problem(err, schema, loc)))
+    return several(found, path)
+
+
+_TYPE_TAGS = frozenset({"int", "float", "str", "bool", "list", "dict", "none"})
+
+
+def _value_loc(loc: tuple[int | str, ...]) -> tuple[int | str, ...]:
+    """The location of the value an error is about: cut at the first union member tag pydantic
+    inserts ('constrained-int', 'InputFile', 'list'); file keys are lower-case words without '-'."""
+    for i, part in enumerate(loc):
+        if isinstance(part, str) and ("-" in part or part[:1].isupper() or part in _TYPE_TAGS):
+            return loc[:i]
+    return loc
+
+
+def several(errors: list[_LocatedError], file: str | Path, more: bool = False) -> _LocatedError:
+    """One error of independent ones: the error itself when there is one, else a list naming each
+    with its file and key (`more`: further problems may follow, not looked for)."""
+    if len(errors) == 1 and not more:
+        return errors[0]
+    shown = errors[:MAX_LISTED_PROBLEMS]
+    lines = "".join(f"\n  {e}" for e in shown)
+    tail = ""
+    if more or len(errors) > len(shown):
+        tail = f"\n  (listed the first {len(shown)}; fix these and check again for more)"
+    return type(errors[0])(file, None, f"{len(errors) if not tail else str(len(shown)) + ' or more'} problems:"
+                                       f"{lines}{tail}")
+
+
+def _problem(err: Any, schema: type[BaseModel], loc: tuple[int | str, ...]) -> str:
+    kind = err["type"]
     if kind == "extra_forbidden":
         known = _fields_at(schema, loc[:-1])
         hint = difflib.get_close_matches(str(loc[-1]), known, n=1, cutoff=0.6)
         suggestion = f"; did you mean '{hint[0]}'?" if hint else (f"; known keys: {', '.join(known)}" if known else "")
-        problem = f"unknown key{suggestion}"
-    elif kind == "missing":
-        problem = "required key is missing"
-    else:
-        problem = _clean_message(first["msg"])
-        if "input" in first and kind not in ("value_error", "assertion_error"):
-            problem += f", got {_show(first['input'])}"
-    more = len(exc.errors()) - 1
-    if more:
-        problem += f" (and {more} more problem{'s' if more > 1 else ''})"
-    return error(path, key_path(loc) or None, problem)
+        return f"unknown key{suggestion}"
+    if kind == "missing":
+        return "required key is missing"
+    problem = _clean_message(err["msg"])
+    if "input" in err and kind not in ("value_error", "assertion_error"):
+        problem += f", got {_show(err['input'])}"
+    return problem
 
 
 def _fields_at(schema: type[BaseModel], loc: tuple[int | str, ...]) -> list[str]:

@@ -102,8 +102,8 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
     if failures:
         names = ", ".join(f"{f.seam}/{f.name} ({f.reason})" for f in failures)
         what = "station(s) cannot be reached" if cell.tending else "spot(s) cannot be welded"
-        return PlanResult(cell.name, robot.name, "infeasible", f"{len(failures)} {what}: {names}",
-                          failures=failures)
+        return PlanResult(cell.name, robot.name, "infeasible",
+                          f"{len(failures)} {what}: {names}{_workpiece_hint(cell, spots)}", failures=failures)
     if options.baseline:
         spots = [_baseline_candidate(c) for c in spots]
 
@@ -325,6 +325,29 @@ def verify_trajectory(world: CollisionWorld, robot: RobotModel, traj: Trajectory
         return check_carried_motion(cell, robot, world, loads.worlds, traj.t, traj.q, spots, stop_at_first=True,
                                     velocity_rtol=PLAN_VELOCITY_RTOL)
     return check_motion(world, robot, traj.t, traj.q, stop_at_first=True, velocity_rtol=PLAN_VELOCITY_RTOL)
+
+
+def _workpiece_hint(cell: CellSpec, spots: list[SpotCandidates]) -> str:
+    """'; every spot ... mark it `workpiece: true`' when every spot of the cell failed and each had
+    candidates refused for the tool's tips touching the same object that is not a workpiece: the
+    part being welded, most likely, not marked as one (the tips may touch only a workpiece). A
+    clamp over some spots is a real obstacle, so the hint needs every spot; '' otherwise."""
+    if not spots or any(len(c) for c in spots):
+        return ""
+    common: set[str] | None = None
+    for c in spots:
+        touched = set()
+        for r in c.rejected:
+            a, _, b = r.detail.partition(" vs ")
+            if r.kind == "collision" and "tool_tips" in (a, b):
+                touched.add(b if a == "tool_tips" else a)
+        common = touched if common is None else common & touched
+    workpieces = {o.name for o in cell.objects if o.workpiece}
+    named = sorted((common or set()) - workpieces - {"tool_tips"})
+    if not named or cell.tending or cell.parts:
+        return ""
+    return (f"; every spot fails on 'tool_tips vs {named[0]}': the gun's tips may touch only a workpiece; if "
+            f"{named[0]} is the part being welded, mark it `workpiece: true` in the cell file")
 
 
 def _failure(cell: CellSpec, c: SpotCandidates) -> SpotFailure:

@@ -70,7 +70,7 @@ def test_plan_plot_writes_the_png_beside_the_program(tmp_path: Path, write_small
     assert result.exit_code == EXIT_OK, result.output
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
         "small_cell.json", "small_cell.manifest.json", "small_cell.png", "small_cell.srcl"]
-    assert str(out / "small_cell.png") in json.loads(result.output)["files"]
+    assert str(out / "small_cell.png") in json.loads(result.stdout)["files"]
     with Image.open(out / "small_cell.png") as png:
         assert png.format == "PNG" and png.size[0] > 500 and png.size[1] > 150
 

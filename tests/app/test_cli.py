@@ -116,7 +116,7 @@ def test_plan_reference_cell_twice_is_byte_identical(tmp_path: Path, reference_c
         out = tmp_path / f"run{k}"
         result = runner.invoke(app, ["plan", str(reference_cell_path), "-o", str(out), "--json"])
         assert result.exit_code == EXIT_OK, result.output
-        report = json.loads(result.output)
+        report = json.loads(result.stdout)
         assert report["status"] == "planned" and len(report["spots"]) == 15
         outputs.append((out / "cabin_flange.json").read_bytes())
     assert outputs[0] == outputs[1]
