@@ -27,10 +27,10 @@ def _cycles(adj: dict[str, list[str]]) -> list[list[str]]:
     on: set[str] = set()
     stack: list[str] = []
     out: list[list[str]] = []
-    for root in adj:
+    for root, successors in adj.items():
         if root in index:
             continue
-        work = [(root, iter(adj[root]))]
+        work = [(root, iter(successors))]
         index[root] = low[root] = len(index)
         stack.append(root)
         on.add(root)

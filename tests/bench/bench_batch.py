@@ -30,10 +30,10 @@ sys.path.insert(0, str(REPO / "tests"))
 # Workers (forkserver children, Ray workers) import robomax_py from this checkout too.
 os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH", "")) if p)
 
-from conftest import REFERENCE_CELL, _write_small_cell  # noqa: E402
+from conftest import REFERENCE_CELL, _write_small_cell
 
-from robomax_py.app.batch import BatchOptions, CellOutcome, run_batch  # noqa: E402
-from robomax_py.io.variants import write_variants  # noqa: E402
+from robomax_py.app.batch import BatchOptions, CellOutcome, run_batch
+from robomax_py.io.variants import write_variants
 
 
 def one_batch(files: list[str], out: Path, jobs: int, use_ray: bool) -> tuple[float, tuple[CellOutcome, ...]]:

@@ -31,24 +31,24 @@ from pathlib import Path
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.plan import (  # noqa: E402
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.plan import (
     PlanOptions,
     PlanResult,
     plan_cell,
     resolved_options,
     weld_end,
 )
-from robomax_py.plan.candidates import SpotCandidates, seam_candidates  # noqa: E402
-from robomax_py.plan.junction import WeldEnd, time_junction  # noqa: E402
-from robomax_py.plan.poses import orientation_grid  # noqa: E402
-from robomax_py.program import as_written_joints, written_speed, written_tcp_speed  # noqa: E402
-from robomax_py.spec import CellSpec  # noqa: E402
-from robomax_py.timing import ptp_time_estimate  # noqa: E402
-from robomax_py.world.collision import CollisionWorld  # noqa: E402
-from robomax_py.world.scene import build_scene  # noqa: E402
+from robomax_py.plan.candidates import SpotCandidates, seam_candidates
+from robomax_py.plan.junction import WeldEnd, time_junction
+from robomax_py.plan.poses import orientation_grid
+from robomax_py.program import as_written_joints, written_speed, written_tcp_speed
+from robomax_py.spec import CellSpec
+from robomax_py.timing import ptp_time_estimate
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[2]
 REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
@@ -138,7 +138,7 @@ def main() -> None:
     base = plan_cell(cell, robot, PlanOptions(baseline=True))
     assert opt.status == base.status == "planned", (opt.message, base.message)
     legs_o, weld, lines_o = legs_of(opt)
-    legs_b, weld_b, lines_b = legs_of(base)
+    legs_b, _weld_b, lines_b = legs_of(base)
     by_key_o = {leg.key: leg for leg in legs_o}
     if {leg.key for leg in legs_b} != set(by_key_o):
         print("the two plans join different pairs of stops; leg-by-leg comparison skipped")

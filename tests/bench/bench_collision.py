@@ -17,20 +17,20 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-import argparse  # noqa: E402
-import sys  # noqa: E402
-import time  # noqa: E402
-from pathlib import Path  # noqa: E402
+import argparse
+import sys
+import time
+from pathlib import Path
 
-import numpy as np  # noqa: E402
+import numpy as np
 
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO))
 
-from robomax_py.app.bench import median_cpu_seconds  # noqa: E402
-from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.world.collision import CollisionWorld  # noqa: E402
-from robomax_py.world.scene import build_scene  # noqa: E402
+from robomax_py.app.bench import median_cpu_seconds
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.scene import build_scene
 
 RUNS = 5
 REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
@@ -82,10 +82,12 @@ def main() -> None:
     for label, world, n in (("pre-filter", broad, n_configs), ("coal broad phase", manager, n_configs),
                             ("exhaustive", exhaustive, max(n_configs // 10, 500))):
         sub = qs[:n]
-        single = n / median_cpu_seconds(lambda: [world.is_free(q) for q in sub], RUNS)
-        batch = n / median_cpu_seconds(lambda: world.are_free(sub), RUNS)
         m = n_segments if world is broad else max(n_segments // 10, 10)
-        seg_time = median_cpu_seconds(lambda: [world.segment_free(a, b) for a, b in zip(seg_a[:m], seg_b[:m])], RUNS)
+        # Each lambda is timed before the loop moves on; the defaults bind this round's values.
+        single = n / median_cpu_seconds(lambda w=world, s=sub: [w.is_free(q) for q in s], RUNS)
+        batch = n / median_cpu_seconds(lambda w=world, s=sub: w.are_free(s), RUNS)
+        seg_time = median_cpu_seconds(
+            lambda w=world, m=m: [w.segment_free(a, b) for a, b in zip(seg_a[:m], seg_b[:m])], RUNS)
         rows.append((label, single, batch, m / seg_time, seg_done * m / seg_time))
 
     print(f"cell {cell.name}: robot {robot.name}, tool {cell.tool.name}, clearance {cell.process.clearance} m")

@@ -12,23 +12,23 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-import argparse  # noqa: E402
-import sys  # noqa: E402
-from collections.abc import Callable  # noqa: E402
-from importlib import metadata  # noqa: E402
-from pathlib import Path  # noqa: E402
+import argparse
+import sys
+from collections.abc import Callable
+from importlib import metadata
+from pathlib import Path
 
-import numpy as np  # noqa: E402
-import pinocchio as pin  # noqa: E402
+import numpy as np
+import pinocchio as pin
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from robomax_py.app.bench import median_cpu_seconds  # noqa: E402
-from robomax_py.robot.ik._chain import chain_to_frame, frame_pose  # noqa: E402
-from robomax_py.robot.ik.numeric import numeric_ik  # noqa: E402
-from robomax_py.robot.ik.opw import OpwParams, opw_fk, opw_ik  # noqa: E402
-from robomax_py.robot.ik.turns import expand, turn_shifts  # noqa: E402
-from robomax_py.robot.ik.ur import UR10_EXAMPLE_ROBOT_DATA, ur_fk, ur_ik  # noqa: E402
+from robomax_py.app.bench import median_cpu_seconds
+from robomax_py.robot.ik._chain import chain_to_frame, frame_pose
+from robomax_py.robot.ik.numeric import numeric_ik
+from robomax_py.robot.ik.opw import OpwParams, opw_fk, opw_ik
+from robomax_py.robot.ik.turns import expand, turn_shifts
+from robomax_py.robot.ik.ur import UR10_EXAMPLE_ROBOT_DATA, ur_fk, ur_ik
 
 RUNS = 5
 KR16 = OpwParams(

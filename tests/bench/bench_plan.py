@@ -24,17 +24,19 @@ from pathlib import Path
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
+import itertools
 
-from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.plan import PlanOptions, method_options, plan_cell  # noqa: E402
+import numpy as np
+
+from robomax_py.cspace.grid import nearest_cell
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.plan import PlanOptions, method_options, plan_cell
+from robomax_py.plan.cspace_detour import local_grid
 from robomax_py.plan.graph import Sequencer as _Sequencer
 from robomax_py.plan.results import resolved_options
-from robomax_py.cspace.grid import nearest_cell  # noqa: E402
-from robomax_py.plan.cspace_detour import local_grid  # noqa: E402
-from robomax_py.plan.roadmap import Roadmap  # noqa: E402
-from robomax_py.world.collision import CollisionWorld  # noqa: E402
-from robomax_py.world.scene import build_scene  # noqa: E402
+from robomax_py.plan.roadmap import Roadmap
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[2]
 REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
@@ -98,7 +100,7 @@ def grid_detour(world: CollisionWorld, q_start: np.ndarray, q_goal: np.ndarray, 
     # The map only tests cell centres: sweep the path it found with our 2 mm bound to see if it holds.
     index = {c: k for k, c in enumerate(np.ndindex(r, r, r))}
     waypoints = [q_start, *[qs[index[c]] for c in reversed(cells[1:-1])], q_goal] if found else []
-    sweep_free = found and all(world.segment_free(a, b) for a, b in zip(waypoints[:-1], waypoints[1:]))
+    sweep_free = found and all(world.segment_free(a, b) for a, b in itertools.pairwise(waypoints))
     return tests, seconds, found, max(0, len(cells) - 1), sweep_free
 
 

@@ -38,7 +38,7 @@ REPO = HERE.parents[1]
 sys.path.insert(0, str(HERE))
 
 from corpus_cells import scaled_cell
-from scale_cells import FAMILIES, write_scale_cell  # noqa: E402
+from scale_cells import FAMILIES, write_scale_cell
 
 CHILD = r"""
 import json, os, resource, sys, time
@@ -68,7 +68,7 @@ def run_child(cell: Path, code_dir: Path, baseline: bool, timeout: float) -> dic
     env = dict(os.environ, PYTHONPATH=str(code_dir), OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
     try:
         done = subprocess.run([sys.executable, "-c", CHILD, str(cell), "1" if baseline else "0"], env=env,
-                              capture_output=True, text=True, timeout=timeout, cwd=str(code_dir))
+                              capture_output=True, text=True, timeout=timeout, cwd=str(code_dir), check=False)
     except subprocess.TimeoutExpired:
         return {"status": "timeout", "cpu": math.nan}
     for line in done.stdout.splitlines():

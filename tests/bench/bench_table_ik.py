@@ -17,13 +17,13 @@ import os
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import statistics  # noqa: E402
-import time  # noqa: E402
+import statistics
+import time
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from robomax_py.robot.ik.table import JointGrid, build_table  # noqa: E402
-from robomax_py.robot.planar import Container, PlanarArm  # noqa: E402
+from robomax_py.robot.ik.table import JointGrid, build_table
+from robomax_py.robot.planar import Container, PlanarArm
 
 PAPER = {(18, False): 1598, (18, True): 1128, (9, False): 134}
 HELD_M = 0.25

@@ -28,20 +28,20 @@ import os
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import argparse  # noqa: E402
-import statistics  # noqa: E402
-import time  # noqa: E402
-from dataclasses import replace  # noqa: E402
-from pathlib import Path  # noqa: E402
+import argparse
+import statistics
+import time
+from dataclasses import replace
+from pathlib import Path
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.plan import PlanOptions, PlanResult, plan_cell  # noqa: E402
-from robomax_py.robot import RobotModel  # noqa: E402
-from robomax_py.spec import CellSpec, MachineSpec  # noqa: E402
-from robomax_py.world.collision import CollisionWorld  # noqa: E402
-from robomax_py.world.scene import build_scene  # noqa: E402
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.plan import PlanOptions, PlanResult, plan_cell
+from robomax_py.robot import RobotModel
+from robomax_py.spec import CellSpec, MachineSpec
+from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[2]
 

@@ -19,9 +19,9 @@ from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-from robomax_py.app.bench import lower_bound  # noqa: E402
-from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.plan import PlanOptions, plan_cell  # noqa: E402
+from robomax_py.app.bench import lower_bound
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.plan import PlanOptions, plan_cell
 
 REPO = Path(__file__).resolve().parents[2]
 REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"

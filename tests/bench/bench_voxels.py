@@ -12,16 +12,16 @@ import os
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import statistics  # noqa: E402
-import sys  # noqa: E402
-import time  # noqa: E402
-from pathlib import Path  # noqa: E402
+import statistics
+import sys
+import time
+from pathlib import Path
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from robomax_py.io.cell import load_cell, load_cell_robot  # noqa: E402
-from robomax_py.world.scene import build_scene  # noqa: E402
-from robomax_py.world.voxels import build_voxels  # noqa: E402
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.world.scene import build_scene
+from robomax_py.world.voxels import build_voxels
 
 REPO = Path(__file__).resolve().parents[2]
 CELLS = [REPO / "tests" / "data" / "reference" / "cabin_flange.yaml", *sorted((REPO / "cells").glob("*.yaml"))]

@@ -19,8 +19,22 @@ import numpy as np
 import pytest
 import trimesh
 
-from robomax_py.cspace import CSpaceGrid, build_map, cover_radius, learned_map, learned_model, surface_points
-from robomax_py.cspace.learned import TrainingSettings, VirtualBase, _basis, _fit, from_arrays, to_arrays
+from robomax_py.cspace import (
+    CSpaceGrid,
+    build_map,
+    cover_radius,
+    learned_map,
+    learned_model,
+    surface_points,
+)
+from robomax_py.cspace.learned import (
+    TrainingSettings,
+    VirtualBase,
+    _basis,
+    _fit,
+    from_arrays,
+    to_arrays,
+)
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.world.scene import build_scene
 

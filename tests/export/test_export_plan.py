@@ -90,7 +90,7 @@ def test_the_process_cell_waits_and_welds_as_asked(process_cell: dict[str, Any])
     first_weld = next(k for k, i in enumerate(program.instructions) if isinstance(i, Spot))
     clamp_wait = next(k for k, i in enumerate(program.instructions) if isinstance(i, WaitFor) and i.signal == "clamp1_closed")
     assert clamp_wait < first_weld
-    weld = [p for p in process_cell["result"].trajectory.phases_of("weld") if p.label.endswith("/s8")][0]
+    weld = next(p for p in process_cell["result"].trajectory.phases_of("weld") if p.label.endswith("/s8"))
     assert weld.t_end - weld.t_start == pytest.approx(0.8, abs=1e-9)
 
 

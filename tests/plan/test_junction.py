@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 from typing import Any
 
@@ -38,7 +39,7 @@ WAYPOINTS = np.array([[0.0, 0.0, 0.0], [0.6, 0.0, 0.0], [0.6, 0.6, 0.0], [1.2, 0
 
 def _distance_to_polyline(p: np.ndarray) -> float:
     best = np.inf
-    for a, b in zip(WAYPOINTS[:-1], WAYPOINTS[1:]):
+    for a, b in itertools.pairwise(WAYPOINTS):
         d = b - a
         s = np.clip(np.dot(p - a, d) / np.dot(d, d), 0.0, 1.0)
         best = min(best, float(np.linalg.norm(p - (a + s * d))))
@@ -52,7 +53,7 @@ class _SegmentWorld:
         raise NotImplementedError
 
     def check_path(self, points: np.ndarray) -> SegmentCheck:
-        for k, (a, b) in enumerate(zip(points[:-1], points[1:]), start=1):
+        for k, (a, b) in enumerate(itertools.pairwise(points), start=1):
             if not self.segment_free(a, b):
                 return SegmentCheck(False, k, len(points), 0, None)
         return SegmentCheck(True, max(len(points) - 1, 1), len(points), 0, None)
@@ -176,7 +177,7 @@ def test_approach_points_are_flown_by_and_the_electrodes_keep_the_axis(small_pla
 
 
 def test_tcp_speed_holds_on_lines_and_their_joins(small_plan: Any) -> None:
-    cell, robot, result = small_plan
+    _cell, robot, result = small_plan
     traj = result.trajectory
     p = fk_tcp(robot, traj.q)[:, :3, 3]
     v = np.linalg.norm(np.diff(p, axis=0), axis=1) / np.diff(traj.t)

@@ -7,6 +7,7 @@ table, clamp1) with a 3x3 alpha/beta grid at gamma = 0, so each plan takes one o
 
 from __future__ import annotations
 
+import itertools
 import shutil
 from pathlib import Path
 from typing import Any
@@ -177,7 +178,7 @@ def test_ordered_seam_keeps_its_order_and_unordered_may_reorder(tmp_path: Path) 
 
     assert [s.name for s in ordered.spots] == ZIGZAG
     arrive = [s.t_arrive for s in ordered.spots]
-    assert all(b > a for a, b in zip(arrive[:-1], arrive[1:])), "spots are not listed in weld order"
+    assert all(b > a for a, b in itertools.pairwise(arrive)), "spots are not listed in weld order"
 
     free_order = [s.name for s in free.spots]
     assert sorted(free_order) == sorted(ZIGZAG)
@@ -211,7 +212,7 @@ def test_given_order_keeps_the_file_order_and_chooses_among_every_candidate(tmp_
 
 def test_spot_out_of_reach_is_reported_unreachable(tmp_path: Path) -> None:
     path = write_cell(tmp_path, [SPOTS["s7"], FAR_SPOT, SPOTS["s8"]], PANEL_ON_TABLE)
-    cell, robot, result = plan_file(path)
+    _cell, robot, result = plan_file(path)
     # Independent of the IK: the spot lies beyond the TCP's reach from the axis-1 line
     # (sampled flange reach + tool offset, with 0.5 m to spare for the sampling).
     tool_offset = float(np.linalg.norm(np.asarray(robot.T_flange_tcp)[:3, 3]))
@@ -282,7 +283,7 @@ def test_trajectory_meets_spec_section_5(clamp_plan: tuple[CellSpec, Any, PlanRe
 
 
 def test_planning_twice_gives_identical_results(clamp_plan: tuple[CellSpec, Any, PlanResult]) -> None:
-    cell, robot, first = clamp_plan
+    cell, _robot, first = clamp_plan
     second = plan_cell(load_cell(cell.source), load_cell_robot(cell))
     assert first.status == second.status == "planned"
     assert [s.name for s in first.spots] == [s.name for s in second.spots]

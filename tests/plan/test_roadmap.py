@@ -9,6 +9,7 @@ over the same graph and weights).
 from __future__ import annotations
 
 import heapq
+import itertools
 
 import numpy as np
 import pytest
@@ -40,7 +41,7 @@ class BallWorld:
 
 def _path_free(path: np.ndarray) -> bool:
     world = BallWorld()
-    return all(world.check_segment(a, b).free for a, b in zip(path[:-1], path[1:]))
+    return all(world.check_segment(a, b).free for a, b in itertools.pairwise(path))
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -76,7 +77,7 @@ def test_first_checked_path_is_the_shortest() -> None:
         return start if u == -1 else (goal if u == -2 else roadmap.nodes[u])
 
     def length(p: list[int]) -> float:
-        return float(sum(ptp_time_estimate(point(a), point(b), LIMITS) for a, b in zip(p[:-1], p[1:])))
+        return float(sum(ptp_time_estimate(point(a), point(b), LIMITS) for a, b in itertools.pairwise(p)))
 
     # Reference: a plain heap Dijkstra over the same graph.
     adj: dict[int, list[tuple[int, float]]] = {-1: [(v, float(w)) for v, w in zip(start_links, start_w)]}

@@ -42,7 +42,7 @@ def brute_force_choice(order, edge, node) -> float:
     best = np.inf
     for choice in itertools.product(*(range(len(node[s])) for s in order)):
         stops = [(HOME, 0), *zip(order, choice), (HOME, 0)]
-        cost = sum(edge(a, b)[ca, cb] for (a, ca), (b, cb) in zip(stops[:-1], stops[1:]))
+        cost = sum(edge(a, b)[ca, cb] for (a, ca), (b, cb) in itertools.pairwise(stops))
         cost += sum(node[s][c] for s, c in zip(order, choice))
         best = min(best, cost)
     return float(best)
@@ -58,7 +58,7 @@ def test_dp_is_exact_for_a_fixed_order(seed: int) -> None:
     assert abs(cost - brute_force_choice(order, edge, node)) < COST_TOL_S
     # The returned choice really has the returned cost.
     stops = [(HOME, 0), *zip(order, choice), (HOME, 0)]
-    recomputed = sum(edge(a, b)[ca, cb] for (a, ca), (b, cb) in zip(stops[:-1], stops[1:]))
+    recomputed = sum(edge(a, b)[ca, cb] for (a, ca), (b, cb) in itertools.pairwise(stops))
     recomputed += sum(node[s][c] for s, c in zip(order, choice))
     assert abs(recomputed - cost) < COST_TOL_S
 

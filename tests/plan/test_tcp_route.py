@@ -3,6 +3,7 @@ opening, waits outside while the door is closed, and the arm follows it in one b
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import replace
 from pathlib import Path
 
@@ -42,13 +43,13 @@ def test_the_route_into_a_machine_passes_the_door_opening(cell_world: dict[str, 
     assert not isinstance(route, NoRoute), route
     np.testing.assert_allclose(route[[0, -1]], [p0, p1])
     # Where the route crosses the door's plane, it is inside the opening.
-    for a, b in zip(route[:-1], route[1:]):
+    for a, b in itertools.pairwise(route):
         if (a[0] - DOOR_X) * (b[0] - DOOR_X) < 0:
             s = (DOOR_X - a[0]) / (b[0] - a[0])
             y, z = (a + s * (b - a))[1:]
             assert abs(y) < OPENING_Y and OPENING_Z[0] < z < OPENING_Z[1]
     # Every point of it lies in free voxels (the tips' reach and the clearance kept from the walls).
-    dense = np.vstack([a + np.linspace(0, 1, 40)[:, None] * (b - a) for a, b in zip(route[:-1], route[1:])])
+    dense = np.vstack([a + np.linspace(0, 1, 40)[:, None] * (b - a) for a, b in itertools.pairwise(route)])
     assert space.voxels.is_free(dense).all()          # type: ignore[union-attr]
     followed = follow(robot, cell_world["world"], route, q0, q1)  # type: ignore[arg-type]
     assert followed is not None

@@ -118,7 +118,7 @@ def test_kr_like_round_trip_with_limits(rng: np.random.Generator) -> None:
     q, valid = numeric_ik(model, fid, T, KR_LOWER, KR_UPPER, rng, n_seeds=24, max_solutions=6)
     assert q.shape == (N_POSES, 6, 6)
     check_solutions(model, fid, T, q, valid)
-    exact, exact_valid = opw_ik(KR16_LIKE, T)
+    exact, _exact_valid = opw_ik(KR16_LIKE, T)
     close = np.all(wrapped_diff(q[:, :, None], exact[:, None, :]) < 1e-5, axis=-1)
     assert close.any(axis=-1)[valid].mean() > 0.999
     assert valid.any(axis=-1).mean() > 0.97

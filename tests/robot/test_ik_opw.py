@@ -268,7 +268,7 @@ def test_params_from_mapping_converts_degrees() -> None:
     assert_allclose(params.offsets, KR6_R700.offsets, atol=1e-15)
     assert params.sign_corrections == KR6_R700.sign_corrections
     assert params.c3 == 0.365 and isinstance(params.b, float)
-    defaults = params_from_mapping("opw", {k: v for k, v in KR6_YAML.items() if k in "a1 a2 b c1 c2 c3 c4".split()})
+    defaults = params_from_mapping("opw", {k: v for k, v in KR6_YAML.items() if k in ["a1", "a2", "b", "c1", "c2", "c3", "c4"]})
     assert isinstance(defaults, OpwParams)
     assert defaults.offsets == (0.0,) * 6 and defaults.sign_corrections == (1,) * 6
     assert defaults.flange_rpy == (0.0, 0.0, 0.0)

@@ -71,7 +71,7 @@ def test_expand_350_degree_joint_gets_both_turns() -> None:
 def test_expand_filters_limits_and_keeps_invalid_branches_invalid() -> None:
     variants = turn_shifts(KR_LOWER, KR_UPPER)
     q = np.array([[175 * DEG, 0, 0, 0, 0, 0], [0, 0, 0, 0, 0, 0], [np.nan] * 6])
-    out, valid = expand(q, np.array([True, True, False]), variants)
+    _out, valid = expand(q, np.array([True, True, False]), variants)
     V = variants.count
     assert not valid[:V].any()                 # A1 at 175 deg is beyond 170 and has no other turn
     assert valid[V : 2 * V].sum() == 1         # all zero: +-360 deg is outside every limit

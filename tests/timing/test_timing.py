@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 
 import numpy as np
 import pytest
@@ -410,7 +411,7 @@ def test_path_move_stop_follows_the_polyline_exactly(limits: JointLimits) -> Non
         k = int(np.argmin(np.linalg.norm(move.segment.q - w, axis=1)))
         assert_allclose(move.segment.q[k], w, atol=ENDPOINT_TOL_RAD)
         assert_allclose(move.segment.qd[k], 0.0, atol=REST_TOL)
-    legs = sum(float(jerk_limited_time_estimate(a, b, limits)) for a, b in zip(WAYPOINTS[:-1], WAYPOINTS[1:]))
+    legs = sum(float(jerk_limited_time_estimate(a, b, limits)) for a, b in itertools.pairwise(WAYPOINTS))
     assert move.segment.duration == pytest.approx(legs, abs=1e-6)
 
 

@@ -12,8 +12,14 @@ import re
 from collections.abc import Callable
 
 import pytest
-
-from conftest import Edit, Placed, detour_into_the_part, model_execution, placement_mm_zyx, read_execution
+from conftest import (
+    Edit,
+    Placed,
+    detour_into_the_part,
+    model_execution,
+    placement_mm_zyx,
+    read_execution,
+)
 from controller_model.fanuc import run_fanuc
 
 
@@ -53,7 +59,7 @@ def _taught_with_tool_1(placed: Placed) -> dict[str, Edit]:
 
 
 def _selections_deleted(placed: Placed) -> dict[str, Edit]:
-    return {".ls": lambda t: re.sub(r"^\s*\d+:\s+(UFRAME_NUM|UTOOL_NUM)=\d+ ;\r?\n", "", t, flags=re.M)}
+    return {".ls": lambda t: re.sub(r"^\s*\d+:\s+(UFRAME_NUM|UTOOL_NUM)=\d+ ;\r?\n", "", t, flags=re.MULTILINE)}
 
 
 def _taught_in_user_frame_1(placed: Placed) -> dict[str, Edit]:

@@ -17,16 +17,22 @@ import re
 from collections.abc import Callable
 
 import pytest
-from scipy.spatial.transform import Rotation
-
-from conftest import Edit, Placed, detour_into_the_part, model_execution, placement_mm_zyx, read_execution
+from conftest import (
+    Edit,
+    Placed,
+    detour_into_the_part,
+    model_execution,
+    placement_mm_zyx,
+    read_execution,
+)
 from controller_model.krl import run_krl
+from scipy.spatial.transform import Rotation
 
 FRAME = re.compile(r"\{X (-?[\d.]+), Y (-?[\d.]+), Z (-?[\d.]+), A (-?[\d.]+), B (-?[\d.]+), C (-?[\d.]+)\}")
 
 
 def _frame_text(xyz: list[float], zyx: list[float]) -> str:
-    return "{X %.3f, Y %.3f, Z %.3f, A %.4f, B %.4f, C %.4f}" % (*xyz, *zyx)
+    return "{{X {:.3f}, Y {:.3f}, Z {:.3f}, A {:.4f}, B {:.4f}, C {:.4f}}}".format(*xyz, *zyx)
 
 
 def _placement_as_base(placed: Placed) -> dict[str, Edit]:

@@ -17,11 +17,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from scipy.spatial.transform import Rotation
-
-from conftest import Edit, Placed, detour_into_the_part, model_execution, placement_mm_zyx, read_execution
+from conftest import (
+    Edit,
+    Placed,
+    detour_into_the_part,
+    model_execution,
+    placement_mm_zyx,
+    read_execution,
+)
 from controller_model.common import Call, Motion
 from controller_model.rapid import run_rapid
+from scipy.spatial.transform import Rotation
+
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import plan_cell
 from robomax_py.publish import publish

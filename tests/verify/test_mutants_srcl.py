@@ -8,15 +8,15 @@ import re
 from collections.abc import Callable
 
 import pytest
+from conftest import Edit, Placed, placement_mm_zyx
 from scipy.spatial.transform import Rotation
 
-from conftest import Edit, Placed, placement_mm_zyx
 from robomax_py.errors import ProgramError
 
 
 def _placement_as_base(placed: Placed) -> dict[str, Edit]:
     xyz, zyx = placement_mm_zyx(placed.cell)
-    frame = "(POS(%.3f, %.3f, %.3f), ORI(%.4f, %.4f, %.4f))" % (*xyz, *zyx)
+    frame = "(POS({:.3f}, {:.3f}, {:.3f}), ORI({:.4f}, {:.4f}, {:.4f}))".format(*xyz, *zyx)
     return {".srcl": lambda t: re.sub(r"(BASE FRAME \d* ?:= )\([^;]*\)(;)", lambda m: m[1] + frame + m[2], t)}
 
 

@@ -10,10 +10,16 @@ import re
 from collections.abc import Callable
 
 import pytest
-from scipy.spatial.transform import Rotation
-
-from conftest import Edit, Placed, detour_into_the_part, model_execution, placement_mm_zyx, read_execution
+from conftest import (
+    Edit,
+    Placed,
+    detour_into_the_part,
+    model_execution,
+    placement_mm_zyx,
+    read_execution,
+)
 from controller_model.urscript import run_urscript
+from scipy.spatial.transform import Rotation
 
 
 def _placement_as_feature(placed: Placed) -> dict[str, Edit]:
@@ -41,7 +47,7 @@ def _joints_in_degrees(placed: Placed) -> dict[str, Edit]:
 
 
 def _tcp_never_set(placed: Placed) -> dict[str, Edit]:
-    return {".script": lambda t: re.sub(r"^\s*set_tcp\(.*\)\n", "", t, flags=re.M)}
+    return {".script": lambda t: re.sub(r"^\s*set_tcp\(.*\)\n", "", t, flags=re.MULTILINE)}
 
 
 def _feature_left_out(placed: Placed) -> dict[str, Edit]:

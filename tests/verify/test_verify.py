@@ -41,7 +41,7 @@ def kinds(cell: Path, program: dict[str, Any], tmp: Path) -> set[str]:
 
 
 def test_plan_output_is_clean(planned: tuple[Path, dict[str, Any], Path]) -> None:
-    cell, program, tmp = planned
+    cell, _program, tmp = planned
     result = runner.invoke(app, ["verify", str(cell), str(tmp / "out" / "small_cell.json")])
     assert result.exit_code == EXIT_OK, result.output
     assert "clean" in result.output

@@ -73,7 +73,7 @@ def test_removed_detour_collides(planned: dict[str, Any]) -> None:
 
 
 def test_skipped_spot(planned: dict[str, Any]) -> None:
-    edited = re.sub(r"^\s*SPOT s8 .*\n", "", planned["text"], count=1, flags=re.M)
+    edited = re.sub(r"^\s*SPOT s8 .*\n", "", planned["text"], count=1, flags=re.MULTILINE)
     assert "spot" in violations(planned, edited)
 
 

@@ -8,6 +8,7 @@ coal's default request, with the pair's margin.
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 
@@ -418,7 +419,7 @@ def test_path_check_equals_its_segments_checked_one_by_one(
         centre = q_near + rng.uniform(-0.5, 0.5, robot.dof)
         pts = centre + rng.uniform(-0.15, 0.15, size=(4, robot.dof))
         pts[1] = pts[0]                                          # a zero-length segment too
-        segs = [world.check_segment(a, b) for a, b in zip(pts[:-1], pts[1:])]
+        segs = [world.check_segment(a, b) for a, b in itertools.pairwise(pts)]
         res = world.check_path(pts)
         assert res.free == all(seg.free for seg in segs)
         assert res.states == 1 + sum(seg.states - 1 for seg in segs if seg.states > 1)
