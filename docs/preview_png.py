@@ -4,8 +4,9 @@
 
 PROGRAM is a `.json` or `.srcl` written by `robomax plan CELL -o DIR`; without it the reference cell is
 planned into a temporary folder first (about a minute). The animation is paused at T seconds (default:
-when the middle spot of the program is welded). Needs Debian's chromium (/usr/bin/chromium) and the
-`playwright` package (`pip install -e '.[test]'`); no browser is downloaded.
+when the middle spot of the program is welded) with the page's own slider, so the picture shows the
+overlay as a person sees it: cell name, legend, time and spot. Needs Debian's chromium
+(/usr/bin/chromium) and the `playwright` package (`pip install -e '.[test]'`); no browser is downloaded.
 """
 
 from __future__ import annotations
@@ -59,8 +60,10 @@ def main() -> int:
             try:
                 page = browser.new_page(viewport={"width": VIEWPORT_PX[0], "height": VIEWPORT_PX[1]})
                 page.goto(page_file.as_uri())
-                page.wait_for_function("typeof viewer !== 'undefined' && viewer.animator.duration > 0")
-                page.evaluate("t => { viewer.animator.pause(); viewer.animator.seek(t); }", t_show)
+                page.wait_for_function("!document.getElementById('robomax-play').disabled")
+                # Moving the slider holds the animation there, as it does under a person's hand.
+                page.evaluate("t => { const s = document.getElementById('robomax-scrub'); s.value = String(t);"
+                              " s.dispatchEvent(new Event('input', {bubbles: true})); }", t_show)
                 page.wait_for_timeout(800)
                 png = page.screenshot()
             finally:

@@ -42,6 +42,30 @@ PHASE_COLOURS: dict[str, int] = {
 }
 
 
+# What each colour means, in the words of the preview's legend: key -> (label, colour). Keys are the
+# role names, the phase kinds drawn as path lines, and the other things drawn. Moves and blends share
+# a colour and one entry; weld and wait phases draw no line (the robot stands at the spot / still).
+LEGEND: dict[str, tuple[str, int]] = {
+    "robot": ("robot", ROBOT),
+    "tool_body": ("weld gun", TOOL_BODY),
+    "tool_tips": ("gun tips", TOOL_TIPS),
+    "part": ("workpiece", ROLE_COLOURS["part"]),
+    "clamp": ("clamp", ROLE_COLOURS["clamp"]),
+    "fixture": ("fixture (table, plate, post)", ROLE_COLOURS["fixture"]),
+    "dynamic": ("moving obstacle (shown while present)", ROLE_COLOURS["dynamic"]),
+    "spot": ("weld spot (triad: the gun's frame there)", SPOT),
+    "approach": ("path: approach", PHASE_COLOURS["approach"]),
+    "retract": ("path: retract", PHASE_COLOURS["retract"]),
+    "move": ("path: move", PHASE_COLOURS["move"]),
+    "detour": ("path: detour", PHASE_COLOURS["detour"]),
+    "voxel": ("blocked voxel", VOXEL),
+}
+# The phase kinds each path legend entry stands for.
+PATH_LEGEND_KINDS: dict[str, tuple[str, ...]] = {
+    "approach": ("approach",), "retract": ("retract",), "move": ("move", "blend"), "detour": ("detour",),
+}
+
+
 def object_role(obj: ObjectSpec, dynamic: bool = False) -> str:
     """The role a cell object is drawn as: "part", "clamp", "fixture" or "dynamic".
 
@@ -70,6 +94,8 @@ def hex_colour(colour: int) -> str:
 __all__ = [
     "DYNAMIC_OPACITY",
     "FLOOR",
+    "LEGEND",
+    "PATH_LEGEND_KINDS",
     "PHASE_COLOURS",
     "ROBOT",
     "ROLE_COLOURS",

@@ -18,13 +18,15 @@ camera looks at (between the robot base and the spots) is the viewer's origin, w
 controls always look at; the floor grid is shifted with it.
 
 `write_html` writes one self-contained page (meshcat's `static_html`, which inlines the viewer's
-three.js bundle and the scene); `serve` keeps a meshcat server running until interrupted. Both
-draw through the preview's own server (`preview_server`: meshcat's bridge bound to 127.0.0.1 unless
+three.js bundle and the scene); `serve` keeps a meshcat server running until interrupted. Both pages
+carry the overlay of `preview_overlay` (cell name, legend, clock, play/pause, slider, current spot).
+Both draw through the preview's own server (`preview_server`: meshcat's bridge bound to 127.0.0.1 unless
 a host is given, its WebSocket opened only to the page's own Origin, nothing served but the viewer).
 """
 
 from __future__ import annotations
 
+import json
 import math
 import re
 from collections.abc import Callable
@@ -37,6 +39,7 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray
 from robomax_py.app import palette
+from robomax_py.app.preview_overlay import inject, overlay_facts, overlay_html
 from robomax_py.app.preview_parts import CarriedPart, carried_parts
 from robomax_py.app.preview_program import ShownProgram
 from robomax_py.app.preview_server import LOOPBACK
@@ -180,16 +183,17 @@ def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram,
 
 def write_html(path: Path, cell: CellSpec, robot: RobotModel, program: ShownProgram, fps: int = DEFAULT_FPS,
                voxels: VoxelMap | None = None) -> PreviewContent:
-    """Write the preview as one self-contained HTML page (atomically); works offline.
+    """Write the preview as one self-contained HTML page (atomically), with its overlay; works offline.
 
     A meshcat server runs only while the page is made (meshcat builds the page from its scene).
     """
     from robomax_py.io.files import write_atomic
 
+    overlay = overlay_html(overlay_facts(cell, program, voxels is not None))
     vis = _visualizer()
     try:
         content = populate(vis, cell, robot, program, fps, voxels)
-        html = vis.static_html()
+        html = inject(vis.static_html(), overlay)
     finally:
         _close(vis)
     write_atomic(path, html)
@@ -215,7 +219,7 @@ def serve(cell: CellSpec, robot: RobotModel, program: ShownProgram, announce: Ca
     """
     import time
 
-    vis = _visualizer(host, port)
+    vis = _visualizer(host, port, overlay_html(overlay_facts(cell, program, voxels is not None)))
     try:
         populate(vis, cell, robot, program, fps, voxels)
         announce(vis.url())
@@ -227,15 +231,16 @@ def serve(cell: CellSpec, robot: RobotModel, program: ShownProgram, announce: Ca
         _close(vis)
 
 
-def _visualizer(host: str = LOOPBACK, port: int | None = None) -> Any:
+def _visualizer(host: str = LOOPBACK, port: int | None = None, overlay: str | None = None) -> Any:
     """A meshcat visualizer drawing into its own preview server (`preview_server`), which it stops
-    in `_close`; meshcat's own URL banner is not printed."""
+    in `_close`; meshcat's own URL banner is not printed. `overlay`: an HTML fragment the server puts
+    into the page it serves."""
     import contextlib
     import io
 
     import meshcat
 
-    proc, zmq_url = _start_server(host, port)
+    proc, zmq_url = _start_server(host, port, overlay)
     try:
         with contextlib.redirect_stdout(io.StringIO()):
             vis = meshcat.Visualizer(zmq_url=zmq_url)
@@ -246,10 +251,11 @@ def _visualizer(host: str = LOOPBACK, port: int | None = None) -> Any:
     return vis
 
 
-def _start_server(host: str, port: int | None) -> tuple[Any, str]:
+def _start_server(host: str, port: int | None, overlay: str | None = None) -> tuple[Any, str]:
     """Start `preview_server` and return the process and its ZMQ URL.
 
-    The server stays in this process group (a Ctrl-C or a signal to the group ends it too) and
+    `overlay` goes to the server as the first line of its stdin (JSON), read before it listens; no
+    size limit, unlike an argument, and nothing on disk. The server stays in this process group (a Ctrl-C or a signal to the group ends it too) and
     stops by itself when its stdin, a pipe kept open by this process, closes (this process ended,
     however). Its stderr goes to the null device: it says what went wrong on stdout.
     """
@@ -265,7 +271,16 @@ def _start_server(host: str, port: int | None) -> tuple[Any, str]:
     args = [sys.executable, "-u", "-m", "robomax_py.app.preview_server", "--host", host]
     if port is not None:
         args += ["--port", str(port)]
+    if overlay is not None:
+        args.append("--overlay-stdin")
     proc = subprocess.Popen(args, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env)
+    if overlay is not None:
+        assert proc.stdin is not None
+        try:
+            proc.stdin.write(json.dumps(overlay).encode("ascii") + b"\n")
+            proc.stdin.flush()
+        except BrokenPipeError:
+            pass                                  # it exited already; said below, from its stdout
     found: dict[str, str] = {}
     assert proc.stdout is not None
     for raw in proc.stdout:                       # ends at end of file: the server exited

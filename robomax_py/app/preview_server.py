@@ -15,13 +15,16 @@ for a foreign page that rebinds its own host name to 127.0.0.1) or when the requ
   port the system picks, whatever `--host` is (only this machine's robomax process drives it);
 - the WebSocket handshake answered 403 unless its Origin is the page's own (`OriginPolicy`): a
   missing Origin and any other site are refused, whatever Host or Sec-Fetch-Site say;
-- only the viewer served: GET /static/ (meshcat's index.html) and /static/main.min.js; every other
+- only the viewer served: GET /static/ (meshcat's index.html, with the preview's overlay when one is
+  given: `preview_overlay`) and /static/main.min.js; every other
   path is 404 (no directory listing, none of the viewer folder's other files), except the icon
   browsers ask for by themselves, /favicon.ico, answered with an empty 204;
 - messages from the page ignored (the page needs to send none; meshcat uses them only to capture
   images, which the preview does not do).
 
-It runs as `python -m robomax_py.app.preview_server --host H [--port P]`, prints `zmq_url=...` and
+It runs as `python -m robomax_py.app.preview_server --host H [--port P] [--overlay-stdin]` (with
+`--overlay-stdin` it first reads one line from stdin: the overlay's HTML as a JSON string), prints
+`zmq_url=...` and
 `web_url=...` (or one `error=...` line and exits 1), and from then on writes nothing: its stdout and
 stderr point at the null device, so that a pipe nobody reads can never stall it (tornado logs every
 refused request). It stops when its stdin reaches end of file, i.e. when the robomax process that
@@ -133,11 +136,41 @@ def _is_local_address(host: str) -> bool:
     return True
 
 
-def _viewer_files() -> dict[str, tuple[bytes, str]]:
-    """The served files' bytes (read once) by the name after /static/."""
+def _viewer_files(overlay: str | None = None) -> dict[str, tuple[bytes, str]]:
+    """The served files' bytes (read once) by the name after /static/; `overlay` (an HTML fragment)
+    put into the page."""
     from meshcat.servers.zmqserver import VIEWER_ROOT
 
-    return {name: ((Path(VIEWER_ROOT) / file).read_bytes(), kind) for name, (file, kind) in SERVED.items()}
+    from robomax_py.app.preview_overlay import inject
+
+    files = {}
+    for name, (file, kind) in SERVED.items():
+        body = (Path(VIEWER_ROOT) / file).read_bytes()
+        if overlay is not None and file == "index.html":
+            body = inject(body.decode("utf-8"), overlay).encode("utf-8")
+        files[name] = (body, kind)
+    return files
+
+
+def read_overlay(fd: int) -> str | None:
+    """The overlay sent as the first line of `fd` (a JSON string); None at end of file (the process
+    that started this one is gone).
+
+    Read with os.read, not a buffered file, so that nothing after the line is taken from the pipe
+    that `_watch_parent` watches afterwards.
+    """
+    import json
+
+    line = b""
+    while not line.endswith(b"\n"):
+        chunk = os.read(fd, 1)
+        if not chunk:
+            return None
+        line += chunk
+    value = json.loads(line)
+    if isinstance(value, str):
+        return value
+    raise ValueError("the overlay sent on stdin is not a JSON string")
 
 
 def _handlers() -> tuple[type, type, type]:
@@ -200,7 +233,7 @@ def _bridge_class() -> type:
         a page) is meshcat's.
         """
 
-        def __init__(self, host: str, port: int | None) -> None:
+        def __init__(self, host: str, port: int | None, overlay: str | None = None) -> None:
             import tornado.httpserver
             import tornado.ioloop
             from meshcat.servers.tree import SceneTree
@@ -214,6 +247,7 @@ def _bridge_class() -> type:
             self.fileserver_port = sockets[0].getsockname()[1]
             bound = sorted({s.getsockname()[0] for s in sockets})
             self.policy = origin_policy(host, bound, self.fileserver_port)
+            self.overlay = overlay
             self.app = self.make_app()
             server = tornado.httpserver.HTTPServer(self.app, xheaders=False)
             server.add_sockets(sockets)
@@ -225,7 +259,7 @@ def _bridge_class() -> type:
 
             scene_socket, viewer_file, no_icon = _handlers()
             return tornado.web.Application(
-                [(r"/static/([A-Za-z0-9_.-]*)", viewer_file, {"files": _viewer_files()}),
+                [(r"/static/([A-Za-z0-9_.-]*)", viewer_file, {"files": _viewer_files(self.overlay)}),
                  (r"/favicon\.ico", no_icon),
                  (r"/", scene_socket, {"bridge": self, "policy": self.policy})],
                 websocket_max_message_size=MAX_MESSAGE_BYTES,
@@ -294,9 +328,20 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description="robomax preview: meshcat's server, bound and fenced")
     parser.add_argument("--host", default=LOOPBACK)
     parser.add_argument("--port", type=int, default=None)
+    parser.add_argument("--overlay-stdin", action="store_true", help="read the page's overlay (a JSON string line) from stdin first")
     args = parser.parse_args(argv)
+    overlay = None
+    if args.overlay_stdin:
+        try:
+            overlay = read_overlay(sys.stdin.fileno())
+        except ValueError as exc:
+            print(f"error=bad overlay: {exc}", flush=True)
+            return 1
+        if overlay is None:
+            print("error=stdin closed before the overlay arrived", flush=True)
+            return 1
     try:
-        bridge = _bridge_class()(args.host, args.port)
+        bridge = _bridge_class()(args.host, args.port, overlay)
     except (OSError, ValueError) as exc:
         detail = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
         print(f"error=cannot listen on {args.host}" + (f" port {args.port}" if args.port is not None else "")
