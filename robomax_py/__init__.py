@@ -76,7 +76,7 @@ if TYPE_CHECKING:
         write_programs,
     )
 
-from robomax_py._version import __version__  # noqa: E402
+from robomax_py._version import __version__
 
 # Names served from robomax_py.app.api on first use (it imports the planner: numpy, Pinocchio, ...).
 _API = (

@@ -16,6 +16,7 @@ import dataclasses
 import math
 import time
 from dataclasses import dataclass
+from typing import Any, cast
 
 import numpy as np
 
@@ -201,8 +202,8 @@ def _same(a: object, b: object) -> bool:
     rest = [f for f in fields if f != "zyx_deg"]
     if any(getattr(a, f) != getattr(b, f) for f in rest):
         return False
-    Ra = lin_pose(LinMove((0.0, 0.0, 0.0), getattr(a, "zyx_deg")))[:3, :3]
-    Rb = lin_pose(LinMove((0.0, 0.0, 0.0), getattr(b, "zyx_deg")))[:3, :3]
+    Ra = lin_pose(LinMove((0.0, 0.0, 0.0), cast(Any, a).zyx_deg))[:3, :3]     # a dataclass with zyx_deg (above)
+    Rb = lin_pose(LinMove((0.0, 0.0, 0.0), cast(Any, b).zyx_deg))[:3, :3]
     angle = math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(Ra.T @ Rb) - 1.0) / 2.0))))
     return angle <= TOL.readback_angle_deg
 

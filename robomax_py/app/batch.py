@@ -347,7 +347,7 @@ def write_outcome_programs(out_dir: Path, outcome: CellOutcome, taken: dict[str,
 
 def summary_rows(outcomes: Sequence[CellOutcome]) -> list[dict[str, str]]:
     """One row per cell, columns SUMMARY_COLUMNS, fixed formats (s with 3 decimals)."""
-    def num(v: float | int | None, fmt: str) -> str:
+    def num(v: float | None, fmt: str) -> str:
         return "" if v is None else format(v, fmt)
 
     return [

@@ -19,7 +19,7 @@ import signal
 import sys
 from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import Annotated, Any, TypeVar
+from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeVar
 
 import typer
 from rich.console import Console
@@ -29,6 +29,10 @@ from typer.core import TyperCommand, TyperGroup
 from robomax_py._version import __version__
 from robomax_py.errors import RobomaxError
 from robomax_py.io.files import signals_held
+
+if TYPE_CHECKING:                     # the commands import what they use when they run
+    from robomax_py._typing import FloatArray
+    from robomax_py.publish import CheckedProgram
 
 EXIT_OK = 0
 EXIT_VIOLATIONS = 1
@@ -340,7 +344,7 @@ def plan(
         _honour_signals()
         seconds = time.perf_counter() - t0
         written: list[Path] = []
-        checked = []
+        checked: list[CheckedProgram] = []
         removed: tuple[str, ...] = ()
         unlisted: tuple[str, ...] = ()
         if result.status == "planned":
@@ -545,7 +549,7 @@ def cspace(
         check_arm(robot)
         scene = build_scene(spec, robot)             # one world for the wrist's IK check and the map
         world = CollisionWorld(robot, scene, spec.process.clearance)
-        values = "home" if wrist == "home" else spot_wrist(spec, robot, wrist, world)
+        values: Literal["home"] | FloatArray = "home" if wrist == "home" else spot_wrist(spec, robot, wrist, world)
         m = build_map(spec, robot, values, resolution, jobs or default_workers(), world)
         path = None
         if program is not None:

@@ -88,11 +88,11 @@ def learned_summary(cell: CellSpec, robot: RobotModel, scene: Scene, exact: CSpa
         "learned_blocked_by_objects": int(m.obstacle.sum()),
         "learned_wrongly_free": int((exact.obstacle & ~m.obstacle).sum()),
         "learned_wrongly_blocked": int((~exact.obstacle & m.obstacle).sum()),
-        "learned_points": int(len(points)),
+        "learned_points": len(points),
         "learned_sphere_radius_m": round(radius, 4),
         "learned_cpu_s": round(m.cpu_seconds, 3),
         "training": "cached" if cached else f"{model.train_cpu_seconds:.1f} s CPU, {model.train_checks:,} checks",
-        "training_neurons": int(len(model.centres)),
+        "training_neurons": len(model.centres),
     }, model
 
 

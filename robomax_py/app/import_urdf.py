@@ -66,15 +66,15 @@ from robomax_py.transforms import rpy_from_matrix
 # further files the import would not copy).
 MESH_SUFFIXES = (".stl", ".dae", ".obj", ".ply", ".off", ".glb")
 _BRAND_PATTERNS = (
-    ("kuka", re.compile(r"kuka|(^|[^a-z])kr\s*\d", re.I)),
-    ("abb", re.compile(r"abb|irb\s*\d", re.I)),
-    ("fanuc", re.compile(r"fanuc|lrmate|(^|[^a-z])(m|r|cr|crx|arc|lr)[-_]?\d+i[a-z]", re.I)),
-    ("ur", re.compile(r"(^|[^a-z])ur\d+e?([^a-z0-9]|$)|universal", re.I)),
+    ("kuka", re.compile(r"kuka|(^|[^a-z])kr\s*\d", re.IGNORECASE)),
+    ("abb", re.compile(r"abb|irb\s*\d", re.IGNORECASE)),
+    ("fanuc", re.compile(r"fanuc|lrmate|(^|[^a-z])(m|r|cr|crx|arc|lr)[-_]?\d+i[a-z]", re.IGNORECASE)),
+    ("ur", re.compile(r"(^|[^a-z])ur\d+e?([^a-z0-9]|$)|universal", re.IGNORECASE)),
     # ROS-Industrial package names: motoman_*_support, staubli_*_support, kawasaki_* (Yaskawa's
     # arms are Motoman).
-    ("yaskawa", re.compile(r"motoman|yaskawa", re.I)),
-    ("staubli", re.compile(r"st(a|ä)ubli", re.I)),
-    ("kawasaki", re.compile(r"kawasaki", re.I)),
+    ("yaskawa", re.compile(r"motoman|yaskawa", re.IGNORECASE)),
+    ("staubli", re.compile(r"st(a|ä)ubli", re.IGNORECASE)),
+    ("kawasaki", re.compile(r"kawasaki", re.IGNORECASE)),
 )
 
 
@@ -558,11 +558,11 @@ def _fit(model: object, frame_id: int, solver: str | None) -> tuple[str, object,
             tried.append(f"{name}: the URDF has {model.nq} joints, not six")  # type: ignore[attr-defined]
             continue
         try:
-            params = fit(model, frame_id)  # type: ignore[arg-type]
+            params = fit(model, frame_id)
         except FitError as exc:
             tried.append(f"{name}: {exc.problem}")
             continue
-        agreement = fk_agreement(model, frame_id, params)  # type: ignore[arg-type]
+        agreement = fk_agreement(model, frame_id, params)
         if agreement.ok:
             return name, params, agreement.position_m, None
         tried.append(f"{name}: fitted parameters disagree with the URDF by {agreement.position_m * 1000:.3f} mm")
@@ -712,7 +712,7 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
 
     try:
         model = urdf_model((stage / urdf_name).read_text(encoding="utf-8"))
-    except Exception as exc:  # Pinocchio raises plain errors for bad URDFs
+    except Exception as exc:  # noqa: BLE001 - Pinocchio raises plain errors for bad URDFs
         raise RobotModelError(source, None, f"cannot parse URDF: {exc}") from None
     if not model.existFrame(flange):
         frames = ", ".join(f.name for f in model.frames if f.type == pin.FrameType.BODY)

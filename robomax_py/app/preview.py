@@ -391,7 +391,7 @@ def _draw_tool(root: Any, cell: CellSpec) -> list[str]:
     for part, file, colour in (("body", cell.tool.body, palette.TOOL_BODY), ("tips", cell.tool.tips, palette.TOOL_TIPS)):
         try:
             mesh = load_mesh(Path(file))
-        except Exception as exc:  # trimesh raises many kinds for unreadable files
+        except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
             raise RobotModelError(cell.tool.source, part, f"cannot read mesh {file}: {exc}") from None
         path = f"robot/tool/{part}"
         root[path].set_object(_mesh_geometry(mesh.vertices, mesh.faces), g.MeshLambertMaterial(color=colour))
@@ -406,7 +406,7 @@ def _link_nodes(robot: RobotModel) -> list[_LinkNode]:
         if mesh_path and Path(mesh_path).is_file():
             try:
                 mesh = load_mesh(Path(mesh_path), np.asarray(obj.meshScale, dtype=float))
-            except Exception as exc:
+            except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
                 raise RobotModelError(robot.source, f"link {obj.name}", f"cannot read mesh {mesh_path}: {exc}") from None
         else:
             shape = _coal_shape(obj.geometry)

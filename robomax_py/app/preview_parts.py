@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -43,7 +44,7 @@ class CarriedPart:
         return self.T_place
 
 
-def carried_parts(cell: CellSpec, spots: list[dict]) -> list[CarriedPart]:
+def carried_parts(cell: CellSpec, spots: list[dict[str, Any]]) -> list[CarriedPart]:
     """The transfers' parts of a pick-and-place program, from its stops (`plan.loads.holds`: the
     entries `seam`, `name`, `t_arrive`, `t_leave`); empty for other cells."""
     out: list[CarriedPart] = []

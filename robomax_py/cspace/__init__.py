@@ -14,9 +14,15 @@ import numpy as np
 from robomax_py._typing import FloatArray
 from robomax_py.cspace.cache import cache_dir, learned_model
 from robomax_py.cspace.exact import CSpaceMap, default_workers, exact_map
+from robomax_py.cspace.grid import (
+    MAX_RESOLUTION,
+    MIN_RESOLUTION,
+    CSpaceError,
+    CSpaceGrid,
+    check_arm,
+)
 from robomax_py.cspace.learned import LearnedModel, TrainingSettings, learned_map
 from robomax_py.cspace.points import cover_radius, surface_points
-from robomax_py.cspace.grid import MAX_RESOLUTION, MIN_RESOLUTION, CSpaceError, CSpaceGrid, check_arm
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.world.collision import CollisionWorld

@@ -9,6 +9,7 @@ for any number of processes.
 
 from __future__ import annotations
 
+import itertools
 import multiprocessing
 import os
 import time
@@ -73,7 +74,7 @@ def exact_map(world: CollisionWorld, grid: CSpaceGrid, workers: int = 1) -> CSpa
     n = grid.size
     workers = min(workers, max(1, n // BLOCK))
     bounds = np.linspace(0, n, workers + 1).astype(int)
-    ranges = [(int(a), int(b)) for a, b in zip(bounds[:-1], bounds[1:])]
+    ranges = [(int(a), int(b)) for a, b in itertools.pairwise(bounds)]
     _SHARED.update(grid=grid, obstacles=obstacles, self=itself)
     try:
         if workers == 1 or "fork" not in multiprocessing.get_all_start_methods():

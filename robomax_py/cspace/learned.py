@@ -184,7 +184,7 @@ def train(scene0: Scene, robot: RobotModel, wrist: FloatArray, radius: float,
     d_max = _reach_from(base, robot, scene0) + radius
     distances = np.arange(0.0, d_max + settings.d_step, settings.d_step)
     grid = CSpaceGrid(axes=(base.q1_sign * dq1, q2, q3), wrist=wrist)   # q1 values in the arm's own sense
-    n_bands = max(1, int(round(360.0 / settings.band_deg)))
+    n_bands = max(1, round(360.0 / settings.band_deg))
     bands = np.linspace(-math.pi, math.pi, n_bands + 1)
     band_of = np.minimum(np.searchsorted(bands, dq1, side="right") - 1, n_bands - 1)
     rows, checks = [], 0
@@ -268,7 +268,7 @@ def learned_map(model: LearnedModel, points: FloatArray, grid: CSpaceGrid) -> CS
 
 
 def _axis(lo: float, hi: float, step: float) -> FloatArray:
-    n = max(2, int(math.ceil((hi - lo) / step)) + 1)
+    n = max(2, math.ceil((hi - lo) / step) + 1)
     return np.linspace(lo, hi, n)
 
 

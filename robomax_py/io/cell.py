@@ -115,7 +115,7 @@ def _printable_name(v: str) -> str:
         raise ValueError("must not be blank")
     bad = next((ch for ch in v if not ch.isprintable()), None)
     if bad is not None:
-        raise ValueError(f"must be printable text, got the control character {ascii(bad)}")
+        raise ValueError(f"must be printable text, got the control character {bad!a}")
     return v
 
 
@@ -851,7 +851,7 @@ def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError, tri
                                                  f"{CELL_LIMITS.cell_triangles:,} a cell may have (cell_triangles)")
     try:
         n = len(load_mesh(mesh).faces)
-    except Exception as exc:  # trimesh raises many kinds for unreadable files
+    except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
         raise type(error)(error.file, error.key, f"{error.problem}: {exc}") from None
     if n > limit:
         raise type(error)(error.file, error.key, f"mesh {mesh} has {n:,} triangles, more than the {limit:,} a mesh "

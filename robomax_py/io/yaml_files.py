@@ -294,8 +294,7 @@ def _inner_model(annotation: Any) -> Any:
 
 def _clean_message(msg: str) -> str:
     for prefix in ("Value error, ", "Assertion failed, "):
-        if msg.startswith(prefix):
-            msg = msg[len(prefix):]
+        msg = msg.removeprefix(prefix)
     return msg[:1].lower() + msg[1:]
 
 

@@ -176,7 +176,7 @@ def kinematic_model(spec: RobotSpec) -> pin.Model:
         model = urdf_model(_urdf_text(spec.urdf, spec.source))
     except RobotModelError:
         raise
-    except Exception as exc:  # Pinocchio raises plain RuntimeError/ValueError for bad URDFs
+    except Exception as exc:  # noqa: BLE001 - Pinocchio raises plain RuntimeError/ValueError for bad URDFs
         raise RobotModelError(spec.urdf, None, f"cannot parse URDF: {exc}") from None
     if not model.existFrame(spec.flange):
         raise RobotModelError(spec.source, "flange", f"URDF {spec.urdf.name} has no frame '{spec.flange}'")
@@ -436,7 +436,7 @@ def _build_geometry(model: pin.Model, spec: RobotSpec, kind: Any, package_dirs: 
     text = pinocchio_urdf_text(_urdf_text(spec.urdf, spec.source))
     try:
         return pin.buildGeomFromUrdfString(model, text, kind, package_dirs=package_dirs)
-    except Exception as exc:  # a missing or unreadable mesh surfaces here
+    except Exception as exc:  # noqa: BLE001 - a missing or unreadable mesh surfaces here, of any kind
         raise RobotModelError(spec.urdf, None, f"cannot load link geometry: {exc}") from None
 
 
@@ -447,6 +447,6 @@ def _make_meshes_convex(geom_model: pin.GeometryModel, spec: RobotSpec) -> None:
             continue
         try:
             mesh = load_mesh(Path(obj.meshPath), np.asarray(obj.meshScale))
-        except Exception as exc:
+        except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
             raise RobotModelError(spec.urdf, f"link {obj.name}", f"cannot read mesh {obj.meshPath}: {exc}") from None
         obj.geometry = convex_hull_shape(mesh.vertices)

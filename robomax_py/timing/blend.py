@@ -20,6 +20,7 @@ the end of a Cartesian retract into the next joint move).
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -207,7 +208,7 @@ def blend_chain(paths: Sequence[GeometricPath], radii: Sequence[float]) -> Blend
     """
     if len(paths) == 0 or len(radii) != len(paths) - 1:
         raise TimingError(f"blend_chain needs m paths and m - 1 radii, got {len(paths)} and {len(radii)}")
-    for a, b in zip(paths[:-1], paths[1:]):
+    for a, b in itertools.pairwise(paths):
         if float(np.max(np.abs(b.start - a.end))) > PATH_JOIN_TOL:
             raise TimingError("blend_chain: each path must start where the previous one ends")
     m = len(paths)

@@ -17,6 +17,7 @@ Paths must be C1 for a move to pass through without stopping; `time_path` stops 
 
 from __future__ import annotations
 
+import itertools
 import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -91,7 +92,7 @@ def time_path(
     lim = scaled_limits(limits, speed, accel)
     stops = [0.0, *kinks(path).tolist(), path.length]
     parts: list[Segment] = []
-    for a, b in zip(stops[:-1], stops[1:]):
+    for a, b in itertools.pairwise(stops):
         piece = path if (a == 0.0 and b == path.length) else path.restrict(a, b)
         shifted = None if path_speed_limit is None else _shifted(path_speed_limit, a)
         parts.append(_time_piece(piece, lim, shifted, dt, kind, label))
@@ -212,7 +213,7 @@ def time_path_phases(
     lim = scaled_limits(limits, speed, accel)
     stops = [0.0, *kinks(path).tolist(), path.length]
     laws = []
-    for a, b in zip(stops[:-1], stops[1:]):
+    for a, b in itertools.pairwise(stops):
         piece = path if (a == 0.0 and b == path.length) else path.restrict(a, b)
         shifted = None if path_speed_limit is None else _shifted(path_speed_limit, a)
         laws.append((a, b, piece, _TimingLaw.of(piece, lim, shifted)))
@@ -241,7 +242,7 @@ def _toppra_sd_squared(
 
     defer("matplotlib.pyplot")      # toppra.algorithm imports it for its plots, which we never draw
     import toppra.algorithm as algo
-    import toppra.constraint as constraint
+    from toppra import constraint
 
     constraints: list[Any] = [
         constraint.JointVelocityConstraint(lim.velocity),

@@ -8,6 +8,7 @@ spot's arrive and leave times are exact sample times.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -268,7 +269,7 @@ def resample(traj: Trajectory, max_dt: float = SPEC_MAX_DT_S) -> Trajectory:
         raise TimingError(f"max_dt must be > 0 s, got {max_dt}")
     bounds = np.unique(np.array([traj.t[0], traj.t[-1], *(p.t_start for p in traj.phases), *(p.t_end for p in traj.phases)]))
     pieces = [bounds[:1]]
-    for a, b in zip(bounds[:-1], bounds[1:]):
+    for a, b in itertools.pairwise(bounds):
         steps = max(1, int(np.ceil((b - a) / (max_dt * (1.0 - 1e-9)))))
         piece = np.linspace(a, b, steps + 1)[1:]
         piece[-1] = b

@@ -81,7 +81,7 @@ def serve_preview(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Callable
             # with `&`) inherits SIGINT ignored, and Python then never raises KeyboardInterrupt.
             proc = subprocess.Popen([sys.executable, "-m", "robomax_py", "preview", str(cell), *args],
                                     stdout=subprocess.PIPE, stderr=err_out, env=env, start_new_session=True,
-                                    preexec_fn=_default_interrupt)
+                                    preexec_fn=_default_interrupt)  # noqa: PLW1509 - one thread here
         started.append(proc)
         assert proc.stdout is not None
         for raw in proc.stdout:                # ends when the command exits without a URL

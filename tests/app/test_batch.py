@@ -71,7 +71,7 @@ def test_batch_statuses_in_argument_order_and_exit_2_for_a_bad_file(batch_run: B
     rows = read_summary(batch_run.out)
     assert [r["file"] for r in rows] == batch_run.files
     assert [r["status"] for r in rows] == [PLANNED, INFEASIBLE, BAD_INPUT, PLANNED]
-    a, far, bad, b = rows
+    a, far, bad, _b = rows
     assert float(a["cycle_time_s"]) > 0 and a["spots"] == "2" and a["detours"] != ""
     assert "flange/far: unreachable" in far["reasons"] and far["cycle_time_s"] == ""
     assert "cell_bad.yaml" in bad["reasons"] and "process.weld_time" in bad["reasons"]

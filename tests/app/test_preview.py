@@ -72,7 +72,7 @@ def object_colours(commands: list[dict[str, Any]]) -> dict[str, int]:
 
 def test_scene_has_every_object_robot_tool_spot_and_path_in_its_colour(planned: tuple[Path, Path]) -> None:
     cell_path, out = planned
-    content, commands, shown = record(cell_path, out / "small_cell.json")
+    content, commands, _shown = record(cell_path, out / "small_cell.json")
     colours = object_colours(commands)
     cell = load_cell(cell_path)
     robot = load_cell_robot(cell)
@@ -130,7 +130,7 @@ def test_animation_runs_on_the_programs_real_timeline(planned: tuple[Path, Path]
 
 def test_without_program_the_robot_stands_at_home(planned: tuple[Path, Path]) -> None:
     cell_path, _ = planned
-    content, commands, shown = record(cell_path, None)
+    content, commands, _shown = record(cell_path, None)
     assert content.frames == 0 and content.path_lines == ()
     assert not [c for c in commands if c["type"] == "set_animation"]
     assert len(content.spots) == 2 and len(content.robot) > 0

@@ -52,7 +52,7 @@ def _browser_or_skip() -> Any:
     if not CHROMIUM.is_file():
         problem = f"{CHROMIUM} not found (apt-get install chromium)"
     try:
-        import playwright.sync_api as sync_api
+        from playwright import sync_api
     except ImportError:
         problem = problem or "the playwright package is not installed (pip install -e '.[test]')"
         sync_api = None

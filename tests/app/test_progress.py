@@ -7,7 +7,6 @@ import logging
 from pathlib import Path
 
 import numpy as np
-
 import pytest
 from rich.console import Console
 

@@ -15,6 +15,7 @@ functions handed in, so the same table serves a 6-axis arm, a planar test arm or
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -172,7 +173,7 @@ def route(table: TableIk, start: int, goal: int, k: int, edge_free: Callable[[Fl
             path.append(int(pred[path[-1]]))
         path.reverse()
         blocked = False
-        for u, v in zip(path[:-1], path[1:]):
+        for u, v in itertools.pairwise(path):
             e = (min(u, v), max(u, v))
             if e not in known:
                 checks += 1
@@ -193,7 +194,7 @@ def jacobian_interpolation(q0: FloatArray, p1: FloatArray, forward: Forward, jac
     q = np.asarray(q0, dtype=float).copy()
     p0 = np.asarray(forward(q[None, :]), dtype=float)[0]
     p1 = np.asarray(p1, dtype=float)
-    n_steps = max(1, int(math.ceil(float(np.linalg.norm(p1 - p0)) / step)))
+    n_steps = max(1, math.ceil(float(np.linalg.norm(p1 - p0)) / step))
     rows = [q.copy()]
     worst = 0.0
     for s in range(1, n_steps + 1):
