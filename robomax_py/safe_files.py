@@ -1,4 +1,4 @@
-"""The one guarded reading path for every file robomax_py reads (issue 16), below the YAML layer.
+"""The one guarded reading path for every file robomax_py reads, below the YAML layer.
 
 Before a file is opened its path is checked: no NUL byte, not too long, no symlink loop, a regular
 file (not a folder, device or pipe, which could block a read forever), not larger than the limit

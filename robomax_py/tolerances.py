@@ -13,8 +13,8 @@ class Tolerances:
     # Numeric IK stops here; looser because damped least squares converges linearly near the end.
     ik_numeric_pos_m: float = 1e-6
     ik_numeric_rot_rad: float = 1e-6
-    # A closed-form solver's FK (given or fitted parameters) must agree with the URDF's to this
-    # (issue 14): far below any process tolerance, far above round-off of a correct parameter set.
+    # A closed-form solver's FK (given or fitted parameters) must agree with the URDF's to this:
+    # far below any process tolerance, far above round-off of a correct parameter set.
     ik_fit_m: float = 1e-6
     ik_fit_rad: float = 1e-6
     # docs/cell-files.md, "The trajectory file": the TCP is at the spot within 0.1 mm.

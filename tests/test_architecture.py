@@ -1,4 +1,4 @@
-"""The import contract (issue 15): stages import downwards only (`lint-imports`, configured in
+"""The import contract: stages import downwards only (`lint-imports`, configured in
 pyproject.toml), and no module takes part in an import cycle, counting imports inside functions
 (grimp sees those, so a lazy import cannot hide a cycle)."""
 

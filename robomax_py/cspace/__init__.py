@@ -1,4 +1,4 @@
-"""Configuration-space maps of A1-A3 with the wrist fixed (the ROBOMAX C-space method, issue 19).
+"""Configuration-space maps of A1-A3 with the wrist fixed (the ROBOMAX C-space method).
 
 `build_map(cell, robot, wrist, resolution)` checks every cell of the grid exactly with the cell's
 collision world; `learned_model` (trained once, cached on disk) and `learned_map` give the same map

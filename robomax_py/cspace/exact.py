@@ -1,7 +1,7 @@
 """The exact configuration-space map: every grid cell checked by the collision world.
 
 Two masks over the same grid: cells where the robot or its tool is within the clearance of a cell
-object, and cells where it touches itself. The learned model (issue 19) predicts the first; the
+object, and cells where it touches itself. The learned model (cspace.learned) predicts the first; the
 second depends on the robot, tool and wrist alone. Cells are checked in blocks, optionally in
 several processes (forked, each with its own copy of the world's scratch); the answer is the same
 for any number of processes.

@@ -7,7 +7,7 @@ states them exactly); every variant but the exact-stop one leaves the checked po
 so it is used only when its geometric path checks collision-free and it is faster.
 
 The electrode tips may come near the part only on the electrode axis: over `process.approach`
-from the spot the TCP stays on the line (issue 17). A blend cuts into the lines it joins, so a
+from the spot the TCP stays on the line. A blend cuts into the lines it joins, so a
 variant that flies by a retract or an approach extends that line beyond the approach point, to
 `WeldEnd.T_ext`, by as much as its largest blend cuts in (`extension`); the blend then starts and
 ends beyond the approach distance, and `_straight` checks that it does.

@@ -158,7 +158,7 @@ def time_tour(
         phase = traj.phases_of("weld", label)[0]
         q_spot = np.asarray(traj.q[phase.i_start], dtype=float)
         # Each target states its own configuration: on ABB and FANUC arms J2 is often near 0 at
-        # the spot and changes sign over the approach line (issue 14).
+        # the spot and changes sign over the approach line.
         q_retract = retract_q[k]
         plans.append(SpotPlan(seam.name, c.name, c.angles[a], config_text(robot, c.q_spot[a]), q_spot,
                               as_written_joints(c.q_app[a]), float(phase.t_start), float(phase.t_end), T_spot, T_app,

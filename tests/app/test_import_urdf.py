@@ -208,7 +208,7 @@ def test_import_warns_where_the_controllers_joint_convention_is_not_known(tmp_pa
     leaves J2 and J3 uncoupled (abb_driver passes the values through: irb6640) are known; the
     IRB 2400's abb_driver couples J3 with J2 (its launch file's J23_coupled), which robot.yaml does
     not state for ABB: a warning. The KR 210 L150 (A1 about +z, A2 = 0 upright, kuka_experimental
-    issue 98) gets its keys derived, and says so."""
+    kuka_experimental issue 98) gets its keys derived, and says so."""
     irb6640 = ROSI / "abb_irb6640_support/urdf/irb6640_185_280.xacro"
     srdf6640 = ROSI / "abb_irb6640_moveit_config/config/abb_irb6640_185_280.srdf"
 
@@ -567,7 +567,7 @@ def test_each_arm_plans_and_verifies(arms: dict[str, Path], tmp_path: Path, name
 
 @pytest.mark.slow
 def test_lin_whose_j2_changes_sign_states_each_targets_configuration(arms: dict[str, Path], tmp_path: Path) -> None:
-    """Regression (issue 14): the retract LIN was written with the spot's CONFIG; on this ABB arm
+    """Regression: the retract LIN was written with the spot's CONFIG; on this ABB arm
     J2 is near 0 at the spot and changes sign over the 30 mm line, so KUKA turn bits differ."""
     import shutil
 

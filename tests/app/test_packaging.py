@@ -1,4 +1,4 @@
-"""The robot library is package data: a built wheel carries it (issue 14: a non-editable install
+"""The robot library is package data: a built wheel carries it (a non-editable install
 had no robots), and `package://` meshes resolve near the robot folder and via ROS_PACKAGE_PATH."""
 
 from __future__ import annotations

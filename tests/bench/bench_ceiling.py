@@ -52,7 +52,7 @@ from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[2]
 REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
-TARGET_SAVING = 0.15      # issue 4: cycle time >= 15 % shorter than the baseline
+TARGET_SAVING = 0.15      # the goal: cycle time >= 15 % shorter than the baseline
 
 
 @dataclass(frozen=True, slots=True)

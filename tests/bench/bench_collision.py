@@ -7,7 +7,7 @@ Each rate is the median of 5 runs (after one warm-up run). Reported with the bro
 and without it (every enabled pair to the narrow phase, same early exit, same answers).
 Modes: the default (bounding-volume pre-filter, then coal's exact test of the pairs it leaves),
 coal's broad phase alone (Pinocchio's manager, the mode before the pre-filter; same run, for the
-ratio) and the exhaustive narrow phase. Target (issue 18): >= 250,000 configuration checks/s.
+ratio) and the exhaustive narrow phase. Target: >= 250,000 configuration checks/s.
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ of a 2 x 2 m container with shelves (`robot.planar`; the shelves laid out after 
 its dimensions not given), held part 0.25 m. Prints the table sizes K* for J = 18 (the paper's
 "10 deg": 180/17 = 10.6 deg) and J = 9 ("20 deg": 22.5 deg), without and with the part, beside the
 paper's 1,598 / 1,128 / 134, the CPU seconds to build each, and lookups per second (one process,
-median of 3): 100,000 random targets in one batch, and one target per call. Issue 21's target is
+median of 3): 100,000 random targets in one batch, and one target per call. The target is
 100,000 lookups per second.
 """
 

@@ -3,7 +3,7 @@
 Builds the adaptive voxel map (`world.voxels`) of each cell's static objects over a cube round the
 robot's reach (x, y in +-3.2 m, z from -0.5 to 2.9 m, base frame) at precision limits of 40, 20 and
 10 mm, no inflation; prints leaves, free leaves, coal tests and the CPU seconds of this process
-(median of 3). Issue 20's target: a shipped cell in < 2 s at 10 mm on one core.
+(median of 3). The target: a shipped cell in < 2 s at 10 mm on one core.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Output that never half-exists (issue 16): atomic replace, one complete set of programs when two
+"""Output that never half-exists: atomic replace, one complete set of programs when two
 writers share a folder, temporary files of a killed writer removed by the next one."""
 
 from __future__ import annotations

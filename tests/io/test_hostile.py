@@ -1,4 +1,4 @@
-"""Hostile and broken input (issue 16): a seeded generator of more than 1,000 mutants of the shipped
+"""Hostile and broken input: a seeded generator of more than 1,000 mutants of the shipped
 cells, robot folders and program files, each run through the command in-process with a time and
 memory bound. The test fails on any traceback, any run past the bound, any refusal whose message
 does not name a file, and any file written. A smaller sample runs through `plan` and `batch` (slow).
@@ -545,7 +545,7 @@ def _golden_name(suffix: str) -> str:
 
 
 def _dialect_mutants(rng: np.random.Generator) -> list[tuple[str, str, bytes]]:
-    """(name, file suffix, content) of broken controller programs (issue 17), from the small cell's
+    """(name, file suffix, content) of broken controller programs, from the small cell's
     golden files: truncated, lines dropped or doubled, numbers replaced, bytes that are not text."""
     out: list[tuple[str, str, bytes]] = []
     numbers = [b"1e999", b"nan", b"9" * 400, b"-", b"1.2.3", b"0x10"]
@@ -606,7 +606,7 @@ def test_broken_controller_programs_are_refused_cleanly_by_verify(tmp_path: Path
     assert not failures, f"{len(failures)} failures:\n" + "\n".join(failures[:20])
 
 
-# The classes that used to end in a traceback, a hang or a crashed batch row (issue 16).
+# The classes that used to end in a traceback, a hang or a crashed batch row.
 ONCE_FATAL = ("mesh=symlink_loop", "mesh=long_name", "mesh=nul", "mesh=fifo", "mesh=device", "bomb_in_spots",
               "bomb_in_home", "recursive_alias", "deep_list", "complex_key_list", "complex_key_map", "huge_int",
               "name=long", "robot.model=long", "tool=long", "name=nul", "window_1e308", "nul_byte",

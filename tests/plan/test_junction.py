@@ -27,7 +27,7 @@ ON_AXIS_TOL_M = 2e-5
 # Relative slack on the TCP speed measured by finite differences of 4 ms samples.
 TCP_SPEED_RTOL = 0.01
 # toppra holds its limits at grid points; between them the joint speed may exceed them slightly
-# (seen: 0.4 %), as issue 5 allows (1 %).
+# (seen: 0.4 %), within the 1 % the timing tolerates.
 SPEED_RTOL = 0.01
 
 LIMITS = JointLimits(
@@ -148,7 +148,7 @@ def small_plan(tmp_path_factory: pytest.TempPathFactory, write_small_cell: Any) 
 
 def test_approach_points_are_flown_by_and_the_electrodes_keep_the_axis(small_plan: Any) -> None:
     """Junctions fly by where it is faster, and within the approach distance of every spot the TCP
-    is on the electrode axis (issue 17): a fly-by continues the line beyond the approach point."""
+    is on the electrode axis: a fly-by continues the line beyond the approach point."""
     cell, robot, result = small_plan
     assert result.status == "planned", result.message
     traj = result.trajectory
