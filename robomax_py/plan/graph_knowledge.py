@@ -1,0 +1,307 @@
+"""What the sequencer (`plan.graph.Sequencer`) knows and what it costs: straight moves found free or
+blocked, detour-only and unconnected spot pairs, detours found and their legs checked, and the
+estimated move-time matrices the order search and the exact DP read, cached per spot pair."""
+
+from __future__ import annotations
+
+import copy
+from collections import Counter
+
+import numpy as np
+
+from robomax_py._typing import FloatArray, IntArray
+from robomax_py.plan.candidates import SpotCandidates
+from robomax_py.plan.loads import Loads
+from robomax_py.plan.results import Progress, ResolvedOptions, _no_progress
+from robomax_py.plan.roadmap import Detour, Roadmap
+from robomax_py.plan.sequence import (
+    HOME,
+)
+from robomax_py.plan.thinning import representatives
+from robomax_py.robot import RobotModel
+from robomax_py.spec import CellSpec
+from robomax_py.timing import (
+    ptp_time_estimate,
+)
+from robomax_py.world.collision import CollisionWorld
+
+# Cost of a detour not yet found, as a multiple of the straight move's estimate.
+DETOUR_PRIOR = 1.6
+# Blocked detour legs between two spots after which only verified legs are offered for that pair:
+# each blocked leg bans one (candidate, candidate, detour) triple, and two spots with hundreds of
+# candidates each would otherwise let the optimiser try a fresh unverified triple every round.
+MAX_BLOCKED_LEGS = 4
+# Placeholder keeping detour indices stable for pairs a detour cannot serve.
+_UNUSABLE = Detour(np.zeros((0, 0)), float("inf"), 0)
+_ONE = np.zeros(1, dtype=np.int64)   # home's only candidate
+# Blocked straight moves between two spots after which only straight moves known to be free are
+# offered between them (a `straight_tries` batch is checked after each blocked one).
+MAX_BLOCKED_STRAIGHT = 24
+# Failed detour searches between two spots after which they count as unconnected (but for
+# detours found at their ends).
+MAX_FAILED_DETOURS = 6
+
+
+class SequencerKnowledge:
+    """The state of a `Sequencer` and the costs read from it (the base of `SequencerDetours`)."""
+
+    def __init__(
+        self, cell: CellSpec, robot: RobotModel, world: CollisionWorld, roadmap: Roadmap,
+        spots: list[SpotCandidates], options: ResolvedOptions, rng: np.random.Generator,
+        progress: Progress = _no_progress, loads: Loads | None = None,
+    ) -> None:
+        self.cell, self.robot, self.world, self.roadmap = cell, robot, world, roadmap
+        # Pick and place: the moves leaving a grip carry the part (their own world and roadmap).
+        self.loads = loads
+        self._roadmaps: dict[str | None, Roadmap] = {None: roadmap}
+        self.progress = progress
+        self.spots, self.options, self.rng = spots, options, rng
+        self.limits = robot.limits
+        self.home = np.asarray(cell.home)[None, :]
+        self.checks = 0
+        self.rounds = 0
+        self.dp_evaluations = 0
+        # Per spot: time of approach + weld + retract (joint-time estimate of the short LIN moves).
+        weld = [cell.process.weld_time_of(cell.seams[c.seam_index].spots[c.spot_index]) for c in spots]
+        self.node = [2 * ptp_time_estimate(c.q_app, c.q_spot, self.limits, options.speed) + w for c, w in zip(spots, weld)]
+        self.straight: dict[tuple[int, int], dict[tuple[int, int], bool]] = {}   # (i, j) -> (a, b) -> free
+        self.detour_only: set[tuple[int, int]] = set()                           # unordered spot pairs
+        self.no_way: dict[tuple[int, int], set[tuple[int, int]]] = {}            # (i, j) -> {(a, b)} unconnectable
+        self.detours: list[tuple[int, int, Detour]] = []                          # (from spot, to spot, path)
+        self.legs_bad: dict[tuple[int, int], set[tuple[int, int, int]]] = {}      # (i, j) -> {(a, b, v)}
+        self.legs_ok: dict[tuple[int, int], set[tuple[int, int, int]]] = {}
+        # The order search sees a few representatives per spot; the exact DP then uses every candidate.
+        self.reps = [representatives(c.q_app, n, self.limits.velocity, options.order_candidates)
+                     for c, n in zip(spots, self.node)]
+        self.node_reps = [n[r] for n, r in zip(self.node, self.reps)]
+        self._matrices: dict[tuple[int, int], FloatArray] = {}   # representatives x representatives
+        self._full: dict[tuple[int, int], FloatArray] = {}       # every candidate, pairs of the last order only
+        self.unresolved: Counter[str] = Counter()                                 # move label -> rounds left open
+        self.failed_detours: Counter[tuple[int, int]] = Counter()                 # unordered spot pair -> searches
+        self.unconnected: set[tuple[int, int]] = set()                            # unordered spot pairs given up
+        self._exit_cache: dict[tuple[int, int], list[FloatArray]] = {}            # (spot, candidate) -> exits
+        self._inner: dict[tuple[int, bool], float] = {}                           # (detour, reversed) -> time
+        # What `_probe_pairs` learnt (straight moves, detour-only pairs, checks) and the generator as
+        # it was before any round: a sequencer of the given order starts from them (`given_order`).
+        self._probed: tuple[dict[tuple[int, int], dict[tuple[int, int], bool]], set[tuple[int, int]], int] | None = None
+        self._rng_at_start = copy.deepcopy(rng)
+
+    # ------------------------------------------------------------------ knowledge and costs
+
+    def q(self, i: int) -> FloatArray:
+        return self.home if i == HOME else self.spots[i].q_app
+
+    def _load(self, i: int) -> str | None:
+        return None if self.loads is None else self.loads.part_after(i)
+
+    def world_from(self, i: int) -> CollisionWorld:
+        """The collision world of the moves leaving stop i (with the part it grips, if any)."""
+        return self.world if self.loads is None else self.loads.world_after(i, self.world)
+
+    def roadmap_from(self, i: int) -> Roadmap:
+        """The roadmap of the moves leaving stop i, built for a held part when first needed."""
+        part = self._load(i)
+        if part not in self._roadmaps:
+            assert self.loads is not None and part is not None
+            rng = np.random.default_rng([self.cell.planner.seed, 1 + sorted(self.loads.worlds).index(part)])
+            anchors = np.vstack([self.home, *[c.q_app for c in self.spots]])
+            self._roadmaps[part] = Roadmap(self.world_from(i), self.limits, anchors, rng, self.options.roadmap_nodes,
+                                           self.options.roadmap_k, seeds=anchors)
+        return self._roadmaps[part]
+
+    def _forget(self, i: int, j: int) -> None:
+        for table in (self._matrices, self._full):
+            table.pop((i, j), None)
+            table.pop((j, i), None)
+
+    def _rows(self, i: int) -> IntArray:
+        """The candidates of spot i the order search sees."""
+        return _ONE if i == HOME else self.reps[i]
+
+    def _positions(self, i: int, rows: IntArray) -> IntArray:
+        """Candidate index -> position in `rows` (-1 where absent)."""
+        pos = np.full(len(self.q(i)), -1, dtype=np.int64)
+        pos[rows] = np.arange(len(rows))
+        return pos
+
+    def estimate(self, i: int, j: int) -> FloatArray:
+        """Estimated straight-move time between every candidate of spot i and every one of spot j
+        (not cached: only asked for when a move was found blocked)."""
+        return ptp_time_estimate(self.q(i)[:, None, :], self.q(j)[None, :, :], self.limits, self.options.speed)
+
+    def vias_for(self, i: int, j: int) -> list[Detour]:
+        """Known detours usable from spot i to spot j, oriented i -> j: those found between i and j,
+        and those leaving i or reaching j (another leg then joins their far end to the other spot).
+        Indices are stable: new detours are only appended."""
+        out: list[Detour] = []
+        for di, dj, det in self.detours:
+            if self._load(di) != self._load(i):
+                out.append(_UNUSABLE)            # found for another load: not checked for this one
+            elif di == i or dj == j:
+                out.append(det)
+            elif dj == i or di == j:
+                out.append(Detour(det.waypoints[::-1].copy(), det.time_estimate, det.checks))
+            else:
+                out.append(_UNUSABLE)
+        return out
+
+    def _via_costs(self, i: int, j: int, vias: list[Detour], rows: IntArray, cols: IntArray, pi: IntArray,
+                   pj: IntArray) -> FloatArray:
+        """Least time of enter leg + detour + leave leg over the usable detours `vias` (from
+        `vias_for`) between candidates `rows` of i and `cols` of j (positions `pi`, `pj`), inf where
+        none. The enter and leave legs of every detour are estimated in one call each: per detour,
+        two calls on a few rows cost numpy's overhead many times the arithmetic, and a spot beside
+        clamps collects dozens of detours."""
+        out = np.full((len(rows), len(cols)), np.inf)
+        usable = [v for v, det in enumerate(vias) if det is not _UNUSABLE]
+        if not usable:
+            return out
+        sp = self._detour_speed()
+        starts = np.array([vias[v].waypoints[0] for v in usable])
+        ends = np.array([vias[v].waypoints[-1] for v in usable])
+        enter = ptp_time_estimate(self.q(i)[rows][:, None, :], starts[None, :, :], self.limits, sp)   # rows x vias
+        leave = ptp_time_estimate(ends[:, None, :], self.q(j)[cols][None, :, :], self.limits, sp)     # vias x cols
+        bad = self.legs_bad.get((i, j), set())
+        verified_only = len(bad) >= MAX_BLOCKED_LEGS
+        marks: dict[int, list[tuple[int, int]]] = {}
+        for a, b, vv in (self.legs_ok.get((i, j), ()) if verified_only else bad):
+            if pi[a] >= 0 and pj[b] >= 0:
+                marks.setdefault(vv, []).append((int(pi[a]), int(pj[b])))
+        for k, v in enumerate(usable):
+            via = enter[:, k, None] + self._inner_time(v, vias[v]) + leave[k][None, :]
+            cells = marks.get(v, ())
+            if verified_only:
+                verified = np.full_like(via, np.inf)
+                for r, c in cells:
+                    verified[r, c] = via[r, c]
+                via = verified
+            else:
+                for r, c in cells:
+                    via[r, c] = np.inf
+            out = np.minimum(out, via)
+        return out
+
+    def _detour_speed(self) -> float:
+        """The speed fraction detour moves are estimated at (options resolved from the cell)."""
+        speed, detour = self.options.speed, self.options.detour_speed
+        assert speed is not None and detour is not None
+        return speed * detour
+
+    def _inner_time(self, v: int, det: Detour) -> float:
+        """Estimated time along detour v oriented as `det` (from `vias_for`), cached per direction
+        (the sum taken in the order travelled, as it always was)."""
+        wp = det.waypoints
+        key = (v, not np.array_equal(wp[0], self.detours[v][2].waypoints[0]))
+        got = self._inner.get(key)
+        if got is None:
+            sp = self._detour_speed()
+            got = self._inner[key] = float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits, sp)))
+        return got
+
+    def _pair_via_costs(self, i: int, a: int, j: int, b: int) -> FloatArray:
+        """`_via_costs` of every known detour for one candidate pair (a of i, b of j), at once:
+        `_verify` asks this for every leg of every tour checked."""
+        vias = self.vias_for(i, j)
+        out = np.full(len(vias), np.inf)
+        usable = [v for v, det in enumerate(vias) if det is not _UNUSABLE]
+        if not usable:
+            return out
+        sp = self._detour_speed()
+        enter = ptp_time_estimate(self.q(i)[a][None, :], np.array([vias[v].waypoints[0] for v in usable]),
+                                  self.limits, sp)
+        leave = ptp_time_estimate(np.array([vias[v].waypoints[-1] for v in usable]), self.q(j)[b][None, :],
+                                  self.limits, sp)
+        via = enter + np.array([self._inner_time(v, vias[v]) for v in usable]) + leave
+        bad = self.legs_bad.get((i, j), set())
+        if len(bad) >= MAX_BLOCKED_LEGS:
+            ok = self.legs_ok.get((i, j), set())
+            keep = np.array([(a, b, v) in ok for v in usable])
+        else:
+            keep = np.array([(a, b, v) not in bad for v in usable])
+        out[usable] = np.where(keep, via, np.inf)
+        return out
+
+    def _costs(self, i: int, j: int, rows: IntArray, cols: IntArray) -> FloatArray:
+        """Estimated move time between candidates `rows` of i and `cols` of j, using what is known
+        about blockages."""
+        key = (i, j)
+        est = ptp_time_estimate(self.q(i)[rows][:, None, :], self.q(j)[cols][None, :, :], self.limits,
+                                self.options.speed)
+        pi, pj = self._positions(i, rows), self._positions(j, cols)
+        vias = self.vias_for(i, j)
+        if (min(i, j), max(i, j)) in self.detour_only:
+            # Until a detour is known, price one at a multiple of the straight move: optimistic
+            # enough to be explored, costly enough not to be preferred.
+            usable = any(d is not _UNUSABLE for d in vias)
+            unconnected = (min(i, j), max(i, j)) in self.unconnected
+            est = np.full_like(est, np.inf) if usable or unconnected else est * DETOUR_PRIOR
+        else:
+            known = self.straight.get(key, {})
+            if self._verified_straight_only(i, j):
+                # Mostly blocked between these spots: only straight moves known to be free are
+                # offered, or the DP picks a fresh unchecked pair of candidates every round.
+                verified = np.full_like(est, np.inf)
+                for (a, b), free in known.items():
+                    if free and pi[a] >= 0 and pj[b] >= 0:
+                        verified[pi[a], pj[b]] = est[pi[a], pj[b]]
+                est = verified
+            else:
+                for (a, b), free in known.items():
+                    if not free and pi[a] >= 0 and pj[b] >= 0:
+                        est[pi[a], pj[b]] = np.inf
+        est = np.minimum(est, self._via_costs(i, j, vias, rows, cols, pi, pj))
+        for a, b in self.no_way.get(key, ()):
+            if pi[a] >= 0 and pj[b] >= 0:
+                est[pi[a], pj[b]] = np.inf
+        return est
+
+    def _verified_straight_only(self, i: int, j: int) -> bool:
+        """Whether only straight moves known to be free are offered between spots i and j: many
+        found blocked, or the pair given up (no detour found MAX_FAILED_DETOURS times), where
+        every fresh candidate pair tried would cost another detour search."""
+        known = self.straight.get((i, j), {})
+        blocked = sum(1 for free in known.values() if not free)
+        # Given up on detours, yet most straight moves checked are free: the failed searches were
+        # for candidate pairs the gun cannot join without turning (two spins on one flange), not a
+        # wall between the spots, and the next unchecked straight move is as likely free as not.
+        return (blocked >= MAX_BLOCKED_STRAIGHT
+                or ((min(i, j), max(i, j)) in self.unconnected and blocked >= len(known) - blocked))
+
+    def cost(self, i: int, j: int) -> FloatArray:
+        """`_costs` between the representatives of two spots (what the order search sees), cached."""
+        key = (i, j)
+        got = self._matrices.get(key)
+        if got is None:
+            got = self._matrices[key] = self._costs(i, j, self._rows(i), self._rows(j))
+        return got
+
+    def full_cost(self, i: int, j: int) -> FloatArray:
+        """`_costs` between every candidate of two spots (for the exact DP of one order), cached."""
+        key = (i, j)
+        got = self._full.get(key)
+        if got is None:
+            got = self._full[key] = self._costs(i, j, np.arange(len(self.q(i))), np.arange(len(self.q(j))))
+        return got
+
+    def _try_straight(self, i: int, a: int, j: int, b: int) -> bool:
+        """Check the straight move from candidate a of i to b of j, count and record it; a free one
+        takes the pair off the detour-only list."""
+        res = self.world_from(i).check_segment(self.q(i)[a], self.q(j)[b])
+        self.checks += res.checks
+        self._record_straight(i, a, j, b, res.free)
+        if res.free:
+            self.detour_only.discard((min(i, j), max(i, j)))
+        return bool(res.free)
+
+    def _record_straight(self, i: int, a: int, j: int, b: int, free: bool) -> None:
+        self.straight.setdefault((i, j), {})[(a, b)] = free
+        if self._load(i) == self._load(j):       # else the way back is checked in another world
+            self.straight.setdefault((j, i), {})[(b, a)] = free
+        self._forget(i, j)
+
+    def _record_leg(self, i: int, a: int, j: int, b: int, v: int, ok: bool) -> None:
+        table = self.legs_ok if ok else self.legs_bad
+        table.setdefault((i, j), set()).add((a, b, v))
+        if self._load(i) == self._load(j):
+            table.setdefault((j, i), set()).add((b, a, v))
+        self._forget(i, j)

@@ -1,0 +1,267 @@
+"""The compiled loops of the bounding-volume pre-filter (`world.prefilter`, numba): forward
+kinematics of the serial chain, the pieces' spheres and boxes placed, and the pair bounds of a batch
+of configurations, read from the packed float and int tables `Prefilter` holds."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+_N_HEADER, _N_FLOAT_TABLES, _N_INT_TABLES = 6, 19, 16
+
+
+@njit(cache=True, nogil=True)
+def _forward(q: Any, parent: Any, kind: Any, axis: Any, jrot: Any, jtrans: Any, jq: Any, rot: Any, trans: Any) -> None:
+    """Joint frames in the base frame: oMi[j] = oMi[parent] * placement[j] * motion_j(q)."""
+    rot[0, :, :] = 0.0
+    rot[0, 0, 0] = rot[0, 1, 1] = rot[0, 2, 2] = 1.0
+    trans[0, :] = 0.0
+    m = np.empty((3, 3))
+    for j in range(1, parent.shape[0]):
+        p = parent[j]
+        # placement in the base frame: R = Rp @ Rj, t = tp + Rp @ tj
+        for r in range(3):
+            acc = trans[p, r]
+            for c in range(3):
+                acc += rot[p, r, c] * jtrans[j, c]
+                s = 0.0
+                for k in range(3):
+                    s += rot[p, r, k] * jrot[j, k, c]
+                m[r, c] = s
+            trans[j, r] = acc
+        x = q[jq[j]]
+        ax, ay, az = axis[j, 0], axis[j, 1], axis[j, 2]
+        if kind[j] == 0:
+            # Rodrigues: R = I + sin x K + (1 - cos x) K^2, K the cross-product matrix of the axis
+            s, c1 = math.sin(x), 1.0 - math.cos(x)
+            m00 = 1.0 - c1 * (ay * ay + az * az)
+            m11 = 1.0 - c1 * (ax * ax + az * az)
+            m22 = 1.0 - c1 * (ax * ax + ay * ay)
+            m01 = -s * az + c1 * ax * ay
+            m10 = s * az + c1 * ax * ay
+            m02 = s * ay + c1 * ax * az
+            m20 = -s * ay + c1 * ax * az
+            m12 = -s * ax + c1 * ay * az
+            m21 = s * ax + c1 * ay * az
+            for r in range(3):
+                a0, a1, a2 = m[r, 0], m[r, 1], m[r, 2]
+                rot[j, r, 0] = a0 * m00 + a1 * m10 + a2 * m20
+                rot[j, r, 1] = a0 * m01 + a1 * m11 + a2 * m21
+                rot[j, r, 2] = a0 * m02 + a1 * m12 + a2 * m22
+        else:
+            for r in range(3):
+                trans[j, r] += x * (m[r, 0] * ax + m[r, 1] * ay + m[r, 2] * az)
+                rot[j, r, 0], rot[j, r, 1], rot[j, r, 2] = m[r, 0], m[r, 1], m[r, 2]
+
+
+@njit(cache=True, nogil=True)
+def _offsets(I: Any) -> Any:
+    """Where each float and each int table starts in the packed buffers (see `_pack`)."""
+    fo = I[_N_HEADER:_N_HEADER + _N_FLOAT_TABLES]
+    io = I[_N_HEADER + _N_FLOAT_TABLES:_N_HEADER + _N_FLOAT_TABLES + _N_INT_TABLES]
+    return fo, io
+
+
+@njit(cache=True, nogil=True)
+def _chain_tables(F: Any, I: Any) -> Any:
+    """The chain's tables in `_forward`'s argument order: parent, kind, axis, rotation, translation, q index."""
+    J = I[0]
+    fo, io = _offsets(I)
+    return (I[io[0]:io[0] + J], I[io[1]:io[1] + J], F[fo[0]:fo[0] + 3 * J].reshape((J, 3)),
+            F[fo[1]:fo[1] + 9 * J].reshape((J, 3, 3)), F[fo[2]:fo[2] + 3 * J].reshape((J, 3)), I[io[2]:io[2] + J])
+
+
+@njit(cache=True, nogil=True)
+def _placements(q: Any, F: Any, I: Any) -> Any:
+    J = I[0]
+    parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
+    rot = np.empty((J, 3, 3))
+    trans = np.empty((J, 3))
+    _forward(q, parent, kind, axis, jrot, jtrans, jq, rot, trans)
+    return rot, trans
+
+
+@njit(cache=True, nogil=True)
+def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
+    J, G, P, NG, NB, C = I[0], I[1], I[2], I[3], I[4], I[5]
+    fo, io = _offsets(I)
+    parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
+    centre = F[fo[3]:fo[3] + 3 * G].reshape((G, 3))
+    radius = F[fo[4]:fo[4] + G]
+    box_lo = F[fo[5]:fo[5] + 3 * G].reshape((G, 3))
+    box_hi = F[fo[6]:fo[6] + 3 * G].reshape((G, 3))
+    margin = F[fo[7]:fo[7] + P]
+    g_centre = F[fo[8]:fo[8] + 3 * NG].reshape((NG, 3))
+    g_radius = F[fo[9]:fo[9] + NG]
+    b_margin = F[fo[10]:fo[10] + NB]
+    obb_c = F[fo[11]:fo[11] + 3 * G].reshape((G, 3))
+    obb_r = F[fo[12]:fo[12] + 9 * G].reshape((G, 3, 3))
+    obb_h = F[fo[13]:fo[13] + 3 * G].reshape((G, 3))
+    ch_c = F[fo[14]:fo[14] + 3 * C].reshape((C, 3))
+    ch_rad = F[fo[15]:fo[15] + C]
+    ch_bc = F[fo[16]:fo[16] + 3 * C].reshape((C, 3))
+    ch_br = F[fo[17]:fo[17] + 9 * C].reshape((C, 3, 3))
+    ch_h = F[fo[18]:fo[18] + 3 * C].reshape((C, 3))
+    piece_joint = I[io[3]:io[3] + G]
+    pair_a, pair_b, pair_obstacle = I[io[4]:io[4] + P], I[io[5]:io[5] + P], I[io[6]:io[6] + P]
+    group_joint = I[io[7]:io[7] + NG]
+    b_kind, b_a, b_b, b_end = I[io[8]:io[8] + NB], I[io[9]:io[9] + NB], I[io[10]:io[10] + NB], I[io[11]:io[11] + NB]
+    b_pairs = I[io[12]:io[12] + P]
+    ch_start, ch_end, ch_skip = I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C]
+
+    n_cfg = qs.shape[0]
+    rot = np.empty((J, 3, 3))
+    trans = np.empty((J, 3))
+    world = np.empty((G, 3))
+    g_world = np.empty((NG, 3))
+    box_c = np.empty((G, 3))
+    box_r = np.empty((G, 3, 3))
+    placed = np.zeros(G, dtype=np.bool_)     # world box of the piece computed for this configuration
+    counts = np.zeros(n_cfg, dtype=np.int64)
+    out = np.empty(n_cfg * P, dtype=np.int64)
+    filled = 0
+    for i in range(n_cfg):
+        _forward(qs[i], parent, kind, axis, jrot, jtrans, jq, rot, trans)
+        for g in range(G):
+            _place(rot, trans, piece_joint[g], centre, g, world)
+        for g in range(NG):
+            _place(rot, trans, group_joint[g], g_centre, g, g_world)
+        placed[:] = False
+        first = filled
+        begin = 0
+        for blk in range(NB):
+            stop = b_end[blk]
+            ga, gb = b_a[blk], b_b[blk]
+            if b_kind[blk] == 0:
+                cleared = _sphere_box(g_world, ga, g_radius[ga] + b_margin[blk], box_lo, box_hi, gb)
+            else:
+                cleared = _sphere_point(g_world, ga, g_world, gb, g_radius[ga] + g_radius[gb] + b_margin[blk])
+            if not cleared:
+                for n in range(begin, stop):
+                    k = b_pairs[n]
+                    if not active[k]:
+                        continue
+                    a, b = pair_a[k], pair_b[k]
+                    if pair_obstacle[k]:
+                        ok = _sphere_box(world, a, radius[a] + margin[k], box_lo, box_hi, b)
+                        if not ok and ch_start[b] >= 0:   # near the obstacle's box: chunk by chunk
+                            if not placed[a]:
+                                _place_box(rot, trans, piece_joint[a], obb_c, obb_r, a, box_c, box_r)
+                                placed[a] = True
+                            ok = True
+                            c = ch_start[b]
+                            while c < ch_end[b]:          # the chunk tree, pre-order, without a stack
+                                if _sphere_point(world, a, ch_c, c, radius[a] + ch_rad[c] + margin[k]) or \
+                                        _boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, margin[k]):
+                                    c = ch_skip[c]        # cleared: past its subtree
+                                elif ch_skip[c] == c + 1:
+                                    ok = False            # a leaf it cannot clear
+                                    break
+                                else:
+                                    c += 1                # into its first child
+                    else:
+                        ok = _sphere_point(world, a, world, b, radius[a] + radius[b] + margin[k])
+                        if not ok:                # the spheres overlap: try the pieces' boxes
+                            for g in (a, b):
+                                if not placed[g]:
+                                    _place_box(rot, trans, piece_joint[g], obb_c, obb_r, g, box_c, box_r)
+                                    placed[g] = True
+                            ok = _boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b, margin[k])
+                    if not ok:
+                        out[filled] = k
+                        filled += 1
+            begin = stop
+        for n in range(first + 1, filled):      # into pair order: a few entries, insertion sort
+            k = out[n]
+            m = n - 1
+            while m >= first and out[m] > k:
+                out[m + 1] = out[m]
+                m -= 1
+            out[m + 1] = k
+        counts[i] = filled - first
+    return counts, out[:filled]
+
+
+@njit(cache=True, nogil=True)
+def _place(rot: Any, trans: Any, j: int, local: Any, g: int, world: Any) -> None:
+    for r in range(3):
+        world[g, r] = trans[j, r] + rot[j, r, 0] * local[g, 0] + rot[j, r, 1] * local[g, 1] + rot[j, r, 2] * local[g, 2]
+
+
+@njit(cache=True, nogil=True)
+def _sphere_box(world: Any, a: int, reach: float, lo: Any, hi: Any, b: int) -> bool:
+    """Whether sphere centre a is farther than `reach` from box b (an inf reach is never cleared)."""
+    d2 = 0.0
+    for r in range(3):
+        c = world[a, r]
+        e = lo[b, r] - c
+        if c - hi[b, r] > e:
+            e = c - hi[b, r]
+        if e > 0.0:
+            d2 += e * e
+    return d2 > reach * reach
+
+
+@njit(cache=True, nogil=True)
+def _sphere_point(world: Any, a: int, points: Any, c: int, reach: float) -> bool:
+    """Whether point world[a] is farther than `reach` from point points[c]."""
+    d2 = 0.0
+    for r in range(3):
+        e = world[a, r] - points[c, r]
+        d2 += e * e
+    return d2 > reach * reach
+
+
+@njit(cache=True, nogil=True)
+def _place_box(rot: Any, trans: Any, j: int, local_c: Any, local_r: Any, g: int, box_c: Any, box_r: Any) -> None:
+    for r in range(3):
+        box_c[g, r] = trans[j, r] + rot[j, r, 0] * local_c[g, 0] + rot[j, r, 1] * local_c[g, 1] \
+            + rot[j, r, 2] * local_c[g, 2]
+        for c in range(3):
+            box_r[g, r, c] = rot[j, r, 0] * local_r[g, 0, c] + rot[j, r, 1] * local_r[g, 1, c] \
+                + rot[j, r, 2] * local_r[g, 2, c]
+
+
+@njit(cache=True, nogil=True)
+def _boxes_apart(ca: Any, ra: Any, ha: Any, a: int, cb: Any, rb: Any, hb: Any, b: int, gap: float) -> bool:
+    """Whether oriented box a (centre ca[a], axes the columns of ra[a], half extents ha[a]) and box b
+    are more than `gap` apart along one of the 15 separating axes (Gottschalk's test; a cross-product
+    axis's gap scaled by its length). False proves nothing."""
+    ea, eb = ha[a], hb[b]
+    if not (np.isfinite(ea[0]) and np.isfinite(eb[0])):
+        return False
+    R = np.empty((3, 3))
+    AbsR = np.empty((3, 3))
+    t = np.empty(3)
+    for i in range(3):
+        t[i] = 0.0
+        for k in range(3):
+            t[i] += ra[a, k, i] * (cb[b, k] - ca[a, k])
+        for j in range(3):
+            v = 0.0
+            for k in range(3):
+                v += ra[a, k, i] * rb[b, k, j]
+            R[i, j] = v
+            AbsR[i, j] = abs(v) + 1e-9          # near-parallel edges: no false separation
+    for i in range(3):
+        if abs(t[i]) > ea[i] + eb[0] * AbsR[i, 0] + eb[1] * AbsR[i, 1] + eb[2] * AbsR[i, 2] + gap:
+            return True
+    for j in range(3):
+        if abs(t[0] * R[0, j] + t[1] * R[1, j] + t[2] * R[2, j]) > \
+                ea[0] * AbsR[0, j] + ea[1] * AbsR[1, j] + ea[2] * AbsR[2, j] + eb[j] + gap:
+            return True
+    for i in range(3):
+        i1, i2 = (i + 1) % 3, (i + 2) % 3
+        for j in range(3):
+            j1, j2 = (j + 1) % 3, (j + 2) % 3
+            length = math.sqrt(max(0.0, 1.0 - R[i, j] * R[i, j]))
+            if length < 1e-6:
+                continue
+            ra = ea[i1] * AbsR[i2, j] + ea[i2] * AbsR[i1, j]
+            rb = eb[j1] * AbsR[i, j2] + eb[j2] * AbsR[i, j1]
+            if abs(t[i2] * R[i1, j] - t[i1] * R[i2, j]) > ra + rb + gap * length:
+                return True
+    return False
