@@ -65,7 +65,7 @@ DEAD_END_DETOURS = 3
 
 def _moves_of(order: tuple[int, ...]) -> set[tuple[int, int]]:
     stops = (HOME, *order, HOME)
-    return set(zip(stops[:-1], stops[1:]))
+    return set(itertools.pairwise(stops))
 
 
 
@@ -312,7 +312,7 @@ class Sequencer(SequencerDetours):
         stops = [(HOME, 0), *zip(tour.order, tour.choice), (HOME, 0)]
         out: list[Transition] = []
         complete = True
-        for (i, a), (j, b) in zip(stops[:-1], stops[1:]):
+        for (i, a), (j, b) in itertools.pairwise(stops):
             qa, qb = self.q(i)[a], self.q(j)[b]
             label = f"{self._name(i)} -> {self._name(j)}"
             # As `_costs` offers it: an unchecked straight move is tried only where it is offered.

@@ -9,11 +9,10 @@ at i, until a release.
 
 from __future__ import annotations
 
-from typing import Any
-
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 

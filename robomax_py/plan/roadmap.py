@@ -11,6 +11,7 @@ move). Every collision check is counted.
 from __future__ import annotations
 
 import copy
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -177,7 +178,7 @@ class Roadmap:
                 return None
             bad = None
             known: bool | None
-            for u, v in zip(path[:-1], path[1:]):
+            for u, v in itertools.pairwise(path):
                 key = (min(u, v), max(u, v))
                 if u >= 0 and v >= 0:
                     known, used = self._edge(u, v)

@@ -130,7 +130,7 @@ def best_choice(order: Sequence[int], costs: _Costs) -> tuple[tuple[int, ...], f
         return (), float(costs(HOME, HOME)[0, 0])
     value = costs(HOME, order[0])[0] + costs.node[order[0]]
     back: list[np.ndarray] = []
-    for prev, nxt in zip(order[:-1], order[1:]):
+    for prev, nxt in itertools.pairwise(order):
         total = value[:, None] + costs(prev, nxt)           # (N_prev, N_next)
         arg = np.argmin(total, axis=0)
         value = total[arg, np.arange(total.shape[1])] + costs.node[nxt]
@@ -300,7 +300,7 @@ def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> _Moves:
 def _bound(order: tuple[int, ...], costs: _Costs) -> float:
     """Spot-level lower bound of an order's cost (min edge per pair, min node per spot)."""
     stops = (HOME, *order, HOME)
-    edges = sum(costs.lower_bound(a, b) for a, b in zip(stops[:-1], stops[1:]))
+    edges = sum(costs.lower_bound(a, b) for a, b in itertools.pairwise(stops))
     return edges + sum(costs.node_min[s] for s in order)
 
 

@@ -17,6 +17,7 @@ keeps the configuration roadmap alone.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -96,7 +97,7 @@ def dynamic_boxes(scene: Scene) -> tuple[tuple[FloatArray, FloatArray, Windows],
 
 
 def _line_free(space: TcpSpace, a: FloatArray, b: FloatArray) -> bool:
-    n = max(2, int(math.ceil(float(np.linalg.norm(b - a)) / (PRECISION_M / 2))) + 1)
+    n = max(2, math.ceil(float(np.linalg.norm(b - a)) / (PRECISION_M / 2)) + 1)
     return bool(space.voxels.is_free(a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)).all())
 
 
@@ -160,8 +161,8 @@ def _dense(route: FloatArray) -> FloatArray:
     """The route with points added so that none is farther than FOLLOW_STEP_M from the next: the
     arm's straight joint moves between them then stay near the TCP's line."""
     out = [route[0]]
-    for a, b in zip(route[:-1], route[1:]):
-        n = max(1, int(math.ceil(float(np.linalg.norm(b - a)) / FOLLOW_STEP_M)))
+    for a, b in itertools.pairwise(route):
+        n = max(1, math.ceil(float(np.linalg.norm(b - a)) / FOLLOW_STEP_M))
         out.extend(a + (b - a) * (i / n) for i in range(1, n + 1))
     return np.array(out)
 
@@ -194,7 +195,7 @@ def follow(robot: RobotModel, world: CollisionWorld, route: FloatArray, q_start:
         return None
     qs.append(np.asarray(q_goal, dtype=float))
     path = np.array(qs)
-    for a, b in zip(path[:-1], path[1:]):
+    for a, b in itertools.pairwise(path):
         if not world.check_segment(a, b).free:
             return None
     return path

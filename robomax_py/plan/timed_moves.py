@@ -17,6 +17,7 @@ when it finishes before waiting at rest would; otherwise, or when anything fails
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -171,7 +172,7 @@ def _graph(ctx: JunctionContext, waypoints: FloatArray, q_action: FloatArray | N
     for inner in chains:
         chain = [start, *range(at, at + len(inner)), goal]
         at += len(inner)
-        for a, b in zip(chain[:-1], chain[1:]):
+        for a, b in itertools.pairwise(chain):
             links.setdefault(a, set()).add(b)
             links.setdefault(b, set()).add(a)
             known_free.add((min(a, b), max(a, b)))
@@ -232,7 +233,7 @@ def _timed(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray,
     cuts = [i for i, s in enumerate(route.steps) if 0 < i < len(nodes) - 1 and s.depart - s.arrive > 1e-6]
     bounds = [0, *cuts, len(nodes) - 1]
     # Rounded as the program states them, so the written program is exactly the motion timed.
-    pieces = [as_written_joints(_shortcut(ctx, points[nodes[a:b + 1]])) for a, b in zip(bounds[:-1], bounds[1:])]
+    pieces = [as_written_joints(_shortcut(ctx, points[nodes[a:b + 1]])) for a, b in itertools.pairwise(bounds)]
     # One corner and one junction radius for every piece (the program states one per transition),
     # the largest that times and stays free in every piece; the pieces stop where they wait.
     for rj_deg, rd_deg in STAGED_RADII_DEG:
@@ -306,7 +307,7 @@ def _compress(ctx: JunctionContext, path: FloatArray) -> FloatArray:
             len(path) - 1]
     keep = sorted(set(keep))
     out = [path[:1]]
-    for a, b in zip(keep[:-1], keep[1:]):
+    for a, b in itertools.pairwise(keep):
         out.append(_shortcut(ctx, path[a:b + 1])[1:])
     return np.vstack(out)
 

@@ -66,6 +66,7 @@ makes fresh scratch (no re-sampling).
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -174,7 +175,7 @@ class CollisionWorld:
     Not thread-safe: owns Pinocchio scratch. `copy()` gives an independent world cheaply.
     """
 
-    __slots__ = ("_s", "_data", "_gdata", "_manager", "_callback", "_present", "_active_before", "_pf", "_active", "_allowed")
+    __slots__ = ("_active", "_active_before", "_allowed", "_callback", "_data", "_gdata", "_manager", "_pf", "_present", "_s")
 
     def __init__(
         self, robot: RobotModel, scene: Scene, clearance: float = 0.0, options: CollisionOptions = CollisionOptions()
@@ -460,7 +461,7 @@ class CollisionWorld:
         q0 = np.asarray(q0, dtype=np.float64)
         q1 = np.asarray(q1, dtype=np.float64)
         dq = q1 - q0
-        m = int(math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12))
+        m = math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12)
         timed = t0 is not None and t1 is not None and self._s.dynamic_ids.size > 0
         if m == 0:
             m = 1 if timed and t0 != t1 else 0
@@ -511,8 +512,8 @@ class CollisionWorld:
         if pts.ndim != 2 or len(pts) == 0:
             raise ValueError("points must be a non-empty (k, n) array")
         pieces = [pts[:1]]
-        for q0, q1 in zip(pts[:-1], pts[1:]):
-            m = int(math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12))
+        for q0, q1 in itertools.pairwise(pts):
+            m = math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12)
             if m == 0:
                 continue                  # check_segment checks q0 alone: already in
             states = q0 + (np.arange(1, m + 1) / m)[:, None] * (q1 - q0)

@@ -198,8 +198,7 @@ def _sphere_box(world: Any, a: int, reach: float, lo: Any, hi: Any, b: int) -> b
     for r in range(3):
         c = world[a, r]
         e = lo[b, r] - c
-        if c - hi[b, r] > e:
-            e = c - hi[b, r]
+        e = max(e, c - hi[b, r])
         if e > 0.0:
             d2 += e * e
     return d2 > reach * reach

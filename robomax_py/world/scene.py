@@ -277,7 +277,7 @@ def _build_mesh_pieces(
 ) -> tuple[tuple[coal.CollisionGeometry, ...], str]:
     try:
         mesh = load_mesh(Path(path))
-    except Exception as exc:  # trimesh raises many kinds for unreadable files
+    except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
         raise error(file, key, f"cannot read mesh {path}: {exc}") from None
     pieces = mesh_collision_shapes(mesh)
     convex = not any(isinstance(p, coal.BVHModelBase) for p in pieces)
