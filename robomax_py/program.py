@@ -1,7 +1,7 @@
 """A robot program as values, independent of any controller dialect.
 
-An exporter turns a `Program` into text (`export/srcl.py`) and a parser turns text back into one
-(`parse_program`, both in `export/srcl.py`). Every float is rounded *when the value is built* to the fixed number of
+An exporter turns a `Program` into text (`export/srcl/`) and a parser turns text back into one
+(`parse_program`, both in `export/srcl/`). Every float is rounded *when the value is built* to the fixed number of
 decimals the program files carry, so ``parse(write(p)) == p`` holds exactly:
 
 =================================  =========  ========

@@ -238,7 +238,7 @@ class ProgramRun:
     dialect: str
     events: tuple[Event, ...]
     issues: tuple[Issue, ...]
-    j23_coupling: bool = False   # FANUC: joint positions count J3 from the horizontal (see fanuc.py)
+    j23_coupling: bool = False   # FANUC: joint positions count J3 from the horizontal (see export/fanuc)
     # Where the program stopped before its last statement: an end (RETURN of the main routine,
     # EXIT, ABORT, halt()) or a pause that waits for the operator (HALT, Stop, PAUSE), after which
     # nothing runs in the cycle; None when it ran to its end.

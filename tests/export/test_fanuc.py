@@ -1,5 +1,5 @@
 """FANUC TP as the controller prints and loads it: program names, remarks, /ATTR and the statement
-layout within the controller's limits (robomax_py/export/fanuc.py gives the sources), the reader on
+layout within the controller's limits (robomax_py/export/fanuc/ gives the sources), the reader on
 real exports (tests/data/programs/SOURCES.md) and on SpotTool+ welds, and a cell whose names are far
 longer than TP allows planned and proven."""
 

@@ -118,7 +118,7 @@ def test_the_package_weld_program_is_clean_and_welds_with_spot(placed_package: P
 
 
 # ------------------------------------------------------------------ what the controller executes
-# Mutants of the program's flow, speeds and weld times (fanuc.py's docstring, export/flow.py):
+# Mutants of the program's flow, speeds and weld times (export/fanuc's docstring, export/flow.py):
 # each is caught with the violation the controller's execution implies; labels and a jump to the
 # statement after one still verify clean.
 

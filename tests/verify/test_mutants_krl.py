@@ -4,7 +4,7 @@ have written it (the robot's placement as the base frame, the tool's angles in a
 order, lengths in metres, joint values in radians, the wrist flag flipped, the folds' FDAT selecting
 tool 1 or base 0, or the lines that select the frames deleted).
 
-What the controller does without them (BAS.SRC, krl.py's docstring): a fold without its FDAT_ACT
+What the controller does without them (BAS.SRC, export/krl's docstring): a fold without its FDAT_ACT
 line runs BAS with the FDAT_ACT last assigned, so with every FDAT_ACT line gone the frames are the
 controller's from an earlier run (unknown: the program selects none); a fold without its BAS line
 changes no frame, so with every BAS line gone the INI fold's BAS(#INITMOV) frames stay in force:
@@ -111,7 +111,7 @@ def test_the_written_krl_program_is_clean(placed: Placed) -> None:
 
 
 # ------------------------------------------------------------------ what the controller executes
-# Mutants of the program's flow, speeds and weld times (krl.py's docstring, export/flow.py): each
+# Mutants of the program's flow, speeds and weld times (export/krl's docstring, export/flow.py): each
 # is caught with the violation the controller's execution implies, and the program with flow it
 # can follow exactly (a label, a jump to the next statement, a call of a routine without motion)
 # still verifies clean.

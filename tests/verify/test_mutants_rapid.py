@@ -216,7 +216,7 @@ def test_the_controller_model_stops_every_spotl_at_its_spot(placed_package: Plac
 
 
 # ------------------------------------------------------------------ what the controller executes
-# Mutants of the module's flow, speeds and weld times (rapid.py's docstring, export/flow.py): each
+# Mutants of the module's flow, speeds and weld times (export/rapid's docstring, export/flow.py): each
 # is caught with the violation the controller's execution implies; a module with flow verify can
 # follow exactly (labels, one on the line of the statement it marks, a jump to the next
 # statement, a call of a PROC without motion) still verifies clean.

@@ -79,7 +79,7 @@ def test_the_written_script_is_clean(placed: Placed) -> None:
 
 
 # ------------------------------------------------------------------ what the controller executes
-# Mutants of the script's flow, speeds and weld times (urscript.py's docstring, export/flow.py):
+# Mutants of the script's flow, speeds and weld times (export/urscript's docstring, export/flow.py):
 # each is caught with the violation the controller's execution implies; a call of a function
 # without motion still verifies clean. URScript has no jumps: a weld under a condition or in a
 # loop stands for them.

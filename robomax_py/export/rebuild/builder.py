@@ -1,27 +1,10 @@
-"""A robot program -> the motion it commands, built the way the planner built it (`timing.chain`).
-
-Speeds and weld times are checked as the program states them, in SI units (each reader converts
-its dialect's units): a joint move's speed or acceleration, or a line's acceleration, above 100 % of
-the axes' limits (the robot's); a line faster than the cell's line speed (`planner.tcp_speed`, the
-TCP speed the cell's approach and retract lines are planned with); a weld that takes another time
-than the cell's spot (a time written in ms is a thousand times the cell's). The motion is rebuilt
-with the speeds capped at 100 %, as the program cannot move faster than the axes can.
-
-Semantics (docs/srcl.md, "Motion semantics"): the first PTP is the start; moves are grouped into
-chains at their FLYBY radii; a chain of one PTP is a jerk-limited joint move, every other chain is
-timed by toppra on its blended path with the LIN lines' TCP speeds; SPOT and WAIT hold at rest;
-`WAIT FOR <object>_clear` holds until the dynamic object `<object>` is absent. What the program
-states that cannot be executed as stated (a LIN the arm cannot follow in its configuration, a
-SPOT while flying by, a LIN ending in another configuration than its CONFIG) is a problem of the
-program, reported with the time it happens; what makes the program unreadable for this cell
-(another robot, other joints) is bad input.
-"""
+"""`rebuild`, a program's motion built move by move (`_Builder`) the way the planner built it, with
+its speeds, weld times, frames and interlocks checked."""
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +12,16 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
+from robomax_py.export.rebuild.result import (
+    CONFIG_TOL_RAD,
+    FRAME_TOL_DEG,
+    FRAME_TOL_MM,
+    TCP_SPEED_TOL_MM_S,
+    WELD_TIME_TOL_S,
+    Problem,
+    Rebuilt,
+    Span,
+)
 from robomax_py.plan.waiting import clear_wait, signal_of
 from robomax_py.program import (
     NULL_FRAME,
@@ -54,61 +47,12 @@ from robomax_py.timing import (
     LinMoveError,
     Segment,
     TimingError,
-    Trajectory,
     concatenate,
     dwell,
     resample,
 )
 from robomax_py.timing.chain import LinStep, PtpStep, Step, chain_path, time_chain
-from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.scene import clamps_near
-
-# Frame definitions must match the cell's tool and base within the program's decimals.
-FRAME_TOL_MM = TOL.frame_tol_mm
-FRAME_TOL_DEG = TOL.frame_tol_deg
-# A target's configuration data may name either side of a boundary the joint is this close to.
-CONFIG_TOL_RAD = math.radians(TOL.config_tol_deg)
-# A line's TCP speed may exceed the cell's line speed by this much (FANUC TP states whole mm/sec).
-TCP_SPEED_TOL_MM_S = 0.5
-# A weld time is the cell's within half the last decimal programs state it with (3 decimals, s).
-WELD_TIME_TOL_S = 0.5e-3 + 1e-9
-
-
-@dataclass(frozen=True, slots=True)
-class Problem:
-    t: float | None
-    kind: str
-    detail: str
-    line: int | None = None          # the program line of the statement, where known
-
-
-@dataclass(frozen=True, slots=True)
-class Span:
-    """The time a statement's motion takes in the rebuilt trajectory (s, from program start)."""
-
-    t_start: float
-    t_end: float
-    line: int | None
-
-
-@dataclass(slots=True)
-class Rebuilt:
-    """The motion of a program: a trajectory (None when it could not be built to the end), the
-    spots it welds (as the trajectory file's `spots` entries) and what was wrong on the way."""
-
-    trajectory: Trajectory | None
-    spots: list[dict[str, Any]] = field(default_factory=list)
-    problems: list[Problem] = field(default_factory=list)
-    spans: list[Span] = field(default_factory=list)
-
-    def line_at(self, t: float | None) -> int | None:
-        """The program line whose statement commands the motion at time t (s)."""
-        if t is None:
-            return None
-        for span in self.spans:
-            if span.t_start - 1e-9 <= t <= span.t_end + 1e-9:
-                return span.line
-        return None
 
 
 def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | str,
