@@ -219,8 +219,8 @@ _STAMP = re.compile(r"^written (?P<stamp>\S.*)$")
 def header_lines(h: Header) -> list[str]:
     """The header as comment texts (without the dialect's comment marks), in every dialect alike."""
     lines = [
-        f"{h.generator or 'robomax_py ?'} | cell {h.cell} | cell file sha256 {h.cell_sha256 or 'unknown'} "
-        f"| planned cycle {h.cycle_time_s:.3f} s",
+        (f"{h.generator or 'robomax_py ?'} | cell {h.cell} | cell file sha256 {h.cell_sha256 or 'unknown'} "
+         f"| planned cycle {h.cycle_time_s:.3f} s"),
         f"robot {h.robot} | tool {h.tool} | axes {' '.join(h.joints)}",
     ]
     if h.stamp:

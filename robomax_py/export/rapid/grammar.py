@@ -34,23 +34,23 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 """
 
 _UNSIMULATED = re.compile(r"^(MoveJ|MoveC|MoveLDO|MoveJDO|MoveLSync|MoveJSync|MoveCSync|MoveExtJ|SearchL|SearchC|"
-                          r"TriggL|TriggJ|TriggC|MoveLRel|MoveAbsJDO|MoveAbsJSync|SpotJ|SpotML|SpotMJ)\b", re.I)
-_KNOWN = re.compile(r"^(MoveAbsJ|MoveL|SpotL|VelSet|AccSet|WaitTime|WaitDI|spot_weld|grip|release)\b", re.I)
+                          r"TriggL|TriggJ|TriggC|MoveLRel|MoveAbsJDO|MoveAbsJSync|SpotJ|SpotML|SpotMJ)\b", re.IGNORECASE)
+_KNOWN = re.compile(r"^(MoveAbsJ|MoveL|SpotL|VelSet|AccSet|WaitTime|WaitDI|spot_weld|grip|release)\b", re.IGNORECASE)
 # Lines that end a statement without ';': routine heads and ends, a routine's handler sections,
 # and control-flow lines.
 _HEADLINE = re.compile(r"^(MODULE|ENDMODULE|(LOCAL\s+)?PROC|ENDPROC|(LOCAL\s+)?FUNC|ENDFUNC|(LOCAL\s+)?TRAP|ENDTRAP|"
-                       r"ERROR|BACKWARD|UNDO)\b", re.I)
+                       r"ERROR|BACKWARD|UNDO)\b", re.IGNORECASE)
 # A label `name:` opening a line (RAPID reference, GOTO: "GOTO next; ... next:"); a statement may
 # follow it on the same line. CASE ...: and DEFAULT: open a TEST's branches instead.
 _LABEL = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*:(?!=)\s*(.*)$")
-_OPENS = re.compile(r"\b(THEN|DO)\s*$|^(TEST\b.*|ELSE|DEFAULT\s*:|CASE\b.*:)\s*$", re.I)
-_CLOSES = re.compile(r"^(ENDIF|ENDWHILE|ENDFOR|ENDTEST|ELSE)\s*$", re.I)
+_OPENS = re.compile(r"\b(THEN|DO)\s*$|^(TEST\b.*|ELSE|DEFAULT\s*:|CASE\b.*:)\s*$", re.IGNORECASE)
+_CLOSES = re.compile(r"^(ENDIF|ENDWHILE|ENDFOR|ENDTEST|ELSE)\s*$", re.IGNORECASE)
 # The declarations the motion depends on (spotdata: a package weld's schedule); others (num,
 # confdata, syncident, arrays ...) are ignored.
 _MOTION_DATA = re.compile(r"^((LOCAL|TASK)\s+)*(CONST|PERS|VAR)\s+(robtarget|jointtarget|speeddata|zonedata|tooldata|wobjdata|spotdata)\b",
-                          re.I)
-_PREDEFINED_SPEED = re.compile(r"^v([0-9]+)$", re.I)
-_PREDEFINED_ZONE = re.compile(r"^z([0-9]+)$", re.I)
+                          re.IGNORECASE)
+_PREDEFINED_SPEED = re.compile(r"^v([0-9]+)$", re.IGNORECASE)
+_PREDEFINED_ZONE = re.compile(r"^z([0-9]+)$", re.IGNORECASE)
 # The spot option's gundata of gun n (`gun_data`); another name leaves the gun unknown (0).
 _GUN_DATA = re.compile(r"^gun([0-9]+)$", re.IGNORECASE)
 

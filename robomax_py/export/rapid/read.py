@@ -235,12 +235,12 @@ class _Reader:
         if _CLOSES.match(text) and not text.upper().startswith("ELSE"):
             self.depth = max(0, self.depth - 1)
             return
-        if re.match(r"^(IF|WHILE|FOR|TEST)\b", text, re.I) and (_OPENS.search(text) or text.upper().startswith("TEST")):
+        if re.match(r"^(IF|WHILE|FOR|TEST)\b", text, re.IGNORECASE) and (_OPENS.search(text) or text.upper().startswith("TEST")):
             self.depth += 1
             self.ignored.append((line, text))
             return
         if _MOTION_DATA.match(text):
-            self.declare(self.tree(re.sub(r"^((LOCAL|TASK)\s+)*", "", text, flags=re.I), line), comment, line)
+            self.declare(self.tree(re.sub(r"^((LOCAL|TASK)\s+)*", "", text, flags=re.IGNORECASE), line), comment, line)
             return
         conditional = self.depth > 0 and (_KNOWN.match(text) or _UNSIMULATED.match(text))
         if _UNSIMULATED.match(text) or conditional:

@@ -34,8 +34,7 @@ DIALECT = "robomax SRCL/1"
 
 # Upper-case keywords; they cannot be used as names (names are case-sensitive, so `spot` is a name).
 RESERVED: frozenset[str] = frozenset(
-    "PROGRAM CELL ROBOT AXES TOOL CYCLE SEC VAR FRAME BASE POS ORI BEGIN ENDPROGRAM "
-    "MOVE PTP LIN AXIS SPEED ACCEL FLYBY CONFIG SPOT SEAM TIME WAIT FOR GUN SCHEDULE GRIP RELEASE INPUT".split()
+    ["PROGRAM", "CELL", "ROBOT", "AXES", "TOOL", "CYCLE", "SEC", "VAR", "FRAME", "BASE", "POS", "ORI", "BEGIN", "ENDPROGRAM", "MOVE", "PTP", "LIN", "AXIS", "SPEED", "ACCEL", "FLYBY", "CONFIG", "SPOT", "SEAM", "TIME", "WAIT", "FOR", "GUN", "SCHEDULE", "GRIP", "RELEASE", "INPUT"]
 )
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")

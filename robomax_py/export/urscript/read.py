@@ -135,7 +135,8 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             keywords.setdefault(key, value)
 
         def kw(key: str, default: float) -> float:
-            return _numbers(keywords[key], file, number)[0] if key in keywords else default
+            # Called only within this statement's iteration, so the loop's values are the right ones.
+            return _numbers(keywords[key], file, number)[0] if key in keywords else default  # noqa: B023
 
         target = args[0] if args else None
         if func == "movej":
