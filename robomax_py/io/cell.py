@@ -56,7 +56,6 @@ from robomax_py.spec import (
     Cylinder,
     MachineSpec,
     MeshShape,
-    Notice,
     ObjectSpec,
     PartSpec,
     PlannerSpec,
@@ -622,8 +621,7 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
         tcp_limits=_tcp_limits(parsed.pick_place.unloaded) if parsed.pick_place is not None else None,
     )
     cell = dataclasses.replace(cell, controller=_controller(parsed.robot.controller, cell, path))
-    notices = tuple(Notice(*expansion.locate(n.file, n.key, n.message)) for n in lint_cell(parsed, cell, path))
-    return dataclasses.replace(cell, notices=notices)
+    return dataclasses.replace(cell, notices=tuple(map(expansion.relocated_notice, lint_cell(parsed, cell, path))))
 
 
 def _controller(ctrl: RobotControllerFile, cell: CellSpec, path: Path) -> ControllerSetup:

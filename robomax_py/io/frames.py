@@ -228,7 +228,7 @@ def _matrix(pose: PoseFile) -> np.ndarray:
     return pose_matrix(pose.xyz, np.radians(pose.rpy))
 
 
-def _moved(pose: PoseFile, T: np.ndarray) -> PoseFile:
+def _moved(pose: PoseFile, T: np.ndarray) -> Any:
     return _pose_file(T @ _matrix(pose))
 
 

@@ -28,6 +28,7 @@ from robomax_py.errors import CellFileError
 from robomax_py.io.robot import resolve_robot_file, resolve_tool_file
 from robomax_py.io.yaml_files import load_yaml, validation_error
 from robomax_py.safe_files import LIMITS, read_text
+from robomax_py.spec import Notice
 
 # The lists an included file's items are appended to, and the keys given once in the whole tree.
 MERGED_LISTS = ("frames", "objects", "dynamic", "seams")
@@ -93,6 +94,10 @@ class Expansion:
             return ref if str(other) == where else f"{ref} in {other}"
 
         return where, key, _LIST_REF.sub(place, problem)
+
+    def relocated_notice(self, notice: Notice) -> Notice:
+        file, key, message = self.locate(notice.file, notice.key, notice.message)
+        return Notice(file or notice.file, key or notice.key, message)
 
     def relocated(self, exc: CellFileError) -> CellFileError:
         file, key, problem = self.locate(exc.file, exc.key, exc.problem)

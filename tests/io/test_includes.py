@@ -16,7 +16,12 @@ from typer.testing import CliRunner
 
 from robomax_py.app.cli import app
 from robomax_py.errors import CellFileError
-from robomax_py.io.cell import dump_cell_file, load_cell, load_cell_robot, read_cell_file
+from robomax_py.io.cell import (
+    dump_cell_file,
+    load_cell,
+    load_cell_robot,
+    read_cell_file,
+)
 from robomax_py.plan import PlanOptions, plan_cell
 from tests.conftest import SmallCell
 
