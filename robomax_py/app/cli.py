@@ -257,10 +257,10 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
         if not as_json:
             out.print(cell_summary(spec, robot))
             for file in included:
-                out.print(f"includes {file}", markup=False, highlight=False)
+                out.print(f"includes {file}", markup=False, highlight=False, soft_wrap=True)
             if tree:
                 out.print("frames:\n" + "\n".join(f"  {line}" for line in format_tree(tree)), markup=False,
-                          highlight=False)
+                          highlight=False, soft_wrap=True)
         reach = reach_report(spec, robot)
         far = [r for r in reach if not r.reachable]
         stop = "station" if spec.tending else "spot"          # gripper actions (tending, pick and place)

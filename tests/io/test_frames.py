@@ -11,6 +11,7 @@ import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from pydantic import ValidationError
 from scipy.spatial.transform import Rotation
 
 from robomax_py.errors import CellFileError
@@ -132,7 +133,7 @@ def test_a_robot_on_a_frame_and_an_error_names_the_cell_file(tmp_path: Path, wri
 
 
 def test_a_part_placed_by_its_locations_takes_no_frame() -> None:
-    with pytest.raises(Exception, match="no pose, frame"):
+    with pytest.raises(ValidationError, match="no pose, frame"):
         CellFile.model_validate({**BASE, "pick_place": {
             "parts": [{"name": "p", "box": [0.1, 0.1, 0.1], "mass": 1, "frame": "x"}],
             "locations": [{"name": "a", "pose": {}}, {"name": "b", "pose": {}}],
@@ -150,3 +151,27 @@ def test_read_cell_file_is_flat_so_a_rewritten_cell_stands_alone(tmp_path: Path,
     assert "frame" not in yaml.safe_load(flat.read_text())["seams"][0]
     a, b = load_cell(path), load_cell(flat)
     assert [s.xyz.tolist() for s in a.seams[0].spots] == [s.xyz.tolist() for s in b.seams[0].spots]
+
+
+def test_stations_doors_locations_and_dynamic_objects_take_frames_too() -> None:
+    M = {"xyz": [2.0, 1.0, 0.5], "rpy": [0.0, 0.0, 90.0]}
+    T = _T(M["xyz"], M["rpy"])
+    door = {"name": "door", "box": [0.1, 1, 1], "pose": {"xyz": [0.5, 0, 0]}, "frame": "machine"}
+    cell = _cell(frames=[{"name": "machine", "pose": M}],
+                 dynamic=[{"name": "cart", "box": [1, 1, 1], "frame": "machine", "present": [[0, 1]]}],
+                 tending={"machines": [{"name": "m", "door": door, "schedule": {"machining": 5, "period": 10}}],
+                          "stations": [{"name": "in", "xyz": [0.3, 0, 0.2], "rpy": [180, 0, 0], "action": "grip",
+                                        "frame": "machine"}]})
+    flat, _ = resolve_frames(cell, Path("f.yaml"))
+    station = flat.tending.stations[0]
+    assert station.frame is None
+    assert np.allclose(_T(station.xyz, station.rpy), T @ _T([0.3, 0, 0.2], [180, 0, 0]), atol=TOL, rtol=0)
+    assert np.allclose(flat.tending.machines[0].door.pose.xyz, (T @ np.r_[0.5, 0, 0, 1])[:3], atol=TOL, rtol=0)
+    assert np.allclose(_T(flat.dynamic[0].pose.xyz, flat.dynamic[0].pose.rpy), T, atol=TOL, rtol=0)
+    picks = _cell(frames=[{"name": "shelf", "pose": M}], pick_place={
+        "parts": [{"name": "p", "box": [0.1, 0.1, 0.1], "mass": 1}],
+        "locations": [{"name": "a", "pose": {}, "frame": "shelf"}, {"name": "b", "pose": {"xyz": [1, 0, 0]}}],
+        "transfers": [{"part": "p", "from": "a", "to": "b"}]})
+    flat, _ = resolve_frames(picks, Path("f.yaml"))
+    assert np.allclose(_T(flat.pick_place.locations[0].pose.xyz, flat.pick_place.locations[0].pose.rpy), T, atol=TOL)
+    assert flat.pick_place.locations[1] == picks.pick_place.locations[1]
