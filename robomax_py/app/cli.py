@@ -245,15 +245,22 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
     def run() -> None:
         from robomax_py.app.summary import cell_summary
         from robomax_py.errors import CellFileError
-        from robomax_py.io.cell import load_cell, load_cell_robot
+        from robomax_py.io.cell import load_cell, load_cell_robot, read_cell_frames
+        from robomax_py.io.frames import format_tree
         from robomax_py.plan.reach import reach_report, self_contacts
 
         spec = load_cell(cell)
+        tree, included = read_cell_frames(cell)
         _warn([str(n) for n in spec.notices])   # probable mistakes: warnings, the cell is still valid
         robot = load_cell_robot(spec)
         _warn(robot.warnings)
         if not as_json:
             out.print(cell_summary(spec, robot))
+            for file in included:
+                out.print(f"includes {file}", markup=False, highlight=False, soft_wrap=True)
+            if tree:
+                out.print("frames:\n" + "\n".join(f"  {line}" for line in format_tree(tree)), markup=False,
+                          highlight=False, soft_wrap=True)
         reach = reach_report(spec, robot)
         far = [r for r in reach if not r.reachable]
         stop = "station" if spec.tending else "spot"          # gripper actions (tending, pick and place)
@@ -280,7 +287,8 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
                 "reach": None if tight is None else {
                     stop + "s": len(reach), "least_margin_m": round(-tight.out_by_m, 6), "at": f"{tight.seam}/{tight.name}"},
                 "self_contacts_at_home": [list(p) for p in at_home],
-                "self_contacts_always": [list(p) for p in always]})
+                "self_contacts_always": [list(p) for p in always],
+                "frames": [node.as_dict() for node in tree], "includes": [str(file) for file in included]})
             return
         out.print(f"[green]ok[/]: {cell} is a valid cell")
 

@@ -7,7 +7,6 @@ file, the key path (e.g. `seams[0].spots[3].normal`) and the problem; nothing he
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
 import math
 import re
@@ -30,6 +29,8 @@ from pydantic import (
 
 from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.io.cell_lint import library_hint, lint_cell
+from robomax_py.io.frames import FrameNode, resolve_frames
+from robomax_py.io.includes import Expansion, expand_includes
 from robomax_py.io.robot import (
     load_robot_spec,
     load_tool_spec,
@@ -201,6 +202,7 @@ class RobotControllerFile(_Strict):
 class RobotRefFile(_Strict):
     model: Reference
     base: PoseFile = PoseFile()
+    frame: Name | None = None        # base given in this frame (docs/frames.md); default: the world
     home: list[Finite]               # deg (m for a prismatic joint)
     controller: RobotControllerFile = RobotControllerFile()
 
@@ -225,6 +227,7 @@ class ObjectFile(_Strict):
     capsule: CylinderFile | None = None
     mesh: Reference | None = None
     pose: PoseFile = PoseFile()
+    frame: Name | None = None           # pose given in this frame (docs/frames.md); default: the world
     workpiece: bool = False
     signal: Name | None = None          # extension: clamp interlock input (docs/cell-extensions.md)
 
@@ -290,6 +293,7 @@ class SpotFile(_Strict):
     gamma: Angle | None = None
     config: Annotated[str, Field(min_length=1, max_length=64)] | None = None
     skip: bool = False
+    frame: Name | None = None           # xyz, normal, direction in this frame; default: the seam's
 
     @model_validator(mode="after")
     def _pinned_together(self) -> SpotFile:
@@ -305,6 +309,7 @@ class SeamFile(_Strict):
     ordered: bool = False
     tolerance: ToleranceFile = ToleranceFile()
     grid: Annotated[int, Field(ge=1, le=64)] = 1
+    frame: Name | None = None           # the frame of its spots (docs/frames.md); default: the world
     spots: Annotated[list[SpotFile], Field(min_length=1)]
 
 
@@ -340,6 +345,7 @@ class StationFile(_Strict):
     action: Literal["grip", "release"]
     machine: Name | None = None               # the machine whose door the station lies behind
     config: Annotated[str, Field(min_length=1, max_length=64)] | None = None
+    frame: Name | None = None                 # xyz, rpy in this frame (docs/frames.md); default: the world
 
 
 class ScheduleFile(_Strict):
@@ -394,14 +400,15 @@ class PartFile(ObjectFile):
 
     @model_validator(mode="after")
     def _no_placement(self) -> PartFile:
-        if self.pose != PoseFile() or self.workpiece or self.signal is not None:
-            raise ValueError("a part has no pose, workpiece or signal: its locations place it")
+        if self.pose != PoseFile() or self.frame is not None or self.workpiece or self.signal is not None:
+            raise ValueError("a part has no pose, frame, workpiece or signal: its locations place it")
         return self
 
 
 class LocationFile(_Strict):
     name: Name
     pose: PoseFile                            # the part's frame when it lies here
+    frame: Name | None = None                 # pose given in this frame (docs/frames.md); default: the world
     support: list[Name] = []                  # objects the part rests on here (it may touch them)
 
 
@@ -419,9 +426,22 @@ class PickPlaceFile(_Strict):
     transfers: Annotated[list[TransferFile], Field(min_length=1, max_length=10_000)]
 
 
+class FrameFile(_Strict):
+    """A named frame (docs/frames.md): its pose in its parent, the world or another frame or object."""
+
+    name: Name
+    pose: PoseFile = PoseFile()
+    parent: Name | None = None                # default: the world
+
+
+IncludePath = Annotated[str, Field(min_length=1, max_length=4096), AfterValidator(_printable_name)]
+
+
 class CellFile(_Strict):
     robomax: int
     name: CellName | None = None
+    include: list[IncludePath] = []           # merged before anything else is read (io.includes)
+    frames: list[FrameFile] = []
     robot: RobotRefFile
     tool: Reference
     objects: list[ObjectFile] = []
@@ -433,6 +453,20 @@ class CellFile(_Strict):
     pick_place: PickPlaceFile | None = None
 
 
+class IncludeFile(_Strict):
+    """What a file a cell includes may hold (docs/frames.md, "Includes"): lists merged into the
+    including cell's, a robot and tool given once in the whole tree, further includes."""
+
+    robomax: int | None = None
+    include: list[IncludePath] = []
+    frames: list[FrameFile] = []
+    robot: RobotRefFile | None = None
+    tool: Reference | None = None
+    objects: list[ObjectFile] = []
+    dynamic: list[DynamicObjectFile] = []
+    seams: list[SeamFile] = []
+
+
 def load_cell(path: str | Path) -> CellSpec:
     """Read and check a cell file and the robot.yaml / tool.yaml / meshes it names.
 
@@ -441,13 +475,22 @@ def load_cell(path: str | Path) -> CellSpec:
     """
     path = Path(path)
     text = read_text(path, LIMITS.cell, CellFileError, "cell file")
-    # Programs name the exact cell file they were planned from (their header).
-    digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
     early = count_items(text, (("seams", "*", "spots"), ("objects",), ("dynamic",)))
     if early is not None:                  # before the guarded reader composes what may be a very long list
         _refuse_counts(early[("seams", "*", "spots")], early[("objects",)] + early[("dynamic",)], path)
     data = read_yaml_mapping(path, CellFileError, "cell file", LIMITS.cell)
-    return _cell_from_data(data, path, digest)
+    expansion = expand_includes(data, path, IncludeFile)
+    # Programs name the exact cell file they were planned from (their header): its bytes and its includes'.
+    return _located(expansion, _cell_from_data, expansion.data, path, expansion.digest(text.encode("utf-8")),
+                    expansion)
+
+
+def _located(expansion: Expansion, build: Callable[..., T], *args: Any) -> T:
+    """`build(*args)`, an error in what an included file brought naming that file and its own key."""
+    try:
+        return build(*args)
+    except CellFileError as exc:
+        raise expansion.relocated(exc) from None
 
 
 # The file a cell given as a mapping is named as in messages (there is none).
@@ -469,10 +512,11 @@ def cell_from_mapping(data: Mapping[str, Any], base_dir: str | Path) -> CellSpec
     if plain.get("name") is None:
         raise CellFileError(MAPPING_FILE, "name", "required for a cell given as a mapping (its programs are named "
                                                   "after it)")
-    digest = hashlib.sha256(json.dumps(plain, sort_keys=True, separators=(",", ":")).encode("utf-8")).hexdigest()
     stand_in = Path(base_dir) / MAPPING_FILE   # so that relative paths resolve against base_dir
     try:
-        return _cell_from_data(plain, stand_in, digest)
+        expansion = expand_includes(plain, stand_in, IncludeFile)
+        digest = expansion.digest(json.dumps(plain, sort_keys=True, separators=(",", ":")).encode("utf-8"))
+        return _located(expansion, _cell_from_data, expansion.data, stand_in, digest, expansion)
     except (CellFileError, RobotModelError) as exc:
         if exc.file != str(stand_in):
             raise
@@ -502,9 +546,9 @@ def _plain(value: object, key: str, depth: int) -> Any:
                                                    f"got {type(value).__name__}")
 
 
-def _cell_from_data(data: dict[str, Any], path: Path, digest: str) -> CellSpec:
-    """The checked cell of a cell file's parsed YAML; `path` names it in messages and anchors its relative
-    paths."""
+def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Expansion) -> CellSpec:
+    """The checked cell of a cell file's parsed YAML, its includes merged (`expansion`); `path` names it
+    in messages and anchors its relative paths."""
     _check_counts(data, path)              # before validating: the data as read, aliases expanded
     version = data.get("robomax")
     if "robomax" in data and version not in SUPPORTED_VERSIONS:
@@ -514,9 +558,10 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str) -> CellSpec:
         parsed = CellFile.model_validate(data)
     except ValidationError as exc:
         raise validation_error(exc, CellFile, path, CellFileError) from None
+    parsed, _ = resolve_frames(parsed, path)   # world coordinates from here on
     # Independent checks each run, and their errors are reported together (up to MAX_LISTED_PROBLEMS);
     # a check that needs what an earlier one refused waits until those are fixed.
-    problems = _Problems(path)
+    problems = _Problems(path, expansion.relocated)
     problems.attempt(_check_unique_names, parsed, path)
     jobs_ok = not problems.found           # one job, named uniquely: its seams can be built
     problems.attempt(_check_orientations, parsed, path)
@@ -576,7 +621,7 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str) -> CellSpec:
         tcp_limits=_tcp_limits(parsed.pick_place.unloaded) if parsed.pick_place is not None else None,
     )
     cell = dataclasses.replace(cell, controller=_controller(parsed.robot.controller, cell, path))
-    return dataclasses.replace(cell, notices=lint_cell(parsed, cell, path))
+    return dataclasses.replace(cell, notices=tuple(map(expansion.relocated_notice, lint_cell(parsed, cell, path))))
 
 
 def _controller(ctrl: RobotControllerFile, cell: CellSpec, path: Path) -> ControllerSetup:
@@ -627,8 +672,9 @@ def _job_seams(parsed: CellFile, path: Path, problems: _Problems) -> tuple[SeamS
 class _Problems:
     """The CellFileErrors of a cell file's independent checks, raised together as one (`several`)."""
 
-    def __init__(self, path: Path) -> None:
+    def __init__(self, path: Path, locate: Callable[[CellFileError], CellFileError]) -> None:
         self.path = path
+        self.locate = locate               # an included file's item is named by its file and key there
         self.found: list[CellFileError] = []
 
     def attempt(self, check: Callable[..., T], *args: Any) -> T | None:
@@ -637,7 +683,7 @@ class _Problems:
         try:
             return check(*args)
         except CellFileError as exc:
-            self.found.append(exc)
+            self.found.append(self.locate(exc))
             if len(self.found) >= MAX_LISTED_PROBLEMS:
                 raise several(list(self.found), self.path, more=True) from None
             return None
@@ -1064,16 +1110,36 @@ def _unit(v: list[float], path: Path, key: str) -> np.ndarray:
 
 
 def read_cell_file(path: str | Path) -> CellFile:
-    """A cell file as its checked schema (file units, keys as written), for tools that rewrite cells.
+    """A cell file as its checked schema (file units), for tools that rewrite cells: flat, its
+    includes merged (their paths relative to the cell) and every pose in world coordinates
+    (docs/frames.md), so what is written from it stands alone.
 
-    Only the file itself is checked here; `load_cell` checks what it names (robot, tool, meshes).
+    Only the files themselves are checked here; `load_cell` checks what they name (robot, tool, meshes).
     """
-    path = Path(path)
+    flat = _read_resolved(Path(path))[0].model_copy(update={"frames": [], "include": []})
+    flat.__pydantic_fields_set__.difference_update({"frames", "include"})   # resolved: not written back
+    return flat
+
+
+def read_cell_frames(path: str | Path) -> tuple[tuple[FrameNode, ...], tuple[Path, ...]]:
+    """The cell's frame tree (`io.frames.FrameNode`, file order) and the files it includes (reading order)."""
+    _, tree, files = _read_resolved(Path(path))
+    return tree, files
+
+
+def _read_resolved(path: Path) -> tuple[CellFile, tuple[FrameNode, ...], tuple[Path, ...]]:
     data = read_yaml_mapping(path, CellFileError, "cell file", LIMITS.cell)
-    try:
-        return CellFile.model_validate(data)
-    except ValidationError as exc:
-        raise validation_error(exc, CellFile, path, CellFileError) from None
+    expansion = expand_includes(data, path, IncludeFile)
+
+    def parse() -> tuple[CellFile, tuple[FrameNode, ...]]:
+        try:
+            parsed = CellFile.model_validate(expansion.data)
+        except ValidationError as exc:
+            raise validation_error(exc, CellFile, path, CellFileError) from None
+        return resolve_frames(parsed, path)
+
+    parsed, tree = _located(expansion, parse)
+    return parsed, tree, tuple(file for file, _ in expansion.files)
 
 
 def dump_cell_file(cell: CellFile, header: str = "") -> str:
