@@ -843,6 +843,48 @@ def import_urdf_command(
     _guarded(run, "import-urdf" if as_json else None)
 
 
+@_command("import-spots")
+def import_spots_command(
+    cell: Annotated[Path, typer.Argument(help="cell file (YAML); it may have no seams yet")],
+    spots: Annotated[Path, typer.Argument(help="CSV spot list: id, x, y, z, optional normal, group, weld time, schedule")],
+    part: Annotated[str, typer.Option("--part", help="the object whose frame the list's coordinates are in")],
+    out_file: Annotated[Path, typer.Option("-o", "--out", help="the new cell file, beside CELL")],
+    units: Annotated[str | None, typer.Option("--units", help="m | mm, of the list's coordinates (default: m, "
+                                                              "with a warning when they look like mm)")] = None,
+    tolerance_mm: Annotated[float, typer.Option("--tolerance", min=0.001, max=1000,
+                                                help="mm a spot may lie off the part's surface")] = 2.0,
+    force: Annotated[bool, typer.Option("--force", help="replace the -o file if it exists")] = False,
+    as_json: JsonFlag = False,
+) -> None:
+    """Write a new cell with a spot list's spots added as seams (docs/spot-lists.md).
+
+    Missing normals come from the part's surface, missing directions from the seam's course; without
+    a group column, seams are formed from the part's geometry and listed on stderr to check."""
+
+    def run() -> None:
+        from robomax_py.app.import_spots import import_spots
+        from robomax_py.errors import CellFileError
+
+        if units not in (None, "m", "mm"):
+            raise CellFileError(None, "--units", f"expected m or mm, got {units!r}")
+        r = import_spots(cell, spots, part, out_file, units, tolerance_mm / 1000, force)
+        _warn([*r.warnings, *r.sides])
+        for line in r.formed:
+            err.print(line, markup=False, highlight=False, soft_wrap=True)
+        if as_json:
+            _print_json("import-spots", True, {
+                "cell": str(r.cell), "seams": [{"name": n, "spots": k} for n, k in r.seams],
+                "recovered_normals": r.recovered_normals, "recovered_directions": r.recovered_directions,
+                "ambiguous": list(r.sides), "warnings": list(r.warnings), "cpu_s": round(r.cpu_s, 3)})
+            return
+        count = sum(k for _, k in r.seams)
+        out.print(f"wrote {r.cell}: {count} spots in {len(r.seams)} seams, {r.recovered_normals} normals from the "
+                  f"part's surface, {r.recovered_directions} directions from the seams' course ({r.cpu_s:.2f} s CPU)",
+                  markup=False)
+
+    _guarded(run, "import-spots" if as_json else None)
+
+
 @_command()
 def examples(
     folder: Annotated[Path, typer.Argument(help="folder to copy the example cells into (made if missing)")],

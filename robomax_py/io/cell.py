@@ -56,6 +56,7 @@ from robomax_py.spec import (
     Cylinder,
     MachineSpec,
     MeshShape,
+    Notice,
     ObjectSpec,
     PartSpec,
     PlannerSpec,
@@ -313,6 +314,18 @@ class SeamFile(_Strict):
     spots: Annotated[list[SpotFile], Field(min_length=1)]
 
 
+class SpotListFile(_Strict):
+    """A CSV spot list whose spots become seams (docs/spot-lists.md)."""
+
+    file: Reference                           # relative to the cell file
+    part: Name                                # the object whose frame the list's coordinates are in
+    units: Literal["m", "mm"]                 # of the list's coordinates: a file read again and again does not guess
+    max_distance: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.002   # m from the part's surface
+    ordered: bool = False                     # of every seam the list gives
+    tolerance: ToleranceFile = ToleranceFile()
+    grid: Annotated[int, Field(ge=1, le=64)] = 1
+
+
 class ProcessFile(_Strict):
     weld_time: NonNegative = 0.5
     approach: NonNegative = 0.03
@@ -446,6 +459,7 @@ class CellFile(_Strict):
     tool: Reference
     objects: list[ObjectFile] = []
     seams: list[SeamFile] = []                # required unless the cell tends machines
+    spot_lists: list[SpotListFile] = []       # seams read from CSV spot lists, after `seams`
     process: ProcessFile = ProcessFile()
     planner: PlannerFile = PlannerFile()
     dynamic: list[DynamicObjectFile] = []
@@ -559,6 +573,7 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
     except ValidationError as exc:
         raise validation_error(exc, CellFile, path, CellFileError) from None
     parsed, _ = resolve_frames(parsed, path)   # world coordinates from here on
+    parsed, listed = _with_spot_lists(parsed, path)   # placed by their parts, already in the world
     # Independent checks each run, and their errors are reported together (up to MAX_LISTED_PROBLEMS);
     # a check that needs what an earlier one refused waits until those are fixed.
     problems = _Problems(path, expansion.relocated)
@@ -621,7 +636,45 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
         tcp_limits=_tcp_limits(parsed.pick_place.unloaded) if parsed.pick_place is not None else None,
     )
     cell = dataclasses.replace(cell, controller=_controller(parsed.robot.controller, cell, path))
-    return dataclasses.replace(cell, notices=tuple(map(expansion.relocated_notice, lint_cell(parsed, cell, path))))
+    return dataclasses.replace(cell, notices=listed + tuple(map(expansion.relocated_notice, lint_cell(parsed, cell, path))))
+
+
+def spot_list_seams(parsed: CellFile, path: Path, key: str, csv_file: Path, part: str, units: str | None,
+                    max_distance: float, seam: Mapping[str, Any] | None = None) -> tuple[list[SeamFile], Any]:
+    """The seams a CSV spot list gives in the cell `parsed` (read from `path`), and the
+    `io.spot_list.SpotListResult` with what a person should check. `key` names the list's place
+    in messages; `seam` holds the seams' settings as a file gives them (ordered, tolerance, grid)."""
+    from robomax_py.io.spot_list import read_spot_list
+    from robomax_py.io.spot_list import spot_list_seams as list_seams
+
+    index = next((i for i, o in enumerate(parsed.objects) if o.name == part), None)
+    if index is None:
+        known = ", ".join(o.name for o in parsed.objects) or "none"
+        raise CellFileError(path, f"{key}.part" if key else "--part", f"no object '{part}' in the cell "
+                                                                      f"(objects: {known})")
+    objects = [_object(o, path, f"objects[{i}]", []) for i, o in enumerate(parsed.objects)]
+    if key:                                # a cell's list: a missing file is the cell's key's mistake
+        checked_file(csv_file, LIMITS.cell, named_by(CellFileError, path, f"{key}.file"), f"spot list {csv_file}")
+    spots = read_spot_list(csv_file, units)
+    result = list_seams(spots, objects[index], objects, _pose(parsed.robot.base), parsed.process.approach,
+                        max_distance)
+    seams = [SeamFile.model_validate({**(seam or {}), **s}) for s in result.seams]
+    return seams, result
+
+
+def _with_spot_lists(parsed: CellFile, path: Path) -> tuple[CellFile, tuple[Notice, ...]]:
+    """The cell with its spot lists' seams after its own, and their reports as notices."""
+    if not parsed.spot_lists:
+        return parsed, ()
+    seams, notices = list(parsed.seams), []
+    for i, entry in enumerate(parsed.spot_lists):
+        settings = entry.model_dump(mode="json", include={"ordered", "tolerance", "grid"}, exclude_unset=True)
+        more, result = spot_list_seams(parsed, path, f"spot_lists[{i}]", path.parent / entry.file, entry.part,
+                                       entry.units, entry.max_distance, settings)
+        seams += more
+        notices += [Notice(str(path), f"spot_lists[{i}]", line) for line in (*result.warnings, *result.sides, *(result.formed if result.by_geometry else ()))]
+    _refuse_counts(sum(len(s.spots) for s in seams), 0, path)
+    return parsed.model_copy(update={"seams": seams, "spot_lists": []}), tuple(notices)
 
 
 def _controller(ctrl: RobotControllerFile, cell: CellSpec, path: Path) -> ControllerSetup:

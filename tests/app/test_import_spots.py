@@ -1,0 +1,43 @@
+"""`robomax import-spots`: the new cell `robomax check` accepts; refusals write nothing."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import yaml
+from spot_list_case import cell_data, known_spots, write_cell, write_csv
+from typer.testing import CliRunner
+
+from robomax_py.app.cli import app
+
+
+def _setup(tmp_path: Path) -> tuple[Path, Path]:
+    csv = write_csv(tmp_path / "spots.csv", known_spots()[:60], mm=True, groups=True)
+    return write_cell(tmp_path / "cell.yaml", cell_data()), csv
+
+
+def test_writes_a_cell_check_accepts(tmp_path: Path) -> None:
+    cell, csv = _setup(tmp_path)
+    out = tmp_path / "new.yaml"
+    done = CliRunner().invoke(app, ["import-spots", str(cell), str(csv), "--part", "plate", "--units", "mm",
+                                    "-o", str(out), "--json"])
+    assert done.exit_code == 0, done.output
+    report = json.loads(done.stdout)
+    assert report["schema"] == "robomax.cli.import-spots/1" and report["ok"]
+    assert report["seams"] == [{"name": "top1", "spots": 30}, {"name": "top2", "spots": 30}]
+    assert [s["name"] for s in yaml.safe_load(out.read_text())["seams"]] == ["top1", "top2"]
+    assert CliRunner().invoke(app, ["check", str(out)]).exit_code == 0
+    again = CliRunner().invoke(app, ["import-spots", str(cell), str(csv), "--part", "plate", "-o", str(out)])
+    assert again.exit_code == 2 and "exists; use --force" in again.output
+
+
+def test_bad_input_writes_nothing(tmp_path: Path) -> None:
+    cell, csv = _setup(tmp_path)
+    out = tmp_path / "new.yaml"
+    for args in (["--part", "nothing", "--units", "mm"], ["--part", "plate", "--units", "m"]):
+        done = CliRunner().invoke(app, ["import-spots", str(cell), str(csv), *args, "-o", str(out)])
+        assert done.exit_code == 2 and "Traceback" not in done.output
+        assert not out.exists()
+    same = CliRunner().invoke(app, ["import-spots", str(cell), str(csv), "--part", "plate", "-o", str(cell)])
+    assert same.exit_code == 2 and "another file" in same.output
