@@ -30,6 +30,14 @@ from pydantic import (
 
 from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.io.cell_lint import library_hint, lint_cell
+from robomax_py.io.mesh_keys import (
+    MESH_ONLY_KEYS,
+    MeshScale,
+    MeshTolerance,
+    MeshUnits,
+    mesh_shape,
+    misplaced_mesh_keys,
+)
 from robomax_py.io.robot import (
     load_robot_spec,
     load_tool_spec,
@@ -43,7 +51,7 @@ from robomax_py.io.yaml_files import (
     several,
     validation_error,
 )
-from robomax_py.robot.geometry import load_mesh
+from robomax_py.robot.geometry import load_mesh, mesh_shape_trimesh
 from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
 from robomax_py.spec import (
     Box,
@@ -224,6 +232,9 @@ class ObjectFile(_Strict):
     sphere: SphereFile | None = None
     capsule: CylinderFile | None = None
     mesh: Reference | None = None
+    units: MeshUnits | None = None      # of the mesh file's numbers (docs/cad.md)
+    scale: MeshScale | None = None
+    tolerance: MeshTolerance | None = None
     pose: PoseFile = PoseFile()
     workpiece: bool = False
     signal: Name | None = None          # extension: clamp interlock input (docs/cell-extensions.md)
@@ -234,6 +245,8 @@ class ObjectFile(_Strict):
         if len(given) != 1:
             got = ", ".join(given) if given else "none"
             raise ValueError(f"exactly one of {', '.join(_SHAPE_KEYS)} is required, got {got}")
+        if (stray := misplaced_mesh_keys({k: getattr(self, k) for k in ("mesh", *MESH_ONLY_KEYS)})) is not None:
+            raise ValueError(stray)
         return self
 
 
@@ -799,9 +812,9 @@ def _object(obj: ObjectFile, path: Path, key: str, triangles: list[int]) -> Obje
         assert obj.mesh is not None  # guaranteed by ObjectFile._one_shape
         named = path.parent / obj.mesh
         mesh = checked_file(named, LIMITS.mesh, named_by(CellFileError, path, f"{key}.mesh"), f"mesh {named}")
-        triangles.append(_check_mesh_readable(mesh, CellFileError(path, f"{key}.mesh", f"cannot read mesh {mesh}"),
+        shape = mesh_shape(mesh, obj.units, obj.scale, obj.tolerance, path, key)
+        triangles.append(_check_mesh_readable(shape, CellFileError(path, f"{key}.mesh", f"cannot read mesh {mesh}"),
                                               triangles))
-        shape = MeshShape(path=mesh)
     present = None
     if isinstance(obj, DynamicObjectFile):
         present = tuple((float(t0), float(t1)) for t0, t1 in obj.present)
@@ -834,11 +847,12 @@ def _stem_name(path: Path) -> str:
 
 
 
-def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError, triangles: list[int]) -> int:
+def _check_mesh_readable(shape: Path | MeshShape, error: CellFileError | RobotModelError, triangles: list[int]) -> int:
     """The mesh's triangles, when it reads, has at most `CELL_LIMITS.mesh_triangles` and keeps the
     cell's meshes read so far (`triangles`) within `CELL_LIMITS.cell_triangles`. What the file
     states of its size is judged before it is read (reading a mesh of millions of triangles takes
     seconds)."""
+    mesh = shape.path if isinstance(shape, MeshShape) else shape
     limit, total = CELL_LIMITS.mesh_triangles, sum(triangles)
     declared, exact = _declared_triangles(mesh)
     more = "" if exact else " or more"
@@ -850,7 +864,7 @@ def _check_mesh_readable(mesh: Path, error: CellFileError | RobotModelError, tri
                                                  f"{total + declared:,} triangles{more}, more than the "
                                                  f"{CELL_LIMITS.cell_triangles:,} a cell may have (cell_triangles)")
     try:
-        n = len(load_mesh(mesh).faces)
+        n = len((mesh_shape_trimesh(shape) if isinstance(shape, MeshShape) else load_mesh(mesh)).faces)
     except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
         raise type(error)(error.file, error.key, f"{error.problem}: {exc}") from None
     if n > limit:
