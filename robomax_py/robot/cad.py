@@ -20,9 +20,14 @@ once, whichever command reads it next.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import os
 import re
+import sys
 import tempfile
+import zipfile
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -91,15 +96,19 @@ def load_step(path: Path, tolerance_mm: float | None = None) -> trimesh.Trimesh:
     try:
         with np.load(cached) as stored:
             return trimesh.Trimesh(vertices=stored["vertices"], faces=stored["faces"], process=False)
-    except (OSError, KeyError, ValueError):
+    except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile):
         pass                                    # not cached yet, or unreadable: tessellate again
     with tempfile.TemporaryDirectory() as folder:
         glb = Path(folder) / "part.glb"
+        log = Path(folder) / "opencascade.log"
         # cascadio reads from a path; the file is read as given (its bytes hashed above).
-        cascadio.step_to_glb(str(path), str(glb), tol_linear=tol, tol_angular=ANGULAR_TOLERANCE_RAD,
-                             tol_relative=False)
+        with _c_output_to(log):
+            cascadio.step_to_glb(str(path), str(glb), tol_linear=tol, tol_angular=ANGULAR_TOLERANCE_RAD,
+                                 tol_relative=False)
         if not glb.is_file():
-            raise ValueError("OpenCASCADE read no shape from the file (not a STEP file, or it holds no solid)")
+            said = _first_message(log)
+            raise ValueError("OpenCASCADE read no shape from the file (not a STEP file, or it holds no solid)"
+                             + (f": {said}" if said else ""))
         loaded = trimesh.load(str(glb), force="mesh", process=False)
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
         raise ValueError("the STEP file holds no surface to mesh")
@@ -107,3 +116,40 @@ def load_step(path: Path, tolerance_mm: float | None = None) -> trimesh.Trimesh:
     faces = np.asarray(loaded.faces, dtype=np.int64)
     store_arrays(cached, {"vertices": vertices, "faces": faces})
     return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+
+
+@contextlib.contextmanager
+def _c_output_to(log: Path) -> Iterator[None]:
+    """OpenCASCADE's own messages (a STEP syntax error on stdout, "Failed to transfer" on stderr)
+    written to `log` instead of the terminal: they would break `--json` output on stdout and come
+    without the file and key a message of robomax names. Redirects the process's file descriptors
+    1 and 2 for the duration."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    try:
+        with open(log, "wb") as sink:
+            os.dup2(sink.fileno(), 1)
+            os.dup2(sink.fileno(), 2)
+            yield
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in saved:
+            os.close(fd)
+
+
+_ANSI = re.compile(r"\x1b\[[0-9;]*m")
+
+
+def _first_message(log: Path) -> str:
+    """OpenCASCADE's first message in `log`, without colour codes and its `****` frame."""
+    try:
+        text = log.read_text(errors="replace")
+    except OSError:
+        return ""
+    for line in _ANSI.sub("", text).splitlines():
+        line = line.strip(" *\t")
+        if line:
+            return line
+    return ""

@@ -178,6 +178,33 @@ def test_mesh_keys_that_do_not_fit_are_refused(tmp_path: Path, reference_cell_pa
         load_cell(path)
 
 
+def test_a_step_that_does_not_read_is_one_message(tmp_path: Path, reference_cell_path: Path,
+                                                  capfd: pytest.CaptureFixture[str]) -> None:
+    pytest.importorskip("cascadio")
+    folder = tmp_path / "files"
+    folder.mkdir()
+    (folder / "broken.step").write_text("ISO-10303-21;\nHEADER;\nnot a step file\n")
+    path = cell_with(tmp_path, reference_cell_path,
+                     {"name": "broken", "mesh": "parts/broken.step", "pose": {"xyz": PART_XYZ}},
+                     {"broken.step": folder / "broken.step"})
+    capfd.readouterr()
+    with pytest.raises(CellFileError, match=r"objects\[9\]\.mesh: cannot read mesh .*broken\.step: OpenCASCADE "
+                                            r"read no shape from the file"):
+        load_cell(path)
+    # OpenCASCADE's own messages (on the process's stdout and stderr) are kept off the terminal.
+    out, err = capfd.readouterr()
+    assert out == "" and err == "", (out, err)
+
+
+def test_a_corrupt_cache_entry_is_made_again(tmp_path: Path, step_part: Path) -> None:
+    pytest.importorskip("cascadio")
+    first = cad.load_step(step_part, 0.5)
+    for entry in (tmp_path / "cache" / "step").glob("*.npz"):
+        entry.write_bytes(b"PK\x03\x04 not a zip")
+    again = cad.load_step(step_part, 0.5)
+    np.testing.assert_array_equal(first.faces, again.faces)
+
+
 def test_no_cascadio_gives_the_cad_extra(tmp_path: Path, step_part: Path, reference_cell_path: Path,
                                          monkeypatch: pytest.MonkeyPatch) -> None:
     real_import = builtins.__import__
