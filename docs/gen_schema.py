@@ -77,7 +77,12 @@ DESCRIPTIONS: dict[str, str] = {
     "ObjectFile.cylinder": "Cylinder along its local z, centred on its pose.",
     "ObjectFile.sphere": "Sphere centred on its pose.",
     "ObjectFile.capsule": "Capsule along its local z; length is the cylindrical part, the caps add radius at each end.",
-    "ObjectFile.mesh": "Mesh file (any format trimesh reads), relative to the cell file.",
+    "ObjectFile.mesh": "Mesh file (any format trimesh reads, or a STEP part: .step, .stp), relative to the cell file.",
+    "ObjectFile.units": "Unit of the numbers in the mesh file: m (default) or mm. A STEP file states its own and is "
+                        "read in metres from it; there units is the unit of tolerance (default: the file's).",
+    "ObjectFile.scale": "Further factor on the mesh after its units: one number or one per axis (default 1).",
+    "ObjectFile.tolerance": "STEP only: largest distance between the mesh and the exact surface, in units "
+                            "(default 0.1 mm).",
     "ObjectFile.pose": "Pose in the cell's world (or in frame); identity when absent.",
     "ObjectFile.frame": "The frame (or object) pose is given in; the world when absent.",
     "ObjectFile.workpiece": "The electrode tips may touch it (the part being welded); nothing else may.",

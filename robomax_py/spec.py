@@ -186,6 +186,10 @@ class Capsule:
 @dataclass(frozen=True, slots=True)
 class MeshShape:
     path: Path
+    # Factor per axis from the file's numbers to metres: the cell file's `units` (mm: 0.001) times
+    # its `scale` (docs/cad.md). A STEP file is read in metres already, so only `scale` counts.
+    scale: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    tolerance: float | None = None            # m: a STEP's meshing tolerance; None: the default
 
 
 Shape = Box | Cylinder | Sphere | Capsule | MeshShape

@@ -75,7 +75,7 @@ def lint_cell(parsed: CellFile, cell: CellSpec, path: Path) -> tuple[Notice, ...
         The cell file, named in every notice.
     """
     file = str(path)
-    meshes: dict[Path, Any] = {}
+    meshes: dict[MeshShape, Any] = {}
     units = _millimetre_positions(parsed, file) + _oversized_objects(parsed, cell, file, meshes)
     out = [*units, *_process_lengths(parsed, file), *_home_in_radians(parsed, cell, file),
            *_zero_clearance(parsed, cell, file)]
@@ -164,14 +164,21 @@ def _shape_key(obj: ObjectFile) -> str:
     return next(k for k in ("box", "cylinder", "sphere", "capsule", "mesh") if getattr(obj, k) is not None)
 
 
-def _oversized_objects(parsed: CellFile, cell: CellSpec, file: str, meshes: dict[Path, Any]) -> list[Notice]:
+def _oversized_objects(parsed: CellFile, cell: CellSpec, file: str, meshes: dict[MeshShape, Any]) -> list[Notice]:
     found = []
     for key, obj_file, obj in _static_objects(parsed, cell):
         size = float(np.max(_extents(obj, meshes)))
         if size > WORKSHOP_M:
-            what = "its mesh's extents are" if isinstance(obj.shape, MeshShape) else "it measures"
+            if isinstance(obj.shape, MeshShape):
+                # The mesh file's numbers are read as metres unless `units` says otherwise.
+                hint = (("a mesh's numbers are read as metres; drawn in millimetres? write `units: mm` beside "
+                         "`mesh`") if obj_file.units is None and obj_file.scale is None else
+                        "after its units and scale; are they right?")
+                found.append((f"{key}.mesh", (f"{obj.name}: its mesh's extents are {size:g} m across, larger than "
+                                              f"any workshop ({WORKSHOP_M:g} m): {hint}")))
+                continue
             found.append((f"{key}.{_shape_key(obj_file)}",
-                          (f"{obj.name}: {what} {size:g} m across, larger than any workshop ({WORKSHOP_M:g} m): "
+                          (f"{obj.name}: it measures {size:g} m across, larger than any workshop ({WORKSHOP_M:g} m): "
                           "lengths in a cell file and its meshes are metres; drawn in millimetres?")))
     return _grouped(file, found, f"objects over {WORKSHOP_M:g} m")
 
@@ -206,7 +213,7 @@ def _zero_clearance(parsed: CellFile, cell: CellSpec, file: str) -> list[Notice]
                                               "you need in metres, e.g. 0.005")]
 
 
-def _spots_and_objects(parsed: CellFile, cell: CellSpec, file: str, meshes: dict[Path, Any]) -> list[Notice]:
+def _spots_and_objects(parsed: CellFile, cell: CellSpec, file: str, meshes: dict[MeshShape, Any]) -> list[Notice]:
     """Spots (and tending stations) inside an object; weld spots off every workpiece's surface; a
     cell without a workpiece whose spots lie on an object's surface (its tips may not touch it)."""
     stops: list[tuple[str, str, list[float]]] = []
@@ -262,15 +269,16 @@ def _static_objects(parsed: CellFile, cell: CellSpec) -> Iterable[tuple[str, Obj
         yield f"objects[{i}]", obj_file, obj
 
 
-def _mesh(path: Path, meshes: dict[Path, Any]) -> Any:
-    from robomax_py.robot.geometry import load_mesh
+def _mesh(shape: MeshShape, meshes: dict[MeshShape, Any]) -> Any:
+    """The object's mesh as the cell states it (units, scale, tolerance), read once per lint."""
+    from robomax_py.robot.geometry import mesh_shape_trimesh
 
-    if path not in meshes:
-        meshes[path] = load_mesh(path)
-    return meshes[path]
+    if shape not in meshes:
+        meshes[shape] = mesh_shape_trimesh(shape)
+    return meshes[shape]
 
 
-def _extents(obj: ObjectSpec, meshes: dict[Path, Any]) -> np.ndarray:
+def _extents(obj: ObjectSpec, meshes: dict[MeshShape, Any]) -> np.ndarray:
     """(3,) float, m: the object's size along its own axes (a mesh's bounding box)."""
     s = obj.shape
     if isinstance(s, Box):
@@ -281,10 +289,10 @@ def _extents(obj: ObjectSpec, meshes: dict[Path, Any]) -> np.ndarray:
         return np.array([2 * s.radius, 2 * s.radius, s.length])
     if isinstance(s, Capsule):
         return np.array([2 * s.radius, 2 * s.radius, s.length + 2 * s.radius])
-    return np.asarray(_mesh(s.path, meshes).extents, dtype=float)
+    return np.asarray(_mesh(s, meshes).extents, dtype=float)
 
 
-def _signed_distance(obj: ObjectSpec, points: np.ndarray, meshes: dict[Path, Any]) -> np.ndarray:
+def _signed_distance(obj: ObjectSpec, points: np.ndarray, meshes: dict[MeshShape, Any]) -> np.ndarray:
     """(n,) float, m: distance of world points (n, 3) to the object's surface, negative inside.
 
     Primitives are centred on their pose (as the collision world builds them). A mesh's points count
@@ -307,7 +315,7 @@ def _signed_distance(obj: ObjectSpec, points: np.ndarray, meshes: dict[Path, Any
         return np.asarray(np.linalg.norm(local - axis, axis=1) - s.radius)
     import trimesh
 
-    mesh = _mesh(s.path, meshes)
+    mesh = _mesh(s, meshes)
     _, distance, _ = trimesh.proximity.closest_point(mesh, local)  # type: ignore[no-untyped-call]
     distance = np.asarray(distance, dtype=float)
     if mesh.is_watertight:

@@ -23,7 +23,7 @@ from robomax_py.errors import CellFileError
 from robomax_py.transforms import pose_matrix, rpy_from_matrix
 
 if TYPE_CHECKING:
-    from robomax_py.io.cell import CellFile, PoseFile
+    from robomax_py.io.cell_file import CellFile, PoseFile
 
 # The frame everything else is placed in; no frame or object may take its name as a frame.
 WORLD = "world"
@@ -96,7 +96,7 @@ def resolve_frames(cell: CellFile, path: Path) -> tuple[CellFile, tuple[FrameNod
                 # it next) is placed on its own.
                 M = world[o.name] if node is not None and node.key == f"{group}[{i}]" else \
                     frame_of(o.frame, f"{group}[{i}].frame") @ _matrix(o.pose)
-                moved.append(_placed(o, {"pose": _pose_file(M)}))
+                moved.append(_placed(o, {"pose": _pose_file(M, o.pose)}))
             update[group] = moved
     if any(s.frame is not None or any(p.frame is not None for p in s.spots) for s in cell.seams):
         update["seams"] = [_seam(s, f"seams[{i}]", frame_of) for i, s in enumerate(cell.seams)]
@@ -229,13 +229,13 @@ def _matrix(pose: PoseFile) -> np.ndarray:
 
 
 def _moved(pose: PoseFile, T: np.ndarray) -> Any:
-    return _pose_file(T @ _matrix(pose))
+    return _pose_file(T @ _matrix(pose), pose)
 
 
-def _pose_file(M: np.ndarray) -> Any:
-    from robomax_py.io.cell import PoseFile
-
-    return PoseFile(xyz=_listed(M[:3, 3]), rpy=_listed(np.degrees(rpy_from_matrix(M[:3, :3]))))
+def _pose_file(M: np.ndarray, like: PoseFile) -> Any:
+    """The pose M as the file model `like` is (a copy of it: this module does not import the cell's
+    models, which import it)."""
+    return like.model_copy(update={"xyz": _listed(M[:3, 3]), "rpy": _listed(np.degrees(rpy_from_matrix(M[:3, :3])))})
 
 
 def _listed(v: np.ndarray) -> list[float]:

@@ -28,14 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from robomax_py.io.cell import (
-    CellFile,
-    ObjectFile,
-    SeamFile,
-    dump_cell_file,
-    load_cell,
-    read_cell_file,
-)
+from robomax_py.io.cell import dump_cell_file, load_cell, read_cell_file
+from robomax_py.io.cell_file import CellFile, ObjectFile, SeamFile
 from robomax_py.io.robot import resolve_robot_file, resolve_tool_file
 
 DECIMALS = 6                          # written values: µm, µdeg, 1e-6 of a unit vector

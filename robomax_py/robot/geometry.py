@@ -14,6 +14,7 @@ import coal
 import numpy as np
 import trimesh
 
+from robomax_py.robot.cad import is_step, load_step
 from robomax_py.spec import Box, Capsule, Cylinder, MeshShape, Shape, Sphere
 from robomax_py.tolerances import DEFAULT as TOL
 
@@ -21,13 +22,16 @@ from robomax_py.tolerances import DEFAULT as TOL
 CONVEX_VOLUME_RTOL = TOL.convex_volume_rtol
 
 
-def load_mesh(path: Path, scale: np.ndarray | None = None) -> trimesh.Trimesh:
-    """Any format trimesh reads, flattened into one triangle mesh (scene graphs concatenated).
+def load_mesh(path: Path, scale: np.ndarray | None = None, tolerance: float | None = None) -> trimesh.Trimesh:
+    """Any format trimesh reads, flattened into one triangle mesh (scene graphs concatenated), times
+    `scale`; a STEP file (`cad.load_step`, in metres from the unit it states) meshed at `tolerance`
+    (m; None: `cad.DEFAULT_TOLERANCE_MM`).
 
     A vertex that is not finite is an error: trimesh's processing would drop it and the faces using
     it without a word, and the collision geometry would have holes.
     """
-    loaded = trimesh.load(str(path), force="mesh", process=False)
+    loaded = (load_step(path, None if tolerance is None else tolerance * 1000.0) if is_step(path)
+              else trimesh.load(str(path), force="mesh", process=False))
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
         raise ValueError("no triangles in file")
     bad = ~np.isfinite(np.asarray(loaded.vertices)).all(axis=1)
@@ -87,6 +91,12 @@ def primitive_shape(shape: Shape) -> coal.CollisionGeometry:
     raise TypeError(f"not a primitive: {shape!r}")
 
 
+def mesh_shape_trimesh(shape: MeshShape) -> trimesh.Trimesh:
+    """A cell object's mesh as its cell file states it: scaled by its units and scale, a STEP meshed
+    at its tolerance."""
+    return load_mesh(shape.path, np.asarray(shape.scale, dtype=float), shape.tolerance)
+
+
 def shape_trimesh(shape: Shape) -> trimesh.Trimesh:
     """A triangle mesh of any shape in its local frame (for previews and exact-answer tests)."""
     if isinstance(shape, Box):
@@ -101,5 +111,5 @@ def shape_trimesh(shape: Shape) -> trimesh.Trimesh:
     if isinstance(shape, Capsule):
         return trimesh.creation.capsule(height=shape.length, radius=shape.radius, count=[48, 24])
     if isinstance(shape, MeshShape):
-        return load_mesh(shape.path)
+        return mesh_shape_trimesh(shape)
     raise TypeError(f"unknown shape: {shape!r}")

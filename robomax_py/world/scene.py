@@ -34,8 +34,8 @@ from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.robot import RobotModel
 from robomax_py.robot.geometry import (
     bvh_shape,
-    load_mesh,
     mesh_collision_shapes,
+    mesh_shape_trimesh,
     primitive_shape,
 )
 from robomax_py.spec import (
@@ -225,7 +225,7 @@ def shape_pieces(shape: Shape, file: Path | None = None, key: str | None = None)
         geom.computeLocalAABB()
         return (geom,), REPRESENTATION_PRIMITIVE
     if isinstance(shape, MeshShape):
-        return _mesh_pieces(shape.path, CellFileError, file, key)
+        return _mesh_pieces(shape, CellFileError, file, key)
     raise TypeError(f"unknown shape: {shape!r}")
 
 
@@ -245,19 +245,22 @@ def _scene_object(obj: ObjectSpec, T_base_world: FloatArray, source: Path, key: 
 
 
 def _mesh_pieces(
-    path: Path, error: type[CellFileError | RobotModelError], file: Path | None, key: str | None
+    mesh: Path | MeshShape, error: type[CellFileError | RobotModelError], file: Path | None, key: str | None
 ) -> tuple[tuple[coal.CollisionGeometry, ...], str]:
     """Convex pieces if the mesh is a set of closed convex shells, else one exact BVH (see module doc)."""
+    shape = mesh if isinstance(mesh, MeshShape) else MeshShape(path=Path(mesh))
+    path = shape.path
     if not Path(path).is_file():
         raise error(file, key, f"mesh file not found: {path}")
     try:
         st = Path(path).stat()
-        state: tuple[str, int, int, int] | None = (str(Path(path).resolve()), st.st_size, st.st_mtime_ns, st.st_ino)
+        state: _MeshState | None = (str(Path(path).resolve()), st.st_size, st.st_mtime_ns, st.st_ino,
+                                    shape.scale, shape.tolerance)
     except OSError:
         state = None
     if state is not None and state in _MESH_PIECES:
         return _MESH_PIECES[state]
-    built = _build_mesh_pieces(path, error, file, key)
+    built = _build_mesh_pieces(shape, error, file, key)
     if state is not None:
         if len(_MESH_PIECES) >= _MESH_ENTRIES:
             del _MESH_PIECES[next(iter(_MESH_PIECES))]
@@ -265,18 +268,20 @@ def _mesh_pieces(
     return built
 
 
-# A cell's meshes split into pieces, by (path, size, modification time, inode): a plan, its proof
-# and `verify` build the scene several times, and splitting a part mesh takes up to a second. The
-# pieces are shared between scenes and never modified.
-_MESH_PIECES: dict[tuple[str, int, int, int], tuple[tuple[coal.CollisionGeometry, ...], str]] = {}
+# A cell's meshes split into pieces, by (path, size, modification time, inode, scale, tolerance): a
+# plan, its proof and `verify` build the scene several times, and splitting a part mesh takes up to
+# a second. The pieces are shared between scenes and never modified.
+_MeshState = tuple[str, int, int, int, tuple[float, float, float], float | None]
+_MESH_PIECES: dict[_MeshState, tuple[tuple[coal.CollisionGeometry, ...], str]] = {}
 _MESH_ENTRIES = 32
 
 
 def _build_mesh_pieces(
-    path: Path, error: type[CellFileError | RobotModelError], file: Path | None, key: str | None
+    shape: MeshShape, error: type[CellFileError | RobotModelError], file: Path | None, key: str | None
 ) -> tuple[tuple[coal.CollisionGeometry, ...], str]:
+    path = shape.path
     try:
-        mesh = load_mesh(Path(path))
+        mesh = mesh_shape_trimesh(shape)
     except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
         raise error(file, key, f"cannot read mesh {path}: {exc}") from None
     pieces = mesh_collision_shapes(mesh)
