@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from robomax_py.transforms import pose_matrix
+from robomax_py.transforms import invert, pose_matrix
 
 # A 50 mm plate lying on a table, turned 30 deg about z: spots on its top (four lines), on the face
 # toward the robot and on one side.
@@ -70,3 +70,15 @@ def write_csv(path: Path, spots: list[dict[str, Any]], *, normals: bool = False,
 def write_cell(path: Path, data: dict[str, Any]) -> Path:
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     return path
+
+
+# A frame the list may be given in instead of the part's: a station turned about z, off the origin.
+STATION: dict[str, Any] = {"name": "station", "pose": {"xyz": [1.0, 0.2, 0.3], "rpy": [0, 0, -20]}}
+
+
+def station_spots() -> list[dict[str, Any]]:
+    """The known spots moved from the plate's frame into the station's (same places in the world)."""
+    T_plate = pose_matrix(PLATE_POSE["xyz"], [math.radians(a) for a in PLATE_POSE["rpy"]])
+    T_station = pose_matrix(STATION["pose"]["xyz"], [math.radians(a) for a in STATION["pose"]["rpy"]])
+    M = invert(T_station) @ T_plate
+    return [{**s, "xyz": list(M[:3, :3] @ np.asarray(s["xyz"]) + M[:3, 3])} for s in known_spots()[:80]]

@@ -99,6 +99,9 @@ def test_shipped_cell_plans_and_verifies(cell: Path, tmp_path: Path, update_gold
         spec["seams"] = [{"name": "transfers", "ordered": True, "spots": [
             {"name": f"t{k}_{visit}_{loc}"} for k, tr in enumerate(spec["pick_place"]["transfers"], start=1)
             for visit, loc in (("pick", tr["from"]), ("place", tr["to"]))]}]
+    if "spot_lists" in spec:                # seams read from CSV lists (and the cell's own): as loaded
+        spec["seams"] = [{"name": s.name, "ordered": s.ordered, "spots": [{"name": p.name} for p in s.spots]}
+                         for s in load_cell(cell).seams]
     wanted = {(s["name"], p["name"]) for s in spec["seams"] for p in s["spots"]}
     welded = [(s["seam"], s["name"]) for s in data["spots"]]  # type: ignore[union-attr]
     assert sorted(welded) == sorted(wanted)                      # every spot of every seam, once

@@ -854,6 +854,8 @@ def import_spots_command(
     tolerance_mm: Annotated[float, typer.Option("--tolerance", min=0.001, max=1000,
                                                 help="mm a spot may lie off the part's surface")] = 2.0,
     force: Annotated[bool, typer.Option("--force", help="replace the -o file if it exists")] = False,
+    frame: Annotated[str | None, typer.Option("--frame", help="the frame the list's coordinates are in, when not "
+                                                              "the part's: a frame of the cell, an object or world")] = None,
     as_json: JsonFlag = False,
 ) -> None:
     """Write a new cell with a spot list's spots added as seams (docs/spot-lists.md).
@@ -867,7 +869,7 @@ def import_spots_command(
 
         if units not in (None, "m", "mm"):
             raise CellFileError(None, "--units", f"expected m or mm, got {units!r}")
-        r = import_spots(cell, spots, part, out_file, units, tolerance_mm / 1000, force)
+        r = import_spots(cell, spots, part, out_file, units, tolerance_mm / 1000, force, frame)
         _warn([*r.warnings, *r.sides])
         for line in r.formed:
             err.print(line, markup=False, highlight=False, soft_wrap=True)

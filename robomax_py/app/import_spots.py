@@ -16,6 +16,7 @@ from robomax_py.io.cell import (
     dump_cell_file,
     load_cell,
     read_cell_file,
+    read_cell_frames,
     spot_list_seams,
 )
 from robomax_py.io.files import write_atomic
@@ -35,9 +36,11 @@ class ImportedSpots:
 
 
 def import_spots(cell: Path, spots: Path, part: str, out: Path, units: str | None = None,
-                 max_distance: float = DEFAULT_MAX_DISTANCE, force: bool = False) -> ImportedSpots:
+                 max_distance: float = DEFAULT_MAX_DISTANCE, force: bool = False,
+                 frame: str | None = None) -> ImportedSpots:
     """Write `out`: the cell `cell` with the list's spots added as seams after its own, checked as
-    `robomax check` checks it; nothing is written when anything is wrong."""
+    `robomax check` checks it; nothing is written when anything is wrong. The list's coordinates
+    are in the part's frame, or in `frame` (a named frame of the cell, an object, or the world)."""
     start = time.process_time()
     if out.resolve() == cell.resolve():
         raise OutputError(out, None, "is the cell read: the new cell is written to another file")
@@ -48,7 +51,8 @@ def import_spots(cell: Path, spots: Path, part: str, out: Path, units: str | Non
         raise OutputError(out, None, "exists; use --force to replace it")
     parsed = read_cell_file(cell)
     taken = {s.name for s in parsed.seams}
-    seams, result = spot_list_seams(parsed, cell, "", spots, part, units, max_distance)
+    tree = read_cell_frames(cell)[0] if frame is not None else ()    # `parsed` is flat: its named frames are gone
+    seams, result = spot_list_seams(parsed, cell, "", spots, part, units, max_distance, frame=frame, tree=tree)
     clash = next((s.name for s in seams if s.name in taken), None)
     if clash is not None:
         raise CellFileError(spots, None, f"the list's seam '{clash}' is also a seam of {cell}; rename one")

@@ -278,6 +278,7 @@ class SpotListFile(_Strict):
     file: Reference                           # relative to the cell file
     part: Name                                # the object whose frame the list's coordinates are in
     units: Literal["m", "mm"]                 # of the list's coordinates: a file read again and again does not guess
+    frame: Name | None = None                 # the frame the coordinates are in, when not the part's (docs/frames.md)
     max_distance: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.002   # m from the part's surface
     ordered: bool = False                     # of every seam the list gives
     tolerance: ToleranceFile = ToleranceFile()

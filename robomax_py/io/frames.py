@@ -165,6 +165,7 @@ def _used_frames(cell: CellFile) -> set[str]:
     used = {f.parent for f in cell.frames if f.parent is not None}
     used |= {o.frame for o in (*cell.objects, *cell.dynamic) if o.frame is not None}
     used |= {cell.robot.frame} if cell.robot.frame is not None else set()
+    used |= {sl.frame for sl in cell.spot_lists if sl.frame is not None}
     for s in cell.seams:
         used |= {s.frame} if s.frame is not None else set()
         used |= {p.frame for p in s.spots if p.frame is not None}

@@ -268,11 +268,14 @@ def world_mesh(obj: ObjectSpec) -> trimesh.Trimesh:
 
 
 def spot_list_seams(spots: SpotList, part: ObjectSpec, others: Sequence[ObjectSpec], T_world_base: FloatArray,
-                    approach: float, max_distance: float = DEFAULT_MAX_DISTANCE) -> SpotListResult:
-    """The list's spots as seams in the world: each moved by the part's pose, its normal and
-    direction recovered where the list has none, grouped by the group column or the part's geometry."""
-    T = np.asarray(part.T_world_object, dtype=float)
+                    approach: float, max_distance: float = DEFAULT_MAX_DISTANCE,
+                    T_world_frame: FloatArray | None = None) -> SpotListResult:
+    """The list's spots as seams in the world: each moved by the pose of the frame its coordinates
+    are in (`T_world_frame`; the part's own frame when None), its normal and direction recovered
+    where the list has none, grouped by the group column or the part's geometry."""
+    T = np.asarray(part.T_world_object if T_world_frame is None else T_world_frame, dtype=float)
     R = T[:3, :3]
+    R_part = np.asarray(part.T_world_object, dtype=float)[:3, :3]
     rows = spots.rows
     xyz = np.array([R @ r.xyz + T[:3, 3] for r in rows])
     surface = world_mesh(part)
@@ -311,7 +314,7 @@ def spot_list_seams(spots: SpotList, part: ObjectSpec, others: Sequence[ObjectSp
         result.recovered_normals = len(need)
     groups = _groups(rows, xyz, normals) if spots.grouped else _geometric_groups(xyz, normals)
     by = "the group column" if spots.grouped else "the part's geometry (one face, neighbours in a line)"
-    x_axis, y_axis = R[:, 0], R[:, 1]
+    x_axis, y_axis = R_part[:, 0], R_part[:, 1]
     for name, members in groups:
         result.formed.append(f"seam {name}: {len(members)} spots (rows {_rows_text([rows[i].row for i in members])}), "
                              f"grouped by {by}")

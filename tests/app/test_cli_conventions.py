@@ -120,10 +120,10 @@ def test_json_error_object_on_bad_input(command: str, tmp_path: Path) -> None:
 
 
 def test_examples_equal_the_repository_cells() -> None:
-    """The package's copy (what a wheel ships) is cells/ without its generator script."""
+    """The package's copy (what a wheel ships) is cells/ without its generator scripts."""
     cells = REPO / "cells"
     wanted = sorted(p.relative_to(cells) for p in cells.rglob("*")
-                    if p.is_file() and p.suffix in (".yaml", ".stl") and "__pycache__" not in p.parts)
+                    if p.is_file() and p.suffix in (".yaml", ".stl", ".step", ".csv") and "__pycache__" not in p.parts)
     assert example_files() == wanted
     for rel in wanted:
         assert (examples_dir() / rel).read_bytes() == (cells / rel).read_bytes(), (

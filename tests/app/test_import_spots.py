@@ -6,10 +6,18 @@ import json
 from pathlib import Path
 
 import yaml
-from spot_list_case import cell_data, known_spots, write_cell, write_csv
+from spot_list_case import (
+    STATION,
+    cell_data,
+    known_spots,
+    station_spots,
+    write_cell,
+    write_csv,
+)
 from typer.testing import CliRunner
 
 from robomax_py.app.cli import app
+from robomax_py.io.cell import load_cell
 
 
 def _setup(tmp_path: Path) -> tuple[Path, Path]:
@@ -41,3 +49,24 @@ def test_bad_input_writes_nothing(tmp_path: Path) -> None:
         assert not out.exists()
     same = CliRunner().invoke(app, ["import-spots", str(cell), str(csv), "--part", "plate", "-o", str(cell)])
     assert same.exit_code == 2 and "another file" in same.output
+
+
+def test_frame_option_gives_the_cell_keys_spots(tmp_path: Path) -> None:
+    """`--frame`: the list's coordinates in a named frame of the cell, as the key's `frame:` reads them."""
+    csv = write_csv(tmp_path / "station.csv", station_spots()[:60], mm=True, groups=True)
+    cell = write_cell(tmp_path / "cell.yaml", cell_data(frames=[STATION]))
+    out = tmp_path / "new.yaml"
+    done = CliRunner().invoke(app, ["import-spots", str(cell), str(csv), "--part", "plate", "--units", "mm",
+                                    "--frame", "station", "-o", str(out)])
+    assert done.exit_code == 0, done.output
+    keyed = load_cell(write_cell(tmp_path / "k.yaml", cell_data(frames=[STATION], spot_lists=[
+        {"file": "station.csv", "part": "plate", "units": "mm", "frame": "station"}])))
+    imported = load_cell(out)
+    assert [s.name for s in imported.seams] == [s.name for s in keyed.seams] == ["top1", "top2"]
+    for a, b in zip(imported.seams, keyed.seams, strict=True):
+        for p, q in zip(a.spots, b.spots, strict=True):
+            assert p.name == q.name and (abs(p.xyz - q.xyz) < 1e-6).all() and (abs(p.normal - q.normal) < 1e-8).all()
+    bad = CliRunner().invoke(app, ["import-spots", str(cell), str(csv), "--part", "plate", "--units", "mm",
+                                   "--frame", "nowhere", "-o", str(tmp_path / "bad.yaml")])
+    assert bad.exit_code == 2 and "--frame: unknown frame 'nowhere'" in bad.output
+    assert not (tmp_path / "bad.yaml").exists()

@@ -7,7 +7,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from spot_list_case import cell_data, known_spots, world_normal, write_cell, write_csv
+from spot_list_case import (
+    STATION,
+    cell_data,
+    known_spots,
+    station_spots,
+    world_normal,
+    write_cell,
+    write_csv,
+)
 
 from robomax_py.errors import CellFileError
 from robomax_py.io.cell import load_cell, read_cell_file, spot_list_seams
@@ -116,3 +124,29 @@ def test_open_sheet_is_ambiguous_toward_the_base(tmp_path: Path) -> None:
     assert result.sides and "both sides" in result.sides[0]
     spot = seams[0].spots[0]
     assert np.allclose(spot.normal, [0, 0, 1]) and np.allclose(spot.direction, [1, 0, 0])
+
+
+def test_list_in_a_named_frame_equals_the_part_frame(tmp_path: Path) -> None:
+    write_csv(tmp_path / "part.csv", known_spots()[:80], mm=True, groups=True)
+    write_csv(tmp_path / "station.csv", station_spots(), mm=True, groups=True)
+    part = load_cell(write_cell(tmp_path / "p.yaml", cell_data(frames=[STATION], spot_lists=[
+        {"file": "part.csv", "part": "plate", "units": "mm"}])))
+    framed = load_cell(write_cell(tmp_path / "f.yaml", cell_data(frames=[STATION], spot_lists=[
+        {"file": "station.csv", "part": "plate", "units": "mm", "frame": "station"}])))
+    assert [s.name for s in framed.seams] == [s.name for s in part.seams] == ["top1", "top2", "top3"]
+    for a, b in zip(part.seams, framed.seams, strict=True):
+        for p, q in zip(a.spots, b.spots, strict=True):
+            assert np.allclose(p.xyz, q.xyz, atol=1e-6)
+            assert np.allclose(p.normal, q.normal, atol=1e-9) and np.allclose(p.direction, q.direction, atol=1e-6)
+    # The part's own name and the world are frames too.
+    world = load_cell(write_cell(tmp_path / "w.yaml", cell_data(spot_lists=[
+        {"file": "part.csv", "part": "plate", "units": "mm", "frame": "plate"}])))
+    assert np.allclose(world.seams[0].spots[0].xyz, part.seams[0].spots[0].xyz, atol=1e-9)
+
+
+def test_list_in_an_unknown_frame_is_refused(tmp_path: Path) -> None:
+    write_csv(tmp_path / "part.csv", known_spots()[:10], mm=True)
+    cell = write_cell(tmp_path / "c.yaml", cell_data(frames=[STATION], spot_lists=[
+        {"file": "part.csv", "part": "plate", "units": "mm", "frame": "nowhere"}]))
+    with pytest.raises(CellFileError, match=r"spot_lists\[0\]\.frame: unknown frame 'nowhere' \(frames: world, station"):
+        load_cell(cell)
