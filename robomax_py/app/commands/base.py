@@ -1,0 +1,205 @@
+"""What every `robomax` command shares (robomax_py.app.cli describes it): the exit codes, the
+--json envelope, the app object the commands register on, the consoles and the error guard."""
+
+from __future__ import annotations
+
+import signal
+from collections.abc import Callable
+from pathlib import Path
+from typing import Annotated, Any, TypeVar
+
+import typer
+from rich.console import Console
+from typer.core import TyperCommand, TyperGroup
+
+from robomax_py._version import __version__
+from robomax_py.errors import RobomaxError
+
+EXIT_OK = 0
+EXIT_VIOLATIONS = 1
+EXIT_BAD_INPUT = 2
+EXIT_INFEASIBLE = 3
+EXIT_INTERRUPTED = 130                  # 128 + SIGINT
+EXIT_TERMINATED = 143                   # 128 + SIGTERM
+
+# The one table of exit codes, shown under every command's help.
+EXIT_CODES = (
+    (EXIT_OK, "done: valid, planned, clean"),
+    (EXIT_VIOLATIONS, "verify found violations"),
+    (EXIT_BAD_INPUT, "bad input: a file (named with its key) or the command line is wrong"),
+    (EXIT_INFEASIBLE, "infeasible: a spot left unplanned (batch: or a cell timed out or crashed)"),
+    (EXIT_INTERRUPTED, "interrupted (Ctrl-C)"),
+    (EXIT_TERMINATED, "terminated (SIGTERM)"),
+)
+JSON_VERSION = 1
+# "\b" keeps the lines as they are in the help (click's and typer's formatters rewrap otherwise).
+EPILOG = "\b\nExit codes:\n" + "\n".join(f"  {code:>3}  {what}" for code, what in EXIT_CODES) + (
+    f"\n\b\n--json: one object on stdout, {{\"schema\": \"robomax.cli.<command>/{JSON_VERSION}\", \"ok\": ...}}; "
+    "on bad input {\"ok\": false, \"error\": {\"file\", \"key\", \"message\"}}")
+HELP_OPTIONS = {"help_option_names": ["-h", "--help"]}
+
+
+def json_schema(command: str) -> str:
+    """The `schema` value of a command's --json output."""
+    return f"robomax.cli.{command}/{JSON_VERSION}"
+
+
+def _untyped_flags(params: list[Any]) -> list[Any]:
+    """A flag takes no value: typer from 0.2x shows its type (`<bool>`) in the help unless it has a
+    metavar, so flags get an empty one (no effect with older typer, which shows none)."""
+    for param in params:
+        if getattr(param, "is_flag", False) and param.metavar is None:
+            param.metavar = ""
+    return params
+
+
+class _Command(TyperCommand):
+    """A command whose help shows no `<bool>` and names its arguments as the usage line does
+    (CELL, [PROGRAM], CELLS...), not `{cell}`."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        for param in self.params:
+            if param.param_type_name == "argument" and param.metavar is None and param.name:
+                param.metavar = param.name.upper()
+
+    def get_params(self, ctx: Any) -> list[Any]:
+        return _untyped_flags(super().get_params(ctx))
+
+    def collect_usage_pieces(self, ctx: Any) -> list[str]:
+        pieces = [self.options_metavar] if self.options_metavar else []
+        for param in self.get_params(ctx):
+            if param.param_type_name != "argument":
+                pieces.extend(param.get_usage_pieces(ctx))
+                continue
+            name = str(param.metavar or param.name).upper()
+            name = name if param.required else f"[{name}]"
+            pieces.append(name + ("..." if param.nargs != 1 else ""))
+        return pieces
+
+
+class _Group(TyperGroup):
+    def get_params(self, ctx: Any) -> list[Any]:
+        return _untyped_flags(super().get_params(ctx))
+
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, cls=_Group, context_settings=HELP_OPTIONS,
+                  epilog=EPILOG, help="Offline programming for spot-welding robot cells.")
+out = Console(highlight=False)
+err = Console(stderr=True, highlight=False)
+
+
+def _command(name: str | None = None) -> Callable[[Callable[..., T]], Callable[..., T]]:
+    """`app.command` with the conventions every command shares: -h, the exit-code epilog, clean help."""
+    return app.command(name, cls=_Command, epilog=EPILOG)
+
+
+JsonFlag = Annotated[bool, typer.Option("--json", help="print one JSON object on stdout instead of tables "
+                                                       "(see below)")]
+
+
+def _print_json(command: str, ok: bool, payload: dict[str, Any]) -> None:
+    """A command's --json output: `schema` and `ok` first, then the command's own keys."""
+    import json
+
+    out.print_json(json.dumps({"schema": json_schema(command), "ok": ok, **payload}))
+
+
+T = TypeVar("T")
+
+
+def _print_version(wanted: bool) -> None:
+    if wanted:
+        out.print(f"robomax_py {__version__}", markup=False, highlight=False)
+        raise typer.Exit(EXIT_OK)
+
+
+@app.callback()
+def _library(
+    robots_dirs: Annotated[list[Path] | None, typer.Option(
+        "--robots", metavar="DIR",
+        help="a robot library folder searched before ROBOMAX_ROBOTS and the shipped library (repeatable; "
+             "any command takes it, before or after the command name)")] = None,
+    version: Annotated[bool, typer.Option("--version", is_eager=True, callback=_print_version,
+                                          help="print the version and exit")] = False,
+) -> None:
+    """Offline programming for spot-welding robot cells."""
+    if robots_dirs:
+        _prepend_library([str(d) for d in robots_dirs])
+
+
+def _prepend_library(dirs: list[str]) -> None:
+    """Put folders in front of ROBOMAX_ROBOTS; batch workers and local Ray inherit the environment."""
+    import os
+
+    from robomax_py.io.robot import ROBOTS_ENV
+
+    current = [p for p in os.environ.get(ROBOTS_ENV, "").split(os.pathsep) if p]
+    wanted = [str(Path(d).resolve()) for d in dirs]
+    os.environ[ROBOTS_ENV] = os.pathsep.join([*wanted, *[p for p in current if p not in wanted]])
+
+
+def _warn(lines: tuple[str, ...] | list[str]) -> None:
+    from rich.markup import escape
+
+    for line in lines:
+        err.print(f"[yellow]warning:[/] {escape(line)}", soft_wrap=True, highlight=False)
+
+
+def _guarded(action: Callable[[], T], json_command: str | None = None) -> T:
+    """Run a command body; a RobomaxError becomes one message on stderr and exit code 2 (with
+    `json_command`, the --json error object on stdout as well)."""
+    try:
+        return action()
+    except RobomaxError as exc:
+        from rich.markup import escape
+
+        err.print(f"[bold red]error:[/] {escape(str(exc))}", markup=True, soft_wrap=True)
+        if json_command is not None:
+            _print_json(json_command, False, {"error": {
+                "file": getattr(exc, "file", None), "key": getattr(exc, "key", None), "message": str(exc)}})
+        raise typer.Exit(EXIT_BAD_INPUT) from None
+
+
+def _num(value: float | None) -> float | None:
+    """A number for JSON (a numpy scalar as a float)."""
+    return None if value is None else float(value)
+
+
+def _json_failure(command: str, as_json: bool, file: str | None, message: str) -> int:
+    """A bad input found by the command itself (not a RobomaxError): the message on stderr, the
+    error object on stdout with --json; exit code 2."""
+    from rich.markup import escape
+
+    err.print(f"[bold red]error:[/] {escape(message)}", soft_wrap=True)
+    if as_json:
+        _print_json(command, False, {"error": {"file": file, "key": None, "message": message}})
+    return EXIT_BAD_INPUT
+
+
+def _method(baseline: str | None) -> str:
+    """The planning method `--baseline` names (None: the optimiser); a usage error otherwise."""
+    if baseline is None:
+        return "optimised"
+    if baseline not in ("published", "teach-in"):
+        raise typer.BadParameter(f"expected published or teach-in, got {baseline!r}", param_hint="--baseline")
+    return baseline
+
+
+RAY_LOCAL = "local"
+
+
+class _Received:
+    """The termination signal this process received (SIGINT or SIGTERM), for `_honour_signals`.
+    Process state by nature: a signal handler has nowhere else to leave it."""
+
+    signum: int | None = None
+
+
+def _honour_signals() -> None:
+    """End the run as an earlier SIGINT or SIGTERM asked, if its exception was swallowed: called
+    between stages and before anything is written."""
+    if _Received.signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    if _Received.signum is not None:
+        raise SystemExit(128 + _Received.signum)
