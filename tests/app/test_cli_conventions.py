@@ -7,10 +7,7 @@ from __future__ import annotations
 
 import fnmatch
 import json
-import subprocess
-import sys
 import tomllib
-import zipfile
 from collections.abc import Callable
 from pathlib import Path
 
@@ -162,15 +159,3 @@ def test_examples_refuse_to_overwrite(tmp_path: Path) -> None:
     assert result.exit_code == EXIT_OK, result.output
     assert edited.read_bytes() == (examples_dir() / "frame.yaml").read_bytes()
     assert load_cell(folder / "cabin_flange.yaml").name == "cabin_flange"   # its mesh came along
-
-
-@pytest.mark.slow
-def test_wheel_contains_the_example_cells(tmp_path: Path) -> None:
-    done = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q",
-                           "-w", str(tmp_path), str(REPO)], capture_output=True, text=True, check=False)
-    assert done.returncode == 0, done.stderr
-    (wheel,) = tmp_path.glob("robomax_py-*.whl")
-    names = set(zipfile.ZipFile(wheel).namelist())
-    wanted = {f"robomax_py/examples/{rel.as_posix()}" for rel in example_files()}
-    assert wanted <= names, sorted(wanted - names)
-    assert "robomax_py/examples/cabin_flange.yaml" in names

@@ -1,5 +1,5 @@
-"""The robot library is package data: a built wheel carries it (a non-editable install
-had no robots), and `package://` meshes resolve near the robot folder and via ROS_PACKAGE_PATH."""
+"""The robot library and the example cells are package data: a built wheel carries them (a
+non-editable install had no robots), and `package://` meshes resolve near the robot folder and via ROS_PACKAGE_PATH."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from robomax_py.app.examples import example_files
 from robomax_py.errors import RobotModelError
 from robomax_py.io.robot import (
     ROS_PACKAGE_PATH_ENV,
@@ -22,7 +23,7 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.slow
-def test_wheel_contains_the_robot_library(tmp_path: Path) -> None:
+def test_wheel_contains_the_robot_library_and_the_example_cells(tmp_path: Path) -> None:
     done = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps", "-q",
                            "-w", str(tmp_path), str(REPO)], capture_output=True, text=True, check=False)
     assert done.returncode == 0, done.stderr
@@ -33,6 +34,8 @@ def test_wheel_contains_the_robot_library(tmp_path: Path) -> None:
     assert shipped and all(n in names for n in shipped), sorted(set(shipped) - names)[:5]
     assert "robomax_py/robots/kr125/robot.yaml" in names
     assert "robomax_py/robots/tools/spot_gun_c/tool.yaml" in names
+    wanted = {f"robomax_py/examples/{rel.as_posix()}" for rel in example_files()}
+    assert wanted <= names, sorted(wanted - names)
 
 
 def _package(root: Path, name: str) -> Path:
