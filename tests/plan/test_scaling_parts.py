@@ -110,7 +110,8 @@ def test_probe_checks_near_pairs_in_full_and_far_pairs_coarsely(reference: tuple
 def _via_costs_one_by_one(seq: Sequencer, i: int, j: int, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
     """The detour prices as they were computed before the legs were batched: two estimates per
     detour, its blocked (or, past MAX_BLOCKED_LEGS, its verified) legs marked, the least kept."""
-    from robomax_py.plan.graph import _UNUSABLE, MAX_BLOCKED_LEGS
+    from robomax_py.plan.graph import MAX_BLOCKED_LEGS
+    from robomax_py.plan.graph_knowledge import _UNUSABLE
     from robomax_py.timing import ptp_time_estimate
 
     out = np.full((len(rows), len(cols)), np.inf)
