@@ -1,0 +1,161 @@
+"""The scratch and the exact tests under `world.collision.CollisionWorld` (its base): Pinocchio data
+and coal's broad phase attached to the shared geometry, the pre-filter's blocks of states handed to
+coal pair by pair, and the pairs of dynamic obstacles switched on and off with time."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from robomax_py._typing import FloatArray, IntArray
+from robomax_py.world.acm import SharedGeometry, configure_requests
+from robomax_py.world.collision_results import Contact, SegmentCheck
+from robomax_py.world.scene import SceneObject
+
+_FIRST_CHUNK = 8     # states the first pre-filter call of a scan covers (blocked moves stop early)
+
+
+class CollisionWorldCore:
+    """Scratch, pair activation and exact tests of one collision world (the base of `CollisionWorld`)."""
+
+    __slots__ = ("_active", "_active_before", "_allowed", "_callback", "_data", "_gdata", "_manager", "_pf", "_present", "_s")
+
+    # ----------------------------------------------------------------------------------- set-up
+
+    def _attach(self, shared: SharedGeometry) -> None:
+        self._s = shared
+        self._data = shared.model.createData()
+        self._gdata = shared.geom_model.createData()
+        configure_requests(self._gdata, shared.pair_margin)
+        self._manager: Any = None
+        self._callback: Any = None
+        if shared.options.broad_phase:
+            self._manager = pin.BroadPhaseManager_NaiveCollisionManager(shared.model, shared.geom_model, self._gdata)
+            self._callback = pin.CollisionCallBackDefault(shared.geom_model, self._gdata, True)
+        self._present: tuple[bool, ...] = tuple(True for _ in shared.dynamic_ids)
+        self._active_before = np.arange(len(shared.pair_a) + 1, dtype=np.int64)
+        self._active = np.ones(len(shared.pair_a), dtype=bool)
+        self._allowed = np.ones(len(shared.pair_a), dtype=bool)     # pairs this world checks at all
+        self._pf = shared.prefilter if shared.options.broad_phase and shared.options.prefilter else None
+
+    def _restrict(self, allowed: np.ndarray) -> None:
+        self._allowed = allowed.copy()
+        for p in np.flatnonzero(~allowed):
+            self._gdata.deactivateCollisionPair(int(p))
+        self._refresh_active()
+
+    # ------------------------------------------------------------------------------- internals
+
+    def _exact(self, q: FloatArray, pairs: IntArray) -> tuple[bool, int]:
+        """coal's verdict on the pairs the pre-filter left (in pair order): (free, pairs tested)."""
+        if not pairs.size:
+            return True, 0
+        s, gd = self._s, self._gdata
+        gm = s.geom_model
+        pin.updateGeometryPlacements(s.model, self._data, gm, gd, q)
+        for n, p in enumerate(pairs.tolist()):
+            if pin.computeCollision(gm, gd, p):
+                return False, n + 1
+        return True, len(pairs)
+
+    def _scan_timed(self, states: FloatArray, fractions: FloatArray, order: IntArray, m: int, start: float,
+                    span: float) -> SegmentCheck:
+        """`_scan` where dynamic obstacles come and go: state k (of `order`) counts the obstacles
+        present during the time between its neighbouring steps, so the states are scanned in runs
+        that share one presence, each with the pairs active then, stopping at the first collision."""
+        windows = [(start + max(int(step) - 1, 0) / m * span, start + min(int(step) + 1, m) / m * span) for step in order]
+        dynamic = [self._s.obstacles[int(i)] for i in self._s.dynamic_ids]
+        presence = [tuple(_present_during(o, min(a, b), max(a, b)) for o in dynamic) for a, b in windows]
+        tests, k0 = 0, 0
+        while k0 < len(order):
+            k1 = k0 + 1
+            while k1 < len(order) and presence[k1] == presence[k0]:
+                k1 += 1
+            a, b = windows[k0]
+            self._set_presence(min(a, b), max(a, b))
+            res = self._scan(states[k0:k1], fractions[k0:k1], m + 1)
+            tests += res.narrow_phase_tests
+            if not res.free:
+                return SegmentCheck(False, k0 + res.checks, m + 1, tests, res.s_contact)
+            k0 = k1
+        return SegmentCheck(True, len(order), m + 1, tests, None)
+
+    def _scan(self, states: FloatArray, fractions: FloatArray, n_states: int) -> SegmentCheck:
+        """Check `states` in the given order, stopping at the first collision (pre-filter on)."""
+        assert self._pf is not None
+        tests = 0
+        start, chunk = 0, _FIRST_CHUNK
+        while start < len(states):
+            block = states[start:start + chunk]
+            offsets, pairs = self._pf.uncleared(block, self._active)
+            for i in np.flatnonzero(np.diff(offsets)):
+                free, n = self._exact(block[i], pairs[offsets[i]:offsets[i + 1]])
+                tests += n
+                if not free:
+                    k = start + int(i)
+                    return SegmentCheck(False, k + 1, n_states, tests, float(fractions[k]))
+            start += len(block)
+            chunk *= 4
+        return SegmentCheck(True, len(states), n_states, tests, None)
+
+    def _collides(self, q: FloatArray) -> bool:
+        s = self._s
+        if self._manager is not None:
+            return bool(pin.computeCollisions(s.model, self._data, self._manager, self._callback, q))
+        return bool(pin.computeCollisions(s.model, self._data, s.geom_model, self._gdata, q, True))
+
+    def _hit_pair(self) -> int:
+        """Index of the pair that stopped the last colliding query."""
+        if self._manager is not None:
+            return int(self._callback.collisionPairIndex)
+        # Exhaustive mode stops at the first colliding active pair, in order; later results are stale.
+        results, active = self._gdata.collisionResults, self._gdata.activeCollisionPairs
+        for p in range(len(self._s.pair_a)):
+            if active[p] and results[p].isCollision():
+                return p
+        raise RuntimeError("collision reported but no colliding pair found")  # pragma: no cover
+
+    def _tests(self, hit_pair: int) -> int:
+        """Narrow-phase tests of the last query."""
+        if self._manager is not None:
+            return int(self._callback.count)
+        return int(self._active_before[hit_pair + 1] if hit_pair >= 0 else self._active_before[-1])
+
+    def _set_presence(self, ta: float | None, tb: float | None) -> None:
+        """Activate the pairs of dynamic obstacles present at some time in [ta, tb] (None: present)."""
+        s = self._s
+        if not s.dynamic_ids.size:
+            return
+        present = tuple(
+            True if ta is None or tb is None else _present_during(s.obstacles[int(i)], ta, tb) for i in s.dynamic_ids
+        )
+        if present == self._present:
+            return
+        for on_now, on_before, pairs in zip(present, self._present, s.dynamic_pairs):
+            if on_now == on_before:
+                continue
+            for p in pairs:
+                if on_now and self._allowed[p]:
+                    self._gdata.activateCollisionPair(int(p))
+                else:
+                    self._gdata.deactivateCollisionPair(int(p))
+        self._present = present
+        self._refresh_active()
+
+    def _refresh_active(self) -> None:
+        active = np.fromiter(self._gdata.activeCollisionPairs, dtype=bool, count=len(self._s.pair_a))
+        self._active = active
+        self._active_before = np.concatenate([[0], np.cumsum(active)]).astype(np.int64)
+
+    def _contact(self, pair: int) -> Contact:
+        s = self._s
+        a, b = s.pieces[int(s.pair_a[pair])], s.pieces[int(s.pair_b[pair])]
+        return Contact(body_a=a.body, kind_a=a.kind, body_b=b.body, kind_b=b.kind, piece_a=a.name, piece_b=b.name)
+
+
+def _present_during(obj: SceneObject, ta: float, tb: float) -> bool:
+    if obj.present is None:
+        return True
+    return any(w0 <= tb and w1 >= ta for w0, w1 in obj.present)

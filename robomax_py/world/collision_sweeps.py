@@ -1,0 +1,152 @@
+"""The swept checks of `world.collision.CollisionWorld` (its base): a straight joint-space move or a
+polyline subdivided by a bound on how far any robot or tool point moves, its states checked
+coarse-to-fine, stopping at the first collision; dynamic obstacles per the `world.collision`
+module docstring."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pinocchio as pin
+
+from robomax_py._typing import FloatArray
+from robomax_py.tolerances import DEFAULT as TOL
+from robomax_py.world.collision_core import CollisionWorldCore
+from robomax_py.world.collision_results import SegmentCheck, bisection_order
+
+
+class SweptChecks(CollisionWorldCore):
+    """Swept-segment and polyline checks (the base of `CollisionWorld`)."""
+
+    __slots__ = ()
+
+    def sweep_length(self, q0: FloatArray, q1: FloatArray) -> float:
+        """Upper bound (m) on how far any robot or tool point moves along the joint-space line q0 -> q1.
+
+        Point p moves at |dp/ds| <= sum_i |dq_i| dist(p, axis_i); `lever_arms`[i] bounds dist(p, axis_i)
+        over every p beyond joint i and every configuration: for pieces on joint i, the exact largest
+        distance of their (hull / bounding-box) vertices from the axis; for pieces on a descendant
+        joint j, dist(o_c, axis_i) + sum of the joint-origin offsets from c to j (plus the travel of
+        prismatic joints on the way) + the largest vertex distance from o_j (triangle inequality;
+        c is the child of i towards j).
+        """
+        dq = np.abs(np.asarray(q1, dtype=float) - np.asarray(q0, dtype=float))
+        return float(np.dot(self._s.lever, dq))
+
+    def segment_free(
+        self,
+        q0: FloatArray,
+        q1: FloatArray,
+        t0: float | None = None,
+        t1: float | None = None,
+        max_step: float = TOL.sweep_step_m,
+    ) -> bool:
+        """Whether the straight joint-space move q0 -> q1 is collision-free (see `check_segment`)."""
+        return self.check_segment(q0, q1, t0, t1, max_step).free
+
+    def check_segment(
+        self,
+        q0: FloatArray,
+        q1: FloatArray,
+        t0: float | None = None,
+        t1: float | None = None,
+        max_step: float = TOL.sweep_step_m,
+    ) -> SegmentCheck:
+        """Check the straight joint-space move q0 -> q1, both ends included.
+
+        The move is split into m = ceil(sweep_length(q0, q1) / max_step) equal joint steps, so no
+        robot or tool point moves more than `max_step` between consecutive states; states are
+        checked coarse-to-fine (ends, middle, quarters, ...), stopping at the first collision.
+
+        Parameters
+        ----------
+        q0, q1 : (n,) float, rad
+        t0, t1 : float or None, s
+            Times at q0 and q1 (both or neither); state k is at t0 + k/m (t1 - t0). Dynamic obstacles
+            are included per the module docstring. None: every dynamic obstacle present.
+        max_step : float, m
+        """
+        if (t0 is None) != (t1 is None):
+            raise ValueError("give both t0 and t1, or neither")
+        if not max_step > 0:
+            raise ValueError(f"max_step must be > 0 m, got {max_step}")
+        q0 = np.asarray(q0, dtype=np.float64)
+        q1 = np.asarray(q1, dtype=np.float64)
+        dq = q1 - q0
+        m = math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12)
+        timed = t0 is not None and t1 is not None and self._s.dynamic_ids.size > 0
+        if m == 0:
+            m = 1 if timed and t0 != t1 else 0
+        order = bisection_order(m)
+        fractions = order / m if m else np.zeros(1)
+        states = q0 + fractions[:, None] * dq
+        states[order == m] = q1                       # the end exactly, not q0 + 1.0 * dq
+        checks = tests = 0
+        if not timed:
+            self._set_presence(None, None)
+        if not timed and self._pf is not None:        # the common case: pre-filter, then coal's exact test
+            return self._scan(states, fractions, m + 1)
+        if not timed and self._manager is not None:
+            model, data, manager, callback = self._s.model, self._data, self._manager, self._callback
+            for k in range(len(order)):
+                hit = pin.computeCollisions(model, data, manager, callback, states[k])
+                tests += callback.count
+                if hit:
+                    return SegmentCheck(False, k + 1, m + 1, int(tests), float(fractions[k]))
+            return SegmentCheck(True, len(order), m + 1, int(tests), None)
+        start = float(t0) if t0 is not None else 0.0
+        span = float(t1) - start if t1 is not None else 0.0
+        if self._pf is not None:
+            return self._scan_timed(states, fractions, order, m, start, span)
+        for k, step in enumerate(order):
+            if timed:
+                ta = start + max(step - 1, 0) / m * span
+                tb = start + min(step + 1, m) / m * span
+                self._set_presence(min(ta, tb), max(ta, tb))
+            hit = self._collides(states[k])
+            checks += 1
+            tests += self._tests(self._hit_pair() if hit else -1)
+            if hit:
+                return SegmentCheck(False, checks, m + 1, tests, float(fractions[k]))
+        return SegmentCheck(True, checks, m + 1, tests, None)
+
+    def check_path(self, points: FloatArray, max_step: float = TOL.sweep_step_m) -> SegmentCheck:
+        """Check the joint-space polyline through `points` (k, n), every dynamic obstacle present.
+
+        Exactly the states `check_segment` checks on each segment, a state shared by two segments
+        once, in coarse-to-fine order over the whole polyline (a blocked path is found early); the
+        polyline is free iff every `check_segment` of its segments is. s_contact is the colliding
+        state's fraction of the states, start to end.
+        """
+        if not max_step > 0:
+            raise ValueError(f"max_step must be > 0 m, got {max_step}")
+        pts = np.asarray(points, dtype=np.float64)
+        if pts.ndim != 2 or len(pts) == 0:
+            raise ValueError("points must be a non-empty (k, n) array")
+        pieces = [pts[:1]]
+        for q0, q1 in itertools.pairwise(pts):
+            m = math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12)
+            if m == 0:
+                continue                  # check_segment checks q0 alone: already in
+            states = q0 + (np.arange(1, m + 1) / m)[:, None] * (q1 - q0)
+            states[-1] = q1               # the end exactly, as check_segment
+            pieces.append(states)
+        states = np.concatenate(pieces)
+        self._set_presence(None, None)
+        last = len(states) - 1
+        order = bisection_order(last)
+        if self._pf is not None:
+            return self._scan(states[order], order / last if last else np.zeros(len(order)), len(states))
+        tests = 0
+        for k, idx in enumerate(order):
+            hit = self._collides(states[idx])
+            tests += self._tests(self._hit_pair() if hit else -1)
+            if hit:
+                return SegmentCheck(False, k + 1, len(states), int(tests), float(idx) / last if last else 0.0)
+        return SegmentCheck(True, len(order), len(states), int(tests), None)
+
+    def path_free(self, points: FloatArray, max_step: float = TOL.sweep_step_m) -> bool:
+        """Whether the joint-space polyline through `points` is collision-free (see `check_path`)."""
+        return self.check_path(points, max_step).free
