@@ -21,11 +21,22 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomax_py._typing import FloatArray
+from robomax_py.plan.sequence_moves import (
+    OR_OPT_WINDOW,
+    Blocks,
+    _flatten,
+    _Moves,
+    _neighbours,
+    _perturb,
+)
+
+__all__ = [
+    "EXACT_ORDERS", "HOME", "KEPT_NEIGHBOURHOODS", "MAX_STALE_KICKS", "OR_OPT_WINDOW", "Blocks", "EdgeCosts",
+    "SeamBlock", "SearchStats", "Tour", "admissible_orders", "best_choice", "choice_for_order", "exact_tour",
+    "optimise", "order_count",
+]
 
 HOME = -1  # the start/end configuration, a layer of one node
-# Or-opt moves a run at most this many positions: spots of a seam lie along a line, far moves are
-# rarely good and are still reachable through 2-opt and perturbations; keeps neighbourhoods O(n^2).
-OR_OPT_WINDOW = 6
 # Consecutive perturbations that found no unseen order before the search gives up.
 MAX_STALE_KICKS = 50
 # Neighbourhoods (all orders one move away) a search keeps for orders it may pass through again.
@@ -144,10 +155,6 @@ def best_choice(order: Sequence[int], costs: _Costs) -> tuple[tuple[int, ...], f
     return tuple(reversed(choice)), best
 
 
-# A tour under construction: seams in visiting order, each (seam id, its spots in visiting order).
-Blocks = list[tuple[int, tuple[int, ...]]]
-
-
 class _PrefixCost:
     """The DP cost of orders near an anchor order (a descent's current one): the anchor's layer
     values are kept, so an order that first differs from it at position p is costed from layer p
@@ -192,109 +199,6 @@ class _PrefixCost:
 def choice_for_order(order: Sequence[int], edge: EdgeCosts, node: Sequence[FloatArray]) -> tuple[tuple[int, ...], float]:
     """The exact best candidates for a fixed spot order (public form of `best_choice`)."""
     return best_choice(order, _Costs(edge, node))
-
-
-def _flatten(blocks: Blocks) -> tuple[int, ...]:
-    return tuple(s for _, block in blocks for s in block)
-
-
-class _Moves:
-    """The orders one move away from `origin`, kept compactly: for a move within seam b the new
-    order of that seam's spots (a row of `local[b]`), else the whole new blocks (seam moves). Flat
-    orders and blocks are built on demand: a descent looks at a few of its thousands of moves."""
-
-    def __init__(self, origin: Blocks) -> None:
-        self.origin = origin
-        self.parts: list[tuple[int, np.ndarray]] = []      # (block index, (M_b, n_b) new block orders)
-        self.whole: list[Blocks] = []                       # seam moves, after every block move
-        self.n_local = 0
-
-    def __len__(self) -> int:
-        return self.n_local + len(self.whole)
-
-    def _locate(self, k: int) -> tuple[int, np.ndarray] | Blocks:
-        if k >= self.n_local:
-            return self.whole[k - self.n_local]
-        for b, rows in self.parts:
-            if k < len(rows):
-                return b, rows[k]
-            k -= len(rows)
-        raise IndexError(k)  # pragma: no cover
-
-    def blocks(self, k: int) -> Blocks:
-        where = self._locate(k)
-        if isinstance(where, list):
-            return where
-        b, row = where
-        return self.origin[:b] + [(self.origin[b][0], tuple(int(s) for s in row))] + self.origin[b + 1:]
-
-    def flat(self, k: int) -> tuple[int, ...]:
-        return _flatten(self.blocks(k))
-
-    def rows(self) -> np.ndarray:
-        """(len, S) every move's flat order, in move order (for the bounds; not kept)."""
-        flats = [block for _, block in self.origin]
-        out = []
-        for b, rows in self.parts:
-            prefix = np.array([s for f in flats[:b] for s in f], dtype=np.int64)
-            suffix = np.array([s for f in flats[b + 1:] for s in f], dtype=np.int64)
-            out.append(np.concatenate([np.broadcast_to(prefix, (len(rows), len(prefix))), rows,
-                                       np.broadcast_to(suffix, (len(rows), len(suffix)))], axis=1))
-        out.extend(np.array([_flatten(w)], dtype=np.int64) for w in self.whole)
-        return np.concatenate(out) if out else np.zeros((0, 0), dtype=np.int64)
-
-
-_MOVE_TABLES: dict[int, np.ndarray] = {}
-
-
-def _move_table(n: int) -> np.ndarray:
-    """(M, n) the new positions of every distinct move within a free seam of n spots: 2-opt
-    (reverse positions i..j-1), then Or-opt (a run of 1-3 spots moved at most OR_OPT_WINDOW places,
-    both ways round); each new order once, first occurrence first; the unchanged order is no move.
-    The same for every seam of n spots, so made once per n."""
-    got = _MOVE_TABLES.get(n)
-    if got is not None:
-        return got
-    pos = tuple(range(n))
-    made: list[tuple[int, ...]] = []
-    for i in range(n):
-        for j in range(i + 2, n + 1):
-            made.append(pos[:i] + pos[i:j][::-1] + pos[j:])
-    for length in (1, 2, 3):
-        for i in range(n - length + 1):
-            run = pos[i:i + length]
-            rest = pos[:i] + pos[i + length:]
-            for k in range(max(0, i - OR_OPT_WINDOW), min(len(rest), i + OR_OPT_WINDOW) + 1):
-                if k == i:
-                    continue
-                for piece in (run, run[::-1]) if length > 1 else (run,):
-                    made.append(rest[:k] + piece + rest[k:])
-    fresh = [new for new in dict.fromkeys(made) if new != pos]
-    table = np.array(fresh, dtype=np.int64).reshape(len(fresh), n)
-    _MOVE_TABLES[n] = table
-    return table
-
-
-def _neighbours(blocks: Blocks, ordered: Sequence[bool]) -> _Moves:
-    """Every order one move away: within free seams Or-opt (1-3 spots, moved at most
-    OR_OPT_WINDOW places) and 2-opt; seam swaps; seam-level 2-opt."""
-    out = _Moves(blocks)
-    for b, (seam, block) in enumerate(blocks):
-        if ordered[seam] or len(block) < 2:
-            continue
-        rows = np.asarray(block, dtype=np.int64)[_move_table(len(block))]
-        out.parts.append((b, rows))
-        out.n_local += len(rows)
-    for a, c in itertools.combinations(range(len(blocks)), 2):  # seam order
-        swapped = list(blocks)
-        swapped[a], swapped[c] = swapped[c], swapped[a]
-        out.whole.append(swapped)
-    # 2-opt at the seam level: a run of seams visited backwards, each free seam in it reversed
-    # (rows of seams are then welded as a serpentine, which pairwise swaps reach only one by one).
-    for a, c in itertools.combinations(range(len(blocks)), 2):
-        run = [(seam, spots if ordered[seam] else spots[::-1]) for seam, spots in reversed(blocks[a:c + 1])]
-        out.whole.append(blocks[:a] + run + blocks[c + 1:])
-    return out
 
 
 def _bound(order: tuple[int, ...], costs: _Costs) -> float:
@@ -444,25 +348,6 @@ def _insertion_start(blocks: Sequence[SeamBlock], costs: _Costs) -> Blocks:
             best = min(options, key=lambda o: _bound(_flatten([*out, (seam, o)]), costs))
             tour = list(best)
         out.append((seam, tuple(tour)))
-    return out
-
-
-def _perturb(blocks: Blocks, ordered: Sequence[bool], rng: np.random.Generator) -> Blocks:
-    """A random kick: move a random run of a free seam elsewhere, reversed; or swap two seams."""
-    out = list(blocks)
-    free = [b for b, (seam, spots) in enumerate(out) if not ordered[seam] and len(spots) >= 3]
-    if free and (len(out) < 2 or rng.random() < 0.8):
-        b = free[int(rng.integers(len(free)))]
-        seam, block = out[b]
-        n = len(block)
-        i = int(rng.integers(n))
-        j = int(rng.integers(i + 1, n + 1))
-        run, rest = block[i:j][::-1], block[:i] + block[j:]
-        k = int(rng.integers(len(rest) + 1))
-        out[b] = (seam, rest[:k] + run + rest[k:])
-    elif len(out) >= 2:
-        a, c = rng.choice(len(out), size=2, replace=False)
-        out[a], out[c] = out[c], out[a]
     return out
 
 
