@@ -1,5 +1,6 @@
-"""CAD parts and mesh units (docs/cad.md): a STEP file made here with build123d (OpenCASCADE), in
-millimetres, read through a cell with `units: mm`; its mesh checked against the exact solid it was
+"""CAD parts and mesh units (docs/cad.md): a STEP file made by the project's own script with
+build123d (OpenCASCADE; tests/data/cad/make_block.py, its output committed so the tests need no CAD
+kernel beyond cascadio), in millimetres, read through a cell with `units: mm`; its mesh checked against the exact solid it was
 made from; an STL in millimetres read with `units: mm` equals the same STL in metres; no cascadio
 gives one clear message."""
 
@@ -37,11 +38,10 @@ PART_XYZ = [1.85, -0.8, 0.631]
 
 @pytest.fixture(scope="module")
 def step_part(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The test part as a STEP file in millimetres, made by OpenCASCADE (build123d)."""
-    b3d = pytest.importorskip("build123d")
-    part = b3d.Box(LENGTH, WIDTH, HEIGHT) - b3d.Cylinder(HOLE_R, HEIGHT)
+    """The test part as a STEP file in millimetres (tests/data/cad/block.step, written by
+    make_block.py from the dimensions above), copied so a test may not change the original."""
     path = tmp_path_factory.mktemp("cad") / "block.step"
-    assert b3d.export_step(part, str(path))
+    shutil.copy(Path(__file__).resolve().parents[1] / "data" / "cad" / "block.step", path)
     return path
 
 
