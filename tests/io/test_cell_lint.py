@@ -233,3 +233,10 @@ def test_plan_without_workpiece_hints_it_and_lists_warnings_in_json(tmp_path: Pa
     assert report["warnings"] == [{"file": str(path), "key": "objects[2]", "message": report["warnings"][0]["message"]}]
     assert "cabin_panel is not marked `workpiece: true`" in report["warnings"][0]["message"]
     assert "warning:" in result.stderr
+
+
+def test_preview_prints_the_cell_warnings(tmp_path: Path) -> None:
+    path = _copy(tmp_path, lambda d: d["process"].update(clearance=0))
+    result = runner.invoke(app, ["preview", str(path), "--html", str(tmp_path / "page.html")])
+    assert result.exit_code == EXIT_OK, result.output
+    assert f"warning: {path}: process.clearance:" in " ".join(result.stderr.split())

@@ -43,6 +43,7 @@ def preview(
         if html is not None and (host != LOOPBACK or port is not None):
             raise typer.BadParameter("--html writes a file; --host and --port are for serving", param_hint="--host/--port")
         spec = load_cell(cell)
+        _warn([str(n) for n in spec.notices])   # what is probably a mistake shows in the scene too
         robot = load_cell_robot(spec)
         shown = home_program(spec) if program is None else load_program(program, spec, robot)
         vmap = None
