@@ -36,7 +36,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Literal
 
-__all__ = ["MAX_CALL_DEPTH", "Flow", "Followed", "Routine", "Statement", "Step", "follow"]
+__all__ = ["MAX_CALL_DEPTH", "Flow", "Followed", "Routine", "Statement", "Step", "follow", "not_resting"]
 
 # Calls nested deeper than this are reported rather than followed (no program robomax reads
 # nests routines so deep; a deeper chain is more likely a recursion through several routines).
@@ -246,6 +246,29 @@ class _Walker:
     def _runs(self, statements: tuple[Statement, ...]) -> bool:
         """Whether any of `statements` is more than a label, a comment or a blank line."""
         return any(s.text.strip() and self.classify(s).kind != "label" for s in statements)
+
+
+def not_resting(routine: Routine, rests: Callable[[str], bool], rest_words: str, missing_line: int,
+                skip: Callable[[str], bool] = lambda text: False) -> list[tuple[int, str, str]]:
+    """(line, statement, why) of what a default routine (spot_weld, grip, release) does besides
+    resting its time once, in any dialect: `rests` tells the dialect's one rest statement (the
+    routine `write` gives), `skip` what else may stand there (declarations, remarks); a call of
+    such a routine is then a weld or a gripper action of that time, and anything else in it is
+    reported. `rest_words` names the rest statement and `missing_line` is the line reported when
+    the routine never rests."""
+    waits = 0
+    out: list[tuple[int, str, str]] = []
+    for st in routine.body:
+        if not st.text or skip(st.text):
+            continue
+        if waits == 0 and rests(st.text):
+            waits += 1
+            continue
+        out.append((st.line, st.text, (f"{routine.name}: a weld or gripper routine that does more than rest its time "
+                                       "(verify takes a call of it for the weld or action it names)")))
+    if waits == 0:
+        out.append((missing_line, routine.name, f"{routine.name}: it does not rest its time ({rest_words})"))
+    return out
 
 
 def _depths(flows: list[Flow]) -> list[int]:

@@ -24,7 +24,7 @@ from robomax_py.cspace.grid import nearest_cell
 from robomax_py.plan.roadmap import Detour
 from robomax_py.plan.shortcut import greedy_shortcut
 from robomax_py.robot import JointLimits
-from robomax_py.timing import ptp_time_estimate
+from robomax_py.timing import polyline_time_estimate, ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
 
 RESOLUTION = 24             # samples per axis of the local grid
@@ -71,7 +71,7 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
     checks += spent
     if short is None:
         return None, checks
-    return Detour(short, float(np.sum(ptp_time_estimate(short[:-1], short[1:], limits))), checks), checks
+    return Detour(short, polyline_time_estimate(short, limits), checks), checks
 
 
 def local_grid(qa: FloatArray, qb: FloatArray, lower: FloatArray, upper: FloatArray, resolution: int,

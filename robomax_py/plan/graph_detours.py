@@ -20,6 +20,7 @@ from robomax_py.robot import fk_tcp
 from robomax_py.robot.ik.turns import wrap_to_pi
 from robomax_py.robot.solve import solve_all
 from robomax_py.timing import (
+    polyline_time_estimate,
     ptp_time_estimate,
 )
 from robomax_py.transforms import invert
@@ -79,7 +80,7 @@ class SequencerDetours(SequencerKnowledge):
                 checks += used
                 if free:
                     wp = _distinct(path)
-                    return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits))), checks)
+                    return Detour(wp, polyline_time_estimate(wp, self.limits), checks)
         self.checks += checks
         return None
 
@@ -180,7 +181,7 @@ class SequencerDetours(SequencerKnowledge):
                     checks += used
                     if free:
                         wp = _distinct(path)
-                        return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits))), checks)
+                        return Detour(wp, polyline_time_estimate(wp, self.limits), checks)
         self.checks += checks
         return None
 

@@ -21,6 +21,7 @@ from robomax_py.plan.thinning import representatives
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.timing import (
+    polyline_time_estimate,
     ptp_time_estimate,
 )
 from robomax_py.world.collision import CollisionWorld
@@ -195,7 +196,7 @@ class SequencerKnowledge:
         got = self._inner.get(key)
         if got is None:
             sp = self._detour_speed()
-            got = self._inner[key] = float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], self.limits, sp)))
+            got = self._inner[key] = polyline_time_estimate(wp, self.limits, sp)
         return got
 
     def _pair_via_costs(self, i: int, a: int, j: int, b: int) -> FloatArray:

@@ -22,7 +22,7 @@ from scipy.spatial import cKDTree
 from robomax_py._typing import FloatArray
 from robomax_py.plan.shortcut import greedy_shortcut
 from robomax_py.robot import JointLimits
-from robomax_py.timing import ptp_time_estimate
+from robomax_py.timing import polyline_time_estimate, ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
 
 # Sampling box margin around the work's joint-space spread, rad (or m), per joint.
@@ -195,7 +195,7 @@ class Roadmap:
                 waypoints, used = self._shortcut(waypoints)
                 checks += used
                 self.edge_checks += checks
-                return Detour(waypoints, _polyline_time(waypoints, self._limits), checks)
+                return Detour(waypoints, polyline_time_estimate(waypoints, self._limits), checks)
             blocked += 1
         self.edge_checks += checks
         return None
@@ -246,6 +246,3 @@ class Roadmap:
         assert kept is not None                       # neighbours are not checked: always a path
         return waypoints[kept], checks
 
-
-def _polyline_time(waypoints: FloatArray, limits: JointLimits) -> float:
-    return float(np.sum(ptp_time_estimate(waypoints[:-1], waypoints[1:], limits)))

@@ -20,7 +20,7 @@ from robomax_py._typing import FloatArray
 from robomax_py.plan.roadmap import Detour
 from robomax_py.plan.shortcut import greedy_shortcut
 from robomax_py.robot import JointLimits
-from robomax_py.timing import ptp_time_estimate
+from robomax_py.timing import polyline_time_estimate
 from robomax_py.world.collision import CollisionWorld
 
 # Swept checks (tree extensions and connections) per search, and per pair of trees: the trees are
@@ -116,7 +116,7 @@ def rrt_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: F
     keep = greedy_shortcut(len(joined), lambda i, j: free(joined[i], joined[j]))
     assert keep is not None                              # neighbours were checked as tree edges
     wp = joined[keep]
-    return Detour(wp, float(np.sum(ptp_time_estimate(wp[:-1], wp[1:], limits))), checks), checks
+    return Detour(wp, polyline_time_estimate(wp, limits), checks), checks
 
 
 def _swept_validator(ob: Any, si: Any, motion_free: Any) -> Any:

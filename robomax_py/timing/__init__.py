@@ -26,7 +26,11 @@ from robomax_py.timing.blend import (
     blend_join,
     blended_polyline_path,
 )
-from robomax_py.timing.estimate import jerk_limited_time_estimate, ptp_time_estimate
+from robomax_py.timing.estimate import (
+    jerk_limited_time_estimate,
+    polyline_time_estimate,
+    ptp_time_estimate,
+)
 from robomax_py.timing.lin import LinPath, lin_move, lin_path, time_lin_path
 from robomax_py.timing.paths import (
     GeometricPath,
@@ -80,6 +84,7 @@ __all__ = [
     "path_move",
     "polyline_distance",
     "polyline_path",
+    "polyline_time_estimate",
     "ptp_move",
     "ptp_time_estimate",
     "resample",

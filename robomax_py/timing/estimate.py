@@ -61,6 +61,12 @@ def ptp_time_estimate(
     return _largest(_trapezoid_time(r_v, r_a) for r_v, r_a in per_joint)
 
 
+def polyline_time_estimate(waypoints: FloatArray, limits: JointLimits, speed: float = 1.0) -> float:
+    """`ptp_time_estimate` summed along a joint-space polyline (k, n): each leg rest to rest, in
+    the order travelled (the estimate every detour is ranked by)."""
+    return float(np.sum(ptp_time_estimate(waypoints[:-1], waypoints[1:], limits, speed)))
+
+
 def jerk_limited_time_estimate(
     q0: FloatArray,
     q1: FloatArray,

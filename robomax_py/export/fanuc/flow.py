@@ -6,7 +6,7 @@ import re
 
 from robomax_py.export.fanuc.grammar import _statements
 from robomax_py.export.fanuc.write import ROUTINES
-from robomax_py.export.flow import Flow, Routine, Statement
+from robomax_py.export.flow import Flow, Routine, Statement, not_resting
 
 # ------------------------------------------------------------------ control flow
 
@@ -79,16 +79,5 @@ def _program(text: str, source: str) -> Routine | None:
 def _not_resting(routine: Routine) -> list[tuple[int, str, str]]:
     """(line, statement, why) of what a default routine (SPOT_WELD, GRIP, RELEASE) does besides
     resting for its second argument: remarks and one `WAIT AR[2]` (the routine `write` gives)."""
-    waits = 0
-    out: list[tuple[int, str, str]] = []
-    for st in routine.body:
-        if not st.text or st.text.startswith("!"):
-            continue
-        if re.fullmatch(r"WAIT\s+AR\[\s*2\s*\]", st.text, re.IGNORECASE) and waits == 0:
-            waits += 1
-            continue
-        out.append((st.line, st.text, (f"{routine.name}: a weld or gripper routine that does more than rest its time "
-                                       "(verify takes a call of it for the weld or action it names)")))
-    if waits == 0:
-        out.append((0, routine.name, f"{routine.name}: it does not rest its time (WAIT AR[2])"))
-    return out
+    return not_resting(routine, lambda text: bool(re.fullmatch(r"WAIT\s+AR\[\s*2\s*\]", text, re.IGNORECASE)),
+                       "WAIT AR[2]", 0, skip=lambda text: text.startswith("!"))

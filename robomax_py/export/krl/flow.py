@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 
-from robomax_py.export.flow import Flow, Routine, Statement
+from robomax_py.export.flow import Flow, Routine, Statement, not_resting
 from robomax_py.export.krl.grammar import (
     _BLOCK_END,
     _BLOCK_START,
@@ -107,21 +107,14 @@ def _not_resting(routine: Routine) -> list[tuple[int, str, str]]:
     resting for its second parameter: its declarations, comments and one `WAIT SEC <it>` (the
     routine `write` gives). A call of it is then a weld or a gripper action of that time;
     anything else in it (a motion, another time, another unit) is reported."""
-    head = f"{routine.name}: "
     time = routine.params[1] if len(routine.params) == 2 else None
-    waits = 0
-    out: list[tuple[int, str, str]] = []
-    for st in routine.body:
-        text = st.text
-        if not text or re.fullmatch(r"(DECL\s+)?(INT|REAL)\s+[A-Za-z_]\w*(\s*,\s*[A-Za-z_]\w*)*", text, re.IGNORECASE):
-            continue
+
+    def rests(text: str) -> bool:
         wait = re.fullmatch(r"WAIT\s+SEC\s+([A-Za-z_]\w*)", text, re.IGNORECASE)
-        if wait and time is not None and wait.group(1).lower() == time.lower() and waits == 0:
-            waits += 1
-            continue
-        out.append((st.line, text, head + "a weld or gripper routine that does more than rest its time (verify takes a "
-                                          "call of it for the weld or action it names)"))
-    if waits == 0:
-        line = routine.body[0].line - 1 if routine.body else 0
-        out.append((line, routine.name, head + "it does not rest its time (WAIT SEC of its second parameter)"))
-    return out
+        return bool(wait and time is not None and wait.group(1).lower() == time.lower())
+
+    def declaration(text: str) -> bool:
+        return bool(re.fullmatch(r"(DECL\s+)?(INT|REAL)\s+[A-Za-z_]\w*(\s*,\s*[A-Za-z_]\w*)*", text, re.IGNORECASE))
+
+    return not_resting(routine, rests, "WAIT SEC of its second parameter",
+                       routine.body[0].line - 1 if routine.body else 0, skip=declaration)

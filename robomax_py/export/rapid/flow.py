@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 
-from robomax_py.export.flow import Flow, Routine, Statement
+from robomax_py.export.flow import Flow, Routine, Statement, not_resting
 from robomax_py.export.rapid.grammar import (
     _KNOWN,
     _MOTION_DATA,
@@ -124,18 +124,9 @@ def _not_resting(routine: Routine) -> list[tuple[int, str, str]]:
     resting for its second parameter: comments and one `WaitTime [\\InPos,] <it>` (the routine
     `write` gives); anything else (a motion, another time, another unit) is reported."""
     time = routine.params[1] if len(routine.params) == 2 else None
-    waits = 0
-    out: list[tuple[int, str, str]] = []
-    for st in routine.body:
-        wait = re.fullmatch(r"WaitTime\s+(\\InPos\s*,\s*)?([A-Za-z_]\w*)", st.text, re.IGNORECASE)
-        if not st.text:
-            continue
-        if wait and time is not None and wait.group(2).lower() == time.lower() and waits == 0:
-            waits += 1
-            continue
-        out.append((st.line, st.text, (f"{routine.name}: a weld or gripper routine that does more than rest its time "
-                                       "(verify takes a call of it for the weld or action it names)")))
-    if waits == 0:
-        line = routine.body[0].line if routine.body else 0
-        out.append((line, routine.name, f"{routine.name}: it does not rest its time (WaitTime of its second parameter)"))
-    return out
+
+    def rests(text: str) -> bool:
+        wait = re.fullmatch(r"WaitTime\s+(\\InPos\s*,\s*)?([A-Za-z_]\w*)", text, re.IGNORECASE)
+        return bool(wait and time is not None and wait.group(2).lower() == time.lower())
+
+    return not_resting(routine, rests, "WaitTime of its second parameter", routine.body[0].line if routine.body else 0)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from lark import Token, Tree
 from lark.exceptions import UnexpectedInput
 
 from robomax_py.errors import ProgramError
@@ -34,26 +35,24 @@ def parse_program(text: str, file: str | Path | None = None) -> Program:
     ProgramError
         With key "line L, column C" and a readable problem.
     """
-    parser = _parser()
-    try:
-        tree = parser.parse(text)
-    except UnexpectedInput as exc:
-        line, column, problem = _describe(parser, text, exc)
-        raise ProgramError(file, f"line {line}, column {column}", problem) from None
-    return _Builder(file).program(tree)
+    return _Builder(file).program(_tree(text, file))
 
 
 def parse_with_lines(text: str, file: str | Path | None = None) -> tuple[Program, tuple[int, ...]]:
     """`parse_program`, and the line of each instruction."""
+    builder = _Builder(file)
+    program = builder.program(_tree(text, file))
+    return program, tuple(builder.lines)
+
+
+def _tree(text: str, file: str | Path | None) -> Tree[Token]:
+    """The parse tree of an SRCL text; ProgramError with key "line L, column C" when it does not parse."""
     parser = _parser()
     try:
-        tree = parser.parse(text)
+        return parser.parse(text)
     except UnexpectedInput as exc:
         line, column, problem = _describe(parser, text, exc)
         raise ProgramError(file, f"line {line}, column {column}", problem) from None
-    builder = _Builder(file)
-    program = builder.program(tree)
-    return program, tuple(builder.lines)
 
 
 def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 
-from robomax_py.export.flow import Flow, Routine, Statement
+from robomax_py.export.flow import Flow, Routine, Statement, not_resting
 from robomax_py.export.urscript.grammar import _CALLS, _UNSIMULATED, _split
 
 # ------------------------------------------------------------------ control flow
@@ -126,17 +126,6 @@ def _not_resting(routine: Routine) -> list[tuple[int, str, str]]:
         return [(line, routine.name, ("wait_for_signal: not the routine robomax writes (verify takes a call of it "
                                       "for a wait for that input)"))]
     time = routine.params[1] if len(routine.params) == 2 else None
-    waits = 0
-    out: list[tuple[int, str, str]] = []
-    for st in routine.body:
-        if not st.text:
-            continue
-        if time is not None and re.fullmatch(rf"sleep\(\s*{re.escape(time)}\s*\)", st.text) and waits == 0:
-            waits += 1
-            continue
-        out.append((st.line, st.text, (f"{routine.name}: a weld or gripper routine that does more than rest its time "
-                                       "(verify takes a call of it for the weld or action it names)")))
-    if waits == 0:
-        line = routine.body[0].line if routine.body else 0
-        out.append((line, routine.name, f"{routine.name}: it does not rest its time (sleep of its second parameter)"))
-    return out
+    return not_resting(routine,
+                       lambda text: time is not None and bool(re.fullmatch(rf"sleep\(\s*{re.escape(time)}\s*\)", text)),
+                       "sleep of its second parameter", routine.body[0].line if routine.body else 0)
