@@ -4,13 +4,18 @@ Before a file is opened its path is checked: no NUL byte, not too long, no symli
 file (not a folder, device or pipe, which could block a read forever), not larger than the limit
 of its kind. Text must be UTF-8. Each refusal is one located error naming the file, the key and
 the limit. `io.yaml_files` adds the bounded YAML loader on top.
+
+Since every read passes here, `recording_reads` can list the files a step read: `robomax batch`
+ships exactly those with each cell to a machine that shares no folder with the one that started it.
 """
 
 from __future__ import annotations
 
 import os
 import stat
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -49,6 +54,22 @@ class FileLimits:
 
 
 LIMITS = FileLimits()
+
+# The files passed by `checked_file` while `recording_reads` is active (per thread and task).
+_RECORDING: ContextVar[list[str] | None] = ContextVar("robomax_recorded_reads", default=None)
+
+
+@contextmanager
+def recording_reads() -> Iterator[list[str]]:
+    """A list that collects, in reading order, every file `checked_file` lets through while the
+    block runs: absolute, normalised paths as named (not resolved through symbolic links, so that
+    the same relative paths lead to them from a copy of the files), repeats included."""
+    found: list[str] = []
+    token = _RECORDING.set(found)
+    try:
+        yield found
+    finally:
+        _RECORDING.reset(token)
 
 
 def named_by(error: Callable[[Any, Any, str], _LocatedError], file: Path, key: str) -> ErrorFactory:
@@ -92,6 +113,9 @@ def checked_file(path: Path, limit: int, error: ErrorFactory, what: str, key: st
         raise error(shown, key, f"{what}: not a regular file (a device, pipe or socket)")
     if st.st_size > limit:
         raise error(shown, key, f"{what}: {st.st_size / MB:.1f} MB is more than the {limit / MB:.0f} MB allowed")
+    recording = _RECORDING.get()
+    if recording is not None:
+        recording.append(os.path.abspath(text))
     return resolved
 
 
