@@ -64,21 +64,27 @@ def task_memory_mb(poses: int) -> float:
 
 def plan_shipped(cell: ShippedCell, settings: PlanSettings, timeout: float | None, worker: Worker,
                  *blobs: bytes) -> CellOutcome:
-    """The Ray task: write the cell's files out, plan it in a process of its own, name the driver's
-    paths in what it says."""
+    """The Ray task (`plan_unpacked`), its outcome naming the node that planned it."""
     import socket
 
     import ray
 
     # The host, and Ray's id of the node (several nodes may share a host), as `ray status` shows it.
     node = f"{socket.gethostname()}/{ray.get_runtime_context().get_node_id()[:8]}"
+    return replace(plan_unpacked(cell, settings, timeout, worker, blobs), node=node)
+
+
+def plan_unpacked(cell: ShippedCell, settings: PlanSettings, timeout: float | None, worker: Worker,
+                  blobs: Sequence[bytes]) -> CellOutcome:
+    """Write the cell's files out, plan it in a process of its own (`batch_local.run_local`: its
+    deadline from now, its crash its own outcome) and name the driver's paths in what it says."""
+    from robomax_py.app.batch_local import run_local
+
     with unpacked(cell, blobs) as box:
         options = BatchOptions(jobs=1, timeout=timeout, method=settings.method, formats=settings.formats)
-        from robomax_py.app.batch_local import run_local
-
         (got,) = run_local([box.file], options, worker=worker, env=box.env)
         return replace(got, file=cell.file, reasons=box.outside(got.reasons), notes=box.outside(got.notes),
-                       inputs=tuple((box.outside(p), h) for p, h in got.inputs), node=node)
+                       inputs=tuple((box.outside(p), h) for p, h in got.inputs))
 
 
 @dataclass(frozen=True, slots=True)

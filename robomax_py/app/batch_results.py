@@ -135,9 +135,13 @@ def journal_line(outcome: CellOutcome, options: Mapping[str, Any]) -> str:
 
 def append_line(path: Path, line: str) -> None:
     """Append one line and sync it: a killed driver loses at most the line being written (which
-    `read_journals` then skips)."""
-    with open(path, "a", encoding="utf-8") as fh:
-        fh.write(line)
+    `read_journals` then skips; the next line starts on a line of its own)."""
+    with open(path, "a+b") as fh:
+        if fh.tell() > 0:
+            fh.seek(-1, os.SEEK_END)
+            if fh.read(1) != b"\n":
+                line = "\n" + line
+        fh.write(line.encode("utf-8"))
         fh.flush()
         os.fsync(fh.fileno())
 

@@ -1,0 +1,116 @@
+"""A cell's files carried with its Ray task: the driver lists every file the cell reads, and the task
+plans from copies of them alone, with the driver's robot library, naming the driver's paths.
+
+No Ray here: `plan_unpacked` is the task's body. The copies stand for files that exist on the driver
+only: the driver's paths given to the task lie under a folder that does not exist."""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+import yaml
+
+from robomax_py.app.batch import BAD_INPUT, PLANNED, CellOutcome, PlanSettings, plan_cell_file
+from robomax_py.app.batch_cell import file_digests
+from robomax_py.app.batch_ray import plan_unpacked, task_memory_mb
+from robomax_py.app.batch_ship import ShippedCell, survey
+from robomax_py.io.robot_paths import ROBOTS_ENV, shipped_robots_dir
+from robomax_py.safe_files import recording_reads
+
+SmallCell = Callable[..., Path]
+ELSEWHERE = "/nonexistent-driver"          # where the driver's files are, as far as the task can tell
+
+
+def robot_folder(library: Path, name: str) -> Path:
+    """The shipped kr125 copied into a library folder as robot `name` (a user's own robot)."""
+    folder = library / name
+    shutil.copytree(shipped_robots_dir() / "kr125", folder)
+    robot = folder / "robot.yaml"
+    robot.write_text(robot.read_text().replace("name: kr125", f"name: {name}"))
+    return folder
+
+
+def cell_with_robot(folder: Path, write_small_cell: SmallCell, stem: str, robot: str) -> Path:
+    path = write_small_cell(folder, stem)
+    data = yaml.safe_load(path.read_text())
+    data["robot"]["model"] = robot
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def elsewhere(cell: ShippedCell) -> tuple[ShippedCell, list[bytes]]:
+    """The cell as a driver whose files are under ELSEWHERE would ship it, and the files' bytes."""
+    def moved(paths: tuple[str, ...]) -> tuple[str, ...]:
+        return tuple(ELSEWHERE + p for p in paths)
+
+    blobs = [Path(p).read_bytes() for p in cell.paths]
+    return replace(cell, file=ELSEWHERE + cell.file, paths=moved(cell.paths), robots=moved(cell.robots),
+                   ros_packages=moved(cell.ros_packages)), blobs
+
+
+def probe_worker(file: str, settings: PlanSettings) -> CellOutcome:
+    """Loads the cell as the planner would (robot model included) and says which robot.yaml it used."""
+    from robomax_py.io.cell import load_cell, load_cell_robot
+
+    with recording_reads() as reads:
+        spec = load_cell(file)
+        load_cell_robot(spec)
+    return CellOutcome(file, spec.name, PLANNED, 0.0, notes=str(spec.robot.source), inputs=file_digests(reads))
+
+
+@pytest.fixture
+def library(tmp_path: Path) -> Path:
+    """A robot library folder with robot `robo_x` (a copy of kr125) and `robo_bad`, whose collision
+    mesh of link 2 is not a mesh: it passes the driver's checks and fails in the worker."""
+    lib = tmp_path / "lib"
+    robot_folder(lib, "robo_x")
+    bad = robot_folder(lib, "robo_bad")
+    (bad / "meshes" / "collision" / "link_2_0.stl").write_bytes(b"\x07 not a mesh " * 100)
+    return lib
+
+
+def test_survey_lists_every_file_the_cell_reads_once(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    cell = write_small_cell(tmp_path, "small")
+    found = survey(str(cell))
+    paths = found.shipped.paths
+    assert len(paths) == len(set(paths)) and all(Path(p).is_absolute() for p in paths)
+    names = {str(Path(p).relative_to(shipped_robots_dir())) for p in paths if p.startswith(str(shipped_robots_dir()))}
+    assert {"kr125/robot.yaml", "kr125/kr125.urdf", "tools/spot_gun_c/tool.yaml", "tools/spot_gun_c/body.stl",
+            "tools/spot_gun_c/tips.stl"} <= names
+    assert sum(1 for n in names if n.startswith("kr125/meshes/")) > 10          # every link mesh the URDF names
+    assert str(cell) in paths and str(tmp_path / "parts" / "cabin_panel.stl") in paths
+    # 2 spots, a grid of 3 with gamma fixed: 3 x 3 orientations each.
+    assert (found.spots, found.poses) == (2, 18)
+    assert task_memory_mb(found.poses) > task_memory_mb(0)
+
+
+def test_a_shipped_cell_plans_from_its_copies_with_the_drivers_robot_library(
+        tmp_path: Path, write_small_cell: SmallCell, library: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    cell = cell_with_robot(tmp_path / "cells", write_small_cell, "mine", "robo_x")
+    with monkeypatch.context() as m:            # the driver's `--robots`; the task's process never sees it
+        m.setenv(ROBOTS_ENV, str(library))
+        found = survey(str(cell))
+    shipped, blobs = elsewhere(found.shipped)
+    got = plan_unpacked(shipped, PlanSettings(), None, probe_worker, blobs)
+    assert got.status == PLANNED, got.reasons
+    assert got.file == ELSEWHERE + str(cell)
+    assert got.notes == f"{ELSEWHERE}{library}/robo_x/robot.yaml"      # found by name, in the copy of --robots
+    assert {p for p, _ in got.inputs} == set(shipped.paths)
+    assert "robomax-cell-" not in got.notes                               # no path of the copies is left
+
+
+def test_a_cell_failing_in_the_worker_names_the_drivers_files(
+        tmp_path: Path, write_small_cell: SmallCell, library: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    cell = cell_with_robot(tmp_path / "cells", write_small_cell, "bad", "robo_bad")
+    with monkeypatch.context() as m:
+        m.setenv(ROBOTS_ENV, str(library))
+        found = survey(str(cell))                # the driver's load does not read link meshes
+    shipped, blobs = elsewhere(found.shipped)
+    got = plan_unpacked(shipped, PlanSettings(), None, plan_cell_file, blobs)
+    assert got.status == BAD_INPUT
+    assert f"{ELSEWHERE}{library}/robo_bad/meshes/collision/link_2_0.stl" in got.reasons
+    assert "robomax-cell-" not in got.reasons
