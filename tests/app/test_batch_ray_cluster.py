@@ -1,0 +1,243 @@
+"""`robomax batch --ray` on a real Ray cluster: a head node and a worker node started on this machine
+with `ray start --block` (1 CPU each, their own temporary folders and ports, so that nothing of
+another Ray on the machine is shared), planned through the command line as a user would.
+
+The cells name a robot that only the driver's `--robots` folder holds (the nodes are given no robot
+library); one cell's robot has a link mesh that is not a mesh, which only the worker finds. While
+a cell is being planned on the worker node, the whole node is killed: every cell still ends
+planned, or failed with its reason, and the lost one was submitted again. Then the driver itself is
+killed mid-batch and `--resume` keeps what was written.
+
+Timeouts here are hang guards only; nothing is asserted about how long anything takes."""
+
+from __future__ import annotations
+
+import csv
+import importlib.util
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+import yaml
+
+from robomax_py.io.robot_paths import shipped_robots_dir
+
+pytestmark = [pytest.mark.slow,
+              pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="ray is not installed")]
+
+REPO = Path(__file__).resolve().parents[2]
+HANG_S = 300.0                              # hang guard of every wait
+SmallCell = Callable[..., Path]
+
+
+def _free_ports(n: int) -> list[int]:
+    socks = [socket.socket() for _ in range(n)]
+    try:
+        for s in socks:
+            s.bind(("127.0.0.1", 0))
+        return [int(s.getsockname()[1]) for s in socks]
+    finally:
+        for s in socks:
+            s.close()
+
+
+def _processes(session: int) -> list[tuple[int, int, str, str]]:
+    """(pid, parent pid, state, command line) of every process of a session (Linux /proc)."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+            cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+        except OSError:
+            continue
+        fields = stat[stat.rindex(")") + 2:].split()        # state, ppid, pgrp, session, ...
+        if int(fields[3]) == session:
+            found.append((int(entry.name), int(fields[1]), fields[0], cmdline))
+    return found
+
+
+def _signal_all(pids: list[int], signum: int) -> None:
+    for pid in pids:
+        try:
+            os.kill(pid, signum)
+        except ProcessLookupError:
+            pass
+
+
+@dataclass
+class Node:
+    """A `ray start --block` in a session of its own. Ray gives its worker processes process groups
+    of their own inside that session, so the node is ended by signalling every process of the session."""
+
+    proc: subprocess.Popen[bytes]
+
+    def kill(self) -> None:
+        _signal_all([p for p, *_ in _processes(self.proc.pid)], signal.SIGKILL)
+        self.proc.wait(HANG_S)
+
+    def stopped_while_planning(self) -> bool:
+        """Stop the whole node (SIGSTOP) and say whether a cell's process (a child of a fork
+        server) is alive in it, so that killing it now loses a task in flight; else let it go on."""
+        pids = [p for p, *_ in _processes(self.proc.pid)]
+        _signal_all(pids, signal.SIGSTOP)
+        procs = _processes(self.proc.pid)
+        servers = {p for p, _, _, cmd in procs if "multiprocessing.forkserver" in cmd}
+        if any(parent in servers and state != "Z" for _, parent, state, _ in procs):
+            return True
+        _signal_all(pids, signal.SIGCONT)
+        return False
+
+
+@dataclass
+class Cluster:
+    address: str
+    head: Node
+    worker: Node
+    env: dict[str, str]                      # what the nodes run with, and the driver too
+
+
+def _start(args: list[str], temp: Path, env: dict[str, str], log: Path) -> Node:
+    ports = iter(_free_ports(14))
+    node_args = ["--block", "--num-cpus", "1", "--object-store-memory", str(100 * 2**20), "--temp-dir", str(temp),
+                 "--disable-usage-stats", "--node-manager-port", str(next(ports)),
+                 "--object-manager-port", str(next(ports)), "--dashboard-agent-listen-port", str(next(ports)),
+                 "--dashboard-agent-grpc-port", str(next(ports)), "--runtime-env-agent-port", str(next(ports)),
+                 "--metrics-export-port", str(next(ports)),
+                 "--worker-port-list", ",".join(str(next(ports)) for _ in range(8))]
+    ray = shutil.which("ray", path=str(Path(sys.executable).parent)) or "ray"
+    with log.open("wb") as sink:
+        proc = subprocess.Popen([ray, "start", *args, *node_args], env=env, stdout=sink, stderr=subprocess.STDOUT,
+                                start_new_session=True)
+    return Node(proc)
+
+
+@pytest.fixture(scope="module")
+def cluster(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Cluster]:
+    tmp = tmp_path_factory.mktemp("ray")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("RAY_") and k != "ROBOMAX_ROBOTS"}
+    env.update(PYTHONPATH=str(REPO), RAY_AUTH_MODE="disabled",
+               # The head declares a node dead after ~3 s without an answer (default: ~30 s).
+               RAY_health_check_initial_delay_ms="1000", RAY_health_check_period_ms="1000",
+               RAY_health_check_timeout_ms="1000", RAY_health_check_failure_threshold="3")
+    gcs, client = _free_ports(2)
+    address = f"127.0.0.1:{gcs}"
+    head = _start(["--head", "--port", str(gcs), "--ray-client-server-port", str(client), "--include-dashboard",
+                   "false"], tmp / "head", env, tmp / "head.log")
+    worker = None
+    try:
+        worker = _start(["--address", address], tmp / "worker", env, tmp / "worker.log")
+        # Both nodes alive, as the cluster itself says.
+        wait = ("import ray, sys, time\nray.init(address=sys.argv[1], log_to_driver=False)\n"
+                "while sum(n['Alive'] for n in ray.nodes()) < 2: time.sleep(0.2)\n")
+        subprocess.run([sys.executable, "-c", wait, address], env=env, check=True, timeout=HANG_S,
+                       capture_output=True)
+        yield Cluster(address, head, worker, env)
+    finally:
+        for node in (worker, head):
+            if node is not None:
+                node.kill()
+
+
+def _cell(folder: Path, write_small_cell: SmallCell, stem: str, robot: str) -> str:
+    path = write_small_cell(folder, stem)
+    data = yaml.safe_load(path.read_text())
+    data["robot"]["model"] = robot
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return str(path)
+
+
+def _robot(library: Path, name: str) -> Path:
+    folder = library / name
+    shutil.copytree(shipped_robots_dir() / "kr125", folder)
+    (folder / "robot.yaml").write_text((folder / "robot.yaml").read_text().replace("name: kr125", f"name: {name}"))
+    return folder
+
+
+def _driver(cluster: Cluster, library: Path, cells: list[str], out: Path, *args: str,
+            env: dict[str, str] | None = None) -> subprocess.Popen[bytes]:
+    command = [sys.executable, "-m", "robomax_py", "--robots", str(library), "batch", *cells, "-o", str(out), *args]
+    return subprocess.Popen(command, env=env or cluster.env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            start_new_session=True)
+
+
+def _rows(out: Path) -> dict[str, dict[str, str]]:
+    with (out / "summary.csv").open(newline="") as fh:
+        return {r["cell"]: r for r in csv.DictReader(fh)}
+
+
+def _journal(out: Path) -> list[dict[str, object]]:
+    rows = []
+    for line in (out / "results.jsonl").read_text().splitlines():
+        try:
+            rows.append(json.loads(line))
+        except ValueError:
+            continue
+    return rows
+
+
+def _until(what: str, done: Callable[[], bool], driver: subprocess.Popen[bytes]) -> None:
+    deadline = time.monotonic() + HANG_S
+    while not done():
+        if driver.poll() is not None:
+            pytest.fail(f"the batch ended before {what} (exit {driver.returncode}): "
+                        f"{driver.stderr.read().decode() if driver.stderr else ''}")
+        if time.monotonic() > deadline:
+            pytest.fail(f"hang guard: no {what} within {HANG_S:g} s")
+        time.sleep(0.05)
+
+
+def test_a_lost_node_and_a_killed_driver_lose_no_cell(cluster: Cluster, tmp_path: Path,
+                                                      write_small_cell: SmallCell) -> None:
+    library = tmp_path / "robots"
+    _robot(library, "robo_x")
+    bad = _robot(library, "robo_bad")
+    (bad / "meshes" / "collision" / "link_2_0.stl").write_bytes(b"\x07 not a mesh " * 100)
+    folder = tmp_path / "cells"
+    cells = [_cell(folder, write_small_cell, f"c{k}", "robo_x") for k in range(1, 5)]
+    cells.append(_cell(folder, write_small_cell, "bad", "robo_bad"))
+    out = tmp_path / "out"
+
+    # 1. The worker node is killed while it plans a cell; RAY_ADDRESS names the cluster, as Ray has it.
+    driver = _driver(cluster, library, cells, out, "--ray", env={**cluster.env, "RAY_ADDRESS": cluster.address})
+    _until("cell planned on the worker node", cluster.worker.stopped_while_planning, driver)
+    cluster.worker.kill()
+    _, stderr = driver.communicate(timeout=HANG_S)
+    assert driver.returncode == 2, stderr.decode()              # the bad cell
+    rows = _rows(out)
+    assert {c: r["status"] for c, r in rows.items()} == {"c1": "planned", "c2": "planned", "c3": "planned",
+                                                         "c4": "planned", "bad": "bad input"}
+    # Found in the worker, named with the driver's paths (not those of the task's copies).
+    assert str(bad / "meshes" / "collision" / "link_2_0.stl") in rows["bad"]["reasons"]
+    assert "robomax-cell-" not in rows["bad"]["reasons"]
+    retried = [r for r in rows.values() if int(r["attempts"]) > 1]
+    assert retried and all(r["status"] == "planned" and "was lost" in r["notes"] for r in retried)
+    planned_then = {c: json.loads((out / f"{c}.manifest.json").read_text())["plan"] for c in ("c1", "c2", "c3", "c4")}
+
+    # 2. Two more cells, --resume; the driver is killed once one of them is written.
+    more = cells + [_cell(folder, write_small_cell, f"c{k}", "robo_x") for k in (5, 6)]
+    driver = _driver(cluster, library, more, out, "--ray-address", cluster.address, "--resume")
+    _until("new cell written", lambda: any(r["cell"] in ("c5", "c6") for r in _journal(out)), driver)
+    os.killpg(driver.pid, signal.SIGKILL)
+    driver.wait(HANG_S)
+    kept = {str(r["cell"]) for r in _journal(out) if r["status"] == "planned"}
+
+    # 3. --resume again: what was written is kept, the rest planned.
+    driver = _driver(cluster, library, more, out, "--ray-address", cluster.address, "--resume")
+    _, stderr = driver.communicate(timeout=HANG_S)
+    assert driver.returncode == 2, stderr.decode()
+    rows = _rows(out)
+    assert [rows[f"c{k}"]["status"] for k in range(1, 7)] == ["planned"] * 6 and rows["bad"]["status"] == "bad input"
+    assert {c for c, r in rows.items() if r["resumed"] == "yes"} == kept
+    assert {"c1", "c2", "c3", "c4"} < kept < {f"c{k}" for k in range(1, 7)}
+    assert {c: json.loads((out / f"{c}.manifest.json").read_text())["plan"] for c in planned_then} == planned_then
