@@ -18,16 +18,15 @@ import json
 import os
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 import yaml
+from ray_nodes import HANG_S, Cluster, local_cluster, node_env
 
 from robomax_py.io.robot_paths import shipped_robots_dir
 
@@ -35,118 +34,14 @@ pytestmark = [pytest.mark.slow,
               pytest.mark.skipif(importlib.util.find_spec("ray") is None, reason="ray is not installed")]
 
 REPO = Path(__file__).resolve().parents[2]
-HANG_S = 300.0                              # hang guard of every wait
 SmallCell = Callable[..., Path]
-
-
-def _free_ports(n: int) -> list[int]:
-    socks = [socket.socket() for _ in range(n)]
-    try:
-        for s in socks:
-            s.bind(("127.0.0.1", 0))
-        return [int(s.getsockname()[1]) for s in socks]
-    finally:
-        for s in socks:
-            s.close()
-
-
-def _processes(session: int) -> list[tuple[int, int, str, str]]:
-    """(pid, parent pid, state, command line) of every process of a session (Linux /proc)."""
-    found = []
-    for entry in Path("/proc").iterdir():
-        if not entry.name.isdigit():
-            continue
-        try:
-            stat = (entry / "stat").read_text()
-            cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
-        except OSError:
-            continue
-        fields = stat[stat.rindex(")") + 2:].split()        # state, ppid, pgrp, session, ...
-        if int(fields[3]) == session:
-            found.append((int(entry.name), int(fields[1]), fields[0], cmdline))
-    return found
-
-
-def _signal_all(pids: list[int], signum: int) -> None:
-    for pid in pids:
-        try:
-            os.kill(pid, signum)
-        except ProcessLookupError:
-            pass
-
-
-@dataclass
-class Node:
-    """A `ray start --block` in a session of its own. Ray gives its worker processes process groups
-    of their own inside that session, so the node is ended by signalling every process of the session."""
-
-    proc: subprocess.Popen[bytes]
-
-    def kill(self) -> None:
-        _signal_all([p for p, *_ in _processes(self.proc.pid)], signal.SIGKILL)
-        self.proc.wait(HANG_S)
-
-    def stopped_while_planning(self) -> bool:
-        """Stop the whole node (SIGSTOP) and say whether a cell's process (a child of a fork
-        server) is alive in it, so that killing it now loses a task in flight; else let it go on."""
-        pids = [p for p, *_ in _processes(self.proc.pid)]
-        _signal_all(pids, signal.SIGSTOP)
-        procs = _processes(self.proc.pid)
-        servers = {p for p, _, _, cmd in procs if "multiprocessing.forkserver" in cmd}
-        if any(parent in servers and state != "Z" for _, parent, state, _ in procs):
-            return True
-        _signal_all(pids, signal.SIGCONT)
-        return False
-
-
-@dataclass
-class Cluster:
-    address: str
-    head: Node
-    worker: Node
-    env: dict[str, str]                      # what the nodes run with, and the driver too
-
-
-def _start(args: list[str], temp: Path, env: dict[str, str], log: Path) -> Node:
-    ports = iter(_free_ports(14))
-    node_args = ["--block", "--num-cpus", "1", "--object-store-memory", str(100 * 2**20), "--temp-dir", str(temp),
-                 "--disable-usage-stats", "--node-manager-port", str(next(ports)),
-                 "--object-manager-port", str(next(ports)), "--dashboard-agent-listen-port", str(next(ports)),
-                 "--dashboard-agent-grpc-port", str(next(ports)), "--runtime-env-agent-port", str(next(ports)),
-                 "--metrics-export-port", str(next(ports)),
-                 "--worker-port-list", ",".join(str(next(ports)) for _ in range(8))]
-    ray = shutil.which("ray", path=str(Path(sys.executable).parent)) or "ray"
-    with log.open("wb") as sink:
-        proc = subprocess.Popen([ray, "start", *args, *node_args], env=env, stdout=sink, stderr=subprocess.STDOUT,
-                                start_new_session=True)
-    return Node(proc)
 
 
 @pytest.fixture(scope="module")
 def cluster(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Cluster]:
-    tmp = tmp_path_factory.mktemp("ray")
-    env = {k: v for k, v in os.environ.items() if not k.startswith("RAY_") and k != "ROBOMAX_ROBOTS"}
-    env.update(PYTHONPATH=str(REPO), RAY_AUTH_MODE="disabled",
-               # The head declares a node dead after ~3 s without an answer (default: ~30 s).
-               RAY_health_check_initial_delay_ms="1000", RAY_health_check_period_ms="1000",
-               RAY_health_check_timeout_ms="1000", RAY_health_check_failure_threshold="3")
-    gcs, client = _free_ports(2)
-    address = f"127.0.0.1:{gcs}"
-    head = _start(["--head", "--port", str(gcs), "--ray-client-server-port", str(client), "--include-dashboard",
-                   "false"], tmp / "head", env, tmp / "head.log")
-    worker = None
-    try:
-        worker = _start(["--address", address], tmp / "worker", env, tmp / "worker.log")
-        # Both nodes alive, as the cluster itself says.
-        wait = ("import ray, sys, time\nray.init(address=sys.argv[1], log_to_driver=False)\n"
-                "while sum(n['Alive'] for n in ray.nodes()) < 2: time.sleep(0.2)\n")
-        subprocess.run([sys.executable, "-c", wait, address], env=env, check=True, timeout=HANG_S,
-                       capture_output=True)
-        yield Cluster(address, head, worker, env)
-    finally:
-        for node in (worker, head):
-            if node is not None:
-                node.kill()
+    """A head and a worker node, importing robomax_py from this checkout, with no robot library."""
+    with local_cluster(tmp_path_factory.mktemp("ray"), 2, node_env([REPO])) as started:
+        yield started
 
 
 def _cell(folder: Path, write_small_cell: SmallCell, stem: str, robot: str) -> str:
@@ -210,8 +105,8 @@ def test_a_lost_node_and_a_killed_driver_lose_no_cell(cluster: Cluster, tmp_path
 
     # 1. The worker node is killed while it plans a cell; RAY_ADDRESS names the cluster, as Ray has it.
     driver = _driver(cluster, library, cells, out, "--ray", env={**cluster.env, "RAY_ADDRESS": cluster.address})
-    _until("cell planned on the worker node", cluster.worker.stopped_while_planning, driver)
-    cluster.worker.kill()
+    _until("cell planned on the worker node", cluster.nodes[1].stopped_while_planning, driver)
+    cluster.nodes[1].kill()
     _, stderr = driver.communicate(timeout=HANG_S)
     assert driver.returncode == 2, stderr.decode()              # the bad cell
     rows = _rows(out)

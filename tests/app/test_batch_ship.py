@@ -14,7 +14,13 @@ from pathlib import Path
 import pytest
 import yaml
 
-from robomax_py.app.batch import BAD_INPUT, PLANNED, CellOutcome, PlanSettings, plan_cell_file
+from robomax_py.app.batch import (
+    BAD_INPUT,
+    PLANNED,
+    CellOutcome,
+    PlanSettings,
+    plan_cell_file,
+)
 from robomax_py.app.batch_cell import file_digests
 from robomax_py.app.batch_ray import plan_unpacked, task_memory_mb
 from robomax_py.app.batch_ship import ShippedCell, survey

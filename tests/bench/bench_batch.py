@@ -1,45 +1,189 @@
 """Batch planning benchmark (a script, not a test).
 
     python tests/bench/bench_batch.py [--cell CELL] [--n 20] [--runs 3] [--quick] [--no-ray]
+    python tests/bench/bench_batch.py --driver 200        the driver's peak memory for 200 cells
+    python tests/bench/bench_batch.py --memory            the measurements behind batch_ray's memory model
 
-Writes `--n` variants of the cell (default: the reference cell; `--quick`: the small 2-spot test
-cell) and plans them as a batch with 1 and 2 local worker processes and on a local Ray with 2 CPUs.
-Reports per setting, as medians over `--runs`: wall time, throughput (cells/min), parallel
-efficiency (throughput with 2 workers / (2 x throughput with 1)), the largest and median peak RSS of
-a worker process (each worker measures its own, getrusage), and the statuses. Ray's start-up
-(ray.init) is timed separately; it and one untimed warm-up batch of the small cell per setting (the fork
-server's imports, Ray's worker processes) are not counted in the throughput.
+Throughput (the default): writes `--n` variants of the cell (default: the reference cell; `--quick`:
+the small 2-spot test cell) and plans them as a batch with 1 and 2 local worker processes and on a
+Ray cluster of 1 and of 2 nodes started on this machine (`ray start`, 1 CPU each: tests/ray_nodes.py).
+Reports per setting, as medians over `--runs`: wall time, throughput (cells/min), parallel efficiency
+(throughput / (workers x throughput with 1 local worker)), the wall time a cell takes more than in the
+local pool with as many workers (the overhead of a Ray task: shipping the cell's files, scheduling, the
+task's process), the driver's CPU time per cell (loading the cell to ship it, writing its results),
+the largest and median peak RSS of a plan's process, and the statuses. Connecting to Ray and one
+untimed warm-up batch of the small cell per setting (fork servers, Ray's worker processes) are not
+counted.
+
+`--driver N`: N variants of the small cell planned by `robomax batch --ray-address` on 2 local nodes
+(real plans); reports the driver process's peak RSS and CPU seconds (getrusage of the command).
+
+`--memory`: plans cells of growing size (the scaling benchmark's open family with orientation grids
+of 3, 5 and 7, the clamped family, the shipped cells) one process each and prints each plan's peak
+RSS against `batch_ray.task_memory_mb`'s model of it.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
 from collections import Counter
 from pathlib import Path
 
+import yaml
+
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 REPO = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(REPO / "tests"))
-# Workers (forkserver children, Ray workers) import robomax_py from this checkout too.
-os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH", "")) if p)
+sys.path[:0] = [str(REPO), str(REPO / "tests")]
+sys.path.insert(0, str(REPO / "tests" / "bench"))
+# Workers (forkserver children, Ray's nodes) import robomax_py from this checkout too.
+PATHS = [REPO, REPO / "tests", REPO / "tests" / "bench"]
+os.environ["PYTHONPATH"] = os.pathsep.join([*map(str, PATHS), *filter(None, [os.environ.get("PYTHONPATH")])])
 
 from conftest import REFERENCE_CELL, _write_small_cell
+from ray_nodes import local_cluster, node_env
+from scale_cells import scale_cell
 
-from robomax_py.app.batch import BatchOptions, CellOutcome, run_batch
+from robomax_py.app.batch import BatchOptions, CellOutcome, run_batch, run_local
+from robomax_py.app.batch_ray import PLAN_BASE_MB, PLAN_MB_PER_POSE
 from robomax_py.io.variants import write_variants
 
 
-def one_batch(files: list[str], out: Path, jobs: int, use_ray: bool) -> tuple[float, tuple[CellOutcome, ...]]:
-    t0 = time.perf_counter()
-    outcomes = run_batch(files, out, BatchOptions(jobs=jobs), use_ray=use_ray)
-    return time.perf_counter() - t0, outcomes
+def one_batch(files: list[str], out: Path, jobs: int | None, address: str | None
+              ) -> tuple[float, float, tuple[CellOutcome, ...]]:
+    """Wall and this process's CPU seconds of one batch, and its outcomes."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    outcomes = run_batch(files, out, BatchOptions(jobs=jobs), use_ray=address is not None, ray_address=address)
+    return time.perf_counter() - t0, time.process_time() - c0, outcomes
+
+
+def throughput(args: argparse.Namespace, tmp: Path) -> None:
+    cell = _write_small_cell(tmp / "src", "small") if args.quick else args.cell
+    variants = write_variants(cell, args.n, args.seed, tmp / "variants")
+    files = [str(v.path) for v in variants]
+    warm = [str(_write_small_cell(tmp / "warm", f"warm{k}")) for k in range(2)]
+    print(f"{len(files)} variants of {cell} in {tmp / 'variants'}; {os.cpu_count()} CPU(s), "
+          f"load average {os.getloadavg()[0]:.2f}", flush=True)
+    walls: dict[str, list[float]] = {}
+    cpus: dict[str, list[float]] = {}
+    rss: dict[str, list[float]] = {}
+    statuses: dict[str, Counter[str]] = {}
+    workers: dict[str, int] = {}
+    reference: dict[str, bytes] = {}
+
+    def measure(name: str, jobs: int, address: str | None) -> None:
+        workers[name] = jobs
+        one_batch(warm[:jobs], tmp / "warmup", jobs if address is None else None, address)
+        for run in range(args.runs):
+            out = tmp / f"out_{name.replace(' ', '_').replace(',', '')}_{run}"
+            wall, cpu, outcomes = one_batch(files, out, jobs if address is None else None, address)
+            walls.setdefault(name, []).append(wall)
+            cpus.setdefault(name, []).append(cpu)
+            rss.setdefault(name, []).extend(o.peak_rss_mb for o in outcomes if o.peak_rss_mb is not None)
+            statuses[name] = Counter(o.status for o in outcomes)
+            programs = {p.name: p.read_bytes() for p in sorted(out.iterdir())          # the sets' files, not their
+                        if p.suffix in (".srcl", ".json") and not p.name.startswith(".")   # hidden folders
+                        and not p.name.endswith(".manifest.json")}
+            if not reference:
+                reference.update(programs)
+            same = "same programs" if programs == reference else "PROGRAMS DIFFER"
+            print(f"run {run + 1}/{args.runs} {name}: {wall:.1f} s, driver {cpu:.1f} CPU s, {same}", flush=True)
+
+    measure("local, 1 worker", 1, None)
+    measure("local, 2 workers", 2, None)
+    connect: dict[str, float] = {}
+    if not args.no_ray:
+        import ray
+
+        env = node_env(PATHS)
+        os.environ.update({k: v for k, v in env.items() if k.startswith("RAY_")})
+        for nodes in (1, 2):
+            with local_cluster(Path(tempfile.mkdtemp(prefix="nodes_", dir=tmp)), nodes, env) as cluster:
+                name = f"Ray, {nodes} node(s)"
+                t0 = time.perf_counter()
+                ray.init(address=cluster.address, log_to_driver=False)
+                connect[name] = time.perf_counter() - t0
+                try:
+                    measure(name, nodes, cluster.address)
+                finally:
+                    ray.shutdown()
+
+    n = len(files)
+    thr = {name: n / (statistics.median(w) / 60) for name, w in walls.items()}
+    base = thr["local, 1 worker"]
+    print()
+    print("| setting | wall (s) | cells/min | efficiency | extra wall per cell vs local (s) | driver CPU per cell (s) "
+          "| plan peak RSS max / median (MiB) | statuses |")
+    print("|---|---|---|---|---|---|---|---|")
+    for name, w in walls.items():
+        jobs = workers[name]
+        local = f"local, {jobs} worker" + ("s" if jobs > 1 else "")
+        extra = "" if name.startswith("local") else f"{(statistics.median(w) - statistics.median(walls[local])) * jobs / n:.2f}"
+        r = rss[name]
+        mem = f"{max(r):.0f} / {statistics.median(r):.0f}" if r else "-"
+        st = ", ".join(f"{v} {k}" for k, v in sorted(statuses[name].items()))
+        print(f"| {name} | {statistics.median(w):.1f} | {thr[name]:.2f} | {thr[name] / (jobs * base):.2f} | {extra} "
+              f"| {statistics.median(cpus[name]) / n:.3f} | {mem} | {st} |")
+    for name, s in connect.items():
+        print(f"connecting to the cluster ({name}, not counted above): {s:.1f} s")
+    print(f"medians over {args.runs} run(s); output in {tmp}")
+
+
+def driver_memory(args: argparse.Namespace, tmp: Path) -> None:
+    cell = _write_small_cell(tmp / "src", "small")
+    files = [str(v.path) for v in write_variants(cell, args.driver, args.seed, tmp / "variants")]
+    env = node_env(PATHS)
+    # The command runs under a small wrapper whose only child it is: getrusage(RUSAGE_CHILDREN) there
+    # is the command's own (on Ray it starts no process of its own).
+    wrapper = ("import json, resource, subprocess, sys\n"
+               "done = subprocess.run(sys.argv[1:], capture_output=True)\n"
+               "r = resource.getrusage(resource.RUSAGE_CHILDREN)\n"
+               "print(json.dumps({'code': done.returncode, 'rss_mib': r.ru_maxrss / 1024, "
+               "'cpu_s': r.ru_utime + r.ru_stime, 'out': done.stdout.decode()}))\n")
+    with local_cluster(tmp / "nodes", 2, env) as cluster:
+        t0 = time.perf_counter()
+        done = subprocess.run([sys.executable, "-c", wrapper, sys.executable, "-m", "robomax_py", "batch", *files,
+                               "-o", str(tmp / "out"), "--ray-address", cluster.address, "--json"],
+                              env=env, capture_output=True, check=True)
+        wall = time.perf_counter() - t0
+    got = json.loads(done.stdout)
+    statuses = Counter(c["status"] for c in json.loads(got["out"])["cells"])
+    print(f"{len(files)} cells on 2 local nodes: exit {got['code']}, {wall:.0f} s wall, driver peak RSS "
+          f"{got['rss_mib']:.0f} MiB, driver CPU {got['cpu_s']:.1f} s ({dict(statuses)})")
+
+
+def memory_model(args: argparse.Namespace, tmp: Path) -> None:
+    from robomax_py.app.batch_ship import survey
+
+    folder = tmp / "cells"
+    folder.mkdir()
+    files = [str(_write_small_cell(folder, "small"))]
+    for family, n, grid in [("open", 8, 5), ("open", 30, 5), ("open", 60, 5), ("open", 120, 5), ("open", 240, 5),
+                            ("open", 60, 3), ("open", 60, 7), ("clamped", 60, 5)]:
+        data = scale_cell(family, n)
+        for seam in data["seams"]:
+            seam["grid"] = grid
+        data["name"] = f"{family}_{n}_grid{grid}"
+        path = folder / f"{data['name']}.yaml"
+        path.write_text(yaml.safe_dump(data, sort_keys=False))
+        files.append(str(path))
+    files += [str(REPO / "cells" / f"{c}.yaml") for c in ("cabin_flange", "frame", "ur10_tray", "tending")]
+    outcomes = run_local(files, BatchOptions(jobs=1))
+    print("| cell | spots | poses | peak RSS (MiB) | model (MiB) | peak / model |")
+    print("|---|---|---|---|---|---|")
+    for file, o in zip(files, outcomes, strict=True):
+        poses = survey(file).poses
+        model = PLAN_BASE_MB + PLAN_MB_PER_POSE * poses
+        peak = o.peak_rss_mb or 0.0
+        print(f"| {Path(file).stem} | {o.spots} | {poses:,} | {peak:.0f} | {model:.0f} | {peak / model:.2f} |")
 
 
 def main() -> None:
@@ -49,68 +193,17 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=3, help="repetitions (medians are reported)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--quick", action="store_true", help="the small 2-spot test cell instead of --cell")
-    ap.add_argument("--no-ray", action="store_true", help="skip the Ray setting")
+    ap.add_argument("--no-ray", action="store_true", help="skip the Ray settings")
+    ap.add_argument("--driver", type=int, metavar="N", help="measure the driver's peak memory for N cells instead")
+    ap.add_argument("--memory", action="store_true", help="measure plans' peak memory against the model instead")
     args = ap.parse_args()
-
     tmp = Path(tempfile.mkdtemp(prefix="bench_batch_"))
-    cell = _write_small_cell(tmp / "src", "small") if args.quick else args.cell
-    variants = write_variants(cell, args.n, args.seed, tmp / "variants")
-    files = [str(v.path) for v in variants]
-    print(f"{len(files)} variants of {cell} in {tmp / 'variants'}; {os.cpu_count()} CPU(s), "
-          f"load average {os.getloadavg()[0]:.2f}", flush=True)
-
-    settings: list[tuple[str, int, bool]] = [("local, 1 worker", 1, False), ("local, 2 workers", 2, False)]
-    ray_start = None
-    if not args.no_ray:
-        try:
-            import ray
-        except ImportError:
-            print("ray is not installed: the Ray setting is skipped")
-        else:
-            t0 = time.perf_counter()
-            ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False,
-                     runtime_env={"env_vars": {"PYTHONPATH": os.environ["PYTHONPATH"]}})
-            ray_start = time.perf_counter() - t0
-            settings.append(("Ray local, 2 CPUs", 2, True))
-
-    walls: dict[str, list[float]] = {name: [] for name, _, _ in settings}
-    rss: dict[str, list[float]] = {name: [] for name, _, _ in settings}
-    statuses: dict[str, Counter[str]] = {name: Counter() for name, _, _ in settings}
-    reference: dict[str, bytes] = {}
-    # Untimed warm-up on the small cell: the fork server's imports, Ray's worker processes.
-    warm = [str(_write_small_cell(tmp / "warm", f"warm{k}")) for k in range(2)]
-    for name, jobs, use_ray in settings:
-        one_batch(warm[:jobs], tmp / "warmup", jobs, use_ray)
-    for run in range(args.runs):
-        for name, jobs, use_ray in settings:
-            out = tmp / f"out_{run}_{jobs}_{int(use_ray)}"
-            wall, outcomes = one_batch(files, out, jobs, use_ray)
-            walls[name].append(wall)
-            rss[name].extend(o.peak_rss_mb for o in outcomes if o.peak_rss_mb is not None)
-            statuses[name] = Counter(o.status for o in outcomes)
-            programs = {p.name: p.read_bytes() for p in sorted(out.iterdir())          # the sets' files, not their
-                    if not p.name.startswith(("summary", "."))}                  # hidden folders
-            if not reference:
-                reference = programs
-            same = "same programs" if programs == reference else "PROGRAMS DIFFER"
-            print(f"run {run + 1}/{args.runs} {name}: {wall:.1f} s, {same}", flush=True)
-
-    n = len(files)
-    thr = {name: n / (statistics.median(w) / 60) for name, w in walls.items()}
-    print()
-    print("| setting | wall (s) | cells/min | efficiency | peak RSS max / median (MiB) | statuses |")
-    print("|---|---|---|---|---|---|")
-    base = thr["local, 1 worker"]
-    for name, jobs, _ in settings:
-        eff = thr[name] / (jobs * base)
-        r = rss[name]
-        mem = f"{max(r):.0f} / {statistics.median(r):.0f}" if r else "-"
-        st = ", ".join(f"{v} {k}" for k, v in sorted(statuses[name].items()))
-        print(f"| {name} | {statistics.median(walls[name]):.1f} | {thr[name]:.2f} | {eff:.2f} | {mem} | {st} |")
-    if ray_start is not None:
-        print(f"\nRay start-up (ray.init, not counted above): {ray_start:.1f} s")
-    print(f"parallel efficiency, 2 local workers: {thr['local, 2 workers'] / (2 * base):.2f} "
-          f"(medians over {args.runs} run(s); output in {tmp})")
+    if args.driver:
+        driver_memory(args, tmp)
+    elif args.memory:
+        memory_model(args, tmp)
+    else:
+        throughput(args, tmp)
 
 
 if __name__ == "__main__":
