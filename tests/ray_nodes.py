@@ -49,6 +49,20 @@ def processes(session: int) -> list[tuple[int, int, str, str]]:
     return found
 
 
+def session_cpu_s(session: int) -> float:
+    """CPU seconds of the session's processes and of the children they waited for (Linux /proc)."""
+    ticks = os.sysconf("SC_CLK_TCK")
+    total = 0.0
+    for pid, *_ in processes(session):
+        try:
+            stat = Path(f"/proc/{pid}/stat").read_text()
+        except OSError:
+            continue
+        fields = stat[stat.rindex(")") + 2:].split()           # utime, stime, cutime, cstime: fields 11-14
+        total += sum(int(v) for v in fields[11:15]) / ticks
+    return total
+
+
 def _signal_all(pids: list[int], signum: int) -> None:
     for pid in pids:
         try:

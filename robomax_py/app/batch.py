@@ -20,6 +20,7 @@ from __future__ import annotations
 import os
 import re
 from collections.abc import Mapping, Sequence
+from contextlib import nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -47,7 +48,7 @@ from robomax_py.app.batch_local import (
     default_context,
     run_local,
 )
-from robomax_py.app.batch_ray import run_ray
+from robomax_py.app.batch_ray import connected, run_ray
 from robomax_py.app.batch_results import (
     SUMMARY_COLUMNS,
     BatchWriter,
@@ -120,28 +121,31 @@ def run_batch(
     record = run_options(options)
     suffix = shard.suffix if shard else ""
     earlier = resumable(out_dir, record) if resume and out_dir.is_dir() else {}
-    writer = BatchWriter(out_dir, picked, record, journal=f"results{suffix}", summary=f"summary{suffix}",
-                         fresh=not resume)
-
-    def done(k: int, outcome: CellOutcome) -> CellOutcome:
-        kept = writer.add(k, outcome)
-        return kept if on_done is None else on_done(k, kept)
-
-    todo = []
+    kept: dict[int, CellOutcome] = {}
     for k, file in enumerate(picked):
         row = earlier.get(os.path.abspath(file))
-        kept = resumed_outcome(row, file, out_dir) if row is not None else None
-        if kept is None:
-            todo.append(k)
-        else:
-            done(k, kept)
+        found = resumed_outcome(row, file, out_dir) if row is not None else None
+        if found is not None:
+            kept[k] = found
+    todo = [k for k in range(len(picked)) if k not in kept]
     rest = [picked[k] for k in todo]
+    # Ray first: a cluster that cannot be reached leaves the output folder as it was.
+    with connected(ray_address, options.jobs, ray_init) if rest and use_ray else nullcontext():
+        writer = BatchWriter(out_dir, picked, record, journal=f"results{suffix}", summary=f"summary{suffix}",
+                             fresh=not resume)
 
-    def done_rest(j: int, outcome: CellOutcome) -> CellOutcome:
-        return done(todo[j], outcome)
+        def done(k: int, outcome: CellOutcome) -> CellOutcome:
+            added = writer.add(k, outcome)
+            return added if on_done is None else on_done(k, added)
 
-    if rest and use_ray:
-        run_ray(rest, options, ray_address, done_rest, worker, ray_init)
-    elif rest:
-        run_local(rest, options, done_rest, worker)
+        for k, found in kept.items():
+            done(k, found)
+
+        def done_rest(j: int, outcome: CellOutcome) -> CellOutcome:
+            return done(todo[j], outcome)
+
+        if rest and use_ray:
+            run_ray(rest, options, ray_address, done_rest, worker, ray_init)
+        elif rest:
+            run_local(rest, options, done_rest, worker)
     return writer.outcomes()

@@ -21,9 +21,11 @@ its attempts and names what was lost.
 from __future__ import annotations
 
 import os
+import socket
 import time
 from collections import deque
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -41,6 +43,8 @@ from robomax_py.app.batch_local import OnDone
 from robomax_py.app.batch_ship import ShippedCell, Survey, survey, unpacked
 
 LOCAL = "local"
+# How long a cluster's head may take to accept a connection before it counts as unreachable, s.
+CONNECT_S = 10.0
 # The driver's wait for finished tasks, s: how soon an interrupt is seen while tasks run.
 WAIT_S = 1.0
 # Peak resident memory of a plan (the worker process), MiB, from its size: TCP poses to solve, the
@@ -113,27 +117,53 @@ def run_ray(
     """Plan every file as a Ray task (module docstring); outcomes in argument order, as `run_local`
     gives them, `on_done` called as each cell finishes.
 
-    When Ray is running in this process already, that connection is used (and kept). `init_kwargs`
-    are passed on to `ray.init` (a runtime_env, for instance).
-    Raises ImportError when ray is not installed, ConnectionError when the cluster cannot be reached.
+    When Ray is running in this process already, that connection is used (and kept); otherwise as
+    `connected` says. Raises ImportError when ray is not installed, ConnectionError when the cluster
+    cannot be reached.
     """
     import ray
 
-    started_here = not ray.is_initialized()
-    if started_here:
-        where = resolve_address(address)
-        kwargs: dict[str, Any] = {"address": where, "log_to_driver": False}
-        if where == LOCAL:
-            kwargs["include_dashboard"] = False
-            if options.jobs is not None:
-                kwargs["num_cpus"] = options.jobs
-        kwargs.update(init_kwargs or {})
-        ray.init(**kwargs)
-    try:
+    with connected(address, options.jobs, init_kwargs):
         return _run(ray, files, options, on_done, worker)
+
+
+@contextmanager
+def connected(address: str | None, jobs: int | None = None,
+              init_kwargs: Mapping[str, Any] | None = None) -> Iterator[None]:
+    """Ray connected in this process for the block (`resolve_address`; a local Ray started here gets
+    `jobs` CPUs, default all, and is ended after); nothing is done when it is connected already.
+    `init_kwargs` are passed on to `ray.init` (a runtime_env, for instance). ConnectionError, at
+    once, when nothing answers at a `host:port` address (Ray itself would retry for minutes)."""
+    import ray
+
+    if ray.is_initialized():
+        yield
+        return
+    where = resolve_address(address)
+    _check_reachable(where)
+    kwargs: dict[str, Any] = {"address": where, "log_to_driver": False}
+    if where == LOCAL:
+        kwargs["include_dashboard"] = False
+        if jobs is not None:
+            kwargs["num_cpus"] = jobs
+    kwargs.update(init_kwargs or {})
+    ray.init(**kwargs)
+    try:
+        yield
     finally:
-        if started_here:
-            ray.shutdown()
+        ray.shutdown()
+
+
+def _check_reachable(address: str) -> None:
+    """ConnectionError when a `host:port` address (not `local`, `auto` or a `ray://` one) refuses
+    a TCP connection or does not answer within CONNECT_S."""
+    host, sep, port = address.rpartition(":")
+    if "://" in address or not sep or not port.isdigit():
+        return
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=CONNECT_S).close()
+    except OSError as exc:
+        raise ConnectionError(f"nothing answers at {address} ({exc.strerror or exc})") from None
 
 
 def _largest_node_mb(ray: Any) -> float | None:
@@ -193,12 +223,11 @@ def _run(ray: Any, files: Sequence[str], options: BatchOptions, on_done: OnDone 
             ready, _ = ray.wait(list(running), num_returns=1, timeout=WAIT_S)
             for ref in ready:
                 task = running.pop(ref)
-                outcome, again = _received(ray, ref, task, files[task.index], options, lost_kinds)
-                if again is not None:
-                    submit(again)
+                got = _received(ray, ref, task, files[task.index], options, lost_kinds)
+                if isinstance(got, _Task):
+                    submit(got)
                 else:
-                    assert outcome is not None
-                    finish(task.index, outcome)
+                    finish(task.index, got)
     finally:
         for ref in running:                  # interrupted: no task is left running
             ray.cancel(ref, force=True)
@@ -206,7 +235,7 @@ def _run(ray: Any, files: Sequence[str], options: BatchOptions, on_done: OnDone 
 
 
 def _received(ray: Any, ref: Any, task: _Task, file: str, options: BatchOptions,
-              lost_kinds: tuple[type[BaseException], ...]) -> tuple[CellOutcome | None, _Task | None]:
+              lost_kinds: tuple[type[BaseException], ...]) -> CellOutcome | _Task:
     """A finished task's outcome, or the task to submit again after a lost worker, node or result."""
     def failed(reason: str) -> CellOutcome:
         return CellOutcome(file, Path(file).stem, CRASHED, time.monotonic() - task.submitted, reasons=reason,
@@ -215,16 +244,16 @@ def _received(ray: Any, ref: Any, task: _Task, file: str, options: BatchOptions,
     try:
         got: CellOutcome = ray.get(ref)
     except ray.exceptions.RayTaskError as exc:        # the task's own code raised (a bug): no retry
-        return failed(f"Ray task failed: {type(exc).__name__}: {_first_line(exc)}"), None
+        return failed(f"Ray task failed: {type(exc).__name__}: {_first_line(exc)}")
     except lost_kinds as exc:
         lost = f"{type(exc).__name__}: {_first_line(exc)}"
         if task.attempts <= options.retries:
-            return None, replace(task, attempts=task.attempts + 1, lost=(*task.lost, lost))
-        return failed(f"worker or node lost on each of {task.attempts} attempt(s); the last: {lost}"), None
+            return replace(task, attempts=task.attempts + 1, lost=(*task.lost, lost))
+        return failed(f"worker or node lost on each of {task.attempts} attempt(s); the last: {lost}")
     except ray.exceptions.RayError as exc:
-        return failed(f"Ray task failed: {type(exc).__name__}: {_first_line(exc)}"), None
+        return failed(f"Ray task failed: {type(exc).__name__}: {_first_line(exc)}")
     notes = "; ".join(n for n in (_retried(task), _as_given(got.notes, file)) if n)
-    return replace(got, file=file, reasons=_as_given(got.reasons, file), notes=notes, attempts=task.attempts), None
+    return replace(got, file=file, reasons=_as_given(got.reasons, file), notes=notes, attempts=task.attempts)
 
 
 def _retried(task: _Task) -> str:

@@ -10,6 +10,7 @@ import csv
 import hashlib
 import json
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -164,4 +165,16 @@ def test_bad_batch_options_exit_2_before_anything_is_written(tmp_path: Path, arg
     result = runner.invoke(app, ["batch", cell, "-o", str(out), *args])
     assert result.exit_code == EXIT_BAD_INPUT
     assert message in " ".join(result.output.split())
+    assert not out.exists()
+
+
+def test_an_unreachable_cluster_exits_2_before_anything_is_written(tmp_path: Path,
+                                                                   free_port: Callable[..., int]) -> None:
+    pytest.importorskip("ray")
+    (cell,) = write_cells(tmp_path / "cells", a={})
+    out = tmp_path / "out"
+    address = f"127.0.0.1:{free_port()}"
+    result = runner.invoke(app, ["batch", cell, "-o", str(out), "--ray-address", address])
+    assert result.exit_code == EXIT_BAD_INPUT
+    assert f"cannot reach the Ray cluster at {address}: nothing answers" in " ".join(result.output.split())
     assert not out.exists()

@@ -120,3 +120,35 @@ def test_a_cell_failing_in_the_worker_names_the_drivers_files(
     assert got.status == BAD_INPUT
     assert f"{ELSEWHERE}{library}/robo_bad/meshes/collision/link_2_0.stl" in got.reasons
     assert "robomax-cell-" not in got.reasons
+
+
+def test_a_lost_worker_is_submitted_again_and_a_failing_task_is_not(tmp_path: Path,
+                                                                     write_small_cell: SmallCell) -> None:
+    ray = pytest.importorskip("ray")
+    from types import SimpleNamespace
+
+    from robomax_py.app.batch import BatchOptions
+    from robomax_py.app.batch_ray import LOST, _received, _Task
+
+    cell = str(write_small_cell(tmp_path, "small"))
+    lost_kinds = tuple(getattr(ray.exceptions, n) for n in LOST if hasattr(ray.exceptions, n))
+
+    def received(error: Exception | None, task: _Task) -> object:
+        def get(ref: object) -> CellOutcome:
+            if error is not None:
+                raise error
+            return CellOutcome(ELSEWHERE + cell, "small", PLANNED, 1.0)
+
+        fake = SimpleNamespace(get=get, exceptions=ray.exceptions)
+        return _received(fake, None, task, cell, BatchOptions(retries=1), lost_kinds)
+
+    task = _Task(0, survey(cell), (), None)
+    again = received(ray.exceptions.NodeDiedError("the node died"), task)
+    assert isinstance(again, _Task) and again.attempts == 2 and "NodeDiedError: the node died" in again.lost[0]
+    done = received(None, again)                       # planned on the second attempt
+    assert isinstance(done, CellOutcome) and done.status == PLANNED and done.attempts == 2
+    assert done.file == cell and "attempt 1 was lost (NodeDiedError: the node died)" in done.notes
+    last = received(ray.exceptions.WorkerCrashedError(), again)          # lost again: retries used up
+    assert isinstance(last, CellOutcome) and last.status == "crashed" and "each of 2 attempt(s)" in last.reasons
+    failing = received(ray.exceptions.RayTaskError("plan_shipped", "Traceback ...", ValueError("a bug")), task)
+    assert isinstance(failing, CellOutcome) and failing.status == "crashed" and failing.attempts == 1

@@ -18,6 +18,10 @@ counted.
 `--driver N`: N variants of the small cell planned by `robomax batch --ray-address` on 2 local nodes
 (real plans); reports the driver process's peak RSS and CPU seconds (getrusage of the command).
 
+`--overhead N`: N cells through a stand-in worker that plans nothing (it returns a small program at
+once), in the local pool (1 worker) and on a Ray cluster of 1 local node: the CPU seconds and wall
+time a cell costs besides its plan (driver, node processes and the cell's own process).
+
 `--memory`: plans cells of growing size (the scaling benchmark's open family with orientation grids
 of 3, 5 and 7, the clamped family, the shipped cells) one process each and prints each plan's peak
 RSS against `batch_ray.task_memory_mb`'s model of it.
@@ -28,6 +32,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -49,10 +54,17 @@ PATHS = [REPO, REPO / "tests", REPO / "tests" / "bench"]
 os.environ["PYTHONPATH"] = os.pathsep.join([*map(str, PATHS), *filter(None, [os.environ.get("PYTHONPATH")])])
 
 from conftest import REFERENCE_CELL, _write_small_cell
-from ray_nodes import local_cluster, node_env
+from ray_nodes import local_cluster, node_env, session_cpu_s
 from scale_cells import scale_cell
 
-from robomax_py.app.batch import BatchOptions, CellOutcome, run_batch, run_local
+from robomax_py.app.batch import (
+    PLANNED,
+    BatchOptions,
+    CellOutcome,
+    PlanSettings,
+    run_batch,
+    run_local,
+)
 from robomax_py.app.batch_ray import PLAN_BASE_MB, PLAN_MB_PER_POSE
 from robomax_py.io.variants import write_variants
 
@@ -160,6 +172,83 @@ def driver_memory(args: argparse.Namespace, tmp: Path) -> None:
           f"{got['rss_mib']:.0f} MiB, driver CPU {got['cpu_s']:.1f} s ({dict(statuses)})")
 
 
+def stand_in_worker(file: str, settings: PlanSettings) -> CellOutcome:
+    """Plans nothing: a planned outcome with a program of a plan's size, at once (for --overhead)."""
+    text = "; a program line of a typical length, repeated as a small plan's program is long\n" * 400
+    name = Path(file).stem
+    return CellOutcome(file, name, PLANNED, 0.0, cycle_time=1.0, spots=2, detours=0,
+                       programs=((f"{name}.json", "{}"), (f"{name}.srcl", text)), cell_sha256="0" * 64)
+
+
+def overhead(args: argparse.Namespace, tmp: Path) -> None:
+    # The worker by its module's name, not __main__'s: the cells' processes and Ray's nodes import it.
+    from bench_batch import stand_in_worker
+
+    cell = _write_small_cell(tmp / "src", "small")
+    files = [str(v.path) for v in write_variants(cell, args.overhead, args.seed, tmp / "variants")]
+    warm = files[:2]
+    n = len(files)
+    rows = []
+    # The local pool: this process and its children (the fork server and the cells' processes).
+    run_batch(warm, tmp / "warm_local", BatchOptions(jobs=1), worker=stand_in_worker)
+    c0, k0, t0 = time.process_time(), _children_cpu_s(), time.perf_counter()
+    run_batch(files, tmp / "local", BatchOptions(jobs=1), worker=stand_in_worker)
+    rows.append(("local, 1 worker", time.perf_counter() - t0, time.process_time() - c0, _children_cpu_s() - k0))
+    import ray
+
+    env = node_env(PATHS)
+    os.environ.update({k: v for k, v in env.items() if k.startswith("RAY_")})
+    with local_cluster(tmp / "nodes", 1, env) as cluster:
+        ray.init(address=cluster.address, log_to_driver=False)
+        try:
+            run_batch(warm, tmp / "warm_ray", BatchOptions(), worker=stand_in_worker, use_ray=True)
+            session = cluster.nodes[0].proc.pid
+            c0, k0, t0 = time.process_time(), session_cpu_s(session), time.perf_counter()
+            run_batch(files, tmp / "ray", BatchOptions(), worker=stand_in_worker, use_ray=True)
+            rows.append(("Ray, 1 node", time.perf_counter() - t0, time.process_time() - c0, session_cpu_s(session) - k0))
+        finally:
+            ray.shutdown()
+    print(f"{n} cells through a stand-in worker that plans nothing; load average {os.getloadavg()[0]:.2f}")
+    print("| setting | wall per cell (s) | driver CPU per cell (s) | CPU per cell elsewhere (s) |")
+    print("|---|---|---|---|")
+    for name, wall, driver, other in rows:
+        print(f"| {name} | {wall / n:.3f} | {driver / n:.3f} | {other / n:.3f} |")
+    print("(elsewhere: the local pool's fork server and cells' processes; on Ray every process of the node: "
+          "raylet, Ray worker, fork server, the cells' processes)")
+
+
+def _children_cpu_s() -> float:
+    """CPU seconds of this process's children it waited for (the cells' processes are the fork
+    server's children: counted once the fork server ends) and of the live fork server's."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    total = usage.ru_utime + usage.ru_stime
+    ticks = os.sysconf("SC_CLK_TCK")
+    for pid in _descendants(os.getpid()):
+        try:
+            fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        total += sum(int(v) for v in fields[11:15]) / ticks
+    return total
+
+
+def _descendants(pid: int) -> list[int]:
+    children: dict[int, list[int]] = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                parent = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
+            except (OSError, IndexError, ValueError):
+                continue
+            children.setdefault(parent, []).append(int(entry.name))
+    found, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            found.append(child)
+            todo.append(child)
+    return found
+
+
 def memory_model(args: argparse.Namespace, tmp: Path) -> None:
     from robomax_py.app.batch_ship import survey
 
@@ -195,11 +284,14 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="the small 2-spot test cell instead of --cell")
     ap.add_argument("--no-ray", action="store_true", help="skip the Ray settings")
     ap.add_argument("--driver", type=int, metavar="N", help="measure the driver's peak memory for N cells instead")
+    ap.add_argument("--overhead", type=int, metavar="N", help="measure the cost of a cell besides its plan instead")
     ap.add_argument("--memory", action="store_true", help="measure plans' peak memory against the model instead")
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="bench_batch_"))
     if args.driver:
         driver_memory(args, tmp)
+    elif args.overhead:
+        overhead(args, tmp)
     elif args.memory:
         memory_model(args, tmp)
     else:
