@@ -142,6 +142,7 @@ def local_cluster(folder: Path, n_nodes: int, env: dict[str, str]) -> Iterator[C
     ports = iter(free_ports(2 + NODE_PORTS * n_nodes))       # all at once: no port given twice
     gcs, client = next(ports), next(ports)
     address = f"127.0.0.1:{gcs}"
+    folder.mkdir(parents=True, exist_ok=True)
     temp = Path(tempfile.mkdtemp(prefix="rn"))
     nodes: list[Node] = []
     try:

@@ -50,7 +50,7 @@ WAIT_S = 1.0
 # Peak resident memory of a plan (the worker process), MiB, from its size: TCP poses to solve, the
 # cell's spots x orientation samples summed over its seams. An upper bound of the peaks measured by
 # `tests/bench/bench_batch.py --memory` (docs/benchmarks.md, "Batch planning on Ray": 277-2,270 MiB
-# for 18-24,000 poses, the largest 8 % under the bound).
+# for 18-24,000 poses, each under the bound, the closest 6 % below it).
 PLAN_BASE_MB = 400.0
 PLAN_MB_PER_POSE = 0.1
 # What a task holds besides its plan's process: the Ray worker process and the fork server it

@@ -57,14 +57,7 @@ from conftest import REFERENCE_CELL, _write_small_cell
 from ray_nodes import local_cluster, node_env, session_cpu_s
 from scale_cells import scale_cell
 
-from robomax_py.app.batch import (
-    PLANNED,
-    BatchOptions,
-    CellOutcome,
-    PlanSettings,
-    run_batch,
-    run_local,
-)
+from robomax_py.app.batch import BatchOptions, CellOutcome, run_batch, run_local
 from robomax_py.app.batch_ray import PLAN_BASE_MB, PLAN_MB_PER_POSE
 from robomax_py.io.variants import write_variants
 
@@ -172,17 +165,8 @@ def driver_memory(args: argparse.Namespace, tmp: Path) -> None:
           f"{got['rss_mib']:.0f} MiB, driver CPU {got['cpu_s']:.1f} s ({dict(statuses)})")
 
 
-def stand_in_worker(file: str, settings: PlanSettings) -> CellOutcome:
-    """Plans nothing: a planned outcome with a program of a plan's size, at once (for --overhead)."""
-    text = "; a program line of a typical length, repeated as a small plan's program is long\n" * 400
-    name = Path(file).stem
-    return CellOutcome(file, name, PLANNED, 0.0, cycle_time=1.0, spots=2, detours=0,
-                       programs=((f"{name}.json", "{}"), (f"{name}.srcl", text)), cell_sha256="0" * 64)
-
-
 def overhead(args: argparse.Namespace, tmp: Path) -> None:
-    # The worker by its module's name, not __main__'s: the cells' processes and Ray's nodes import it.
-    from bench_batch import stand_in_worker
+    from batch_stand_in import stand_in_worker
 
     cell = _write_small_cell(tmp / "src", "small")
     files = [str(v.path) for v in write_variants(cell, args.overhead, args.seed, tmp / "variants")]
@@ -206,6 +190,11 @@ def overhead(args: argparse.Namespace, tmp: Path) -> None:
             c0, k0, t0 = time.process_time(), session_cpu_s(session), time.perf_counter()
             run_batch(files, tmp / "ray", BatchOptions(), worker=stand_in_worker, use_ray=True)
             rows.append(("Ray, 1 node", time.perf_counter() - t0, time.process_time() - c0, session_cpu_s(session) - k0))
+            # The node's processes at rest for as long: what the raylet, GCS and monitors take anyway.
+            idle0, t1 = session_cpu_s(session), time.perf_counter()
+            time.sleep(rows[-1][1])
+            idle = (session_cpu_s(session) - idle0) * rows[-1][1] / (time.perf_counter() - t1)
+            resident = _resident_mib(session)
         finally:
             ray.shutdown()
     print(f"{n} cells through a stand-in worker that plans nothing; load average {os.getloadavg()[0]:.2f}")
@@ -213,8 +202,30 @@ def overhead(args: argparse.Namespace, tmp: Path) -> None:
     print("|---|---|---|---|")
     for name, wall, driver, other in rows:
         print(f"| {name} | {wall / n:.3f} | {driver / n:.3f} | {other / n:.3f} |")
+    print(f"the Ray node at rest for as long as the batch took: {idle / n:.3f} CPU s per cell of it")
     print("(elsewhere: the local pool's fork server and cells' processes; on Ray every process of the node: "
           "raylet, Ray worker, fork server, the cells' processes)")
+    print("resident memory on the node after the batch, MiB: " +
+          ", ".join(f"{k}: {' + '.join(f'{v:.0f}' for v in vs)}" for k, vs in resident.items()))
+
+
+def _resident_mib(session: int) -> dict[str, list[float]]:
+    """VmRSS of the node's task processes, MiB, by kind: Ray's worker processes (`ray::...` but
+    Ray's own agents) and the fork servers they started."""
+    from ray_nodes import processes
+
+    found: dict[str, list[float]] = {}
+    for pid, _, _, cmd in processes(session):
+        kind = ("fork server" if "multiprocessing.forkserver" in cmd else
+                "Ray worker" if cmd.startswith("ray::") and "Agent" not in cmd else None)
+        if kind is None:
+            continue
+        try:
+            line = next(x for x in Path(f"/proc/{pid}/status").read_text().splitlines() if x.startswith("VmRSS:"))
+        except (OSError, StopIteration):
+            continue
+        found.setdefault(kind, []).append(int(line.split()[1]) / 1024)
+    return found
 
 
 def _children_cpu_s() -> float:
