@@ -53,8 +53,9 @@ WAIT_S = 1.0
 # for 18-24,000 poses, each under the bound, the closest 6 % below it).
 PLAN_BASE_MB = 400.0
 PLAN_MB_PER_POSE = 0.1
-# What a task holds besides its plan's process: the Ray worker process and the fork server it
-# starts (the imported planner; its pages are shared with the plan's process), MiB.
+# What a task holds besides its plan's process, MiB: the Ray worker process (~90 MiB measured) and
+# the fork server it starts (~280 MiB: the imported planner, whose pages the plan's process shares
+# and counts in its own peak).
 TASK_OVERHEAD_MB = 250.0
 # Ray errors of a lost worker process, node or result object: the task is submitted again.
 LOST = ("WorkerCrashedError", "NodeDiedError", "LocalRayletDiedError", "OutOfMemoryError", "ObjectLostError",
