@@ -29,6 +29,8 @@ from multiprocessing.process import BaseProcess
 from pathlib import Path
 from typing import Any
 
+from robomax_py.spec import Notice
+
 PLANNED = "planned"
 INFEASIBLE = "infeasible"
 BAD_INPUT = "bad input"
@@ -37,7 +39,7 @@ CRASHED = "crashed"
 STATUSES = (PLANNED, INFEASIBLE, BAD_INPUT, TIMEOUT, CRASHED)
 
 SUMMARY_COLUMNS = ("cell", "file", "status", "cycle_time_s", "planning_s", "spots", "detours", "reasons",
-                   "peak_rss_mb")
+                   "warnings", "peak_rss_mb")
 # After a worker sent its result it exits at once; one that does not within this is killed.
 EXIT_GRACE_S = 10.0
 # Modules the fork server imports once, so each cell's process starts warm (the planner imports the
@@ -71,6 +73,7 @@ class CellOutcome:
     written: tuple[str, ...] = ()    # program files written by the caller
     cell_sha256: str = ""            # the cell file's digest, named by the programs' manifest
     peak_rss_mb: float | None = None  # peak resident memory of the worker's process so far, MiB (Unix)
+    warnings: tuple[Notice, ...] = ()  # the cell file's likely mistakes (`CellSpec.notices`), cells read only
 
 
 Worker = Callable[[str, str], CellOutcome]
@@ -99,10 +102,11 @@ def plan_cell_file(file: str, method: str) -> CellOutcome:
     n_spots = sum(len(seam.spots) for seam in spec.seams)
     if result.status != PLANNED:
         reasons = "; ".join(f"{f.seam}/{f.name}: {f.reason} ({f.detail})" for f in result.failures)
-        return CellOutcome(file, spec.name, INFEASIBLE, seconds, spots=n_spots, reasons=reasons or result.message)
+        return CellOutcome(file, spec.name, INFEASIBLE, seconds, spots=n_spots, reasons=reasons or result.message,
+                           warnings=spec.notices)
     detours = sum(1 for t in result.transitions if t.kind == "detour")
     return CellOutcome(file, spec.name, PLANNED, seconds, cycle_time=result.cycle_time, spots=n_spots,
-                       detours=detours, programs=programs, cell_sha256=spec.digest)
+                       detours=detours, programs=programs, cell_sha256=spec.digest, warnings=spec.notices)
 
 
 def run_worker(worker: Worker, file: str, method: str) -> CellOutcome:
@@ -353,7 +357,8 @@ def summary_rows(outcomes: Sequence[CellOutcome]) -> list[dict[str, str]]:
     return [
         {"cell": o.cell, "file": o.file, "status": o.status, "cycle_time_s": num(o.cycle_time, ".3f"),
          "planning_s": num(o.seconds, ".3f"), "spots": num(o.spots, "d"), "detours": num(o.detours, "d"),
-         "reasons": o.reasons, "peak_rss_mb": num(o.peak_rss_mb, ".0f")}
+         "reasons": o.reasons, "warnings": "" if o.spots is None else str(len(o.warnings)),
+         "peak_rss_mb": num(o.peak_rss_mb, ".0f")}
         for o in outcomes
     ]
 

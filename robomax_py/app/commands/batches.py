@@ -20,6 +20,7 @@ from robomax_py.app.commands.base import (
     _method,
     _num,
     _print_json,
+    _warn,
     err,
     out,
 )
@@ -37,6 +38,8 @@ def batch(
     as_json: JsonFlag = False,
 ) -> None:
     """Plan many cells in parallel (one process per cell); write their programs and a summary table.
+
+    Each cell file's warnings (as `check` prints them) are printed and counted in the summary.
 
     Exit 0 all planned; 3 some infeasible, timed out or crashed; 2 a cell file is bad (reported in its
     row, the others still plan) or does not exist (nothing is planned).
@@ -91,6 +94,7 @@ def batch(
                 detail = f"cycle {o.cycle_time:.2f} s" if o.cycle_time is not None else o.reasons
                 progress.console.print(f"[{style}]{o.status}[/]: {o.file} ({o.seconds:.1f} s) {detail}",
                                        soft_wrap=True, markup=True, highlight=False)
+                _warn([str(n) for n in o.warnings])    # as check and plan print them
                 progress.advance(task)
                 return o
 
@@ -102,15 +106,18 @@ def batch(
                 "out": str(out_dir), "summary": [str(out_dir / "summary.csv"), str(out_dir / "summary.md")],
                 "cells": [{"cell": o.cell, "file": o.file, "status": o.status, "cycle_time": _num(o.cycle_time),
                            "seconds": round(o.seconds, 3), "spots": o.spots, "detours": o.detours,
-                           "reasons": o.reasons, "written": list(o.written)} for o in outcomes]})
+                           "reasons": o.reasons, "written": list(o.written),
+                           "warnings": [{"file": n.file, "key": n.key, "message": n.message} for n in o.warnings]}
+                          for o in outcomes]})
             return code
         table = Table(title=f"batch: {out_dir / 'summary.md'}", title_justify="left")
-        for col in ("cell", "status", "cycle (s)", "planning (s)", "spots", "detours"):
+        for col in ("cell", "status", "cycle (s)", "planning (s)", "spots", "detours", "warnings"):
             table.add_column(col)
         for o in outcomes:
             table.add_row(o.cell, o.status, "" if o.cycle_time is None else f"{o.cycle_time:.2f}",
                           f"{o.seconds:.1f}", "" if o.spots is None else str(o.spots),
-                          "" if o.detours is None else str(o.detours))
+                          "" if o.detours is None else str(o.detours),
+                          "" if o.spots is None else str(len(o.warnings)))
         out.print(table)
         return code
 
