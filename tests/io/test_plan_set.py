@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robomax_py.io import files as files_module
+from robomax_py.io import plan_set
 from robomax_py.io.files import TMP_SUFFIX, check_set, commit_set
 
 # Two plans of one cell: "all" dialects, then srcl alone (large enough that writing takes a while).
@@ -113,7 +113,7 @@ def test_without_symbolic_links_files_are_replaced_one_by_one_and_the_manifest_l
     def refuse(*_: object, **__: object) -> None:
         raise OSError(errno.EPERM, "Operation not permitted")
 
-    monkeypatch.setattr(files_module.os, "symlink", refuse)
+    monkeypatch.setattr(plan_set.os, "symlink", refuse)
     old = commit_set(tmp_path, "c", OLD, "cellsha", SHARED)
     assert not old.linked and set_state(tmp_path, "c") == old.plan
     done = commit_set(tmp_path, "c", NEW, "cellsha", SHARED)
