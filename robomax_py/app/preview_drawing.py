@@ -100,11 +100,11 @@ def _draw_tool(root: Any, cell: CellSpec) -> list[str]:
     import meshcat.geometry as g
 
     drawn = []
-    for part, file, colour in (("body", cell.tool.body, palette.TOOL_BODY), ("tips", cell.tool.tips, palette.TOOL_TIPS)):
+    for part, shape, colour in (("body", cell.tool.body, palette.TOOL_BODY), ("tips", cell.tool.tips, palette.TOOL_TIPS)):
         try:
-            mesh = load_mesh(Path(file))
+            mesh = shape_trimesh(shape)         # in its units and scale, as the collision world reads it
         except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
-            raise RobotModelError(cell.tool.source, part, f"cannot read mesh {file}: {exc}") from None
+            raise RobotModelError(cell.tool.source, part, f"cannot read mesh {shape.path}: {exc}") from None
         path = f"robot/tool/{part}"
         root[path].set_object(_mesh_geometry(mesh.vertices, mesh.faces), g.MeshLambertMaterial(color=colour))
         drawn.append(path)
