@@ -1,6 +1,6 @@
 """JSON Schemas of the files people write (cell, robot.yaml, tool.yaml), from the pydantic models.
 
-The models in `robomax_py/io/cell.py` and `robomax_py/io/robot.py` are what robomax accepts; this
+The models in `robomax_py/io/cell_file.py` and `robomax_py/io/robot.py` are what robomax accepts; this
 script turns them into JSON Schema for editors (YAML completion and checking as you type) and into
 the key tables of the documentation, with a one-line description of every key from DESCRIPTIONS
 below. A key the models gain without a description here makes `python docs/gen_schema.py` fail, and
@@ -195,9 +195,20 @@ DESCRIPTIONS: dict[str, str] = {
     "CollisionFile.disable": "Pairs of link names never checked.",
     # tool.yaml
     "ToolFile.name": "Must equal the folder name.",
-    "ToolFile.body": "Mesh of the tool body in the flange frame; collides with everything.",
-    "ToolFile.tips": "Mesh of the electrode tips or fingers; may touch workpieces only.",
+    "ToolFile.body": "Mesh of the tool body in the flange frame; collides with everything. A path, or "
+                     "{mesh, units, scale, tolerance} for keys of its own.",
+    "ToolFile.tips": "Mesh of the electrode tips or fingers; may touch workpieces only. A path, or "
+                     "{mesh, units, scale, tolerance} for keys of its own.",
     "ToolFile.tcp": "The TCP in the flange frame; its z is the electrode closing axis.",
+    "ToolFile.units": "Unit of the numbers in both mesh files: m (default) or mm; as beside a cell object's mesh "
+                      "(docs/cad.md). A STEP states its own; there units is the unit of tolerance.",
+    "ToolFile.scale": "Further factor on both meshes after their units: one number or one per axis (default 1).",
+    "ToolFile.tolerance": "STEP only: largest distance between a mesh and the exact surface, in units "
+                          "(default 0.1 mm, at least 0.01 mm).",
+    "ToolMeshFile.mesh": "The mesh file, relative to the tool.yaml: any format trimesh reads, or a STEP.",
+    "ToolMeshFile.units": "Unit of this mesh's numbers (overrides the tool's units): m or mm.",
+    "ToolMeshFile.scale": "Further factor on this mesh after its units (overrides the tool's scale).",
+    "ToolMeshFile.tolerance": "STEP only: this mesh's meshing tolerance in units (overrides the tool's).",
 }
 
 FILES: dict[str, tuple[type[BaseModel], str]] = {

@@ -152,12 +152,13 @@ class JointLoadLimits:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class ToolSpec:
-    """A tool.yaml, checked: meshes in the flange frame, TCP pose in the flange frame."""
+    """A tool.yaml, checked: meshes in the flange frame (with the units, scale and STEP tolerance
+    the file gives them), TCP pose in the flange frame."""
 
     name: str
     source: Path
-    body: Path
-    tips: Path
+    body: MeshShape
+    tips: MeshShape
     T_flange_tcp: FloatArray          # (4, 4)
 
 

@@ -79,5 +79,12 @@ class Tolerances:
     # Over the approach distance the TCP stays on the electrode axis within this (m): the LIN
     # lines follow it to 1e-5 m (lin_path_tol_m); blends start beyond it.
     straight_tol_m: float = 1e-4
+    # io.spot_grouping: a seam formed from a spot list's geometry turns by at most this at any spot
+    # (deg): a flange curving at 200 mm radius turns 11.5 deg between spots 40 mm apart, while a
+    # corner turns 45-90 deg and a chain zig-zagging between two rows 60-120 deg.
+    seam_turn_deg: float = 20.0
+    # ... and two steps meeting at a spot differ in length by at most this factor: a spot left out
+    # (over a hole) doubles a step; a jump to another seam's end is longer still.
+    seam_spacing_ratio: float = 2.5
 
 DEFAULT = Tolerances()

@@ -19,6 +19,27 @@ SHIPPED_CELL = REPO / "tests" / "data" / "flange_cell" / "cabin_flange.yaml"
 SmallCell = Callable[..., Path]
 
 
+def _build_each_command_once() -> None:
+    """`typer.testing.CliRunner.invoke` builds the click command from the Typer app on every call
+    (~25 ms of signature inspection); the suite runs `robomax` in-process thousands of times (the
+    hostile-file sweeps), so each app's command is built once here. A built click command keeps
+    nothing of a run: each invocation makes its own context."""
+    import typer.testing
+
+    build = typer.testing._get_command
+    built: dict[int, tuple[Any, Any]] = {}
+
+    def get_command(app: Any) -> Any:
+        if id(app) not in built:
+            built[id(app)] = (app, build(app))      # the app kept alive, so its id is not reused
+        return built[id(app)][1]
+
+    typer.testing._get_command = get_command  # type: ignore[attr-defined]
+
+
+_build_each_command_once()
+
+
 def _write_small_cell(folder: Path, name: str = "small_cell", extra_spots: list[dict[str, Any]] | None = None) -> Path:
     """s7 and s8 of the shipped cell (no clamp between them), grid 3, gamma fixed: plans in ~2 s."""
     data = yaml.safe_load(SHIPPED_CELL.read_text())

@@ -3,8 +3,11 @@ trajectory file and every dialect's program the arm's robot.yaml has the data fo
 shipped arm states its encoder pulses), and `robomax verify` passes on each (its motion
 rebuilt from the program's own statements); the frame's seams are all welded and its ordered
 pillar seam keeps its order; the programs are byte for byte the committed ones
-(tests/golden/shipped: the .srcl text, and the SHA-256 of every other file), so a restructuring
-that changes no behaviour is shown to change no program. The tending cell's program waits in front
+(tests/golden/shipped: the .srcl text, and the SHA-256 of every other program file), so a
+restructuring that changes no behaviour is shown to change no program. The trajectory file, whose
+10 ms samples carry six decimals, is compared with a thinned golden copy within stated tolerances
+instead: a new release of numpy or scipy moves the last decimal of a sample now and then, which is no
+change of behaviour. The tending cell's program waits in front
 of the doors for their signals and grips and releases at the stations, and its motion keeps the
 clearance from every door while it is closed. Slow: each cell plans in 10-60 s."""
 
@@ -13,6 +16,7 @@ from __future__ import annotations
 import hashlib
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -31,7 +35,11 @@ CELLS = sorted((REPO / "cells").glob("*.yaml"))
 GOLDEN = REPO / "tests" / "golden" / "shipped"
 runner = CliRunner()
 MAIN_FILES = (".json", ".srcl", ".src", ".mod", ".ls", ".script")
-HASHED = (".json", ".src", ".dat", ".mod", ".ls", ".script")
+HASHED = (".src", ".dat", ".mod", ".ls", ".script")
+# The trajectory's golden copy: every THIN-th sample, and the spots' times and configurations.
+THIN = 25
+T_TOL_S = 1e-4          # a sample's or a spot's time, and the cycle (100x the file's last decimal)
+Q_TOL_RAD = 1e-4        # a joint angle (0.006 deg: far below any program's own resolution)
 
 
 def test_at_least_three_shipped_cells() -> None:
@@ -89,6 +97,7 @@ def test_shipped_cell_plans_and_verifies(cell: Path, tmp_path: Path, update_gold
     assert srcl == (GOLDEN / f"{name}.srcl").read_bytes(), f"{name}.srcl differs from tests/golden/shipped"
     for file, digest in digests.items():
         assert digest == sums.get(file), f"{file} differs from tests/golden/shipped/SHA256SUMS"
+    _same_trajectory(data, GOLDEN / f"{name}.trajectory.json", update_golden)
     spec = yaml.safe_load(cell.read_text())
     if "tending" in spec:                   # the job as one ordered seam of station visits per cycle
         job = spec["tending"]
@@ -113,6 +122,29 @@ def test_shipped_cell_plans_and_verifies(cell: Path, tmp_path: Path, update_gold
 
     if "tending" in spec:
         _tending_program_and_doors(cell, tmp_path / f"{name}.srcl", data)
+
+
+def _thinned(data: dict[str, Any]) -> dict[str, Any]:
+    return {"cycle_time": data["cycle_time"], "t": data["t"][::THIN], "q": data["q"][::THIN],
+            "spots": [{k: s[k] for k in ("seam", "name", "t_arrive", "t_leave", "config")} for s in data["spots"]]}
+
+
+def _same_trajectory(data: dict[str, Any], golden: Path, update: bool) -> None:
+    """The trajectory file against its thinned golden copy: the same spots in the same order with
+    the same configurations, and times and joint angles within T_TOL_S and Q_TOL_RAD."""
+    mine = _thinned(data)
+    if update:
+        golden.write_text(json.dumps(mine, separators=(",", ":")) + "\n")
+    want = json.loads(golden.read_text())
+    assert [(s["seam"], s["name"], s["config"]) for s in mine["spots"]] == \
+        [(s["seam"], s["name"], s["config"]) for s in want["spots"]], f"{golden.name}: other spots or configurations"
+    for key in ("t_arrive", "t_leave"):
+        got, ref = (np.array([s[key] for s in d["spots"]]) for d in (mine, want))
+        np.testing.assert_allclose(got, ref, rtol=0, atol=T_TOL_S, err_msg=f"{golden.name}: spot {key}")
+    assert abs(mine["cycle_time"] - want["cycle_time"]) <= T_TOL_S, (mine["cycle_time"], want["cycle_time"])
+    assert len(mine["t"]) == len(want["t"]), f"{golden.name}: {len(mine['t'])} thinned samples, golden {len(want['t'])}"
+    np.testing.assert_allclose(mine["t"], want["t"], rtol=0, atol=T_TOL_S, err_msg=f"{golden.name}: t")
+    np.testing.assert_allclose(mine["q"], want["q"], rtol=0, atol=Q_TOL_RAD, err_msg=f"{golden.name}: q")
 
 
 def _tending_program_and_doors(cell_path: Path, srcl: Path, data: dict[str, object]) -> None:

@@ -14,6 +14,10 @@ import traceback
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:                     # numpy and the specs are not imported for `robomax batch -h`
+    from robomax_py.spec import Notice
 
 PLANNED = "planned"
 INFEASIBLE = "infeasible"
@@ -75,6 +79,7 @@ class CellOutcome:
     notes: str = ""                  # what to know about a cell that is not a reason: formats passed over, retries
     plan: str = ""                   # the id of the program set written (its manifest's `plan`)
     resumed: bool = False            # --resume: planned by an earlier run, its programs kept
+    warnings: tuple[Notice, ...] = ()  # the cell file's likely mistakes (`CellSpec.notices`), cells read only
 
 
 Worker = Callable[[str, PlanSettings], CellOutcome]
@@ -107,11 +112,12 @@ def plan_cell_file(file: str, settings: PlanSettings) -> CellOutcome:
     n_spots = sum(len(seam.spots) for seam in spec.seams)
     if result.status != PLANNED:
         reasons = "; ".join(f"{f.seam}/{f.name}: {f.reason} ({f.detail})" for f in result.failures)
-        return CellOutcome(file, spec.name, INFEASIBLE, seconds, spots=n_spots, reasons=reasons or result.message)
+        return CellOutcome(file, spec.name, INFEASIBLE, seconds, spots=n_spots, reasons=reasons or result.message,
+                           warnings=spec.notices)
     detours = sum(1 for t in result.transitions if t.kind == "detour")
     return CellOutcome(file, spec.name, PLANNED, seconds, cycle_time=result.cycle_time, spots=n_spots,
                        detours=detours, programs=programs, cell_sha256=spec.digest, inputs=file_digests(reads),
-                       notes="; ".join(s.message for s in chosen.skipped))
+                       notes="; ".join(s.message for s in chosen.skipped), warnings=spec.notices)
 
 
 def file_digests(paths: list[str] | tuple[str, ...]) -> tuple[tuple[str, str], ...]:

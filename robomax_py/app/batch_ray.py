@@ -89,7 +89,9 @@ def plan_unpacked(cell: ShippedCell, settings: PlanSettings, timeout: float | No
         options = BatchOptions(jobs=1, timeout=timeout, method=settings.method, formats=settings.formats)
         (got,) = run_local([box.file], options, worker=worker, env=box.env)
         return replace(got, file=cell.file, reasons=box.outside(got.reasons), notes=box.outside(got.notes),
-                       inputs=tuple((box.outside(p), h) for p, h in got.inputs))
+                       inputs=tuple((box.outside(p), h) for p, h in got.inputs),
+                       warnings=tuple(replace(n, file=box.outside(n.file), message=box.outside(n.message))
+                                      for n in got.warnings))
 
 
 @dataclass(frozen=True, slots=True)
@@ -254,7 +256,9 @@ def _received(ray: Any, ref: Any, task: _Task, file: str, options: BatchOptions,
     except ray.exceptions.RayError as exc:
         return failed(f"Ray task failed: {type(exc).__name__}: {_first_line(exc)}")
     notes = "; ".join(n for n in (_retried(task), _as_given(got.notes, file)) if n)
-    return replace(got, file=file, reasons=_as_given(got.reasons, file), notes=notes, attempts=task.attempts)
+    warnings = tuple(replace(n, file=_as_given(n.file, file), message=_as_given(n.message, file)) for n in got.warnings)
+    return replace(got, file=file, reasons=_as_given(got.reasons, file), notes=notes, attempts=task.attempts,
+                   warnings=warnings)
 
 
 def _retried(task: _Task) -> str:

@@ -34,7 +34,7 @@ from robomax_py.app.batch_cell import (
 )
 
 SUMMARY_COLUMNS = ("cell", "file", "status", "cycle_time_s", "planning_s", "spots", "detours", "reasons",
-                   "peak_rss_mb", "attempts", "node", "resumed", "notes")
+                   "warnings", "peak_rss_mb", "attempts", "node", "resumed", "notes")
 JOURNAL_FORMAT = "robomax.batch.result/1"
 
 
@@ -78,7 +78,8 @@ def summary_rows(outcomes: Sequence[CellOutcome]) -> list[dict[str, str]]:
     return [
         {"cell": o.cell, "file": o.file, "status": o.status, "cycle_time_s": num(o.cycle_time, ".3f"),
          "planning_s": num(o.seconds, ".3f"), "spots": num(o.spots, "d"), "detours": num(o.detours, "d"),
-         "reasons": o.reasons, "peak_rss_mb": num(o.peak_rss_mb, ".0f"), "attempts": str(o.attempts),
+         "reasons": o.reasons, "warnings": "" if o.spots is None else str(len(o.warnings)),
+         "peak_rss_mb": num(o.peak_rss_mb, ".0f"), "attempts": str(o.attempts),
          "node": o.node, "resumed": "yes" if o.resumed else "", "notes": o.notes}
         for o in outcomes
     ]
@@ -126,6 +127,7 @@ def journal_line(outcome: CellOutcome, options: Mapping[str, Any]) -> str:
            "cell": outcome.cell, "status": outcome.status, "cycle_time_s": outcome.cycle_time,
            "planning_s": round(outcome.seconds, 3), "spots": outcome.spots, "detours": outcome.detours,
            "reasons": outcome.reasons, "notes": outcome.notes,
+           "warnings": [{"file": n.file, "key": n.key, "message": n.message} for n in outcome.warnings],
            "peak_rss_mb": None if outcome.peak_rss_mb is None else round(outcome.peak_rss_mb),
            "attempts": outcome.attempts, "node": outcome.node, "cell_sha256": outcome.cell_sha256,
            "plan": outcome.plan, "programs": [Path(p).name for p in outcome.written],
@@ -182,6 +184,7 @@ def resumed_outcome(row: Mapping[str, Any], file: str, out_dir: Path) -> CellOut
     from robomax_py.errors import RobomaxError
     from robomax_py.export import SHARED_FILES
     from robomax_py.io.files import MANIFEST_SUFFIX, check_set
+    from robomax_py.spec import Notice
 
     try:
         inputs = [(str(p), str(h)) for p, h in row["inputs"]]
@@ -196,7 +199,8 @@ def resumed_outcome(row: Mapping[str, Any], file: str, out_dir: Path) -> CellOut
                            spots=row["spots"], detours=row["detours"], written=tuple(str(out_dir / n) for n in programs),
                            cell_sha256=str(row["cell_sha256"]), peak_rss_mb=row["peak_rss_mb"],
                            inputs=tuple(inputs), attempts=int(row["attempts"]), node=str(row["node"]),
-                           notes=str(row["notes"]), plan=str(row["plan"]), resumed=True)
+                           notes=str(row["notes"]), plan=str(row["plan"]), resumed=True,
+                           warnings=tuple(Notice(str(n["file"]), str(n["key"]), str(n["message"])) for n in row["warnings"]))
     except (KeyError, TypeError, ValueError, IndexError, RobomaxError):
         return None
 

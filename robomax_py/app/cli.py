@@ -71,7 +71,8 @@ def import_spots_command(
     """Write a new cell with a spot list's spots added as seams (docs/spot-lists.md).
 
     Missing normals come from the part's surface, missing directions from the seam's course; without
-    a group column, seams are formed from the part's geometry and listed on stderr to check."""
+    a group column, seams are formed from the part's geometry (chains of spots on one face turning by
+    at most 20 deg at each spot: parallel rows and corners split) and listed on stderr to check."""
 
     def run() -> None:
         from robomax_py.app.import_spots import import_spots

@@ -62,7 +62,7 @@ from robomax_py.app.import_urdf_staging import (
     _staging,
     clean_stale_staging,
 )
-from robomax_py.app.xacro_sandbox import _package_candidates
+from robomax_py.app.xacro_sandbox.expansion import _package_candidates
 from robomax_py.errors import RobotModelError
 from robomax_py.io.robot import check_urdf, srdf_disabled_pairs, urdf_base_link
 from robomax_py.safe_files import (
@@ -178,7 +178,7 @@ def expanded(source: Path, roots: Sequence[Path], limits: FileLimits = LIMITS,
     # machine, where a process gets a fraction of a CPU).
     wall_s = 10 * limits.xacro_cpu_s + 30
     try:
-        done = subprocess.run([sys.executable, "-I", "-X", "utf8", str(Path(xacro_sandbox.__file__))],
+        done = subprocess.run([sys.executable, "-I", "-X", "utf8", str(Path(xacro_sandbox.__file__).with_name("__main__.py"))],
                               input=json.dumps(request).encode(), capture_output=True, timeout=wall_s,
                               env={}, check=False)
     except subprocess.TimeoutExpired:

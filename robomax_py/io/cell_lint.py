@@ -43,6 +43,13 @@ MM_POSITION_M = 50.0
 # A workshop hall is rarely over 100 m long; an object larger than that is a part or table drawn in
 # millimetres (a 700 mm table read as 700 m), or a mesh exported in millimetres.
 WORKSHOP_M = 100.0
+# A tool is carried by an arm that reaches about 4 m at the most, so no gun or gripper measures 5 m
+# across; the smallest gun body or electrode tip drawn in millimetres (tens of mm) read as metres
+# measures tens of metres.
+TOOL_MM_M = 5.0
+# No part of a tool is smaller than 2 mm across (an electrode cap is 13-20 mm, a finger pad some
+# 10 mm); a gun drawn in metres and read with `units: mm` (0.4 m -> 0.4 mm) is.
+TOOL_TINY_M = 0.002
 # An approach or a clearance of over a metre is longer than any gun's stroke or safety margin and
 # more than a third of most arms' reach; 30 (meant as 30 mm) is the usual cause.
 MM_PROCESS_M = 1.0
@@ -77,7 +84,7 @@ def lint_cell(parsed: CellFile, cell: CellSpec, path: Path) -> tuple[Notice, ...
     file = str(path)
     meshes: dict[MeshShape, Any] = {}
     units = _millimetre_positions(parsed, file) + _oversized_objects(parsed, cell, file, meshes)
-    out = [*units, *_process_lengths(parsed, file), *_home_in_radians(parsed, cell, file),
+    out = [*units, *_tool_sizes(cell, meshes), *_process_lengths(parsed, file), *_home_in_radians(parsed, cell, file),
            *_zero_clearance(parsed, cell, file)]
     if not units:                   # in millimetres, every spot is off every surface: one mistake, named above
         out += _spots_and_objects(parsed, cell, file, meshes)
@@ -181,6 +188,34 @@ def _oversized_objects(parsed: CellFile, cell: CellSpec, file: str, meshes: dict
                           (f"{obj.name}: it measures {size:g} m across, larger than any workshop ({WORKSHOP_M:g} m): "
                           "lengths in a cell file and its meshes are metres; drawn in millimetres?")))
     return _grouped(file, found, f"objects over {WORKSHOP_M:g} m")
+
+
+def _tool_sizes(cell: CellSpec, meshes: dict[MeshShape, Any]) -> list[Notice]:
+    """The tool's body or tips larger than any tool (a mesh in millimetres read as metres) or
+    smaller than any part of one (in metres, read as millimetres); named in the tool.yaml."""
+    from robomax_py.robot.cad import is_step
+
+    large: list[tuple[str, str]] = []
+    small: list[tuple[str, str]] = []
+    for key, shape in (("body", cell.tool.body), ("tips", cell.tool.tips)):
+        size = float(np.max(_mesh(shape, meshes).extents))
+        if TOOL_TINY_M <= size <= TOOL_MM_M:
+            continue
+        if is_step(shape.path):
+            hint = "a STEP is read in the length unit it states: does the file state the right one?"
+        elif size > TOOL_MM_M:
+            hint = ("a mesh's numbers are read as metres; drawn in millimetres? write `units: mm` in the tool.yaml "
+                    "(at the top for both meshes, or beside this one's `mesh`)"
+                    if shape.scale == (1.0, 1.0, 1.0) else "after its units and scale; are they right?")
+        else:
+            hint = ("`units: mm` given to a mesh drawn in metres?" if max(shape.scale) < 1.0
+                    else "are its units and scale right?")
+        bound = (f"larger than any tool ({TOOL_MM_M:g} m)" if size > TOOL_MM_M
+                 else f"smaller than any part of a tool ({TOOL_TINY_M * 1000:g} mm)")
+        (large if size > TOOL_MM_M else small).append(
+            (key, f"{cell.tool.name}: its {key} mesh measures {size:.3g} m across, {bound}: {hint}"))
+    file = str(cell.tool.source)
+    return _grouped(file, large, "meshes that large") + _grouped(file, small, "meshes that small")
 
 
 def _home_in_radians(parsed: CellFile, cell: CellSpec, file: str) -> list[Notice]:

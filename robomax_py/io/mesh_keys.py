@@ -1,4 +1,5 @@
-"""The keys beside a cell object's `mesh`: `units`, `scale` and `tolerance` (docs/cad.md).
+"""The keys beside a mesh: `units`, `scale` and `tolerance` (docs/cad.md), for a cell object's
+`mesh` and a tool.yaml's `body` and `tips` alike.
 
     - name: door
       mesh: parts/door.step       # or .stl, .obj, .ply, .glb ...
@@ -13,12 +14,13 @@ file from a CAD system) and, when given, must be that unit.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated, Literal
 
 from pydantic import Field
 
-from robomax_py.errors import CellFileError
+from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.robot.cad import (
     DEFAULT_TOLERANCE_MM,
     MIN_TOLERANCE_MM,
@@ -47,9 +49,18 @@ def misplaced_mesh_keys(given: dict[str, object]) -> str | None:
 
 
 def mesh_shape(mesh: Path, units: MeshUnits | None, scale: float | list[float] | None, tolerance: float | None,
-               file: Path, key: str) -> MeshShape:
-    """The MeshShape of an object's mesh file (checked to exist and be readable) and the keys beside
-    it; `key` is the object's key (objects[i]). CellFileError on keys that do not fit the file."""
+               file: Path, key: str, error: type[CellFileError | RobotModelError] = CellFileError,
+               keys: Mapping[str, str] | None = None) -> MeshShape:
+    """The MeshShape of a mesh file (checked to exist and be readable) and the keys beside it.
+
+    `key` is the item the keys sit in (a cell's `objects[i]`): a problem with `units` is reported
+    at `{key}.units`, unless `keys` names another place for it (a tool.yaml's top-level `units`,
+    given for both its meshes). `error` (CellFileError, or RobotModelError for a tool.yaml) is
+    raised, naming `file`, on keys that do not fit the mesh file.
+    """
+    def at(name: str) -> str:
+        return (keys or {}).get(name, f"{key}.{name}")
+
     factors = (1.0, 1.0, 1.0)
     if isinstance(scale, list):
         factors = (float(scale[0]), float(scale[1]), float(scale[2]))
@@ -57,8 +68,8 @@ def mesh_shape(mesh: Path, units: MeshUnits | None, scale: float | list[float] |
         factors = (float(scale),) * 3
     if not is_step(mesh):
         if tolerance is not None:
-            raise CellFileError(file, f"{key}.tolerance", f"{mesh.name} is already triangles; a tolerance is "
-                                                          "for meshing a STEP file (.step, .stp)")
+            raise error(file, at("tolerance"), f"{mesh.name} is already triangles; a tolerance is "
+                                               "for meshing a STEP file (.step, .stp)")
         unit = METRES_PER_UNIT[units or "m"]
         return MeshShape(path=mesh, scale=(factors[0] * unit, factors[1] * unit, factors[2] * unit))
     try:
@@ -66,13 +77,13 @@ def mesh_shape(mesh: Path, units: MeshUnits | None, scale: float | list[float] |
     except OSError:
         stated = None                           # unreadable: refused, naming the mesh key, when it is read
     if units is not None and stated in METRES_PER_UNIT and units != stated:
-        raise CellFileError(file, f"{key}.units", f"{mesh.name} states its lengths in {stated} and is read in "
-                                                  f"them; units: {units} contradicts it (leave units out, or "
-                                                  f"write units: {stated})")
+        raise error(file, at("units"), f"{mesh.name} states its lengths in {stated} and is read in "
+                                       f"them; units: {units} contradicts it (leave units out, or "
+                                       f"write units: {stated})")
     unit_name = units or (stated if stated in METRES_PER_UNIT else "mm")
     metres = (DEFAULT_TOLERANCE_MM / 1000.0 if tolerance is None
               else float(tolerance) * METRES_PER_UNIT[unit_name])
     if metres < MIN_TOLERANCE_MM / 1000.0:
-        raise CellFileError(file, f"{key}.tolerance", f"{tolerance:g} {unit_name} is finer than the "
-                                                      f"{MIN_TOLERANCE_MM:g} mm a STEP is meshed at, at the finest")
+        raise error(file, at("tolerance"), f"{tolerance:g} {unit_name} is finer than the "
+                                           f"{MIN_TOLERANCE_MM:g} mm a STEP is meshed at, at the finest")
     return MeshShape(path=mesh, scale=factors, tolerance=metres)

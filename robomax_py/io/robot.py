@@ -15,6 +15,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from robomax_py.errors import RobotModelError
+from robomax_py.io.mesh_keys import MeshScale, MeshTolerance, MeshUnits, mesh_shape
 from robomax_py.io.robot_paths import (
     PACKAGE_SEARCH_DEPTH,
     PACKAGE_SEARCH_PARENTS,
@@ -57,6 +58,7 @@ __all__ = [
     "JOINT_POSITION_BOUND", "JOINT_VELOCITY_RANGE", "PACKAGE_SEARCH_DEPTH", "PACKAGE_SEARCH_PARENTS",
     "ROBOTS_ENV", "ROS_INDUSTRIAL_BASE_LINK", "ROS_PACKAGE_PATH_ENV", "CollisionFile", "ControllerFile",
     "Finite", "IkFile", "LimitsFile", "LinkName", "LoadedLimitsFile", "PoseFile", "RobotFile", "ToolFile",
+    "ToolMeshFile",
     "Vec3", "check_urdf", "load_robot_spec", "load_tool_spec", "mesh_candidates", "package_dirs_for",
     "package_share_dirs", "parse_urdf", "resolve_package_uri", "resolve_robot_file", "resolve_tool_file",
     "robot_library", "shipped_robots_dir", "srdf_disabled_pairs", "urdf_base_link", "urdf_package_dirs",
@@ -175,11 +177,25 @@ class RobotFile(_Strict):
     description: str = ""
 
 
+class ToolMeshFile(_Strict):
+    """A tool mesh with its own keys, as a cell object gives them beside `mesh` (docs/cad.md)."""
+
+    mesh: str
+    units: MeshUnits | None = None
+    scale: MeshScale | None = None
+    tolerance: MeshTolerance | None = None
+
+
 class ToolFile(_Strict):
     name: str
-    body: str
-    tips: str
+    body: str | ToolMeshFile                  # a path, or {mesh, units, scale, tolerance}
+    tips: str | ToolMeshFile
     tcp: PoseFile = PoseFile()
+    # Extensions (docs/cad.md, "Tool meshes"): the unit and factor of both meshes' numbers, and a
+    # STEP's meshing tolerance; a mesh given as a mapping overrides each key it gives.
+    units: MeshUnits | None = None
+    scale: MeshScale | None = None
+    tolerance: MeshTolerance | None = None
 
 
 # ------------------------------------------------------------------------------ loading
@@ -259,7 +275,11 @@ def load_robot_spec(path: Path) -> RobotSpec:
 
 
 def load_tool_spec(path: Path) -> ToolSpec:
-    """Read and check a tool.yaml; its meshes must exist (they are read when the scene is built)."""
+    """Read and check a tool.yaml; its meshes must exist (they are read when the scene is built).
+
+    Each mesh's `units`, `scale` and `tolerance` are its own when it is given as a mapping, else
+    the tool's top-level ones; they mean what they mean beside a cell object's mesh (docs/cad.md).
+    """
     data = read_yaml_mapping(path, RobotModelError, "tool description", LIMITS.description)
     try:
         parsed = ToolFile.model_validate(data)
@@ -267,8 +287,17 @@ def load_tool_spec(path: Path) -> ToolSpec:
         raise validation_error(exc, ToolFile, path, RobotModelError) from None
     meshes = {}
     for key in ("body", "tips"):
-        named = path.parent / getattr(parsed, key)
-        meshes[key] = checked_file(named, LIMITS.mesh, named_by(RobotModelError, path, key), f"mesh {named}")
+        given = getattr(parsed, key)
+        own = given if isinstance(given, ToolMeshFile) else ToolMeshFile(mesh=given)
+        mesh_key = f"{key}.mesh" if isinstance(given, ToolMeshFile) else key
+        named = path.parent / own.mesh
+        found = checked_file(named, LIMITS.mesh, named_by(RobotModelError, path, mesh_key), f"mesh {named}")
+        # A key the mesh leaves out comes from the top level, and a problem with it is named there.
+        keys = {name: name for name in ("units", "scale", "tolerance") if getattr(own, name) is None}
+        meshes[key] = mesh_shape(found, own.units or parsed.units,
+                                 own.scale if own.scale is not None else parsed.scale,
+                                 own.tolerance if own.tolerance is not None else parsed.tolerance,
+                                 path, key, RobotModelError, keys)
     rpy = [math.radians(a) for a in parsed.tcp.rpy]
     return ToolSpec(
         name=parsed.name,

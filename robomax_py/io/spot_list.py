@@ -7,8 +7,10 @@ into a new cell file. What a list leaves out is recovered from the part:
 - a missing normal is the normal of the part's surface nearest the spot, turned to the side the gun
   can reach (the side whose approach line is free of the part and the other objects; toward the
   robot base when both are, and the spot is reported as ambiguous);
-- a missing direction follows the seam's course (its spots in list order);
-- without a group column, spots are grouped into seams by the part's geometry.
+- a missing direction follows the seam's course (its spots in the seam's order: the list's for a
+  group column, along the chain for seams formed from the geometry);
+- without a group column, spots are grouped into seams by the part's geometry: chains that turn
+  gently at every spot, on one face (`io.spot_grouping`).
 
 A spot further from the part's surface than the distance tolerance is an error naming its row.
 Nothing here prints; what a person should check is returned in the `SpotListResult`.
@@ -29,6 +31,7 @@ import trimesh
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import CellFileError, _LocatedError
+from robomax_py.io.spot_grouping import SpotGroup, geometric_groups
 from robomax_py.io.yaml_files import MAX_LISTED_PROBLEMS, several
 from robomax_py.robot.geometry import shape_trimesh
 from robomax_py.safe_files import LIMITS, checked_file, read_text
@@ -40,10 +43,6 @@ UNITS = {"m": 1.0, "mm": 0.001}
 DEFAULT_MAX_DISTANCE = 0.002        # m: a spot further from the part's surface is an error
 # Coordinates in metres beyond this, in the part's own frame, are probably millimetres.
 LOOKS_LIKE_MM = 10.0
-# Grouping by geometry: one seam's neighbouring spots have normals within this angle and lie within
-# GAP_FACTOR times the list's median nearest-neighbour spacing of each other.
-SAME_FACE_DEG = 10.0
-GAP_FACTOR = 3.0
 # The side test starts this far off the surface (a ray from the surface itself hits it at zero).
 SIDE_OFFSET = 5e-4
 # Rounding of what is written: 0.1 um and 1e-9 of a unit vector, far below any weld's accuracy, so
@@ -312,10 +311,11 @@ def spot_list_seams(spots: SpotList, part: ObjectSpec, others: Sequence[ObjectSp
                                      f"({approach * 1000:g} mm); the normal points out of the part, check it")
             normals[i] = n
         result.recovered_normals = len(need)
-    groups = _groups(rows, xyz, normals) if spots.grouped else _geometric_groups(xyz, normals)
-    by = "the group column" if spots.grouped else "the part's geometry (one face, neighbours in a line)"
+    groups = _groups(rows) if spots.grouped else geometric_groups(xyz, normals)
+    by = "the group column" if spots.grouped else "the part's geometry (one face, a chain turning gently at each spot)"
     x_axis, y_axis = R_part[:, 0], R_part[:, 1]
-    for name, members in groups:
+    for group in groups:
+        name, members = group.name, list(group.members)
         result.formed.append(f"seam {name}: {len(members)} spots (rows {_rows_text([rows[i].row for i in members])}), "
                              f"grouped by {by}")
         course = xyz[members]
@@ -374,43 +374,10 @@ def _reachable_sides(surface: trimesh.Trimesh, others: Sequence[ObjectSpec], poi
     return [(not blocked[i], not blocked[n + i]) for i in range(n)]
 
 
-def _groups(rows: Sequence[SpotRow], xyz: FloatArray, normals: FloatArray) -> list[tuple[str, list[int]]]:
+def _groups(rows: Sequence[SpotRow]) -> list[SpotGroup]:
     """Seams by the group column, in the order each group first appears; spots in list order."""
     out: dict[str, list[int]] = {}
     for i, r in enumerate(rows):
         assert r.group is not None
         out.setdefault(r.group, []).append(i)
-    return list(out.items())
-
-
-def _geometric_groups(xyz: FloatArray, normals: FloatArray) -> list[tuple[str, list[int]]]:
-    """Seams seam1..n by geometry: spots joined when their normals are within SAME_FACE_DEG and they
-    lie within GAP_FACTOR x the median nearest-neighbour spacing (a chain of neighbours along a
-    flange); numbered by their first spot in the list, spots in list order."""
-    from scipy.spatial import cKDTree
-
-    count = len(xyz)
-    if count == 1:
-        return [("seam1", [0])]
-    tree = cKDTree(xyz)
-    nearest, _ = tree.query(xyz, k=2)
-    gap = max(GAP_FACTOR * float(np.median(nearest[:, 1])), 1e-6)
-    parent = list(range(count))
-
-    def root(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    cos_face = math.cos(math.radians(SAME_FACE_DEG))
-    for i, j in sorted(tree.query_pairs(gap)):
-        if float(np.dot(normals[i], normals[j])) >= cos_face:
-            a, b = root(i), root(j)
-            if a != b:
-                parent[max(a, b)] = min(a, b)
-    members: dict[int, list[int]] = {}
-    for i in range(count):
-        members.setdefault(root(i), []).append(i)
-    ordered = sorted(members.values(), key=lambda m: m[0])
-    return [(f"seam{k + 1}", m) for k, m in enumerate(ordered)]
+    return [SpotGroup(name, tuple(members)) for name, members in out.items()]

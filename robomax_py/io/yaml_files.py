@@ -210,30 +210,70 @@ def validation_error(
 ) -> _LocatedError:
     """The schema violations as one located error, with a 'did you mean' for unknown keys: the
     error itself when there is one, else every one (up to MAX_LISTED_PROBLEMS) on its own line. A
-    value that fits no member of a union is reported once, at its own key."""
-    found: list[_LocatedError] = []
-    seen: list[tuple[int | str, ...]] = []
+    value that fits no member of a union is reported at its own key, by the member its kind fits
+    (a mapping by a mapping member, so a misspelt key inside it is named; a list by a list member)."""
+    entries = []
     for err in exc.errors(include_url=False):
-        # Pydantic appends the union member or validator name ('function-after[...]') to locations; drop it.
-        loc = tuple(p for p in err["loc"] if not (isinstance(p, str) and "[" in p))
-        value = _value_loc(loc)
-        if any(value[:len(s)] == s or s[:len(value)] == value for s in seen):
-            continue                     # the same value, seen through another member of a union
-        seen.append(value)
-        found.append(error(path, key_path(loc) or None, _problem(err, schema, loc)))
-    return several(found, path)
+        # Pydantic names a validator wrapping a value ('function-after[...]') in locations; drop it.
+        loc = tuple(p for p in err["loc"] if not (isinstance(p, str) and p.startswith("function-")))
+        entries.append((loc, err))
+    return several([error(path, key_path(loc) or None, _problem(err, schema, loc))
+                    for loc, err in _fitting_members(entries)], path)
 
 
 _TYPE_TAGS = frozenset({"int", "float", "str", "bool", "list", "dict", "none"})
 
 
+def _is_member_tag(part: int | str) -> bool:
+    """A union member's name pydantic inserts in a location ('constrained-int', 'InputFile', 'str',
+    'list[...]'); file keys are lower-case words without '-'."""
+    return isinstance(part, str) and ("-" in part or "[" in part or part[:1].isupper() or part in _TYPE_TAGS)
+
+
 def _value_loc(loc: tuple[int | str, ...]) -> tuple[int | str, ...]:
-    """The location of the value an error is about: cut at the first union member tag pydantic
-    inserts ('constrained-int', 'InputFile', 'list'); file keys are lower-case words without '-'."""
+    """The location of the value an error is about: cut at the first union member tag."""
     for i, part in enumerate(loc):
-        if isinstance(part, str) and ("-" in part or part[:1].isupper() or part in _TYPE_TAGS):
+        if _is_member_tag(part):
             return loc[:i]
     return loc
+
+
+def _fitting_members(entries: list[tuple[tuple[int | str, ...], Any]]) -> list[tuple[tuple[int | str, ...], Any]]:
+    """The errors to report, each with its location free of member tags: of a value that fits no
+    member of a union, only the errors of the member its kind fits (the first member when none
+    does), unions inside that member chosen alike."""
+    groups: dict[tuple[int | str, ...], list[tuple[tuple[int | str, ...], Any]]] = {}
+    for loc, err in entries:
+        groups.setdefault(_value_loc(loc), []).append((loc, err))
+    out: list[tuple[tuple[int | str, ...], Any]] = []
+    seen: list[tuple[int | str, ...]] = []
+    for value, group in groups.items():
+        if any(value[:len(s)] == s or s[:len(value)] == value for s in seen):
+            continue                     # the same value, seen through another member of a union
+        seen.append(value)
+        tagged = [(loc, err) for loc, err in group if len(loc) > len(value)]
+        if not tagged:
+            out += group
+            continue
+        given = next((err["input"] for loc, err in tagged if len(loc) == len(value) + 1 and "input" in err), None)
+        members = list(dict.fromkeys(loc[len(value)] for loc, _ in tagged))
+        member = next((m for m in members if _member_kind(m) == _input_kind(given)), members[0])
+        out += _fitting_members([(value + loc[len(value) + 1:], err) for loc, err in tagged
+                                 if loc[len(value)] == member])
+    return out
+
+
+def _member_kind(tag: int | str) -> str:
+    text = str(tag)
+    if text[:1].isupper() or text.startswith("dict["):
+        return "mapping"
+    return "list" if text.startswith(("list[", "tuple[")) or text in ("list", "tuple") else "scalar"
+
+
+def _input_kind(value: Any) -> str:
+    if isinstance(value, dict):
+        return "mapping"
+    return "list" if isinstance(value, (list, tuple)) else "scalar"
 
 
 def several(errors: list[_LocatedError], file: str | Path, more: bool = False) -> _LocatedError:

@@ -80,7 +80,9 @@ def _key(robot: RobotModel, gm: pin.GeometryModel, n_self: int, pair_sets: Seque
 def _shape_bytes(geometry: Any) -> bytes | None:
     """The bytes that determine a coal shape: a convex hull by its points (coal does not pickle
     `ConvexBase`), any other shape by its pickle; None for neither."""
-    kind = f"{type(geometry).__name__}|{geometry.getNodeType()}|{geometry.getSweptSphereRadius()!r}|".encode()
+    # A triangle BVH (a tool mesh that is not convex pieces) has no swept-sphere radius in coal 3.
+    radius = geometry.getSweptSphereRadius() if hasattr(geometry, "getSweptSphereRadius") else None
+    kind = f"{type(geometry).__name__}|{geometry.getNodeType()}|{radius!r}|".encode()
     if hasattr(geometry, "points") and hasattr(geometry, "num_points"):
         return kind + np.ascontiguousarray(np.asarray(geometry.points(), dtype=float)).tobytes()
     try:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import json
 import os
 import signal
 import time
@@ -90,6 +91,40 @@ def test_batch_writes_programs_of_planned_cells_only_and_a_markdown_table(batch_
     assert "| cell_far |" in table[3] and f"| {INFEASIBLE} |" in table[3]
 
 
+def _notices(file: str) -> list[str]:
+    from robomax_py.io.cell import load_cell
+
+    return [str(n) for n in load_cell(file).notices]
+
+
+def test_batch_counts_each_cell_s_warnings_and_prints_them(batch_run: Batch) -> None:
+    """The small cell keeps `clearance: 0` beside its workpiece (docs/cell_warnings.md): the summary
+    and the printed table count each cell's warnings, as `check` finds them, and stderr gives each
+    text as `check` prints it; a file that does not load has none to count."""
+    a, far, _bad, b = batch_run.files
+    warned = {f: _notices(f) for f in (a, far, b)}
+    assert any("process.clearance" in line for line in warned[a])
+    rows = read_summary(batch_run.out)
+    assert [r["warnings"] for r in rows] == [str(len(warned[a])), str(len(warned[far])), "", str(len(warned[b]))]
+    for lines in warned.values():
+        for line in lines:
+            assert f"warning: {line}" in batch_run.output
+    md = [line.split("|") for line in (batch_run.out / "summary.md").read_text().splitlines() if line.startswith("|")]
+    column = [c.strip() for c in md[0]].index("warnings")
+    assert [row[column].strip() for row in md[2:]] == [r["warnings"] for r in rows]
+    assert "warnings" in batch_run.output.split("batch:", 1)[1]          # the printed table's column
+
+
+def test_batch_json_lists_each_cell_s_warnings(batch_run: Batch, tmp_path: Path) -> None:
+    """--json gives each cell's warnings as `plan --json` does: file, key and message."""
+    far = batch_run.files[1]
+    result = runner.invoke(app, ["batch", far, "-o", str(tmp_path / "out"), "--json"])
+    assert result.exit_code == EXIT_INFEASIBLE, result.output
+    (cell,) = json.loads(result.stdout)["cells"]
+    assert cell["status"] == INFEASIBLE
+    assert [f"{w['file']}: {w['key']}: {w['message']}" for w in cell["warnings"]] == _notices(far) != []
+
+
 def test_batch_programs_equal_plan_programs_byte_for_byte(batch_run: Batch, tmp_path: Path) -> None:
     result = runner.invoke(app, ["plan", batch_run.files[0], "-o", str(tmp_path)])
     assert result.exit_code == EXIT_OK, result.output
@@ -165,6 +200,11 @@ def test_ray_batch_gives_the_same_bytes_as_the_local_pool(batch_run: Batch, tmp_
     assert [r["status"] for r in read_summary(out)] == [PLANNED, INFEASIBLE, BAD_INPUT, PLANNED]
     for name in ("cell_a.json", "cell_a.srcl", "cell_b.json", "cell_b.srcl"):
         assert (out / name).read_bytes() == (batch_run.out / name).read_bytes()
+    # The same reasons and warnings, naming the cell files as given (not the task's copies of them).
+    for key in ("reasons", "warnings"):
+        assert [r[key] for r in read_summary(out)] == [r[key] for r in read_summary(batch_run.out)]
+    for line in (line for line in batch_run.output.splitlines() if line.startswith("warning:")):
+        assert line in result.output
 
 
 @pytest.mark.slow

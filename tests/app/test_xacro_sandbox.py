@@ -9,6 +9,7 @@ test/test_xacro.py (the installed xacro 2.1.1's branch); the line of each is giv
 
 from __future__ import annotations
 
+import ast
 import math
 import os
 import shutil
@@ -21,6 +22,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from robomax_py.app import xacro_sandbox
 from robomax_py.app.import_urdf import allowed_folders, expand
 from robomax_py.app.xacro_sandbox import FUNCTIONS, Expansion, Refused
 from robomax_py.errors import RobotModelError
@@ -263,3 +265,22 @@ def test_arithmetic_agrees_with_python(expr: str) -> None:
         return
     got = expansion.evaluate(expr, dict(expansion.symbols))
     assert got == want or (isinstance(want, float) and math.isnan(want) and math.isnan(got))
+
+
+def test_the_sandbox_imports_the_standard_library_xacro_and_itself_only() -> None:
+    """The child runs as `python -I` and must not import robomax_py (another version may be the one
+    installed, and the package imports much): each module of the sandbox imports only the standard
+    library, xacro and its siblings (relatively, which `__main__` makes work without robomax_py)."""
+    files = sorted(Path(xacro_sandbox.__file__).parent.glob("*.py"))
+    assert {f.name for f in files} >= {"__init__.py", "__main__.py", "evaluator.py", "expansion.py", "child.py"}
+    for file in files:
+        for node in ast.walk(ast.parse(file.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                names = [] if node.level else [str(node.module)]
+            else:
+                continue
+            for name in names:
+                top = name.split(".")[0]
+                assert top in sys.stdlib_module_names or top == "xacro", f"{file.name} imports {name}"

@@ -176,6 +176,13 @@ def test_mesh_keys_that_do_not_fit_are_refused(tmp_path: Path, reference_cell_pa
                       "pose": {"xyz": PART_XYZ}})
     with pytest.raises(CellFileError, match=r"objects\[9\]\.tolerance: cabin_panel\.stl is already triangles"):
         load_cell(path)
+    # A scale fits neither member of its union (a number, or three): named at its own key.
+    for scale, problem in ((-1, "greater than 0"), ([1, 2], "at least 3 items")):
+        path = cell_with(tmp_path / f"scale{len(str(scale))}", reference_cell_path,
+                         {"name": "panel2", "mesh": "parts/cabin_panel.stl", "scale": scale, "pose": {"xyz": PART_XYZ}})
+        with pytest.raises(CellFileError) as err:
+            load_cell(path)
+        assert err.value.key == "objects[9].scale" and problem in err.value.problem, err.value
 
 
 def test_a_step_that_does_not_read_is_one_message(tmp_path: Path, reference_cell_path: Path,

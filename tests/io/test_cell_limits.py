@@ -20,6 +20,7 @@ from typer.testing import CliRunner
 from robomax_py.app.cli import EXIT_BAD_INPUT, app
 from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.io import cell as cell_io
+from robomax_py.io import cell_limits
 from robomax_py.io.cell import CELL_LIMITS, load_cell, load_cell_robot
 from robomax_py.io.yaml_files import count_items
 from robomax_py.plan import candidates
@@ -115,10 +116,10 @@ def test_a_mesh_of_too_many_triangles_is_refused(tmp_path: Path, write_small_cel
     # The shipped panel is a binary STL: its header says how many triangles it has.
     stl = tmp_path / "parts" / "cabin_panel.stl"
     n = int.from_bytes(stl.read_bytes()[80:84], "little")
-    monkeypatch.setattr(cell_io, "CELL_LIMITS", dataclasses.replace(CELL_LIMITS, mesh_triangles=n - 1))
+    monkeypatch.setattr(cell_limits, "CELL_LIMITS", dataclasses.replace(CELL_LIMITS, mesh_triangles=n - 1))
     with pytest.raises(CellFileError, match=re.escape(f"has {n:,} triangles, more than the {n - 1:,}")):
         load_cell(cell)
-    monkeypatch.setattr(cell_io, "CELL_LIMITS", dataclasses.replace(CELL_LIMITS, cell_triangles=n - 1))
+    monkeypatch.setattr(cell_limits, "CELL_LIMITS", dataclasses.replace(CELL_LIMITS, cell_triangles=n - 1))
     with pytest.raises(CellFileError, match=r"\(cell_triangles\)"):
         load_cell(cell)
 
@@ -134,14 +135,14 @@ def test_an_obj_of_too_many_faces_is_refused_before_it_is_read(tmp_path: Path, w
     panel = int.from_bytes((tmp_path / "parts" / "cabin_panel.stl").read_bytes()[80:84], "little")
     limit = max(panel, 10_000)
     (tmp_path / "grid.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n" + "f 1 2 3\nf 2 4 3\n" * (limit // 2 + 1))
-    monkeypatch.setattr(cell_io, "CELL_LIMITS", dataclasses.replace(CELL_LIMITS, mesh_triangles=limit))
-    read = cell_io.load_mesh
+    monkeypatch.setattr(cell_limits, "CELL_LIMITS", dataclasses.replace(CELL_LIMITS, mesh_triangles=limit))
+    read = cell_limits.load_mesh
 
     def only_others(mesh: Path) -> Any:
         assert mesh.name != "grid.obj", "the refused mesh was read"
         return read(mesh)
 
-    monkeypatch.setattr(cell_io, "load_mesh", only_others)
+    monkeypatch.setattr(cell_limits, "load_mesh", only_others)
     with pytest.raises(CellFileError, match=rf"grid.obj has {2 * (limit // 2 + 1):,} triangles or more, more than "
                                             rf"the {limit:,} a mesh may have \(mesh_triangles\)"):
         load_cell(cell)
@@ -155,12 +156,12 @@ def test_the_cell_s_meshes_are_totalled_by_what_they_state_before_any_is_read(
 
     cell = _edit(write_small_cell(tmp_path), twice_more)
     n = int.from_bytes((tmp_path / "parts" / "cabin_panel.stl").read_bytes()[80:84], "little")
-    monkeypatch.setattr(cell_io, "CELL_LIMITS", dataclasses.replace(CELL_LIMITS, cell_triangles=2 * n))
+    monkeypatch.setattr(cell_limits, "CELL_LIMITS", dataclasses.replace(CELL_LIMITS, cell_triangles=2 * n))
 
     def not_read(mesh: Path) -> Any:
         raise AssertionError(f"{mesh} was read")
 
-    monkeypatch.setattr(cell_io, "load_mesh", not_read)
+    monkeypatch.setattr(cell_limits, "load_mesh", not_read)
     with pytest.raises(CellFileError, match=rf"objects\[\d+\]\.mesh: the cell's meshes up to this one have {3 * n:,} "
                                             rf"triangles, more than the {2 * n:,} a cell may have \(cell_triangles\)"):
         load_cell(cell)

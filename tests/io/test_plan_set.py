@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from robomax_py.io import files as files_module
+from robomax_py.io import plan_set
 from robomax_py.io.files import TMP_SUFFIX, check_set, commit_set
 
 # Two plans of one cell: "all" dialects, then srcl alone (large enough that writing takes a while).
@@ -113,7 +113,7 @@ def test_without_symbolic_links_files_are_replaced_one_by_one_and_the_manifest_l
     def refuse(*_: object, **__: object) -> None:
         raise OSError(errno.EPERM, "Operation not permitted")
 
-    monkeypatch.setattr(files_module.os, "symlink", refuse)
+    monkeypatch.setattr(plan_set.os, "symlink", refuse)
     old = commit_set(tmp_path, "c", OLD, "cellsha", SHARED)
     assert not old.linked and set_state(tmp_path, "c") == old.plan
     done = commit_set(tmp_path, "c", NEW, "cellsha", SHARED)
@@ -128,12 +128,21 @@ def test_without_symbolic_links_files_are_replaced_one_by_one_and_the_manifest_l
 
 
 def _commit_forever(folder: str) -> None:
-    # As `robomax` does: SIGTERM unwinds (temporary files and unfinished set folders removed).
-    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
+    # As `robomax` does: SIGTERM unwinds (temporary files and unfinished set folders removed), and
+    # the signal is also kept and honoured between steps, since Python drops the exception a
+    # handler raises while a finaliser runs (`app.commands.base._honour_signals` does this there).
+    received: list[int] = []
+
+    def on_term(signum: int, frame: object) -> None:
+        received.append(signum)
+        sys.exit(128 + signum)
+
+    signal.signal(signal.SIGTERM, on_term)
     k = 0
-    while True:
+    while not received:
         commit_set(Path(folder), "c", NEW if k % 2 == 0 else OLD, "cellsha", SHARED)
         k += 1
+    sys.exit(128 + received[0])
 
 
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM])
@@ -151,7 +160,11 @@ def test_a_writer_killed_at_any_instant_leaves_one_whole_set(tmp_path: Path, sig
         time.sleep(float(rng.uniform(0.0, 0.4)))
         assert proc.pid is not None
         os.kill(proc.pid, sig)
-        proc.join(30)
+        proc.join(120)                          # a hang guard only: it ends in milliseconds
+        if proc.exitcode is None:               # never read the folder beside a live writer
+            proc.kill()
+            proc.join()
+            pytest.fail(f"the writer still ran 120 s after {sig.name}")
         state = plan_set_state(tmp_path, "c")
         assert state in (old, new), state
     commit_set(tmp_path, "c", NEW, "cellsha", SHARED)

@@ -61,6 +61,27 @@ def test_recovered_normals_positions_and_seams(tmp_path: Path) -> None:
     assert np.allclose(top[5].direction, world_normal([1, 0, 0]), atol=1e-6)
 
 
+def test_two_close_rows_in_any_order_are_two_seams_along_their_rows(tmp_path: Path) -> None:
+    """Two staggered rows 20 mm apart on the plate's top, 30 mm pitch, listed in a shuffled order:
+    each spot's nearest neighbour is in the other row, yet the seams are the rows, their spots in
+    order along them and their directions along the rows."""
+    hz = 0.025                                                # the plate's top, in its frame
+    rows = [[{"xyz": [-0.3 + 0.03 * k + 0.015 * r, 0.02 * r, hz], "normal": [0, 0, 1], "seam": f"row{r}",
+              "id": f"R{r}_{k:02d}"} for k in range(15)] for r in (0, 1)]
+    spots = rows[0] + rows[1]
+    order = np.random.default_rng(3).permutation(len(spots))
+    write_csv(tmp_path / "spots.csv", [spots[i] for i in order], mm=True)
+    cell = write_cell(tmp_path / "cell.yaml", cell_data())
+    seams, result = spot_list_seams(read_cell_file(cell), cell, "", tmp_path / "spots.csv", "plate", "mm", 0.002)
+    assert result.by_geometry and len(seams) == 2
+    got = sorted([sp.name for sp in s.spots] for s in seams)
+    want = sorted([[sp["id"] for sp in row] for row in rows])
+    assert [g if g[0] < g[-1] else g[::-1] for g in got] == want
+    along = world_normal([1, 0, 0])
+    for seam in seams:
+        assert all(abs(abs(float(np.dot(sp.direction, along))) - 1) < 1e-6 for sp in seam.spots)
+
+
 def test_group_column_and_given_normals(tmp_path: Path) -> None:
     seams, result = _import(tmp_path, normals=True, groups=True)
     assert [s.name for s in seams] == ["top1", "top2", "top3", "top4", "front", "side"]

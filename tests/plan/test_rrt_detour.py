@@ -19,6 +19,7 @@ from robomax_py.robot import RobotModel, load_robot
 from robomax_py.spec import (
     Box,
     CellSpec,
+    MeshShape,
     ObjectSpec,
     ProcessSpec,
     RobotSpec,
@@ -44,7 +45,7 @@ def pillar_world(tmp_path_factory: pytest.TempPathFactory) -> tuple[RobotModel, 
     folder = tmp_path_factory.mktemp("stub_tool")
     trimesh.creation.box([0.06, 0.06, 0.12]).apply_translation([0.0, 0.0, 0.06]).export(folder / "body.stl")
     trimesh.creation.box([0.02, 0.02, 0.02]).apply_translation([0.0, 0.0, 0.13]).export(folder / "tips.stl")
-    tool = ToolSpec("stub", folder / "tool.yaml", folder / "body.stl", folder / "tips.stl",
+    tool = ToolSpec("stub", folder / "tool.yaml", MeshShape(folder / "body.stl"), MeshShape(folder / "tips.stl"),
                     frozen_array(pose_matrix([0.0, 0.0, 0.14], [0.0, 0.0, 0.0])))
     pillar = ObjectSpec("pillar", Box((0.2, 0.2, 0.6)), frozen_array(pose_matrix([0.9, 0.0, 0.3], [0.0, 0.0, 0.0])))
     cell = CellSpec(

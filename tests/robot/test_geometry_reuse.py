@@ -13,6 +13,7 @@ import pytest
 import trimesh
 
 from robomax_py.io.robot import load_robot_spec
+from robomax_py.robot import link_geometry
 from robomax_py.robot import model as robot_model
 from robomax_py.robot.model import load_robot
 
@@ -29,15 +30,15 @@ def kr16(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> tuple[Path, list[st
     """A copy of the KR 16 folder, an empty reuse table, and the URDFs built (kinds) as they happen."""
     folder = tmp_path / "kr16"
     shutil.copytree(KR16, folder)
-    monkeypatch.setattr(robot_model, "_GEOMETRY", {})
+    monkeypatch.setattr(link_geometry, "_GEOMETRY", {})
     built: list[str] = []
-    build = robot_model._build_geometry
+    build = link_geometry._build_geometry
 
     def counted(model, spec, kind, dirs):  # type: ignore[no-untyped-def]
         built.append(str(kind))
         return build(model, spec, kind, dirs)
 
-    monkeypatch.setattr(robot_model, "_build_geometry", counted)
+    monkeypatch.setattr(link_geometry, "_build_geometry", counted)
     return folder, built
 
 

@@ -88,7 +88,7 @@ def gun(tmp_path_factory: pytest.TempPathFactory) -> ToolSpec:
     tips = trimesh.creation.box([0.02, 0.02, 0.05]).apply_translation([-0.10, 0.0, 0.325])
     body.export(folder / "body.stl")
     tips.export(folder / "tips.stl")
-    return ToolSpec("gun", folder / "tool.yaml", folder / "body.stl", folder / "tips.stl",
+    return ToolSpec("gun", folder / "tool.yaml", MeshShape(folder / "body.stl"), MeshShape(folder / "tips.stl"),
                     frozen_array(pose_matrix([-0.1, 0.0, 0.3], [0.0, 0.0, 0.0])))
 
 
@@ -526,10 +526,10 @@ def test_gun_mounting_block_may_touch_the_wrist_at_the_flange(
 ) -> None:
     """A tool piece reaching back over the flange into the link before it touches it in every
     configuration: allowed ("tool touches flange link"), and the arm is not reported colliding."""
-    body = trimesh.load(gun.body, force="mesh")
+    body = trimesh.load(gun.body.path, force="mesh")
     mount = trimesh.creation.box([0.09, 0.09, 0.2]).apply_translation([0.0, 0.0, -0.05])
     trimesh.util.concatenate([body, mount]).export(tmp_path / "body.stl")
-    mounted = ToolSpec(gun.name, gun.source, tmp_path / "body.stl", gun.tips, gun.T_flange_tcp)
+    mounted = ToolSpec(gun.name, gun.source, MeshShape(tmp_path / "body.stl"), gun.tips, gun.T_flange_tcp)
     w = world_for(ur10, mounted, options=CollisionOptions())
     allowed = [(d.piece_a, d.piece_b) for d in w.acm.disabled if d.reason == "tool touches flange link"]
     assert allowed == [("wrist_2_link_0", "tool_body[3]")]

@@ -67,7 +67,7 @@ def gun(tmp_path_factory: pytest.TempPathFactory) -> ToolSpec:
     tips = trimesh.creation.box([0.02, 0.02, 0.05]).apply_translation([-0.10, 0.0, 0.325])
     body.export(folder / "body.stl")
     tips.export(folder / "tips.stl")
-    return ToolSpec("gun", folder / "tool.yaml", folder / "body.stl", folder / "tips.stl",
+    return ToolSpec("gun", folder / "tool.yaml", MeshShape(folder / "body.stl"), MeshShape(folder / "tips.stl"),
                     frozen_array(pose_matrix([-0.1, 0.0, 0.3], [0.0, 0.0, 0.0])))
 
 
@@ -225,7 +225,7 @@ def test_missing_or_unreadable_mesh_is_a_located_cell_error(ur10: RobotModel, gu
 
 
 def test_missing_tool_mesh_names_the_tool_file(ur10: RobotModel, gun: ToolSpec, tmp_path: Path) -> None:
-    broken = ToolSpec(gun.name, gun.source, tmp_path / "missing_body.stl", gun.tips, gun.T_flange_tcp)
+    broken = ToolSpec(gun.name, gun.source, MeshShape(tmp_path / "missing_body.stl"), gun.tips, gun.T_flange_tcp)
     with pytest.raises(RobotModelError) as err:
         build_scene(make_cell(ur10, broken), ur10)
     assert err.value.key == "body" and err.value.file == str(gun.source)

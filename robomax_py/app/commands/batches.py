@@ -22,6 +22,7 @@ from robomax_py.app.commands.base import (
     _method,
     _num,
     _print_json,
+    _warn,
     err,
     out,
 )
@@ -49,6 +50,8 @@ def batch(
 ) -> None:
     """Plan many cells in parallel (one process per cell, or one Ray task); write each cell's programs and
     its row of the summary table as it finishes.
+
+    Each cell file's warnings (as `check` prints them) are printed and counted in the summary.
 
     Exit 0 all planned; 3 some infeasible, timed out or crashed; 2 a cell file is bad (reported in its
     row, the others still plan) or does not exist (nothing is planned).
@@ -113,6 +116,7 @@ def batch(
                     f" (attempt {o.attempts})" if o.attempts > 1 else "")
                 progress.console.print(f"[{style}]{o.status}[/]: {o.file} ({o.seconds:.1f} s){extra} {detail}",
                                        soft_wrap=True, markup=True, highlight=False)
+                _warn([str(n) for n in o.warnings])    # as check and plan print them
                 progress.advance(task)
                 return o
 
@@ -133,15 +137,18 @@ def batch(
                 "cells": [{"cell": o.cell, "file": o.file, "status": o.status, "cycle_time": _num(o.cycle_time),
                            "seconds": round(o.seconds, 3), "spots": o.spots, "detours": o.detours,
                            "reasons": o.reasons, "written": list(o.written), "attempts": o.attempts,
-                           "node": o.node, "resumed": o.resumed, "notes": o.notes} for o in outcomes]})
+                           "node": o.node, "resumed": o.resumed, "notes": o.notes,
+                           "warnings": [{"file": n.file, "key": n.key, "message": n.message} for n in o.warnings]}
+                          for o in outcomes]})
             return code
         table = Table(title=f"batch: {summary[1]}", title_justify="left")
-        for col in ("cell", "status", "cycle (s)", "planning (s)", "spots", "detours"):
+        for col in ("cell", "status", "cycle (s)", "planning (s)", "spots", "detours", "warnings"):
             table.add_column(col)
         for o in outcomes:
             table.add_row(o.cell, o.status, "" if o.cycle_time is None else f"{o.cycle_time:.2f}",
                           f"{o.seconds:.1f}", "" if o.spots is None else str(o.spots),
-                          "" if o.detours is None else str(o.detours))
+                          "" if o.detours is None else str(o.detours),
+                          "" if o.spots is None else str(len(o.warnings)))
         out.print(table)
         return code
 

@@ -1,0 +1,84 @@
+"""A cell's `robot` section beyond its model: the home pose checked against the URDF, and the
+controller's tool and user frames, registers and inputs."""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+
+from robomax_py.errors import CellFileError
+from robomax_py.io.cell_file import CellFile, RobotControllerFile
+from robomax_py.io.cell_objects import _pose
+from robomax_py.spec import (
+    CellSpec,
+    ControllerFrame,
+    ControllerInput,
+    ControllerSetup,
+    RobotSpec,
+    UserFrame,
+    frozen_array,
+)
+
+
+def _controller(ctrl: RobotControllerFile, cell: CellSpec, path: Path) -> ControllerSetup:
+    """`robot.controller`: the tool and user frame programs select, registers, inputs, weld style."""
+    key = "robot.controller"
+    tool = None
+    if ctrl.tool is not None:
+        tool = ControllerFrame(ctrl.tool.number or 1, ctrl.tool.name or f"{cell.tool.name}_tcp", ctrl.tool.name is not None)
+    frame = None
+    if ctrl.frame is not None:
+        f = ctrl.frame
+        if f.object is not None:
+            obj = next((o for o in cell.objects if o.name == f.object), None)
+            if obj is None:
+                known = ", ".join(o.name for o in cell.objects) or "none"
+                raise CellFileError(path, f"{key}.frame.object", f"no object '{f.object}' in the cell (objects: {known})")
+            T = np.asarray(obj.T_world_object)
+        else:
+            assert f.pose is not None  # guaranteed by UserFrameFile._one_place
+            T = _pose(f.pose)
+        name = f.name or (f.object if f.object and re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,31}", f.object) else "user_frame")
+        frame = UserFrame(ControllerFrame(f.number or 1, name, f.name is not None), frozen_array(T))
+    signals = cell.signals
+    inputs: list[ControllerInput] = []
+    for signal, given in ctrl.inputs.items():
+        if signal not in signals:
+            raise CellFileError(path, f"{key}.inputs.{signal}", f"the cell has no signal '{signal}' (its signals: "
+                                f"{', '.join(signals) or 'none'}; clamps name theirs, dynamic objects wait for "
+                                "<name>_clear, machine doors for <machine>_open)")
+        entry = ControllerInput(signal, given, None) if isinstance(given, int) else \
+            ControllerInput(signal, given.number, given.name)
+        twin = next((i for i in inputs if i.number == entry.number), None)
+        if twin is not None:
+            raise CellFileError(path, f"{key}.inputs.{signal}", f"input {entry.number} is also {twin.signal}'s")
+        inputs.append(entry)
+    return ControllerSetup(tool=tool, frame=frame, position_registers=tuple(ctrl.registers.position),
+                           numeric_registers=tuple(ctrl.registers.numeric), inputs=tuple(inputs), weld=ctrl.weld)
+
+
+def _home(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray:
+    """`robot.home` in SI, checked against the URDF: deg -> rad, prismatic joints stay in metres."""
+    from robomax_py.robot import active_joints, kinematic_model, prismatic_mask
+
+    model = kinematic_model(robot)
+    given = np.asarray(parsed.robot.home, dtype=float)
+    if len(given) != model.nq:
+        raise CellFileError(path, "robot.home", f"expected {model.nq} joint values for {robot.name}, got {len(given)}")
+    prismatic = prismatic_mask(model)
+    home = np.where(prismatic, given, np.radians(given))
+    lower, upper = np.asarray(model.lowerPositionLimit), np.asarray(model.upperPositionLimit)
+    tol = 1e-9
+    outside = (home < lower - tol) | (home > upper + tol)
+    if outside.any():
+        i = int(np.flatnonzero(outside)[0])
+        unit, scale = ("m", 1.0) if prismatic[i] else ("deg", 180 / math.pi)
+        raise CellFileError(
+            path, f"robot.home[{i}]",
+            f"{model.names[active_joints(model)[i]]} = {given[i]:.3f} {unit} is outside its limits "
+            f"[{lower[i] * scale:.3f}, {upper[i] * scale:.3f}] {unit}",
+        )
+    return home
