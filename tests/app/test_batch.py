@@ -35,6 +35,7 @@ from robomax_py.app.cli import (
 )
 
 SmallCell = Callable[..., Path]   # conftest.write_small_cell
+FORMATS = "srcl,krl"              # batch --format, as plan takes it
 FAR_SPOT = {"name": "far", "xyz": [4.0, 0.0, 1.0], "normal": [-1, 0, 0], "direction": [0, 1, 0]}
 runner = CliRunner()
 
@@ -59,7 +60,7 @@ def batch_run(tmp_path_factory: pytest.TempPathFactory, write_small_cell: SmallC
     bad.write_text(bad.read_text().replace("weld_time: 0.5", "weld_time: -1"))
     files = [str(p) for p in (a, far, bad, b)]
     out = cells / "out"
-    result = runner.invoke(app, ["batch", *files, "-j", "2", "-o", str(out)])
+    result = runner.invoke(app, ["batch", *files, "-j", "2", "-o", str(out), "--format", FORMATS])
     return Batch(cells, files, out, result.exit_code, result.output)
 
 
@@ -82,8 +83,10 @@ def test_batch_statuses_in_argument_order_and_exit_2_for_a_bad_file(batch_run: B
 
 def test_batch_writes_programs_of_planned_cells_only_and_a_markdown_table(batch_run: Batch) -> None:
     names = sorted(p.name for p in batch_run.out.iterdir() if not p.name.startswith("."))
-    assert names == ["cell_a.json", "cell_a.manifest.json", "cell_a.srcl", "cell_b.json", "cell_b.manifest.json",
-                     "cell_b.srcl", "results.jsonl", "summary.csv", "summary.md"]
+    krl = ["{}.dat", "{}.src", "{}_frames.src"]
+    assert names == sorted([*(f.format(c) for c in ("cell_a", "cell_b") for f in ["{}.json", "{}.manifest.json",
+                                                                                  "{}.srcl", *krl]),
+                            "results.jsonl", "summary.csv", "summary.md"])
     md = (batch_run.out / "summary.md").read_text().splitlines()
     table = [line for line in md if line.startswith("|")]
     assert table[0].split("|")[1:4] == [" cell ", " file ", " status "]
@@ -126,10 +129,10 @@ def test_batch_json_lists_each_cell_s_warnings(batch_run: Batch, tmp_path: Path)
 
 
 def test_batch_programs_equal_plan_programs_byte_for_byte(batch_run: Batch, tmp_path: Path) -> None:
-    result = runner.invoke(app, ["plan", batch_run.files[0], "-o", str(tmp_path)])
+    result = runner.invoke(app, ["plan", batch_run.files[0], "-o", str(tmp_path), "--format", FORMATS])
     assert result.exit_code == EXIT_OK, result.output
     # The same set, written the same way: its manifest (the cell file's digest, each file's sha256) too.
-    for ext in (".json", ".srcl", ".manifest.json"):
+    for ext in (".json", ".srcl", ".src", ".dat", "_frames.src", ".manifest.json"):
         assert (tmp_path / f"cell_a{ext}").read_bytes() == (batch_run.out / f"cell_a{ext}").read_bytes()
         assert (batch_run.out / f"cell_a{ext}").is_symlink()
 
@@ -195,10 +198,11 @@ def test_bare_ray_flag_means_a_local_ray() -> None:
 def test_ray_batch_gives_the_same_bytes_as_the_local_pool(batch_run: Batch, tmp_path: Path) -> None:
     pytest.importorskip("ray")
     out = tmp_path / "out"
-    result = runner.invoke(app, ["batch", *batch_run.files, "-j", "2", "-o", str(out), "--ray=local"])
+    result = runner.invoke(app, ["batch", *batch_run.files, "-j", "2", "-o", str(out), "--format", FORMATS,
+                                 "--ray=local"])
     assert result.exit_code == EXIT_BAD_INPUT, result.output
     assert [r["status"] for r in read_summary(out)] == [PLANNED, INFEASIBLE, BAD_INPUT, PLANNED]
-    for name in ("cell_a.json", "cell_a.srcl", "cell_b.json", "cell_b.srcl"):
+    for name in ("cell_a.json", "cell_a.srcl", "cell_a.src", "cell_b.json", "cell_b.srcl", "cell_b.dat"):
         assert (out / name).read_bytes() == (batch_run.out / name).read_bytes()
     # The same reasons and warnings, naming the cell files as given (not the task's copies of them).
     for key in ("reasons", "warnings"):
