@@ -87,7 +87,7 @@ def test_a_route_uses_only_free_edges(tables: dict[str, object]) -> None:
     start = int(np.argmin(np.linalg.norm(table.x - [-0.8, 0.85], axis=1)))   # type: ignore[union-attr]
     goal = int(np.argmin(np.linalg.norm(table.x - [0.8, 1.5], axis=1)))      # type: ignore[union-attr]
     found = route(table, start, goal, 6, edge_free)                    # type: ignore[arg-type]
-    assert found is not None and found.nodes[0] == start and found.nodes[-1] == goal
+    assert found.found and found.nodes[0] == start and found.nodes[-1] == goal
     for u, v in zip(found.nodes[:-1], found.nodes[1:]):
         assert edge_free(table.q[u], table.q[v])                       # type: ignore[union-attr]
     with pytest.raises(ValueError):
