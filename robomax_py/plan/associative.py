@@ -45,6 +45,7 @@ from robomax_py.plan.candidates import SpotCandidates
 from robomax_py.plan.loads import Loads
 from robomax_py.plan.results import Transition
 from robomax_py.plan.sequence import HOME, Tour
+from robomax_py.program import as_written_joints
 from robomax_py.robot import RobotModel
 from robomax_py.robot.ik._chain import (
     Chain,
@@ -279,7 +280,9 @@ def associative_moves(robot: RobotModel, loads: Loads, tour: Tour, transitions: 
         if part is None:
             out.append(trans)
             continue
-        wp = np.asarray(trans.waypoints, dtype=float)
+        # From the two ends as the program states them, so that the route is the one the written
+        # ends give (the table's grid is laid out from them).
+        wp = as_written_joints(np.asarray(trans.waypoints, dtype=float))
         found = plan_transfer(robot, loads.worlds[part], wp[0], wp[-1], settings, points)
         if found.status != "routed":
             return AssociativeMoves((), tuple(planned), f"{trans.label} carrying {part}: {found.detail}")

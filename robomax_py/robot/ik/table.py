@@ -36,6 +36,10 @@ Jacobian = Callable[[FloatArray], FloatArray]         # (n,) joints -> (d, n) d 
 
 # Rows filled per call of the forward kinematics and the collision test.
 BATCH = 65_536
+# A step of `follow_edge` turning a joint by more than this (rad) jumped through a singular
+# configuration: a step of a few millimetres of the point turns a well-conditioned arm's joints by
+# hundredths of a radian.
+MAX_JOINT_STEP = 0.2
 # `TableIk.nearest` scans tables of up to this many stored numbers (rows x point dimension).
 SCAN_MAX_VALUES = 50_000
 
@@ -256,9 +260,10 @@ def jacobian_interpolation(q0: FloatArray, p1: FloatArray, forward: Forward, jac
 class EdgeFollow:
     """An edge of a route followed by `jacobian_interpolation`: the joint rows (m, n) from the
     edge's first configuration towards the second's point; `arrived` when they end within the
-    tolerance of the second configuration (the last row is then that configuration exactly; else
-    the interpolation reached the point in another branch, or not at all); `off_line` the largest
-    distance (point units) of the point from the edge's straight line."""
+    tolerance of the second configuration and no step turns a joint by more than the bound (the
+    last row is then that configuration exactly; else the interpolation reached the point in
+    another branch, not at all, or by a jump through a singular configuration); `off_line` the
+    largest distance (point units) of the point from the edge's straight line."""
 
     rows: FloatArray
     arrived: bool
@@ -266,12 +271,13 @@ class EdgeFollow:
 
 
 def follow_edge(q_a: FloatArray, q_b: FloatArray, forward: Forward, jacobian: Jacobian, step: float,
-                arrival_tol: float) -> EdgeFollow:
+                arrival_tol: float, max_joint_step: float = MAX_JOINT_STEP) -> EdgeFollow:
     """The edge from configuration q_a to q_b by Jacobian interpolation (formula (15) of the paper)."""
     q_b = np.asarray(q_b, dtype=float)
     rows, off_line = jacobian_interpolation(q_a, np.asarray(forward(q_b[None, :]), dtype=float)[0], forward, jacobian,
                                             step)
-    arrived = float(np.max(np.abs(rows[-1] - q_b))) <= arrival_tol
+    arrived = float(np.max(np.abs(rows[-1] - q_b))) <= arrival_tol and \
+        float(np.max(np.abs(np.diff(rows, axis=0)))) <= max_joint_step
     if arrived:
         rows[-1] = q_b
     return EdgeFollow(rows, arrived, off_line)
