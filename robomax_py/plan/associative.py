@@ -20,13 +20,17 @@ For one carried move, from the grip's approach configuration to the release's:
    when the Jacobian interpolation (15) from its first configuration towards its second's point
    arrives at that configuration (within ARRIVAL_TOL_RAD, so not in another IK branch), within
    the joint limits, every step collision-free with the part held.
-5. The motion: the interpolated joint rows of the route, written as PTP waypoints every
-   WAYPOINT_SPACING of the point's path and at every node, flown by as every detour is, then timed
-   and checked like every other move (`time_junction`, the planner's final check, `verify`).
+5. The motion: the route's nodes written as PTP waypoints (and the interpolated rows every
+   WAYPOINT_SPACING of the point's path, by default none; an edge whose straight joint move leaves
+   free space keeps all its rows), flown by as every detour is, then timed and checked like every
+   other move (`time_junction`, the planner's final check, `verify`). The paper's controller runs
+   (15) itself in position mode; a robot program states targets, and the controller interpolates
+   between them.
 
-Each carried move's two ends are chosen before sequencing (`pin_transfer_ends`): the pair of
-grip and release candidates in one IK branch whose straight move is quickest, since the Jacobian
-interpolation follows poses continuously and cannot change branch on the way.
+Each carried move's two ends are chosen before sequencing (`pin_transfer_ends`): grip and release
+candidates in one IK branch, the nearest pair in joint space, since the Jacobian interpolation
+follows poses continuously and cannot change branch on the way. docs/associative.md has the
+measurements.
 """
 
 from __future__ import annotations
@@ -63,16 +67,20 @@ STEP_RAD = math.radians(20.0)
 # The box of the grid reaches this many steps beyond the move's two configurations on each side.
 MARGIN_STEPS = 1
 # k of the k-NN graph; the paper asks k >= 3 and chooses it by trial. A six-axis grid row has 12
-# neighbours one step away; with 12 the route search finds the moves tested (bench_transfers.py).
-NEIGHBOURS = 12
+# neighbours one step along one joint: with k = 12 a route turns one joint at a time and
+# cells/pick_place.yaml's transfers took 47 % longer than with 48; beyond 48 they shorten little
+# while the graph's edges grow (bench_transfers.py --sweep, docs/associative.md).
+NEIGHBOURS = 48
 # A grid larger than this is not built (about 0.6 s of collision checks per 100,000 rows, KR 16).
 MAX_ROWS = 400_000
 # Steps of formula (15) along an edge, point units (m).
 INTERPOLATION_STEP = 0.01
 # An edge's interpolation must end this close (rad, every joint) to the far node's configuration.
 ARRIVAL_TOL_RAD = 0.02
-# Waypoints written along the route at most this far apart in the point space (m).
-WAYPOINT_SPACING = 10.0
+# Waypoints written along the route at most this far apart in the point space (m); inf: the nodes
+# alone. The rows every 0.1 m as well lengthened cells/pick_place.yaml's cycle (every via point is
+# flown by under the part's limits) and its planning (bench_transfers.py, docs/associative.md).
+WAYPOINT_SPACING = math.inf
 # Blocked edges after which a move's route search gives up.
 MAX_BLOCKED = 400
 

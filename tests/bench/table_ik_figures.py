@@ -37,8 +37,9 @@ HELD_M = 0.25
 # The pick and place points of the route figure (m): the low left shelf to the high right one.
 PICK = (-0.8, 0.85)
 PLACE = (0.8, 1.45)
-# k of the paper's route figure ("k >= 3"), and of the checked route (a pose point has more
-# neighbours in other branches: 12 found every route tried, `bench_transfers.py` uses the same).
+# k of the paper's route figure ("k >= 3"), and of the checked route (a pose point's nearest
+# neighbours include rows of the other elbow branch, which no edge reaches: 12 found every route
+# tried on the planar arm).
 PAPER_K = 4
 CHECKED_K = 12
 # Steps of formula (15) (m) and the arrival tolerance (rad) of the checked route.

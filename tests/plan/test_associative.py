@@ -35,6 +35,7 @@ from robomax_py.plan.associative import (
 )
 from robomax_py.plan.loads import Loads, check_carried_motion
 from robomax_py.robot.ik.table import TableIk, TableRoute, knn_graph, route
+from robomax_py.robot.solve import config_text
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.scene import build_scene
 
@@ -63,7 +64,8 @@ def _same_graph(x: np.ndarray, k: int) -> nx.Graph:
     g = nx.Graph()
     built = knn_graph(x, k)
     g.add_nodes_from(range(len(x)))
-    g.add_weighted_edges_from((int(a), int(b), float(np.linalg.norm(x[a] - x[b]))) for a, b in zip(built.a, built.b))
+    length = np.linalg.norm(x[built.a] - x[built.b], axis=1)
+    g.add_weighted_edges_from(zip(built.a.tolist(), built.b.tolist(), length.tolist()))
     return g
 
 
@@ -172,6 +174,8 @@ def test_carried_moves_follow_their_routes_through_stored_rows(two_transfers: di
     for trans in carried:
         assert trans.kind == "detour"
         wp = np.asarray(trans.waypoints)
+        # The two ends in one IK branch (the configuration status; turns may differ).
+        assert config_text(robot, wp[0]).split()[0] == config_text(robot, wp[-1]).split()[0]
         world = loads.worlds[str(trans.part)]
         again = plan_transfer(robot, world, wp[0], wp[-1])
         assert again.status == "routed"
