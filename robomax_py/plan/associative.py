@@ -58,7 +58,14 @@ from robomax_py.robot.ik._chain import (
     frame_pose_and_jacobian,
 )
 from robomax_py.robot.ik.pose_table import ROTATION_WEIGHT_M, grid_of, pose_features
-from robomax_py.robot.ik.table import JointGrid, TableIk, TableRoute, follow_edge, route
+from robomax_py.robot.ik.table import (
+    EdgeFollow,
+    JointGrid,
+    TableIk,
+    TableRoute,
+    follow_edge,
+    route,
+)
 from robomax_py.spec import CellSpec
 from robomax_py.world.collision import CollisionWorld
 
@@ -119,7 +126,7 @@ class AssociativeTransfer:
     grid_rows, stored : rows of the grid, and those free with the part held (the table's K*).
     route : the route's nodes and what its search spent.
     line_error : the largest distance (point units) of the interpolated point from the straight
-        line of its edge.
+        line of its edge, over the route's edges.
     """
 
     status: TransferStatus
@@ -159,30 +166,28 @@ def _skew(v: FloatArray) -> FloatArray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
+@dataclass(frozen=True, slots=True)
+class GridTooLarge:
+    """A move's grid of more rows than `AssociativeSettings.max_rows`: not built."""
+
+    rows: int
+
+
 def transfer_table(robot: RobotModel, world: CollisionWorld, points: TcpPoints, q_start: FloatArray,
-                   q_goal: FloatArray, settings: AssociativeSettings) -> TransferTable | int:
-    """The memory of the move from q_start to q_goal; the grid's row count when it is larger than
-    settings.max_rows."""
+                   q_goal: FloatArray, settings: AssociativeSettings) -> TransferTable | GridTooLarge:
+    """The memory of the move from q_start to q_goal (module docstring, 1-3)."""
     lo_lim, hi_lim = np.asarray(robot.limits.lower, dtype=float), np.asarray(robot.limits.upper, dtype=float)
     margin = settings.margin_steps * settings.step
     lo = np.maximum(np.minimum(q_start, q_goal) - margin, lo_lim)
     hi = np.minimum(np.maximum(q_start, q_goal) + margin, hi_lim)
     grid = grid_of(lo, hi, (settings.step,) * robot.dof)
     if grid.size > settings.max_rows:
-        return grid.size
+        return GridTooLarge(grid.size)
     rows = grid.rows(0, grid.size)
     stored = rows[world.are_free(rows)]
     q = np.vstack([stored, np.asarray(q_start, dtype=float)[None], np.asarray(q_goal, dtype=float)[None]])
     x = points.points(q)
     return TransferTable(TableIk(q, x, grid.size, cKDTree(x)), grid, len(stored), len(stored) + 1)
-
-
-@dataclass(slots=True)
-class _Edges:
-    """The interpolated rows of the edges checked so far, by (from, to) configuration bytes."""
-
-    rows: dict[tuple[bytes, bytes], FloatArray]
-    worst: float = 0.0
 
 
 def plan_transfer(robot: RobotModel, world: CollisionWorld, q_start: FloatArray, q_goal: FloatArray,
@@ -193,35 +198,39 @@ def plan_transfer(robot: RobotModel, world: CollisionWorld, q_start: FloatArray,
     points = points if points is not None else TcpPoints(robot)
     q_start, q_goal = np.asarray(q_start, dtype=float), np.asarray(q_goal, dtype=float)
     memory = transfer_table(robot, world, points, q_start, q_goal, settings)
-    if isinstance(memory, int):
-        return AssociativeTransfer("grid_too_large", q_start[None], memory, 0, TableRoute("no_route"),
-                                   detail=f"the grid has {memory:,} rows, more than {settings.max_rows:,}")
-    edges = _Edges({})
+    if isinstance(memory, GridTooLarge):
+        return AssociativeTransfer("grid_too_large", q_start[None], memory.rows, 0, TableRoute("no_route"),
+                                   detail=f"the grid has {memory.rows:,} rows, more than {settings.max_rows:,}")
+    followed: dict[tuple[bytes, bytes], EdgeFollow] = {}      # the usable edges checked, by their ends
 
     def edge_free(qa: FloatArray, qb: FloatArray) -> bool:
         edge = follow_edge(qa, qb, points.points, points.jacobian, settings.interpolation_step, ARRIVAL_TOL_RAD)
-        # Not arrived: the interpolation lands in another branch, or short of the far node.
+        # Not arrived: the interpolation lands in another branch, short of the far node, or jumps.
         if not edge.arrived or not bool(robot.limits.contains(edge.rows).all()) or \
                 not world.check_path(edge.rows).free:
             return False
-        edges.rows[(qa.tobytes(), qb.tobytes())] = edge.rows
-        edges.worst = max(edges.worst, edge.off_line)
+        followed[(qa.tobytes(), qb.tobytes())] = edge
         return True
 
     table = memory.table
     found = route(table, memory.start, memory.goal, settings.k, edge_free, max_blocked=MAX_BLOCKED)
+    stored = memory.goal - 1
     if not found.found:
         why = "no route joins the two ends" if found.status == "no_route" else f"{len(found.blocked)} edges blocked"
-        return AssociativeTransfer("no_route", q_start[None], memory.grid.size, memory.goal - 1, found,
-                                   detail=f"{why} on the k-NN graph of {memory.goal - 1:,} stored rows")
-    legs = []
+        return AssociativeTransfer("no_route", q_start[None], memory.grid.size, stored, found,
+                                   detail=f"{why} on the k-NN graph of {stored:,} stored rows")
+    legs: list[FloatArray] = []
+    line_error = 0.0
     for u, v in itertools.pairwise(found.nodes):
         qa, qb = table.q[u], table.q[v]
-        rows = edges.rows.get((qa.tobytes(), qb.tobytes()))
+        edge = followed.get((qa.tobytes(), qb.tobytes()))
         # An edge checked in the other direction is followed back along the same rows.
-        legs.append(rows if rows is not None else edges.rows[(qb.tobytes(), qa.tobytes())][::-1])
+        back = edge is None
+        edge = edge if edge is not None else followed[(qb.tobytes(), qa.tobytes())]
+        legs.append(edge.rows[::-1] if back else edge.rows)
+        line_error = max(line_error, edge.off_line)
     waypoints = _waypoints(world, points, legs, settings.waypoint_spacing)
-    return AssociativeTransfer("routed", waypoints, memory.grid.size, memory.goal - 1, found, edges.worst)
+    return AssociativeTransfer("routed", waypoints, memory.grid.size, stored, found, line_error)
 
 
 def _waypoints(world: CollisionWorld, points: TcpPoints, legs: Sequence[FloatArray], spacing: float) -> FloatArray:

@@ -30,6 +30,7 @@ from robomax_py.plan.associative import (
     STEP_RAD,
     AssociativeSettings,
     TcpPoints,
+    TransferTable,
     plan_transfer,
     transfer_table,
 )
@@ -182,7 +183,7 @@ def test_carried_moves_follow_their_routes_through_stored_rows(two_transfers: di
         # Planned from the ends as written: the same route, as written.
         np.testing.assert_allclose(wp, again.waypoints, atol=WRITTEN_RAD)
         memory = transfer_table(robot, world, TcpPoints(robot), wp[0], wp[-1], AssociativeSettings())
-        assert not isinstance(memory, int)
+        assert isinstance(memory, TransferTable)
         inner = wp[1:-1]
         start = np.asarray(memory.grid.start)
         spacing = (np.asarray(memory.grid.end) - start) / (np.asarray(memory.grid.counts) - 1)
