@@ -126,6 +126,7 @@ DESCRIPTIONS: dict[str, str] = {
     "PlannerFile.detours": "Where detours are searched: roadmap, cspace or both.",
     "PlannerFile.dynamic": "timed: plan round dynamic objects in time; rest: wait at rest for them.",
     "PlannerFile.max_wait": "Longest wait at one place a timed search may propose, s.",
+    "PlannerFile.transfers": "Pick and place: moves plans carried moves as every move; associative by the associative-memory table, k-NN graph, Dijkstra route and Jacobian interpolation (docs/associative.md).",
     "TendingFile.cycles": "How many times the sequence runs.",
     "TendingFile.gripper": "Seconds the gripper takes to close and to open.",
     "TendingFile.machines": "Machines whose doors close while they machine.",

@@ -270,6 +270,9 @@ class PlannerSpec:
     # or going round); "rest" plans them as absent and waits at rest before the blocked move.
     dynamic: str = "timed"
     max_wait: float = 600.0       # s: a search that would wait longer at one place has no solution
+    # Pick and place: carried moves planned as every move ("moves") or by Diane and Anikina's
+    # associative memory, k-NN graph, Dijkstra route and Jacobian interpolation ("associative").
+    transfers: str = "moves"
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -304,6 +304,7 @@ class PlannerFile(_Strict):
     detours: Literal["roadmap", "cspace", "both"] = "both"
     dynamic: Literal["timed", "rest"] = "timed"
     max_wait: Annotated[float, Field(gt=0, le=MAX_WINDOW_S, allow_inf_nan=False)] = 600.0
+    transfers: Literal["moves", "associative"] = "moves"
 
 
 # Tending cells (docs/cell-extensions.md, "Machine tending"): stations visited in a fixed order per cycle, machines

@@ -85,7 +85,7 @@ def lint_cell(parsed: CellFile, cell: CellSpec, path: Path) -> tuple[Notice, ...
     meshes: dict[MeshShape, Any] = {}
     units = _millimetre_positions(parsed, file) + _oversized_objects(parsed, cell, file, meshes)
     out = [*units, *_tool_sizes(cell, meshes), *_process_lengths(parsed, file), *_home_in_radians(parsed, cell, file),
-           *_zero_clearance(parsed, cell, file)]
+           *_zero_clearance(parsed, cell, file), *_transfers_without_parts(parsed, file)]
     if not units:                   # in millimetres, every spot is off every surface: one mistake, named above
         out += _spots_and_objects(parsed, cell, file, meshes)
     return tuple(out)
@@ -237,6 +237,13 @@ def _home_in_radians(parsed: CellFile, cell: CellSpec, file: str) -> list[Notice
 
 def _weld_seams(parsed: CellFile) -> bool:
     return bool(parsed.seams) and parsed.tending is None and parsed.pick_place is None
+
+
+def _transfers_without_parts(parsed: CellFile, file: str) -> list[Notice]:
+    if parsed.planner.transfers == "moves" or parsed.pick_place is not None:
+        return []
+    return [Notice(file, "planner.transfers", f"{parsed.planner.transfers} plans the carried moves of a "
+                                              "`pick_place` job, and this cell has none: it changes nothing")]
 
 
 def _zero_clearance(parsed: CellFile, cell: CellSpec, file: str) -> list[Notice]:

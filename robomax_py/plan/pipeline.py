@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from robomax_py.plan.associative import associative_moves, pin_transfer_ends
 from robomax_py.plan.candidates import SpotCandidates, check_ik_work, seam_candidates
 from robomax_py.plan.graph import Sequencer
 from robomax_py.plan.loads import Loads, check_carried_motion
@@ -106,6 +107,9 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
                           f"{len(failures)} {what}: {names}{_workpiece_hint(cell, spots)}", failures=failures)
     if options.baseline:
         spots = [_baseline_candidate(c) for c in spots]
+    if options.transfers == "associative" and loads is not None:
+        # The Jacobian interpolation cannot change IK branch: each transfer's ends are one branch.
+        spots = pin_transfer_ends(cell, spots)
 
     t0 = time.perf_counter()
     rng = np.random.default_rng(cell.planner.seed)
@@ -127,8 +131,10 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
     t0 = time.perf_counter()
     timed = _time_and_check(cell, robot, world, full_world, spots, tour, outcome.transitions, options, progress,
                             roadmap, loads)
-    clock["timing"] = time.perf_counter() - t0 - timed.verify_seconds
+    clock["timing"] = time.perf_counter() - t0 - timed.verify_seconds - timed.transfer_seconds
     clock["verify"] = timed.verify_seconds
+    if options.transfers == "associative" and loads is not None:
+        clock["transfers"] = timed.transfer_seconds
     verify_checks = timed.verify_checks
     # The optimiser also weighs the cell file's own order, planned as the published method plans it
     # (same candidates, detours and timing): the order search ranks orders on estimated leg times
@@ -197,13 +203,32 @@ class _Timed:
     verify_checks: int
     verify_seconds: float
     failure: str | None = None
+    transfer_seconds: float = 0.0     # planning the carried moves again (`planner.transfers: associative`)
 
 
 def _time_and_check(cell: CellSpec, robot: RobotModel, world: CollisionWorld, full_world: CollisionWorld,
                     spots: list[SpotCandidates], tour: Tour, found: Sequence[Transition], options: ResolvedOptions,
                     progress: Progress, roadmap: Roadmap, loads: Loads | None) -> _Timed:
     """The tour timed (fly-by blends, else stopping at every corner where a blend fails the check)
-    and the first timing that passes the plan's own check."""
+    and the first timing that passes the plan's own check. With `transfers: associative` the
+    carried moves are first planned again by that method (`plan.associative`)."""
+    transfer_seconds = 0.0
+    if options.transfers == "associative" and loads is not None:
+        t_start = time.perf_counter()
+        moves = associative_moves(robot, loads, tour, found)
+        transfer_seconds = time.perf_counter() - t_start
+        if moves.failure is not None:
+            return _Timed(None, [], [], options, 0, 0.0, f"associative transfer: {moves.failure}",
+                          transfer_seconds)
+        found = moves.transitions
+    timed = _checked_timing(cell, robot, world, full_world, spots, tour, found, options, progress, roadmap, loads)
+    return replace(timed, transfer_seconds=transfer_seconds)
+
+
+def _checked_timing(cell: CellSpec, robot: RobotModel, world: CollisionWorld, full_world: CollisionWorld,
+                    spots: list[SpotCandidates], tour: Tour, found: Sequence[Transition], options: ResolvedOptions,
+                    progress: Progress, roadmap: Roadmap, loads: Loads | None) -> _Timed:
+    """`_time_and_check` once the transitions are final."""
     try:
         timings = _timed_tours(cell, robot, world, spots, tour, list(found), options, progress, roadmap, loads)
     except TimingError as exc:

@@ -70,6 +70,10 @@ class PlanOptions:
       None takes the cell's `planner.detours`.
     - `dynamic`: how dynamic objects are planned around: "timed" (time-aware moves) or "rest"
       (waits at rest); None takes the cell's `planner.dynamic`.
+    - `transfers`: how a pick-and-place cell's carried moves are planned: "moves" (as every other
+      move: straight, or a detour where that is blocked) or "associative" (Diane and Anikina's
+      table, k-NN graph, Dijkstra route and Jacobian interpolation, `plan.associative`); None
+      takes the cell's `planner.transfers`.
     - `roadmap_nodes`, `roadmap_k`: size of the detour roadmap and the neighbours each node is
       joined to.
     - `straight_tries`: blocked straight moves between two spots before that pair takes detours only.
@@ -89,6 +93,7 @@ class PlanOptions:
     detour_speed: float | None = None
     detours: str | None = None
     dynamic: str | None = None
+    transfers: str | None = None
     roadmap_nodes: int = 600
     roadmap_k: int = 12
     straight_tries: int = 12
@@ -116,6 +121,7 @@ class ResolvedOptions(PlanOptions):
     detour_speed: float = 1.0
     detours: str = "both"
     dynamic: str = "timed"
+    transfers: str = "moves"
 
 
 # The methods `plan --baseline` and the benchmarks compare, each as the options that plan it (every
@@ -281,6 +287,7 @@ def resolved_options(cell: CellSpec, options: PlanOptions) -> ResolvedOptions:
         "detour_speed": p.detour_speed if options.detour_speed is None else options.detour_speed,
         "detours": p.detours if options.detours is None else options.detours,
         "dynamic": p.dynamic if options.dynamic is None else options.dynamic,
+        "transfers": p.transfers if options.transfers is None else options.transfers,
     })
 
 

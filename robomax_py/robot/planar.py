@@ -6,7 +6,7 @@ Joint 1 turns from the vertical (0: the first link points straight up), each fur
 the link before; angles in rad, lengths in m, the container's floor on y = 0 from x = -1 to 1.
 The arm's links (and a held part, a bar carried along the last link beyond its tip) are line
 segments of a stated radius; they collide with a rectangle (a shelf, or the container's walls,
-floor and ceiling) when a point sampled along them at `SAMPLE_M` lies within the radius of it.
+floor and ceiling) when they come within the radius of it (an exact segment-rectangle distance).
 The shelves are laid out after the paper's figure (its exact dimensions are not given).
 """
 
@@ -17,9 +17,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomax_py._typing import BoolArray, FloatArray
+from robomax_py.robot.ik.pose_table import ROTATION_WEIGHT_M
 
-# Points along each segment tested against the rectangles are this far apart at most (m).
-SAMPLE_M = 0.005
+# The first link's first FOOT_M (m) stand on the floor and are not tested: its radius, and 5 mm.
+FOOT_M = 0.025
 
 
 @dataclass(frozen=True, slots=True)
@@ -50,6 +51,22 @@ class PlanarArm:
             out[1, i] = -np.sum(np.asarray(self.links[i:]) * np.sin(heading[i:]))
         return out
 
+    def pose(self, q: FloatArray) -> FloatArray:
+        """(m, 4) the tip's pose as a point, for rows q (m, n): its position and the last link's
+        direction (cos, sin of its heading) times ROTATION_WEIGHT_M, as `pose_table.pose_features`
+        weighs a six-axis arm's rotation. The tip's (x, y) alone leaves a 3-link arm one degree of
+        freedom; its pose does not."""
+        q = np.atleast_2d(np.asarray(q, dtype=float))
+        heading = q.sum(axis=1)
+        return np.column_stack([self.tip(q), ROTATION_WEIGHT_M * np.cos(heading), ROTATION_WEIGHT_M * np.sin(heading)])
+
+    def pose_jacobian(self, q: FloatArray) -> FloatArray:
+        """(4, n) d pose / d q at one configuration."""
+        q = np.asarray(q, dtype=float)
+        heading = float(q.sum())
+        turn = np.array([-np.sin(heading), np.cos(heading)])[:, None] * ROTATION_WEIGHT_M * np.ones((1, len(q)))
+        return np.vstack([self.jacobian(q), turn])
+
     def segments(self, q: FloatArray) -> FloatArray:
         """(m, s, 2, 2) the segments that can collide: every link, and the held part if any."""
         pts = self.joints(q)
@@ -79,18 +96,46 @@ class Container:
         return Container(walls + shelves)
 
     def free(self, arm: PlanarArm, q: FloatArray) -> BoolArray:
-        """(m,) whether rows q keep the arm (and its held part) clear of every rectangle."""
+        """(m,) whether rows q keep the arm (and its held part) clear of every rectangle: no segment
+        within the arm's radius of one (exactly: the segment crosses it, or an end of one is that
+        close to the other). The first link's foot stands on the floor: its first FOOT_M along it
+        are not tested."""
         segs = arm.segments(q)                                       # (m, s, 2, 2)
-        length = float(max(max(arm.links), arm.held))
-        t = np.linspace(0.0, 1.0, int(np.ceil(length / SAMPLE_M)) + 1)
-        pts = segs[:, :, :1] + t[None, None, :, None] * (segs[:, :, 1:] - segs[:, :, :1])   # (m, s, k, 2)
-        # The first link's foot stands on the floor: its first points are not tested against it.
-        hit = np.zeros(len(segs), dtype=bool)
-        r = arm.radius
-        for x0, y0, x1, y1 in self.rects:
-            dx = np.maximum(np.maximum(x0 - pts[..., 0], pts[..., 0] - x1), 0.0)
-            dy = np.maximum(np.maximum(y0 - pts[..., 1], pts[..., 1] - y1), 0.0)
-            near = dx * dx + dy * dy <= r * r
-            near[:, 0, : int(np.ceil(r / (arm.links[0] / (len(t) - 1)))) + 1] = False
-            hit |= near.any(axis=(1, 2))
-        return ~hit
+        a, b = segs[:, :, 0].copy(), segs[:, :, 1]
+        first = b[:, 0] - a[:, 0]
+        a[:, 0] += first * (FOOT_M / np.linalg.norm(first, axis=1, keepdims=True))
+        hit = np.zeros(segs.shape[:2], dtype=bool)
+        for rect in self.rects:
+            hit |= _near(a, b, rect, arm.radius)
+        return np.asarray(~hit.any(axis=1))
+
+
+def _near(a: FloatArray, b: FloatArray, rect: tuple[float, float, float, float], r: float) -> BoolArray:
+    """(...,) whether segments a -> b (..., 2) come within r of the rectangle (x0, y0, x1, y1)."""
+    lo, hi = np.array(rect[:2]), np.array(rect[2:])
+    d = b - a
+    # Crossing: the segment's parameter interval inside both slabs (Liang-Barsky) is not empty.
+    t0 = np.zeros(a.shape[:-1])
+    t1 = np.ones(a.shape[:-1])
+    inside = np.ones(a.shape[:-1], dtype=bool)
+    for k in range(2):
+        moving = d[..., k] != 0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ta = (lo[k] - a[..., k]) / d[..., k]
+            tb = (hi[k] - a[..., k]) / d[..., k]
+        t0 = np.where(moving, np.maximum(t0, np.minimum(ta, tb)), t0)
+        t1 = np.where(moving, np.minimum(t1, np.maximum(ta, tb)), t1)
+        inside &= moving | ((a[..., k] >= lo[k]) & (a[..., k] <= hi[k]))
+    crossing = inside & (t0 <= t1)
+    # Apart, the nearest points are an end of the segment or a corner of the rectangle.
+    def to_rect(p: FloatArray) -> FloatArray:
+        g = np.maximum(np.maximum(lo - p, p - hi), 0.0)
+        return np.asarray(np.hypot(g[..., 0], g[..., 1]))
+
+    near = np.minimum(to_rect(a), to_rect(b))
+    length2 = np.maximum((d * d).sum(axis=-1), np.finfo(float).tiny)
+    for corner in ((lo[0], lo[1]), (hi[0], lo[1]), (lo[0], hi[1]), (hi[0], hi[1])):
+        c = np.array(corner)
+        t = np.clip(((c - a) * d).sum(axis=-1) / length2, 0.0, 1.0)
+        near = np.minimum(near, np.linalg.norm(a + t[..., None] * d - c, axis=-1))
+    return np.asarray(crossing | (near <= r))

@@ -1,6 +1,7 @@
 """The associative-memory IK (robot.ik.table) on the planar storage arm (robot.planar): the grid is
 the paper's formula, the table keeps exactly the free rows, lookups are the nearest stored point,
-routes over the k-NN graph only use free edges, and Jacobian interpolation stays on the line."""
+routes over the k-NN graph only use free edges, Jacobian interpolation stays on the line and
+arrives only in its own branch, and the container's exact collision test agrees with sampling."""
 
 from __future__ import annotations
 
@@ -9,13 +10,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from robomax_py.robot.ik.pose_table import ROTATION_WEIGHT_M
 from robomax_py.robot.ik.table import (
     JointGrid,
     build_table,
+    follow_edge,
     jacobian_interpolation,
     route,
 )
-from robomax_py.robot.planar import Container, PlanarArm
+from robomax_py.robot.planar import FOOT_M, Container, PlanarArm
 
 HALF_PI = np.pi / 2
 # Jacobian interpolation in steps of 5 mm keeps the tip within 0.5 mm of the straight line (the
@@ -87,7 +90,7 @@ def test_a_route_uses_only_free_edges(tables: dict[str, object]) -> None:
     start = int(np.argmin(np.linalg.norm(table.x - [-0.8, 0.85], axis=1)))   # type: ignore[union-attr]
     goal = int(np.argmin(np.linalg.norm(table.x - [0.8, 1.5], axis=1)))      # type: ignore[union-attr]
     found = route(table, start, goal, 6, edge_free)                    # type: ignore[arg-type]
-    assert found is not None and found.nodes[0] == start and found.nodes[-1] == goal
+    assert found.found and found.nodes[0] == start and found.nodes[-1] == goal
     for u, v in zip(found.nodes[:-1], found.nodes[1:]):
         assert edge_free(table.q[u], table.q[v])                       # type: ignore[union-attr]
     with pytest.raises(ValueError):
@@ -120,3 +123,57 @@ def test_a_grid_wholly_in_collision_is_refused() -> None:
     grid = JointGrid.stepped((-HALF_PI,) * 3, (HALF_PI,) * 3, 3)
     with pytest.raises(ValueError, match="every one of the grid's 27 rows is in collision"):
         build_table(grid, arm.tip, lambda q: np.zeros(len(q), dtype=bool))
+
+
+def _sampled_hits(arm: PlanarArm, box: Container, q: np.ndarray, radius: float) -> np.ndarray:
+    """Collisions found by points at most 1 mm apart along each segment (an independent test)."""
+    segs = arm.segments(q)
+    t = np.linspace(0.0, 1.0, 1001)
+    pts = segs[:, :, :1] + t[None, None, :, None] * (segs[:, :, 1:] - segs[:, :, :1])
+    along = t[None, None, :] * np.linalg.norm(segs[:, :, 1] - segs[:, :, 0], axis=2)[:, :, None]
+    tested = np.ones(pts.shape[:3], dtype=bool)
+    tested[:, 0] = along[:, 0] >= FOOT_M                 # the first link's foot stands on the floor
+    hit = np.zeros(len(q), dtype=bool)
+    for x0, y0, x1, y1 in box.rects:
+        dx = np.maximum(np.maximum(x0 - pts[..., 0], pts[..., 0] - x1), 0.0)
+        dy = np.maximum(np.maximum(y0 - pts[..., 1], pts[..., 1] - y1), 0.0)
+        hit |= ((dx * dx + dy * dy <= radius * radius) & tested).any(axis=(1, 2))
+    return hit
+
+
+@pytest.mark.parametrize("held", [0.0, 0.25])
+def test_the_containers_exact_test_agrees_with_dense_sampling(held: float) -> None:
+    """A sample within the radius is a collision for the exact test; a collision of the exact test
+    has a sample within the radius and half the spacing (0.5 mm: the 1 m link at 1,001 points)."""
+    arm, box = PlanarArm(held=held), Container.storage()
+    q = np.random.default_rng(7).uniform(-HALF_PI, HALF_PI, size=(400, 3))
+    exact = ~box.free(arm, q)
+    assert exact.any() and not exact.all()
+    assert not (_sampled_hits(arm, box, q, arm.radius) & ~exact).any()
+    assert not (exact & ~_sampled_hits(arm, box, q, arm.radius + 0.0005 + 1e-9)).any()
+
+
+def _other_elbow(arm: PlanarArm, q: np.ndarray) -> np.ndarray:
+    """The configuration with the same tip pose and the elbow (joint 2) mirrored."""
+    L1, L2, L3 = arm.links
+    heading = float(q.sum())
+    wrist = arm.tip(q[None])[0] - L3 * np.array([-np.sin(heading), np.cos(heading)])
+    h_w = np.arctan2(-wrist[0], wrist[1])                 # the wrist point's heading from the vertical
+    beta = np.arctan2(L2 * np.sin(q[1]), L1 + L2 * np.cos(q[1]))
+    q1, q2 = h_w + beta, -q[1]
+    return np.array([q1, q2, heading - q1 - q2])
+
+
+def test_an_edge_arrives_only_in_its_own_branch() -> None:
+    """Following the tip's pose (a non-redundant point) the interpolation reaches a neighbouring
+    configuration exactly, off the straight line in the pose space by the sagitta of the heading's
+    arc (its weighted cosine and sine move on a circle) and 0.1 mm; the same pose with the elbow
+    mirrored is not arrived at."""
+    arm = PlanarArm()
+    q_a = np.array([0.3, 0.6, 0.5])
+    near = follow_edge(q_a, q_a + 0.05, arm.pose, arm.pose_jacobian, STEP_M, 0.02)
+    sagitta = ROTATION_WEIGHT_M * (1 - np.cos(3 * 0.05 / 2))          # the heading turns by 0.15 rad
+    assert near.arrived and np.array_equal(near.rows[-1], q_a + 0.05) and near.off_line <= sagitta + 1e-4
+    mirrored = _other_elbow(arm, q_a + 0.05)
+    np.testing.assert_allclose(arm.pose(mirrored[None]), arm.pose((q_a + 0.05)[None]), atol=1e-12)
+    assert not follow_edge(q_a, mirrored, arm.pose, arm.pose_jacobian, STEP_M, 0.02).arrived

@@ -7,7 +7,8 @@ configuration whose point is nearest the target (`argmin |x - x*|`, a k-d tree),
 as the lookup's error. The stored points are also the nodes of a k-nearest-neighbour graph over
 which a route between two configurations is found by Dijkstra (edges checked only when a route
 uses them), and a route is followed by damped Jacobian interpolation, `q += J+ (p(t+dt) - p(t))`,
-which keeps the point on the straight line between two nodes within a stated error.
+which keeps the point on the straight line between two nodes within a stated error (`follow_edge`:
+an edge is usable where that interpolation arrives at the far node's configuration).
 
 The module knows nothing of the robot: forward kinematics, the Jacobian and the collision test are
 functions handed in, so the same table serves a 6-axis arm, a planar test arm or anything else.
@@ -19,6 +20,7 @@ import itertools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 from numba import njit
@@ -26,7 +28,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
-from robomax_py._typing import BoolArray, FloatArray
+from robomax_py._typing import BoolArray, FloatArray, IntArray
 
 Forward = Callable[[FloatArray], FloatArray]          # (m, n) joint rows -> (m, d) points
 FreeTest = Callable[[FloatArray], BoolArray]          # (m, n) joint rows -> (m,) collision-free
@@ -34,6 +36,10 @@ Jacobian = Callable[[FloatArray], FloatArray]         # (n,) joints -> (d, n) d 
 
 # Rows filled per call of the forward kinematics and the collision test.
 BATCH = 65_536
+# A step of `follow_edge` turning a joint by more than this (rad) jumped through a singular
+# configuration: a step of a few millimetres of the point turns a well-conditioned arm's joints by
+# hundredths of a radian.
+MAX_JOINT_STEP = 0.2
 # `TableIk.nearest` scans tables of up to this many stored numbers (rows x point dimension).
 SCAN_MAX_VALUES = 50_000
 
@@ -130,60 +136,100 @@ def build_table(grid: JointGrid, forward: Forward, free: FreeTest) -> TableIk:
     return TableIk(q, x, grid.size, cKDTree(x))
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class KnnGraph:
+    """The undirected k-nearest-neighbour graph of stored points: each point joined to its k
+    nearest others (so a node may have more than k edges, never fewer), every edge once, a < b,
+    its length the distance between the points (point units; zero lengths raised to the smallest
+    positive float, for a graph library that reads 0 as no edge)."""
+
+    a: IntArray
+    b: IntArray
+    length: FloatArray
+    n: int
+
+
+def knn_graph(x: FloatArray, k: int, tree: cKDTree | None = None) -> KnnGraph:
+    """The k-NN graph (`KnnGraph`) of points x (m, d); k >= 3 as the paper asks."""
+    if k < 3:
+        raise ValueError(f"k must be at least 3, got {k}")
+    x = np.asarray(x, dtype=float)
+    n = len(x)
+    kk = min(k + 1, n)
+    dist, idx = (tree if tree is not None else cKDTree(x)).query(x, k=kk)
+    src = np.repeat(np.arange(n), kk - 1)
+    dst = np.asarray(idx)[:, 1:].reshape(-1)
+    w = np.maximum(np.asarray(dist)[:, 1:].reshape(-1), np.finfo(float).tiny)
+    lo, hi = np.minimum(src, dst), np.maximum(src, dst)
+    keep = lo != hi
+    key = lo[keep].astype(np.int64) * n + hi[keep]
+    _, first = np.unique(key, return_index=True)
+    return KnnGraph(lo[keep][first], hi[keep][first], w[keep][first], n)
+
+
+RouteStatus = Literal["found", "no_route", "too_many_blocked"]
+
+
 @dataclass(frozen=True, slots=True)
 class TableRoute:
-    """Stored rows from the start's to the goal's (indices into the table), and the checks spent."""
+    """A route over the k-NN graph: `status` "found" (nodes from the start's to the goal's,
+    indices into the table), "no_route" (the graph, less its blocked edges, does not join them) or
+    "too_many_blocked" (max_blocked edges found blocked); the edge checks spent, the route's length
+    (point units) and the edges found blocked (a < b), dropped from the graph."""
 
-    nodes: tuple[int, ...]
-    edge_checks: int
+    status: RouteStatus
+    nodes: tuple[int, ...] = ()
+    edge_checks: int = 0
+    length: float = math.inf
+    blocked: tuple[tuple[int, int], ...] = ()
+
+    @property
+    def found(self) -> bool:
+        return self.status == "found"
 
 
 def route(table: TableIk, start: int, goal: int, k: int, edge_free: Callable[[FloatArray, FloatArray], bool],
-          max_blocked: int = 200) -> TableRoute | None:
-    """Dijkstra over the k-nearest-neighbour graph of the stored points (k >= 3), lengths in the
-    point space; an edge is checked (`edge_free` of its two configurations) only when a shortest
-    route uses it, and a blocked one is dropped and the search repeated (lazily). None: no route."""
-    if k < 3:
-        raise ValueError(f"k must be at least 3, got {k}")
-    n = len(table)
-    kk = min(k + 1, n)
-    dist, idx = table.tree.query(table.x, k=kk)
-    rows = np.repeat(np.arange(n), kk - 1)
-    cols = idx[:, 1:].reshape(-1)
-    w = np.maximum(dist[:, 1:].reshape(-1), np.finfo(float).tiny)
-    pairs = {}
-    for r, c, wt in zip(rows, cols, w):
-        a, b = (int(r), int(c)) if r < c else (int(c), int(r))
-        if a != b:
-            pairs[(a, b)] = float(wt)
-    known: dict[tuple[int, int], bool] = {}
+          max_blocked: int = 200) -> TableRoute:
+    """Dijkstra (scipy) over the k-nearest-neighbour graph of the stored points (k >= 3), lengths in
+    the point space; an edge is checked (`edge_free` of its two configurations, in the direction
+    the route takes it) only when a shortest route uses it, and a blocked one is dropped and the
+    search repeated (lazily)."""
+    graph = knn_graph(table.x, k, table.tree)
+    n = graph.n
+    # The graph is built once; a blocked edge's length becomes infinite (never on a shortest route).
+    order = csr_matrix((np.arange(1, len(graph.a) + 1, dtype=float), (graph.a, graph.b)), shape=(n, n))
+    edge_of = order.data.astype(np.int64) - 1
+    position = np.empty(len(graph.a), dtype=np.int64)
+    position[edge_of] = np.arange(len(edge_of))
+    csr = order.copy()
+    csr.data = graph.length[edge_of]
+    keys = graph.a * n + graph.b                  # sorted: knn_graph orders its edges by (a, b)
+    known: dict[int, bool] = {}
+    blocked: list[tuple[int, int]] = []
     checks = 0
-    for _ in range(max_blocked):
-        keys = [e for e in pairs if known.get(e) is not False]
-        if not keys:
-            return None
-        src = np.array([e[0] for e in keys])
-        dst = np.array([e[1] for e in keys])
-        graph = csr_matrix((np.array([pairs[e] for e in keys]), (src, dst)), shape=(n, n))
-        d, pred = dijkstra(graph, directed=False, indices=start, return_predecessors=True)
+    while True:
+        d, pred = dijkstra(csr, directed=False, indices=start, return_predecessors=True)
         if not math.isfinite(d[goal]):
-            return None
+            return TableRoute("no_route", (), checks, math.inf, tuple(blocked))
         path = [goal]
         while path[-1] != start:
             path.append(int(pred[path[-1]]))
         path.reverse()
-        blocked = False
+        clear = True
         for u, v in itertools.pairwise(path):
-            e = (min(u, v), max(u, v))
+            e = int(np.searchsorted(keys, min(u, v) * n + max(u, v)))
             if e not in known:
                 checks += 1
                 known[e] = bool(edge_free(table.q[u], table.q[v]))
             if not known[e]:
-                blocked = True
+                csr.data[position[e]] = np.inf
+                blocked.append((min(u, v), max(u, v)))
+                clear = False
                 break
-        if not blocked:
-            return TableRoute(tuple(path), checks)
-    return None
+        if clear:
+            return TableRoute("found", tuple(path), checks, float(d[goal]), tuple(blocked))
+        if len(blocked) >= max_blocked:
+            return TableRoute("too_many_blocked", (), checks, math.inf, tuple(blocked))
 
 
 def jacobian_interpolation(q0: FloatArray, p1: FloatArray, forward: Forward, jacobian: Jacobian, step: float,
@@ -197,16 +243,44 @@ def jacobian_interpolation(q0: FloatArray, p1: FloatArray, forward: Forward, jac
     n_steps = max(1, math.ceil(float(np.linalg.norm(p1 - p0)) / step))
     rows = [q.copy()]
     worst = 0.0
+    p = p0
     for s in range(1, n_steps + 1):
         target = p0 + (p1 - p0) * (s / n_steps)
-        p = np.asarray(forward(q[None, :]), dtype=float)[0]
         J = np.asarray(jacobian(q), dtype=float)
         # Damped least squares: J^T (J J^T + lambda^2 I)^-1, steady near singular configurations.
         dq = J.T @ np.linalg.solve(J @ J.T + damping ** 2 * np.eye(J.shape[0]), target - p)
         q = q + dq
         rows.append(q.copy())
-        worst = max(worst, _off_line(np.asarray(forward(q[None, :]), dtype=float)[0], p0, p1))
+        p = np.asarray(forward(q[None, :]), dtype=float)[0]
+        worst = max(worst, _off_line(p, p0, p1))
     return np.array(rows), worst
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class EdgeFollow:
+    """An edge of a route followed by `jacobian_interpolation`: the joint rows (m, n) from the
+    edge's first configuration towards the second's point; `arrived` when they end within the
+    tolerance of the second configuration and no step turns a joint by more than the bound (the
+    last row is then that configuration exactly; else the interpolation reached the point in
+    another branch, not at all, or by a jump through a singular configuration); `off_line` the
+    largest distance (point units) of the point from the edge's straight line."""
+
+    rows: FloatArray
+    arrived: bool
+    off_line: float
+
+
+def follow_edge(q_a: FloatArray, q_b: FloatArray, forward: Forward, jacobian: Jacobian, step: float,
+                arrival_tol: float, max_joint_step: float = MAX_JOINT_STEP) -> EdgeFollow:
+    """The edge from configuration q_a to q_b by Jacobian interpolation (formula (15) of the paper)."""
+    q_b = np.asarray(q_b, dtype=float)
+    rows, off_line = jacobian_interpolation(q_a, np.asarray(forward(q_b[None, :]), dtype=float)[0], forward, jacobian,
+                                            step)
+    arrived = float(np.max(np.abs(rows[-1] - q_b))) <= arrival_tol and \
+        float(np.max(np.abs(np.diff(rows, axis=0)))) <= max_joint_step
+    if arrived:
+        rows[-1] = q_b
+    return EdgeFollow(rows, arrived, off_line)
 
 
 def _off_line(p: FloatArray, a: FloatArray, b: FloatArray) -> float:
