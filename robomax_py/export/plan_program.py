@@ -118,7 +118,13 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
                 radius = 0.0                     # the robot stops there to wait
             speed = opts.speed * (opts.detour_speed if trans.kind == "detour" else 1.0) if trans.speed is None \
                 else trans.speed
-            emit(q, PtpMove(tuple(np.degrees(q)), speed, trans.accel, flyby=math.degrees(radius), comment=note.strip(", ")))
+            if trans.lin_targets is not None:
+                # A detour of TCP lines (`planner.detour_moves: lin`): a LIN to each via point, stopping there.
+                emit(q, lin(trans.lin_targets[w - 1], trans.lin_configs[w - 1], trans.lin_speed * 1000.0,
+                            comment=note.strip(", "), accel=trans.accel))
+            else:
+                emit(q, PtpMove(tuple(np.degrees(q)), speed, trans.accel, flyby=math.degrees(radius),
+                                comment=note.strip(", ")))
             for stage in trans.stages:
                 if stage.index == w:
                     emit(q, *_wait(stage.wait, setup))
