@@ -9,6 +9,7 @@ two candidates of different configuration are never joined. The cell keys are va
 
 from __future__ import annotations
 
+import itertools
 import re
 from pathlib import Path
 from typing import Any
@@ -102,7 +103,7 @@ def test_the_clamp_is_passed_on_straight_collision_free_tcp_lines(lin_plan: tupl
             assert off.max() <= LINE_TOL_M, f"{trans.label}: {off.max() * 1000:.4f} mm off its line"
             assert along.min() >= -LINE_TOL_M and along.max() <= np.linalg.norm(b - a) + LINE_TOL_M
             assert len(set(status_of(robot, q).tolist())) == 1, "the configuration changes along a line"
-            for q0, q1 in zip(q[:-1], q[1:]):
+            for q0, q1 in itertools.pairwise(q):
                 assert world.check_segment(q0, q1).free, f"{trans.label}: a step of a line collides"
             checked += len(q)
     assert checked > 20
