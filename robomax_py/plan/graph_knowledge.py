@@ -254,7 +254,9 @@ class SequencerKnowledge:
         if (min(i, j), max(i, j)) in self.detour_only:
             # Until a detour is known, price one at a multiple of the straight move: optimistic
             # enough to be explored, costly enough not to be preferred.
-            usable = any(d is not _UNUSABLE for d in vias)
+            # A detour of TCP lines joins only its own two candidates (`_via_costs`): the others
+            # keep the prior, so that lines are sought between them too.
+            usable = any(d is not _UNUSABLE and d.poses is None for d in vias)
             unconnected = (min(i, j), max(i, j)) in self.unconnected
             est = np.full_like(est, np.inf) if usable or unconnected else est * DETOUR_PRIOR
         else:

@@ -36,6 +36,7 @@ SMOKE: dict[str, list[str]] = {
     "bench_scale.py": ["--sizes", "8", "--families", "open", "--runs", "1"],
     "bench_startup.py": [SMALL, "--runs", "1"],
     "bench_table_ik.py": [],
+    "bench_tcp_detours.py": ["--quick", "--png", f"{OUT}/orientations.png"],
     "bench_tending.py": ["--cycles", "1"],
     "bench_timing.py": [SMALL, "--runs", "1"],
     "bench_voxels.py": [SMALL],
