@@ -1,8 +1,9 @@
 """A planned result -> the dialect-independent robot program (`robomax_py.program`).
 
 PTP moves to every stop, FLYBY with the radius the planner chose and checked (detour corners, the
-joins retract -> move -> approach), LIN approach and retract along the electrode axis, each with the configuration data of its own
-target (the controller brand's), a SPOT
+joins retract -> move -> approach), LIN moves through the via points of a detour of TCP lines
+(`planner.detour_moves: lin`, stopping at each), LIN approach and retract along the electrode axis,
+each with the configuration data of its own target (the controller brand's), a SPOT
 statement per spot, and comments carrying the planned times and orientation angles. Cartesian
 targets are TCP poses in the program's user frame (mm, ZYX degrees; by default the controller's
 robot base frame itself), each naming the tool and user frame it is stated with; their values are
