@@ -124,6 +124,8 @@ DESCRIPTIONS: dict[str, str] = {
     "PlannerFile.tcp_speed": "TCP speed on the approach and retract lines, m/s.",
     "PlannerFile.detour_speed": "Speed fraction of moves through detours.",
     "PlannerFile.detours": "Where detours are searched: roadmap, cspace or both.",
+    "PlannerFile.detour_moves": "How detours move: ptp (joint-space moves) or lin (straight TCP lines through via points).",
+    "PlannerFile.detour_tcp_speed": "TCP speed on the LIN lines of detours (detour_moves: lin), m/s.",
     "PlannerFile.dynamic": "timed: plan round dynamic objects in time; rest: wait at rest for them.",
     "PlannerFile.max_wait": "Longest wait at one place a timed search may propose, s.",
     "PlannerFile.transfers": "Pick and place: moves plans carried moves as every move; associative by the associative-memory table, k-NN graph, Dijkstra route and Jacobian interpolation (docs/associative.md).",

@@ -266,6 +266,10 @@ class PlannerSpec:
     tcp_speed: float = 0.5        # m/s on the LIN approach and retract lines
     detour_speed: float = 1.0     # speed fraction of PTP moves through detours (near clamps)
     detours: str = "both"         # where detours are searched: "roadmap", "cspace" (local A1-A3 map) or "both"
+    # How a detour moves: "ptp" (joint-space straight moves between its points) or "lin" (straight
+    # TCP lines through via points, as paper 003 builds them; joint-space where none exists).
+    detour_moves: str = "ptp"
+    detour_tcp_speed: float = 1.0  # m/s on the LIN lines of a detour (`detour_moves: lin`)
     # Dynamic obstacles: "timed" searches the roadmap with their windows (waiting where it pays,
     # or going round); "rest" plans them as absent and waits at rest before the blocked move.
     dynamic: str = "timed"

@@ -64,7 +64,8 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
         for s in result.spots
     ]
     report["detours"] = [
-        {"between": t.label, "waypoints": len(t.waypoints), "checks_to_find": t.checks}
+        {"between": t.label, "waypoints": len(t.waypoints), "checks_to_find": t.checks,
+         "moves": "lin" if t.lin_targets is not None else "ptp"}
         for t in result.transitions if t.kind == "detour"
     ]
     # Pick and place: each move's load and the overrides its limits asked for.
@@ -96,7 +97,8 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
         head.add_row("cycle time", f"{report['cycle_time']:.2f} s  ({split})")
         if "order" in report:
             head.add_row("order", report["order"]["line"])
-        detours = ", ".join(f"{d['between']} ({d['checks_to_find']} checks)" for d in report["detours"])
+        detours = ", ".join(f"{d['between']} ({'TCP lines, ' if d['moves'] == 'lin' else ''}{d['checks_to_find']} "
+                            "checks)" for d in report["detours"])
         head.add_row("detours", detours or "none")
         carried = [c for c in report.get("carried", []) if c["part"]]
         if carried:

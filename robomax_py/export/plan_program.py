@@ -1,8 +1,9 @@
 """A planned result -> the dialect-independent robot program (`robomax_py.program`).
 
 PTP moves to every stop, FLYBY with the radius the planner chose and checked (detour corners, the
-joins retract -> move -> approach), LIN approach and retract along the electrode axis, each with the configuration data of its own
-target (the controller brand's), a SPOT
+joins retract -> move -> approach), LIN moves through the via points of a detour of TCP lines
+(`planner.detour_moves: lin`, stopping at each), LIN approach and retract along the electrode axis,
+each with the configuration data of its own target (the controller brand's), a SPOT
 statement per spot, and comments carrying the planned times and orientation angles. Cartesian
 targets are TCP poses in the program's user frame (mm, ZYX degrees; by default the controller's
 robot base frame itself), each naming the tool and user frame it is stated with; their values are
@@ -118,7 +119,13 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
                 radius = 0.0                     # the robot stops there to wait
             speed = opts.speed * (opts.detour_speed if trans.kind == "detour" else 1.0) if trans.speed is None \
                 else trans.speed
-            emit(q, PtpMove(tuple(np.degrees(q)), speed, trans.accel, flyby=math.degrees(radius), comment=note.strip(", ")))
+            if trans.lin_targets is not None:
+                # A detour of TCP lines (`planner.detour_moves: lin`): a LIN to each via point, stopping there.
+                emit(q, lin(trans.lin_targets[w - 1], trans.lin_configs[w - 1], trans.lin_speed * 1000.0,
+                            comment=note.strip(", "), accel=trans.accel))
+            else:
+                emit(q, PtpMove(tuple(np.degrees(q)), speed, trans.accel, flyby=math.degrees(radius),
+                                comment=note.strip(", ")))
             for stage in trans.stages:
                 if stage.index == w:
                     emit(q, *_wait(stage.wait, setup))

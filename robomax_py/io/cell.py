@@ -213,6 +213,8 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
         ),
         planner=PlannerSpec(seed=parsed.planner.seed, speed=parsed.planner.speed, tcp_speed=parsed.planner.tcp_speed,
                             detour_speed=parsed.planner.detour_speed, detours=parsed.planner.detours,
+                            detour_moves=parsed.planner.detour_moves,
+                            detour_tcp_speed=parsed.planner.detour_tcp_speed,
                             dynamic=parsed.planner.dynamic, max_wait=parsed.planner.max_wait,
                             transfers=parsed.planner.transfers),
         dynamic=tuple(o for o in dynamic if o is not None) + doors,

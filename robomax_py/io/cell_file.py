@@ -302,6 +302,9 @@ class PlannerFile(_Strict):
     tcp_speed: Annotated[float, Field(gt=0, le=2)] = 0.5
     detour_speed: Annotated[float, Field(gt=0, le=1)] = 1.0
     detours: Literal["roadmap", "cspace", "both"] = "both"
+    detour_moves: Literal["ptp", "lin"] = "ptp"
+    # KSS caps a LIN's $VEL.CP at 2 m/s (export.krl), as it does the approach lines' `tcp_speed`.
+    detour_tcp_speed: Annotated[float, Field(gt=0, le=2)] = 1.0
     dynamic: Literal["timed", "rest"] = "timed"
     max_wait: Annotated[float, Field(gt=0, le=MAX_WINDOW_S, allow_inf_nan=False)] = 600.0
     transfers: Literal["moves", "associative"] = "moves"

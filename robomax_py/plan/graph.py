@@ -338,7 +338,13 @@ class Sequencer(SequencerDetours):
                 complete = False
                 self.unresolved[label] += 1
                 continue
-            out.append(Transition("detour", path, label, self.vias_for(i, j)[best_v].checks))
+            via = self.vias_for(i, j)[best_v]
+            if via.poses is not None:
+                # Lines join exactly their own ends (`_via_costs`): the path is the detour's, each
+                # waypoint after the first reached by a line to its pose.
+                out.append(Transition("detour", via.waypoints, label, via.checks, lin_targets=via.poses[1:]))
+                continue
+            out.append(Transition("detour", path, label, via.checks))
         return _TourCheck(complete, tuple(out))
 
     def _check_straight(self, i: int, a: int, j: int, b: int) -> bool:

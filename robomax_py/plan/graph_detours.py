@@ -11,11 +11,13 @@ import numpy as np
 from robomax_py._typing import FloatArray
 from robomax_py.plan.cspace_detour import grid_detour
 from robomax_py.plan.graph_knowledge import MAX_FAILED_DETOURS, SequencerKnowledge
+from robomax_py.plan.program_frames import cell_program_frames
 from robomax_py.plan.roadmap import Detour
 from robomax_py.plan.rrt_detour import rrt_detour
 from robomax_py.plan.sequence import (
     HOME,
 )
+from robomax_py.plan.tcp_detour import tcp_detour
 from robomax_py.robot import fk_tcp
 from robomax_py.robot.ik.turns import wrap_to_pi
 from robomax_py.robot.solve import solve_all
@@ -83,6 +85,26 @@ class SequencerDetours(SequencerKnowledge):
                     return Detour(wp, polyline_time_estimate(wp, self.limits), checks)
         self.checks += checks
         return None
+
+    def _tcp_detour(self, i: int, a: int, j: int, b: int) -> Detour | None:
+        """Straight TCP lines between two spots' candidates (`plan.tcp_detour`): the single line,
+        else through via points lifted as `_lift_detour` lifts its ends (up, back along the
+        approach lines, both), for rising heights. Not from or to home: home is a joint posture."""
+        if HOME in (i, j):
+            return None
+        self.tcp_detour_searches += 1
+        up = self._up()
+        back_a, back_b = self._back_direction(i, a), self._back_direction(j, b)
+        aways = [(up, up), (back_a, back_b), ((up + back_a) / np.sqrt(2.0), (up + back_b) / np.sqrt(2.0))]
+        options = self.options
+        found = tcp_detour(self.robot, self.world_from(i), self.limits, self.q(i)[a], self.q(j)[b], aways,
+                           LIFT_HEIGHTS_M, cell_program_frames(self.cell).written, options.speed,
+                           options.detour_tcp_speed * options.speed)
+        if found.detour is None:
+            self.checks += found.checks
+            return None
+        self.tcp_detours_found += 1
+        return found.detour
 
     def _up(self) -> FloatArray:
         """World up in the robot base frame."""
@@ -218,7 +240,10 @@ class SequencerDetours(SequencerKnowledge):
         # Lift first: on clamp cells it is found in ~1,000 checks; the roadmap is the general fallback.
         # Where neither finds a way, the gun's C may still hold the sheet at both approach points
         # (moves between two faces of a part): off the flange first (`_withdrawn_detour`).
-        det = (self._lift_detour(i, a, j, b) or self._searched_detour(i, self.q(i)[a], self.q(j)[b])
+        # `planner.detour_moves: lin`: straight TCP lines first (paper 003's detours), joint-space
+        # detours only where none is found.
+        det = self._tcp_detour(i, a, j, b) if self.options.detour_moves == "lin" else None
+        det = (det or self._lift_detour(i, a, j, b) or self._searched_detour(i, self.q(i)[a], self.q(j)[b])
                or self._withdrawn_detour(i, a, j, b))
         if det is None and last_resort:
             # A tour with no other way on (`_open_dead_end`): trees grown between the two ends find

@@ -41,6 +41,14 @@ MAX_BLOCKED_STRAIGHT = 24
 # Failed detour searches between two spots after which they count as unconnected (but for
 # detours found at their ends).
 MAX_FAILED_DETOURS = 6
+# A detour of TCP lines starts and ends in the configurations it was found between: another
+# candidate this close (rad, any joint) is that configuration (`plan.tcp_detour.GOAL_TOL_RAD`).
+JOIN_TOL_RAD = 1e-6
+
+
+def _same(a: FloatArray, b: FloatArray) -> np.ndarray:
+    """Whether configurations (broadcast over all but the last axis) are the same, to JOIN_TOL_RAD."""
+    return np.asarray(np.max(np.abs(a - b), axis=-1) <= JOIN_TOL_RAD)
 
 
 class SequencerKnowledge:
@@ -82,6 +90,8 @@ class SequencerKnowledge:
         self.unconnected: set[tuple[int, int]] = set()                            # unordered spot pairs given up
         self._exit_cache: dict[tuple[int, int], list[FloatArray]] = {}            # (spot, candidate) -> exits
         self._inner: dict[tuple[int, bool], float] = {}                           # (detour, reversed) -> time
+        self.tcp_detour_searches = 0          # `planner.detour_moves: lin`: searches for TCP lines
+        self.tcp_detours_found = 0            # ... and those that found them
         # What `_probe_pairs` learnt (straight moves, detour-only pairs, checks) and the generator as
         # it was before any round: a sequencer of the given order starts from them (`given_order`).
         self._probed: tuple[dict[tuple[int, int], dict[tuple[int, int], bool]], set[tuple[int, int]], int] | None = None
@@ -141,7 +151,7 @@ class SequencerKnowledge:
             elif di == i or dj == j:
                 out.append(det)
             elif dj == i or di == j:
-                out.append(Detour(det.waypoints[::-1].copy(), det.time_estimate, det.checks))
+                out.append(det.reversed())
             else:
                 out.append(_UNUSABLE)
         return out
@@ -162,6 +172,12 @@ class SequencerKnowledge:
         ends = np.array([vias[v].waypoints[-1] for v in usable])
         enter = ptp_time_estimate(self.q(i)[rows][:, None, :], starts[None, :, :], self.limits, sp)   # rows x vias
         leave = ptp_time_estimate(ends[:, None, :], self.q(j)[cols][None, :, :], self.limits, sp)     # vias x cols
+        lines = np.array([vias[v].poses is not None for v in usable])
+        if lines.any():
+            # A detour of TCP lines joins only the configurations it starts and ends in: a joint
+            # move onto it from another candidate would not be a line.
+            enter = np.where(lines[None, :] & ~_same(self.q(i)[rows][:, None, :], starts[None, :, :]), np.inf, enter)
+            leave = np.where(lines[:, None] & ~_same(ends[:, None, :], self.q(j)[cols][None, :, :]), np.inf, leave)
         bad = self.legs_bad.get((i, j), set())
         verified_only = len(bad) >= MAX_BLOCKED_LEGS
         marks: dict[int, list[tuple[int, int]]] = {}
@@ -192,6 +208,8 @@ class SequencerKnowledge:
         """Estimated time along detour v oriented as `det` (from `vias_for`), cached per direction
         (the sum taken in the order travelled, as it always was)."""
         wp = det.waypoints
+        if det.poses is not None:
+            return det.time_estimate             # lines: estimated where found, the same both ways
         key = (v, not np.array_equal(wp[0], self.detours[v][2].waypoints[0]))
         got = self._inner.get(key)
         if got is None:
@@ -208,11 +226,14 @@ class SequencerKnowledge:
         if not usable:
             return out
         sp = self._detour_speed()
-        enter = ptp_time_estimate(self.q(i)[a][None, :], np.array([vias[v].waypoints[0] for v in usable]),
-                                  self.limits, sp)
-        leave = ptp_time_estimate(np.array([vias[v].waypoints[-1] for v in usable]), self.q(j)[b][None, :],
-                                  self.limits, sp)
+        starts = np.array([vias[v].waypoints[0] for v in usable])
+        ends = np.array([vias[v].waypoints[-1] for v in usable])
+        enter = ptp_time_estimate(self.q(i)[a][None, :], starts, self.limits, sp)
+        leave = ptp_time_estimate(ends, self.q(j)[b][None, :], self.limits, sp)
         via = enter + np.array([self._inner_time(v, vias[v]) for v in usable]) + leave
+        lines = np.array([vias[v].poses is not None for v in usable])
+        joined = _same(self.q(i)[a][None, :], starts) & _same(ends, self.q(j)[b][None, :])
+        via = np.where(lines & ~joined, np.inf, via)      # as `_via_costs`: lines join their own ends only
         bad = self.legs_bad.get((i, j), set())
         if len(bad) >= MAX_BLOCKED_LEGS:
             ok = self.legs_ok.get((i, j), set())
@@ -233,7 +254,9 @@ class SequencerKnowledge:
         if (min(i, j), max(i, j)) in self.detour_only:
             # Until a detour is known, price one at a multiple of the straight move: optimistic
             # enough to be explored, costly enough not to be preferred.
-            usable = any(d is not _UNUSABLE for d in vias)
+            # A detour of TCP lines joins only its own two candidates (`_via_costs`): the others
+            # keep the prior, so that lines are sought between them too.
+            usable = any(d is not _UNUSABLE and d.poses is None for d in vias)
             unconnected = (min(i, j), max(i, j)) in self.unconnected
             est = np.full_like(est, np.inf) if usable or unconnected else est * DETOUR_PRIOR
         else:

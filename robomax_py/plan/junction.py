@@ -109,6 +109,8 @@ def time_junction(
     accel: float = 1.0,
     jerk_limited: bool = True,
     flyby: bool = True,
+    lin_targets: FloatArray | None = None,
+    lin_speed: float = 0.0,
 ) -> Junction:
     """The fastest collision-free way through a junction.
 
@@ -118,7 +120,12 @@ def time_junction(
     waypoints : (m, n) the transition's joint path: first row where it starts (not used: the
         motion starts where the retract ends, or at q_start), then the PTP targets, the last the
         approach point of `after` (or home).
+    lin_targets : (m - 1, 4, 4), optional: the waypoints after the first are reached by straight
+        TCP lines to these poses (robot base frame) at `lin_speed` m/s instead of joint moves; the
+        robot then stops at every line's end (no fly-by: the TCP stays on the lines).
     """
+    if lin_targets is not None:
+        flyby = False
     lin_cache: dict[bytes, LinPath] = {}
     extended = _extension(robot, np.asarray(q_start, dtype=float), waypoints, before, after) if flyby else None
 
@@ -126,7 +133,8 @@ def time_junction(
         ext = extended if rj > 0 else None
         if rj > 0 and ext is None:
             return None
-        steps = _steps(waypoints, kind, label, before, after, tcp_speed, speed, rj, rd, ext, accel)
+        steps = _steps(waypoints, kind, label, before, after, tcp_speed, speed, rj, rd, ext, accel,
+                       lin_targets=lin_targets, lin_speed=lin_speed)
         try:
             return _time_steps(robot, limits, q_start, steps, jerk_limited, lin_cache)
         except TimingError:
@@ -220,11 +228,19 @@ def _exact_lower_bound(q_start: FloatArray, steps: list[Step], paths: list[Chain
 def _steps(
     waypoints: FloatArray, kind: str, label: str, before: WeldEnd | None, after: WeldEnd | None,
     tcp_speed: float, speed: float, rj: float, rd: float, ext: Extension | None = None, accel: float = 1.0,
+    *, lin_targets: FloatArray | None = None, lin_speed: float = 0.0,
 ) -> list[Step]:
     steps: list[Step] = []
     if before is not None:
         T = ext.retract_T if ext is not None and ext.retract_T is not None else before.T_app
         steps.append(LinStep(T, tcp_speed, before.column, flyby=rj, kind="retract", label=before.label, accel=accel))
+    if lin_targets is not None:
+        # Lines through the detour's via points, each in the branch it starts in, stopping at each.
+        steps += [LinStep(T, lin_speed, None, kind=kind, label=label, accel=accel) for T in lin_targets]
+        if after is not None:
+            steps.append(LinStep(after.T_spot, tcp_speed, after.column, kind="approach", label=after.label,
+                                 accel=accel))
+        return steps
     targets = np.asarray(waypoints, dtype=float)[1:]
     if after is not None and ext is not None and ext.approach_q is not None:
         targets = np.vstack([targets[:-1], ext.approach_q[None, :]])

@@ -166,6 +166,8 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
         sequencing_checks=sequencer.checks + given_checks, roadmap_checks=roadmap.sampling_checks + roadmap.edge_checks,
         verify_checks=verify_checks, detours=sum(1 for t in transitions if t.kind == "detour"),
         rounds=sequencer.rounds, dp_evaluations=sequencer.dp_evaluations, seconds=clock,
+        tcp_detour_searches=sequencer.tcp_detour_searches, tcp_detours_found=sequencer.tcp_detours_found,
+        lin_detours=sum(1 for t in transitions if t.lin_targets is not None),
     )
     return PlanResult(cell.name, robot.name, "planned", "planned", spots=tuple(plans), transitions=tuple(transitions),
                       trajectory=trajectory, stats=plan_stats, baseline=options.method != "optimised", joint_names=robot.joint_names,

@@ -68,6 +68,11 @@ class PlanOptions:
       `planner.detour_speed` (default 1.0).
     - `detours`: where detours are searched: "roadmap", "cspace" (the local A1-A3 map) or "both";
       None takes the cell's `planner.detours`.
+    - `detour_moves`: "ptp" (joint-space moves between detour points) or "lin" (straight TCP lines
+      through via points, joint-space only where none is found); None takes the cell's
+      `planner.detour_moves`.
+    - `detour_tcp_speed`: m/s on the LIN lines of detours, before the override; None takes the
+      cell's `planner.detour_tcp_speed` (default 1.0).
     - `dynamic`: how dynamic objects are planned around: "timed" (time-aware moves) or "rest"
       (waits at rest); None takes the cell's `planner.dynamic`.
     - `transfers`: how a pick-and-place cell's carried moves are planned: "moves" (as every other
@@ -92,6 +97,8 @@ class PlanOptions:
     tcp_speed: float | None = None
     detour_speed: float | None = None
     detours: str | None = None
+    detour_moves: str | None = None
+    detour_tcp_speed: float | None = None
     dynamic: str | None = None
     transfers: str | None = None
     roadmap_nodes: int = 600
@@ -120,6 +127,8 @@ class ResolvedOptions(PlanOptions):
     tcp_speed: float = 0.5
     detour_speed: float = 1.0
     detours: str = "both"
+    detour_moves: str = "ptp"
+    detour_tcp_speed: float = 1.0
     dynamic: str = "timed"
     transfers: str = "moves"
 
@@ -201,6 +210,13 @@ class Transition:
     speed: float | None = None              # None: the plan's (`planner.speed`, `detour_speed`)
     accel: float = 1.0
     tcp_speed: float | None = None          # None: the plan's (`planner.tcp_speed`)
+    # A detour of straight TCP lines (`planner.detour_moves: lin`): the TCP pose each line ends at,
+    # one per waypoint after the first ((m - 1, 4, 4), robot base frame, as the program states
+    # them), the configuration data there and the lines' TCP speed (m/s, as written). None: the
+    # moves between the waypoints are joint moves (PTP).
+    lin_targets: FloatArray | None = None
+    lin_configs: tuple[str, ...] = ()
+    lin_speed: float = 0.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -236,6 +252,11 @@ class PlanStats:
     rounds: int
     dp_evaluations: int
     seconds: dict[str, float] = field(default_factory=dict)
+    # `planner.detour_moves: lin`: detour searches that tried straight TCP lines, those that found
+    # them, and the plan's detours made of such lines (the others are joint-space).
+    tcp_detour_searches: int = 0
+    tcp_detours_found: int = 0
+    lin_detours: int = 0
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -286,6 +307,8 @@ def resolved_options(cell: CellSpec, options: PlanOptions) -> ResolvedOptions:
         "tcp_speed": p.tcp_speed if options.tcp_speed is None else options.tcp_speed,
         "detour_speed": p.detour_speed if options.detour_speed is None else options.detour_speed,
         "detours": p.detours if options.detours is None else options.detours,
+        "detour_moves": p.detour_moves if options.detour_moves is None else options.detour_moves,
+        "detour_tcp_speed": p.detour_tcp_speed if options.detour_tcp_speed is None else options.detour_tcp_speed,
         "dynamic": p.dynamic if options.dynamic is None else options.dynamic,
         "transfers": p.transfers if options.transfers is None else options.transfers,
     })

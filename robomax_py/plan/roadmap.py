@@ -42,6 +42,14 @@ class Detour:
     waypoints: FloatArray
     time_estimate: float          # s, stopping at every waypoint (an upper bound for blended timing)
     checks: int                   # collision checks this query spent (roadmap sampling not included)
+    # A detour of straight TCP lines (`plan.tcp_detour`): the TCP pose at every waypoint (m, 4, 4),
+    # robot base frame; the moves between waypoints are then lines, not joint moves. None: joint moves.
+    poses: FloatArray | None = None
+
+    def reversed(self) -> Detour:
+        """The same detour travelled the other way."""
+        poses = None if self.poses is None else self.poses[::-1].copy()
+        return Detour(self.waypoints[::-1].copy(), self.time_estimate, self.checks, poses)
 
 
 class Roadmap:

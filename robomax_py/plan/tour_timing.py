@@ -109,12 +109,13 @@ def time_tour(
         checked = loads.world_after(leaving, world) if loads is not None else world
         speed = options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)
         load = LoadOverrides.of(cell, robot, part, speed, options.tcp_speed * options.speed)
+        lin_targets, lin_speed = _lines(cell, trans, after, part, options)
 
         def timed(load: LoadOverrides) -> Junction:
             return time_junction(
                 robot, checked, robot.limits, q_start, waypoints, trans.kind, trans.label, before, after,
                 tcp_speed=load.tcp_speed, speed=load.speed, accel=load.accel, jerk_limited=options.jerk_limited,
-                flyby=options.blend,
+                flyby=options.blend, lin_targets=lin_targets, lin_speed=lin_speed,
             )
 
         junction = timed(load)
@@ -129,6 +130,12 @@ def time_tour(
         if part is not None or tcp_limits is not None:
             trans = replace(trans, part=part, speed=load.speed, accel=load.accel, tcp_speed=load.tcp_speed)
         block = list(junction.segments)
+        if lin_targets is not None:
+            # The lines as timed: the configuration each ends in, its configuration data.
+            legs = [seg for seg in block if seg.kind == trans.kind]
+            line_ends = np.array([seg.q[-1] for seg in legs])
+            trans = replace(trans, waypoints=np.vstack([legs[0].q[0][None, :], line_ends]), lin_targets=lin_targets,
+                            lin_configs=tuple(config_text(robot, q) for q in line_ends), lin_speed=lin_speed)
         ext = junction.extension
         if after is not None:
             block.append(dwell(block[-1].q[-1], weld_times[k], kind="weld", label=after.label))
@@ -166,6 +173,23 @@ def time_tour(
                               weld_times[k], cell.process.gun,
                               cell.process.schedule_of(spec_of[k]), waits_for[k], spec_of[k].action))
     return traj, plans, timed
+
+
+def _lines(cell: CellSpec, trans: Transition, after: WeldEnd | None, part: str | None,
+           options: ResolvedOptions) -> tuple[FloatArray | None, float]:
+    """A detour of TCP lines: its targets as the program states them (the last the next approach
+    point, `after.T_app`) and their TCP speed (m/s, as written, within a carried part's limit);
+    (None, 0) for joint moves."""
+    if trans.lin_targets is None:
+        return None, 0.0
+    targets = np.array(trans.lin_targets, dtype=float)
+    if after is not None:
+        targets[-1] = after.T_app
+    speed = written_tcp_speed(options.detour_tcp_speed * options.speed)
+    limits = tcp_limits_after(cell, part)
+    if limits is not None and limits.v < speed:
+        speed = math.floor(limits.v * 1000.0) / 1000.0
+    return targets, speed
 
 
 # A line continued for a fly-by gets this much more than the blend cuts in, and at most this (m).
@@ -296,7 +320,8 @@ def _next_block(ctx: JunctionContext | None, options: ResolvedOptions, dynamic_w
         return block, trans
     rest_end = math.inf if rest is None else t + rest.seconds + sum(s.duration for s in block)
     staged: StagedJunction | NoRoute | None = None
-    if ctx is not None:
+    # A detour of TCP lines keeps its lines and waits at rest: the time-aware search plans joint moves.
+    if ctx is not None and trans.lin_targets is None:
         has_action = k < len(ends)
         speed = options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)
         staged = staged_junction(

@@ -36,6 +36,7 @@ SMOKE: dict[str, list[str]] = {
     "bench_scale.py": ["--sizes", "8", "--families", "open", "--runs", "1"],
     "bench_startup.py": [SMALL, "--runs", "1"],
     "bench_table_ik.py": ["--quick", "--figures", OUT],
+    "bench_tcp_detours.py": ["--quick", "--png", f"{OUT}/orientations.png"],
     "bench_tending.py": ["--cycles", "1"],
     "bench_transfers.py": ["--transfers", "1", "--runs", "1", "--out", OUT],
     "bench_timing.py": [SMALL, "--runs", "1"],

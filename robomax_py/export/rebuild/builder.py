@@ -140,6 +140,7 @@ class _Builder:
         self.step_lines: list[int | None] = []            # of the pending steps
         self.spans: list[Span] = []
         self.waited: set[str] = set()                      # clamp inputs waited for so far
+        self.after_action = False                          # a weld or gripper action since the last move
 
     def start(self, q: FloatArray) -> None:
         self.q = np.asarray(q, dtype=float)
@@ -147,14 +148,16 @@ class _Builder:
 
     def add(self, ins: Any, following: Any, index: int) -> bool:
         if isinstance(ins, (PtpMove, LinMove)):
-            ins = self._check_speeds(ins)
+            kind = self._kind(ins, following)
+            self.after_action = False
+            ins = self._check_speeds(ins, kind)
             tool = None
             if isinstance(ins, LinMove):
                 resolved = self._frames_of(ins)
                 if resolved is None:
                     return False
                 tool, base = resolved
-                step: Step = self._lin_step(ins, base, following, index)
+                step: Step = self._lin_step(ins, base, kind, index)
             else:
                 step = self._step(ins, following, index)
             self.pending.append(step)
@@ -186,15 +189,26 @@ class _Builder:
                                "brand": self.brand, "controller": self.controller})
             self.spans.append(Span(self.t, self.t + ins.time_s, self.line))
             self.t += ins.time_s
+            self.after_action = True
         elif isinstance(ins, Wait):
             self._hold(ins.seconds, "WAIT")
         elif isinstance(ins, WaitFor):
             self._wait_for(ins)
         return True
 
-    def _check_speeds(self, ins: PtpMove | LinMove) -> PtpMove | LinMove:
+    def _kind(self, ins: PtpMove | LinMove, following: Any) -> str:
+        """What a move is: a line into a weld or gripper action is its approach, the first move
+        after one its retract, any other line a detour's (`planner.detour_moves: lin`)."""
+        if not isinstance(ins, LinMove):
+            return "move"
+        if isinstance(following, (Spot, Gripper)):
+            return "approach"
+        return "retract" if self.after_action else "detour"
+
+    def _check_speeds(self, ins: PtpMove | LinMove, kind: str = "move") -> PtpMove | LinMove:
         """A speed or acceleration above the axes' limits, or a line faster than the cell's line
-        speed, is reported; the move is rebuilt at most at the axes' limits."""
+        speed (a detour's line: its detour line speed), is reported; the move is rebuilt at most
+        at the axes' limits."""
         what = "joint move" if isinstance(ins, PtpMove) else "line"
         fractions = {"acceleration": ins.accel}
         if isinstance(ins, PtpMove):
@@ -204,10 +218,13 @@ class _Builder:
             self.problems.append(Problem(self.t, "speed", f"a {what} at {100.0 * v:.0f} % of the axes' {k}: above 100 %",
                                          self.line))
         if isinstance(ins, LinMove):
-            limit_mm_s = 1000.0 * self.cell.planner.tcp_speed
+            planner = self.cell.planner
+            detour = kind == "detour"
+            limit_mm_s = 1000.0 * (planner.detour_tcp_speed if detour else planner.tcp_speed)
             if ins.speed_mm_s > limit_mm_s + TCP_SPEED_TOL_MM_S:
+                name, key = ("detour line speed", "detour_tcp_speed") if detour else ("line speed", "tcp_speed")
                 self.problems.append(Problem(self.t, "speed", f"a line at {ins.speed_mm_s:.1f} mm/s, faster than the "
-                                                              f"cell's line speed {limit_mm_s:.1f} mm/s (planner.tcp_speed)",
+                                                              f"cell's {name} {limit_mm_s:.1f} mm/s (planner.{key})",
                                              self.line))
         if not over:
             return ins
@@ -237,10 +254,9 @@ class _Builder:
         return PtpStep(ptp_target(ins), speed=ins.speed, accel=ins.accel, flyby=math.radians(ins.flyby),
                        kind="move", label=ins.comment or f"statement {index + 1}", flyby_tcp=ins.flyby_mm / 1000.0)
 
-    def _lin_step(self, ins: LinMove, T_ctrl_frame: FloatArray, following: Any, index: int) -> Step:
+    def _lin_step(self, ins: LinMove, T_ctrl_frame: FloatArray, kind: str, index: int) -> Step:
         # The controller's composition: its robot base (in the URDF root), the user frame, the target.
         T = from_frame(self.robot.controller.T_root_base, T_ctrl_frame @ lin_pose(ins))
-        kind = "approach" if isinstance(following, (Spot, Gripper)) else "retract"
         return LinStep(T, ins.speed_mm_s / 1000.0, None, flyby=math.radians(ins.flyby), kind=kind,
                        label=ins.comment or f"statement {index + 1}", flyby_tcp=ins.flyby_mm / 1000.0, accel=ins.accel)
 
