@@ -252,10 +252,17 @@ def _verify_motion(cell: CellSpec, robot: RobotModel, name: str, data: dict[str,
 def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> list[Violation]:
     t, q = data["t"], data["q"]
     out: list[Violation] = []
+    from robomax_py.export.plan_program import identifier
+
     wanted = {(seam.name, spot.name): (seam, spot) for seam in cell.seams for spot in seam.spots}
+    # A controller program names a spot by its identifiers (a seam called `seam`, a keyword, is
+    # written `seam_`; `door-L 2` is `door_L_2`): read back as the cell's own names.
+    written_as = {(identifier(seam.name), identifier(spot.name)): key for key, (seam, spot) in wanted.items()}
     seen: dict[tuple[str, str], float] = {}
     for entry in data["spots"]:
         key = (str(entry["seam"]), str(entry["name"]))
+        if key not in wanted:
+            key = written_as.get(key, key)
         label = f"{key[0]}/{key[1]}"
         if key not in wanted:
             out.append(Violation(None, "spot", f"{label} is not a spot of the cell"))
