@@ -62,6 +62,7 @@ from robomax_py.io.yaml_files import (
 from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
 from robomax_py.spec import (
     CellSpec,
+    LearnedMapSpec,
     PlannerSpec,
     ProcessSpec,
     frozen_array,
@@ -213,6 +214,7 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
         ),
         planner=PlannerSpec(seed=parsed.planner.seed, speed=parsed.planner.speed, tcp_speed=parsed.planner.tcp_speed,
                             detour_speed=parsed.planner.detour_speed, detours=parsed.planner.detours,
+                            learned=LearnedMapSpec(**parsed.planner.learned.model_dump()),
                             dynamic=parsed.planner.dynamic, max_wait=parsed.planner.max_wait),
         dynamic=tuple(o for o in dynamic if o is not None) + doors,
         digest=digest,
