@@ -128,7 +128,7 @@ DESCRIPTIONS: dict[str, str] = {
     "LearnedMapFile.resolution": "Samples per axis of the A1-A3 map (8-60).",
     "LearnedMapFile.spacing": "Distance between the surface points the objects become, m.",
     "LearnedMapFile.inflation": "Added to the points' cover radius and the clearance, m.",
-    "LearnedMapFile.training": "The model's training grid: standard or coarse (about 20 times cheaper).",
+    "LearnedMapFile.training": "The model's training grid: coarse, or standard (about 30 times the training cost).",
     "LearnedMapFile.neurons": "Most hidden neurons of the RBF network; grown until it fits when absent.",
     "PlannerFile.dynamic": "timed: plan round dynamic objects in time; rest: wait at rest for them.",
     "PlannerFile.max_wait": "Longest wait at one place a timed search may propose, s.",

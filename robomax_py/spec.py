@@ -266,7 +266,7 @@ class LearnedMapSpec:
     resolution: int = 40          # samples per axis of the A1-A3 map
     spacing: float = 0.1          # m between the surface points the objects become
     inflation: float = 0.06       # m added to the points' cover radius and the clearance
-    training: str = "standard"    # the model's training grid: "standard" or "coarse"
+    training: str = "coarse"      # the model's training grid: "coarse" or "standard"
     neurons: int | None = None    # most hidden neurons of the network; None: grown until it fits
 
 

@@ -92,7 +92,7 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
                 "training_cpu_s": round(m.training_cpu_seconds, 3), "training_checks": m.training_checks,
                 "map_cpu_s": round(m.map_cpu_seconds, 3), "searches": m.searches, "found": m.found,
                 "refused_segments": m.refused_segments, "refused_entries": m.refused_entries,
-                "no_entry": m.no_entry, "no_path": m.no_path,
+                "no_entry": m.no_entry, "no_path": m.no_path, "gave_up": m.gave_up,
             }
     return report
 

@@ -302,7 +302,7 @@ class LearnedMapFile(_Strict):
     resolution: Annotated[int, Field(ge=8, le=60)] = 40
     spacing: Annotated[float, Field(ge=0.02, le=1.0, allow_inf_nan=False)] = 0.1      # m between surface points
     inflation: Annotated[float, Field(ge=0, le=0.5, allow_inf_nan=False)] = 0.06     # m
-    training: Literal["standard", "coarse"] = "standard"
+    training: Literal["standard", "coarse"] = "coarse"
     neurons: Annotated[int, Field(ge=2, le=1000)] | None = None
 
 

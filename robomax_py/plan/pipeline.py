@@ -342,8 +342,8 @@ def _learned_note(learned: LearnedDetours | None) -> str:
         return ""
     r = learned.report()
     return (f"; learned C-space map: {r.searches} detour searches, {r.found} found, {r.no_entry} without a checked "
-            f"way into or out of the map, {r.no_path} without a path, {r.refused_segments} path segments refused by "
-            "the exact check")
+            f"way into or out of the map, {r.no_path} without a path, {r.gave_up} given up after repairs, "
+            f"{r.refused_segments} path segments refused by the exact check")
 
 
 def _workpiece_hint(cell: CellSpec, spots: list[SpotCandidates]) -> str:

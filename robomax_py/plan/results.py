@@ -244,6 +244,7 @@ class LearnedMapReport:
     refused_entries: int            # legs from a stop into the map the exact check refused
     no_entry: int                   # searches with no leg into or out of the map passing the check
     no_path: int                    # searches where the map (with its repairs) held no path
+    gave_up: int                    # searches that repaired MAX_REPAIRS refused segments and stopped
 
 
 @dataclass(frozen=True, slots=True)

@@ -130,8 +130,9 @@ def search(detours: LearnedDetours, world: CollisionWorld, qa: np.ndarray, qb: n
     det, checks = detours.query(world, qa, qb)
     if det is not None:
         return f"found, {len(det.waypoints)} waypoints, est. {det.time_estimate:.2f} s ({checks:,} checks)", True
-    grew = {k for k in ("no_entry", "no_path") if detours.counts[k] > before.get(k, 0)}
-    why = "no checked way into or out of the map" if "no_entry" in grew else "no path in the map"
+    grew = {k for k in ("no_entry", "no_path", "gave_up") if detours.counts[k] > before.get(k, 0)}
+    why = ("no checked way into or out of the map" if "no_entry" in grew else
+           "every path refused by the exact check (repairs used up)" if "gave_up" in grew else "no path in the map")
     return f"none: {why} ({checks:,} checks)", False
 
 
@@ -154,8 +155,12 @@ def why_not(learned: LearnedDetours, exact: LearnedDetours, world: CollisionWorl
     if cells is None:
         return "the exact map's path is gone too"
     blocked = int((~learned.free[cells]).sum())
-    return (f"no path: the learned map blocks {blocked} of the exact path's {len(cells)} cells "
-            f"({100.0 * blocked / len(cells):.0f} % false blocked along it)")
+    repaired = int((learned.free[cells] != ~(learned.obstacle | learned.self_contact).reshape(-1)[cells]).sum())
+    joined = learned.free[ends].all() and learned.path(ends[0], ends[1]) is not None
+    return (f"the learned map blocks {blocked} of the exact path's {len(cells)} cells "
+            f"({100.0 * blocked / len(cells):.0f} % false blocked along it; {repaired} of them taken out by repairs)"
+            + ("; from the exact map's ways in, the learned map has a path: its own ways in lead elsewhere"
+               if joined else ""))
 
 
 def main() -> None:

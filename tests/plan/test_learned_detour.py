@@ -23,6 +23,7 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
+from robomax_py.cspace import exact_map
 from robomax_py.errors import CellFileError
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import plan_cell
@@ -34,6 +35,7 @@ from robomax_py.world.scene import build_scene
 REPO = Path(__file__).resolve().parents[2]
 FLANGE_CELL = REPO / "tests" / "data" / "flange_cell" / "cabin_flange.yaml"
 WRIST_TOL_RAD = 1e-12
+WALL_PAIRS = 6             # searches across walls of the exact map in a map without obstacles
 # s5 and s6 of the frozen reference cell with clamp 1 on the flange between them, the panel on its
 # table: the straight moves home -> s5 -> s6 -> home are blocked, so the plan needs detours.
 KEEP_OBJECTS = ("table", "fixture_plate", "cabin_panel", "clamp1_jaw", "clamp1_arm", "clamp1_post")
@@ -110,31 +112,40 @@ def test_a_clamped_cell_plans_in_the_learned_map_and_every_motion_is_free(  # ty
     assert report["learned_map"]["found"] == m.found and report["learned_map"]["neurons"] == m.neurons
 
 
-def test_a_path_the_exact_check_refuses_is_repaired_and_never_offered(clamp_cell, learned_plan) -> None:  # type: ignore[no-untyped-def]
+def test_a_path_the_exact_check_refuses_is_repaired_and_never_offered(clamp_cell) -> None:  # type: ignore[no-untyped-def]
     _, cell, robot = clamp_cell
     world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
     spots = seam_candidates(cell, robot, world, 0)[0]
-    real = LearnedDetours.build(cell, robot, world, spots, cell.planner.learned)
-    assert real.figures.cached                                # the plan's model, from the cache
-    # A map that knows of no obstacle: its shortest way from s5 to s6 runs through the clamp.
+    real = LearnedDetours.build(cell, robot, world, spots, cell.planner.learned)   # trained once per module
+    # A map that knows of no obstacle, asked for ways between map cells on either side of a wall of
+    # two cells the exact map blocks along A1: its shortest ways run into the objects.
+    exact = exact_map(world, real.grid)
     nothing = np.zeros_like(real.obstacle)
     wrong = LearnedDetours(real.grid, nothing, nothing, robot.limits, real.model, real.figures)
-    s5, s6 = learned_plan.spots
-    assert not world.segment_free(s5.q_app, s6.q_app)
-    det, checks = wrong.query(world, s5.q_app, s6.q_app)
-    assert checks > 0
-    assert wrong.counts["refused_segments"] >= 1               # refused by the exact check, repaired
-    if det is not None:
-        np.testing.assert_array_equal(det.waypoints[[0, -1]], [s5.q_app, s6.q_app])
-        assert all(world.segment_free(a, b) for a, b in itertools.pairwise(det.waypoints))
-    assert wrong.report().searches == 1
+    free = ~(exact.obstacle | exact.self_contact)
+    r = real.grid.resolution
+    walls = np.argwhere(free[:-3] & free[3:] & exact.obstacle[1:-2] & exact.obstacle[2:-1])
+    pairs = walls[np.linspace(0, len(walls) - 1, WALL_PAIRS).astype(int)]
+    for i, j, k in pairs:
+        qa = real.configs[(i * r + j) * r + k]
+        qb = real.configs[((i + 3) * r + j) * r + k]
+        assert not world.segment_free(qa, qb)
+        det, checks = wrong.query(world, qa, qb)
+        assert checks > 0
+        if det is not None:                                   # what is offered is free, end to end
+            np.testing.assert_array_equal(det.waypoints[[0, -1]], [qa, qb])
+            assert all(world.segment_free(a, b) for a, b in itertools.pairwise(det.waypoints))
+    report = wrong.report()
+    assert report.searches == WALL_PAIRS
+    assert report.refused_segments >= 1, report               # refused by the exact check, repaired
+    assert report.found >= 1, report
 
 
 def test_the_cell_keys_take_learned_and_refuse_bad_settings(tmp_path: Path) -> None:
     cell = load_cell(write_clamp_cell(tmp_path, {"detours": "learned", "learned": {"neurons": 8, "spacing": 0.2}}))
     assert cell.planner.detours == "learned"
     assert (cell.planner.learned.neurons, cell.planner.learned.spacing) == (8, 0.2)
-    assert cell.planner.learned.resolution == 40 and cell.planner.learned.training == "standard"
+    assert cell.planner.learned.resolution == 40 and cell.planner.learned.training == "coarse"
     for bad, key in (({"resolution": 2}, "planner.learned.resolution"), ({"training": "fine"}, "planner.learned.training"),
                      ({"spacing": 0}, "planner.learned.spacing"), ({"radius": 1}, "planner.learned.radius")):
         with pytest.raises(CellFileError, match=key.replace(".", r"\.")):
