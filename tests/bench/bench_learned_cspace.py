@@ -25,9 +25,11 @@ an SRCL program from it. For CELL (default: the reference cell), on the map the 
    map loses), as counts and shares of the exactly blocked and free samples;
 3. detours: each move of the file's order (nominal candidates, home at both ends) that the exact
    swept check blocks, searched in each map and in the exact map of the same grid (the same search
-   over the exact masks). Where a learned map finds none and the exact one does it says why: no
-   checked way into or out of the map (and the learned map's blocked share of the exactly free
-   cells the search tries nearest the stop), or no path (its blocked share of the exact path's cells);
+   over the exact masks). Where a learned map finds none and the exact one does it says why,
+   measured: no checked way into or out of the map (false blocked near the stops: its blocked share
+   of the exactly free cells nearest them), every path it found refused by the exact check until
+   the repairs ran out (false free), or no path (false blocked along the exact map's path: its
+   blocked share of that path's cells);
 4. with `--plan`: the cell planned with `planner.detours: learned` (ours) and with the default,
    cycle and CPU seconds, and the learned plan's program verified as `robomax verify` does.
 
@@ -63,6 +65,7 @@ from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan.candidates import SpotCandidates, seam_candidates
 from robomax_py.plan.learned_detour import (
     ENTRY_POOL,
+    MAX_REPAIRS,
     LearnedDetours,
     MapFigures,
     map_grid,
@@ -124,43 +127,47 @@ def held_out(grid: CSpaceGrid, samples: int, rng: np.random.Generator) -> CSpace
     return CSpaceGrid(axes=axes, wrist=grid.wrist)  # type: ignore[arg-type]
 
 
-def search(detours: LearnedDetours, world: CollisionWorld, qa: np.ndarray, qb: np.ndarray) -> tuple[str, bool]:
-    """One detour search: what it found (or why it found nothing, as the search counted it)."""
+def search(detours: LearnedDetours, world: CollisionWorld, qa: np.ndarray, qb: np.ndarray) -> tuple[str, str]:
+    """One detour search: what it found, or why it found nothing as the search counted it
+    ("found", "no_entry", "no_path" or "gave_up"), and a line saying so."""
     before = dict(detours.counts)
     det, checks = detours.query(world, qa, qb)
     if det is not None:
-        return f"found, {len(det.waypoints)} waypoints, est. {det.time_estimate:.2f} s ({checks:,} checks)", True
-    grew = {k for k in ("no_entry", "no_path", "gave_up") if detours.counts[k] > before.get(k, 0)}
-    why = ("no checked way into or out of the map" if "no_entry" in grew else
-           "every path refused by the exact check (repairs used up)" if "gave_up" in grew else "no path in the map")
-    return f"none: {why} ({checks:,} checks)", False
+        return "found", f"found, {len(det.waypoints)} waypoints, est. {det.time_estimate:.2f} s ({checks:,} checks)"
+    why = next(k for k in ("no_entry", "gave_up", "no_path") if detours.counts[k] > before.get(k, 0))
+    text = {"no_entry": "no checked way into or out of the map", "no_path": "no path in the map",
+            "gave_up": f"{MAX_REPAIRS} paths in a row refused by the exact check"}[why]
+    return why, f"none: {text} ({checks:,} checks)"
 
 
-def why_not(learned: LearnedDetours, exact: LearnedDetours, world: CollisionWorld, qa: np.ndarray,
+def why_not(why: str, learned: LearnedDetours, exact: LearnedDetours, world: CollisionWorld, qa: np.ndarray,
             qb: np.ndarray) -> str:
-    """Why the learned map has no detour where the exact map has one, measured."""
-    ends = [exact.entry(world, q)[0] for q in (qa, qb)]
-    if any(learned.entry(world, q)[0] is None for q in (qa, qb)):
-        shares = []
+    """Why the learned map has no detour where the exact map of the same grid has one, measured."""
+    if why == "no_entry":
+        lost, wrong = [], []
         vel = np.asarray(exact.limits.velocity)[:3]
+
+        def nearest(mask: np.ndarray, q: np.ndarray) -> np.ndarray:
+            cells = np.flatnonzero(mask)
+            cost = np.max(np.abs(exact.configs[cells, :3] - q[:3]) / vel, axis=1)
+            return cells[np.argsort(cost, kind="stable")[:ENTRY_POOL]]
+
         for q in (qa, qb):
-            free = np.flatnonzero(exact.free)
-            cost = np.max(np.abs(exact.configs[free, :3] - q[:3]) / vel, axis=1)
-            near = free[np.argsort(cost, kind="stable")[:ENTRY_POOL]]
-            shares.append(100.0 * float((~learned.free[near]).mean()))
-        return (f"no checked way into the learned map: it blocks {shares[0]:.0f} % / {shares[1]:.0f} % of the "
-                f"{ENTRY_POOL} exactly free cells nearest the two stops")
+            lost.append(100.0 * float((~learned.free[nearest(exact.free, q)]).mean()))
+            wrong.append(100.0 * float((~exact.free[nearest(learned.free, q)]).mean()))
+        return (f"near the stops it blocks {lost[0]:.0f} % / {lost[1]:.0f} % of the {ENTRY_POOL} exactly free cells "
+                f"nearest them (false blocked), and {wrong[0]:.0f} % / {wrong[1]:.0f} % of the {ENTRY_POOL} cells it "
+                "calls free nearest them are blocked (false free)")
+    ends = [exact.entry(world, q)[0] for q in (qa, qb)]
     assert ends[0] is not None and ends[1] is not None
     cells = exact.path(ends[0], ends[1])
     if cells is None:
         return "the exact map's path is gone too"
     blocked = int((~learned.free[cells]).sum())
-    repaired = int((learned.free[cells] != ~(learned.obstacle | learned.self_contact).reshape(-1)[cells]).sum())
-    joined = learned.free[ends].all() and learned.path(ends[0], ends[1]) is not None
-    return (f"the learned map blocks {blocked} of the exact path's {len(cells)} cells "
-            f"({100.0 * blocked / len(cells):.0f} % false blocked along it; {repaired} of them taken out by repairs)"
-            + ("; from the exact map's ways in, the learned map has a path: its own ways in lead elsewhere"
-               if joined else ""))
+    along = f"it blocks {blocked} of the exact path's {len(cells)} cells ({100.0 * blocked / len(cells):.0f} %)"
+    if why == "gave_up":
+        return f"false free: the cells it called free along its paths were not, {MAX_REPAIRS} times; {along}"
+    return f"false blocked along the way: {along}"
 
 
 def main() -> None:
@@ -243,14 +250,14 @@ def main() -> None:
     for (na, qa), (nb, qb) in itertools.pairwise(stops):
         if world.check_segment(qa, qb).free:
             continue
-        line, best = search(exact_search, world, qa, qb)
+        best, line = search(exact_search, world, qa, qb)
         print(f"  {na} -> {nb}:\n    {'exact map (same grid and search)':40s} {line}")
         for v, detours in maps:
-            line, found = search(detours, world, qa, qb)
-            if not found and best:
-                line += f"; {why_not(detours, exact_search, world, qa, qb)}"
+            why, line = search(detours, world, qa, qb)
+            if why != "found" and best == "found":
+                line += f"; {why_not(why, detours, exact_search, world, qa, qb)}"
             print(f"    {v.name:40s} {line}")
-    for v, detours in maps:
+    for v, detours in [(Variant("exact map", ours_points, ours_r, settings), exact_search), *maps]:
         r = detours.report()
         print(f"  {v.name}: {r.searches} searches, {r.found} found, {r.refused_segments} path segments refused by "
               f"the exact check (repaired), {r.refused_entries} entry legs refused")

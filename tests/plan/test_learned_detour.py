@@ -5,7 +5,8 @@ learned map (the detours' inner waypoints are map cells, at the map's wrist), it
 and every step of the timed motion passes the exact swept check of a collision world built here (an
 independent check: the learned map has no say in it); a map that is wrong on purpose (no obstacle
 at all) has its path through the clamp refused by the exact check, counted and repaired, and what
-it offers, if anything, is free; the cell keys take `learned` and its settings and refuse bad ones.
+it offers, if anything, is free; the cell keys take `learned` and its settings and refuse bad ones;
+a robot the method cannot map is one message naming the cell and the key.
 The model is trained on the coarse grid into a folder of the test's own (seconds).
 """
 
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import re
 import shutil
 from collections.abc import Iterator
 from pathlib import Path
@@ -23,10 +25,10 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from robomax_py.cspace import exact_map
+from robomax_py.cspace import CSpaceError, exact_map
 from robomax_py.errors import CellFileError
 from robomax_py.io.cell import load_cell, load_cell_robot
-from robomax_py.plan import plan_cell
+from robomax_py.plan import learned_detour, plan_cell
 from robomax_py.plan.candidates import seam_candidates
 from robomax_py.plan.learned_detour import LearnedDetours
 from robomax_py.world.collision import CollisionWorld
@@ -150,3 +152,14 @@ def test_the_cell_keys_take_learned_and_refuse_bad_settings(tmp_path: Path) -> N
                      ({"spacing": 0}, "planner.learned.spacing"), ({"radius": 1}, "planner.learned.radius")):
         with pytest.raises(CellFileError, match=key.replace(".", r"\.")):
             load_cell(write_clamp_cell(tmp_path, {"detours": "learned", "learned": bad}))
+
+
+def test_a_robot_the_method_cannot_map_is_one_message_naming_the_key(clamp_cell, monkeypatch: pytest.MonkeyPatch) -> None:  # type: ignore[no-untyped-def]
+    _, cell, robot = clamp_cell
+
+    def refuse(_robot: object) -> None:
+        raise CSpaceError("robot kr125: A1 is not vertical; the C-space map needs a vertical A1")
+
+    monkeypatch.setattr(learned_detour, "check_arm", refuse)
+    with pytest.raises(CSpaceError, match=rf"^{re.escape(str(cell.source))}: planner\.detours: learned: robot kr125: A1"):
+        LearnedDetours.build(cell, robot, None, [], cell.planner.learned)  # type: ignore[arg-type]
