@@ -228,7 +228,7 @@ class LearnedMapReport:
     wrist: tuple[float, ...]        # rad, A4-A6 held fixed over the map
     resolution: int                 # samples per axis of A1-A3
     blocked_by_objects: int         # cells the learned model blocks
-    blocked_by_itself: int          # cells where the arm touches itself (checked exactly)
+    blocked_by_itself: int          # cells free of objects where the arm touches itself (checked exactly)
     points: int                     # surface points the objects became
     points_in_reach: int            # of them, those the arm can touch (the paper's N')
     sphere_radius: float            # m, the training sphere's: clearance + cover radius + inflation

@@ -26,14 +26,16 @@ an SRCL program from it. For CELL (default: the reference cell), on the map the 
 3. detours: each move of the file's order (nominal candidates, home at both ends) that the exact
    swept check blocks, searched in each map and in the exact map of the same grid (the same search
    over the exact masks). Where a learned map finds none and the exact one does it says why,
-   measured: no checked way into or out of the map (false blocked near the stops: its blocked share
-   of the exactly free cells nearest them), every path it found refused by the exact check until
+   measured: no checked way into or out of the map (near the stops: its blocked share of the
+   exactly free cells, and the exactly blocked share of the cells it calls free), every path it
+   found refused by the exact check until
    the repairs ran out (false free), or no path (false blocked along the exact map's path: its
    blocked share of that path's cells);
 4. with `--plan`: the cell planned with `planner.detours: learned` (ours) and with the default,
    cycle and CPU seconds, and the learned plan's program verified as `robomax verify` does.
 
-CPU seconds of this process. Models are cached (ROBOMAX_CACHE).
+CPU seconds of this process. Models are cached (ROBOMAX_CACHE); `--quick` trains on a toy grid into
+a temporary folder, 16^3 cells, 12^3 samples.
 """
 
 from __future__ import annotations
