@@ -260,16 +260,30 @@ class ProcessSpec:
 
 
 @dataclass(frozen=True, slots=True)
+class LearnedMapSpec:
+    """The learned C-space map detours are searched in under `planner.detours: learned`."""
+
+    resolution: int = 40          # samples per axis of the A1-A3 map
+    spacing: float = 0.1          # m between the surface points the objects become
+    inflation: float = 0.06       # m added to the points' cover radius and the clearance
+    training: str = "coarse"      # the model's training grid: "coarse" or "standard"
+    neurons: int | None = None    # most hidden neurons of the network; None: grown until it fits
+
+
+@dataclass(frozen=True, slots=True)
 class PlannerSpec:
     seed: int = 0
     speed: float = 1.0            # override of every programmed speed, fraction in (0, 1]
     tcp_speed: float = 0.5        # m/s on the LIN approach and retract lines
     detour_speed: float = 1.0     # speed fraction of PTP moves through detours (near clamps)
-    detours: str = "both"         # where detours are searched: "roadmap", "cspace" (local A1-A3 map) or "both"
+    # Where detours are searched: "roadmap", "cspace" (local A1-A3 map), "both", or "learned" (the
+    # learned C-space map alone, `learned`).
+    detours: str = "both"
     # How a detour moves: "ptp" (joint-space straight moves between its points) or "lin" (straight
     # TCP lines through via points, as paper 003 builds them; joint-space where none exists).
     detour_moves: str = "ptp"
     detour_tcp_speed: float = 1.0  # m/s on the LIN lines of a detour (`detour_moves: lin`)
+    learned: LearnedMapSpec = LearnedMapSpec()
     # Dynamic obstacles: "timed" searches the roadmap with their windows (waiting where it pays,
     # or going round); "rest" plans them as absent and waits at rest before the blocked move.
     dynamic: str = "timed"

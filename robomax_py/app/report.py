@@ -83,6 +83,18 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
             "roadmap_checks": st.roadmap_checks, "sequencing_rounds": st.rounds, "dp_evaluations": st.dp_evaluations,
             "stage_seconds": {k: round(v, 3) for k, v in st.seconds.items()},
         }
+        if st.learned is not None:
+            m = st.learned
+            report["learned_map"] = {
+                "wrist_deg": [round(math.degrees(v), 3) for v in m.wrist], "resolution": m.resolution,
+                "blocked_by_objects": m.blocked_by_objects, "blocked_by_itself": m.blocked_by_itself,
+                "points": m.points, "points_in_reach": m.points_in_reach, "sphere_radius_m": round(m.sphere_radius, 4),
+                "neurons": m.neurons, "weights": m.weights, "training_cached": m.training_cached,
+                "training_cpu_s": round(m.training_cpu_seconds, 3), "training_checks": m.training_checks,
+                "map_cpu_s": round(m.map_cpu_seconds, 3), "searches": m.searches, "found": m.found,
+                "refused_segments": m.refused_segments, "refused_entries": m.refused_entries,
+                "no_entry": m.no_entry, "no_path": m.no_path, "gave_up": m.gave_up,
+            }
     return report
 
 
@@ -118,6 +130,13 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
         st = report["stats"]
         head.add_row("work", f"{st['candidates']} candidates, {st['collision_checks']:,} collision checks, "
                              f"{st['sequencing_rounds']} sequencing rounds")
+    if "learned_map" in report:
+        m = report["learned_map"]
+        trained = "from the cache, trained in" if m["training_cached"] else "trained in"
+        head.add_row("learned map", f"{m['points']:,} points ({m['points_in_reach']:,} in reach), {m['neurons']} neurons "
+                     f"({trained} {m['training_cpu_s']:.1f} s CPU), {m['resolution']}^3 cells at wrist "
+                     f"{m['wrist_deg']} deg; {m['found']} of {m['searches']} detour searches found, "
+                     f"{m['refused_segments']} path segments refused by the exact check and repaired")
     for p in report.get("programs", []):
         head.add_row("proven", f"{p['format']}: read back, rebuilt within {p['rebuilt_joint_deg']:.4f} deg, "
                                f"{p['rebuilt_tcp_mm']:.3f} mm, {p['rebuilt_time_ms']:.1f} ms of the plan")

@@ -2,7 +2,8 @@
 
 `build_map(cell, robot, wrist, resolution)` checks every cell of the grid exactly with the cell's
 collision world; `learned_model` (trained once, cached on disk) and `learned_map` give the same map
-from the method's learned point model (`cspace.learned`). Detours through a map are not built yet.
+from the method's learned point model (`cspace.learned`). Detours are searched in a learned map by
+`plan.learned_detour` (`planner.detours: learned`), in exact local maps by `plan.cspace_detour`.
 """
 
 from __future__ import annotations

@@ -62,6 +62,7 @@ from robomax_py.io.yaml_files import (
 from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
 from robomax_py.spec import (
     CellSpec,
+    LearnedMapSpec,
     PlannerSpec,
     ProcessSpec,
     frozen_array,
@@ -215,6 +216,7 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
                             detour_speed=parsed.planner.detour_speed, detours=parsed.planner.detours,
                             detour_moves=parsed.planner.detour_moves,
                             detour_tcp_speed=parsed.planner.detour_tcp_speed,
+                            learned=LearnedMapSpec(**parsed.planner.learned.model_dump()),
                             dynamic=parsed.planner.dynamic, max_wait=parsed.planner.max_wait,
                             transfers=parsed.planner.transfers),
         dynamic=tuple(o for o in dynamic if o is not None) + doors,

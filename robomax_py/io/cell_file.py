@@ -295,16 +295,28 @@ class ProcessFile(_Strict):
     interlock_distance: Annotated[float, Field(ge=0, le=10, allow_inf_nan=False)] = 0.2
 
 
+class LearnedMapFile(_Strict):
+    """The learned C-space map of `planner.detours: learned` (docs/learned-cspace.md)."""
+
+    # The map has resolution^3 cells and ~26 edges each: 60 keeps its graph near 150 MB.
+    resolution: Annotated[int, Field(ge=8, le=60)] = 40
+    spacing: Annotated[float, Field(ge=0.02, le=1.0, allow_inf_nan=False)] = 0.1      # m between surface points
+    inflation: Annotated[float, Field(ge=0, le=0.5, allow_inf_nan=False)] = 0.06     # m
+    training: Literal["standard", "coarse"] = "coarse"
+    neurons: Annotated[int, Field(ge=2, le=1000)] | None = None
+
+
 class PlannerFile(_Strict):
     seed: Annotated[int, Field(ge=0)] = 0
     # Extensions (docs/cell-extensions.md): speeds the program states per move.
     speed: Annotated[float, Field(gt=0, le=1)] = 1.0
     tcp_speed: Annotated[float, Field(gt=0, le=2)] = 0.5
     detour_speed: Annotated[float, Field(gt=0, le=1)] = 1.0
-    detours: Literal["roadmap", "cspace", "both"] = "both"
+    detours: Literal["roadmap", "cspace", "both", "learned"] = "both"
     detour_moves: Literal["ptp", "lin"] = "ptp"
     # KSS caps a LIN's $VEL.CP at 2 m/s (export.krl), as it does the approach lines' `tcp_speed`.
     detour_tcp_speed: Annotated[float, Field(gt=0, le=2)] = 1.0
+    learned: LearnedMapFile = LearnedMapFile()
     dynamic: Literal["timed", "rest"] = "timed"
     max_wait: Annotated[float, Field(gt=0, le=MAX_WINDOW_S, allow_inf_nan=False)] = 600.0
     transfers: Literal["moves", "associative"] = "moves"

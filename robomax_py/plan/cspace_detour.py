@@ -8,7 +8,8 @@ exactly (the exact map, with the pre-filter: a 24³ grid costs ~14,000 checks); 
 26-connected path of free cells in a time metric (Dijkstra, scipy) joins the cells nearest qa and
 qb; it is shortened greedily and every segment of the result, qa and qb included, is checked
 exactly by the swept check before the detour is offered. A learned map is not used here: it holds
-for one fixed wrist, and training one per detour (minutes) costs far more than the exact local map.
+for one fixed wrist, and training one per detour (minutes) costs far more than the exact local map;
+`planner.detours: learned` searches one learned map per plan instead (`plan.learned_detour`).
 """
 
 from __future__ import annotations

@@ -223,7 +223,7 @@ class Sequencer(SequencerDetours):
         assert self._probed is not None, "run() first"
         other = Sequencer(self.cell, self.robot, self.world, self.roadmap.fresh(), self.spots,
                           replace(self.options, given_order=True), copy.deepcopy(self._rng_at_start),
-                          loads=self.loads)
+                          loads=self.loads, learned=None if self.learned is None else self.learned.fresh())
         straight, detour_only, _ = self._probed
         other.straight = {k: dict(v) for k, v in straight.items()}
         other.detour_only = set(detour_only)

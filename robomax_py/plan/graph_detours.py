@@ -208,10 +208,18 @@ class SequencerDetours(SequencerKnowledge):
         return None
 
     def _searched_detour(self, i: int, qa: FloatArray, qb: FloatArray) -> Detour | None:
-        """The roadmap's detour, the local C-space map's, or the faster of both (`planner.detours`)."""
+        """The roadmap's detour, the local C-space map's, the faster of both, or the learned C-space
+        map's (`planner.detours`)."""
         kind = self.options.detours                   # resolved from the cell (`resolved_options`)
-        if kind not in ("roadmap", "cspace", "both"):
-            raise ValueError(f"planner.detours must be roadmap, cspace or both, got {kind!r}")
+        if kind not in ("roadmap", "cspace", "both", "learned"):
+            raise ValueError(f"planner.detours must be roadmap, cspace, both or learned, got {kind!r}")
+        if kind == "learned":
+            if self.learned is None:
+                raise ValueError("planner.detours: learned needs the plan's learned map (LearnedDetours.build)")
+            det, spent = self.learned.query(self.world_from(i), qa, qb)
+            if det is None:
+                self.checks += spent           # a found detour's checks are counted with it
+            return det
         found: list[Detour] = []
         if kind in ("roadmap", "both"):
             det = self.roadmap_from(i).query(qa, qb)
@@ -240,12 +248,17 @@ class SequencerDetours(SequencerKnowledge):
         # Lift first: on clamp cells it is found in ~1,000 checks; the roadmap is the general fallback.
         # Where neither finds a way, the gun's C may still hold the sheet at both approach points
         # (moves between two faces of a part): off the flange first (`_withdrawn_detour`).
-        # `planner.detour_moves: lin`: straight TCP lines first (paper 003's detours), joint-space
-        # detours only where none is found.
-        det = self._tcp_detour(i, a, j, b) if self.options.detour_moves == "lin" else None
-        det = (det or self._lift_detour(i, a, j, b) or self._searched_detour(i, self.q(i)[a], self.q(j)[b])
-               or self._withdrawn_detour(i, a, j, b))
-        if det is None and last_resort:
+        # The learned map is the method under study: every detour is its own, nothing else is tried.
+        learned_only = self.options.detours == "learned"
+        if learned_only:
+            det = self._searched_detour(i, self.q(i)[a], self.q(j)[b])
+        else:
+            # `planner.detour_moves: lin`: straight TCP lines first (paper 003's detours), joint-space
+            # detours only where none is found.
+            det = self._tcp_detour(i, a, j, b) if self.options.detour_moves == "lin" else None
+            det = (det or self._lift_detour(i, a, j, b) or self._searched_detour(i, self.q(i)[a], self.q(j)[b])
+                   or self._withdrawn_detour(i, a, j, b))
+        if det is None and last_resort and not learned_only:
             # A tour with no other way on (`_open_dead_end`): trees grown between the two ends find
             # narrow ways out that the shared roadmap samples too thinly (a few CPU seconds at most).
             det, spent = rrt_detour(self.world_from(i), self.limits, self.q(i)[a], self.q(j)[b], self.rng)

@@ -11,6 +11,7 @@ import numpy as np
 
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.plan.candidates import SpotCandidates
+from robomax_py.plan.learned_detour import LearnedDetours
 from robomax_py.plan.loads import Loads
 from robomax_py.plan.results import Progress, ResolvedOptions, _no_progress
 from robomax_py.plan.roadmap import Detour, Roadmap
@@ -57,9 +58,11 @@ class SequencerKnowledge:
     def __init__(
         self, cell: CellSpec, robot: RobotModel, world: CollisionWorld, roadmap: Roadmap,
         spots: list[SpotCandidates], options: ResolvedOptions, rng: np.random.Generator,
-        progress: Progress = _no_progress, loads: Loads | None = None,
+        progress: Progress = _no_progress, loads: Loads | None = None, learned: LearnedDetours | None = None,
     ) -> None:
         self.cell, self.robot, self.world, self.roadmap = cell, robot, world, roadmap
+        # `planner.detours: learned`: the plan's learned C-space map, where every detour is searched.
+        self.learned = learned
         # Pick and place: the moves leaving a grip carry the part (their own world and roadmap).
         self.loads = loads
         self._roadmaps: dict[str | None, Roadmap] = {None: roadmap}

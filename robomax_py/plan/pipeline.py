@@ -20,6 +20,7 @@ import numpy as np
 from robomax_py.plan.associative import associative_moves, pin_transfer_ends
 from robomax_py.plan.candidates import SpotCandidates, check_ik_work, seam_candidates
 from robomax_py.plan.graph import Sequencer
+from robomax_py.plan.learned_detour import LearnedDetours
 from robomax_py.plan.loads import Loads, check_carried_motion
 from robomax_py.plan.results import (
     FailureReason,
@@ -110,6 +111,13 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
     if options.transfers == "associative" and loads is not None:
         # The Jacobian interpolation cannot change IK branch: each transfer's ends are one branch.
         spots = pin_transfer_ends(cell, spots)
+    learned = None
+    if options.detours == "learned":
+        # The learned C-space map every detour is searched in (trained once per robot, tool and
+        # wrist, then cached; docs/learned-cspace.md).
+        t0 = time.perf_counter()
+        learned = LearnedDetours.build(cell, robot, world, spots, cell.planner.learned)
+        clock["learned map"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
     rng = np.random.default_rng(cell.planner.seed)
@@ -119,13 +127,13 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
     log.debug("roadmap: %d nodes in %.2f s", len(roadmap.nodes), clock["roadmap"])
 
     t0 = time.perf_counter()
-    sequencer = Sequencer(cell, robot, world, roadmap, spots, options, rng, progress, loads=loads)
+    sequencer = Sequencer(cell, robot, world, roadmap, spots, options, rng, progress, loads=loads, learned=learned)
     outcome = sequencer.run()
     clock["sequencing"] = time.perf_counter() - t0
     log.debug("sequencing: %d rounds, %d DP evaluations, %d collision checks in %.2f s", sequencer.rounds,
               sequencer.dp_evaluations, sequencer.checks, clock["sequencing"])
     if outcome.status != "found" or outcome.tour is None:
-        return PlanResult(cell.name, robot.name, "infeasible", outcome.message)
+        return PlanResult(cell.name, robot.name, "infeasible", outcome.message + _learned_note(learned))
     tour = outcome.tour
 
     t0 = time.perf_counter()
@@ -168,6 +176,7 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
         rounds=sequencer.rounds, dp_evaluations=sequencer.dp_evaluations, seconds=clock,
         tcp_detour_searches=sequencer.tcp_detour_searches, tcp_detours_found=sequencer.tcp_detours_found,
         lin_detours=sum(1 for t in transitions if t.lin_targets is not None),
+        learned=None if learned is None else learned.report(),
     )
     return PlanResult(cell.name, robot.name, "planned", "planned", spots=tuple(plans), transitions=tuple(transitions),
                       trajectory=trajectory, stats=plan_stats, baseline=options.method != "optimised", joint_names=robot.joint_names,
@@ -352,6 +361,16 @@ def verify_trajectory(world: CollisionWorld, robot: RobotModel, traj: Trajectory
         return check_carried_motion(cell, robot, world, loads.worlds, traj.t, traj.q, spots, stop_at_first=True,
                                     velocity_rtol=PLAN_VELOCITY_RTOL)
     return check_motion(world, robot, traj.t, traj.q, stop_at_first=True, velocity_rtol=PLAN_VELOCITY_RTOL)
+
+
+def _learned_note(learned: LearnedDetours | None) -> str:
+    """What the learned map's searches came to, for a plan that found no tour through it."""
+    if learned is None:
+        return ""
+    r = learned.report()
+    return (f"; learned C-space map: {r.searches} detour searches, {r.found} found, {r.no_entry} without a checked "
+            f"way into or out of the map, {r.no_path} without a path, {r.gave_up} given up after repairs, "
+            f"{r.refused_segments} path segments refused by the exact check")
 
 
 def _workpiece_hint(cell: CellSpec, spots: list[SpotCandidates]) -> str:

@@ -66,8 +66,9 @@ class PlanOptions:
       `planner.tcp_speed` (default 0.5).
     - `detour_speed`: speed fraction of detour moves, before the override; None takes the cell's
       `planner.detour_speed` (default 1.0).
-    - `detours`: where detours are searched: "roadmap", "cspace" (the local A1-A3 map) or "both";
-      None takes the cell's `planner.detours`.
+    - `detours`: where detours are searched: "roadmap", "cspace" (the local A1-A3 map), "both", or
+      "learned" (the learned C-space map alone, `plan.learned_detour`); None takes the cell's
+      `planner.detours`.
     - `detour_moves`: "ptp" (joint-space moves between detour points) or "lin" (straight TCP lines
       through via points, joint-space only where none is found); None takes the cell's
       `planner.detour_moves`.
@@ -242,6 +243,33 @@ class OrderChoice:
 
 
 @dataclass(frozen=True, slots=True)
+class LearnedMapReport:
+    """The learned C-space map a plan searched its detours in (`planner.detours: learned`), and what
+    the exact check made of the paths it found."""
+
+    wrist: tuple[float, ...]        # rad, A4-A6 held fixed over the map
+    resolution: int                 # samples per axis of A1-A3
+    blocked_by_objects: int         # cells the learned model blocks
+    blocked_by_itself: int          # cells free of objects where the arm touches itself (checked exactly)
+    points: int                     # surface points the objects became
+    points_in_reach: int            # of them, those the arm can touch (the paper's N')
+    sphere_radius: float            # m, the training sphere's: clearance + cover radius + inflation
+    neurons: int                    # hidden neurons of the network
+    weights: int                    # output weights of the network
+    training_cached: bool           # the model came from the cache (its training cost is as stored)
+    training_cpu_seconds: float
+    training_checks: int
+    map_cpu_seconds: float          # the map from the model, and the exact self-contact mask
+    searches: int                   # detour searches in the map
+    found: int                      # detours offered, every segment passed by the exact check
+    refused_segments: int           # map path segments the exact check refused (each repaired)
+    refused_entries: int            # legs from a stop into the map the exact check refused
+    no_entry: int                   # searches with no leg into or out of the map passing the check
+    no_path: int                    # searches where the map (with its repairs) held no path
+    gave_up: int                    # searches that repaired MAX_REPAIRS refused segments and stopped
+
+
+@dataclass(frozen=True, slots=True)
 class PlanStats:
     candidates: int
     candidate_checks: int
@@ -257,6 +285,7 @@ class PlanStats:
     tcp_detour_searches: int = 0
     tcp_detours_found: int = 0
     lin_detours: int = 0
+    learned: LearnedMapReport | None = None     # `planner.detours: learned` only
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -30,6 +30,7 @@ SMOKE: dict[str, list[str]] = {
     "bench_collision.py": ["--cell", SMALL, "--quick"],
     "bench_dialects.py": ["--runs", "1", SMALL],
     "bench_ik.py": ["--quick"],
+    "bench_learned_cspace.py": [SMALL, "--quick"],
     "bench_import.py": ["--runs", "1", "--poses", "20"],
     "bench_pick_place.py": ["--quick", "--out", OUT],
     "bench_plan.py": ["--runs", "1", "--resolutions", "20"],

@@ -84,6 +84,15 @@ def test_network_grows_until_every_profile_fits() -> None:
     assert np.abs(_basis(d, centres) @ weights - targets).max() <= 0.05 + 1e-12
 
 
+def test_network_stops_growing_at_max_neurons() -> None:
+    d = np.linspace(0.0, 3.0, 31)
+    targets = np.stack([np.sin(3 * d), np.where(d > 1.5, 1.0, -1.0)], axis=1)
+    free = _fit(d, targets, TrainingSettings(start_neurons=4, tolerance_steps=0.5), q23_step=0.1)
+    capped = _fit(d, targets, TrainingSettings(start_neurons=4, tolerance_steps=0.5, max_neurons=6), q23_step=0.1)
+    assert len(free[0]) > 6 and len(capped[0]) == 6
+    assert capped[2] > 0.5 >= free[2]                # held at 6 neurons, the fit misses its tolerance
+
+
 def test_virtual_base_coordinates_follow_a1_and_the_arm_plane(small) -> None:  # type: ignore[no-untyped-def]
     _, _, robot, _, model = small
     base = model.base
