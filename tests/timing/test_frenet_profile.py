@@ -7,8 +7,9 @@ a path and its reverse take the same time.
 Tolerances: the measured ellipses and components within 1e-3 of their limits (central differences
 average the jerk over 20 ms and turn with the path over 10 ms; measured up to 0.9999 on the
 warehouse legs, the profile keeping 1e-3 inside v_max on the bounds it follows); the profile no
-more than 0.5 % slower than ruckig's exact optimum on a straight line (it keeps inside its limits
-by 0.1-0.2 % on the bounds it follows and its nodes are 1 cm apart; measured 0.2 %)."""
+more than 0.5 % slower than ruckig's exact optimum on a straight line (it keeps 0.01-0.1 % inside
+its limits and its nodes are 1 cm apart; measured up to 0.38 %, on 0.4 m unloaded); a path and its
+reverse within 0.5 % (measured 0.12 % and 0.22 %)."""
 
 from __future__ import annotations
 
