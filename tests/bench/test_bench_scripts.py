@@ -26,6 +26,7 @@ OUT = "{out}"                   # replaced by a folder of the test's own
 SMOKE: dict[str, list[str]] = {
     "bench_batch.py": ["--quick", "--n", "2", "--runs", "1", "--no-ray"],
     "bench_bezier.py": ["--repeat", "1"],
+    "bench_bezier_paper.py": ["--quick", "--out", OUT],
     "bench_ceiling.py": [SMALL, "--pairs", "2"],
     "bench_collision.py": ["--cell", SMALL, "--quick"],
     "bench_dialects.py": ["--runs", "1", SMALL],
