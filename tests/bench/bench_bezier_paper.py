@@ -4,13 +4,15 @@ paper's constraints measured on every profile from its positions alone, the proj
 profile (box limits, `timing.bezier`) measured against the same constraints, and the paths and
 profiles drawn.
 
-    python tests/bench/bench_bezier_paper.py [--evaluations 1500] [--out DIR] [--save-turns FILE] [--quick]
+    python tests/bench/bench_bezier_paper.py [--evaluations 1500] [--out DIR] [--save-turns FILE]
+                                             [--wall-clearance 0] [--quick]
 
 Each of the six turns (three drop-offs, optimised for the loaded and for the unloaded robot) is
 optimised for the travel time of its two-step jerk-limited profile (`timing.frenet_shape`, grid
 2 cm), starting from a round turn; every leg is then timed on a 1 cm grid under both limit sets.
 --quick: no optimisation (every leg on the round turn), 2 cm grid, no box-limit comparison: the
-smoke run. --save-turns writes the optimised turns' parameters as JSON (tests/data/bezier_paper_turns.json
+smoke run. --wall-clearance keeps the turns that far (m) from the wall (the assumed floor plan's
+sensitivity). --save-turns writes the optimised turns' parameters as JSON (tests/data/bezier_paper_turns.json
 is such a file: tests/timing/test_bezier_paper.py recomputes table 2 on it). CPU is
 `time.process_time` of one process.
 """
@@ -67,6 +69,7 @@ def main() -> None:
     ap.add_argument("--out", type=Path, default=Path("bench_bezier_paper"), help="folder for the PNGs")
     ap.add_argument("--quick", action="store_true", help="no optimisation, coarse grid (smoke run)")
     ap.add_argument("--save-turns", type=Path, default=None, help="write the turns' parameters (JSON) here")
+    ap.add_argument("--wall-clearance", type=float, default=0.0, help="keep the turns this far (m) from the wall")
     args = ap.parse_args()
     step = 0.02 if args.quick else 0.01
     cpu: dict[str, float] = {}
@@ -79,8 +82,8 @@ def main() -> None:
             if args.quick:
                 turns[(x, p)] = START
             else:
-                turns[(x, p)] = optimise_shape(shape(Turn(DROP_OFFS[x][0])), START, SCALES, LIMITS[p],
-                                               args.evaluations).x
+                turn = Turn(DROP_OFFS[x][0], RACK_END_X - FLOOR_X + args.wall_clearance)
+                turns[(x, p)] = optimise_shape(shape(turn), START, SCALES, LIMITS[p], args.evaluations).x
             cpu[f"optimise turn {x} {NAMES[p]}"] = time.process_time() - t0
 
     if args.save_turns is not None:
