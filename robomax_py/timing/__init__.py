@@ -10,6 +10,11 @@ Module map:
 - `topp`        toppra time-optimal timing of a GeometricPath (velocity, acceleration, path speed)
 - `via`         `path_move`: moves through waypoints: stop, blend (toppra) or jerk-limited fly-by (ruckig)
 - `lin`         Cartesian straight lines in one IK branch, timed with a TCP speed limit
+- `bezier`      minimum-time quintic Bézier paths under box TCP limits (the project's own)
+- `bezier_construct`, `quintic_chain`, `frenet_profile`, `frenet_measure`, `frenet_shape`
+                the published method (Benko Loknar et al.): seven-step quintics, their chains, the
+                two-step profile under ellipses of tangential and normal acceleration and jerk, its
+                check from positions, shapes optimised for its time (docs/bezier-paper.md)
 """
 
 from __future__ import annotations
