@@ -20,8 +20,10 @@ from robomax_py.export.rebuild.result import (
     WELD_TIME_TOL_S,
     Problem,
     Rebuilt,
+    SignalEvent,
     Span,
 )
+from robomax_py.export.rebuild.signals import output_signal
 from robomax_py.plan.waiting import clear_wait, signal_of
 from robomax_py.program import (
     NULL_FRAME,
@@ -32,6 +34,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -47,6 +50,7 @@ from robomax_py.timing import (
     LinMoveError,
     Segment,
     TimingError,
+    Trajectory,
     concatenate,
     dwell,
     resample,
@@ -57,7 +61,8 @@ from robomax_py.world.scene import clamps_near
 
 def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | str,
             lines: tuple[int, ...] | None = None, brand: str | None = None,
-            stored: tuple[FrameDef, ...] = (), controller: bool = False) -> Rebuilt:
+            stored: tuple[FrameDef, ...] = (), controller: bool = False,
+            station: frozenset[str] | None = None) -> Rebuilt:
     """Rebuild the motion; ProgramError when the program is not for this cell's robot.
 
     lines : the program line of each instruction (as the parser read them), for messages.
@@ -73,6 +78,9 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
         so the configuration a LIN ends in is stated from the controller's values of the joints the
         arm reaches (`solve.brand_text_of`) before it is compared with the written one. The
         program's joint targets are the URDF's here (`dialect.in_controller_joints` inverse).
+    station : the signals the robots of a station set (a station replay); a wait for one of them,
+        or for a signal the cell does not know, is then a `SignalEvent` that takes no time here.
+        None: a lone program, whose waits for unknown signals are problems.
     A program that does not name its robot (a header with robot "" and no joints, as
     programs written by others) is taken to be for the cell's robot, joints in URDF order.
     """
@@ -82,7 +90,7 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
     if header.joints and tuple(header.joints) != tuple(robot.joint_names):
         raise ProgramError(file, "AXES", f"expected {list(robot.joint_names)}, got {list(header.joints)}")
     builder = _Builder(cell, robot, brand or robot.controller.brand, {**_by_name(stored), **_by_name(program.frames)},
-                       controller)
+                       controller, station)
     numbered = [(ins, None if lines is None else lines[i]) for i, ins in enumerate(program.instructions)]
     moves = [(ins, line) for ins, line in numbered if not isinstance(ins, Comment)]
     if not moves or not isinstance(moves[0][0], PtpMove):
@@ -97,14 +105,14 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
         if isinstance(ins, PtpMove) and len(ins.target_deg) != robot.dof:
             builder.problems.append(Problem(builder.t, "format", f"a joint move gives {len(ins.target_deg)} axis "
                                             f"values, the robot has {robot.dof} joints", builder.line))
-            return Rebuilt(None, builder.spots, builder.problems, builder.spans)
+            return builder.result(None)
         if not builder.add(ins, moves[k + 1][0] if k + 1 < len(moves) else None, k):
-            return Rebuilt(None, builder.spots, builder.problems, builder.spans)
+            return builder.result(None)
     if builder.pending:
         builder.problems.append(Problem(builder.t, "flyby", "the program ends flying by: the last move has FLYBY",
                                         builder.line))
         if not builder.flush():
-            return Rebuilt(None, builder.spots, builder.problems, builder.spans)
+            return builder.result(None)
     traj = resample(concatenate(builder.segments))
     # Spot times from the trajectory's own weld phases (exactly on its samples), in program order.
     welds: dict[str, list[Any]] = {}
@@ -113,7 +121,7 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
     for spot in builder.spots:
         phase = welds[f"{spot['seam']}/{spot['name']}"].pop(0)
         spot["t_arrive"], spot["t_leave"] = float(phase.t_start), float(phase.t_end)
-    return Rebuilt(traj, builder.spots, builder.problems, builder.spans)
+    return builder.result(traj)
 
 
 def _by_name(frames: tuple[FrameDef, ...]) -> dict[tuple[str, str], FrameDef]:
@@ -122,7 +130,8 @@ def _by_name(frames: tuple[FrameDef, ...]) -> dict[tuple[str, str], FrameDef]:
 
 class _Builder:
     def __init__(self, cell: CellSpec, robot: RobotModel, brand: str,
-                 frames: dict[tuple[str, str], FrameDef], controller: bool = False) -> None:
+                 frames: dict[tuple[str, str], FrameDef], controller: bool = False,
+                 station: frozenset[str] | None = None) -> None:
         self.cell, self.robot, self.brand = cell, robot, brand
         self.controller = controller                       # configuration data in the controller's joint values
         self.frames = frames
@@ -141,6 +150,11 @@ class _Builder:
         self.spans: list[Span] = []
         self.waited: set[str] = set()                      # clamp inputs waited for so far
         self.after_action = False                          # a weld or gripper action since the last move
+        self.station = station                             # signals the robots of a station set
+        self.events: list[SignalEvent] = []
+
+    def result(self, traj: Trajectory | None) -> Rebuilt:
+        return Rebuilt(traj, self.spots, self.problems, self.spans, self.events)
 
     def start(self, q: FloatArray) -> None:
         self.q = np.asarray(q, dtype=float)
@@ -167,7 +181,8 @@ class _Builder:
                 self.configs.append((len(self.pending) - 1, ins.config))
             return True if ins.flies else self.flush()
         if self.pending:
-            what = "weld" if isinstance(ins, Spot) else ("gripper action" if isinstance(ins, Gripper) else "wait")
+            what = "weld" if isinstance(ins, Spot) else ("gripper action" if isinstance(ins, Gripper) else
+                                                         "output" if isinstance(ins, SetSignal) else "wait")
             self.problems.append(Problem(self.t, "flyby", f"a {what} after a move that flies by (blended): the robot "
                                                           "is not at rest", self.line))
             if not self.flush():
@@ -194,6 +209,8 @@ class _Builder:
             self._hold(ins.seconds, "WAIT")
         elif isinstance(ins, WaitFor):
             self._wait_for(ins)
+        elif isinstance(ins, SetSignal):
+            self._set_signal(ins)
         return True
 
     def _kind(self, ins: PtpMove | LinMove, following: Any) -> str:
@@ -409,6 +426,17 @@ class _Builder:
                                                                   f"waiting for its input {obj.signal}", self.line))
                 self.waited.add(identifier(str(obj.signal)))
 
+    def _set_signal(self, ins: SetSignal) -> None:
+        """An output set at rest: recorded for the station replay (no time here)."""
+        signal = output_signal(self.cell, ins)
+        if signal is None:
+            known = ", ".join(f"{o.number} ({o.signal})" for o in self.cell.controller.outputs) or "none mapped"
+            self.problems.append(Problem(self.t, "signal", f"the program sets output {ins.number}, which the cell "
+                                                           f"maps to no signal (robot.controller.outputs: {known})",
+                                         self.line))
+            return
+        self.events.append(SignalEvent(self.t, "set", signal, ins.value, self.line))
+
     def _wait_for(self, ins: WaitFor) -> None:
         """A wait on an input number means the cell signal mapped to that number (the controller
         knows numbers, not names); a wait by name, the cell signal of that name."""
@@ -429,10 +457,15 @@ class _Builder:
             named = next((i for i in self.cell.controller.inputs if i.name and i.name.lower() == signal.lower()), None)
             if named is not None:
                 signal = identifier(named.signal)
-        if any(obj.signal and identifier(obj.signal) == signal for obj in self.cell.objects):
+        if any(obj.signal and identifier(obj.signal) == signal for obj in self.cell.objects) and \
+                (self.station is None or signal not in self.station):
             self.waited.add(signal)           # a clamp input: set once the clamp is closed, no time planned
             return
         obstacle = next((d for d in self.cell.dynamic if signal_of(identifier(d.name), d.door) == signal), None)
+        if obstacle is None and self.station is not None:
+            # Another robot's signal (or one that no robot sets: the replay says it waits forever).
+            self.events.append(SignalEvent(self.t, "wait", signal, True, self.line))
+            return
         if obstacle is None:
             known = ", ".join([*(signal_of(identifier(d.name), d.door) for d in self.cell.dynamic),
                                *(identifier(str(o.signal)) for o in self.cell.objects if o.signal)]) or "none in this cell"
