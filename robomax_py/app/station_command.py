@@ -4,10 +4,18 @@ is proven."""
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from pathlib import Path
 
-from robomax_py.app.commands.base import EXIT_INFEASIBLE, EXIT_OK, _print_json, _warn, err, out
+from robomax_py.app.commands.base import (
+    EXIT_INFEASIBLE,
+    EXIT_OK,
+    _print_json,
+    _warn,
+    err,
+    out,
+)
 
 
 def plan_station_files(path: Path, out_dir: Path, formats: str, speed: float | None, as_json: bool,
@@ -47,8 +55,8 @@ def plan_station_files(path: Path, out_dir: Path, formats: str, speed: float | N
         if p.result is None or p.result.trajectory is None:
             continue                         # a robot with nothing to weld stays home: no program
         setup = with_interlock_io(p.cell.controller, p.robot, interlocks)
-        result = _with_controller(p.result, setup)
-        cell = _cell_with_controller(p.cell, setup)
+        result = dataclasses.replace(p.result, controller=setup)
+        cell = dataclasses.replace(p.cell, controller=setup)
         texts, _ = publish(result, cell, p.model, chosen[p.robot].names, stamp=stamp,
                            edit=interlock_edit(p.robot, result, interlocks), station=signals)
         json_name = f"{result.cell}.json"
@@ -77,15 +85,3 @@ def plan_station_files(path: Path, out_dir: Path, formats: str, speed: float | N
     for f in (*committed.paths, committed.manifest):
         out.print(f"  wrote {f}", markup=False, highlight=False, soft_wrap=True)
     return EXIT_OK
-
-
-def _with_controller(result, setup):  # type: ignore[no-untyped-def]
-    import dataclasses
-
-    return dataclasses.replace(result, controller=setup)
-
-
-def _cell_with_controller(cell, setup):  # type: ignore[no-untyped-def]
-    import dataclasses
-
-    return dataclasses.replace(cell, controller=setup)
