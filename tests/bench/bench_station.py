@@ -23,10 +23,10 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
-from robomax_py.io.cell import load_cell_robot  # noqa: E402
-from robomax_py.io.station import load_station  # noqa: E402
-from robomax_py.station.pipeline import StationOptions, plan_station  # noqa: E402
-from tests.bench.station_cells import station, write  # noqa: E402
+from robomax_py.io.cell import load_cell_robot
+from robomax_py.io.station import load_station
+from robomax_py.station.pipeline import StationOptions, plan_station
+from tests.bench.station_cells import station, write
 
 METHODS = ("nearest", "minmax", "full")
 
