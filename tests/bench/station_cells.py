@@ -21,9 +21,9 @@ import yaml
 # arm -> tool, distance of its base from the rim's outer edge (m), base height (m), home (deg),
 # brand's interlock I/O (inputs, outputs), clamp inputs start.
 ARMS: dict[str, dict[str, Any]] = {
-    "kr125": {"tool": "spot_gun_c", "reach": 1.25, "z": 0.0, "home": [0, -90, 90, 0, 0, 0],
+    "kr125": {"tool": "spot_gun_c", "reach": 1.25, "z": 0.0, "home": [0, -115, 115, 0, 50, 0],
               "io": ([101, 116], [101, 116]), "clamps": 11},
-    "kr16": {"tool": "spot_gun_light", "reach": 0.85, "z": 0.2, "home": [0, -90, 90, 0, 0, 0],
+    "kr16": {"tool": "spot_gun_light", "reach": 0.85, "z": 0.2, "home": [0, -110, 110, 0, 50, 0],
              "io": ([101, 116], [101, 116]), "clamps": 11},
     "ur10": {"tool": "spot_gun_light", "reach": 0.55, "z": 0.6, "home": [0, -90, 90, -90, -90, 0],
              "io": ([4, 7], [4, 7]), "clamps": 0},
