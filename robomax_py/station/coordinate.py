@@ -1,15 +1,15 @@
 """Coordinating timed robots by interlocks, with the least waiting.
 
 Each pair of robots has a coordination diagram: robot a's own time on one axis, b's on the other,
-and the cells where the two collide (`bodies.clash_map`); each connected region of collisions is
-a shared zone, its extent on a's axis the time a spends in it, on b's the time b does. An
-interlock orders one zone: the waiting robot stops at a point of its program before it would enter
-(a weld done, or home) until the leading robot signals that it has left (at the first weld done, or
-home reached, after the zone); the two can then never be in the zone together, whatever else
-delays either (the diagram's path keeps outside the zone's box).
+and the cells where the two collide (`bodies.clash_map`). A robot's program is cut into segments at
+the points where it rests and may wait or signal (home, each weld done, home again). An interlock
+orders two segments that collide: the waiting robot may not start its segment (it waits at its
+start, at rest) until the leading robot has finished its own (it signals there). The two segments'
+box in the diagram is then never entered, whatever else delays either robot; a robot resting at a
+segment's start is in that segment, so a rest posture in the other's way is ordered too.
 
-Which zones need an interlock depends on the waits already set, so zones are resolved one at a
-time, earliest collision on the shared clock first. Per zone both orders are tried, each followed
+Which segments need an interlock depends on the waits already set, so collisions are resolved one
+at a time, the earliest on the shared clock first. Per collision both orders are tried, each followed
 by a greedy completion of the rest (the order with the shorter makespan at every later zone); the
 order whose completed makespan is shorter is kept: a rollout, not first come first served (which
 `fcfs=True` gives, the baseline). A cycle of interlocks (a deadlock) rules an order out.
@@ -19,12 +19,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
-from robomax_py._typing import BoolArray, FloatArray, IntArray
+from robomax_py._typing import BoolArray, FloatArray
 
 # Zones resolved per station at most (each resolution adds one interlock); beyond it the plan fails.
 MAX_INTERLOCKS = 400
@@ -44,30 +43,23 @@ class Timeline:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class PairMap:
-    """The coordination diagram of robots a and b sampled every `dt` s of their own clocks."""
+    """The coordination diagram of robots a and b sampled every `dt` s of their own clocks:
+    `clash[i, j]` where a at i * dt and b at j * dt come too close."""
 
     a: str
     b: str
     dt: float
     clash: BoolArray          # (ka, kb)
-    labels: IntArray = field(init=False)
-    boxes: tuple[tuple[int, int, int, int], ...] = field(init=False)   # per zone: i0, i1, j0, j1 (ends included)
-
-    def __post_init__(self) -> None:
-        labels, n = ndimage.label(self.clash, structure=np.ones((3, 3), dtype=int))
-        boxes = tuple((s[0].start, s[0].stop - 1, s[1].start, s[1].stop - 1) for s in ndimage.find_objects(labels))
-        object.__setattr__(self, "labels", labels)
-        object.__setattr__(self, "boxes", boxes[:n])
 
 
 @dataclass(frozen=True, slots=True)
 class Interlock:
     """`waiter` waits at its own time `wait_at` until `leader` reaches its own time `signal_at`
-    (where it sets the signal). `pair`, `zone`: the diagram and region it orders; the zone's time
-    spans on each robot's own clock, s."""
+    (where it sets the signal). `pair`, `zone`: the diagram and the two program segments (between
+    rest points) it orders; their time spans on each robot's own clock, s."""
 
     pair: tuple[str, str]
-    zone: int
+    zone: tuple[int, int]     # the program segments of pair[0] and pair[1] it orders
     leader: str
     waiter: str
     signal_at: float
@@ -135,34 +127,47 @@ def own_time(schedule: Schedule, robot: str, shared: FloatArray) -> FloatArray:
     return out
 
 
-def _first_clash(pairs: Sequence[PairMap], schedule: Schedule) -> tuple[PairMap, int, float] | None:
-    """The earliest collision on the shared clock under `schedule`: (diagram, zone index, shared time)."""
-    best: tuple[PairMap, int, float] | None = None
+def _first_clash(pairs: Sequence[PairMap], schedule: Schedule) -> tuple[PairMap, float, float, float] | None:
+    """The earliest collision on the shared clock under `schedule`: (diagram, a's own time, b's own
+    time, shared time)."""
+    best: tuple[PairMap, float, float, float] | None = None
     for p in pairs:
         stop = min(schedule.ends[p.a], schedule.ends[p.b])
         shared = np.arange(0.0, stop + p.dt, p.dt / 2)
-        i = np.clip(np.rint(own_time(schedule, p.a, shared) / p.dt).astype(int), 0, p.clash.shape[0] - 1)
-        j = np.clip(np.rint(own_time(schedule, p.b, shared) / p.dt).astype(int), 0, p.clash.shape[1] - 1)
+        ta, tb = own_time(schedule, p.a, shared), own_time(schedule, p.b, shared)
+        i = np.clip(np.rint(ta / p.dt).astype(int), 0, p.clash.shape[0] - 1)
+        j = np.clip(np.rint(tb / p.dt).astype(int), 0, p.clash.shape[1] - 1)
         hit = np.flatnonzero(p.clash[i, j])
-        if len(hit) and (best is None or shared[hit[0]] < best[2]):
+        if len(hit) and (best is None or shared[hit[0]] < best[3]):
             k = hit[0]
-            best = (p, int(p.labels[i[k], j[k]]) - 1, float(shared[k]))
+            best = (p, float(ta[k]), float(tb[k]), float(shared[k]))
     return best
 
 
-def _option(p: PairMap, zone: int, leader_is_a: bool, timelines: Mapping[str, Timeline]) -> Interlock | None:
-    """The interlock letting one robot through a zone first; None when the other has no point to wait
-    at before it (the zone starts where it starts)."""
-    i0, i1, j0, j1 = p.boxes[zone]
-    a_span, b_span = ((i0 - 1) * p.dt, (i1 + 1) * p.dt), ((j0 - 1) * p.dt, (j1 + 1) * p.dt)
+def _segments(line: Timeline) -> list[float]:
+    """The robot's program points where it is at rest and may wait or signal: home, each weld done,
+    home again; segment s runs from point s to point s + 1."""
+    return sorted({0.0, *line.wait_points, *line.signal_points, line.end})
+
+
+def _segment(points: list[float], own: float) -> int:
+    """The segment a robot at its own time `own` is in; at a point, the one that starts there (the
+    robot rests there before it moves on)."""
+    return max(0, min(len(points) - 2, int(np.searchsorted(points, own + TIME_EPS, side="right")) - 1))
+
+
+def _option(p: PairMap, at: tuple[float, float], leader_is_a: bool, timelines: Mapping[str, Timeline]
+            ) -> Interlock | None:
+    """The interlock that orders the two program segments the robots collide in: the waiter may not
+    start its segment until the leader has finished its own. None for a robot that never moves."""
     leader, waiter = (p.a, p.b) if leader_is_a else (p.b, p.a)
-    lspan, wspan = (a_span, b_span) if leader_is_a else (b_span, a_span)
-    lt, wt = timelines[leader], timelines[waiter]
-    signal = next((s for s in lt.signal_points if s >= lspan[1] - TIME_EPS), lt.end)
-    wait = [w for w in wt.wait_points if w <= wspan[0] + TIME_EPS]
-    if not wait or wspan[0] < 0:
+    own_l, own_w = at if leader_is_a else at[::-1]
+    lp, wp = _segments(timelines[leader]), _segments(timelines[waiter])
+    if len(lp) < 2 or len(wp) < 2:
         return None
-    return Interlock((p.a, p.b), zone, leader, waiter, signal, wait[-1], lspan, wspan)
+    k, m = _segment(lp, own_l), _segment(wp, own_w)
+    return Interlock((p.a, p.b), (k, m) if leader_is_a else (m, k), leader, waiter, lp[k + 1], wp[m],
+                     (lp[k], lp[k + 1]), (wp[m], wp[m + 1]))
 
 
 def _entry(schedule: Schedule, robot: str, own: float) -> float:
@@ -186,14 +191,13 @@ def coordinate(timelines: Sequence[Timeline], pairs: Sequence[PairMap], fcfs: bo
                 return Coordination(tuple(locks), schedule)
             if len(locks) >= MAX_INTERLOCKS:
                 return Coordination(tuple(locks), schedule, f"more than {MAX_INTERLOCKS} interlocks needed")
-            p, zone, t = hit
-            options = [o for o in (_option(p, zone, True, by_name), _option(p, zone, False, by_name)) if o is not None]
-            if any(o in locks for o in options):
-                return Coordination(tuple(locks), schedule, f"{p.a} and {p.b} collide at {t:.2f} s on the shared "
-                                    "clock although the zone is interlocked")
+            p, ta, tb, t = hit
+            options = [o for o in (_option(p, (ta, tb), True, by_name), _option(p, (ta, tb), False, by_name))
+                       if o is not None and o not in locks]
             if not options:
-                return Coordination(tuple(locks), schedule, f"{p.a} and {p.b} collide at {t:.2f} s where neither "
-                                    "can wait before the zone (at their start)")
+                return Coordination(tuple(locks), schedule, f"{p.a} and {p.b} collide at {t:.2f} s on the shared "
+                                    f"clock ({p.a} at {ta:.2f} s, {p.b} at {tb:.2f} s of their own) whichever "
+                                    "goes first")
             if mode == "fcfs":
                 # First come first served, passing over an order that would deadlock.
                 live = [o for o in options if not simulate(timelines, [*locks, o]).deadlock] or options

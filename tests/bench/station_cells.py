@@ -32,7 +32,7 @@ RIM_Z = 0.75            # m, the sheet's top
 RIM_W = 0.12            # m, width of the rim's sheet
 SHEET = 0.003           # m
 EDGE = 0.02             # m, spot inside the outer edge
-PITCH = 1.3             # m of rail per robot on a side
+PITCH = 1.8             # m of rail per robot on a side (arms this far apart keep out of each other's homes)
 
 
 def station(robots: int, spots: int, seed: int, arms: list[str] | None = None, name: str | None = None

@@ -96,3 +96,22 @@ def test_interlock_range_clashing_with_an_input(tmp_path: Path) -> None:
     with pytest.raises(CellFileError, match="clamp_front") as err:
         load_station(_write(tmp_path, data))
     assert err.value.key == "robots[0].controller.interlock_io.inputs"
+
+
+def test_check_command_summarises_a_station_and_refuses_a_bad_one(tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from robomax_py.app.cli import app
+
+    runner = CliRunner()
+    done = runner.invoke(app, ["check", str(STATION)])
+    assert done.exit_code == 0, done.output
+    assert "2 robots" in done.output and "valid station" in done.output
+    data = _data()
+    data["robots"][1]["name"] = "r1"
+    bad = _write(tmp_path, data)
+    done = runner.invoke(app, ["check", str(bad)])
+    assert done.exit_code == 2
+    assert "robots[1].name" in done.output and "Traceback" not in done.output
+    done = runner.invoke(app, ["plan", str(bad), "-o", str(tmp_path / "out")])
+    assert done.exit_code == 2 and not (tmp_path / "out").exists()

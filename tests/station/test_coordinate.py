@@ -55,7 +55,7 @@ def test_no_interlock_where_the_paths_never_meet_in_time() -> None:
 
 def test_a_wait_is_as_long_as_the_leader_needs() -> None:
     lines = [_timeline("a", 10.0, [4.0]), _timeline("b", 6.0, [1.0])]
-    lock = Interlock(("a", "b"), 0, "a", "b", 4.0, 1.0, (2.0, 3.5), (1.5, 3.0))
+    lock = Interlock(("a", "b"), (0, 0), "a", "b", 4.0, 1.0, (2.0, 3.5), (1.5, 3.0))
     schedule = simulate(lines, [lock])
     assert schedule.waits["b"] == ((1.0, pytest.approx(3.0)),)
     assert schedule.ends["b"] == pytest.approx(9.0)
@@ -64,6 +64,6 @@ def test_a_wait_is_as_long_as_the_leader_needs() -> None:
 
 def test_interlocks_waiting_on_each_other_are_a_deadlock() -> None:
     lines = [_timeline("a", 10.0, [2.0, 6.0]), _timeline("b", 10.0, [2.0, 6.0])]
-    locks = [Interlock(("a", "b"), 0, "a", "b", 6.0, 2.0, (3.0, 5.0), (3.0, 5.0)),
-             Interlock(("a", "b"), 1, "b", "a", 6.0, 2.0, (3.0, 5.0), (3.0, 5.0))]
+    locks = [Interlock(("a", "b"), (1, 1), "a", "b", 6.0, 2.0, (3.0, 5.0), (3.0, 5.0)),
+             Interlock(("a", "b"), (1, 1), "b", "a", 6.0, 2.0, (3.0, 5.0), (3.0, 5.0))]
     assert simulate(lines, locks).deadlock
