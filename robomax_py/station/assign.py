@@ -5,8 +5,8 @@ min-max problem), and the lower bound every station plan's makespan is measured 
 The estimate: a robot's tour is home -> its spots -> home over the quickest of a few representative
 configurations per spot (`reach.cost_matrix`), ordered by nearest neighbour and 2-opt, plus the weld
 and approach lines of each spot. The search: regret insertion (the spot whose best and second best
-robot differ most is placed first), then moves and swaps of spots off the robot with the longest tour
-while the longest tour shortens. The real planner then sequences each robot's spots itself.
+robot differ most is placed first), then moves of spots between robots while the longest tour shortens,
+or stays and the sum of all tours shortens. The real planner then sequences each robot's spots itself.
 """
 
 from __future__ import annotations
@@ -140,11 +140,12 @@ def assign(reaches: Sequence[RobotReach], spots: Sequence[SpotKey], groups: Sequ
     while left:                                   # regret insertion
         best: tuple[float, float, int, int] | None = None
         for u in left:
-            options = sorted((_insert_cost(tours, k, units[u]), k) for k in able[u])
-            makespan = [max(tours.time(k) + add, _others(tours, k)) for add, k in options]
-            regret = (sorted(makespan)[1] - min(makespan)) if len(options) > 1 else np.inf
-            k = options[int(np.argmin(makespan))][1]
-            cand = (regret, -min(makespan), u, k)
+            # Per able robot: the makespan after inserting there, then the time it adds (so that a
+            # spot whose insertion leaves the makespan alone goes where it costs least).
+            costs = sorted((max(tours.time(k) + add, _others(tours, k)), add, k)
+                           for add, k in ((_insert_cost(tours, k, units[u]), k) for k in able[u]))
+            regret = costs[1][0] - costs[0][0] + costs[1][1] - costs[0][1] if len(costs) > 1 else np.inf
+            cand = (regret, -costs[0][0], u, costs[0][2])
             if best is None or cand[:2] > best[:2]:
                 best = cand
         assert best is not None
@@ -176,30 +177,35 @@ def _others(tours: _Tours, k: int) -> float:
 
 
 def _local_search(tours: _Tours, units: list[tuple[SpotKey, ...]], able: list[list[int]]) -> None:
-    """Move units off the robot with the longest tour while that lowers the longest tour."""
+    """Move units between robots while that lowers the longest tour, or keeps it and lowers the sum
+    of all tours (the min-max objective alone leaves every robot but the longest-running free to take
+    anything, and its tie-breaks then send robots across each other)."""
     unit_of = {key: u for u, unit in enumerate(units) for key in unit}
+    n = len(tours.tour)
     for _ in range(MAX_LOCAL_ROUNDS):
-        times = [tours.time(k) for k in range(len(tours.tour))]
-        worst = int(np.argmax(times))
-        best: tuple[float, int, int] | None = None
-        keys = [tours.reaches[worst].keys[i - 1] for i in tours.tour[worst][1:-1]]
-        for u in dict.fromkeys(unit_of[key] for key in keys):
-            nodes = [tours.node[worst][key] for key in units[u]]
-            rest = [n for n in tours.tour[worst] if n not in nodes]
-            t_rest = tours.time(worst, rest)
-            for k in able[u]:
-                if k == worst:
-                    continue
-                new = max(t_rest, times[k] + _insert_cost(tours, k, units[u]),
-                          max((times[j] for j in range(len(times)) if j not in (k, worst)), default=0.0))
-                if new < times[worst] - 1e-6 and (best is None or new < best[0]):
-                    best = (new, u, k)
+        times = [tours.time(k) for k in range(n)]
+        now = (max(times), sum(times))
+        best: tuple[tuple[float, float], int, int, int] | None = None
+        for src in range(n):
+            keys = [tours.reaches[src].keys[i - 1] for i in tours.tour[src][1:-1]]
+            for u in dict.fromkeys(unit_of[key] for key in keys):
+                nodes = [tours.node[src][key] for key in units[u]]
+                t_rest = tours.time(src, [x for x in tours.tour[src] if x not in nodes])
+                for k in able[u]:
+                    if k == src:
+                        continue
+                    new = list(times)
+                    new[src], new[k] = t_rest, times[k] + _insert_cost(tours, k, units[u])
+                    score = (max(new), sum(new))
+                    better = score[0] < now[0] - 1e-6 or (score[0] <= now[0] + 1e-9 and score[1] < now[1] - 1e-6)
+                    if better and (best is None or score < best[0]):
+                        best = (score, u, src, k)
         if best is None:
             return
-        _, u, k = best
-        nodes = [tours.node[worst][key] for key in units[u]]
-        tours.tour[worst] = [n for n in tours.tour[worst] if n not in nodes]
+        _, u, src, k = best
+        nodes = [tours.node[src][key] for key in units[u]]
+        tours.tour[src] = [x for x in tours.tour[src] if x not in nodes]
         for key in units[u]:
             tours.tour[k].insert(tours.insertion(k, tours.node[k][key])[1], tours.node[k][key])
-        tours.two_opt(worst)
+        tours.two_opt(src)
         tours.two_opt(k)

@@ -156,18 +156,25 @@ def _segment(points: list[float], own: float) -> int:
     return max(0, min(len(points) - 2, int(np.searchsorted(points, own + TIME_EPS, side="right")) - 1))
 
 
-def _option(p: PairMap, at: tuple[float, float], leader_is_a: bool, timelines: Mapping[str, Timeline]
-            ) -> Interlock | None:
+def _option(p: PairMap, at: tuple[float, float], leader_is_a: bool, timelines: Mapping[str, Timeline],
+            locks: Sequence[Interlock] = ()) -> Interlock | None:
     """The interlock that orders the two program segments the robots collide in: the waiter may not
-    start its segment until the leader has finished its own. None for a robot that never moves."""
+    start its segment until the leader has finished its own. Where that interlock is already set
+    (the waiter, resting where it waits, is itself in the leader's way), the waiter waits a segment
+    earlier. None for a robot that never moves, or one with no earlier segment."""
     leader, waiter = (p.a, p.b) if leader_is_a else (p.b, p.a)
     own_l, own_w = at if leader_is_a else at[::-1]
     lp, wp = _segments(timelines[leader]), _segments(timelines[waiter])
     if len(lp) < 2 or len(wp) < 2:
         return None
     k, m = _segment(lp, own_l), _segment(wp, own_w)
-    return Interlock((p.a, p.b), (k, m) if leader_is_a else (m, k), leader, waiter, lp[k + 1], wp[m],
-                     (lp[k], lp[k + 1]), (wp[m], wp[m + 1]))
+    while m >= 0:
+        lock = Interlock((p.a, p.b), (k, m) if leader_is_a else (m, k), leader, waiter, lp[k + 1], wp[m],
+                         (lp[k], lp[k + 1]), (wp[m], wp[m + 1]))
+        if lock not in locks:
+            return lock
+        m -= 1
+    return None
 
 
 def _entry(schedule: Schedule, robot: str, own: float) -> float:
@@ -192,8 +199,8 @@ def coordinate(timelines: Sequence[Timeline], pairs: Sequence[PairMap], fcfs: bo
             if len(locks) >= MAX_INTERLOCKS:
                 return Coordination(tuple(locks), schedule, f"more than {MAX_INTERLOCKS} interlocks needed")
             p, ta, tb, t = hit
-            options = [o for o in (_option(p, (ta, tb), True, by_name), _option(p, (ta, tb), False, by_name))
-                       if o is not None and o not in locks]
+            options = [o for o in (_option(p, (ta, tb), True, by_name, locks),
+                                   _option(p, (ta, tb), False, by_name, locks)) if o is not None]
             if not options:
                 return Coordination(tuple(locks), schedule, f"{p.a} and {p.b} collide at {t:.2f} s on the shared "
                                     f"clock ({p.a} at {ta:.2f} s, {p.b} at {tb:.2f} s of their own) whichever "

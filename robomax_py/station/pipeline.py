@@ -40,6 +40,13 @@ Method = Literal["full", "minmax", "nearest"]
 DIAGRAM_DT_S = 0.03
 # Rounds of re-assignment with the waits as costs (method "full").
 REASSIGN_ROUNDS = 2
+# The min-max assignment's prior against robots crossing into each other's side: a spot costs a
+# robot this many seconds per metre its base is farther from the spot than the nearest base of a
+# robot that reaches it. Joint-space tour estimates alone cannot tell a robot's own side from its
+# neighbour's (the legs between spots cost alike on both), and a tie broken the wrong way makes
+# the two robots' whole tours cross (a generated 4-robot station did: every move of one in the
+# other's way).
+SIDE_PRIOR_S_PER_M = 0.5
 
 
 @dataclass(frozen=True, slots=True)
@@ -103,13 +110,15 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
                            f"reach collision-free: {names}", (), Assignment({}, {}), bound, None, clock)
     groups = _ordered_groups(station)
     t0 = time.process_time()
-    chosen = _nearest(station, reaches, keys, groups) if options.method == "nearest" else assign(reaches, keys, groups)
+    prior = _side_prior(station, reaches)
+    chosen = _nearest(station, reaches, keys, groups) if options.method == "nearest" \
+        else assign(reaches, keys, groups, prior)
     clock["assignment"] = time.process_time() - t0
     bodies = {r.name: robot_body(r.name, models[r.name], build_scene(r.cell, models[r.name])) for r in station.robots}
     best = _realise(station, models, bodies, chosen, options, clock, bound)
     if options.method != "full" or best.status != "planned":
         return best
-    penalty: dict[tuple[str, SpotKey], float] = {}
+    penalty: dict[tuple[str, SpotKey], float] = dict(prior)
     rounds = 0
     for _ in range(REASSIGN_ROUNDS):
         assert best.coordination is not None
@@ -126,6 +135,20 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         if trial.status == "planned" and trial.makespan < best.makespan - 1e-6:
             best = trial
     return dataclasses.replace(best, seconds=clock, rounds=rounds)
+
+
+def _side_prior(station: StationSpec, reaches: Sequence[RobotReach]) -> dict[tuple[str, SpotKey], float]:
+    """SIDE_PRIOR_S_PER_M per metre a robot's base is farther from a spot than the nearest base of a
+    robot that reaches it."""
+    xyz = {(seam.name, s.name): np.asarray(s.xyz) for seam in station.robots[0].cell.seams for s in seam.spots}
+    base = {r.name: np.asarray(r.cell.T_world_base)[:3, 3] for r in station.robots}
+    out: dict[tuple[str, SpotKey], float] = {}
+    for key, p in xyz.items():
+        d = {r.robot: float(np.linalg.norm(p[:2] - base[r.robot][:2])) for r in reaches if key in r.index()}
+        nearest = min(d.values(), default=0.0)
+        for robot, dist in d.items():
+            out[(robot, key)] = SIDE_PRIOR_S_PER_M * (dist - nearest)
+    return out
 
 
 def _ordered_groups(station: StationSpec) -> list[tuple[SpotKey, ...]]:

@@ -6,6 +6,8 @@ sides, arms of the shipped library (KR 125-class with the C gun, KR 16-class and
 light gun), each station a valid station file.
 
     python tests/bench/station_cells.py OUT_DIR [--robots 4] [--spots 120] [--seed 0] [--count 1]
+
+The shipped example: `--robots 4 --spots 48 --arms kr125,kr125,ur10,ur10 --name side_frame`.
 """
 
 from __future__ import annotations
@@ -21,18 +23,19 @@ import yaml
 # arm -> tool, distance of its base from the rim's outer edge (m), base height (m), home (deg),
 # brand's interlock I/O (inputs, outputs), clamp inputs start.
 ARMS: dict[str, dict[str, Any]] = {
-    "kr125": {"tool": "spot_gun_c", "reach": 1.25, "z": 0.0, "home": [0, -115, 115, 0, 50, 0],
+    "kr125": {"tool": "spot_gun_c", "reach": 1.7, "z": 0.0, "home": [0, -115, 115, 0, 50, 0],
               "io": ([101, 116], [101, 116]), "clamps": 11},
-    "kr16": {"tool": "spot_gun_light", "reach": 0.85, "z": 0.2, "home": [0, -110, 110, 0, 50, 0],
+    "kr16": {"tool": "spot_gun_light", "reach": 1.0, "z": 0.2, "home": [0, -110, 110, 0, 50, 0],
              "io": ([101, 116], [101, 116]), "clamps": 11},
-    "ur10": {"tool": "spot_gun_light", "reach": 0.55, "z": 0.6, "home": [0, -90, 90, -90, -90, 0],
+    "ur10": {"tool": "spot_gun_light", "reach": 0.45, "z": 0.6, "home": [0, -90, 90, -90, -90, 0],
              "io": ([4, 7], [4, 7]), "clamps": 0},
 }
+PREFIX = {"front": "f", "right": "r", "rear": "b", "left": "l"}   # spot names: f1, r1, b1, l1, ...
 RIM_Z = 0.75            # m, the sheet's top
 RIM_W = 0.12            # m, width of the rim's sheet
 SHEET = 0.003           # m
 EDGE = 0.02             # m, spot inside the outer edge
-PITCH = 1.8             # m of rail per robot on a side (arms this far apart keep out of each other's homes)
+PITCH = 1.6             # m of rail per robot on a side (arms this far apart keep out of each other's homes)
 
 
 def station(robots: int, spots: int, seed: int, arms: list[str] | None = None, name: str | None = None
@@ -42,7 +45,7 @@ def station(robots: int, spots: int, seed: int, arms: list[str] | None = None, n
     arms = arms or [str(a) for a in rng.choice(list(ARMS), size=robots)]
     front = math.ceil(robots / 2)
     L = PITCH * front
-    W = 1.2
+    W = 1.0
     objects: list[dict[str, Any]] = []
     # The rim: four sheets; the fixture: four bars under their inner halves.
     for rail, (cx, cy, sx, sy) in {"front": (0, -W / 2 + RIM_W / 2, L, RIM_W), "rear": (0, W / 2 - RIM_W / 2, L, RIM_W),
@@ -76,7 +79,7 @@ def station(robots: int, spots: int, seed: int, arms: list[str] | None = None, n
         for k, s in enumerate(xs):
             x = start[0] + along[0] * s - out[0] * EDGE
             y = start[1] + along[1] * s - out[1] * EDGE
-            pts.append({"name": f"{rail[0]}{k + 1}", "xyz": [round(float(x), 4), round(float(y), 4), RIM_Z - SHEET / 2],
+            pts.append({"name": f"{PREFIX[rail]}{k + 1}", "xyz": [round(float(x), 4), round(float(y), 4), RIM_Z - SHEET / 2],
                         "normal": [0, 0, 1], "direction": [float(along[0]), float(along[1]), 0]})
         seams.append({"name": f"rim_{rail}", "tolerance": {"alpha": 15, "beta": 15, "gamma": [-30, 30]}, "grid": 3,
                       "spots": pts})
@@ -118,10 +121,11 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--count", type=int, default=1)
     ap.add_argument("--arms", default="", help="comma-separated arms (default: drawn from the seed)")
+    ap.add_argument("--name", default=None, help="the station's name (default: from its size and seed)")
     args = ap.parse_args()
     for k in range(args.count):
         arms = args.arms.split(",") if args.arms else None
-        print(write(args.out, station(args.robots, args.spots, args.seed + k, arms)))
+        print(write(args.out, station(args.robots, args.spots, args.seed + k, arms, args.name)))
 
 
 if __name__ == "__main__":
