@@ -37,7 +37,7 @@ from robomax_py.world.scene import build_scene
 Method = Literal["full", "minmax", "nearest"]
 # Own-clock step of the coordination diagrams, s; the margin kept between robots grows with the
 # distance a piece moves in half a step (`bodies.sample_step`), so a finer step waits less.
-DIAGRAM_DT_S = 0.03
+DIAGRAM_DT_S = 0.04
 # Rounds of re-assignment with the waits as costs (method "full").
 REASSIGN_ROUNDS = 2
 # The min-max assignment's prior against robots crossing into each other's side: a spot costs a

@@ -98,9 +98,10 @@ def station(robots: int, spots: int, seed: int, arms: list[str] | None = None, n
         inputs = {f"{c}_closed": spec["clamps"] + j for j, (c, _, _) in enumerate(clamps)}
         out_robots.append({"name": f"r{i + 1}", "model": arm, "tool": spec["tool"],
                            "base": {"xyz": [round(x, 4), round(y, 4), spec["z"]], "rpy": [0, 0, yaw]},
-                           "home": spec["home"],
+                           "home": list(spec["home"]),
                            "controller": {"inputs": inputs,
-                                          "interlock_io": {"inputs": spec["io"][0], "outputs": spec["io"][1]}}})
+                                          "interlock_io": {"inputs": list(spec["io"][0]),
+                                                           "outputs": list(spec["io"][1])}}})
     return {"robomax": 1, "name": name or f"station_{robots}r_{spots}s_{seed}", "robots": out_robots,
             "objects": objects, "seams": seams,
             "process": {"weld_time": 0.4, "approach": 0.02, "clearance": 0.005}}

@@ -115,3 +115,14 @@ def test_check_command_summarises_a_station_and_refuses_a_bad_one(tmp_path: Path
     assert "robots[1].name" in done.output and "Traceback" not in done.output
     done = runner.invoke(app, ["plan", str(bad), "-o", str(tmp_path / "out")])
     assert done.exit_code == 2 and not (tmp_path / "out").exists()
+
+
+def test_shipped_station_is_valid() -> None:
+    from typer.testing import CliRunner
+
+    from robomax_py.app.cli import app
+
+    shipped = Path(__file__).parents[2] / "cells" / "stations" / "side_frame.yaml"
+    done = CliRunner().invoke(app, ["check", str(shipped)])
+    assert done.exit_code == 0, done.output
+    assert "4 robots, 40 spots" in done.output
