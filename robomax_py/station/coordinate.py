@@ -217,4 +217,15 @@ def coordinate(timelines: Sequence[Timeline], pairs: Sequence[PairMap], fcfs: bo
                 choice = options[k]
             locks = [*locks, choice]
 
-    return run([], "fcfs" if fcfs else ("lookahead" if lookahead else "greedy"))
+    done = run([], "fcfs" if fcfs else ("lookahead" if lookahead else "greedy"))
+    return Coordination(_without_implied(done.interlocks), done.schedule, done.unresolved)
+
+
+def _without_implied(locks: Sequence[Interlock]) -> tuple[Interlock, ...]:
+    """The interlocks without those another implies: a wait at the same point for the same leader's
+    later signal (the leader signals in program order, so the earlier one has been given too)."""
+    def implied(x: Interlock) -> bool:
+        return any(y is not x and (y.leader, y.waiter, y.wait_at) == (x.leader, x.waiter, x.wait_at)
+                   and (y.signal_at > x.signal_at or (y.signal_at == x.signal_at and locks.index(y) < locks.index(x)))
+                   for y in locks)
+    return tuple(x for x in locks if not implied(x))

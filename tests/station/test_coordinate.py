@@ -67,3 +67,14 @@ def test_interlocks_waiting_on_each_other_are_a_deadlock() -> None:
     locks = [Interlock(("a", "b"), (1, 1), "a", "b", 6.0, 2.0, (3.0, 5.0), (3.0, 5.0)),
              Interlock(("a", "b"), (1, 1), "b", "a", 6.0, 2.0, (3.0, 5.0), (3.0, 5.0))]
     assert simulate(lines, locks).deadlock
+
+
+def test_a_wait_implied_by_a_later_signal_is_dropped() -> None:
+    lines = [_timeline("a", 10.0, [2.0, 4.0, 6.0]), _timeline("b", 10.0, [3.0])]
+    # b would collide with a's segments 0 and 1 while it leaves home: both interlocks wait at home.
+    t = np.arange(0.0, 10.0 + DT, DT)
+    clash = ((t <= 3.9)[:, None] & ((t >= 0.5) & (t <= 1.0))[None, :])
+    done = coordinate(lines, [PairMap("a", "b", DT, clash)])
+    assert not done.unresolved
+    assert len([x for x in done.interlocks if x.waiter == "b" and x.wait_at == 0.0]) <= 1
+    assert _first_clash([PairMap("a", "b", DT, clash)], done.schedule) is None
