@@ -62,7 +62,7 @@ def main() -> None:
     ap.add_argument("--methods", default=",".join(METHODS))
     ap.add_argument("--json", type=Path, help="write every row here")
     args = ap.parse_args()
-    sizes = [(2, 4)] if args.quick else [tuple(int(v) for v in s.split("x")) for s in args.sizes.split(",")]
+    sizes = [(2, 8)] if args.quick else [tuple(int(v) for v in s.split("x")) for s in args.sizes.split(",")]
     methods = tuple(args.methods.split(","))
     rows: list[dict[str, object]] = []
     with tempfile.TemporaryDirectory() as tmp:

@@ -70,7 +70,7 @@ def station(robots: int, spots: int, seed: int, arms: list[str] | None = None, n
              ("rear", L, (L / 2, W / 2), (-1, 0), (0, 1)), ("left", W, (-L / 2, W / 2), (0, -1), (-1, 0))]
     total = sum(r[1] for r in rails)
     counts = [max(2, round(spots * r[1] / total)) for r in rails]
-    counts[0] += spots - sum(counts)
+    counts[0] = max(2, counts[0] + spots - sum(counts))     # at least two per rail: 8 spots at least
     seams = []
     for (rail, length, start, along, out), n in zip(rails, counts, strict=True):
         ends = 0.2
