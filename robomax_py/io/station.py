@@ -214,10 +214,6 @@ def _robot(*, shared_data: dict[str, Any], robot: StationRobotFile, index: int, 
         io = IoRangeFile(inputs=[0, 0], outputs=[0, 0])
     inputs, outputs = IoRange(*io.inputs), IoRange(*io.outputs)
     for kind, rng, taken in (("inputs", inputs, cell.controller.inputs), ("outputs", outputs, cell.controller.outputs)):
-        if count > 1 and rng.size < count - 1:
-            raise CellFileError(path, f"{prefix}.controller.interlock_io.{kind}",
-                                f"[{rng.first}, {rng.last}] holds {rng.size} number(s); a robot of a station of {count} "
-                                f"needs at least {count - 1} (one interlock with each other robot)")
         clash = next((t for t in taken if rng.first <= t.number <= rng.last), None)
         if clash is not None:
             raise CellFileError(path, f"{prefix}.controller.interlock_io.{kind}",
