@@ -40,7 +40,10 @@ def plan(
     formats: Annotated[str, typer.Option("--format", help="program dialects, comma-separated: srcl, krl, rapid, fanuc, urscript, inform, as, native (the robot's controller brand) or all (every dialect the robot file has the data for; the others are named in a warning)")] = "srcl",
     stamp: Annotated[bool, typer.Option("--stamp", help="write the date into each program's header (otherwise the same cell gives the same bytes)")] = False,
 ) -> None:
-    """Plan a cell and write its program files (only when the plan is complete and every program proven)."""
+    """Plan a cell and write its program files (only when the plan is complete and every program proven).
+
+    A station file (`robots:`, docs/stations.md) writes every robot's programs with their interlocks,
+    their trajectory files and <station>.station.json."""
     method = _method(baseline)
 
     def run() -> int:
