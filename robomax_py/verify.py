@@ -231,9 +231,10 @@ def _verify_motion(cell: CellSpec, robot: RobotModel, name: str, data: dict[str,
     """Home at both ends, limits and swept collisions, spots: appended to `out`; and the smallest
     clearance reached (when asked)."""
     t, q = data["t"], data["q"]
-    for end, idx in (("start", 0), ("end", -1)):
-        if np.abs(q[idx] - cell.home).max() > HOME_TOL_RAD:
-            out.append(Violation(float(t[idx]), "home", f"program does not {end} at robot.home"))
+    for end, idx, want, where in (("start", 0, cell.q_start, "robot.home" if cell.start is None else
+                                   "the stop configuration it continues from"), ("end", -1, cell.home, "robot.home")):
+        if np.abs(q[idx] - want).max() > HOME_TOL_RAD:
+            out.append(Violation(float(t[idx]), "home", f"program does not {end} at {where}"))
     world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
     loads = Loads.of(cell, robot)
     if loads is None:

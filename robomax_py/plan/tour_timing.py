@@ -95,7 +95,7 @@ def time_tour(
         welded.append((i, a, end.T_spot, end.T_app))
     blocks: list[list[Segment]] = []
     timed: list[Transition] = []
-    q_now = as_written_joints(cell.home)
+    q_now = as_written_joints(cell.q_start)         # home, or where a continuation starts
     spec_of = [cell.seams[spots[i].seam_index].spots[spots[i].spot_index] for i in tour.order]
     weld_times = [written_seconds(cell.process.weld_time_of(spot)) for spot in spec_of]
     def junction_block(k: int, q_start: FloatArray) -> tuple[list[Segment], Transition]:
