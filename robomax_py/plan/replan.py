@@ -40,6 +40,9 @@ __all__ = ["Action", "ReplanInputError", "Stop", "StopHow", "continuation_cell",
 
 # Samples of the slowing-down motion (s): as the trajectory file's (at most 10 ms apart).
 STOP_SAMPLE_S = 0.004
+# At least this many samples, so the last step's mean speed is at most 3 / 64^2 (0.07 %) of the
+# path's speed there: the sampled motion ends at rest, as the profile does.
+STOP_MIN_SAMPLES = 65
 # Slowing-down times tried (s): from 20 ms, each 1.25 times the last, up to 20 s.
 STOP_LADDER_S = tuple(0.02 * 1.25 ** k for k in range(32))
 # Two samples closer than this (rad, every joint) are the robot at rest.
@@ -117,7 +120,7 @@ def _resting_from(t: FloatArray, q: FloatArray, at: float) -> float | None:
 
 def _slowed(t: FloatArray, q: FloatArray, T: float, D: float) -> tuple[FloatArray, FloatArray, float]:
     """The path from T slowed to rest over D s: sample times (from T), configurations, end tau."""
-    u = np.linspace(0.0, D, max(2, math.ceil(D / STOP_SAMPLE_S) + 1))
+    u = np.linspace(0.0, D, max(STOP_MIN_SAMPLES, math.ceil(D / STOP_SAMPLE_S) + 1))
     x = u / D
     tau = T + D * (x - x ** 3 + 0.5 * x ** 4)
     return T + u, _at(t, q, tau), T + 0.5 * D
