@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -57,6 +57,9 @@ class ReplanOutcome:
     old_finish : s, the original program's end (program clock).
     new_finish : s, the stop plus the continuation's cycle (program clock); None when infeasible.
     cell : the continuation's cell (events applied, its clock from the stop).
+    as_it_stands : the program itself run on in the changed cell (its `WAIT FOR <door>_open`
+        statements holding until a late door opens): (clean, finish s, first violation); None for
+        a trajectory file, whose waits are fixed times.
     """
 
     status: Literal["planned", "infeasible"]
@@ -70,6 +73,7 @@ class ReplanOutcome:
     result: PlanResult | None
     cell: CellSpec | None
     seconds: float
+    as_it_stands: tuple[bool, float, str] | None = None
 
 
 def continuation_name(cell: CellSpec, at: float) -> str:
@@ -117,16 +121,17 @@ def planned_motion(cell: CellSpec, robot: RobotModel, path: Path) -> PlannedMoti
 
 
 def replan(cell: CellSpec, robot: RobotModel, program: Path, at: float, events: tuple[str, ...],
-           options: PlanOptions = PlanOptions()) -> ReplanOutcome:
+           options: PlanOptions = PlanOptions(), compare: bool = True) -> ReplanOutcome:
     """The continuation of `program` (for `cell`) asked for at `at` s after the changes `events`
     (`io.replan_events` grammar). Bad input raises (EventError, ProgramError, ReplanInputError);
-    an infeasible continuation is an outcome, its message naming the cause."""
+    an infeasible continuation is an outcome, its message naming the cause. With `compare`, the
+    program as it stands is also run on in the changed cell (`ReplanOutcome.as_it_stands`)."""
     t0 = time.process_time()
     if cell.parts:
         raise ReplanInputError("pick-and-place cells are not replanned (a part held at the stop is not modelled)")
     parsed = tuple(parse_event(e, cell) for e in events)
     motion = planned_motion(cell, robot, program)
-    stop = stop_at(motion.t, motion.q, motion.actions, at, robot.limits)
+    stop = stop_at(motion.t, motion.q, motion.actions, at, robot.limits, robot.joint_names)
     changed = apply_events(cell, parsed, at)
     name = continuation_name(cell, at)
     done = {(a.seam, a.name) for a in stop.done}
@@ -155,7 +160,20 @@ def replan(cell: CellSpec, robot: RobotModel, program: Path, at: float, events: 
     result = plan_cell(cont, robot, options)
     if result.status != "planned":
         return outcome("infeasible", result.message, result, cont)
-    return outcome("planned", "planned", result, cont)
+    return replace(outcome("planned", "planned", result, cont), as_it_stands=_as_it_stands(changed, robot, program) if compare else None)
+
+
+def _as_it_stands(changed: CellSpec, robot: RobotModel, program: Path) -> tuple[bool, float, str] | None:
+    """The program itself run on in the changed cell, as a controller runs it: rebuilt from its
+    statements (a `WAIT FOR` holds until its door opens in the changed windows) and verified against
+    the changed cell. None for a trajectory file (its waits are fixed times)."""
+    if program.suffix.lower() == ".json":
+        return None
+    from robomax_py.verify import verify_program
+
+    report = verify_program(changed, robot, program)
+    first = "" if report.clean else f"{report.violations[0].kind}: {report.violations[0].detail}"
+    return report.clean, float(report.cycle_time), first
 
 
 def summary(o: ReplanOutcome) -> dict[str, Any]:
@@ -169,4 +187,6 @@ def summary(o: ReplanOutcome) -> dict[str, Any]:
         "done": [a.label for a in s.done], "left": list(o.left),
         "old_finish": round(o.old_finish, 4), "new_finish": None if o.new_finish is None else round(o.new_finish, 4),
         "cpu_seconds": round(o.seconds, 3),
+        "as_it_stands": None if o.as_it_stands is None else {
+            "clean": o.as_it_stands[0], "finish": round(o.as_it_stands[1], 4), "violation": o.as_it_stands[2]},
     }

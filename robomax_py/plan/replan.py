@@ -35,21 +35,19 @@ from robomax_py.errors import RobomaxError
 from robomax_py.program import as_written_joints
 from robomax_py.robot import JointLimits
 from robomax_py.spec import CellSpec, MachineSpec, ObjectSpec
+from robomax_py.world.motion import rate_violations
 
 __all__ = ["Action", "ReplanInputError", "Stop", "StopHow", "continuation_cell", "shifted_windows", "stop_at"]
 
-# Samples of the slowing-down motion (s): as the trajectory file's (at most 10 ms apart).
-STOP_SAMPLE_S = 0.004
-# At least this many samples, so the last step's mean speed is at most 3 / 64^2 (0.07 %) of the
-# path's speed there: the sampled motion ends at rest, as the profile does.
-STOP_MIN_SAMPLES = 65
+# Samples of the slowing-down motion at most this far apart (s), as a trajectory file's.
+STOP_SAMPLE_S = 0.010
+# The slowing's last piece is halved this many times towards its end: the last step's mean speed
+# is then below 3 / 4^8 (0.005 %) of the path's speed there: the samples end at rest, as the profile.
+END_HALVINGS = 8
 # Slowing-down times tried (s): from 20 ms, each 1.25 times the last, up to 20 s.
 STOP_LADDER_S = tuple(0.02 * 1.25 ** k for k in range(32))
 # Two samples closer than this (rad, every joint) are the robot at rest.
 REST_TOL_RAD = 1e-9
-# Acceleration is measured by second differences over this step (s): the program's own samples
-# are linear in joint space, so a step of one sample would measure their corners, not the motion.
-ACCEL_STEP_S = 0.02
 
 StopHow = Literal["at rest", "action", "slowed", "program stop"]
 
@@ -80,7 +78,8 @@ class Stop:
     t_stop : s, program clock: when it is at rest at q (the continuation starts then).
     t_path : s, the program time of the path point it stands on (t_stop when it follows the program).
     q : (n,) rad, the stop configuration, a point of the program's path.
-    t, q_motion : (k,), (k, n): the motion from t_request to t_stop (program clock), for checks.
+    t, q_motion : (k,), (k, n): the motion to t_stop (program clock), for checks: from t_request, or
+        when slowing down from the program's sample at or before it.
     done : the actions completed by t_stop, in program order.
     """
 
@@ -119,27 +118,44 @@ def _resting_from(t: FloatArray, q: FloatArray, at: float) -> float | None:
 
 
 def _slowed(t: FloatArray, q: FloatArray, T: float, D: float) -> tuple[FloatArray, FloatArray, float]:
-    """The path from T slowed to rest over D s: sample times (from T), configurations, end tau."""
-    u = np.linspace(0.0, D, max(STOP_MIN_SAMPLES, math.ceil(D / STOP_SAMPLE_S) + 1))
-    x = u / D
-    tau = T + D * (x - x ** 3 + 0.5 * x ** 4)
-    return T + u, _at(t, q, tau), T + 0.5 * D
+    """The path from T slowed to rest over D s: sample times (from T), configurations, end tau.
+
+    Every sample of the program inside the span is a sample here too (where the slowed clock
+    reaches it), the pieces between them split to at most STOP_SAMPLE_S, so the motion bends only
+    where the program's does and finite differences measure the slowing, not the program's corners
+    cut across; the last piece is halved END_HALVINGS times towards the end, where the speed goes
+    to zero."""
+    fine = np.linspace(0.0, 1.0, 20_001)
+    tau_fine = fine - fine ** 3 + 0.5 * fine ** 4            # (tau - T) / D, increasing from 0 to 1/2
+    end = T + 0.5 * D
+    corners = t[(t > T) & (t < end)]
+    knots_x = np.concatenate([[0.0], np.interp((corners - T) / D, tau_fine, fine), [1.0]])
+    knots_tau = np.concatenate([[T], corners, [end]])
+    xs: list[float] = []
+    taus: list[float] = []
+    for k in range(len(knots_x) - 1):
+        x0, x1 = float(knots_x[k]), float(knots_x[k + 1])
+        if x1 - x0 <= 1e-12:
+            continue
+        n = max(1, math.ceil(D * (x1 - x0) / STOP_SAMPLE_S))
+        inner = x0 + (x1 - x0) * np.arange(1, n) / n
+        if k == len(knots_x) - 2:
+            last = float(inner[-1]) if len(inner) else x0
+            inner = np.concatenate([inner, 1.0 - (1.0 - last) * 0.5 ** np.arange(1, END_HALVINGS + 1)])
+        xs += [x0, *inner.tolist()]
+        taus += [float(knots_tau[k]), *(T + D * (inner - inner ** 3 + 0.5 * inner ** 4)).tolist()]
+    xs.append(1.0)
+    taus.append(end)
+    return T + D * np.array(xs), _at(t, q, np.array(taus)), end
 
 
-def _within_limits(ts: FloatArray, qs: FloatArray, limits: JointLimits) -> bool:
-    dt = np.diff(ts)
-    v = np.abs(np.diff(qs, axis=0)) / dt[:, None]
-    if np.any(v > limits.velocity[None, :] * (1.0 + 1e-6)):
-        return False
-    step = max(1, round(ACCEL_STEP_S / float(dt[0])))
-    if len(qs) <= 2 * step:
-        return True
-    h = float(ts[step] - ts[0])
-    a = np.abs(qs[2 * step:] - 2.0 * qs[step:-step] + qs[:-2 * step]) / h ** 2
-    return bool(np.all(a <= limits.acceleration[None, :] * (1.0 + 1e-6)))
+def _within_limits(ts: FloatArray, qs: FloatArray, limits: JointLimits, names: tuple[str, ...]) -> bool:
+    """Velocity and acceleration within the limits, measured as `verify` measures them."""
+    return not rate_violations(limits, names, ts, qs)
 
 
-def stop_at(t: FloatArray, q: FloatArray, actions: Sequence[Action], T: float, limits: JointLimits) -> Stop:
+def stop_at(t: FloatArray, q: FloatArray, actions: Sequence[Action], T: float, limits: JointLimits,
+            names: tuple[str, ...] = ()) -> Stop:
     """Where and when the robot stops after replanning is asked for at T (s, program clock), by
     the rule of this module. t (k,), q (k, n): the program's motion, linear between samples.
     ReplanInputError when T is not inside the program."""
@@ -165,7 +181,13 @@ def stop_at(t: FloatArray, q: FloatArray, actions: Sequence[Action], T: float, l
         if rest is not None and T + 0.5 * D >= rest:
             break                            # the program itself is at rest sooner
         ts, qs, tau = _slowed(t, q, T, D)
-        if _within_limits(ts, qs, limits):
+        # From the program's own sample at or before T (the motion up to T is the program's): a
+        # sample at T itself would cut the program's piece short and make its next corner measure
+        # sharper than it is.
+        i = int(np.searchsorted(t, T, side="right")) - 1
+        if t[i] < T - 1e-12 and len(ts) > 2:
+            ts, qs = np.concatenate([t[i:i + 1], ts[1:]]), np.vstack([q[i:i + 1], qs[1:]])
+        if _within_limits(ts, qs, limits, names or tuple(f"joint {j + 1}" for j in range(q.shape[1]))):
             return Stop(T, float(ts[-1]), tau, qs[-1], "slowed", ts, qs, done_by(T))
     if rest is None:
         raise ReplanInputError(f"the robot cannot stop on its path after t = {T:g} s within its limits")

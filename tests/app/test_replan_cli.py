@@ -93,3 +93,39 @@ def test_bad_input_exits_2_names_the_problem_and_writes_nothing(tmp_path: Path, 
     assert said in text and "Traceback" not in text
     assert ("--at 100" if "--at" in args else "--event:") in text        # the option named
     assert not out.exists()
+
+
+@pytest.mark.slow
+def test_a_trajectory_file_is_replanned_through_the_api(tmp_path: Path, program: Path) -> None:
+    """The continuation's own trajectory file (.json) is a program `replan_program` reads: replanned
+    again, with no event, where the robot is moving; the second continuation is written and verified
+    against its cell, and starts where the first one stops."""
+    from robomax_py.app.api import (
+        LoadedCell,
+        replan_program,
+        verify_program,
+        write_programs,
+    )
+    from robomax_py.io.cell import load_cell_robot
+
+    spec = load_cell(CELL)
+    cell = LoadedCell(spec, load_cell_robot(spec))
+    first = replan_program(cell, program, T_AT, ["late:cnc1=+3"])
+    assert first.status == "planned" and first.cell is not None and first.result is not None
+    first_cell = LoadedCell(first.cell, cell.robot)
+    written = write_programs(first_cell, first.result, tmp_path / "first")
+    assert verify_program(first_cell, written.trajectory).clean
+    # 0.3 s before the first station left: the robot is moving into CNC 1 there.
+    at = first.result.spots[0].t_arrive - 0.3
+    trajectory = json.loads(written.trajectory.read_text())
+    moving = np.max(np.abs(np.diff(np.interp(at + np.array([0.0, 0.01]), trajectory["t"],
+                                             np.array(trajectory["q"])[:, 0]))))
+    second = replan_program(first_cell, written.trajectory, float(at), [])
+    assert second.status == "planned" and second.cell is not None and second.result is not None, second.message
+    assert moving > 0
+    assert second.stop.how in ("slowed", "program stop", "action")
+    second_cell = LoadedCell(second.cell, cell.robot)
+    again = write_programs(second_cell, second.result, tmp_path / "second")
+    assert verify_program(second_cell, again.trajectory).clean
+    q0 = np.array(json.loads(again.trajectory.read_text())["q"][0])
+    np.testing.assert_allclose(np.degrees(q0), np.degrees(second.stop.q), atol=START_TOL_DEG)

@@ -83,6 +83,13 @@ def replan(
             new = "—" if outcome.new_finish is None else f"{outcome.new_finish:.3f} s"
             out.print(f"finish: {new} (planned: {outcome.old_finish:.3f} s); replanning {outcome.seconds:.1f} s CPU",
                       markup=False)
+            if outcome.as_it_stands is not None:
+                clean, finish, first = outcome.as_it_stands
+                out.print(f"the program as it stands (its waits holding for the changed doors): finish {finish:.3f} s, "
+                          + ("clean in the changed cell" + (": it finishes no later, it may run on as it is"
+                                                            if outcome.new_finish is not None
+                                                            and finish <= outcome.new_finish else "")
+                             if clean else f"not safe in the changed cell ({first})"), markup=False, soft_wrap=True)
             for path in written:
                 out.print(f"wrote {path}", markup=False)
             if "verify" in report:
