@@ -101,9 +101,12 @@ def _at(t: FloatArray, q: FloatArray, when: float | FloatArray) -> FloatArray:
 
 
 def _followed(t: FloatArray, q: FloatArray, t0: float, t1: float) -> tuple[FloatArray, FloatArray]:
-    """The program's own samples over [t0, t1], both ends included."""
-    inner = t[(t > t0) & (t < t1)]
-    ts = np.concatenate([[t0], inner, [t1]]) if t1 > t0 else np.array([t0])
+    """The program's own samples over [t0, t1], from its sample at or before t0 (a sample at t0
+    itself would cut a piece short and make the program's next corner measure sharper than it is)
+    to t1 included."""
+    i = max(int(np.searchsorted(t, t0, side="right")) - 1, 0)
+    inner = t[(t >= t[i]) & (t < t1)]
+    ts = np.concatenate([inner, [t1]]) if t1 > t[i] else np.array([t1])
     return ts, _at(t, q, ts)
 
 
