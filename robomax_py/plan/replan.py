@@ -39,10 +39,11 @@ from robomax_py.world.motion import rate_violations
 
 __all__ = ["Action", "ReplanInputError", "Stop", "StopHow", "continuation_cell", "shifted_windows", "stop_at"]
 
-# Samples of the slowing-down motion at most this far apart (s), as a trajectory file's.
+# The slowing-down motion's pieces are split no finer than the program's sample step, at most this (s).
 STOP_SAMPLE_S = 0.010
 # The slowing's last piece is halved this many times towards its end: the last step's mean speed
-# is then below 3 / 4^8 (0.005 %) of the path's speed there: the samples end at rest, as the profile.
+# is then a small fraction (about 3 / 4^(8+1)) of the path's speed there: the samples end at rest,
+# as the profile does.
 END_HALVINGS = 8
 # Slowing-down times tried (s): from 20 ms, each 1.25 times the last, up to 20 s.
 STOP_LADDER_S = tuple(0.02 * 1.25 ** k for k in range(32))
@@ -124,13 +125,14 @@ def _slowed(t: FloatArray, q: FloatArray, T: float, D: float) -> tuple[FloatArra
     """The path from T slowed to rest over D s: sample times (from T), configurations, end tau.
 
     Every sample of the program inside the span is a sample here too (where the slowed clock
-    reaches it), the pieces between them split to at most STOP_SAMPLE_S, so the motion bends only
-    where the program's does and finite differences measure the slowing, not the program's corners
-    cut across; the last piece is halved END_HALVINGS times towards the end, where the speed goes
-    to zero."""
+    reaches it), so the motion bends only where the program's does; a piece between two of them
+    that the slowing stretches is split into pieces no shorter than the program's own sample step
+    (a shorter piece beside a corner makes the corner measure sharper than it is); the last piece's
+    last quarter is halved END_HALVINGS times towards the end, where the speed goes to zero."""
     fine = np.linspace(0.0, 1.0, 20_001)
     tau_fine = fine - fine ** 3 + 0.5 * fine ** 4            # (tau - T) / D, increasing from 0 to 1/2
     end = T + 0.5 * D
+    h = float(np.clip(np.median(np.diff(t)), 0.001, STOP_SAMPLE_S))
     corners = t[(t > T) & (t < end)]
     knots_x = np.concatenate([[0.0], np.interp((corners - T) / D, tau_fine, fine), [1.0]])
     knots_tau = np.concatenate([[T], corners, [end]])
@@ -140,11 +142,11 @@ def _slowed(t: FloatArray, q: FloatArray, T: float, D: float) -> tuple[FloatArra
         x0, x1 = float(knots_x[k]), float(knots_x[k + 1])
         if x1 - x0 <= 1e-12:
             continue
-        n = max(1, math.ceil(D * (x1 - x0) / STOP_SAMPLE_S))
+        n = max(1, math.floor(D * (x1 - x0) / h))
         inner = x0 + (x1 - x0) * np.arange(1, n) / n
         if k == len(knots_x) - 2:
             last = float(inner[-1]) if len(inner) else x0
-            inner = np.concatenate([inner, 1.0 - (1.0 - last) * 0.5 ** np.arange(1, END_HALVINGS + 1)])
+            inner = np.concatenate([inner, 1.0 - 0.25 * (1.0 - last) * 0.5 ** np.arange(END_HALVINGS)])
         xs += [x0, *inner.tolist()]
         taus += [float(knots_tau[k]), *(T + D * (inner - inner ** 3 + 0.5 * inner ** 4)).tolist()]
     xs.append(1.0)

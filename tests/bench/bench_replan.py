@@ -40,6 +40,7 @@ CASES = (
     ("late:cnc2=+4", 10.0), ("late:cnc2=+4", 26.0),
     ("late:cnc1=+8", 35.0),
     ("window:cnc1_door=32-38", 30.0),
+    ("window:cnc1_door=0-9,9.6-12,16-25,32-41", 8.0),
 )
 QUICK = (("late:cnc1=+4", 36.0),)
 
@@ -49,6 +50,7 @@ def main() -> None:
     ap.add_argument("program", nargs="?", type=Path, default=REPO / "tests" / "golden" / "shipped" / "tending.srcl")
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--quick", action="store_true", help="one case, one run (a smoke run)")
+    ap.add_argument("--case", type=int, action="append", help="only the case of this index (repeatable)")
     args = ap.parse_args()
     cell = load_cell(REPO / "cells" / "tending.yaml")
     robot = load_cell_robot(cell)
@@ -56,7 +58,8 @@ def main() -> None:
     print("| event | T (s) | stop | left | CPU (s, median) | (a) planned | (b) program as it stands | "
           "(c) continuation, waiting at rest | (d) continuation, time-aware |")
     print("|---|---|---|---|---|---|---|---|---|")
-    for event, at in QUICK if args.quick else CASES:
+    cases = QUICK if args.quick else tuple(CASES[i] for i in args.case) if args.case else CASES
+    for event, at in cases:
         cpu = []
         outcome = None
         for _ in range(runs):
