@@ -24,6 +24,7 @@ from robomax_py._version import __version__
 from robomax_py.errors import ExportError
 from robomax_py.export.dialect import PlannedProgram
 from robomax_py.plan import PlanResult
+from robomax_py.plan.lead_in import START_LABEL
 from robomax_py.plan.program_frames import ProgramFrames, program_frames
 from robomax_py.plan.results import Transition
 from robomax_py.plan.waiting import WaitPlan, signal_of
@@ -95,9 +96,12 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
         joints.extend(np.asarray(q, dtype=float) for _ in items)
 
     home = np.asarray(result.home, dtype=float)
-    emit(home, Comment(f"start at home; {len(result.spots)} spots, planned cycle {traj.duration:.3f} s"),
-         PtpMove(tuple(np.degrees(home)), opts.speed, 1.0, comment="home"))
     transitions = result.transitions
+    # A continuation (`robomax replan`) starts where the robot stopped, not at home.
+    where = "stop" if transitions and transitions[0].label.startswith(f"{START_LABEL} ->") else "home"
+    emit(home, Comment(f"start at {'the stop configuration' if where == 'stop' else 'home'}; {len(result.spots)} "
+                       f"spots, planned cycle {traj.duration:.3f} s"),
+         PtpMove(tuple(np.degrees(home)), opts.speed, 1.0, comment=where))
     if result.spots and result.spots[0].interlocks:
         emit(home, *_interlocks(result.spots[0].interlocks, setup))
     if transitions and transitions[0].wait is not None:

@@ -21,6 +21,9 @@ from robomax_py.plan.roadmap import Roadmap
 from robomax_py.program import as_written_joints
 from robomax_py.world.collision import CollisionWorld
 
+# The first move of a continuation is labelled `stop -> <first stop>` (a whole program's: `home -> ...`).
+START_LABEL = "stop"
+
 
 class LeadInError(RobomaxError):
     """No collision-free way from the start of a continuation to its first stop."""
@@ -37,7 +40,7 @@ def lead_in(world: CollisionWorld, roadmap: Roadmap | None, start: np.ndarray,
     first = transitions[0]
     q0 = as_written_joints(np.asarray(start, dtype=float))
     goal = np.asarray(first.waypoints[-1], dtype=float)
-    label = "stop ->" + first.label.partition("->")[2] if "->" in first.label else first.label
+    label = f"{START_LABEL} ->" + first.label.partition("->")[2] if "->" in first.label else first.label
     first = replace(first, label=label)
     if world.check_segment(q0, goal).free:
         moved = replace(first, kind="move", waypoints=np.vstack([q0, goal]), checks=0, lin_targets=None,

@@ -60,6 +60,7 @@ def test_a_door_opening_late_is_waited_for_and_the_continuation_verifies(tmp_pat
     load = next(s for s in trajectory["spots"] if s["name"] == "c3_cnc1_load")
     assert t_stop + load["t_arrive"] >= opens - TIME_TOL_S      # it waited for the door
     assert report["left"][0] == "tending/c3_cnc1_load"
+    assert "start at the stop configuration" in (out / f"{name}.srcl").read_text()
     assert report["new_finish"] == pytest.approx(t_stop + trajectory["cycle_time"], abs=1e-3)
     assert report["new_finish"] > report["old_finish"]
 
