@@ -35,6 +35,7 @@ SMOKE: dict[str, list[str]] = {
     "bench_import.py": ["--runs", "1", "--poses", "20"],
     "bench_pick_place.py": ["--quick", "--out", OUT],
     "bench_plan.py": ["--runs", "1", "--resolutions", "20"],
+    "bench_replan.py": ["--quick"],
     "bench_scale.py": ["--sizes", "8", "--families", "open", "--runs", "1"],
     "bench_startup.py": [SMALL, "--runs", "1"],
     "bench_table_ik.py": ["--quick", "--figures", OUT],
