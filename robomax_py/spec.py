@@ -291,6 +291,9 @@ class PlannerSpec:
     # Pick and place: carried moves planned as every move ("moves") or by Diane and Anikina's
     # associative memory, k-NN graph, Dijkstra route and Jacobian interpolation ("associative").
     transfers: str = "moves"
+    # "lin": approach, retract and detour lines as straight LIN moves with fly-by; "spline": a
+    # junction between two spots as one smooth Bézier TCP path where that is faster.
+    cartesian_moves: str = "lin"
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -22,6 +22,7 @@ from robomax_py.export.rebuild.result import (
     Rebuilt,
     Span,
 )
+from robomax_py.export.rebuild.spline_block import SplinePoint, add_point, in_block
 from robomax_py.plan.waiting import clear_wait, signal_of
 from robomax_py.program import (
     NULL_FRAME,
@@ -141,12 +142,15 @@ class _Builder:
         self.spans: list[Span] = []
         self.waited: set[str] = set()                      # clamp inputs waited for so far
         self.after_action = False                          # a weld or gripper action since the last move
+        self.block: list[SplinePoint] = []                 # the spline block being read
 
     def start(self, q: FloatArray) -> None:
         self.q = np.asarray(q, dtype=float)
         self.segments.append(dwell(self.q, 0.0, kind="wait", label="start"))
 
     def add(self, ins: Any, following: Any, index: int) -> bool:
+        if in_block(ins):
+            return add_point(self, ins, following, index)
         if isinstance(ins, (PtpMove, LinMove)):
             kind = self._kind(ins, following)
             self.after_action = False
