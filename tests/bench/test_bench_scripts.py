@@ -27,6 +27,7 @@ SMOKE: dict[str, list[str]] = {
     "bench_batch.py": ["--quick", "--n", "2", "--runs", "1", "--no-ray"],
     "bench_bezier.py": ["--repeat", "1"],
     "bench_bezier_paper.py": ["--quick", "--out", OUT],
+    "bench_cartesian_splines.py": ["--quick"],
     "bench_ceiling.py": [SMALL, "--pairs", "2"],
     "bench_collision.py": ["--cell", SMALL, "--quick"],
     "bench_dialects.py": ["--runs", "1", SMALL],
