@@ -76,7 +76,8 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
             {"between": t.label, "chosen": ch.chosen, "flyby_s": round(ch.flyby_time, 4),
              "spline_s": None if ch.spline_time is None else round(ch.spline_time, 4), "note": ch.note,
              "spline_points": None if t.spline is None else len(t.spline.targets),
-             "bezier_deviation_mm": None if t.spline is None else round(t.spline.deviation_m * 1000.0, 3)}
+             "bezier_deviation_mm": None if t.spline is None else round(t.spline.deviation_m * 1000.0, 3),
+             "as_lines_s": None if t.spline is None or t.spline.lines_time is None else round(t.spline.lines_time, 4)}
             for t in choices if (ch := t.choice) is not None
         ]
     # Pick and place: each move's load and the overrides its limits asked for.
@@ -127,7 +128,8 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
         if moves:
             def move(m: dict[str, Any]) -> str:
                 spline = "none: " + m["note"] if m["spline_s"] is None else f"{m['spline_s']:.3f} s"
-                return f"{m['between']}: {m['chosen']} (spline {spline}, fly-by {m['flyby_s']:.3f} s)"
+                lines = "" if m["as_lines_s"] is None else f", as lines {m['as_lines_s']:.3f} s"
+                return f"{m['between']}: {m['chosen']} (spline {spline}, fly-by {m['flyby_s']:.3f} s{lines})"
 
             head.add_row("splines", f"{sum(m['chosen'] == 'spline' for m in moves)} of {len(moves)} junctions; "
                          + "; ".join(move(m) for m in moves))

@@ -4,10 +4,10 @@
 Each segment of the block becomes a LIN to its point at the segment's speed. The spline points
 are sampled from the planned Bézier path with at most `plan.spline_junction.SPLINE_TOL_M` of
 sagitta, so the lines between them keep within that of the path; each interior point is flown by
-at `FLYBY_FRACTION` of the shorter chord meeting there (the blends of neighbouring points never
-overlap, and a blend cuts the corner by less than the chords' sagitta), except where the straight
-retract and approach meet the curve: there the fly-by is `END_FLYBY_FRACTION` of it, so the TCP
-leaves and reaches the electrode axis all but on it. The last segment (the approach into the
+at a fraction of the shorter chord meeting there (`plan.spline_junction.line_flybys`, which the
+planner times them with too: the blends of neighbouring points never overlap, and a blend cuts the
+corner by less than the chords' sagitta), a smaller one where the straight retract and approach
+meet the curve, so the TCP leaves and reaches the electrode axis all but on it. The last segment (the approach into the
 spot) stops. The controller then runs a path within about twice that sagitta of the plan's and,
 its blends being sharper turns than the spline's, somewhat slower: `publish` checks both against
 `tolerances.spline_lines_mm` and `spline_lines_time`.
@@ -22,14 +22,10 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.export.dialect import PlannedProgram
+from robomax_py.plan.spline_junction import line_flybys
 from robomax_py.program import Comment, Instruction, LinMove
-from robomax_py.robot import RobotModel
+from robomax_py.robot import RobotModel, fk_tcp
 from robomax_py.timing.chain import tcp_flyby_radius
-
-# Fly-by at an interior spline point, as a fraction of the shorter chord meeting there (< 0.5).
-FLYBY_FRACTION = 0.4
-# ... and where the straight retract or approach meets the curve.
-END_FLYBY_FRACTION = 0.1
 
 
 def has_splines(planned: PlannedProgram) -> bool:
@@ -53,24 +49,21 @@ def as_lines(planned: PlannedProgram, robot: RobotModel) -> PlannedProgram:
 
 
 def _convert(out: list[Instruction], block: list[int], joints: tuple[FloatArray, ...], robot: RobotModel) -> None:
-    """The block's segments as lines; each fly-by stated as the joint-space radius (deg) its TCP
-    distance makes on that line (`timing.chain.tcp_flyby_radius`), which every dialect states in
-    its own terms (KRL C_DIS, RAPID zones, URScript r: back to the distance; FANUC CNT)."""
-    moves = [out[k] for k in block]
-    assert all(isinstance(m, LinMove) for m in moves)
-    pts = np.array([m.position_mm for m in moves if isinstance(m, LinMove)], dtype=float)
-    chords = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    """The block's segments as lines; each fly-by (`plan.spline_junction.line_flybys`) stated as
+    the joint-space radius (deg) its TCP distance makes on that line (`timing.chain.tcp_flyby_radius`),
+    which every dialect states in its own terms (KRL C_DIS, RAPID zones, URScript r: back to the
+    distance; FANUC CNT)."""
+    # The chords from the planned joints (robot base frame): the points' own frame may be a user frame.
+    pts = np.array([robot_tcp_mm(robot, joints[k]) for k in block])
+    flybys = line_flybys(pts, robot_tcp_mm(robot, joints[block[0] - 1]))
     for j, k in enumerate(block):
         m = out[k]
         assert isinstance(m, LinMove)
-        flyby = 0.0
-        if 0 < j + 1 < len(block):
-            # The chord into point j + 1 from point j and out of it: point j's neighbours in the block.
-            before = chords[j - 1] if j > 0 else None
-            after = chords[j]
-            shorter = float(after if before is None else min(before, after))
-            ends = j == 0 or j == len(block) - 2
-            flyby = (END_FLYBY_FRACTION if ends else FLYBY_FRACTION) * shorter
         q_prev = joints[block[j - 1]] if j > 0 else joints[k - 1]
-        radius = tcp_flyby_radius(robot, q_prev, joints[k], flyby / 1000.0) if flyby > 0 else 0.0
+        radius = tcp_flyby_radius(robot, q_prev, joints[k], float(flybys[j]) / 1000.0) if flybys[j] > 0 else 0.0
         out[k] = dataclasses.replace(m, spline="", flyby=math.degrees(radius))
+
+
+def robot_tcp_mm(robot: RobotModel, q: FloatArray) -> FloatArray:
+    """The TCP position (mm) at q in the robot base frame (URDF root)."""
+    return np.asarray(fk_tcp(robot, q)[:3, 3] * 1000.0, dtype=float)

@@ -31,6 +31,7 @@ from robomax_py.program import as_written_pose
 from robomax_py.robot import JointLimits, RobotModel, fk_tcp
 from robomax_py.spec import TcpLimits
 from robomax_py.timing import LinMoveError, Segment, TimingError
+from robomax_py.timing.chain import LinStep, chain_path, time_chain
 from robomax_py.timing.curve_move import spline_motion
 from robomax_py.timing.space_bezier import deviation, sample_lines, space_path
 
@@ -42,6 +43,26 @@ MAX_CHORD_M = 0.12
 MIN_CHORD_M = 0.01
 # Samples of the spline measured against the Bézier path.
 DEVIATION_SAMPLES = 400
+# The dialects without spline motion fly by each interior spline point at this fraction of the
+# shorter chord meeting there (< 0.5: neighbouring blends never overlap), and where the straight
+# retract and approach meet the curve at this one (the TCP leaves and reaches the electrode axis
+# all but on it); the last point (the spot) stops.
+LINES_FLYBY_FRACTION = 0.4
+LINES_END_FLYBY_FRACTION = 0.1
+
+
+def line_flybys(points: FloatArray, start: FloatArray) -> FloatArray:
+    """(k,) TCP fly-by distance (same unit as the points) at each of a spline block's points
+    (k, 3), written as lines from `start` (3,): `LINES_FLYBY_FRACTION` of the shorter chord at
+    interior points, `LINES_END_FLYBY_FRACTION` at the first and second-to-last, 0 at the last."""
+    pts = np.vstack([np.asarray(start, dtype=float)[None], np.asarray(points, dtype=float)])
+    chords = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    k = len(chords)
+    out = np.zeros(k)
+    for j in range(k - 1):
+        fraction = LINES_END_FLYBY_FRACTION if j in (0, k - 2) else LINES_FLYBY_FRACTION
+        out[j] = fraction * min(chords[j], chords[j + 1])
+    return out
 # The path must arrive in the planned configuration within this (rad, any joint).
 ARRIVAL_TOL_RAD = 1e-3
 
@@ -134,8 +155,22 @@ def spline_variant(robot: RobotModel, world: PathChecks, limits: JointLimits, q_
     if not res.free:
         return SplineVariant([], None, res.checks, "collides")
     dev = deviation(design, curve.points(np.linspace(0.0, curve.length, DEVIATION_SAMPLES)))
-    moves = SplineMoves(written[1:], speeds, q_targets, (), dev)
+    moves = SplineMoves(written[1:], speeds, q_targets, (), dev, _lines_time(robot, limits, q_start, written, speeds,
+                                                                             settings.accel))
     return SplineVariant(segments, moves, res.checks)
+
+
+def _lines_time(robot: RobotModel, limits: JointLimits, q_start: FloatArray, written: FloatArray,
+                speeds: FloatArray, accel: float) -> float | None:
+    """How long the dialects without spline motion take for the block (`export.spline_lines`):
+    its points as lines flown by, timed as the controller runs them; None where that fails."""
+    radii = line_flybys(written[1:, :3, 3], written[0, :3, 3])
+    steps = [LinStep(T, float(v), flyby_tcp=float(r), accel=accel) for T, v, r in zip(written[1:], speeds, radii,
+                                                                                        strict=True)]
+    try:
+        return sum(s.duration for s in time_chain(chain_path(robot, q_start, steps), steps, limits))
+    except (LinMoveError, TimingError):
+        return None
 
 
 def choose(junction: Junction, variant: SplineVariant) -> tuple[Junction, CartesianChoice]:

@@ -20,7 +20,10 @@ class SplineMoves:
     speeds : (k,) TCP speed of the stretch ending at each target, m/s, as written.
     q : (k, n) the configuration at each target as timed, rad.
     configs : the configuration data at each target (`robot.solve.config_text`).
-    deviation_m : largest distance of the blended lines' TCP path from the Bézier path, m.
+    deviation_m : largest distance of the spline (through the written points, as the controller
+        interpolates it) from the Bézier path they were sampled from, m.
+    lines_time : s, the block as short lines flown by (the dialects without spline motion,
+        `export.spline_lines`), timed as they run it; None where that could not be timed.
     """
 
     targets: FloatArray
@@ -28,6 +31,7 @@ class SplineMoves:
     q: FloatArray
     configs: tuple[str, ...]
     deviation_m: float
+    lines_time: float | None = None
 
 
 @dataclass(frozen=True, slots=True)

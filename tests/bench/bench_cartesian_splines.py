@@ -64,7 +64,9 @@ def measure(path: Path, runs: int, formats: tuple[str, ...]) -> dict[str, Any]:
             row["junctions"] = len(choices)
             row["switched"] = sum(t.choice.chosen == "spline" for t in choices if t.choice)
             row["moves"] = [{"between": t.label, "chosen": c.chosen, "flyby_s": round(c.flyby_time, 3),
-                             "spline_s": None if c.spline_time is None else round(c.spline_time, 3), "note": c.note}
+                             "spline_s": None if c.spline_time is None else round(c.spline_time, 3), "note": c.note,
+                             "as_lines_s": None if t.spline is None or t.spline.lines_time is None
+                             else round(t.spline.lines_time, 3)}
                             for t in choices if (c := t.choice) is not None]
             devs = [t.spline.deviation_m for t in result.transitions if t.spline is not None]
             row["bezier_deviation_mm"] = round(1000.0 * max(devs), 3) if devs else None
@@ -87,7 +89,8 @@ def _print(rows: list[dict[str, Any]]) -> None:
               f"{spl['bezier_deviation_mm']} mm")
         for m in spl["moves"]:
             print(f"  {m['between']:>10}: {m['chosen']:6}  fly-by {m['flyby_s']:.3f} s  spline "
-                  + (f"{m['spline_s']:.3f} s" if m["spline_s"] is not None else f"none ({m['note']})"))
+                  + (f"{m['spline_s']:.3f} s" if m["spline_s"] is not None else f"none ({m['note']})")
+                  + ("" if m["as_lines_s"] is None else f"  as lines {m['as_lines_s']:.3f} s"))
         for fmt, d in spl["dialects"].items():
             print(f"  {fmt:>10}: path {d['path_mm']:.3f} mm, joints {d['joint_deg']:.4f} deg, welds shifted "
                   f"{d['weld_shift_ms']:.1f} ms, cycle {d['cycle_s']:.3f} s")
