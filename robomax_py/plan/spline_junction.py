@@ -124,10 +124,12 @@ def _speeds(settings: SplineSettings, path_kappa: FloatArray, i_ret: int, i_app:
 
 def spline_variant(robot: RobotModel, world: PathChecks, limits: JointLimits, q_start: FloatArray,
                    waypoints: FloatArray, kind: str, label: str, before: WeldEnd, after: WeldEnd,
-                   settings: SplineSettings, lin_targets: FloatArray | None = None) -> SplineVariant:
+                   settings: SplineSettings, lin_targets: FloatArray | None = None,
+                   beat: float = math.inf) -> SplineVariant:
     """The junction from the spot of `before` (at q_start) to the spot of `after` along the
     spline through the points sampled from the Bézier path through its key poses, timed and
-    checked (`problem` says why not)."""
+    checked (`problem` says why not). Where it is faster than `beat` (s), also timed as the
+    lines the dialects without spline motion write (`SplineMoves.lines_time`)."""
     try:
         design = space_path(key_poses(robot, waypoints, before, after, lin_targets), straight_ends=True)
     except TimingError as exc:
@@ -155,9 +157,9 @@ def spline_variant(robot: RobotModel, world: PathChecks, limits: JointLimits, q_
     if not res.free:
         return SplineVariant([], None, res.checks, "collides")
     dev = deviation(design, curve.points(np.linspace(0.0, curve.length, DEVIATION_SAMPLES)))
-    moves = SplineMoves(written[1:], speeds, q_targets, (), dev, _lines_time(robot, limits, q_start, written, speeds,
-                                                                             settings.accel))
-    return SplineVariant(segments, moves, res.checks)
+    faster = sum(s.duration for s in segments) < beat
+    lines = _lines_time(robot, limits, q_start, written, speeds, settings.accel) if faster else None
+    return SplineVariant(segments, SplineMoves(written[1:], speeds, q_targets, (), dev, lines), res.checks)
 
 
 def _lines_time(robot: RobotModel, limits: JointLimits, q_start: FloatArray, written: FloatArray,

@@ -122,11 +122,13 @@ def time_tour(
                 tcp_speed=load.tcp_speed, speed=load.speed, accel=load.accel, jerk_limited=options.jerk_limited,
                 flyby=options.blend, lin_targets=lin_targets, lin_speed=lin_speed,
             )
-            if options.cartesian_moves != "spline" or before is None or after is None or trans.stages:
+            # Splines join two spots in a static world: a junction timed around dynamic objects keeps
+            # the motion its windows were searched for.
+            if options.cartesian_moves != "spline" or before is None or after is None or trans.stages or cell.dynamic:
                 return junction
             settings = _spline_settings(cell, part, options, load)
             variant = spline_variant(robot, checked, robot.limits, q_start, waypoints, trans.kind, trans.label,
-                                     before, after, settings, lin_targets)
+                                     before, after, settings, lin_targets, sum(s.duration for s in junction.segments))
             junction, choice = choose(junction, variant)
             return junction
 
