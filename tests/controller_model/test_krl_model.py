@@ -305,8 +305,9 @@ def test_spline_forms_outside_the_model_are_reported() -> None:
 
 def test_robomax_spline_program_welds_at_the_spots() -> None:
     """The planner's KRL spline program (tests/golden/spline_cell, a cell moved, yawed and raised with
-    its robot: the targets are the same in the robot base as the unmoved cell's in the world) runs
-    cleanly, every block stops where a weld follows, and each weld is at its spot within 0.1 mm."""
+    its robot, targets in user frame 3 on the fixture, stored by the frames program: in the robot
+    base they are where the unmoved cell's spots are in the world) runs cleanly, every block stops
+    where a weld follows, and each weld is at its spot within 0.1 mm."""
     from pathlib import Path
 
     import yaml

@@ -1,5 +1,5 @@
 """`planner.cartesian_moves: spline` end to end on a small cell whose robot stands off the cell's
-origin (moved, yawed and raised with everything else): the planner flies some junction as a
+origin (moved, yawed and raised with everything else), its targets in a user frame on the fixture: the planner flies some junction as a
 Bézier spline where that is faster, KRL and SRCL state it as a spline block and rebuild exactly
 what was planned, RAPID, FANUC and URScript state it as short lines flown by within the stated
 tolerances, and every written program verifies clean against the cell."""
@@ -36,6 +36,10 @@ FORMATS = ("srcl", "krl", "rapid", "fanuc", "urscript")
 def planned(tmp_path_factory: pytest.TempPathFactory, shared_once: Any) -> dict[str, Any]:
     data = yaml.safe_load(CELL.read_text())
     place_cell(data, *PLACEMENT)
+    # The integrator's numbers: targets relative to user frame 3 on the fixture plate, tool 2.
+    data["robot"]["controller"] = {"tool": {"number": 2, "name": "gun2"},
+                                   "frame": {"number": 3, "object": "fixture_plate"},
+                                   "registers": {"position": [40, 41]}}
     folder = tmp_path_factory.mktemp("spline_cell")
     path = folder / "spline_cell.yaml"
     path.write_text(yaml.safe_dump(data, sort_keys=False))
