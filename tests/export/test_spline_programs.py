@@ -146,3 +146,18 @@ def test_krl_spline_forms_it_does_not_model_are_not_simulated(planned: dict[str,
 
 def test_every_dialect_has_its_spline_form() -> None:
     assert {name for name, d in DIALECTS.items() if d.splines} == {"srcl", "krl"}
+
+
+def test_the_report_names_each_junctions_way_and_times(planned: dict[str, Any]) -> None:
+    from rich.console import Console
+
+    from robomax_py.app.report import report_tables
+
+    report = plan_report(planned["result"], 0.0, [])
+    console = Console(width=200, record=True)
+    for table in report_tables(report):
+        console.print(table)
+    text = console.export_text()
+    chosen = [m for m in report["cartesian_moves"] if m["chosen"] == "spline"]
+    assert f"{len(chosen)} of {len(report['cartesian_moves'])} junctions" in text
+    assert all(m["as_lines_s"] is not None and m["as_lines_s"] > m["spline_s"] for m in chosen)

@@ -102,3 +102,4 @@ def test_a_stretch_has_its_own_speed_and_a_key_point_the_lower() -> None:
     at = stretch_speeds(np.array([0.0, 0.03, 0.2, 0.23]), np.array([0.5, 1.0, 0.5]))
     got = at(np.array([0.0, 0.01, 0.03, 0.1, 0.2, 0.21, 0.23]))
     np.testing.assert_allclose(got, [0.5, 0.5, 0.5, 1.0, 0.5, 0.5, 0.5])
+
