@@ -6,8 +6,8 @@ are sampled from the planned Bézier path with at most `plan.spline_junction.SPL
 sagitta, so the lines between them keep within that of the path; each point but the last is flown
 by at a fraction of the shorter chord meeting there (`plan.spline_junction.line_flybys`, which the
 planner times them with too: the blends of neighbouring points never overlap, and a blend cuts the
-corner by less than the chords' sagitta; where the straight retract and approach meet the curve
-the chords are near collinear, so the TCP stays on the electrode axis). The last segment (the
+corner by less than the chords' sagitta; a smaller fraction where the straight retract and
+approach meet the curve, so the TCP stays on the electrode axis). The last segment (the
 approach into the spot) stops. The controller then runs a path within about twice that sagitta of
 the plan's and, its blends being sharper turns than the spline's, somewhat slower: `publish`
 checks both against `tolerances.spline_lines_mm` and `spline_lines_time`.

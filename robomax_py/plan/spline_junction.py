@@ -43,23 +43,28 @@ MAX_CHORD_M = 0.12
 MIN_CHORD_M = 0.01
 # Samples of the spline measured against the Bézier path.
 DEVIATION_SAMPLES = 400
-# The dialects without spline motion fly by each spline point but the last (the spot, a stop) at
-# this fraction of the shorter chord meeting there (< 0.5: neighbouring blends never overlap).
-# Where the straight retract and approach meet the curve the chords are near collinear (the
-# spline's tangent there is the electrode axis), so the blend keeps the TCP on the axis within
-# verify's tolerance. Measured on the bench's cells: 0.4 of the chord takes the lines 10 % longer
-# than 0.49 (docs/bezier-paper.md, "Cartesian moves as splines").
+# The dialects without spline motion fly by each interior spline point at this fraction of the
+# shorter chord meeting there (< 0.5: neighbouring blends never overlap; on the small test cell
+# 0.4 takes the lines 5 % longer than 0.49) ...
 LINES_FLYBY_FRACTION = 0.49
+# ... and the approach points, where the straight retract and approach meet the curve, at this
+# one: a blend there cuts into the approach line, and verify wants the TCP on the electrode axis
+# within 0.1 mm over the approach distance (0.49 left it by 0.15 mm on gazelle_cabin; 0.1 keeps it).
+LINES_END_FLYBY_FRACTION = 0.1
 
 
 def line_flybys(points: FloatArray, start: FloatArray) -> FloatArray:
     """(k,) TCP fly-by distance (same unit as the points) at each of a spline block's points
     (k, 3), written as lines from `start` (3,): `LINES_FLYBY_FRACTION` of the shorter chord
-    meeting there, 0 at the last."""
+    meeting there, `LINES_END_FLYBY_FRACTION` at the first and second-to-last (the approach
+    points), 0 at the last (the spot)."""
     pts = np.vstack([np.asarray(start, dtype=float)[None], np.asarray(points, dtype=float)])
     chords = np.linalg.norm(np.diff(pts, axis=0), axis=1)
-    out = np.zeros(len(chords))
-    out[:-1] = LINES_FLYBY_FRACTION * np.minimum(chords[:-1], chords[1:])
+    k = len(chords)
+    fraction = np.full(k, LINES_FLYBY_FRACTION)
+    fraction[[0, max(k - 2, 0)]] = LINES_END_FLYBY_FRACTION
+    out = np.zeros(k)
+    out[:-1] = fraction[:-1] * np.minimum(chords[:-1], chords[1:])
     return out
 # The path must arrive in the planned configuration within this (rad, any joint).
 ARRIVAL_TOL_RAD = 1e-3
