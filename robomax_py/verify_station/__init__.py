@@ -83,6 +83,8 @@ class StationReport:
     stuck: tuple[Stuck, ...]
     makespan: float                    # s, when the last program that ends ends
     samples: int                       # station clock times at which the robots were posed together
+    unwelded: tuple[tuple[str, str], ...] = ()     # station spots (seam, spot) no program welds
+    repeated: tuple[tuple[str, str], ...] = ()     # station spots welded by more than one program
 
     @property
     def deadlock(self) -> bool:
@@ -91,7 +93,8 @@ class StationReport:
 
     @property
     def clean(self) -> bool:
-        return not self.collisions and not self.stuck and all(m.report.clean for m in self.members)
+        return not (self.collisions or self.stuck or self.unwelded or self.repeated) and \
+            all(m.report.clean for m in self.members)
 
     def idle_share(self, robot: str) -> float:
         """The share of the makespan the robot spends waiting (0..1)."""
@@ -103,11 +106,15 @@ class StationReport:
         return waiting / self.makespan
 
 
-def verify_station(members: Sequence[StationMember], margin: float = 0.0) -> StationReport:
+def verify_station(members: Sequence[StationMember], margin: float = 0.0,
+                   spots: Sequence[tuple[str, str]] = ()) -> StationReport:
     """Replay the members' programs together (see the module docstring); `margin` m: robots closer
-    than this count as in contact. ProgramError when a program cannot be read (bad input)."""
+    than this count as in contact; `spots`: the station's (seam, spot), each to be welded by one
+    program exactly (each program's own verify checks the spots of its cell view). ProgramError
+    when a program cannot be read (bad input)."""
+    from robomax_py.export.plan_program import identifier
     from robomax_py.export.rebuild.signals import output_signal
-    from robomax_py.program import SetSignal
+    from robomax_py.program import SetSignal, Spot
     from robomax_py.world.robot_pairs import robot_body
     from robomax_py.world.scene import build_scene
 
@@ -140,7 +147,12 @@ def verify_station(members: Sequence[StationMember], margin: float = 0.0) -> Sta
     bodies = {m.name: robot_body(m.name, m.robot, build_scene(m.cell, m.robot)) for m in members if m.name in motions}
     grid = _grid(list(motions.values()), until)
     collisions = _collisions(bodies, motions, grid, margin)
-    return StationReport(tuple(out), tuple(collisions), result.stuck, result.makespan, len(grid))
+    welded = [(ins.seam, ins.name) for r in reads for ins in r[2].program.instructions if isinstance(ins, Spot)]
+    # A program names a spot as an identifier of the dialect (`identifier`: a seam called seam is seam_).
+    written = [(identifier(a), identifier(b)) for a, b in spots]
+    unwelded = tuple(k for k, w in zip(spots, written) if w not in welded)
+    repeated = tuple(k for k, w in zip(spots, written) if welded.count(w) > 1)
+    return StationReport(tuple(out), tuple(collisions), result.stuck, result.makespan, len(grid), unwelded, repeated)
 
 
 def _grid(motions: list[StationMotion], until: float) -> FloatArray:

@@ -66,13 +66,14 @@ def station_cells(folder: Path) -> dict[str, tuple[CellSpec, Any]]:
     return out
 
 
-def program(cell: CellSpec, robot: Any, name: str, waits: tuple[str, ...] = (), sets: tuple[str, ...] = ()) -> Program:
-    """Home; wait for each of `waits`; into the zone, weld s1; home; set each of `sets`."""
+def program(cell: CellSpec, robot: Any, name: str, waits: tuple[str, ...] = (), sets: tuple[str, ...] = (),
+            spot: str = "s1") -> Program:
+    """Home; wait for each of `waits`; into the zone, weld `spot`; home; set each of `sets`."""
     number = {i.signal: i.number for i in cell.controller.inputs}
     out_number = {o.signal: o.number for o in cell.controller.outputs}
     ins: list[Instruction] = [PtpMove(HOME_DEG)]
     ins += [WaitFor(s, number.get(s)) for s in waits]
-    ins += [PtpMove(ZONE_DEG), Spot("s1", "zone", 0.5), PtpMove(HOME_DEG)]
+    ins += [PtpMove(ZONE_DEG), Spot(spot, "zone", 0.5), PtpMove(HOME_DEG)]
     ins += [SetSignal(s, out_number.get(s), True) for s in sets]
     header = Header(cell.name, robot.name, cell.tool.name, 0.0, tuple(robot.joint_names))
     return Program(name, header, instructions=tuple(ins))
@@ -102,3 +103,25 @@ def members(folder: Path, cells: dict[str, tuple[CellSpec, Any]], plans: dict[st
         path = write(folder, cell, robot, program(cell, robot, f"st_{name}", waits, sets), dialect)
         out.append(StationMember(name, cell, robot, path))
     return out
+
+
+def station_file(folder: Path, cells: dict[str, tuple[CellSpec, Any]]) -> Path:
+    """The same two robots as one station file `duo.yaml`: r1 welds zone/a1, r2 zone/b1 (each the
+    spot of its own cell view), interlock I/O 1..4 on both."""
+    spots = []
+    for name, spot in (("r1", "a1"), ("r2", "b1")):
+        seam = cells[name][0].seams[0].spots[0]
+        spots.append({"name": spot, "xyz": [float(v) for v in seam.xyz], "normal": [float(v) for v in seam.normal],
+                      "direction": [float(v) for v in seam.direction], "robots": [name]})
+    data = {"robomax": 1, "name": "duo",
+            "robots": [{"name": n, "model": "kr125", "tool": "spot_gun_c",
+                        "base": {"xyz": list(xyz), "rpy": [0, 0, yaw]}, "home": list(HOME_DEG),
+                        "controller": {"interlock_io": {"inputs": [1, 4], "outputs": [1, 4]}}}
+                       for n, (xyz, yaw) in PLACES.items()],
+            "objects": [],
+            "seams": [{"name": "zone", "tolerance": {"alpha": 5, "beta": 5, "gamma": [-180, 180]}, "grid": 3,
+                       "spots": spots}],
+            "process": {"weld_time": 0.5, "approach": 0.0}}
+    path = folder / "duo.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path

@@ -104,3 +104,16 @@ def test_replay_a_signal_turned_off_again_holds_a_later_wait() -> None:
     (hold,) = result.holds["a"]
     assert (hold.t_local, hold.seconds, hold.setter) == (3.0, 2.0, "b")
     assert abs(result.ends["a"] - 6.0) <= CLOCK_TOL_S and not result.stuck
+
+
+def test_the_gantt_chart_holds_each_robots_timeline(tmp_path: Path, cells: dict[str, Any]) -> None:
+    from robomax_py.app.station_chart import render_station_png, station_chart
+
+    report = _run(tmp_path, cells, {"r1": ((), ("r1_z1_clear",), "srcl"), "r2": (("r1_z1_clear",), (), "srcl")})
+    chart = station_chart("duo", report)
+    assert chart.rows == ("r1 (idle 0 %)", "r2 (idle 50 %)")
+    for row, member in enumerate(report.members):
+        bars = [b for b in chart.bars if b.row == row]
+        assert [(b.kind, b.start) for b in bars] == [(a.kind, a.t_start) for a in member.timeline]
+    assert [b.label for b in chart.bars if b.kind == "waiting"] == ["r1_z1_clear of r1"]
+    assert render_station_png(chart).startswith(b"\x89PNG")
