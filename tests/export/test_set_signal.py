@@ -63,12 +63,12 @@ def test_round_trip_and_golden(small: tuple[Any, Any], dialect: str, update_gold
     parsed = d.parse(texts, "station_r1" + d.extensions[0], robot)
     assert _signals(parsed.program) == READ_BACK[dialect]
     assert _signals(parsed.program) == _signals(adapted)
-    main = texts[d.extensions[0]]
-    golden = GOLDEN / f"station_r1{d.extensions[0]}"
-    if update_golden:
-        golden.parent.mkdir(parents=True, exist_ok=True)
-        golden.write_bytes(main.encode("utf-8"))
-    assert main.encode("utf-8") == golden.read_bytes()
+    for key, text in texts.items():         # the set: main file, companions, shared routines
+        golden = GOLDEN / (f"station_r1{key}" if key.startswith((".", "_")) else key)
+        if update_golden:
+            golden.parent.mkdir(parents=True, exist_ok=True)
+            golden.write_bytes(text.encode("utf-8"))
+        assert text.encode("utf-8") == golden.read_bytes(), golden.name
 
 
 STATEMENTS = {"krl": ("$OUT[3]=TRUE", "$OUT[3]=FALSE"), "rapid": ("SetDO doR1Z1, 1;", "SetDO doR1Z1, 0;"),
