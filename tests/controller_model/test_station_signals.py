@@ -78,8 +78,8 @@ def test_krl_outputs(text: str, want: list[tuple[int, bool, bool]]) -> None:
 
 
 def test_rapid_set_reset_and_delayed_set() -> None:
-    run = run_rapid(["MODULE m\n  PROC main()\n    Set do1;\n    Reset do1;\n    SetDO \\SDelay:=0.2, do1, 1;\n"
-                     "  ENDPROC\nENDMODULE\n"], outputs={"do1": 4})
+    run = run_rapid([("MODULE m\n  PROC main()\n    Set do1;\n    Reset do1;\n    SetDO \\SDelay:=0.2, do1, 1;\n"
+                     "  ENDPROC\nENDMODULE\n")], outputs={"do1": 4})
     assert [(e.output_number, e.state) for e in run.events if isinstance(e, SetOutput)] == [(4, True), (4, False)]
     assert any("SetDO" in i.text for i in run.issues)
 
