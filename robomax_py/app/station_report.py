@@ -35,7 +35,7 @@ def print_station_verify(station_file: Path, given: list[Path], as_json: bool, c
     from robomax_py.app.station_verify import verify_station_files
     from robomax_py.io.station import load_station
 
-    results = verify_station_files(station_file, given)
+    results = [(programs, report) for programs, _, report in verify_station_files(station_file, given)]
     name = load_station(station_file).name
     clean = all(r.clean for _, r in results)
     if chart:

@@ -98,8 +98,9 @@ def members_of(station: StationSpec, programs: dict[str, Path]) -> list[StationM
     return out
 
 
-def verify_station_files(station_file: Path, given: list[Path]) -> list[tuple[dict[str, Path], StationReport]]:
-    """Every program set found or named, replayed (see the module docstring)."""
+def verify_station_files(station_file: Path, given: list[Path]) -> list[tuple[dict[str, Path], list[StationMember],
+                                                                         StationReport]]:
+    """Every program set found or named: its files, members and replay (see the module docstring)."""
     from robomax_py.io.station import load_station
 
     station = load_station(station_file)
@@ -109,5 +110,5 @@ def verify_station_files(station_file: Path, given: list[Path]) -> list[tuple[di
     for programs in station_programs(station, given):
         members = members_of(station, programs)
         margin = station.robots[0].cell.process.clearance
-        out.append((programs, verify_station(members, margin=margin, spots=[s.key for s in station.spots])))
+        out.append((programs, members, verify_station(members, margin=margin, spots=[s.key for s in station.spots])))
     return out

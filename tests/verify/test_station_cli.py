@@ -92,3 +92,21 @@ def test_bad_input_exits_two(tmp_path: Path, station: Path, case: str) -> None:
     result = runner.invoke(app, ["verify", str(station), *args])
     assert result.exit_code == EXIT_BAD_INPUT, result.output
     assert "Traceback" not in result.output
+
+
+def test_station_preview_needs_its_folder_and_html(tmp_path: Path, station: Path) -> None:
+    result = runner.invoke(app, ["preview", str(station)])
+    assert result.exit_code == EXIT_BAD_INPUT and "--html" in result.output
+
+
+@pytest.mark.slow
+def test_station_preview_page(tmp_path: Path, station: Path) -> None:
+    """One page: both robots on the replay's clock (a meshcat server runs while it is made)."""
+    _write(tmp_path, station, {"r1": ((), ("r1_z1_clear",), "srcl"), "r2": (("r1_z1_clear",), (), "srcl")})
+    page = tmp_path / "duo.html"
+    result = runner.invoke(app, ["preview", str(station), str(tmp_path), "--html", str(page), "--json"])
+    assert result.exit_code == EXIT_OK, result.output
+    data = json.loads(result.output)
+    replay = json.loads(runner.invoke(app, ["verify", str(station), str(tmp_path), "--json"]).output)["sets"][0]
+    assert data["robots"] == ["r1", "r2"] and abs(data["duration"] - replay["makespan"]) <= 1e-4
+    assert "<html" in page.read_text(encoding="utf-8").lower()

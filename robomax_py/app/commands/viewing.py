@@ -17,10 +17,28 @@ from robomax_py.app.commands.base import (
 )
 
 
+def _preview_station(station: Path, programs: Path | None, html: Path | None, as_json: bool) -> None:
+    """A station's robots on the clock of their replay, as one HTML page (`app.preview_station`)."""
+    from robomax_py.app.preview_station import shown_station, write_station_html
+    from robomax_py.errors import ProgramError
+
+    if programs is None or html is None:
+        raise ProgramError(station, None, "a station's preview needs its output folder (or a program) and --html FILE")
+    robots, zones = shown_station(station, programs)
+    content = write_station_html(html, robots, zones)
+    if as_json:
+        _print_json("preview", True, {"cell": str(station), "program": str(programs), "url": None, "files": [str(html)],
+                                      "frames": content.frames, "duration": round(content.duration, 4),
+                                      "robots": [r.name for r in robots], "zones": len(zones)})
+        return
+    out.print(f"wrote {html} ({len(robots)} robots, {len(zones)} interlock zones, {content.frames} animation frames, "
+              f"{content.duration:.3f} s)")
+
+
 @_command()
 def preview(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
-    program: Annotated[Path | None, typer.Argument(help="program written by plan (.json or .srcl); without it the robot stands at home")] = None,
+    program: Annotated[Path | None, typer.Argument(help="program written by plan (.json or .srcl); without it the robot stands at home; for a station, its output folder (with --html)")] = None,
     html: Annotated[Path | None, typer.Option("--html", help="write one self-contained HTML page instead of serving")] = None,
     voxels: Annotated[float | None, typer.Option("--voxels", min=0.005, max=0.5, metavar="PRECISION",
                                                  help="also draw the voxel map of the static objects (blocked leaves) "
@@ -42,6 +60,11 @@ def preview(
 
         if html is not None and (host != LOOPBACK or port is not None):
             raise typer.BadParameter("--html writes a file; --host and --port are for serving", param_hint="--host/--port")
+        from robomax_py.io.station import is_station_file
+
+        if is_station_file(cell):
+            _preview_station(cell, program, html, as_json)
+            return
         spec = load_cell(cell)
         _warn([str(n) for n in spec.notices])   # what is probably a mistake shows in the scene too
         robot = load_cell_robot(spec)
