@@ -127,3 +127,13 @@ def test_rapid_set_and_reset_are_setdo(small: tuple[Any, Any]) -> None:
     parsed = d.parse({**mod, ".mod": text}, "station_r1.mod", robot)
     assert _signals(parsed.program)[1] == SetSignal("r1_z1_clear", None, True)
     assert any("SDelay" in t for _, t in parsed.ignored)
+
+
+def test_a_planned_interlock_takes_the_cells_output_number() -> None:
+    from robomax_py.export.plan_program import set_signal, wait_for
+
+    setup = ControllerSetup(inputs=(ControllerInput("r2_z1_clear", 2),), outputs=(ControllerOutput("r1_z1_clear", 3),))
+    assert set_signal("r1_z1_clear", setup) == SetSignal("r1_z1_clear", 3, True)
+    assert set_signal("r1_z1_clear", setup, False) == SetSignal("r1_z1_clear", 3, False)
+    assert set_signal("r9_z1_clear", setup) == SetSignal("r9_z1_clear", None, True)
+    assert wait_for("r2_z1_clear", setup) == WaitFor("r2_z1_clear", 2)

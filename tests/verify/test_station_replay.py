@@ -7,11 +7,14 @@ stand off the origin (a riser and a yaw; 4.3 m away, turned 190 deg)."""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from station_case import HOME_DEG, members, station_cells
 
 from robomax_py.export.rebuild import SignalEvent
@@ -117,3 +120,53 @@ def test_the_gantt_chart_holds_each_robots_timeline(tmp_path: Path, cells: dict[
         assert [(b.kind, b.start) for b in bars] == [(a.kind, a.t_start) for a in member.timeline]
     assert [b.label for b in chart.bars if b.kind == "waiting"] == ["r1_z1_clear of r1"]
     assert render_station_png(chart).startswith(b"\x89PNG")
+
+
+@st.composite
+def _programs(draw: st.DrawFn) -> dict[str, tuple[list[SignalEvent], float]]:
+    """Up to three robots, each a few settings and waits of two signals at increasing times, no two
+    events of the station at one time (at one instant the replay's order is its own rule, tested
+    above)."""
+    out = {}
+    pool = draw(st.lists(st.integers(0, 1000), min_size=12, max_size=12, unique=True))
+    for k, name in enumerate(("a", "b", "c")[:draw(st.integers(1, 3))]):
+        times = sorted(t / 100.0 for t in pool[4 * k:4 * k + draw(st.integers(0, 4))])
+        events = [_ev(t, draw(st.sampled_from(["set", "wait"])), draw(st.sampled_from(["s", "u"])), draw(st.booleans()))
+                  for t in times]
+        events = [dataclasses.replace(e, value=True) if e.kind == "wait" else e for e in events]
+        out[name] = (events, max([0.0, *times]) + draw(st.floats(0.0, 2.0, allow_nan=False)))
+    return out
+
+
+@settings(max_examples=100, deadline=None)
+@given(_programs())
+def test_replay_never_passes_a_wait_before_its_signal_is_on(programs: dict[str, Any]) -> None:
+    """Replayed again by brute force from the holds: every wait passes at a moment when the signal,
+    as the settings (shifted by their own robot's holds) leave it, is on; a robot is held exactly
+    until a setting turns it on; the robots left are those whose wait nobody turns on later."""
+    result = replay(programs)
+    settings_at: list[tuple[float, int, str, bool]] = []
+    for k, (name, (events, _)) in enumerate(programs.items()):
+        stuck = next((x for x in result.stuck if x.robot == name), None)
+        held_at = None if stuck is None else stuck.t - sum(h.seconds for h in result.holds[name])
+        done = len(events) if held_at is None else sum(e.t < held_at for e in events)
+        for i, e in enumerate(events[:done]):
+            if e.kind == "set":
+                settings_at.append((e.t + result.offset(name, e.t), k * 100 + i, e.signal, e.value))
+
+    def level(signal: str, t: float) -> bool:
+        state = False
+        for when, _, s, value in sorted(settings_at):
+            if s == signal and when <= t + CLOCK_TOL_S:
+                state = value
+        return state
+
+    for name, holds in result.holds.items():
+        assert all(h.seconds >= 0 for h in holds)
+        for h in holds:
+            released = h.t_local + result.offset(name, h.t_local)
+            assert level(h.signal, released), (name, h)
+        if name in result.ends:
+            assert abs(result.ends[name] - programs[name][1] - sum(h.seconds for h in holds)) <= CLOCK_TOL_S
+    for s in result.stuck:
+        assert not level(s.signal, max([s.t, *(t for t, *_ in settings_at)]))
