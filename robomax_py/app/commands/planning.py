@@ -66,6 +66,18 @@ def plan(
         _honour_signals()
 
         configure_logging(err, verbose)
+        from robomax_py.io.station import is_station_file
+
+        if is_station_file(cell):
+            from robomax_py.app.station_command import plan_station_files
+
+            if method != "optimised" or plot:
+                from robomax_py.errors import CellFileError
+
+                raise CellFileError(cell, "robots", "--baseline and --plot plan single-robot cells; a station "
+                                    "compares its methods in tests/bench/bench_station.py")
+            return plan_station_files(cell, out_dir, formats, speed, as_json,
+                                      datetime.date.today().isoformat() if stamp else "")
         t0 = time.perf_counter()
         spec = load_cell(cell)
         _warn([str(n) for n in spec.notices])
