@@ -7,7 +7,6 @@ from __future__ import annotations
 import dataclasses
 import json
 from pathlib import Path
-from typing import Any
 
 from robomax_py.errors import CellFileError, ProgramError
 from robomax_py.spec import ControllerInput, ControllerOutput
@@ -25,7 +24,9 @@ def station_programs(station: StationSpec, given: list[Path]) -> list[dict[str, 
         folder = given[0]
         sets = []
         for d in DIALECTS.values():
-            found = {r: folder / f"{station.name}_{r}{d.extensions[0]}" for r in robots}
+            # FANUC names its files after the program (CROSSING_R1.ls): the dialect's own name for it.
+            named = d.program_name or (lambda n: n)
+            found = {r: folder / f"{named(f'{station.name}_{r}')}{d.extensions[0]}" for r in robots}
             if all(p.is_file() for p in found.values()):
                 sets.append(found)
         if not sets:
@@ -49,8 +50,9 @@ def station_programs(station: StationSpec, given: list[Path]) -> list[dict[str, 
 
 def interlock_io(station: StationSpec, folder: Path) -> dict[str, tuple[dict[str, int], dict[str, int]]]:
     """Per robot, the interlock inputs and outputs (signal -> number) the plan gave it, from
-    `<station>.station.json` beside the programs (`robots[].inputs` / `robots[].outputs`); none
-    when there is no such file (programs that name their signals, SRCL and RAPID, need none)."""
+    `<station>.station.json` beside the programs: each of its `interlocks` is the `leader`'s
+    output `leader_output` and the `waiter`'s input `waiter_input` of its `signal`. None when
+    there is no such file (programs that name their signals, SRCL and RAPID, need none)."""
     path = folder / f"{station.name}.station.json"
     if not path.is_file():
         return {}
@@ -58,18 +60,25 @@ def interlock_io(station: StationSpec, folder: Path) -> dict[str, tuple[dict[str
         data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
         raise ProgramError(path, None, f"cannot read the station file: {exc}") from None
-    out: dict[str, tuple[dict[str, int], dict[str, int]]] = {}
-    robots = data.get("robots", []) if isinstance(data, dict) else []
-    for i, entry in enumerate(robots if isinstance(robots, list) else []):
-        if not isinstance(entry, dict) or entry.get("name") not in station.robot_names:
-            continue
-        maps = []
-        for key in ("inputs", "outputs"):
-            given: Any = entry.get(key, {})
-            if not isinstance(given, dict) or not all(isinstance(v, int) for v in given.values()):
-                raise ProgramError(path, f"robots[{i}].{key}", "expected {signal: number}")
-            maps.append({str(k): int(v) for k, v in given.items()})
-        out[str(entry["name"])] = (maps[0], maps[1])
+    out: dict[str, tuple[dict[str, int], dict[str, int]]] = {r: ({}, {}) for r in station.robot_names}
+    interlocks = data.get("interlocks", []) if isinstance(data, dict) else None
+    if not isinstance(interlocks, list):
+        raise ProgramError(path, "interlocks", "expected a list")
+    for i, entry in enumerate(interlocks):
+        try:
+            signal, leader, waiter = str(entry["signal"]), str(entry["leader"]), str(entry["waiter"])
+            output, input_ = entry["leader_output"], entry["waiter_input"]
+        except (KeyError, TypeError):
+            raise ProgramError(path, f"interlocks[{i}]", "expected signal, leader, waiter, leader_output and "
+                                                         "waiter_input") from None
+        for robot, number, key in ((leader, output, "leader"), (waiter, input_, "waiter")):
+            if robot not in out:
+                raise ProgramError(path, f"interlocks[{i}].{key}", f"{robot!r} is no robot of station {station.name}")
+            if isinstance(number, int) and not isinstance(number, bool):
+                out[robot][0 if key == "waiter" else 1][signal] = number
+            elif number is not None:
+                raise ProgramError(path, f"interlocks[{i}].{key}_{'input' if key == 'waiter' else 'output'}",
+                                   f"expected an I/O number, got {number!r}")
     return out
 
 
@@ -90,10 +99,14 @@ def members_of(station: StationSpec, programs: dict[str, Path]) -> list[StationM
         spots = [s.key for s in station.spots if (identifier(s.seam), identifier(s.spot)) in welded]
         view = robot_view(station, name, spots)
         inputs, outputs = io.get(name, ({}, {}))
+        # The plan's own setup (with_interlock_io) may hold them already: the file's numbers are added where not.
+        have_in = {i.signal for i in view.controller.inputs}
+        have_out = {o.signal for o in view.controller.outputs}
         controller = dataclasses.replace(
             view.controller,
-            inputs=(*view.controller.inputs, *(ControllerInput(s, n) for s, n in inputs.items())),
-            outputs=(*view.controller.outputs, *(ControllerOutput(s, n) for s, n in outputs.items())))
+            inputs=(*view.controller.inputs, *(ControllerInput(s, n) for s, n in inputs.items() if s not in have_in)),
+            outputs=(*view.controller.outputs,
+                     *(ControllerOutput(s, n) for s, n in outputs.items() if s not in have_out)))
         out.append(StationMember(name, dataclasses.replace(view, controller=controller), robot, path))
     return out
 

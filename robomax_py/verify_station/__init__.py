@@ -97,13 +97,15 @@ class StationReport:
             all(m.report.clean for m in self.members)
 
     def idle_share(self, robot: str) -> float:
-        """The share of the makespan the robot spends waiting (0..1)."""
+        """The share of the makespan the robot is idle (0..1): waiting for another robot's signal,
+        or done while others still work; its own program's time (moves, welds, its own dwells)
+        is not idle. As the station plan counts it: (makespan - own cycle) / makespan."""
         member = next(m for m in self.members if m.name == robot)
         if self.makespan <= 0:
             return 0.0
-        waiting = sum(min(a.t_end, self.makespan) - a.t_start for a in member.timeline
-                      if a.kind == "waiting" and a.t_start < self.makespan)
-        return waiting / self.makespan
+        busy = sum(max(0.0, min(a.t_end, self.makespan) - a.t_start) for a in member.timeline
+                   if not (a.kind == "waiting" and a.signal))
+        return max(0.0, 1.0 - busy / self.makespan)
 
 
 def verify_station(members: Sequence[StationMember], margin: float = 0.0,

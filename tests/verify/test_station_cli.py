@@ -43,8 +43,10 @@ def _write(folder: Path, station: Path, plans: dict[str, Any]) -> list[Path]:
         robot = load_cell_robot(cell)
         spot = "a1" if name == "r1" else "b1"
         paths.append(write(folder, cell, robot, program(cell, robot, f"duo_{name}", waits, sets, spot), dialect))
-    (folder / "duo.station.json").write_text(json.dumps(
-        {"robots": [{"name": n, "inputs": i, "outputs": o} for n, (i, o) in IO.items()]}))
+    # As robomax plan STATION writes it: each interlock the leader's output and the waiter's input.
+    (folder / "duo.station.json").write_text(json.dumps({"interlocks": [
+        {"signal": "r1_z1_clear", "leader": "r1", "waiter": "r2", "leader_output": 3, "waiter_input": 2},
+        {"signal": "r2_z1_clear", "leader": "r2", "waiter": "r1", "leader_output": 4, "waiter_input": 1}]}))
     return paths
 
 
@@ -58,7 +60,10 @@ def test_interlocked_programs_in_two_dialects_are_clean(tmp_path: Path, station:
     (only,) = data["sets"]
     r2 = only["robots"][1]
     assert r2["timeline"][0]["signal"] == "r1_z1_clear" and r2["timeline"][0]["of"] == "r1"
-    assert r2["idle_share"] > 0.4 and only["robots"][0]["idle_share"] == 0.0
+    r1, span = only["robots"][0], only["makespan"]
+    assert abs(r1["idle_share"] - (span - r1["end"]) / span) <= 1e-4        # done while r2 works
+    wait = r2["timeline"][0]
+    assert abs(r2["idle_share"] - (wait["t_end"] - wait["t"]) / span) <= 1e-4
 
 
 def test_a_deadlock_in_the_folder_exits_one_naming_robots_and_signals(tmp_path: Path, station: Path) -> None:
