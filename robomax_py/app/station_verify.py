@@ -25,8 +25,8 @@ def station_programs(station: StationSpec, given: list[Path]) -> list[dict[str, 
         sets = []
         for d in DIALECTS.values():
             # FANUC names its files after the program (CROSSING_R1.ls): the dialect's own name for it.
-            named = d.program_name or (lambda n: n)
-            found = {r: folder / f"{named(f'{station.name}_{r}')}{d.extensions[0]}" for r in robots}
+            stem = d.program_name or (lambda n: n)
+            found = {r: folder / f"{stem(f'{station.name}_{r}')}{d.extensions[0]}" for r in robots}
             if all(p.is_file() for p in found.values()):
                 sets.append(found)
         if not sets:

@@ -60,7 +60,7 @@ def test_the_planned_station_replays_as_planned(tmp_path: Path, planned: dict[st
 
 @pytest.mark.slow
 def test_without_the_wait_the_arms_touch(tmp_path: Path, planned: dict[str, str]) -> None:
-    srcl = {k: v for k, v in planned.items() if k.endswith(".srcl") or k.endswith(".station.json")}
+    srcl = {k: v for k, v in planned.items() if k.endswith((".srcl", ".station.json"))}
     waits = [line for line in srcl["crossing_r1.srcl"].splitlines() if line.strip().startswith("WAIT FOR")]
     assert waits, "the plan makes r1 wait"
     srcl["crossing_r1.srcl"] = "\n".join(line for line in srcl["crossing_r1.srcl"].splitlines()
