@@ -16,7 +16,7 @@ What is drawn, in the station's world frame, under `robomax/`:
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -35,6 +35,7 @@ from robomax_py.app.preview_drawing import (
     _mesh_geometry,
     _node_poses,
 )
+from robomax_py.app.preview_server import LOOPBACK
 from robomax_py.errors import ProgramError
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
@@ -178,6 +179,26 @@ def write_station_html(path: Path, robots: Sequence[ShownRobot], zones: Sequence
     return content
 
 
+def serve_station(robots: Sequence[ShownRobot], zones: Sequence[InterlockZone], announce: Callable[[str], None],
+                  fps: int = DEFAULT_FPS, host: str = LOOPBACK, port: int | None = None) -> None:
+    """Serve the station's preview (as `preview.serve` serves a cell's) until Ctrl-C."""
+    import time
+
+    from robomax_py.app.preview import _visualizer
+    from robomax_py.app.preview_process import _close
+
+    vis = _visualizer(host, port)
+    try:
+        populate_station(vis, robots, zones, fps)
+        announce(vis.url())
+        while True:
+            time.sleep(3600)
+    except KeyboardInterrupt:
+        return
+    finally:
+        _close(vis)
+
+
 def shown_station(station_file: Path, programs: Path) -> tuple[list[ShownRobot], tuple[InterlockZone, ...]]:
     """The robots of the first program set of the station in `programs` (a folder or one program;
     as `verify` finds them), each on the clock of the set's replay, and the zones of its
@@ -195,4 +216,4 @@ def shown_station(station_file: Path, programs: Path) -> tuple[list[ShownRobot],
 
 
 __all__ = ["InterlockZone", "ShownRobot", "StationPreviewContent", "populate_station", "read_zones",
-           "shown_station", "write_station_html"]
+           "serve_station", "shown_station", "write_station_html"]

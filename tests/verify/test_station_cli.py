@@ -99,9 +99,9 @@ def test_bad_input_exits_two(tmp_path: Path, station: Path, case: str) -> None:
     assert "Traceback" not in result.output
 
 
-def test_station_preview_needs_its_folder_and_html(tmp_path: Path, station: Path) -> None:
+def test_station_preview_needs_its_folder(tmp_path: Path, station: Path) -> None:
     result = runner.invoke(app, ["preview", str(station)])
-    assert result.exit_code == EXIT_BAD_INPUT and "--html" in result.output
+    assert result.exit_code == EXIT_BAD_INPUT and "output folder" in result.output
 
 
 @pytest.mark.slow
