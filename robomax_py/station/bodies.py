@@ -81,17 +81,22 @@ def _spheres(body: RobotBody, poses: FloatArray) -> FloatArray:
 
 
 def clash_map(a: RobotBody, poses_a: FloatArray, b: RobotBody, poses_b: FloatArray, margin: float,
-              prefilter: bool = True) -> BoolArray:
+              prefilter: bool = True, slack_a: FloatArray | None = None, slack_b: FloatArray | None = None
+              ) -> BoolArray:
     """(ka, kb) bool: True where robot a at sample i and robot b at sample j come closer than
-    `margin` (m) - any piece of one within `margin` of any piece of the other. `prefilter=False`
-    asks coal of every pair (the slow reference the tests hold the shortcut to)."""
+    `margin + slack_a[i] + slack_b[j]` (m; slacks default 0) - any piece of one within that of any
+    piece of the other. `prefilter=False` asks coal of every pair (the slow reference the tests
+    hold the shortcut to)."""
     ka, kb = len(poses_a), len(poses_b)
+    sa = np.zeros(ka) if slack_a is None else np.asarray(slack_a, dtype=float)
+    sb = np.zeros(kb) if slack_b is None else np.asarray(slack_b, dtype=float)
     out = np.zeros((ka, kb), dtype=bool)
     ca, cb = _spheres(a, poses_a), _spheres(b, poses_b)
     request = coal.CollisionRequest()
     request.security_margin = margin
     if not prefilter:
         for i, j in np.argwhere(np.ones((ka, kb), dtype=bool)):
+            request.security_margin = margin + sa[i] + sb[j]
             out[i, j] = any(_touch(a.pieces[u], poses_a[i, u], b.pieces[v], poses_b[j, v], request)
                             for u in range(len(a.pieces)) for v in range(len(b.pieces)))
         return out
@@ -105,27 +110,30 @@ def clash_map(a: RobotBody, poses_a: FloatArray, b: RobotBody, poses_b: FloatArr
     tf_a, tf_b = _transforms(poses_a), _transforms(poses_b)
     rows = max(1, (1 << 22) // max(kb, 1))
     pairs = np.concatenate([np.argwhere(_sq(Ca[r:r + rows, None, 0] - Cb[None, :, 0])
-                                        < (Ra[r:r + rows, None, 0] + Rb[None, :, 0] + margin) ** 2) + [r, 0]
+                                        < (Ra[r:r + rows, None, 0] + Rb[None, :, 0] + margin + sa[r:r + rows, None]
+                                           + sb[None, :]) ** 2) + [r, 0]
                             for r in range(0, ka, rows)] or [np.zeros((0, 2), dtype=int)])
     for start in range(0, len(pairs), CHUNK):
         chunk = pairs[start:start + CHUNK]
+        m = (margin + sa[chunk[:, 0]] + sb[chunk[:, 1]])[:, None, None]
         links = _sq(La[chunk[:, 0], :, None] - Lb[chunk[:, 1], None, :]) \
-            < (RLa[chunk[:, 0], :, None] + RLb[chunk[:, 1], None, :] + margin) ** 2
-        chunk = chunk[links.any(axis=(1, 2))]
-        links = links[links.any(axis=(1, 2))]
+            < (RLa[chunk[:, 0], :, None] + RLb[chunk[:, 1], None, :] + m) ** 2
+        keep = links.any(axis=(1, 2))
+        chunk, links, m = chunk[keep], links[keep], m[keep]
         if not len(chunk):
             continue
         d2 = _sq(ca[chunk[:, 0], :, None] - cb[chunk[:, 1], None, :])
-        reach = (a.radius[None, :, None] + b.radius[None, None, :] + margin)
+        reach = (a.radius[None, :, None] + b.radius[None, None, :] + m)
         close = (d2 < reach ** 2) & links[:, ga][:, :, gb]
         k, pa, pb = np.nonzero(close)
         if not len(k):
             continue
-        order = np.lexsort((d2[k, pa, pb] - reach[0, pa, pb] ** 2, k))   # per sample pair, the nearest first
+        order = np.lexsort((d2[k, pa, pb] - reach[k, pa, pb] ** 2, k))   # per sample pair, the nearest first
         k, pa, pb = k[order], pa[order], pb[order]
         bounds = np.flatnonzero(np.diff(k)) + 1
         for first, stop in zip(np.r_[0, bounds].tolist(), np.r_[bounds, len(k)].tolist(), strict=True):
             i, j = chunk[k[first]].tolist()
+            request.security_margin = float(m[k[first], 0, 0])
             for u, v in zip(pa[first:stop].tolist(), pb[first:stop].tolist(), strict=True):
                 result = coal.CollisionResult()
                 if coal.collide(a.pieces[u], tf_a(i, u), b.pieces[v], tf_b(j, v), request, result):
@@ -166,6 +174,21 @@ def _groups(centres: FloatArray, radius: FloatArray, group: np.ndarray) -> tuple
     R = np.stack([(np.linalg.norm(centres[:, group == g] - C[:, g, None], axis=2) + radius[group == g]).max(axis=1)
                   for g in range(n)], axis=1)
     return C, R
+
+
+def sample_steps(body: RobotBody, poses: FloatArray) -> FloatArray:
+    """(k,) the farthest any point of any piece moves between sample i and its neighbours (i - 1,
+    i + 1), bounded as `sample_step` bounds it, m: between samples a piece is within half of this
+    of the nearest sample."""
+    if len(poses) < 2:
+        return np.zeros(len(poses))
+    c = _spheres(body, poses)
+    shift = np.linalg.norm(np.diff(c, axis=0), axis=2)
+    R0, R1 = poses[:-1, :, :3, :3], poses[1:, :, :3, :3]
+    angle = np.arccos(np.clip((np.einsum("kpij,kpij->kp", R0, R1) - 1.0) / 2.0, -1.0, 1.0))
+    step = (shift + angle * body.radius).max(axis=1)
+    out: FloatArray = np.maximum(np.r_[step, 0.0], np.r_[0.0, step])
+    return out
 
 
 def sample_step(body: RobotBody, poses: FloatArray) -> float:

@@ -27,7 +27,7 @@ from robomax_py.station.bodies import (
     body_poses,
     clash_map,
     robot_body,
-    sample_step,
+    sample_steps,
 )
 from robomax_py.station.coordinate import Coordination, PairMap, Timeline, coordinate
 from robomax_py.station.reach import RobotReach, robot_reach
@@ -79,7 +79,7 @@ class StationPlan:
     bound: LowerBound
     coordination: Coordination | None
     seconds: Mapping[str, float]
-    margin: float = 0.0          # m kept between robots on the diagrams
+    margin: float = 0.0          # m kept between robots on the diagrams, at most (where both move fastest)
     rounds: int = 0              # re-assignments tried
 
     @property
@@ -180,16 +180,18 @@ def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Map
         timelines.append(_timeline(p))
         samples[p.robot] = _samples(p, options.dt)
     poses = {name: body_poses(bodies[name], qs) for name, qs in samples.items()}
-    steps = {name: sample_step(bodies[name], poses[name]) for name in poses}
+    # Each sample stands for the motion half a step either side of it: the margin there grows by
+    # half the farthest any point moves to its neighbours (slow near welds, fast between).
+    halves = {name: sample_steps(bodies[name], poses[name]) / 2 for name in poses}
     clearance = max(r.cell.process.clearance for r in station.robots)
     pairs = []
     margin = 0.0
     names = [p.robot for p in plans]
     for i, a in enumerate(names):
         for b in names[i + 1:]:
-            m = clearance + (steps[a] + steps[b]) / 2
-            margin = max(margin, m)
-            pairs.append(PairMap(a, b, options.dt, clash_map(bodies[a], poses[a], bodies[b], poses[b], m)))
+            margin = max(margin, clearance + float(halves[a].max(initial=0.0)) + float(halves[b].max(initial=0.0)))
+            pairs.append(PairMap(a, b, options.dt, clash_map(bodies[a], poses[a], bodies[b], poses[b], clearance,
+                                                             slack_a=halves[a], slack_b=halves[b])))
     clock["clash maps"] = clock.get("clash maps", 0.0) + time.process_time() - t0
     t0 = time.process_time()
     done = coordinate(timelines, pairs, fcfs=options.method == "nearest")

@@ -11,6 +11,7 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.plan.candidates import seam_candidates
+from robomax_py.plan.reach import reach_report
 from robomax_py.robot import RobotModel
 from robomax_py.spec_station import SpotKey, StationSpec, robot_view
 from robomax_py.world.collision import CollisionWorld
@@ -52,11 +53,14 @@ class RobotReach:
 
 def robot_reach(station: StationSpec, name: str, model: RobotModel) -> RobotReach:
     """The candidates of every spot robot `name` may weld, found as the single-robot planner finds them."""
-    cell = robot_view(station, name, station.allowed(name))
+    allowed = station.allowed(name)
+    # Spots beyond the arm's reach at every orientation (plan.reach, a few ms) need no candidates.
+    far = {(r.seam, r.name) for r in reach_report(robot_view(station, name, allowed), model) if not r.reachable}
+    cell = robot_view(station, name, [k for k in allowed if k not in far])
     world = CollisionWorld(model, build_scene(cell, model), cell.process.clearance)
     home = np.asarray(cell.home, dtype=float)
     keys: list[SpotKey] = []
-    unreachable: list[SpotKey] = []
+    unreachable: list[SpotKey] = [k for k in allowed if k in far]
     reps, lo, hi, dwell = [], [], [], []
     for s, seam in enumerate(cell.seams):
         found, _ = seam_candidates(cell, model, world, s)

@@ -54,3 +54,17 @@ def test_sample_step_bounds_how_far_points_move(bodies) -> None:  # type: ignore
     step = sample_step(a, poses)
     moved = np.linalg.norm(poses[1, :, :3, 3] - poses[0, :, :3, 3], axis=1).max()
     assert step >= moved
+
+
+def test_prefiltered_equals_every_pair_with_slacks(bodies) -> None:  # type: ignore[no-untyped-def]
+    a, b = bodies
+    rng = np.random.default_rng(11)
+    lim = a.robot.limits
+    qa = rng.uniform(lim.lower, lim.upper, (12, a.robot.dof))
+    qb = rng.uniform(lim.lower, lim.upper, (12, b.robot.dof))
+    pa, pb = body_poses(a, qa), body_poses(b, qb)
+    sa, sb = rng.uniform(0, 0.1, 12), rng.uniform(0, 0.1, 12)
+    fast = clash_map(a, pa, b, pb, 0.01, slack_a=sa, slack_b=sb)
+    exact = clash_map(a, pa, b, pb, 0.01, prefilter=False, slack_a=sa, slack_b=sb)
+    assert 0 < exact.sum() < exact.size
+    np.testing.assert_array_equal(fast, exact)
