@@ -6,7 +6,9 @@ alone (`export.rebuild`), the waits for and settings of signals between robots a
 replays them on one clock (`replay`: a wait holds the robot until another robot's program has set
 the signal; a clamp's input that no robot sets counts as set, as a lone program's verify takes it);
 poses every pair of robots at the same moments (`world.robot_pairs`, coal: links and tools) on
-every sample time of any robot's motion on the station clock (<= 10 ms apart); and reports, as
+every sample time of any robot's motion on the station clock (<= 10 ms apart) and sweeps them
+between those (linear in joint space, as a trajectory's samples are taken; every contact deeper
+than the collision world's 2 mm step is found); and reports, as
 typed values: contacts between robots (each stretch of contact of a pair, with when it starts and
 ends and the pieces that touch first), each program's own violations (its lone verify: cell
 objects, limits, spots, home), and robots that wait forever (a deadlock: each waits for a signal
@@ -27,6 +29,7 @@ from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
+from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.verify import VerifyReport, read_program_files, verify_read
 from robomax_py.verify_station.replay import Hold, Stuck, replay
 from robomax_py.verify_station.timeline import (
@@ -35,6 +38,9 @@ from robomax_py.verify_station.timeline import (
     station_motion,
     timeline,
 )
+
+# Between samples, a contact shallower than this may pass (the collision world's swept bound).
+SWEEP_STEP_M = TOL.sweep_step_m
 
 __all__ = ["Activity", "Hold", "MemberReport", "RobotCollision", "StationMember", "StationReport", "Stuck",
            "verify_station"]
@@ -167,26 +173,40 @@ def _grid(motions: list[StationMotion], until: float) -> FloatArray:
 
 def _collisions(bodies: dict[str, Any], motions: dict[str, StationMotion], grid: FloatArray,
                 margin: float) -> list[RobotCollision]:
-    """Each stretch of contact of each pair of robots, on the grid's times."""
-    from robomax_py.world.robot_pairs import robots_contact
+    """Each stretch of contact of each pair of robots: posed at the grid's times, and between two
+    times where they are apart swept as both move (linearly in joint space between samples, as the
+    trajectory file's motion is taken), to `SWEEP_STEP_M`."""
+    from robomax_py.world.robot_pairs import robots_contact, swept_contact
 
     names = list(motions)
     qs = {n: motions[n].at(grid) for n in names}
     out: list[RobotCollision] = []
     for i, a in enumerate(names):
         for b in names[i + 1:]:
-            open_: tuple[float, str, str] | None = None
-            last = 0.0
-            for k, t in enumerate(grid):
-                contact = robots_contact(bodies[a], qs[a][k], bodies[b], qs[b][k], margin)
-                if contact is not None and open_ is None:
-                    open_ = (float(t), contact.piece_a, contact.piece_b)
-                elif contact is None and open_ is not None:
-                    out.append(RobotCollision(a, b, open_[0], last, open_[1], open_[2]))
-                    open_ = None
-                last = float(t)
-            if open_ is not None:
-                out.append(RobotCollision(a, b, open_[0], last, open_[1], open_[2]))
+            ba, bb, qa, qb = bodies[a], bodies[b], qs[a], qs[b]
+            hits = [robots_contact(ba, qa[k], bb, qb[k], margin) for k in range(len(grid))]
+            found: list[tuple[float, Any]] = [(float(t), h) for t, h in zip(grid, hits)]
+            for k in range(len(grid) - 1):
+                if hits[k] is None and hits[k + 1] is None:
+                    inner = swept_contact(ba, (qa[k], qa[k + 1]), bb, (qb[k], qb[k + 1]), margin, SWEEP_STEP_M)
+                    if inner is not None:
+                        found.append((float(grid[k] + inner[0] * (grid[k + 1] - grid[k])), inner[1]))
+            out += _stretches(a, b, sorted(found, key=lambda x: x[0]))
     return out
 
 
+def _stretches(a: str, b: str, found: list[tuple[float, Any]]) -> list[RobotCollision]:
+    """The stretches of contact in time-ordered (t, contact or None)."""
+    out: list[RobotCollision] = []
+    open_: tuple[float, str, str] | None = None
+    last = 0.0
+    for t, contact in found:
+        if contact is not None and open_ is None:
+            open_ = (t, contact.piece_a, contact.piece_b)
+        elif contact is None and open_ is not None:
+            out.append(RobotCollision(a, b, open_[0], last, open_[1], open_[2]))
+            open_ = None
+        last = t
+    if open_ is not None:
+        out.append(RobotCollision(a, b, open_[0], last, open_[1], open_[2]))
+    return out

@@ -20,6 +20,7 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray
 from robomax_py.robot import RobotModel
+from robomax_py.world.bounds import KinematicBounds
 from robomax_py.world.scene import Scene
 
 
@@ -35,6 +36,8 @@ class RobotBody:
     labels : a name per piece ("link_3_1", "tool_body[2]").
     local_boxes : (n, 2, 3) the pieces' local axis-aligned boxes (min, max), m.
     T_world_base : (4, 4) the robot base in the station's world.
+    lever : (nq,) m/rad (m/m prismatic): how far any of its points moves per unit of each joint at
+        most (`world.bounds`), for checks between two poses.
     """
 
     name: str
@@ -45,6 +48,7 @@ class RobotBody:
     labels: tuple[str, ...]
     local_boxes: FloatArray
     T_world_base: FloatArray
+    lever: FloatArray
 
 
 @dataclass(frozen=True, slots=True)
@@ -73,13 +77,17 @@ def robot_body(name: str, robot: RobotModel, scene: Scene) -> RobotBody:
             joints.append(int(flange.parentJoint))
             placements.append(np.asarray(flange.placement.homogeneous, dtype=float))
             labels.append(f"{kind}[{i}]")
+    gm = pin.GeometryModel()
+    for k, (geom, joint, T) in enumerate(zip(geoms, joints, placements)):
+        gm.addGeometryObject(pin.GeometryObject(labels[k], joint, 0, pin.SE3(T), geom))
+    lever = KinematicBounds.of(robot.model).lever_arms(gm, [True] * len(geoms))
     boxes = []
     for geom in geoms:
         geom.computeLocalAABB()
         box = geom.aabb_local
         boxes.append([np.asarray(box.min_, dtype=float), np.asarray(box.max_, dtype=float)])
     return RobotBody(name, robot.model, tuple(geoms), tuple(joints), np.asarray(placements),
-                     tuple(labels), np.asarray(boxes), np.asarray(scene.T_world_base, dtype=float))
+                     tuple(labels), np.asarray(boxes), np.asarray(scene.T_world_base, dtype=float), lever)
 
 
 def piece_poses(body: RobotBody, q: FloatArray) -> FloatArray:
@@ -118,4 +126,30 @@ def robots_contact(a: RobotBody, qa: FloatArray, b: RobotBody, qb: FloatArray,
         tb = coal.Transform3s(pb[j, :3, :3], pb[j, :3, 3])
         if coal.collide(a.geometries[i], ta, b.geometries[j], tb, request, result):
             return RobotContact(a.labels[i], b.labels[j])
+    return None
+
+
+def swept_contact(a: RobotBody, qa: tuple[FloatArray, FloatArray], b: RobotBody, qb: tuple[FloatArray, FloatArray],
+                  margin: float, step: float) -> tuple[float, RobotContact] | None:
+    """A contact while both robots move linearly in joint space from their first to their second
+    joint values (the two ends apart), as the fraction of the way (0..1) where it is found; None
+    when they stay apart except perhaps for contacts shallower than `step` m. Halves the move
+    while the midpoint's poses, grown by how far any point of either robot can be from them over
+    the half-moves (`lever` times the joint change, halved), touch."""
+    stack = [(0.0, 1.0)]
+    while stack:
+        s0, s1 = stack.pop()
+        qa0, qa1 = (qa[0] + s0 * (qa[1] - qa[0]), qa[0] + s1 * (qa[1] - qa[0]))
+        qb0, qb1 = (qb[0] + s0 * (qb[1] - qb[0]), qb[0] + s1 * (qb[1] - qb[0]))
+        reach = 0.5 * (float(a.lever @ np.abs(qa1 - qa0)) + float(b.lever @ np.abs(qb1 - qb0)))
+        if reach <= step:
+            continue
+        sm = 0.5 * (s0 + s1)
+        qam, qbm = 0.5 * (qa0 + qa1), 0.5 * (qb0 + qb1)
+        if robots_contact(a, qam, b, qbm, margin + reach) is None:
+            continue
+        contact = robots_contact(a, qam, b, qbm, margin)
+        if contact is not None:
+            return sm, contact
+        stack += [(sm, s1), (s0, sm)]          # the earlier half first
     return None

@@ -96,3 +96,26 @@ def test_a_margin_counts_near_as_touching(bodies: dict[str, Any]) -> None:
     assert gap > 0.1 and robots_contact(a, home, b, home) is None
     assert robots_contact(a, home, b, home, margin=gap + 0.01) is not None
     assert robots_contact(a, home, b, home, margin=gap - 0.01) is None
+
+
+def test_a_contact_between_two_free_poses_is_found_by_the_sweep(bodies: dict[str, Any]) -> None:
+    """r1 swings A1 through r2's arm in one step: apart at both ends, touching on the way, where a
+    dense scan of the same joint-space line (0.1 % steps) first touches."""
+    from robomax_py.world.robot_pairs import swept_contact
+
+    a, b = bodies["r1"], bodies["r2"]
+    zone = np.radians(np.asarray(ZONE_DEG))
+    qb = zone + np.radians([0, 8, 0, 0, 0, 0])         # r2 leans into the zone
+    qa0, qa1 = zone + np.radians([-70, 8, 0, 0, 0, 0]), zone + np.radians([70, 8, 0, 0, 0, 0])
+    assert robots_contact(a, qa0, b, qb) is None and robots_contact(a, qa1, b, qb) is None
+    dense = [s for s in np.linspace(0.0, 1.0, 1001) if robots_contact(a, qa0 + s * (qa1 - qa0), b, qb) is not None]
+    assert dense, "the swing must pass through r2"
+    found = swept_contact(a, (qa0, qa1), b, (qb, qb), 0.0, 0.002)
+    assert found is not None
+    s, _ = found
+    assert min(dense) - 1e-3 <= s <= max(dense) + 1e-3
+    assert robots_contact(a, qa0 + s * (qa1 - qa0), b, qb) is not None
+    # r2 turned away (A1 120 deg): the same swing touches nothing on the dense scan, nor in the sweep.
+    away = np.radians([120.0, -90.0, 90.0, 0.0, 0.0, 0.0])
+    assert not [s for s in np.linspace(0.0, 1.0, 1001) if robots_contact(a, qa0 + s * (qa1 - qa0), b, away)]
+    assert swept_contact(a, (qa0, qa1), b, (away, away), 0.0, 0.002) is None
