@@ -277,6 +277,18 @@ class WaitFor:
 
 
 @dataclass(frozen=True, slots=True)
+class SetSignal:
+    """Switch an output: the cell's signal `signal` on (`value` True) or off, on the controller's
+    output `number` (KUKA $OUT, FANUC DO, UR standard digital output); None where the program names
+    the signal only (SRCL, RAPID's named signals). Robots of a station tell each other with it that
+    a shared zone is clear: another robot's `WaitFor` of the same signal name waits for it."""
+
+    signal: str
+    number: int | None
+    value: bool
+
+
+@dataclass(frozen=True, slots=True)
 class Comment:
     """A line of text for the reader; surrounding whitespace is stripped."""
 
@@ -286,7 +298,7 @@ class Comment:
         _set(self, "text", str(self.text).strip())
 
 
-Instruction: TypeAlias = PtpMove | LinMove | Spot | Gripper | Wait | WaitFor | Comment
+Instruction: TypeAlias = PtpMove | LinMove | Spot | Gripper | Wait | WaitFor | SetSignal | Comment
 
 
 @dataclass(frozen=True, slots=True)

@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, cast
 
@@ -103,23 +104,31 @@ def file_names(name: str, files: dict[str, str]) -> dict[str, str]:
 
 
 def publish(result: PlanResult, cell: CellSpec, robot: RobotModel, formats: tuple[str, ...], *,
-            stamp: str = "", method: str = "optimised") -> tuple[dict[str, str], list[CheckedProgram]]:
+            stamp: str = "", method: str = "optimised",
+            edit: Callable[[PlannedProgram], PlannedProgram] | None = None,
+            station: frozenset[str] | None = None) -> tuple[dict[str, str], list[CheckedProgram]]:
     """Every file of a planned result (the trajectory file first, then each format's files), all
     proven; ExportError when any is not.
 
     method : the plan's method; a baseline's files are named `<cell>_published.*` or
         `<cell>_teach_in.*` (`method_suffix`), so that a baseline run never replaces the optimised
         program.
+    edit : a change to the dialect-free program before any dialect writes it (a station's
+        interlocks: statements that take no time in the program's own motion).
+    station : the signals the robots of a station set for each other; the proof then reads a wait
+        for one of them as taking no time (the station replay times it), as `rebuild` does.
     """
     for fmt in formats:                          # before any dialect is proven: one clear message
         require_calibration(fmt, robot)
     name = result.cell + method_suffix(method)
     files = {f"{name}.json": render_trajectory(result)}
     planned = planned_program(result, cell.digest, stamp)
+    if edit is not None:
+        planned = edit(planned)
     checked = []
     reference: list[PlannedPath] = []            # made once, by the first dialect that needs it
     for fmt in formats:
-        one = _checked(fmt, planned, result, cell, robot, name, reference)
+        one = _checked(fmt, planned, result, cell, robot, name, reference, station)
         for file_name in one.files:
             if file_name in files and files[file_name] != one.files[file_name]:
                 raise ExportError(f"two formats write {file_name} with different contents")
@@ -129,7 +138,7 @@ def publish(result: PlanResult, cell: CellSpec, robot: RobotModel, formats: tupl
 
 
 def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSpec, robot: RobotModel,
-             name: str, reference: list[PlannedPath]) -> CheckedProgram:
+             name: str, reference: list[PlannedPath], station: frozenset[str] | None = None) -> CheckedProgram:
     dialect = DIALECTS[fmt]
     t0 = time.process_time()
     if name != result.cell:
@@ -159,7 +168,7 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
     _same_program(fmt, main, adapted, parsed)
     read = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
     rebuilt = rebuild(read, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
-                      controller=bool(dialect.brand))
+                      controller=bool(dialect.brand), station=station)
     if rebuilt.problems or rebuilt.trajectory is None:
         p = rebuilt.problems[0] if rebuilt.problems else None
         where = f"line {p.line}: " if p and p.line else ""

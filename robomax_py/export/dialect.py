@@ -30,6 +30,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     WaitFor,
 )
@@ -177,6 +178,21 @@ def numbered_inputs(program: Program, dialect: str, low: int, high: int) -> None
                                             "number: map the signal to the controller's input")
         if not low <= ins.number <= high:
             raise ControllerSetupError(key, f"input {ins.number} is outside {dialect}'s inputs {low}..{high}")
+
+
+def numbered_outputs(program: Program, dialect: str, low: int, high: int) -> None:
+    """Every set signal names a controller output in [low, high]: ControllerSetupError otherwise,
+    naming the cell key `robot.controller.outputs.<signal>` (a dialect that sets outputs by
+    number cannot guess one)."""
+    for ins in program.instructions:
+        if not isinstance(ins, SetSignal):
+            continue
+        key = f"robot.controller.outputs.{ins.signal}"
+        if ins.number is None:
+            raise ControllerSetupError(key, f"the program sets signal {ins.signal}; {dialect} sets an output "
+                                            "number: map the signal to the controller's output")
+        if not low <= ins.number <= high:
+            raise ControllerSetupError(key, f"output {ins.number} is outside {dialect}'s outputs {low}..{high}")
 
 
 def with_package_welds(program: Program, dialect: str) -> Program:

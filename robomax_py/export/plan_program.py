@@ -38,6 +38,7 @@ from robomax_py.program import (
     Program,
     ProgramSetup,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -211,3 +212,15 @@ def _wait(w: WaitPlan, setup: ControllerSetup) -> list[Instruction]:
     return [note, Wait(w.seconds)]
 
 
+def set_signal(signal: str, setup: ControllerSetup, value: bool = True) -> SetSignal:
+    """A station's interlock: the robot sets `signal` for the other robots (on when it has left
+    their shared zone), on the output the cell maps it to (`robot.controller.outputs`; none:
+    named only, as SRCL and RAPID set it)."""
+    mapped = setup.output_of(signal)
+    return SetSignal(identifier(signal), None if mapped is None else mapped.number, value)
+
+
+def wait_for(signal: str, setup: ControllerSetup) -> WaitFor:
+    """A wait for a signal (another robot's interlock, a clamp's, a door's), on the input the cell
+    maps it to (none: named only)."""
+    return _wait_for(signal, setup)

@@ -37,6 +37,7 @@ SMOKE: dict[str, list[str]] = {
     "bench_pick_place.py": ["--quick", "--out", OUT],
     "bench_plan.py": ["--runs", "1", "--resolutions", "20"],
     "bench_scale.py": ["--sizes", "8", "--families", "open", "--runs", "1"],
+    "bench_station.py": ["--quick"],
     "bench_startup.py": [SMALL, "--runs", "1"],
     "bench_table_ik.py": ["--quick", "--figures", OUT],
     "bench_tcp_detours.py": ["--quick", "--png", f"{OUT}/orientations.png"],

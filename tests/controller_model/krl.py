@@ -68,6 +68,7 @@ from .common import (
     Motion,
     MotionKind,
     ProgramRun,
+    SetOutput,
     Wait,
     Where,
     arg_value,
@@ -123,6 +124,8 @@ class _State:
     base_data: dict[int, FloatArray]
     variables: dict[str, _Value] = field(default_factory=dict)
     signals: dict[str, int] = field(default_factory=dict)
+    outputs: dict[str, int] = field(default_factory=dict)     # SIGNAL name -> $OUT number
+    continued: bool = False                                     # CONTINUE before this statement
     fdat: _Value | None = None
     events: list[Event] = field(default_factory=list)
     issues: list[Issue] = field(default_factory=list)
@@ -317,6 +320,8 @@ def _declaration(line: _Line, state: _State) -> bool:
     if sig:
         if sig.group(2).upper() == "IN" and not sig.group(4):
             state.signals[sig.group(1).upper()] = int(sig.group(3))
+        elif sig.group(2).upper() == "OUT" and not sig.group(4):
+            state.outputs[sig.group(1).upper()] = int(sig.group(3))
         return True
     m = _DECL_RE.match(code)
     if not m or not (m.group(1) or re.fullmatch(_DECL_TYPES, m.group(2), re.IGNORECASE)):
@@ -437,6 +442,18 @@ def _execute(line: _Line, state: _State, moving: set[str]) -> None:
     if not code:
         return
     if _declaration(line, state) or _stored_frame(line, state):
+        return
+    if re.fullmatch(r"CONTINUE", code, re.IGNORECASE):
+        state.continued = True
+        return
+    continued, state.continued = state.continued, False
+    out = re.fullmatch(r"(\$OUT\s*\[\s*(\d+)\s*\]|\w+)\s*=\s*(TRUE|FALSE)", code, re.IGNORECASE)
+    if out and (out.group(2) or _name(out.group(1)) in state.outputs):
+        # KSS: an output assignment stops the advance run unless CONTINUE precedes it (the OUT
+        # inline form's CONT), so it is set once the motion before it has ended.
+        number = int(out.group(2)) if out.group(2) else state.outputs[_name(out.group(1))]
+        state.events.append(SetOutput(line.where, out.group(1), number, out.group(3).upper() == "TRUE",
+                                      after_stop=not continued))
         return
     if _spline(line, state):
         return

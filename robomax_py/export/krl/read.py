@@ -32,6 +32,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Wait,
     WaitFor,
 )
@@ -48,6 +49,8 @@ class _Reader(_DataReader):
         name, var, number = tree.children
         if str(var).upper() == "$IN":
             self.inputs[str(name).upper()] = int(float(str(number)))
+        elif str(var).upper() == "$OUT":
+            self.outputs[int(float(str(number)))] = str(name)
 
     def declare_frame(self, name: str, kind: str, node: Tree[Token], line: int, number: int = 0) -> None:
         """A frame's value as the program states it (missing components are 0, as in $NULLFRAME)."""
@@ -74,6 +77,9 @@ class _Reader(_DataReader):
         index = next((int(float(t)) for t in toks[1:-1] if t.type == "NUMBER"), None)
         rhs = tree.children[-1]
         number = float(rhs) if isinstance(rhs, Token) and rhs.type == "NUMBER" else None
+        if var == "$OUT" and index is not None and isinstance(rhs, Token) and str(rhs).upper() in ("TRUE", "FALSE"):
+            self.add(SetSignal(self.outputs.get(index, f"OUT_{index}"), index, str(rhs).upper() == "TRUE"), line)
+            return
         if var in ("$TOOL", "$BASE"):
             kind = "tool" if var == "$TOOL" else "base"
             if isinstance(rhs, Tree) and rhs.data == "aggregate":

@@ -54,6 +54,7 @@ class _DataReader:
         self.tool, self.base = UNSET_FRAME, UNSET_FRAME    # in force: names of frames
         self.external_tcp = False              # $IPO_MODE = #TCP
         self.inputs: dict[str, int] = {}       # SIGNAL name -> $IN number
+        self.outputs: dict[int, str] = {}      # $OUT number -> its SIGNAL name
         self.vel_axis = [100.0] * 6            # %
         self.acc_axis = [100.0] * 6            # %
         self.vel_cp = DEF_VEL_CP_M_S           # m/s, KSS default $VEL.CP

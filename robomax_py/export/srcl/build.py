@@ -21,6 +21,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -163,4 +164,9 @@ class _Builder:
             (signal,) = self.tokens(tree, "IDENT")
             number = self.tokens(tree, "NUMBER")
             return WaitFor(str(signal), self.whole(number[0], 0) if number else None)
+        if tree.data == "set_signal":
+            (signal,) = self.tokens(tree, "IDENT")
+            number = self.tokens(tree, "NUMBER")
+            on = any(isinstance(c, Tree) and c.data == "set_on" for c in tree.children)
+            return SetSignal(str(signal), self.whole(number[0], 0) if number else None, on)
         return Comment(self.note(tree))
