@@ -178,12 +178,20 @@ def _lines_time(robot: RobotModel, limits: JointLimits, q_start: FloatArray, wri
         return None
 
 
-def choose(junction: Junction, variant: SplineVariant) -> tuple[Junction, CartesianChoice]:
-    """The faster of the junction as planned and its spline variant, and the choice stated."""
+def choose(junction: Junction, variant: SplineVariant, native: bool = True) -> tuple[Junction, CartesianChoice]:
+    """The faster of the junction as planned and its spline variant, and the choice stated.
+
+    `native`: the robot's own controller runs spline blocks (KUKA `SPLINE`). Where it does not,
+    its program runs the block as short lines flown by, which take longer than the spline
+    (`SplineMoves.lines_time`); the spline is then kept only where those lines beat the fly-by
+    too, so that the controller's own program is never slower than without splines."""
     flyby_time = sum(s.duration for s in junction.segments)
     if variant.moves is None:
         return junction, CartesianChoice("flyby", flyby_time, None, variant.problem)
     if variant.duration >= flyby_time:
         return junction, CartesianChoice("flyby", flyby_time, variant.duration, "slower")
+    lines = variant.moves.lines_time
+    if not native and (lines is None or lines >= flyby_time):
+        return junction, CartesianChoice("flyby", flyby_time, variant.duration, "slower as lines")
     chosen = Junction(variant.segments, 0.0, 0.0, junction.checks + variant.checks, spline=variant.moves)
     return chosen, CartesianChoice("spline", flyby_time, variant.duration)

@@ -129,7 +129,8 @@ def time_tour(
             settings = _spline_settings(cell, part, options, load)
             variant = spline_variant(robot, checked, robot.limits, q_start, waypoints, trans.kind, trans.label,
                                      before, after, settings, lin_targets, sum(s.duration for s in junction.segments))
-            junction, choice = choose(junction, variant)
+            # Only KUKA's controllers run a spline block (`Dialect.splines`); the others run its lines.
+            junction, choice = choose(junction, variant, native=robot.controller.brand == "kuka")
             return junction
 
         junction = timed(load)
