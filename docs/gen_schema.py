@@ -138,6 +138,7 @@ DESCRIPTIONS: dict[str, str] = {
     "PlannerFile.dynamic": "timed: plan round dynamic objects in time; rest: wait at rest for them.",
     "PlannerFile.max_wait": "Longest wait at one place a timed search may propose, s.",
     "PlannerFile.transfers": "Pick and place: moves plans carried moves as every move; associative by the associative-memory table, k-NN graph, Dijkstra route and Jacobian interpolation (docs/associative.md).",
+    "PlannerFile.cartesian_moves": "lin: approach, retract and detour lines as straight moves with fly-by; spline: a junction between two spots as one smooth Bézier TCP path, written as a spline block (KRL SPLINE, SRCL SPL) or short lines flown by, where that is faster (docs/bezier-paper.md).",
     "TendingFile.cycles": "How many times the sequence runs.",
     "TendingFile.gripper": "Seconds the gripper takes to close and to open.",
     "TendingFile.machines": "Machines whose doors close while they machine.",

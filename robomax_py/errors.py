@@ -73,3 +73,8 @@ class RobomaxWarning(UserWarning):
     """What the user should know that does not stop the work: a robot file's limits defaulted from its
     URDF, a dialect passed over. The CLI prints these as `warning:` lines; the Python API issues them
     with `warnings.warn`, so `warnings.simplefilter("error", RobomaxWarning)` makes them fatal."""
+
+
+class EventError(_LocatedError):
+    """A replanning event (`robomax replan --event`) is malformed or names nothing in the cell:
+    `key` is the option, `problem` says which event and what is wrong."""

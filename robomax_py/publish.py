@@ -42,6 +42,8 @@ from robomax_py.export.dialect import (
 )
 from robomax_py.export.plan_program import planned_program
 from robomax_py.export.rebuild import rebuild
+from robomax_py.export.spline_lines import as_lines as lines_for_splines
+from robomax_py.export.spline_lines import has_splines
 from robomax_py.plan import PlanResult, method_suffix
 from robomax_py.program import LinMove, Program, lin_pose
 from robomax_py.robot import RobotModel, fk_tcp
@@ -73,7 +75,12 @@ class MotionDifference:
     def identical(self) -> bool:
         return self.joint_deg == 0.0 and self.time_s == 0.0
 
-    def within(self) -> bool:
+    def within(self, cycle_s: float | None = None) -> bool:
+        """Within the rebuilt-motion tolerances; with `cycle_s` (the planned cycle, s), within
+        those of spline blocks written as lines (`export.spline_lines`)."""
+        if cycle_s is not None:
+            return (self.joint_deg <= TOL.spline_lines_joint_deg and self.tcp_mm <= TOL.spline_lines_mm
+                    and self.time_s <= TOL.spline_lines_time * cycle_s)
         return (self.joint_deg <= TOL.rebuilt_joint_deg and self.tcp_mm <= TOL.rebuilt_tcp_mm
                 and self.time_s <= TOL.rebuilt_time_s)
 
@@ -138,6 +145,9 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
         # A baseline program is named apart before the dialect names it its way.
         planned = dataclasses.replace(planned, program=dataclasses.replace(
             planned.program, name=planned.program.name + name[len(result.cell):]))
+    as_lines = has_splines(planned) and not dialect.splines
+    if as_lines:
+        planned = lines_for_splines(planned, robot)
     try:
         if dialect.brand:
             planned = in_controller_terms(planned, robot)
@@ -168,12 +178,14 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
     if not _same_samples(traj, rebuilt.trajectory) and not reference:
         reference.append(PlannedPath.of(traj, robot))
     diff = motion_difference(traj, rebuilt.trajectory, robot, reference[0] if reference else None)
-    if not diff.within():
+    if not diff.within(traj.duration if as_lines else None):
         line = rebuilt.line_at(diff.t_worst)
+        most = (f"{TOL.spline_lines_joint_deg} deg, {TOL.spline_lines_mm} mm, {TOL.spline_lines_time:.0%} of the cycle "
+                "with spline blocks as lines") if as_lines else \
+            f"{TOL.rebuilt_joint_deg} deg, {TOL.rebuilt_tcp_mm} mm, {TOL.rebuilt_time_s * 1000:.0f} ms"
         raise ExportError(
             f"{fmt}: the rebuilt motion differs from the planned one by {diff.joint_deg:.4f} deg, {diff.tcp_mm:.3f} mm, "
-            f"{diff.time_s * 1000:.1f} ms (at most {TOL.rebuilt_joint_deg} deg, {TOL.rebuilt_tcp_mm} mm, "
-            f"{TOL.rebuilt_time_s * 1000:.0f} ms){f', at line {line} of {main}' if line else ''}")
+            f"{diff.time_s * 1000:.1f} ms (at most {most}){f', at line {line} of {main}' if line else ''}")
     report = None
     if not diff.identical:
         report = verify_rebuilt(cell, robot, main, rebuilt, clearance=False)

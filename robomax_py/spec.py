@@ -307,6 +307,9 @@ class PlannerSpec:
     # Pick and place: carried moves planned as every move ("moves") or by Diane and Anikina's
     # associative memory, k-NN graph, Dijkstra route and Jacobian interpolation ("associative").
     transfers: str = "moves"
+    # "lin": approach, retract and detour lines as straight LIN moves with fly-by; "spline": a
+    # junction between two spots as one smooth Bézier TCP path where that is faster.
+    cartesian_moves: str = "lin"
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -376,6 +379,14 @@ class CellSpec:
     tcp_limits: TcpLimits | None = None       # pick-and-place cells: TCP limits without a part
     controller: ControllerSetup = field(default_factory=ControllerSetup)   # the integrator's numbers
     notices: tuple[Notice, ...] = ()          # probable mistakes found at load (`io.cell_lint`)
+    # A continuation (`robomax replan`): the configuration (n,) rad its program starts in, at rest,
+    # instead of `home`; it still ends at home. None: a whole program, from home to home.
+    start: FloatArray | None = None
+
+    @property
+    def q_start(self) -> FloatArray:
+        """Where the program starts: `start` for a continuation, else `home`."""
+        return self.home if self.start is None else self.start
 
     @property
     def signals(self) -> tuple[str, ...]:

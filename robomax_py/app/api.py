@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any, cast, overload
+from typing import TYPE_CHECKING, Any, cast, overload
 
 from robomax_py.errors import ExportError, RobomaxWarning
 from robomax_py.plan import (
@@ -39,10 +39,13 @@ from robomax_py.spec import CellSpec
 from robomax_py.verify import VerifyReport
 from robomax_py.world.motion import Violation
 
+if TYPE_CHECKING:
+    from robomax_py.app.replan import ReplanOutcome
+
 __all__ = [
     "CellWarning", "FailureReason", "FormatSkippedWarning", "LoadedCell", "PlanOptions", "PlanResult", "PlanStage", "PlanStatus",
     "ProgressEvent", "RobomaxWarning", "SpotFailure", "SpotPlan", "Transition", "TransitionKind", "VerifyReport",
-    "Violation", "WrittenPrograms", "load_cell", "plan_cell", "verify_program", "write_programs",
+    "Violation", "WrittenPrograms", "load_cell", "plan_cell", "replan_program", "verify_program", "write_programs",
 ]
 
 
@@ -217,6 +220,27 @@ def write_programs(cell: LoadedCell, result: PlanResult, out_dir: str | Path,
         trajectory=out / f"{name}.json",
         manifest=out / f"{name}{MANIFEST_SUFFIX}",
     )
+
+
+def replan_program(cell: LoadedCell, program: str | Path, at: float, events: Sequence[str],
+                   options: PlanOptions | None = None) -> ReplanOutcome:
+    """The continuation of a running program after its cell changed, as `robomax replan` plans it:
+    the robot stops on its planned path after `at` s (an action in progress completed), and the
+    work left is planned from there with `events` applied (the grammar of `--event`,
+    docs/cli.md); nothing is written.
+
+    The outcome's `cell` is the continuation's cell (events applied, its clock from the stop, its
+    `start` the stop configuration): write with
+    ``write_programs(LoadedCell(outcome.cell, cell.robot), outcome.result, out_dir)`` and verify
+    against that same cell. Bad input (an event, the program, a time outside it) raises a
+    `RobomaxError`; an infeasible continuation is `outcome.status == "infeasible"`, its
+    `message` naming the cause.
+    """
+    from robomax_py.app.replan import replan
+
+    if isinstance(events, str):
+        raise TypeError("events: expected a sequence of event strings, got one string")
+    return replan(cell.spec, cell.robot, Path(program), float(at), tuple(events), options or PlanOptions())
 
 
 def verify_program(cell: LoadedCell, path: str | Path) -> VerifyReport:

@@ -145,6 +145,9 @@ class Dialect:
     # controller's calibration data a program counts in (INFORM's encoder pulses per degree). A
     # dialect asked for by name on such a robot is an error; `--format all` passes it over and says so.
     needs: Callable[[RobotModel], tuple[tuple[str, str], ...]] = needs_nothing
+    # It states spline blocks (`LinMove.spline`: KRL SPLINE, SRCL SPL / SLIN); the others get a
+    # spline block as lines flown by (`spline_lines`).
+    splines: bool = False
     # Whether `--format all` takes it in (a dialect left out is written only when named).
     in_all: bool = True
 

@@ -327,6 +327,9 @@ class PlannerFile(_Strict):
     dynamic: Literal["timed", "rest"] = "timed"
     max_wait: Annotated[float, Field(gt=0, le=MAX_WINDOW_S, allow_inf_nan=False)] = 600.0
     transfers: Literal["moves", "associative"] = "moves"
+    # "spline": a junction's retract, move or detour and approach as one smooth Bézier TCP path
+    # (`plan.spline_junction`) where that is faster than the lines and joint moves with fly-by.
+    cartesian_moves: Literal["lin", "spline"] = "lin"
 
 
 # Tending cells (docs/cell-extensions.md, "Machine tending"): stations visited in a fixed order per cycle, machines

@@ -20,6 +20,7 @@ import numpy as np
 from robomax_py.plan.associative import associative_moves, pin_transfer_ends
 from robomax_py.plan.candidates import SpotCandidates, check_ik_work, seam_candidates
 from robomax_py.plan.graph import Sequencer
+from robomax_py.plan.lead_in import LeadInError, lead_in
 from robomax_py.plan.learned_detour import LearnedDetours
 from robomax_py.plan.loads import Loads, check_carried_motion
 from robomax_py.plan.results import (
@@ -80,6 +81,11 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
     home_contact = world.first_contact(cell.home)
     if home_contact is not None:
         return PlanResult(cell.name, robot.name, "infeasible", f"home is in collision: {home_contact.describe()}")
+    if cell.start is not None:
+        start_contact = full_world.first_contact(cell.start, 0.0)
+        if start_contact is not None:
+            return PlanResult(cell.name, robot.name, "infeasible",
+                              f"the stop configuration is in collision: {start_contact.describe()}")
 
     t0 = time.perf_counter()
     spots: list[SpotCandidates] = []
@@ -121,7 +127,9 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
 
     t0 = time.perf_counter()
     rng = np.random.default_rng(cell.planner.seed)
-    anchors = np.vstack([cell.home[None, :], *[c.q_app for c in spots]])
+    # A continuation's start (`cell.start`) is an anchor too: its first move may need a detour.
+    starts = [] if cell.start is None else [np.asarray(cell.start)[None, :]]
+    anchors = np.vstack([cell.home[None, :], *starts, *[c.q_app for c in spots]])
     roadmap = Roadmap(world, robot.limits, anchors, rng, options.roadmap_nodes, options.roadmap_k, seeds=anchors)
     clock["roadmap"] = time.perf_counter() - t0
     log.debug("roadmap: %d nodes in %.2f s", len(roadmap.nodes), clock["roadmap"])
@@ -183,7 +191,7 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
                       tool=cell.tool.name, T_flange_tcp=np.asarray(robot.T_flange_tcp),
                       T_world_base=np.asarray(cell.T_world_base),
                       T_root_controller=np.asarray(cell.robot.controller.T_root_base), controller=cell.controller,
-                      home=np.asarray(cell.home), options=options,
+                      home=np.asarray(cell.q_start), options=options,
                       weld_time=cell.process.weld_time, clearance=clearance, order=order_choice)
 
 
@@ -246,6 +254,8 @@ def _checked_timing(cell: CellSpec, robot: RobotModel, world: CollisionWorld, fu
         return _Timed(None, [], [], options, 0, 0.0, f"timing failed: {exc}")
     except WaitingError as exc:
         return _Timed(None, [], [], options, 0, 0.0, f"dynamic obstacles: {exc}")
+    except LeadInError as exc:
+        return _Timed(None, [], [], options, 0, 0.0, str(exc))
     t0 = time.perf_counter()
     progress("verify", 0, 1)
     verify_checks = 0
@@ -334,7 +344,10 @@ def _timed_tours(cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots
                  roadmap: Roadmap, loads: Loads | None = None) -> list[tuple[Trajectory, list[SpotPlan], list[Transition]]]:
     """The tour timed, best first. With dynamic objects planned in time (`planner.dynamic: timed`)
     it is also timed waiting at rest, shorter first: the time-aware choice is made junction by
-    junction, and an earlier arrival can meet a door that a later one would not."""
+    junction, and an earlier arrival can meet a door that a later one would not. A continuation
+    (`cell.start`) has its first move made again from its start (`plan.lead_in`)."""
+    if cell.start is not None:
+        transitions = lead_in(world, roadmap, np.asarray(cell.start), transitions)
     if not cell.dynamic or options.dynamic != "timed":
         return [time_tour(cell, robot, world, spots, tour, transitions, options, progress, roadmap, loads)]
     out = []

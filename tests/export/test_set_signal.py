@@ -63,12 +63,12 @@ def test_round_trip_and_golden(small: tuple[Any, Any], dialect: str, update_gold
     parsed = d.parse(texts, "station_r1" + d.extensions[0], robot)
     assert _signals(parsed.program) == READ_BACK[dialect]
     assert _signals(parsed.program) == _signals(adapted)
-    main = texts[d.extensions[0]]
-    golden = GOLDEN / f"station_r1{d.extensions[0]}"
-    if update_golden:
-        golden.parent.mkdir(parents=True, exist_ok=True)
-        golden.write_bytes(main.encode("utf-8"))
-    assert main.encode("utf-8") == golden.read_bytes()
+    for key, text in texts.items():         # the set: main file, companions, shared routines
+        golden = GOLDEN / (f"station_r1{key}" if key.startswith((".", "_")) else key)
+        if update_golden:
+            golden.parent.mkdir(parents=True, exist_ok=True)
+            golden.write_bytes(text.encode("utf-8"))
+        assert text.encode("utf-8") == golden.read_bytes(), golden.name
 
 
 STATEMENTS = {"krl": ("$OUT[3]=TRUE", "$OUT[3]=FALSE"), "rapid": ("SetDO doR1Z1, 1;", "SetDO doR1Z1, 0;"),
@@ -127,3 +127,45 @@ def test_rapid_set_and_reset_are_setdo(small: tuple[Any, Any]) -> None:
     parsed = d.parse({**mod, ".mod": text}, "station_r1.mod", robot)
     assert _signals(parsed.program)[1] == SetSignal("r1_z1_clear", None, True)
     assert any("SDelay" in t for _, t in parsed.ignored)
+
+
+def test_a_planned_interlock_takes_the_cells_output_number() -> None:
+    from robomax_py.export.plan_program import set_signal, wait_for
+
+    setup = ControllerSetup(inputs=(ControllerInput("r2_z1_clear", 2),), outputs=(ControllerOutput("r1_z1_clear", 3),))
+    assert set_signal("r1_z1_clear", setup) == SetSignal("r1_z1_clear", 3, True)
+    assert set_signal("r1_z1_clear", setup, False) == SetSignal("r1_z1_clear", 3, False)
+    assert set_signal("r9_z1_clear", setup) == SetSignal("r9_z1_clear", None, True)
+    assert wait_for("r2_z1_clear", setup) == WaitFor("r2_z1_clear", 2)
+
+
+@pytest.mark.parametrize(("dialect", "on", "off"), [("as", "SIGNAL 3 ; r1_z1_clear", "SIGNAL -3 ; r1_z1_clear"),
+                                                    ("inform", "DOUT OT#(3) ON", "DOUT OT#(3) OFF")])
+def test_as_and_inform_set_their_outputs(small: tuple[Any, Any], dialect: str, on: str, off: str) -> None:
+    """Kawasaki AS: BREAK (the program waits for the motion's end), then SIGNAL k / -k; Yaskawa
+    INFORM: DOUT OT#(k) ON / OFF after a PL=0 point. Read back to the same outputs."""
+    from tests.conftest import with_pulses
+
+    cell, robot = small
+    robot = with_pulses(robot)
+    d = DIALECTS[dialect]
+    adapted = d.adapt(_planned(cell, robot, (ControllerOutput("r1_z1_clear", 3),)), robot)
+    texts = d.write(adapted, robot)
+    lines = [line.strip() for line in texts[d.extensions[0]].splitlines()]
+    assert on in lines and off in lines
+    if dialect == "as":
+        assert lines[lines.index(on) - 1] == "BREAK"
+    parsed = d.parse({d.extensions[0]: texts[d.extensions[0]]}, "station_r1" + d.extensions[0], robot)
+    sets = [i for i in parsed.program.instructions if isinstance(i, SetSignal)]
+    assert [(s.number, s.value) for s in sets] == [(3, True), (3, False)]
+    with pytest.raises(ControllerSetupError, match="robot.controller.outputs.r1_z1_clear"):
+        d.adapt(_planned(cell, robot, (ControllerOutput("r1_z1_clear", 10000),), 10000), robot)
+
+
+def test_an_as_output_without_break_is_not_simulated(small: tuple[Any, Any]) -> None:
+    cell, robot = small
+    d = DIALECTS["as"]
+    text = d.write(d.adapt(_planned(cell, robot, (ControllerOutput("r1_z1_clear", 3),)), robot), robot)[".as"]
+    bare = text.replace("BREAK\r\n", "", 1).replace("  BREAK\r\n", "", 1)
+    parsed = d.parse({".as": bare}, "station_r1.as", robot)
+    assert any("without BREAK" in getattr(i, "text", "") for i in parsed.program.instructions)

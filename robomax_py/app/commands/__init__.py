@@ -8,6 +8,7 @@ registered in that order whichever module is imported first.
 from robomax_py.app.commands import (  # noqa: F401, I001
     checking,
     planning,
+    replanning,
     measuring,
     viewing,
     batches,

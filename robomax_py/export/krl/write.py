@@ -181,6 +181,23 @@ class _Writer:
                         f"APO_DIST {_real(apo)},APO_FAC 50.0000,AXIS_VEL 100.000,AXIS_ACC 100.000,ORI_TYP #VAR,"
                         "CIRC_TYP #BASE,JERK_FAC 50.0000,GEAR_JERK 50.0000,EXAX_IGN 0}")
 
+    def spline_point(self, ins: LinMove, tool: int, base: int, first: bool, last: bool) -> None:
+        """One segment of a spline block (KSS 8.x, Operating and Programming Instructions for
+        System Integrators, "Spline motion type": `SPLINE ... ENDSPLINE` with `SPL` points and
+        `SLIN` straight segments; `WITH $VEL.CP` the segment's path speed in m/s; without
+        `C_SPL` the block ends at an exact stop): the frames selected before the block, the
+        point declared in the .dat."""
+        self.n_point += 1
+        p = f"P{self.n_point}"
+        if first:
+            self.src += [f"$TOOL = TOOL_DATA[{tool}]", f"$BASE = BASE_DATA[{base}]" if base else "$BASE = $NULLFRAME",
+                         "SPLINE"]
+        word = "SLIN" if ins.spline == "slin" else "SPL"
+        self.src.append(f"  {word} X{p} WITH $VEL.CP = {_plain(ins.speed_mm_s / 1000.0, 6)}")
+        self.dat.append(f"DECL E6POS X{p}={_pose(ins)}")
+        if last:
+            self.src.append("ENDSPLINE")
+
     @staticmethod
     def fdat(p: str, tool: int, base: int) -> str:
         return f'DECL FDAT F{p}={{TOOL_NO {tool},BASE_NO {base},IPO_FRAME #BASE,POINT2[] " ",TQ_STATE FALSE}}'
@@ -236,10 +253,18 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     frames = iter(_frames_in_force(program))
     n_call = n_spot = 0
     grips: dict[str, int] = {}
+    moves = [i for i in program.instructions if isinstance(i, (PtpMove, LinMove))]
+    in_block = [isinstance(m, LinMove) and bool(m.spline) for m in moves]
+    k = -1
     for ins in program.instructions:
         if isinstance(ins, Comment):
             w.src.append(f"; {ins.text}" if ins.text else ";")
+        elif isinstance(ins, LinMove) and ins.spline:
+            k += 1
+            w.spline_point(ins, *next(frames), not (k > 0 and in_block[k - 1]),
+                           not (k + 1 < len(moves) and in_block[k + 1]))
         elif isinstance(ins, (PtpMove, LinMove)):
+            k += 1
             w.point(ins, *next(frames))
         elif isinstance(ins, Spot) and ins.package:
             n_spot += 1

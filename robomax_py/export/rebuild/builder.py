@@ -17,13 +17,22 @@ from robomax_py.export.rebuild.result import (
     FRAME_TOL_DEG,
     FRAME_TOL_MM,
     TCP_SPEED_TOL_MM_S,
-    WELD_TIME_TOL_S,
     Problem,
     Rebuilt,
     SignalEvent,
     Span,
 )
-from robomax_py.export.rebuild.signals import output_signal
+from robomax_py.export.rebuild.signals import (
+    input_signal,
+    output_signal,
+    unmapped_output,
+)
+from robomax_py.export.rebuild.spline_block import SplinePoint, add_point, in_block
+from robomax_py.export.rebuild.welds import (
+    schedule_problem,
+    schedule_time,
+    weld_time_problem,
+)
 from robomax_py.plan.waiting import clear_wait, signal_of
 from robomax_py.program import (
     NULL_FRAME,
@@ -150,8 +159,13 @@ class _Builder:
         self.spans: list[Span] = []
         self.waited: set[str] = set()                      # clamp inputs waited for so far
         self.after_action = False                          # a weld or gripper action since the last move
+        self.block: list[SplinePoint] = []                 # the spline block being read
         self.station = station                             # signals the robots of a station set
         self.events: list[SignalEvent] = []
+
+    def _problem(self, kind: str, detail: str | None) -> None:
+        if detail is not None:
+            self.problems.append(Problem(self.t, kind, detail, self.line))
 
     def result(self, traj: Trajectory | None) -> Rebuilt:
         return Rebuilt(traj, self.spots, self.problems, self.spans, self.events)
@@ -161,6 +175,8 @@ class _Builder:
         self.segments.append(dwell(self.q, 0.0, kind="wait", label="start"))
 
     def add(self, ins: Any, following: Any, index: int) -> bool:
+        if in_block(ins):
+            return add_point(self, ins, following, index)
         if isinstance(ins, (PtpMove, LinMove)):
             kind = self._kind(ins, following)
             self.after_action = False
@@ -192,10 +208,12 @@ class _Builder:
             if isinstance(ins, Spot):
                 self._check_interlocks(ins, label)
                 if not ins.package:
-                    self._check_weld_time(ins, label)
+                    self._problem("weld", weld_time_problem(self.cell, ins, label))
                 if ins.package:
-                    self._check_schedule(ins, label)
-                    ins = dataclasses.replace(ins, time_s=self._schedule_time(ins))
+                    self._problem("weld", schedule_problem(self.cell, ins, label))
+                    seconds, problem = schedule_time(self.cell, ins)
+                    self._problem("weld", problem)
+                    ins = dataclasses.replace(ins, time_s=seconds)
             self._check_action(ins, label)
             self.segments.append(dwell(self.q, ins.time_s, kind="weld", label=label))
             config = self.last_config or self.config_text(self.q)
@@ -248,24 +266,6 @@ class _Builder:
         if isinstance(ins, PtpMove):
             return dataclasses.replace(ins, speed=min(ins.speed, 1.0), accel=min(ins.accel, 1.0))
         return dataclasses.replace(ins, accel=min(ins.accel, 1.0))
-
-    def _check_weld_time(self, spot: Spot, label: str) -> None:
-        """A weld call's time is the cell's weld time of that spot (the weld routine rests or
-        welds that long: another time is another weld)."""
-        from robomax_py.export.plan_program import identifier
-
-        seam = next((s for s in self.cell.seams if identifier(s.name) == spot.seam), None)
-        spec = next((p for p in seam.spots if identifier(p.name) == spot.name), None) if seam else None
-        if spec is None or spec.action is not None:
-            return
-        want = self.cell.process.weld_time_of(spec)
-        if abs(spot.time_s - want) <= WELD_TIME_TOL_S:
-            return
-        hint = ""
-        if want > 0 and abs(spot.time_s / want - 1000.0) < 1.0:
-            hint = " (a thousand times: written in ms?)"
-        self.problems.append(Problem(self.t, "weld", f"{label}: the program welds {spot.time_s:.3f} s, the cell's weld "
-                                                     f"time is {want:.3f} s{hint}", self.line))
 
     def _step(self, ins: PtpMove, following: Any, index: int) -> Step:
         return PtpStep(ptp_target(ins), speed=ins.speed, accel=ins.accel, flyby=math.radians(ins.flyby),
@@ -367,36 +367,6 @@ class _Builder:
             self.spans.append(Span(self.t, self.t + seconds, self.line))
             self.t += seconds
 
-    def _schedule_time(self, ins: Spot) -> float:
-        """The weld time of a process-package weld: its gun and schedule's, as the cell's spots
-        with that schedule take it (the controller's schedule table holds one time each); 0 with a
-        problem when the cell has no spot of that schedule or several times for it."""
-        process = self.cell.process
-        times = {process.weld_time_of(spot) for seam in self.cell.seams for spot in seam.spots
-                 if process.gun == ins.gun and process.schedule_of(spot) == ins.schedule}
-        if len(times) != 1:
-            what = "no spot of the cell" if not times else f"the cell's spots {sorted(times)} s"
-            self.problems.append(Problem(self.t, "weld", f"gun {ins.gun} schedule {ins.schedule}: {what} gives its weld "
-                                                         "time", self.line))
-            return 0.0
-        return times.pop()
-
-    def _check_schedule(self, spot: Spot, label: str) -> None:
-        """A process-package weld names the gun and schedule the controller welds with: those of
-        the cell's spot (a weld time alone does not tell a schedule's current from another's)."""
-        from robomax_py.export.plan_program import identifier
-
-        seam = next((s for s in self.cell.seams if identifier(s.name) == spot.seam), None)
-        spec = next((p for p in seam.spots if identifier(p.name) == spot.name), None) if seam else None
-        if spec is None:
-            return
-        process = self.cell.process
-        want = (process.gun, process.schedule_of(spec))
-        if (spot.gun, spot.schedule) != want:
-            self.problems.append(Problem(self.t, "weld", f"{label}: the program welds with gun {spot.gun} schedule "
-                                                         f"{spot.schedule}, the cell with gun {want[0]} schedule "
-                                                         f"{want[1]}", self.line))
-
     def _check_action(self, ins: Spot | Gripper, label: str) -> None:
         """A tending station gets its gripper action, a weld spot a weld."""
         from robomax_py.export.plan_program import identifier
@@ -430,10 +400,7 @@ class _Builder:
         """An output set at rest: recorded for the station replay (no time here)."""
         signal = output_signal(self.cell, ins)
         if signal is None:
-            known = ", ".join(f"{o.number} ({o.signal})" for o in self.cell.controller.outputs) or "none mapped"
-            self.problems.append(Problem(self.t, "signal", f"the program sets output {ins.number}, which the cell "
-                                                           f"maps to no signal (robot.controller.outputs: {known})",
-                                         self.line))
+            self.problems.append(Problem(self.t, "signal", unmapped_output(self.cell, ins), self.line))
             return
         self.events.append(SignalEvent(self.t, "set", signal, ins.value, self.line))
 
@@ -442,21 +409,13 @@ class _Builder:
         knows numbers, not names); a wait by name, the cell signal of that name."""
         from robomax_py.export.plan_program import identifier
 
-        signal = ins.signal
-        if ins.number is not None:
-            mapped = next((i for i in self.cell.controller.inputs if i.number == ins.number), None)
-            if mapped is None:
-                known = ", ".join(f"{i.number} ({i.signal})" for i in self.cell.controller.inputs) or "none mapped"
-                self.problems.append(Problem(self.t, "signal", f"the program waits for input {ins.number}, which the "
-                                                               f"cell maps to no signal (robot.controller.inputs: {known})",
-                                             self.line))
-                return
-            signal = identifier(mapped.signal)
-        else:
-            # A name of the controller's I/O configuration the cell maps to one of its signals.
-            named = next((i for i in self.cell.controller.inputs if i.name and i.name.lower() == signal.lower()), None)
-            if named is not None:
-                signal = identifier(named.signal)
+        signal = input_signal(self.cell, ins)
+        if signal is None:
+            known = ", ".join(f"{i.number} ({i.signal})" for i in self.cell.controller.inputs) or "none mapped"
+            self.problems.append(Problem(self.t, "signal", f"the program waits for input {ins.number}, which the "
+                                                           f"cell maps to no signal (robot.controller.inputs: {known})",
+                                         self.line))
+            return
         if any(obj.signal and identifier(obj.signal) == signal for obj in self.cell.objects) and \
                 (self.station is None or signal not in self.station):
             self.waited.add(signal)           # a clamp input: set once the clamp is closed, no time planned

@@ -24,9 +24,11 @@ kind: "TOOL" -> tool_kind
 pos: "POS" "(" NUMBER "," NUMBER "," NUMBER ")"
 ori: "ORI" "(" NUMBER "," NUMBER "," NUMBER ")"
 
-_stmt: ptp | lin | spot | gripper | wait | wait_for | set_signal | note
+_stmt: ptp | lin | spl | slin | spot | gripper | wait | wait_for | set_signal | note
 ptp: "MOVE" "PTP" "AXIS" "(" NUMBER ("," NUMBER)* ")" "SPEED" NUMBER "ACCEL" NUMBER flyby? COMMENT? ";"
 lin: "MOVE" "LIN" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S ("ACCEL" NUMBER)? flyby? COMMENT? ";"
+spl: "MOVE" "SPL" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S ("ACCEL" NUMBER)? COMMENT? ";"
+slin: "MOVE" "SLIN" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S ("ACCEL" NUMBER)? COMMENT? ";"
 flyby: FLYBY NUMBER
 spot: "SPOT" IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ("GUN" NUMBER "SCHEDULE" NUMBER)? ";"
 gripper: (GRIP | RELEASE) IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ";"

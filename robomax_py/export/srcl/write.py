@@ -36,7 +36,7 @@ DIALECT = "robomax SRCL/1"
 # Upper-case keywords; they cannot be used as names (names are case-sensitive, so `spot` is a name).
 RESERVED: frozenset[str] = frozenset(
     ["PROGRAM", "CELL", "ROBOT", "AXES", "TOOL", "CYCLE", "SEC", "VAR", "FRAME", "BASE", "POS", "ORI", "BEGIN", "ENDPROGRAM", "MOVE", "PTP", "LIN", "AXIS", "SPEED", "ACCEL", "FLYBY", "CONFIG", "SPOT", "SEAM", "TIME", "WAIT", "FOR", "GUN", "SCHEDULE", "GRIP", "RELEASE", "INPUT",
-     "SET", "OUTPUT", "TRUE", "FALSE"]
+     "SET", "OUTPUT", "TRUE", "FALSE", "SPL", "SLIN"]
 )
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -129,7 +129,7 @@ def _statement(ins: Instruction) -> str:
         )
     if isinstance(ins, LinMove):
         return (
-            f"MOVE LIN {_pose(ins.position_mm, ins.zyx_deg)} CONFIG '{ins.config}' "
+            f"MOVE {ins.spline.upper() or 'LIN'} {_pose(ins.position_mm, ins.zyx_deg)} CONFIG '{ins.config}' "
             f"SPEED {_num(ins.speed_mm_s, SPEED_DECIMALS)} MM/S"
             + (f" ACCEL {_num(ins.accel, SPEED_DECIMALS)}" if ins.accel < 1.0 else "") + _tail(ins.flyby, ins.comment)
         )

@@ -1,0 +1,55 @@
+"""A continuation's first move: from where the robot stopped to the first stop of the rest.
+
+The sequencer plans every tour from home to home (`plan.sequence.HOME`, one configuration at both
+ends). A continuation (`CellSpec.start`, `robomax replan`) starts elsewhere: its tour is sequenced
+as usual and its first transition, home to the first approach point, is then made again from the
+start: the straight joint move where it is free of the static obstacles, else a path through the
+plan's roadmap (whose anchors include the start). The order and the candidates were chosen for a
+start at home; on the ordered jobs that replanning serves (a tending cycle's station visits) only
+the candidate of the first stop could differ, and it is still a valid one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from robomax_py.errors import RobomaxError
+from robomax_py.plan.results import Transition
+from robomax_py.plan.roadmap import Roadmap
+from robomax_py.program import as_written_joints
+from robomax_py.world.collision import CollisionWorld
+
+# The first move of a continuation is labelled `stop -> <first stop>` (a whole program's: `home -> ...`).
+START_LABEL = "stop"
+
+
+class LeadInError(RobomaxError):
+    """No collision-free way from the start of a continuation to its first stop."""
+
+
+def lead_in(world: CollisionWorld, roadmap: Roadmap | None, start: np.ndarray,
+            transitions: list[Transition]) -> list[Transition]:
+    """The transitions with the first one starting at `start` (n,) rad instead of home.
+
+    world : the static obstacles (the plan's world); roadmap : the plan's detour roadmap.
+    LeadInError when neither the straight move nor a roadmap path is free."""
+    if not transitions:
+        return transitions
+    first = transitions[0]
+    q0 = as_written_joints(np.asarray(start, dtype=float))
+    goal = np.asarray(first.waypoints[-1], dtype=float)
+    label = f"{START_LABEL} ->" + first.label.partition("->")[2] if "->" in first.label else first.label
+    first = replace(first, label=label)
+    if world.check_segment(q0, goal).free:
+        moved = replace(first, kind="move", waypoints=np.vstack([q0, goal]), checks=0, lin_targets=None,
+                        lin_configs=(), lin_speed=0.0)
+    else:
+        detour = roadmap.query(q0, goal) if roadmap is not None else None
+        if detour is None:
+            raise LeadInError(f"no collision-free move from the stop configuration to the first stop of the rest "
+                              f"({first.label})")
+        moved = replace(first, kind="detour", waypoints=as_written_joints(detour.waypoints), checks=detour.checks,
+                        lin_targets=None, lin_configs=(), lin_speed=0.0)
+    return [moved, *transitions[1:]]
