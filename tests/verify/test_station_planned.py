@@ -1,5 +1,5 @@
-"""`robomax verify` of what `robomax plan STATION` writes (the crossing station of tests/data: r2
-leads through the shared zone, r1 waits for r2_z1_clear): every dialect set replayed clean, with
+"""`robomax verify` of what `robomax plan STATION` writes (the crossing station of tests/data: one
+robot leads through the shared zone, the other waits for its signal): every dialect set replayed clean, with
 the makespan and the idle shares the plan's `<station>.station.json` states, found independently
 by the replay; the same programs without r1's wait make the arms touch."""
 
@@ -61,10 +61,11 @@ def test_the_planned_station_replays_as_planned(tmp_path: Path, planned: dict[st
 @pytest.mark.slow
 def test_without_the_wait_the_arms_touch(tmp_path: Path, planned: dict[str, str]) -> None:
     srcl = {k: v for k, v in planned.items() if k.endswith((".srcl", ".station.json"))}
-    waits = [line for line in srcl["crossing_r1.srcl"].splitlines() if line.strip().startswith("WAIT FOR")]
-    assert waits, "the plan makes r1 wait"
-    srcl["crossing_r1.srcl"] = "\n".join(line for line in srcl["crossing_r1.srcl"].splitlines()
-                                         if line not in waits) + "\n"
+    waiter = json.loads(srcl["crossing.station.json"])["interlocks"][0]["waiter"]   # the robot the plan makes wait
+    program = f"crossing_{waiter}.srcl"
+    waits = [line for line in srcl[program].splitlines() if line.strip().startswith("WAIT FOR")]
+    assert waits, f"the plan makes {waiter} wait"
+    srcl[program] = "\n".join(line for line in srcl[program].splitlines() if line not in waits) + "\n"
     result = runner.invoke(app, ["verify", str(CROSSING), str(_folder(tmp_path, srcl))])
     assert result.exit_code == EXIT_VIOLATIONS, result.output
     assert "r1 and r2 touch" in result.output
