@@ -23,15 +23,16 @@ from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
 from robomax_py.spec import ObjectSpec, PathMotion, RobotMotion, Sphere, frozen_array
 
 TRAJECTORY_FORMAT = "robomax.trajectory/1"      # SPEC §5
-DEFAULT_SWEEP_M = 0.02
+DEFAULT_SWEEP_M = 0.02          # a part on a conveyor
+DEFAULT_ROBOT_SWEEP_M = 0.05    # another robot: its distal links move fast, and every span is an obstacle
 
 
 def moving_object(obj: DynamicObjectFile, path: Path, key: str, triangles: list[int], cycles: int) -> ObjectSpec:
     """The spec of a dynamic entry with `path` or `robot`; `cycles`: the default number of passes
     of a repeated path (the tending cycles, else 1)."""
-    sweep = obj.sweep if obj.sweep is not None else DEFAULT_SWEEP_M
     if obj.robot is not None:
-        return _robot_object(obj, path, key, sweep)
+        return _robot_object(obj, path, key, obj.sweep if obj.sweep is not None else DEFAULT_ROBOT_SWEEP_M)
+    sweep = obj.sweep if obj.sweep is not None else DEFAULT_SWEEP_M
     assert obj.path is not None
     base = _object(obj, path, key, triangles)
     t = np.array([p.t for p in obj.path], dtype=float)

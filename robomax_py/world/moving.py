@@ -44,8 +44,9 @@ from robomax_py.world.bounds import support_points
 # Grid steps move a body by at most this fraction of the sweep, so spans end close to it.
 GRID_FRACTION = 0.25
 # Spans a moving object may be cut into, over all its bodies: beyond, the cell is refused (a larger
-# `sweep` or a slower motion is needed): every span is one obstacle of every collision query.
-MAX_SPANS = 4000
+# `sweep` or a slower motion is needed): every span is one obstacle of every collision world, and
+# Pinocchio's geometry model grows worse than linearly in them (1000 pieces: ~1 s a world).
+MAX_SPANS = 1500
 
 
 @dataclass(frozen=True, slots=True, eq=False)
