@@ -41,7 +41,7 @@ def test_the_part_is_waited_for_and_the_program_verifies_clean(plans: dict[str, 
     assert status == rest_status == "planned"
     # The part stands in the way until it goes back: the robot waits, no longer than waiting at rest
     # for the part's last window to end.
-    assert re.search(r"^\s*WAIT [0-9.]+ SEC;", text, re.M)
+    assert re.search(r"^\s*WAIT [0-9.]+ SEC;", text, re.MULTILINE)
     assert cycle <= rest_cycle + 1e-9
     cell = load_cell(CELL)
     program = tmp_path / "conveyor_cross.srcl"
