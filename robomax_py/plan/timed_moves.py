@@ -122,6 +122,9 @@ class JunctionContext:
     max_wait: float
     tcp: TcpSpace | None = None      # the TCP's free voxels: a route through them is one more way
     moving: frozenset[str] = frozenset()   # moving objects: `windows` holds their spans' windows
+    # The classical A* of the paper (a baseline): the same graph, heuristic and timing, every node
+    # and edge free at all times; the route is timed as if nothing moved (the caller checks it).
+    ignore_time: bool = False
 
 
 class _StageFailed(RobomaxError):
@@ -214,6 +217,11 @@ def _graph(ctx: JunctionContext, waypoints: FloatArray, q_action: FloatArray | N
         return out + [(v, duration(u, v)) for v in sorted(links.get(u, ())) + ends.get(u, [])]
 
     def edge_windows(u: int, v: int) -> Windows | None:
+        if ctx.ignore_time:
+            return edge_static(u, v)
+        return edge_timed(u, v)
+
+    def edge_static(u: int, v: int) -> Windows | None:
         key = (min(u, v), max(u, v))
         if key not in static:
             if key in known_free:
@@ -222,13 +230,19 @@ def _graph(ctx: JunctionContext, waypoints: FloatArray, q_action: FloatArray | N
                 static[key] = roadmap.edge_free(u, v)
             else:
                 static[key] = ctx.world.check_segment(points[u], points[v]).free
-        if not static[key]:
+        return () if static[key] else None
+
+    def edge_timed(u: int, v: int) -> Windows | None:
+        if edge_static(u, v) is None:
             return None
+        key = (min(u, v), max(u, v))
         if key not in dynamic:
             dynamic[key] = ctx.conflicts.segment(points[u], points[v])
         return ctx.conflicts.windows_of(dynamic[key])
 
     def node_windows(u: int) -> Windows:
+        if ctx.ignore_time:
+            return ()
         if u == goal and q_action is not None:
             objs = ctx.conflicts.segment(points[goal], q_action)
             # Arriving at t holds the goal until t + tail: blocked from a window's start - tail.
@@ -263,7 +277,7 @@ def _timed(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray,
         raise _StageFailed("the pieces cannot be timed")
     segments, stages, t, extension = timed
     waypoints = [pieces[0][0], *(q for piece in pieces for q in piece[1:])]
-    if q_action is not None:
+    if q_action is not None and not ctx.ignore_time:
         # The retract after the action leaves along the approach line: nothing may close on it then.
         t_out = t + action_s
         retract_s = sum(s.duration for s in segments if s.kind == "approach")
@@ -303,7 +317,7 @@ def _pieces(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray
                 segments.append(dwell(q_now, w.seconds, kind="wait", label=f"wait for {w.obstacle}"))
                 stages.append(Stage(at, w))
                 t += w.seconds
-        elif first_dynamic_hit(ctx.dynamic_world, check, t) is not None:
+        elif not ctx.ignore_time and first_dynamic_hit(ctx.dynamic_world, check, t) is not None:
             return None                       # the first piece meets a dynamic obstacle as timed
         segments.extend(block)
         t += sum(s.duration for s in block)

@@ -326,6 +326,9 @@ def _next_block(ctx: JunctionContext | None, options: ResolvedOptions, dynamic_w
         return block, trans
     rest_end = math.inf if rest is None else t + rest.seconds + sum(s.duration for s in block)
     staged: StagedJunction | NoRoute | None = None
+    if ctx is not None and options.dynamic == "astar" and trans.lin_targets is None:
+        return _classical_block(ctx, options, dynamic_world, windows, doors, k, t, block, trans, ends, weld_times,
+                                moving, rest, rest_error)
     # A detour of TCP lines keeps its lines and waits at rest: the time-aware search plans joint moves.
     if ctx is not None and trans.lin_targets is None:
         has_action = k < len(ends)
@@ -362,3 +365,44 @@ def _next_block(ctx: JunctionContext | None, options: ResolvedOptions, dynamic_w
     why = staged.detail if isinstance(staged, NoRoute) else "its way finishes no sooner"
     return WaitingError(f"{trans.label}: waiting at rest fails ({rest_error}), and so does the time-aware "
                               f"search ({why}): the schedule cannot be met")
+
+
+def _classical_block(ctx: JunctionContext, options: ResolvedOptions, dynamic_world: CollisionWorld,
+                     windows: dict[str, tuple[tuple[float, float], ...]], doors: frozenset[str], k: int, t: float,
+                     block: list[Segment], trans: Transition, ends: list[WeldEnd], weld_times: list[float],
+                     moving: frozenset[str], rest: WaitPlan | None, rest_error: WaitingError | None,
+                     ) -> tuple[list[Segment], Transition] | WaitingError:
+    """`planner.dynamic: astar`, the paper's classical A* as a baseline: a junction that meets a
+    dynamic object takes the A* route over the same graph the time-aware search uses, time ignored;
+    where that route meets a dynamic object at its time, the robot stops at rest before it until it
+    is clear (`transition.wait`: each is one of the paper's dangerous situations). Without a route
+    it waits at rest on its own path, as `rest` does."""
+    has_action = k < len(ends)
+    speed = options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)
+    staged = staged_junction(
+        replace(ctx, speed=written_speed(speed), ignore_time=True), k, t, np.asarray(block[0].q[0]), trans.waypoints,
+        trans.kind, trans.label, ends[k - 1] if k else None, ends[k] if has_action else None,
+        block[:-1] if has_action else block, weld_times[k] if has_action else 0.0,
+        np.asarray(block[-1].q[0]) if has_action else None)
+    if isinstance(staged, StagedJunction):
+        action = block[-1]
+        routed = staged.segments + ([dwell(staged.segments[-1].q[-1], action.duration, kind=action.kind,
+                                           label=action.label)] if has_action else [])
+        ext = staged.extension
+        new_trans = replace(trans, waypoints=staged.waypoints, stages=staged.stages, blend_radius=staged.corner_radius,
+                            flyby_radius=staged.junction_radius, retract_T=ext.retract_T, retract_q=ext.retract_q,
+                            approach_q=ext.approach_q)
+        try:
+            stop = wait_at_rest(dynamic_world, routed, t, windows, k, doors, moving)
+        except WaitingError as exc:
+            return exc
+        if stop is None:
+            return routed, new_trans
+        return ([dwell(routed[0].q[0], stop.seconds, kind="wait", label=f"wait for {stop.obstacle}"), *routed],
+                replace(new_trans, wait=stop))
+    if rest is not None:
+        return ([dwell(block[0].q[0], rest.seconds, kind="wait", label=f"wait for {rest.obstacle}"), *block],
+                replace(trans, wait=rest))
+    assert rest_error is not None
+    return rest_error
+

@@ -25,8 +25,11 @@ def _plans() -> dict[str, Any]:
     robot = load_cell_robot(cell)
     timed = plan_cell(cell, robot, PlanOptions())
     rest = plan_cell(cell, robot, PlanOptions(dynamic="rest"))
+    astar = plan_cell(cell, robot, PlanOptions(dynamic="astar"))
     return {"timed": (timed.status, timed.cycle_time, write_program(program_from_plan(timed))),
-            "rest": (rest.status, rest.cycle_time)}
+            "rest": (rest.status, rest.cycle_time),
+            "astar": (astar.status, astar.cycle_time, sum(t.wait is not None for t in astar.transitions),
+                      write_program(program_from_plan(astar)))}
 
 
 @pytest.fixture(scope="module")
@@ -63,3 +66,16 @@ def test_verify_catches_a_program_that_meets_the_passing_part(plans: dict[str, A
     assert hits, report.violations
     # The part is in front of the stations from 4 s to 8 s (moving in before, out after).
     assert all(v.t is not None and 0.0 < v.t < 12.0 for v in hits)
+
+
+def test_the_classical_astar_baseline_must_stop_for_the_part(plans: dict[str, Any], tmp_path: Path) -> None:
+    """`dynamic: astar`: the same graph searched with time ignored; its route meets the part at its
+    time, so the robot stops at rest before it (a dangerous situation of the paper); the program
+    with the stop verifies clean and is no shorter than the time-aware one."""
+    status, cycle, stops, text = plans["astar"]
+    assert status == "planned" and stops >= 1
+    assert plans["timed"][1] <= cycle + 1e-9
+    cell = load_cell(CELL)
+    program = tmp_path / "astar.srcl"
+    program.write_text(text)
+    assert verify_program(cell, load_cell_robot(cell), program).clean
