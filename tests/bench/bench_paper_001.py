@@ -36,6 +36,7 @@ import statistics
 import sys
 import tempfile
 import time
+from collections import Counter
 from dataclasses import replace
 from pathlib import Path
 
@@ -108,8 +109,10 @@ def row(cell: CellSpec, robot: RobotModel, scenario: str, mode: str, runs: int) 
     idle = 100 * sum(waits.values()) / (len(waits) * result.cycle_time) if waits else 0.0
     per_hour = 3600.0 * cycles / result.cycle_time
     danger = stops if mode == "astar" else n_hazards
+    by_object = Counter(t.wait.obstacle for t in result.transitions if t.wait is not None)
     print(f"{scenario:8s} {mode:7s} {result.cycle_time:8.3f} {per_hour:9.1f} {cpu:6.1f} {danger:7d} {idle:7.1f}"
-          f" {least * 1000 if least != float('inf') else float('nan'):9.0f}")
+          f" {least * 1000 if least != float('inf') else float('nan'):9.0f}  "
+          + ", ".join(f"{k} {v}" for k, v in sorted(by_object.items())))
     return {"cycle": result.cycle_time, "danger": danger, "idle": idle, "per_hour": per_hour}
 
 
@@ -127,7 +130,7 @@ def main() -> None:
         print(f"{dynamic.name}: {len(dynamic.seams[0].spots)} station visits; dynamic: "
               + ", ".join(d.name for d in dynamic.dynamic))
         print(f"{'scenario':8s} {'planner':7s} {'cycle s':>8s} {'parts/h':>9s} {'CPU s':>6s} {'danger':>7s} "
-              f"{'idle %':>7s} {'least mm':>9s}")
+              f"{'idle %':>7s} {'least mm':>9s}  waits by object")
         ours: dict[str, dict[str, dict[str, float] | None]] = {"static": {}, "dynamic": {}}
         for mode in ("timed", "astar"):
             ours["static"][mode] = row(static, robot, "static", mode, args.runs)
