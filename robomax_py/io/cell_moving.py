@@ -63,6 +63,17 @@ def _robot_object(obj: DynamicObjectFile, path: Path, key: str, sweep: float) ->
         tool = load_tool_spec(tool_file)
     file = path.parent / obj.trajectory
     joints, t, q = read_trajectory(file, path, f"{key}.trajectory")
+    # Checked at load, so `robomax check` refuses it too (the scene checks it again with the model).
+    from robomax_py.robot.kinematics import active_joints, kinematic_model
+
+    model = kinematic_model(robot)
+    names = tuple(model.names[j] for j in active_joints(model))
+    if joints != names:
+        raise CellFileError(path, f"{key}.trajectory", f"{file.name}: joints {list(joints)} are not those of "
+                            f"{robot.name} {list(names)}")
+    lower, upper = np.asarray(model.lowerPositionLimit), np.asarray(model.upperPositionLimit)
+    if not np.all((q >= lower - 1e-6) & (q <= upper + 1e-6)):
+        raise CellFileError(path, f"{key}.trajectory", f"{file.name}: joint values outside {robot.name}'s limits")
     motion = RobotMotion(robot, frozen_array(_pose(other.base)), tool, joints, frozen_array(t), frozen_array(q),
                          file, key, sweep)
     # A robot is present throughout (held at its first and last samples), unless `present` says when.

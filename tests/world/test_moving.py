@@ -73,16 +73,18 @@ def test_bad_moving_objects_are_named_by_file_and_key(tmp_path: Path, entry: str
     assert "cell.yaml" in str(err.value) and key in str(err.value) and words in str(err.value), str(err.value)
 
 
-def test_a_trajectory_of_another_robots_joints_is_refused_when_the_scene_is_built(tmp_path: Path) -> None:
-    text = (DATA / "sweep.json").read_text().replace('"joint_a1"', '"shoulder"')
-    (tmp_path / "other.json").write_text(text)
+@pytest.mark.parametrize(("old", "new", "words"), [('"joint_a1"', '"shoulder"', "shoulder"),
+                                                    ("1.2217304763960306", "12.0", "outside kr16's limits")])
+def test_a_trajectory_not_for_the_robot_is_refused_at_load(tmp_path: Path, old: str, new: str, words: str) -> None:
+    text = (DATA / "sweep.json").read_text()
+    assert old in text
+    (tmp_path / "other.json").write_text(text.replace(old, new, 1))
     path = tmp_path / "cell.yaml"
     path.write_text(CELL + "  - {name: r2, robot: {model: kr16, base: {xyz: [2.45, 0, 0], rpy: [0, 0, 180]}}, "
                            "trajectory: other.json}\n")
-    cell = load_cell(path)
     with pytest.raises(CellFileError) as err:
-        build_scene(cell, load_cell_robot(cell))
-    assert "dynamic[0].trajectory" in str(err.value) and "shoulder" in str(err.value)
+        load_cell(path)
+    assert "dynamic[0].trajectory" in str(err.value) and words in str(err.value), str(err.value)
 
 
 def test_a_repeated_path_is_there_in_every_pass(tmp_path: Path) -> None:
@@ -149,3 +151,47 @@ def test_the_spans_block_every_time_a_fine_step_exact_check_finds_contact(knots:
         assert touching or at is not centre
         missed = [tk for tk in touching if not any(w0 <= tk <= w1 for w0, w1 in windows)]
         assert not missed, (missed[:3], windows)
+
+
+# A link's point may leave the chord between two grid times by a second-order amount the margin
+# does not count (world.moving): contacts deeper than this must lie in a blocked window.
+ROBOT_CHORD_TOL_M = 1e-4
+
+
+def test_another_robots_spans_block_every_time_a_fine_step_exact_check_finds_contact(tmp_path: Path) -> None:
+    """A KR 16-class arm sweeping its axis 1 through 140 deg in 4 s (tests/data/moving/sweep.json):
+    probes where its tool passes, and every 1 ms of the sweep at which a link or the tool at its
+    exact pose (linear in joint space) touches one lies in a window of a span within its margin."""
+    from robomax_py.world.bounds import support_points
+    from robomax_py.world.moving import robot_bodies
+    from robomax_py.world.scene import shape_pieces
+
+    (tmp_path / "sweep.json").write_bytes((DATA / "sweep.json").read_bytes())
+    path = tmp_path / "cell.yaml"
+    path.write_text(CELL + "  - {name: r2, robot: {model: kr16, base: {xyz: [2.45, 0, 0], rpy: [0, 0, 180]}, "
+                           "tool: gripper_2f}, trajectory: sweep.json}\n")
+    cell = load_cell(path)
+    obj = cell.dynamic[0]
+    bodies = robot_bodies(obj, path, lambda mesh, part: shape_pieces(mesh)[0])
+    fine = np.arange(2.0, 6.0, FINE_STEP_S)
+    probe = coal.Sphere(0.005)
+    tool = bodies[-1]
+    # The tool's leading corner at three times: touched then, and only briefly (it moves on).
+    probes = []
+    for t in (3.03, 4.07, 5.21):
+        T0, T1 = tool.poses(np.array([t - 1e-3, t]))
+        corners = np.vstack([support_points(p, T1) for p in tool.pieces])
+        probes.append(corners[int(np.argmax(corners @ (T1[:3, 3] - T0[:3, 3])))])
+    checked = 0
+    for body in bodies:
+        cut = spans(body, (0.0, math.inf), 0.05)
+        exact = body.poses(fine)
+        for at in probes:
+            windows = [(s.t0, s.t1) for s in cut
+                       if min(_distance(p, np.asarray(s.T_world_body), probe, at) for p in body.pieces) <= s.margin]
+            touching = [tk for tk, T in zip(fine, exact)
+                        if min(_distance(p, T, probe, at) for p in body.pieces) <= -ROBOT_CHORD_TOL_M]
+            checked += len(touching)
+            missed = [tk for tk in touching if not any(w0 <= tk <= w1 for w0, w1 in windows)]
+            assert not missed, (body.label, missed[:3], windows)
+    assert checked > 0
