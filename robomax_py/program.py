@@ -50,6 +50,7 @@ from robomax_py.program_instructions import (
     Program,
     ProgramSetup,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -77,6 +78,7 @@ __all__ = [
     "Program",
     "ProgramSetup",
     "PtpMove",
+    "SetSignal",
     "Spot",
     "Wait",
     "WaitFor",
@@ -167,6 +169,10 @@ def find_problem(item: Header | FrameDef | Instruction, n_joints: int) -> str | 
             return f"LIN speed {item.speed_mm_s:.3f} mm/s must be > 0"
         if not 0.0 < item.accel <= 1.0:
             return f"LIN accel {item.accel:.3f} is outside (0, 1] (a fraction of the maximum)"
+        if item.spline not in ("", "spl", "slin"):
+            return f"spline segment {item.spline!r} is neither 'spl' nor 'slin'"
+        if item.spline and item.flies:
+            return "a spline block's segment states no fly-by: the spline passes through its points"
         return _flyby_problem(item)
     if isinstance(item, Spot):
         problem = _finite("weld time", (item.time_s,))

@@ -24,6 +24,8 @@ TIME_DECIMALS = 3    # s
 FLYBY_MM_DECIMALS = 6
 
 FrameKind: TypeAlias = Literal["tool", "base"]
+# A LIN's part in a spline block: none, a spline point, a straight segment (`LinMove.spline`).
+SplineSegment: TypeAlias = Literal["", "spl", "slin"]
 # A LIN's tool or base: the controller's null frame (flange / robot base frame), or none selected.
 NULL_FRAME = ""
 UNSET_FRAME = "?"
@@ -185,6 +187,10 @@ class LinMove:
         executes the move: names of `FrameDef`s (of the program, or stored on the controller).
         `NULL_FRAME` is the controller's null frame (the flange; the robot base frame itself);
         `UNSET_FRAME`: the program did not select one (the controller keeps whatever was active).
+    spline : {"", "spl", "slin"}
+        "": a LIN of its own. Otherwise a segment of a spline block (a run of consecutive moves
+        with `spline` set; KRL `SPLINE ... ENDSPLINE`): "spl" a spline point the path passes
+        through smoothly, "slin" a straight segment (`curve_move`, `space_bezier`).
     """
 
     position_mm: tuple[float, ...]
@@ -197,6 +203,7 @@ class LinMove:
     accel: float = 1.0
     tool: str = NULL_FRAME
     base: str = NULL_FRAME
+    spline: SplineSegment = ""
 
     def __post_init__(self) -> None:
         _set(self, "position_mm", _fixed_all(self.position_mm, MM_DECIMALS))
@@ -270,6 +277,18 @@ class WaitFor:
 
 
 @dataclass(frozen=True, slots=True)
+class SetSignal:
+    """Switch an output: the cell's signal `signal` on (`value` True) or off, on the controller's
+    output `number` (KUKA $OUT, FANUC DO, UR standard digital output); None where the program names
+    the signal only (SRCL, RAPID's named signals). Robots of a station tell each other with it that
+    a shared zone is clear: another robot's `WaitFor` of the same signal name waits for it."""
+
+    signal: str
+    number: int | None
+    value: bool
+
+
+@dataclass(frozen=True, slots=True)
 class Comment:
     """A line of text for the reader; surrounding whitespace is stripped."""
 
@@ -279,7 +298,7 @@ class Comment:
         _set(self, "text", str(self.text).strip())
 
 
-Instruction: TypeAlias = PtpMove | LinMove | Spot | Gripper | Wait | WaitFor | Comment
+Instruction: TypeAlias = PtpMove | LinMove | Spot | Gripper | Wait | WaitFor | SetSignal | Comment
 
 
 @dataclass(frozen=True, slots=True)

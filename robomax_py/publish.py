@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, cast
 
@@ -41,6 +42,8 @@ from robomax_py.export.dialect import (
 )
 from robomax_py.export.plan_program import planned_program
 from robomax_py.export.rebuild import rebuild
+from robomax_py.export.spline_lines import as_lines as lines_for_splines
+from robomax_py.export.spline_lines import has_splines
 from robomax_py.plan import PlanResult, method_suffix
 from robomax_py.program import LinMove, Program, lin_pose
 from robomax_py.robot import RobotModel, fk_tcp
@@ -72,7 +75,12 @@ class MotionDifference:
     def identical(self) -> bool:
         return self.joint_deg == 0.0 and self.time_s == 0.0
 
-    def within(self) -> bool:
+    def within(self, cycle_s: float | None = None) -> bool:
+        """Within the rebuilt-motion tolerances; with `cycle_s` (the planned cycle, s), within
+        those of spline blocks written as lines (`export.spline_lines`)."""
+        if cycle_s is not None:
+            return (self.joint_deg <= TOL.spline_lines_joint_deg and self.tcp_mm <= TOL.spline_lines_mm
+                    and self.time_s <= TOL.spline_lines_time * cycle_s)
         return (self.joint_deg <= TOL.rebuilt_joint_deg and self.tcp_mm <= TOL.rebuilt_tcp_mm
                 and self.time_s <= TOL.rebuilt_time_s)
 
@@ -96,23 +104,31 @@ def file_names(name: str, files: dict[str, str]) -> dict[str, str]:
 
 
 def publish(result: PlanResult, cell: CellSpec, robot: RobotModel, formats: tuple[str, ...], *,
-            stamp: str = "", method: str = "optimised") -> tuple[dict[str, str], list[CheckedProgram]]:
+            stamp: str = "", method: str = "optimised",
+            edit: Callable[[PlannedProgram], PlannedProgram] | None = None,
+            station: frozenset[str] | None = None) -> tuple[dict[str, str], list[CheckedProgram]]:
     """Every file of a planned result (the trajectory file first, then each format's files), all
     proven; ExportError when any is not.
 
     method : the plan's method; a baseline's files are named `<cell>_published.*` or
         `<cell>_teach_in.*` (`method_suffix`), so that a baseline run never replaces the optimised
         program.
+    edit : a change to the dialect-free program before any dialect writes it (a station's
+        interlocks: statements that take no time in the program's own motion).
+    station : the signals the robots of a station set for each other; the proof then reads a wait
+        for one of them as taking no time (the station replay times it), as `rebuild` does.
     """
     for fmt in formats:                          # before any dialect is proven: one clear message
         require_calibration(fmt, robot)
     name = result.cell + method_suffix(method)
     files = {f"{name}.json": render_trajectory(result)}
     planned = planned_program(result, cell.digest, stamp)
+    if edit is not None:
+        planned = edit(planned)
     checked = []
     reference: list[PlannedPath] = []            # made once, by the first dialect that needs it
     for fmt in formats:
-        one = _checked(fmt, planned, result, cell, robot, name, reference)
+        one = _checked(fmt, planned, result, cell, robot, name, reference, station)
         for file_name in one.files:
             if file_name in files and files[file_name] != one.files[file_name]:
                 raise ExportError(f"two formats write {file_name} with different contents")
@@ -122,13 +138,16 @@ def publish(result: PlanResult, cell: CellSpec, robot: RobotModel, formats: tupl
 
 
 def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSpec, robot: RobotModel,
-             name: str, reference: list[PlannedPath]) -> CheckedProgram:
+             name: str, reference: list[PlannedPath], station: frozenset[str] | None = None) -> CheckedProgram:
     dialect = DIALECTS[fmt]
     t0 = time.process_time()
     if name != result.cell:
         # A baseline program is named apart before the dialect names it its way.
         planned = dataclasses.replace(planned, program=dataclasses.replace(
             planned.program, name=planned.program.name + name[len(result.cell):]))
+    as_lines = has_splines(planned) and not dialect.splines
+    if as_lines:
+        planned = lines_for_splines(planned, robot)
     try:
         if dialect.brand:
             planned = in_controller_terms(planned, robot)
@@ -149,7 +168,7 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
     _same_program(fmt, main, adapted, parsed)
     read = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
     rebuilt = rebuild(read, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
-                      controller=bool(dialect.brand))
+                      controller=bool(dialect.brand), station=station)
     if rebuilt.problems or rebuilt.trajectory is None:
         p = rebuilt.problems[0] if rebuilt.problems else None
         where = f"line {p.line}: " if p and p.line else ""
@@ -159,12 +178,14 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
     if not _same_samples(traj, rebuilt.trajectory) and not reference:
         reference.append(PlannedPath.of(traj, robot))
     diff = motion_difference(traj, rebuilt.trajectory, robot, reference[0] if reference else None)
-    if not diff.within():
+    if not diff.within(traj.duration if as_lines else None):
         line = rebuilt.line_at(diff.t_worst)
+        most = (f"{TOL.spline_lines_joint_deg} deg, {TOL.spline_lines_mm} mm, {TOL.spline_lines_time:.0%} of the cycle "
+                "with spline blocks as lines") if as_lines else \
+            f"{TOL.rebuilt_joint_deg} deg, {TOL.rebuilt_tcp_mm} mm, {TOL.rebuilt_time_s * 1000:.0f} ms"
         raise ExportError(
             f"{fmt}: the rebuilt motion differs from the planned one by {diff.joint_deg:.4f} deg, {diff.tcp_mm:.3f} mm, "
-            f"{diff.time_s * 1000:.1f} ms (at most {TOL.rebuilt_joint_deg} deg, {TOL.rebuilt_tcp_mm} mm, "
-            f"{TOL.rebuilt_time_s * 1000:.0f} ms){f', at line {line} of {main}' if line else ''}")
+            f"{diff.time_s * 1000:.1f} ms (at most {most}){f', at line {line} of {main}' if line else ''}")
     report = None
     if not diff.identical:
         report = verify_rebuilt(cell, robot, main, rebuilt, clearance=False)

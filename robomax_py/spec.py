@@ -116,11 +116,22 @@ class ControllerInput:
     name: str | None = None
 
 
+@dataclass(frozen=True, slots=True)
+class ControllerOutput:
+    """A signal the robot sets for others (a station's interlocks) as the controller writes it:
+    output `number` (KUKA $OUT, FANUC DO, UR standard digital output), and for RAPID the signal's
+    `name` in the controller's I/O configuration."""
+
+    signal: str
+    number: int
+    name: str | None = None
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class ControllerSetup:
     """The integrator's numbers on the robot's controller (cell key `robot.controller`): which tool
     and user frame programs select, the registers a program may use, the inputs each cell signal
-    arrives on, and whether welds call the default routine or the controller's process package.
+    arrives on, the outputs of the signals the robot sets (a station's interlocks), and whether welds call the default routine or the controller's process package.
 
     tool : ControllerFrame | None
         None: tool 1, named after the tool (`<tool>_tcp`), declared by the programs.
@@ -134,10 +145,15 @@ class ControllerSetup:
     numeric_registers: tuple[int, ...] = ()
     inputs: tuple[ControllerInput, ...] = ()
     weld: Literal["call", "package"] = "call"
+    outputs: tuple[ControllerOutput, ...] = ()
 
     def input_of(self, signal: str) -> ControllerInput | None:
         """The input a cell signal is mapped to; None when the cell maps none."""
         return next((i for i in self.inputs if i.signal == signal), None)
+
+    def output_of(self, signal: str) -> ControllerOutput | None:
+        """The output a signal the robot sets is mapped to; None when the cell maps none."""
+        return next((o for o in self.outputs if o.signal == signal), None)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -332,6 +348,9 @@ class PlannerSpec:
     # Pick and place: carried moves planned as every move ("moves") or by Diane and Anikina's
     # associative memory, k-NN graph, Dijkstra route and Jacobian interpolation ("associative").
     transfers: str = "moves"
+    # "lin": approach, retract and detour lines as straight LIN moves with fly-by; "spline": a
+    # junction between two spots as one smooth Bézier TCP path where that is faster.
+    cartesian_moves: str = "lin"
 
 
 @dataclass(frozen=True, slots=True, eq=False)

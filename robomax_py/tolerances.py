@@ -70,6 +70,13 @@ class Tolerances:
     rebuilt_joint_deg: float = 0.01
     rebuilt_tcp_mm: float = 0.1
     rebuilt_time_s: float = 0.02
+    # ... and a program whose spline blocks its dialect writes as lines flown by (`export.spline_lines`):
+    # the lines keep within 1 mm of sagitta of the planned path and their blends cut corners by
+    # less; the blends turn more sharply than the spline, so the lines take longer, by at most this
+    # fraction of the planned cycle (measured: docs/bezier-paper.md, "Cartesian moves as splines").
+    spline_lines_mm: float = 2.5
+    spline_lines_joint_deg: float = 0.5
+    spline_lines_time: float = 0.1
     # A Cartesian target read back equals the written one when its rotation is within this (deg):
     # ZYX angles near B = ±90 deg can come back as other angles of the same rotation.
     readback_angle_deg: float = 1e-4

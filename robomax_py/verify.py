@@ -66,14 +66,21 @@ class VerifyReport:
 def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
     """Verify a trajectory file (.json) or a program of any dialect robomax writes (its motion
     rebuilt from its statements alone)."""
+    if path.suffix.lower() == ".json":
+        return _with_set(cell, path, (path,), verify_trajectory_file(cell, robot, path))
+    return verify_read(cell, robot, path, read_program_files(robot, path))[0]
+
+
+def verify_read(cell: CellSpec, robot: RobotModel, path: Path, read: tuple[Any, Path, Any, tuple[Path, ...]],
+                station: frozenset[str] | None = None) -> tuple[VerifyReport, Any]:
+    """Verify a program read by `read_program_files`, and its rebuilt motion (`export.rebuild.Rebuilt`;
+    None when no motion runs). `station`: the signals the robots of a station set (`rebuild`)."""
     from robomax_py.export import controller_frames
     from robomax_py.export.dialect import in_controller_joints
     from robomax_py.export.rebuild import rebuild
     from robomax_py.program import LinMove, PtpMove
 
-    if path.suffix.lower() == ".json":
-        return _with_set(cell, path, (path,), verify_trajectory_file(cell, robot, path))
-    dialect, main, parsed, read = _read_program(robot, path)
+    dialect, main, parsed, files = read
     unsimulated = tuple(Violation(None, "unsupported", f"{text} is not simulated: the program cannot be verified", line)
                         for line, text in _not_simulated(parsed))
     stated = tuple(Violation(None, kind, detail, line) for line, kind, detail in parsed.problems)
@@ -85,26 +92,26 @@ def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyRepor
             Violation(None, "flow", "no motion of the program runs: it moves the robot nowhere"),)
         never = tuple(Violation(None, "spot", f"{seam.name}/{spot.name} is never welded")
                       for seam in cell.seams for spot in seam.spots)
-        return _with_set(cell, path, read,
-                         VerifyReport(str(path), 0, float("nan"), 0, unsimulated + stated + nowhere + never, ignored))
+        return _with_set(cell, path, files, VerifyReport(str(path), 0, float("nan"), 0,
+                                                         unsimulated + stated + nowhere + never, ignored)), None
     # A controller's joint targets count its joints its way (robot.yaml controller.joint_signs/zeros).
     joint_program = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
     rebuilt = rebuild(joint_program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
-                      controller=bool(dialect.brand))
+                      controller=bool(dialect.brand), station=station)
     report = verify_rebuilt(cell, robot, str(path), rebuilt)
     report = dataclasses.replace(report, violations=unsimulated + stated + report.violations, ignored=ignored)
-    return _with_set(cell, path, read, report)
+    return _with_set(cell, path, files, report), rebuilt
 
 
 def read_program(robot: RobotModel, path: Path) -> tuple[Any, Path, Any]:
     """A program's files read as verify reads them: (its `Dialect`, its main file, the `Parsed`
     program), with the files beside it the dialect reads too (a KRL .dat, the companions, the
     dialect's shared routines)."""
-    dialect, main, parsed, _ = _read_program(robot, path)
+    dialect, main, parsed, _ = read_program_files(robot, path)
     return dialect, main, parsed
 
 
-def _read_program(robot: RobotModel, path: Path) -> tuple[Any, Path, Any, tuple[Path, ...]]:
+def read_program_files(robot: RobotModel, path: Path) -> tuple[Any, Path, Any, tuple[Path, ...]]:
     """`read_program` and the files of the program's own set it read (its shared routines, which
     every plan of a folder writes alike, are not among them)."""
     from robomax_py.export import DIALECTS, dialect_for_file

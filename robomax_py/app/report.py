@@ -68,6 +68,18 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
          "moves": "lin" if t.lin_targets is not None else "ptp"}
         for t in result.transitions if t.kind == "detour"
     ]
+    # `planner.cartesian_moves: spline`: per junction between two spots, which way it moves and the
+    # time of each (the spline's None where it has none: `note` says why).
+    choices = [t for t in result.transitions if t.choice is not None]
+    if choices:
+        report["cartesian_moves"] = [
+            {"between": t.label, "chosen": ch.chosen, "flyby_s": round(ch.flyby_time, 4),
+             "spline_s": None if ch.spline_time is None else round(ch.spline_time, 4), "note": ch.note,
+             "spline_points": None if t.spline is None else len(t.spline.targets),
+             "bezier_deviation_mm": None if t.spline is None else round(t.spline.deviation_m * 1000.0, 3),
+             "as_lines_s": None if t.spline is None or t.spline.lines_time is None else round(t.spline.lines_time, 4)}
+            for t in choices if (ch := t.choice) is not None
+        ]
     # Pick and place: each move's load and the overrides its limits asked for.
     slowed = [t for t in result.transitions if t.part is not None or t.tcp_speed is not None]
     if slowed:
@@ -112,6 +124,15 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
         detours = ", ".join(f"{d['between']} ({'TCP lines, ' if d['moves'] == 'lin' else ''}{d['checks_to_find']} "
                             "checks)" for d in report["detours"])
         head.add_row("detours", detours or "none")
+        moves = report.get("cartesian_moves", [])
+        if moves:
+            def move(m: dict[str, Any]) -> str:
+                spline = "none: " + m["note"] if m["spline_s"] is None else f"{m['spline_s']:.3f} s"
+                lines = "" if m["as_lines_s"] is None else f", as lines {m['as_lines_s']:.3f} s"
+                return f"{m['between']}: {m['chosen']} (spline {spline}, fly-by {m['flyby_s']:.3f} s{lines})"
+
+            head.add_row("splines", f"{sum(m['chosen'] == 'spline' for m in moves)} of {len(moves)} junctions; "
+                         + "; ".join(move(m) for m in moves))
         carried = [c for c in report.get("carried", []) if c["part"]]
         if carried:
             head.add_row("carried", ", ".join(

@@ -30,6 +30,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     WaitFor,
 )
@@ -144,6 +145,9 @@ class Dialect:
     # controller's calibration data a program counts in (INFORM's encoder pulses per degree). A
     # dialect asked for by name on such a robot is an error; `--format all` passes it over and says so.
     needs: Callable[[RobotModel], tuple[tuple[str, str], ...]] = needs_nothing
+    # It states spline blocks (`LinMove.spline`: KRL SPLINE, SRCL SPL / SLIN); the others get a
+    # spline block as lines flown by (`spline_lines`).
+    splines: bool = False
     # Whether `--format all` takes it in (a dialect left out is written only when named).
     in_all: bool = True
 
@@ -174,6 +178,21 @@ def numbered_inputs(program: Program, dialect: str, low: int, high: int) -> None
                                             "number: map the signal to the controller's input")
         if not low <= ins.number <= high:
             raise ControllerSetupError(key, f"input {ins.number} is outside {dialect}'s inputs {low}..{high}")
+
+
+def numbered_outputs(program: Program, dialect: str, low: int, high: int) -> None:
+    """Every set signal names a controller output in [low, high]: ControllerSetupError otherwise,
+    naming the cell key `robot.controller.outputs.<signal>` (a dialect that sets outputs by
+    number cannot guess one)."""
+    for ins in program.instructions:
+        if not isinstance(ins, SetSignal):
+            continue
+        key = f"robot.controller.outputs.{ins.signal}"
+        if ins.number is None:
+            raise ControllerSetupError(key, f"the program sets signal {ins.signal}; {dialect} sets an output "
+                                            "number: map the signal to the controller's output")
+        if not low <= ins.number <= high:
+            raise ControllerSetupError(key, f"output {ins.number} is outside {dialect}'s outputs {low}..{high}")
 
 
 def with_package_welds(program: Program, dialect: str) -> Program:

@@ -31,6 +31,8 @@ What a program states:
   the DX100/YRC1000 corner radius (its manual text was not available: UNCONFIRMED);
 - `VJ=` in % with 2 decimals, `V=` in mm/s with 1 decimal; waits `TIMER T=<s>` (2 decimals,
   rounded up) and `WAIT IN#(<k>)=ON` (general input k of the cell's `robot.controller.inputs`);
+  a station's interlock outputs `DOUT OT#(<k>) ON` / `OFF` (general output k of
+  `robot.controller.outputs`), after a `PL=0` point;
 - a weld (`weld: call`) as `MOVL ... PL=0`, then `CALL JOB:SPOTWELD ARGF<n> ARGF<time>` and the
   comment `'seam/name gun G schedule S`; SPOTWELD.jbi takes its second argument (`GETARG LR000
   IARG#(2)`) and rests that long (`TIMER T=LR000`): the job call with arguments is a DX100 option
@@ -40,8 +42,8 @@ What a program states:
   (`fanuc.remarks`).
 
 The reader takes these files and other writers' (RoboDK's): MOVJ / MOVL to C positions (pulse or
-Cartesian), VJ=, V=, PL=, CR=, TIMER T=, WAIT IN#(k)=ON, the weld calls; NOP and END; other
-instructions (DOUT, MSG, PAUSE, SET..., jumps, calls of other jobs, MOVC, MOVS) are reported as
+Cartesian), VJ=, V=, PL=, CR=, TIMER T=, WAIT IN#(k)=ON, DOUT OT#(k) ON/OFF, the weld calls; NOP
+and END; other instructions (DOUT of other signal kinds, MSG, PAUSE, SET..., jumps, calls of other jobs, MOVC, MOVS) are reported as
 not simulated or ignored (an END stops the job, PAUSE stops the verified cycle).
 """
 
@@ -59,6 +61,7 @@ from robomax_py.export.dialect import (
     header_lines,
     numbered_frames,
     numbered_inputs,
+    numbered_outputs,
     read_header,
     read_spot_label,
     require_six_axes,
@@ -79,6 +82,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -90,6 +94,7 @@ __all__ = ["ROUTINES", "adapt", "frame_name", "needs", "parse", "program_name", 
 NAME_CHARS = 32              # a job name (DX100; the NX100 took 8)
 TOOL_SLOTS, USER_SLOTS = 23, 23       # ///TOOL 0..23, ///USER 0..23 (NX100 §4.1.3)
 INPUTS = 1024                # general inputs IN#(1..)
+OUTPUTS = 1024               # general outputs OT#(1..)
 WELD_JOB = "SPOTWELD"
 ROUTINES = (WELD_JOB,)
 ANGLE_DECIMALS = 4           # Rx, Ry, Rz (RoboDK writes 2; robomax's angles carry 4)
@@ -149,6 +154,7 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     ppd = _pulses(robot)
     numbered_frames(planned.program, "INFORM", TOOL_SLOTS, USER_SLOTS)
     numbered_inputs(planned.program, "INFORM", 1, INPUTS)
+    numbered_outputs(planned.program, "INFORM", 1, OUTPUTS)
     program = with_tcp_blends(planned, robot)
     program = with_package_welds(with_frame_names(program, frame_name), "INFORM")
     program = without_comments(with_brand_configs(program, planned.joints, robot, "yaskawa"))
@@ -165,6 +171,8 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
             ins = Wait(_wait_s(ins.seconds))
         elif isinstance(ins, WaitFor):
             ins = WaitFor(f"IN{ins.number}", ins.number)
+        elif isinstance(ins, SetSignal):
+            ins = SetSignal(f"OT{ins.number}", ins.number, ins.value)     # INFORM names outputs by number only
         elif not isinstance(ins, (Spot, Comment)):
             raise ControllerSetupError("robot.controller", f"INFORM cannot state {type(ins).__name__}")
         out.append(ins)
@@ -227,6 +235,9 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
             inst.append(f"TIMER T={_num(ins.seconds, 2)}")
         elif isinstance(ins, WaitFor):
             inst.append(f"WAIT IN#({ins.number})=ON")
+        elif isinstance(ins, SetSignal):
+            # DOUT OT#(k) ON / OFF: general output k; after a PL=0 point the robot has stopped.
+            inst.append(f"DOUT OT#({ins.number}) {'ON' if ins.value else 'OFF'}")
         elif not isinstance(ins, Comment):
             raise ExportError(f"INFORM cannot write {type(ins).__name__}")
     header = [c for line in header_lines(program.header) for c in _comments(line.replace(" | ", ", "))]
@@ -259,6 +270,7 @@ _C = re.compile(r"^C([0-9]{4,5})\s*=\s*(.*)$")
 _MOVE = re.compile(r"^(MOVJ|MOVL)\s+C([0-9]{4,5})\b(.*)$", re.IGNORECASE)
 _TAG = re.compile(r"\b(VJ|V|PL|CR)\s*=\s*([0-9]*\.?[0-9]+)", re.IGNORECASE)
 _TIMER = re.compile(r"^TIMER\s+T\s*=\s*([0-9]*\.?[0-9]+)$", re.IGNORECASE)
+_DOUT = re.compile(r"^DOUT\s+OT#\(\s*([0-9]+)\s*\)\s+(ON|OFF)$", re.IGNORECASE)
 _WAIT_IN = re.compile(r"^WAIT\s+IN#\(\s*([0-9]+)\s*\)\s*=\s*ON$", re.IGNORECASE)
 _WELD = re.compile(rf"^CALL\s+JOB:{WELD_JOB}\s+ARGF\s*([0-9]+)\s+ARGF\s*([0-9]*\.?[0-9]+)$", re.IGNORECASE)
 _SVSPOT = re.compile(r"^SVSPOT\s+GUN#\(\s*([0-9]+)\s*\).*\bWTM\s*=\s*([0-9]+)", re.IGNORECASE)
@@ -385,6 +397,10 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         wait = _WAIT_IN.match(stmt)
         if wait:
             add(WaitFor(f"IN{wait.group(1)}", int(wait.group(1))), number)
+            continue
+        dout = _DOUT.match(stmt)
+        if dout:
+            add(SetSignal(f"OT{dout.group(1)}", int(dout.group(1)), dout.group(2).upper() == "ON"), number)
             continue
         weld = _WELD.match(stmt)
         if weld:

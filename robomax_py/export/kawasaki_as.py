@@ -37,7 +37,9 @@ examples/Kawasaki.pg):
   schedule S`, `.PROGRAM spot_weld(n, t)` resting `TWAIT t`; grippers `CALL grip(n, t)` /
   `CALL release(n, t)` alike; `weld: package` has no AS form here;
 - waits `TWAIT t` (3 decimals) and `SWAIT <1000 + k> ; <signal>`, external input k (AS numbers
-  external inputs from 1001).
+  external inputs from 1001); a station's interlock output `BREAK` then `SIGNAL k ; <signal>`
+  (`SIGNAL -k` off), external output k: AS runs the program ahead of the motion, and BREAK holds
+  it until the robot has stopped.
 
 The reader takes these programs and other writers' (RoboDK's: `SPEED ... ALWAYS`, `ACCURACY ...
 ALWAYS`, `TWAIT`, `WAIT SIG(n)`, `BASE TRANS(...)`, `TOOL TRANS(...)`); JMOVE to a transformation
@@ -61,6 +63,7 @@ from robomax_py.export.dialect import (
     gripper_label,
     header_lines,
     numbered_inputs,
+    numbered_outputs,
     read_gripper,
     read_header,
     read_spot_label,
@@ -80,6 +83,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -166,6 +170,7 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     if planned.program.setup.weld == "package":
         raise ControllerSetupError("robot.controller.weld", "AS programs weld with a call of spot_weld (weld: call)")
     numbered_inputs(planned.program, "AS", 1, 999)
+    numbered_outputs(planned.program, "AS", 1, 999)
     program = without_comments(with_frame_names(with_tcp_blends(planned, robot), frame_name))
     out: list[Instruction] = []
     for ins in program.instructions:
@@ -231,6 +236,10 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
             body.append(f"TWAIT {_num(ins.seconds, 3)}")
         elif isinstance(ins, WaitFor):
             body.append(f"SWAIT {INPUT_BASE + (ins.number or 0)} ; {ins.signal}")
+        elif isinstance(ins, SetSignal):
+            # AS reads ahead of the motion: BREAK holds the program until the robot has stopped,
+            # then SIGNAL k turns external output k on (SIGNAL -k off).
+            body += ["BREAK", f"SIGNAL {'' if ins.value else '-'}{ins.number} ; {ins.signal}"]
         elif not isinstance(ins, Comment):
             raise ExportError(f"AS cannot write {type(ins).__name__}")
     lines = [f".PROGRAM {program.name}()", *(f"  {b}" for b in body), ".END"]
@@ -252,6 +261,7 @@ _ACCEL = re.compile(rf"^(ACCEL|DECEL)\s+({_NUM})\s*(ALWAYS)?$", re.IGNORECASE)
 _ACCURACY = re.compile(rf"^ACCURACY\s+({_NUM})\s*(FINE)?\s*(ALWAYS)?$", re.IGNORECASE)
 _CALL = re.compile(rf"^CALL\s+(spot_weld|grip|release)\s*\(\s*([0-9]+)\s*,\s*({_NUM})\s*\)$", re.IGNORECASE)
 _SWAIT = re.compile(r"^(?:SWAIT\s+([0-9]+)|WAIT\s+SIG\s*\(\s*([0-9]+)\s*\))$", re.IGNORECASE)
+_SIGNAL = re.compile(r"^SIGNAL\s+(-?)([0-9]+)$", re.IGNORECASE)
 _TWAIT = re.compile(rf"^TWAIT\s+({_NUM})$", re.IGNORECASE)
 _FRAME = re.compile(r"^(TOOL|BASE)\s+(.+)$", re.IGNORECASE)
 _UNSIMULATED = re.compile(r"^(C1MOVE|C2MOVE|JAPPRO|LAPPRO|JDEPART|LDEPART|HOME|DRIVE|DRAW|TDRAW|GOTO|IF|CALL|"
@@ -292,11 +302,14 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
     accel: dict[str, float] = {}                  # ACCEL / DECEL for the next motion, in %
     accel_always: dict[str, float] = {}
     leading = True
+    broke = False                                 # a BREAK since the last motion: the robot is at rest
 
     def error(line: int, problem: str) -> ProgramError:
         return ProgramError(file, f"line {line}", problem)
 
     def add(ins: Instruction, line: int) -> None:
+        nonlocal broke
+        broke = broke and not isinstance(ins, (PtpMove, LinMove))
         instructions.append(ins)
         where.append(line)
 
@@ -420,6 +433,17 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         tw = _TWAIT.match(stmt)
         if tw:
             add(Wait(float(tw.group(1))), number)
+            continue
+        if re.fullmatch(r"BREAK", stmt, re.IGNORECASE):
+            broke = True
+            continue
+        sig = _SIGNAL.match(stmt)
+        if sig:
+            if not broke and any(isinstance(i, (PtpMove, LinMove)) for i in instructions):
+                # Without BREAK the controller sets it as the motion before it starts, not at its end.
+                not_simulated(number, stmt, " (an output after a motion without BREAK)")
+            else:
+                add(SetSignal(comment or f"OUT{sig.group(2)}", int(sig.group(2)), not sig.group(1)), number)
             continue
         sw = _SWAIT.match(stmt)
         if sw:

@@ -38,6 +38,7 @@ from robomax_py.program import (
     Program,
     ProgramSetup,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -107,7 +108,16 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
         phases = traj.phases_of(trans.kind, trans.label)
         start = f"t {phases[0].t_start - t0:.3f} s" if phases else ""
         approach_follows = k < len(result.spots)
-        for w, q in enumerate(trans.waypoints[1:], start=1):
+        if trans.spline is not None:
+            # One smooth TCP path (`planner.cartesian_moves: spline`), a spline block: the straight
+            # retract (written with the spot before), the spline points up to the approach point,
+            # the straight approach (written with the spot after).
+            moves = trans.spline
+            for j in range(1, len(moves.targets) - 1):
+                note = f"{trans.label}, {start}, spline" if j == 1 else ""
+                emit(moves.q[j], lin(moves.targets[j], moves.configs[j], float(moves.speeds[j]) * 1000.0,
+                                     comment=note, accel=trans.accel, spline="spl"))
+        for w, q in enumerate(trans.waypoints[1:] if trans.spline is None else (), start=1):
             last = w == len(trans.waypoints) - 1
             if last and approach_follows and trans.approach_q is not None:
                 q = trans.approach_q             # the approach line continued for the fly-by
@@ -138,8 +148,12 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
                                f"{spot.t_leave - t0:.3f} s, alpha {alpha:.1f} beta {beta:.1f} gamma {gamma:.1f} deg"))
         act: Instruction = Spot(identifier(spot.name), identifier(spot.seam), spot.weld_time, spot.gun, spot.schedule) \
             if spot.action is None else Gripper(spot.action, identifier(spot.name), identifier(spot.seam), spot.weld_time)
-        emit(spot.q_spot, lin(spot.T_spot, spot.config, _lin_mm_s(trans, lin_mm_s), comment="approach",
-                              accel=trans.accel), act)
+        if trans.spline is None:
+            emit(spot.q_spot, lin(spot.T_spot, spot.config, _lin_mm_s(trans, lin_mm_s), comment="approach",
+                                  accel=trans.accel), act)
+        else:
+            emit(spot.q_spot, lin(spot.T_spot, spot.config, float(trans.spline.speeds[-1]) * 1000.0,
+                                  comment="approach", accel=trans.accel, spline="slin"), act)
         after = transitions[k + 1] if k + 1 < len(transitions) else None
         # The retract ends where the next move's extended retract does, else at the approach point.
         T_retract, q_end = spot.T_app, spot.q_app
@@ -150,6 +164,11 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
         if after is not None and after.wait is not None:
             emit(spot.q_spot, *_wait(after.wait, setup))
         retract_radius = after.flyby_radius if after is not None else 0.0
+        if after is not None and after.spline is not None:
+            moves = after.spline
+            emit(moves.q[0], lin(moves.targets[0], moves.configs[0], float(moves.speeds[0]) * 1000.0,
+                                 comment="retract, spline", accel=after.accel, spline="slin"))
+            continue
         emit(q_end, lin(T_retract, spot.config_app, lin_mm_s if after is None else _lin_mm_s(after, lin_mm_s),
                         flyby=math.degrees(retract_radius), comment="retract", accel=1.0 if after is None else after.accel))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
@@ -193,3 +212,15 @@ def _wait(w: WaitPlan, setup: ControllerSetup) -> list[Instruction]:
     return [note, Wait(w.seconds)]
 
 
+def set_signal(signal: str, setup: ControllerSetup, value: bool = True) -> SetSignal:
+    """A station's interlock: the robot sets `signal` for the other robots (on when it has left
+    their shared zone), on the output the cell maps it to (`robot.controller.outputs`; none:
+    named only, as SRCL and RAPID set it)."""
+    mapped = setup.output_of(signal)
+    return SetSignal(identifier(signal), None if mapped is None else mapped.number, value)
+
+
+def wait_for(signal: str, setup: ControllerSetup) -> WaitFor:
+    """A wait for a signal (another robot's interlock, a clamp's, a door's), on the input the cell
+    maps it to (none: named only)."""
+    return _wait_for(signal, setup)

@@ -12,9 +12,9 @@ from robomax_py.export.dialect import Dialect
 
 __all__ = ["AS", "FANUC", "INFORM", "KRL", "RAPID", "SHIPPED", "SRCL", "URSCRIPT"]
 
-SRCL = Dialect("srcl", (".srcl",), "", srcl.adapt, srcl.write, srcl.parse)
+SRCL = Dialect("srcl", (".srcl",), "", srcl.adapt, srcl.write, srcl.parse, splines=True)
 KRL = Dialect("krl", (".src", ".dat"), "kuka", krl.adapt, krl.write, krl.parse, krl.frame_name,
-              (krl.FRAMES_FILE,), krl.FILE_ENCODING)
+              (krl.FRAMES_FILE,), krl.FILE_ENCODING, splines=True)
 RAPID = Dialect("rapid", (".mod",), "abb", rapid.adapt, rapid.write, rapid.parse, companions=(rapid.FRAMES_FILE,),
                 named_frames_only=True)
 FANUC = Dialect("fanuc", (".ls",), "fanuc", fanuc.adapt, fanuc.write, fanuc.parse, fanuc.frame_name,

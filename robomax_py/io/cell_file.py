@@ -130,6 +130,11 @@ class InputFile(_Strict):
     name: ControllerName | None = None
 
 
+class OutputFile(_Strict):
+    number: Annotated[int, Field(ge=0, le=65535)]
+    name: ControllerName | None = None
+
+
 class RegistersFile(_Strict):
     position: list[Annotated[int, Field(ge=1, le=9999)]] = []
     numeric: list[Annotated[int, Field(ge=1, le=9999)]] = []
@@ -151,6 +156,8 @@ class RobotControllerFile(_Strict):
     registers: RegistersFile = RegistersFile()
     inputs: dict[Name, Annotated[int, Field(ge=0, le=65535)] | InputFile] = {}
     weld: Literal["call", "package"] = "call"
+    # The signals this robot sets for the others of a station (interlocks), as inputs are given.
+    outputs: dict[Name, Annotated[int, Field(ge=0, le=65535)] | OutputFile] = {}
 
 
 class RobotRefFile(_Strict):
@@ -391,6 +398,9 @@ class PlannerFile(_Strict):
     dynamic: Literal["timed", "rest"] = "timed"
     max_wait: Annotated[float, Field(gt=0, le=MAX_WINDOW_S, allow_inf_nan=False)] = 600.0
     transfers: Literal["moves", "associative"] = "moves"
+    # "spline": a junction's retract, move or detour and approach as one smooth Bézier TCP path
+    # (`plan.spline_junction`) where that is faster than the lines and joint moves with fly-by.
+    cartesian_moves: Literal["lin", "spline"] = "lin"
 
 
 # Tending cells (docs/cell-extensions.md, "Machine tending"): stations visited in a fixed order per cycle, machines

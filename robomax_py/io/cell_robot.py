@@ -1,5 +1,5 @@
 """A cell's `robot` section beyond its model: the home pose checked against the URDF, and the
-controller's tool and user frames, registers and inputs."""
+controller's tool and user frames, registers, inputs and outputs."""
 
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ from robomax_py.spec import (
     CellSpec,
     ControllerFrame,
     ControllerInput,
+    ControllerOutput,
     ControllerSetup,
     RobotSpec,
     UserFrame,
@@ -57,7 +58,23 @@ def _controller(ctrl: RobotControllerFile, cell: CellSpec, path: Path) -> Contro
             raise CellFileError(path, f"{key}.inputs.{signal}", f"input {entry.number} is also {twin.signal}'s")
         inputs.append(entry)
     return ControllerSetup(tool=tool, frame=frame, position_registers=tuple(ctrl.registers.position),
-                           numeric_registers=tuple(ctrl.registers.numeric), inputs=tuple(inputs), weld=ctrl.weld)
+                           numeric_registers=tuple(ctrl.registers.numeric), inputs=tuple(inputs), weld=ctrl.weld,
+                           outputs=_outputs(ctrl, path))
+
+
+def _outputs(ctrl: RobotControllerFile, path: Path) -> tuple[ControllerOutput, ...]:
+    """`robot.controller.outputs`: the signals the robot sets for other robots of a station. Any
+    name is allowed (another robot's input of the same name is what the signal drives); numbers
+    must be unique, as inputs' are."""
+    outputs: list[ControllerOutput] = []
+    for signal, given in ctrl.outputs.items():
+        entry = ControllerOutput(signal, given, None) if isinstance(given, int) else \
+            ControllerOutput(signal, given.number, given.name)
+        twin = next((o for o in outputs if o.number == entry.number), None)
+        if twin is not None:
+            raise CellFileError(path, f"robot.controller.outputs.{signal}", f"output {entry.number} is also {twin.signal}'s")
+        outputs.append(entry)
+    return tuple(outputs)
 
 
 def _home(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray:

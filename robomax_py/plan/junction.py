@@ -21,6 +21,7 @@ from typing import Protocol
 import numpy as np
 
 from robomax_py._typing import FloatArray
+from robomax_py.plan.spline_moves import SplineMoves
 from robomax_py.program import as_written_joints
 from robomax_py.robot import JointLimits, RobotModel, fk_tcp, prismatic_mask
 from robomax_py.robot.ik.turns import wrap_to_pi
@@ -91,6 +92,7 @@ class Junction:
     corner_radius: float
     checks: int
     extension: Extension = Extension()
+    spline: SplineMoves | None = None       # the junction as one Bézier TCP path (`plan.spline_junction`)
 
 
 def time_junction(

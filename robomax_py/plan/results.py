@@ -7,6 +7,7 @@ from dataclasses import dataclass, field, fields, replace
 from typing import Any, Literal
 
 from robomax_py._typing import FloatArray
+from robomax_py.plan.spline_moves import CartesianChoice, SplineMoves
 from robomax_py.plan.waiting import WaitPlan
 from robomax_py.spec import CellSpec, ControllerSetup
 from robomax_py.timing import (
@@ -92,6 +93,9 @@ class PlanOptions:
     - `jerk_limited`: PTP moves and detour legs timed jerk-limited (ruckig); False: toppra
       (velocity and acceleration limits only).
     - `blend`: fly by detour corners and approach points on checked G2 blends where that is faster.
+    - `cartesian_moves`: "lin" or "spline" (a junction between two spots as one smooth Bézier TCP
+      path where that is faster, `plan.spline_junction`); None takes the cell's
+      `planner.cartesian_moves`.
     """
 
     baseline: bool = False
@@ -113,6 +117,7 @@ class PlanOptions:
     probe_neighbours: int = 6
     jerk_limited: bool = True
     blend: bool = True
+    cartesian_moves: str | None = None
 
     @property
     def method(self) -> str:
@@ -134,6 +139,7 @@ class ResolvedOptions(PlanOptions):
     detour_tcp_speed: float = 1.0
     dynamic: str = "timed"
     transfers: str = "moves"
+    cartesian_moves: str = "lin"
 
 
 # The methods `plan --baseline` and the benchmarks compare, each as the options that plan it (every
@@ -220,6 +226,10 @@ class Transition:
     lin_targets: FloatArray | None = None
     lin_configs: tuple[str, ...] = ()
     lin_speed: float = 0.0
+    # `planner.cartesian_moves: spline`: the junction as one smooth Bézier TCP path where that was
+    # chosen (None: as above), and how it was chosen (None: no spline was tried).
+    spline: SplineMoves | None = None
+    choice: CartesianChoice | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -342,6 +352,7 @@ def resolved_options(cell: CellSpec, options: PlanOptions) -> ResolvedOptions:
         "detour_tcp_speed": p.detour_tcp_speed if options.detour_tcp_speed is None else options.detour_tcp_speed,
         "dynamic": p.dynamic if options.dynamic is None else options.dynamic,
         "transfers": p.transfers if options.transfers is None else options.transfers,
+        "cartesian_moves": p.cartesian_moves if options.cartesian_moves is None else options.cartesian_moves,
     })
 
 

@@ -40,6 +40,8 @@ from robomax_py.plan.results import (
 )
 from robomax_py.plan.roadmap import Roadmap
 from robomax_py.plan.sequence import HOME, Tour
+from robomax_py.plan.spline_junction import SplineSettings, choose, spline_variant
+from robomax_py.plan.spline_moves import CartesianChoice
 from robomax_py.plan.tcp_route import TcpSpace, dynamic_boxes, tcp_space
 from robomax_py.plan.timed_moves import (
     DynamicConflicts,
@@ -112,12 +114,25 @@ def time_tour(
         load = LoadOverrides.of(cell, robot, part, speed, options.tcp_speed * options.speed)
         lin_targets, lin_speed = _lines(cell, trans, after, part, options)
 
+        choice: CartesianChoice | None = None
+
         def timed(load: LoadOverrides) -> Junction:
-            return time_junction(
+            nonlocal choice
+            junction = time_junction(
                 robot, checked, robot.limits, q_start, waypoints, trans.kind, trans.label, before, after,
                 tcp_speed=load.tcp_speed, speed=load.speed, accel=load.accel, jerk_limited=options.jerk_limited,
                 flyby=options.blend, lin_targets=lin_targets, lin_speed=lin_speed,
             )
+            # Splines join two spots in a static world: a junction timed around dynamic objects keeps
+            # the motion its windows were searched for.
+            if options.cartesian_moves != "spline" or before is None or after is None or trans.stages or cell.dynamic:
+                return junction
+            settings = _spline_settings(cell, part, options, load)
+            variant = spline_variant(robot, checked, robot.limits, q_start, waypoints, trans.kind, trans.label,
+                                     before, after, settings, lin_targets, sum(s.duration for s in junction.segments))
+            # Only KUKA's controllers run a spline block (`Dialect.splines`); the others run its lines.
+            junction, choice = choose(junction, variant, native=robot.controller.brand == "kuka")
+            return junction
 
         junction = timed(load)
         tcp_limits = tcp_limits_after(cell, part)
@@ -131,7 +146,12 @@ def time_tour(
         if part is not None or tcp_limits is not None:
             trans = replace(trans, part=part, speed=load.speed, accel=load.accel, tcp_speed=load.tcp_speed)
         block = list(junction.segments)
-        if lin_targets is not None:
+        if junction.spline is not None:
+            moves = junction.spline
+            configs = tuple(config_text(robot, q) for q in moves.q)
+            trans = replace(trans, lin_targets=None, lin_configs=(), lin_speed=0.0,
+                            spline=replace(moves, configs=configs))
+        elif lin_targets is not None:
             # The lines as timed: the configuration each ends in, its configuration data.
             legs = [seg for seg in block if seg.kind == trans.kind]
             line_ends = np.array([seg.q[-1] for seg in legs])
@@ -141,7 +161,8 @@ def time_tour(
         if after is not None:
             block.append(dwell(block[-1].q[-1], weld_times[k], kind="weld", label=after.label))
         return block, replace(trans, blend_radius=junction.corner_radius, flyby_radius=junction.junction_radius,
-                              retract_T=ext.retract_T, retract_q=ext.retract_q, approach_q=ext.approach_q)
+                              retract_T=ext.retract_T, retract_q=ext.retract_q, approach_q=ext.approach_q,
+                              choice=choice)
 
     for k in range(len(transitions)):
         progress("timing", k, len(transitions))
@@ -174,6 +195,16 @@ def time_tour(
                               weld_times[k], cell.process.gun,
                               cell.process.schedule_of(spec_of[k]), waits_for[k], spec_of[k].action))
     return traj, plans, timed
+
+
+def _spline_settings(cell: CellSpec, part: str | None, options: ResolvedOptions, load: LoadOverrides) -> SplineSettings:
+    """A spline junction's speeds: the approach lines' as the junction's, the curve's lines at the
+    detour line speed (override applied, within a carried part's limit), the cell's TCP limits."""
+    limits = tcp_limits_after(cell, part)
+    curve = written_tcp_speed(options.detour_tcp_speed * options.speed)
+    if limits is not None and limits.v < curve:
+        curve = math.floor(limits.v * 1000.0) / 1000.0
+    return SplineSettings(load.tcp_speed, curve, load.accel, limits, options.jerk_limited)
 
 
 def _lines(cell: CellSpec, trans: Transition, after: WeldEnd | None, part: str | None,

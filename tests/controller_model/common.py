@@ -3,7 +3,8 @@
 Records
 -------
 A run (`ProgramRun`) is the program's events in execution order — `Motion`, `Call` (a process or
-subroutine call, the FANUC ``SPOT[...]`` option and ABB ``SpotL``/``SpotJ`` included) and `Wait` —
+subroutine call, the FANUC ``SPOT[...]`` option and ABB ``SpotL``/``SpotJ`` included), `Wait` and
+`SetOutput` (a digital output switched: the other half of a wait between robots) —
 plus `Issue`s: statements outside the modelled subset (``unsupported``), controller alarms
 (``alarm``) and data the program uses but neither it nor the caller defines (``undefined``). After
 an issue the model goes on with the next statement, as straight-line execution would; a run with
@@ -216,7 +217,21 @@ class Wait:
     state: bool | None = None
 
 
-Event: TypeAlias = Motion | Call | Wait
+@dataclass(frozen=True, slots=True)
+class SetOutput:
+    """A digital output switched: `signal` as written, its number when the statement or a
+    declaration names one, and the state it is set to. Where the vendor executes it only once the
+    motion before has ended (KRL without CONTINUE, RAPID and FANUC after a stop point, URScript
+    after a move without blend), `after_stop` says the robot is at rest then."""
+
+    where: Where
+    signal: str
+    output_number: int | None
+    state: bool
+    after_stop: bool = True
+
+
+Event: TypeAlias = Motion | Call | Wait | SetOutput
 
 
 @dataclass(frozen=True, slots=True)

@@ -61,6 +61,7 @@ from .common import (
     Motion,
     MotionKind,
     ProgramRun,
+    SetOutput,
     Wait,
     Where,
     arg_value,
@@ -409,6 +410,13 @@ def _execute(line: _Line, positions: dict[int, _Position], state: _State, moving
         return
     if re.match(r"^WAIT\b", code, re.IGNORECASE):
         _wait(line, state)
+        return
+    do = re.fullmatch(r"DO\[\s*(\d+)\s*(?::([^\]]*))?\]\s*=\s*(ON|OFF)", code, re.IGNORECASE)
+    if do:
+        # DO[k]=ON/OFF (FANUC TP I/O instructions): after a FINE point the robot is at rest when it runs.
+        last = next((e for e in reversed(state.events) if isinstance(e, Motion)), None)
+        state.events.append(SetOutput(line.where, f"DO[{do.group(1)}]", int(do.group(1)), do.group(3).upper() == "ON",
+                                      after_stop=last is None or last.stops))
         return
     if _INERT.match(code) and not re.search(r"\bCALL\b|\bRUN\b", code, re.IGNORECASE):
         return

@@ -31,19 +31,27 @@ KRC/R1/Mada/$machine.dat; CHINA = HugoDanielson/ChinaMilling @ 04c963fe, KSS 8.3
   ``C_PTP``/``C_DIS``/``C_VEL``/``C_ORI`` kept as written (KSS 8.3 writes ``LIN X C_DIS C_DIS``);
   none = exact stop. A partial aggregate (missing components are taken from the current position)
   is reported.
+- Spline blocks (KUKA System Software 8.x, Operating and Programming Instructions for System
+  Integrators, "Spline motion type"): ``SPLINE`` ... ``ENDSPLINE`` with ``SPL`` points and ``SLIN``
+  straight segments to named points or aggregates, each with at most ``WITH $VEL.CP = v`` (the
+  segment's path speed: no effect on targets). The path passes through every point without
+  stopping (blend ``"SPLINE"``) and stops at the last (``ENDSPLINE`` without ``C_SPL``). A block
+  ``WITH`` other variables, ``ENDSPLINE C_SPL``, a segment outside a block, ``SCIRC`` and the
+  spline's PTP forms are reported.
 - ``WAIT SEC t``; ``WAIT FOR $IN[k]`` (``==TRUE``/``==FALSE``/``NOT``) or a name declared by
   ``SIGNAL name $IN[k]``. A call of a DEF of the .src without parameters runs its body (`_Flow`:
   RETURN, HALT, GOTO and jump labels too); other subroutine calls are recorded (name, args), not
   followed, and a call with arguments of a routine given in the texts that moves or changes
   frames is reported.
 
-Outside this subset (control flow, relative and spline motions, CIRC, offsets and geometric
-operators, $ROBROOT or $IPO_MODE changes, interrupts other than the template's stop-message
+Outside this subset (control flow, relative motions, spline motions other than the blocks above, CIRC,
+offsets and geometric operators, $ROBROOT or $IPO_MODE changes, interrupts other than the template's stop-message
 handler, assignments to position variables, function calls) a statement is an ``unsupported`` issue.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -60,6 +68,7 @@ from .common import (
     Motion,
     MotionKind,
     ProgramRun,
+    SetOutput,
     Wait,
     Where,
     arg_value,
@@ -115,9 +124,12 @@ class _State:
     base_data: dict[int, FloatArray]
     variables: dict[str, _Value] = field(default_factory=dict)
     signals: dict[str, int] = field(default_factory=dict)
+    outputs: dict[str, int] = field(default_factory=dict)     # SIGNAL name -> $OUT number
+    continued: bool = False                                     # CONTINUE before this statement
     fdat: _Value | None = None
     events: list[Event] = field(default_factory=list)
     issues: list[Issue] = field(default_factory=list)
+    spline: int | None = None          # inside SPLINE ... ENDSPLINE: the index of its first event
 
     def issue(self, line: _Line, kind: IssueKind, reason: str) -> None:
         self.issues.append(Issue(line.where, kind, line.raw.strip(), reason))
@@ -308,6 +320,8 @@ def _declaration(line: _Line, state: _State) -> bool:
     if sig:
         if sig.group(2).upper() == "IN" and not sig.group(4):
             state.signals[sig.group(1).upper()] = int(sig.group(3))
+        elif sig.group(2).upper() == "OUT" and not sig.group(4):
+            state.outputs[sig.group(1).upper()] = int(sig.group(3))
         return True
     m = _DECL_RE.match(code)
     if not m or not (m.group(1) or re.fullmatch(_DECL_TYPES, m.group(2), re.IGNORECASE)):
@@ -429,6 +443,20 @@ def _execute(line: _Line, state: _State, moving: set[str]) -> None:
         return
     if _declaration(line, state) or _stored_frame(line, state):
         return
+    if re.fullmatch(r"CONTINUE", code, re.IGNORECASE):
+        state.continued = True
+        return
+    continued, state.continued = state.continued, False
+    out = re.fullmatch(r"(\$OUT\s*\[\s*(\d+)\s*\]|\w+)\s*=\s*(TRUE|FALSE)", code, re.IGNORECASE)
+    if out and (out.group(2) or _name(out.group(1)) in state.outputs):
+        # KSS: an output assignment stops the advance run unless CONTINUE precedes it (the OUT
+        # inline form's CONT), so it is set once the motion before it has ended.
+        number = int(out.group(2)) if out.group(2) else state.outputs[_name(out.group(1))]
+        state.events.append(SetOutput(line.where, out.group(1), number, out.group(3).upper() == "TRUE",
+                                      after_stop=not continued))
+        return
+    if _spline(line, state):
+        return
     if _UNSUPPORTED_MOTION.match(code):
         state.issue(line, "unsupported", "motion type outside the modelled subset (PTP, LIN)")
         return
@@ -490,6 +518,44 @@ def _execute(line: _Line, state: _State, moving: set[str]) -> None:
             state.issue(line, "unsupported", "function call in an expression (may act on motion)")
         return   # a plain variable assignment: no motion
     state.issue(line, "unsupported", "statement outside the modelled subset")
+
+
+_SEGMENT_RE = re.compile(r"^(SPL|SLIN)\s+(.+?)(?:\s+WITH\s+(.+))?$", re.IGNORECASE)
+
+
+def _spline(line: _Line, state: _State) -> bool:
+    """A statement of a spline block, handled (True) or not one (False)."""
+    code = line.code
+    word = code.split()[0].upper()
+    if word == "SPLINE":
+        if code.upper() != "SPLINE":
+            state.issue(line, "unsupported", "a spline block WITH system variables")
+        elif state.spline is not None:
+            state.issue(line, "alarm", "SPLINE inside a spline block")
+        state.spline = len(state.events)
+        return True
+    if word == "ENDSPLINE":
+        if state.spline is None:
+            state.issue(line, "alarm", "ENDSPLINE without SPLINE")
+        elif code.upper() != "ENDSPLINE":
+            state.issue(line, "unsupported", "an approximated spline block (C_SPL)")
+        elif state.events and len(state.events) > state.spline and isinstance(state.events[-1], Motion):
+            # The block ends at an exact stop at its last point.
+            state.events[-1] = dataclasses.replace(state.events[-1], blend=None)
+        state.spline = None
+        return True
+    segment = _SEGMENT_RE.match(code)
+    if word not in ("SPL", "SLIN") or segment is None:
+        return False
+    if state.spline is None:
+        state.issue(line, "unsupported", f"{word} outside a spline block (a spline motion of its own)")
+        return True
+    if segment.group(3) is not None and not re.fullmatch(r"\$VEL\.CP\s*=\s*[0-9.]+", segment.group(3).strip(),
+                                                         re.IGNORECASE):
+        state.issue(line, "unsupported", "a segment WITH variables other than $VEL.CP")
+        return True
+    _motion(line, word, segment.group(2).strip(), " SPLINE", state)
+    return True
 
 
 def _frame_assignment(line: _Line, which: str, expr: str, state: _State) -> None:
@@ -573,7 +639,7 @@ def _numbered(line: _Line, table_name: str, number: int, table: dict[int, FloatA
 
 
 def _motion(line: _Line, statement: str, target: str, approx: str, state: _State) -> None:
-    kind: MotionKind = "joint" if statement == "PTP" else "linear"
+    kind: MotionKind = "joint" if statement == "PTP" else "linear"      # SPL / SLIN: Cartesian targets
     fields: dict[str, str] | None
     type_: str
     if target.startswith("{"):
@@ -591,14 +657,14 @@ def _motion(line: _Line, statement: str, target: str, approx: str, state: _State
     if fields is None:
         state.issue(line, "unsupported", "malformed aggregate")
         return
-    blend = " ".join(approx.upper().split()) or None   # "C_DIS", or "C_DIS C_DIS" as KSS 8.3 writes LIN
+    blend = " ".join(approx.upper().split()) or None   # "C_DIS", or "C_DIS C_DIS" as KSS 8.3 writes LIN; "SPLINE"
     external = [k for k in ("E1", "E2", "E3", "E4", "E5", "E6") if k in fields and fields[k] != "0"
                 and not (is_number(fields[k]) and float(fields[k]) == 0.0)]
     if external:
         state.issue(line, "unsupported", f"external axis values {', '.join(external)} are not modelled")
     if type_ in {"E6AXIS", "AXIS"}:
-        if statement == "LIN":
-            state.issue(line, "unsupported", "LIN to an axis position")
+        if statement != "PTP":
+            state.issue(line, "unsupported", f"{statement} to an axis position")
             return
         if not all(k in fields and is_number(fields[k]) for k in _AXES):
             state.issue(line, "unsupported", "partial axis aggregate (missing axes keep their current value)")

@@ -56,6 +56,7 @@ from .common import (
     MotionKind,
     ProgramRun,
     RapidConfig,
+    SetOutput,
     Wait,
     Where,
     arg_value,
@@ -81,7 +82,7 @@ _MOTION_LIKE = re.compile(
     r"RestoPath|ActUnit|DeactUnit|Ind[ACDR]Move|IndReset|SoftAct|SoftDeact|CirPathMode|PDisp\w*|EOffs\w*|"
     r"SyncMove\w*|ConfJ|ConfL|CSSAct|CSSDeact|ContactL|SensorOn|SensorOff|WZ\w*)$", re.IGNORECASE)
 _INERT = re.compile(
-    r"^(VelSet|AccSet|SetDO|SetAO|SetGO|PulseDO|Set|Reset|TPWrite|TPErase|ErrWrite|SingArea|GripLoad|"
+    r"^(VelSet|AccSet|SetAO|SetGO|PulseDO|TPWrite|TPErase|ErrWrite|SingArea|GripLoad|"
     r"WorldAccLim|PathAccLim|SpeedRefresh|InvertDO|Load)$", re.IGNORECASE)
 _POSITION_TYPES = {"robtarget", "jointtarget", "tooldata", "wobjdata", "pose", "pos", "orient", "confdata"}
 _IDENTITY_WOBJ: Value = [False, True, "", [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]],
@@ -109,6 +110,7 @@ class _State:
     signals: dict[str, int]
     procedures: dict[str, list[_Statement]]
     parameters: dict[str, bool] = field(default_factory=dict)   # procedure -> whether it has any
+    outputs: dict[str, int] = field(default_factory=dict)      # the I/O configuration's digital outputs
     events: list[Event] = field(default_factory=list)
     issues: list[Issue] = field(default_factory=list)
 
@@ -117,7 +119,7 @@ class _State:
 
 
 def run_rapid(modules: Sequence[str] | Mapping[str, str], *, entry: str = "main",
-              signals: Mapping[str, int] | None = None) -> ProgramRun:
+              signals: Mapping[str, int] | None = None, outputs: Mapping[str, int] | None = None) -> ProgramRun:
     """Runs procedure `entry` of a task made of `modules` (texts; a mapping names them).
 
     Parameters
@@ -127,6 +129,8 @@ def run_rapid(modules: Sequence[str] | Mapping[str, str], *, entry: str = "main"
         The procedure to run (RAPID's main routine, ``main`` by default).
     signals : mapping of signal name to input number, optional
         The I/O configuration's digital inputs, to number the WaitDI signals.
+    outputs : mapping of signal name to output number, optional
+        Its digital outputs, to number the SetDO signals.
 
     Returns
     -------
@@ -136,7 +140,8 @@ def run_rapid(modules: Sequence[str] | Mapping[str, str], *, entry: str = "main"
     """
     named = modules if isinstance(modules, Mapping) else {f"module{i + 1}.mod": t for i, t in enumerate(modules)}
     state = _State(data={"TOOL0": _Data("tooldata", _IDENTITY_TOOL), "WOBJ0": _Data("wobjdata", _IDENTITY_WOBJ)},
-                   signals={k.upper(): v for k, v in (signals or {}).items()}, procedures={})
+                   signals={k.upper(): v for k, v in (signals or {}).items()}, procedures={},
+                   outputs={k.upper(): v for k, v in (outputs or {}).items()})
     for name, text in named.items():
         _read_module(_statements(text, name), state)
     body = state.procedures.get(entry.upper())
@@ -403,6 +408,19 @@ def _execute(st: _Statement, state: _State, moving: set[str]) -> None:
                                      state=args.positional[1] == "1"))
         else:
             state.issue(st, "unsupported", "WaitDI other than WaitDI signal, 0|1")
+        return
+    if upper in ("SETDO", "SET", "RESET"):
+        # SetDO Signal, Value; Set Signal (1); Reset Signal (0) (RAPID instructions reference). After
+        # a stop point (zone fine) the robot is at rest when it runs; \SDelay sets it later, in the
+        # background: not modelled.
+        value = args.positional[1] if upper == "SETDO" and len(args.positional) == 2 else \
+            ("1" if upper == "SET" else "0") if upper != "SETDO" and len(args.positional) == 1 else None
+        if value in ("0", "1") and not set(args.optional) - {"SYNC"}:
+            last = next((e for e in reversed(state.events) if isinstance(e, Motion)), None)
+            state.events.append(SetOutput(st.where, args.positional[0], state.outputs.get(args.positional[0].upper()),
+                                          value == "1", after_stop=last is None or last.stops))
+        else:
+            state.issue(st, "unsupported", f"{name} other than SetDO signal, 0|1 / Set / Reset signal")
         return
     if upper in ("CONFJ", "CONFL"):
         if set(args.optional) == {"ON"} and not args.positional:

@@ -269,3 +269,63 @@ END
     assert_allclose(_known(_motion_at(run.motions, 4).T_base_tcp), T2, atol=POS_TOL_M)
     assert_allclose(_known(_motion_at(run.motions, 6).T_base_tcp), np.eye(4), atol=POS_TOL_M)
     assert_allclose(_known(_motion_at(run.motions, 6).T_flange_tcp), T1, atol=POS_TOL_M)
+
+
+def test_a_spline_block_passes_its_points_and_stops_at_its_last() -> None:
+    src = """DEF t()
+$TOOL = {X 0, Y 0, Z 200, A 0, B 0, C 0}
+$BASE = {X 100, Y 0, Z 0, A 90, B 0, C 0}
+SPLINE
+  SLIN {X 0, Y 0, Z 30, A 0, B 0, C 0} WITH $VEL.CP = 0.5
+  SPL {X 10, Y 5, Z 40, A 0, B 0, C 0} WITH $VEL.CP = 1
+  SPL {X 20, Y 0, Z 30, A 0, B 0, C 0}
+  SLIN {X 20, Y 0, Z 0, A 0, B 0, C 0} WITH $VEL.CP = 0.5
+ENDSPLINE
+END
+"""
+    run = run_krl(src)
+    assert run.clean, run.issues
+    motions = run.motions
+    assert [m.statement for m in motions] == ["SLIN", "SPL", "SPL", "SLIN"]
+    assert [m.stops for m in motions] == [False, False, False, True]
+    # Each point composed with $BASE as a LIN's: 10 mm along the base's X at (100, 10, 0) mm, turned 90 deg.
+    assert_allclose(_known(motions[1].T_base_tcp), _pose((0.095, 0.01, 0.04), _zyx(90, 0, 0)), atol=POS_TOL_M)
+
+
+def test_spline_forms_outside_the_model_are_reported() -> None:
+    head = "DEF t()\n$TOOL = $NULLFRAME\n$BASE = $NULLFRAME\n"
+    point = "{X 0, Y 0, Z 30, A 0, B 0, C 0}"
+    for body, why in ((f"SPLINE\nSLIN {point}\nENDSPLINE C_SPL\n", "C_SPL"),
+                      (f"SPL {point}\n", "outside"),
+                      (f"SPLINE WITH $ACC = {{CP 2.0, ORI1 200, ORI2 200}}\nSLIN {point}\nENDSPLINE\n", "WITH"),
+                      (f"SPLINE\nSLIN {point} WITH $ORI_TYPE = #JOINT\nENDSPLINE\n", "other variables")):
+        run = run_krl(head + body + "END\n")
+        assert any(i.kind == "unsupported" for i in run.issues), why
+
+
+def test_robomax_spline_program_welds_at_the_spots() -> None:
+    """The planner's KRL spline program (tests/golden/spline_cell, a cell moved, yawed and raised with
+    its robot, targets in user frame 3 on the fixture, stored by the frames program: in the robot
+    base they are where the unmoved cell's spots are in the world) runs cleanly, every block stops
+    where a weld follows, and each weld is at its spot within 0.1 mm."""
+    from pathlib import Path
+
+    import yaml
+
+    repo = Path(__file__).resolve().parents[2]
+    golden = repo / "tests" / "golden" / "spline_cell"
+    src, dat = ((golden / f"spline_cell{k}").read_text(encoding="cp1252") for k in (".src", ".dat"))
+    setup = {"spline_cell_frames.src": (golden / "spline_cell_frames.src").read_text(encoding="cp1252")}
+    run = run_krl(src, dat, setup=setup)
+    assert run.clean, run.issues
+    assert any(m.statement == "SPL" for m in run.motions)
+    cell = yaml.safe_load((repo / "tests" / "data" / "spline_cell" / "spline_cell.yaml").read_text())
+    spots = {s["name"]: np.array(s["xyz"], dtype=float) for s in cell["seams"][0]["spots"]}
+    events = list(run.events)
+    welds = [k for k, e in enumerate(events) if getattr(e, "name", "") == "spot_weld"]
+    assert len(welds) == len(spots)
+    for k in welds:
+        before = next(e for e in reversed(events[:k]) if isinstance(e, Motion))
+        assert before.stops, f"the motion before the weld at {events[k].where} flies by"
+        tcp = _known(before.T_base_tcp)[:3, 3]
+        assert min(float(np.linalg.norm(tcp - p)) for p in spots.values()) <= 1e-4

@@ -53,6 +53,7 @@ from .common import (
     Motion,
     MotionKind,
     ProgramRun,
+    SetOutput,
     Wait,
     Where,
     arg_value,
@@ -306,6 +307,17 @@ def _statement(line: _Line, state: _State) -> None:
         if _moves(state.functions[func]):
             state.issue(line, "unsupported", f"{func} moves the robot or sets the TCP; calls are not followed")
         state.events.append(Call(line.where, func, tuple(arg_value(a) for a in args)))
+        return
+    if func == "set_standard_digital_out":
+        # set_standard_digital_out(n, b): standard output n in [0:7] to b (UR Script Manual).
+        if len(args) == 2 and re.fullmatch(r"[0-7]", args[0]) and args[1] in ("True", "False"):
+            last = next((e for e in reversed(state.events) if isinstance(e, Motion)), None)
+            state.events.append(SetOutput(line.where, f"digital_out[{args[0]}]", int(args[0]), args[1] == "True",
+                                          after_stop=last is None or last.stops))
+        elif len(args) == 2 and re.fullmatch(r"\d+", args[0]):
+            state.issue(line, "alarm", f"standard digital output {args[0]} does not exist (0..7)")
+        else:
+            state.issue(line, "unsupported", "set_standard_digital_out with an expression")
         return
     if _INERT_CALL.match(func):
         return

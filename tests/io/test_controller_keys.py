@@ -119,3 +119,29 @@ def test_a_tool_number_beyond_the_controllers_slots_stops_plan(
     result = runner.invoke(app, ["plan", str(path), "-o", str(tmp_path / "out"), "--format", "fanuc"])
     assert result.exit_code == EXIT_BAD_INPUT, result.output
     assert "robot.controller.tool.number" in result.output and "1..10" in result.output
+
+
+def test_outputs_load_as_given(tmp_path: Path, write_small_cell: Callable[..., Path]) -> None:
+    """A station's interlock outputs: any signal name (another robot's input of that name is what
+    it drives), a number or {number, name}, as inputs are given."""
+    path = _cell(tmp_path, write_small_cell, {"outputs": {"r1_z1_clear": 3, "r1_z2_clear": {"number": 4, "name": "doZ2"}}},
+                 signal=False)
+    setup = load_cell(path).controller
+    first, second = setup.output_of("r1_z1_clear"), setup.output_of("r1_z2_clear")
+    assert first is not None and (first.number, first.name) == (3, None)
+    assert second is not None and (second.number, second.name) == (4, "doZ2")
+    assert setup.output_of("r1_z3_clear") is None
+
+
+@pytest.mark.parametrize(("outputs", "key", "problem"), [
+    ({"a_clear": 3, "b_clear": 3}, "robot.controller.outputs.b_clear", "output 3 is also a_clear's"),
+    ({"a_clear": -1}, "robot.controller.outputs", ""),
+    ({"a_clear": {"number": 2, "name": "9do"}}, "robot.controller.outputs", ""),
+])
+def test_output_mistakes_name_the_key(tmp_path: Path, write_small_cell: Callable[..., Path], outputs: dict[str, Any],
+                                      key: str, problem: str) -> None:
+    path = _cell(tmp_path, write_small_cell, {"outputs": outputs}, signal=False)
+    with pytest.raises(CellFileError) as caught:
+        load_cell(path)
+    assert caught.value.key is not None and caught.value.key.startswith(key), caught.value
+    assert problem in str(caught.value)

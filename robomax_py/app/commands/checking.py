@@ -69,8 +69,12 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
         from robomax_py.errors import CellFileError
         from robomax_py.io.cell import load_cell, load_cell_robot, read_cell_frames
         from robomax_py.io.frames import format_tree
+        from robomax_py.io.station import is_station_file
         from robomax_py.plan.reach import reach_report, self_contacts
 
+        if is_station_file(cell):
+            _check_station(cell, as_json)
+            return
         spec = load_cell(cell)
         tree, included = read_cell_frames(cell)
         _warn([str(n) for n in spec.notices])   # probable mistakes: warnings, the cell is still valid
@@ -115,3 +119,45 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
         out.print(f"[green]ok[/]: {cell} is a valid cell")
 
     _guarded(run, "check" if as_json else None)
+
+
+def _check_station(path: Path, as_json: bool) -> None:
+    """`robomax check` of a station file: each robot read as its cell, its reach of the spots it may weld."""
+    from robomax_py.errors import CellFileError
+    from robomax_py.io.cell import load_cell_robot
+    from robomax_py.io.station import load_station
+    from robomax_py.plan.reach import reach_report
+
+    station = load_station(path)
+    _warn([str(n) for n in station.notices])
+    rows = []
+    reachable: dict[tuple[str, str], list[str]] = {}
+    for r in station.robots:
+        robot = load_cell_robot(r.cell)
+        _warn([f"{r.name}: {w}" for w in robot.warnings])
+        allowed = set(station.allowed(r.name))
+        reach = [x for x in reach_report(r.cell, robot) if (x.seam, x.name) in allowed]
+        for x in reach:
+            if x.reachable:
+                reachable.setdefault((x.seam, x.name), []).append(r.name)
+        rows.append({"name": r.name, "model": r.cell.robot.name, "tool": r.cell.tool.name,
+                     "brand": r.cell.robot.controller.brand, "may_weld": len(allowed),
+                     "within_reach": sum(x.reachable for x in reach),
+                     "interlock_inputs": [r.interlock_inputs.first, r.interlock_inputs.last],
+                     "interlock_outputs": [r.interlock_outputs.first, r.interlock_outputs.last]})
+    orphan = [s for s in station.spots if s.key not in reachable]
+    if orphan:
+        more = f" ({len(orphan) - 1} more spot(s) out of every robot's reach)" if len(orphan) > 1 else ""
+        raise CellFileError(path, "seams", f"spot {orphan[0].seam}/{orphan[0].spot} is out of the reach of every robot "
+                            f"that may weld it ({', '.join(orphan[0].robots)}){more}")
+    if as_json:
+        _print_json("check", True, {"cell": str(path), "name": station.name, "station": True, "robots": rows,
+                                    "spots": len(station.spots)})
+        return
+    out.print(f"station {station.name}: {len(station.robots)} robots, {len(station.spots)} spots", markup=False,
+              highlight=False)
+    for row in rows:
+        out.print(f"  {row['name']}: {row['model']} with {row['tool']} ({row['brand']}), may weld {row['may_weld']} "
+                  f"spots, {row['within_reach']} within reach; interlock inputs {row['interlock_inputs']}, outputs "
+                  f"{row['interlock_outputs']}", markup=False, highlight=False, soft_wrap=True)
+    out.print(f"[green]ok[/]: {path} is a valid station")

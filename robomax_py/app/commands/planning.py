@@ -66,6 +66,18 @@ def plan(
         _honour_signals()
 
         configure_logging(err, verbose)
+        from robomax_py.io.station import is_station_file
+
+        if is_station_file(cell):
+            from robomax_py.app.station_command import plan_station_files
+
+            if method != "optimised" or plot:
+                from robomax_py.errors import CellFileError
+
+                raise CellFileError(cell, "robots", "--baseline and --plot plan single-robot cells; a station "
+                                    "compares its methods in tests/bench/bench_station.py")
+            return plan_station_files(cell, out_dir, formats, speed, as_json,
+                                      datetime.date.today().isoformat() if stamp else "")
         t0 = time.perf_counter()
         spec = load_cell(cell)
         _warn([str(n) for n in spec.notices])
@@ -161,15 +173,27 @@ def _stale_programs(out_dir: Path, name: str, every: bool = False) -> list[str]:
 @_command()
 def verify(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
-    program: Annotated[Path, typer.Argument(help="a program (.srcl, .src, .mod, .ls, .script: the motion rebuilt from its statements) or a trajectory file (.json)")],
+    programs: Annotated[list[Path], typer.Argument(help="a program (.srcl, .src, .mod, .ls, .script: the motion rebuilt from its statements) or a trajectory file (.json); for a station, its output folder or one program per robot")],
     as_json: JsonFlag = False,
+    chart: Annotated[bool, typer.Option("--chart", help="station: write the replay's Gantt chart <station>.gantt.png beside the programs")] = False,
 ) -> None:
-    """Re-simulate a program against the cell; report collisions, limit and tolerance violations."""
+    """Re-simulate a program against the cell; report collisions, limit and tolerance violations.
+    A station's programs are replayed together on one clock: robot-robot contacts, each program's
+    own violations, deadlocks and waits for signals no robot sets."""
 
     def run() -> int:
+        from robomax_py.errors import ProgramError
         from robomax_py.io.cell import load_cell, load_cell_robot
+        from robomax_py.io.station import is_station_file
         from robomax_py.verify import verify_program
 
+        if is_station_file(cell):
+            from robomax_py.app.station_report import print_station_verify
+
+            return print_station_verify(cell, programs, as_json, chart)
+        if len(programs) != 1:
+            raise ProgramError(cell, None, f"a cell's verify takes one program, got {len(programs)}")
+        program = programs[0]
         spec = load_cell(cell)
         robot = load_cell_robot(spec)
         report = verify_program(spec, robot, program)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated
 
@@ -17,10 +18,38 @@ from robomax_py.app.commands.base import (
 )
 
 
+def _preview_station(station: Path, programs: Path | None, html: Path | None, as_json: bool,
+                     announce: Callable[[str], None], host: str, port: int | None) -> None:
+    """A station's robots on the clock of their replay (`app.preview_station`): one HTML page, or
+    served until Ctrl-C."""
+    from robomax_py.app.preview_station import (
+        serve_station,
+        shown_station,
+        write_station_html,
+    )
+    from robomax_py.errors import ProgramError
+
+    if programs is None:
+        raise ProgramError(station, None, "a station's preview needs its output folder (or a program of it)")
+    robots, zones = shown_station(station, programs)
+    if html is None:
+        serve_station(robots, zones, announce, host=host, port=port)
+        (err if as_json else out).print("preview stopped")
+        return
+    content = write_station_html(html, robots, zones)
+    if as_json:
+        _print_json("preview", True, {"cell": str(station), "program": str(programs), "url": None, "files": [str(html)],
+                                      "frames": content.frames, "duration": round(content.duration, 4),
+                                      "robots": [r.name for r in robots], "zones": len(zones)})
+        return
+    out.print(f"wrote {html} ({len(robots)} robots, {len(zones)} interlock zones, {content.frames} animation frames, "
+              f"{content.duration:.3f} s)")
+
+
 @_command()
 def preview(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
-    program: Annotated[Path | None, typer.Argument(help="program written by plan (.json or .srcl); without it the robot stands at home")] = None,
+    program: Annotated[Path | None, typer.Argument(help="program written by plan (.json or .srcl); without it the robot stands at home; for a station, its output folder (with --html)")] = None,
     html: Annotated[Path | None, typer.Option("--html", help="write one self-contained HTML page instead of serving")] = None,
     voxels: Annotated[float | None, typer.Option("--voxels", min=0.005, max=0.5, metavar="PRECISION",
                                                  help="also draw the voxel map of the static objects (blocked leaves) "
@@ -42,6 +71,25 @@ def preview(
 
         if html is not None and (host != LOOPBACK or port is not None):
             raise typer.BadParameter("--html writes a file; --host and --port are for serving", param_hint="--host/--port")
+        from robomax_py.io.station import is_station_file
+
+        shown_files = {"cell": str(cell), "program": None if program is None else str(program)}
+
+        def announce(url: str) -> None:
+            # Said once the server listens, so a host it cannot bind gets only the error.
+            if not is_loopback(host):
+                where = "every interface of this machine" if host.strip("[]") in WILDCARDS else host
+                _warn([(f"--host {host}: the preview listens on {where}; anyone who can reach it on the network "
+                        "can open the page and see the cell (no password)")])
+            if as_json:                         # one object, flushed now: the page is served until Ctrl-C
+                _print_json("preview", True, {**shown_files, "url": url, "files": []})
+                err.print("serving (Ctrl-C to stop)")
+                return
+            out.print(f"meshcat preview at {url}  (Ctrl-C to stop)", soft_wrap=True)
+
+        if is_station_file(cell):
+            _preview_station(cell, program, html, as_json, announce, host, port)
+            return
         spec = load_cell(cell)
         _warn([str(n) for n in spec.notices])   # what is probably a mistake shows in the scene too
         robot = load_cell_robot(spec)
@@ -58,7 +106,6 @@ def preview(
 
             lo = np.array([-HALF_WIDTH_M, -HALF_WIDTH_M, -0.5])
             vmap = build_voxels(build_scene(replace(spec, dynamic=()), robot), lo, lo + 2 * HALF_WIDTH_M, voxels)
-        shown_files = {"cell": str(cell), "program": None if program is None else str(program)}
         if html is not None:
             content = write_html(html, spec, robot, shown, voxels=vmap)
             if as_json:
@@ -69,18 +116,6 @@ def preview(
             drawn = f", {content.voxels} blocked voxels" if vmap is not None else ""
             out.print(f"wrote {html} ({content.frames} animation frames, cycle {content.duration:.3f} s{drawn})")
             return
-
-        def announce(url: str) -> None:
-            # Said once the server listens, so a host it cannot bind gets only the error.
-            if not is_loopback(host):
-                where = "every interface of this machine" if host.strip("[]") in WILDCARDS else host
-                _warn([(f"--host {host}: the preview listens on {where}; anyone who can reach it on the network "
-                        "can open the page and see the cell (no password)")])
-            if as_json:                         # one object, flushed now: the page is served until Ctrl-C
-                _print_json("preview", True, {**shown_files, "url": url, "files": []})
-                err.print("serving (Ctrl-C to stop)")
-                return
-            out.print(f"meshcat preview at {url}  (Ctrl-C to stop)", soft_wrap=True)
 
         serve(spec, robot, shown, announce, voxels=vmap, host=host, port=port)
         (err if as_json else out).print("preview stopped")

@@ -12,6 +12,8 @@ _MOVE = re.compile(r"^(J|L)\s+P\[([0-9]+)(?::[^\]]*)?\]\s+([0-9.]+)\s*(%|mm/sec|
                    r"(FINE|CNT\s*([0-9]+))(.*)$", re.IGNORECASE)
 _CALL = re.compile(r"^CALL\s+(SPOT_WELD|GRIP|RELEASE)\s*\(\s*([0-9]+)\s*,\s*([0-9]*\.?[0-9]+)\s*\)$", re.IGNORECASE)
 _WAIT = re.compile(r"^WAIT\s+([0-9]*\.?[0-9]+)\s*\(sec\)$", re.IGNORECASE)
+# DO[k:comment]=ON / OFF (FANUC TP operator's manual, digital I/O instructions).
+_SET_DO = re.compile(r"^DO\[([0-9]+)(?::([^\]]*))?\]\s*=\s*(ON|OFF)$", re.IGNORECASE)
 _WAIT_DI = re.compile(r"^WAIT\s+DI\[([0-9]+)(?::([^\]]*))?\]\s*=\s*ON$", re.IGNORECASE)
 _PR_ELEMENT = re.compile(r"^PR\[([0-9]+),([1-6])\]\s*=\s*\(?\s*([+-]?[0-9]*\.?[0-9]+)\s*\)?$", re.IGNORECASE)
 _FRAME_SET = re.compile(r"^(UTOOL|UFRAME)\[([0-9]+)\]\s*=\s*PR\[([0-9]+)\]$", re.IGNORECASE)

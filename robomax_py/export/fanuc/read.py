@@ -21,6 +21,7 @@ from robomax_py.export.fanuc.grammar import (
     _MOVE,
     _PR_ELEMENT,
     _PR_RESET,
+    _SET_DO,
     _SPOT,
     _TARGET_OPTIONS,
     _UNSIMULATED,
@@ -48,6 +49,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -220,6 +222,11 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         wait_di = _WAIT_DI.match(stmt)
         if wait_di:
             add(WaitFor((wait_di.group(2) or f"DI{wait_di.group(1)}").strip(), int(wait_di.group(1))), number, s)
+            continue
+        set_do = _SET_DO.match(stmt)
+        if set_do:
+            add(SetSignal((set_do.group(2) or f"DO{set_do.group(1)}").strip(), int(set_do.group(1)),
+                          set_do.group(3).upper() == "ON"), number, s)
             continue
         if re.match(r"^WAIT\b", stmt, re.IGNORECASE):
             # A wait on a register, a flag, an expression: how long it holds the robot is not known.

@@ -15,6 +15,7 @@ from robomax_py.export.dialect import (
     header_lines,
     numbered_frames,
     numbered_inputs,
+    numbered_outputs,
     percent,
     require_six_axes,
     spot_label,
@@ -32,6 +33,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -49,6 +51,7 @@ WEAPON = "SPOT_WELD"
 ROUTINES = (WEAPON, "GRIP", "RELEASE")
 # R-30iB: tool frames UTOOL[1..10], user frames UFRAME[1..9] (0 is the world frame).
 TOOL_SLOTS, BASE_SLOTS, INPUTS = 10, 9, 9999
+OUTPUTS = INPUTS     # DO[k], numbered as DI[k]
 
 CNT_DEG = 0.12            # joint-space fly-by radius of CNT1, deg
 # Angles (W, P, R and joint values) with 4 decimals, as every robomax program states them (TP's
@@ -148,6 +151,7 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     require_six_axes(robot, "FANUC TP")
     numbered_frames(planned.program, "FANUC TP", TOOL_SLOTS, BASE_SLOTS)
     numbered_inputs(planned.program, "FANUC TP", 1, INPUTS)
+    numbered_outputs(planned.program, "FANUC TP", 1, OUTPUTS)
     registers = planned.program.setup.position_registers
     if registers and len(registers) < len(planned.program.frames):
         raise ControllerSetupError("robot.controller.registers.position", f"the frames setup program sets "
@@ -176,6 +180,8 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
             ins = Wait(math.ceil(round(ins.seconds * 100, 6)) / 100)
         elif isinstance(ins, WaitFor):
             ins = WaitFor(ins.signal[:COMMENT_CHARS], ins.number)       # the input's comment
+        elif isinstance(ins, SetSignal):
+            ins = SetSignal(ins.signal[:COMMENT_CHARS], ins.number, ins.value)   # the output's comment
         out.append(ins)
     frames = tuple(dataclasses.replace(f, xyz_mm=tuple(_round(v, 3) for v in f.xyz_mm),
                                        zyx_deg=tuple(_round(v, ANGLE_DECIMALS) for v in f.zyx_deg))
@@ -274,6 +280,9 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
             mn.append(f"WAIT {_num(ins.seconds, 2):>6}(sec)")
         elif isinstance(ins, WaitFor):
             mn.append(f"WAIT DI[{ins.number}:{ins.signal[:COMMENT_CHARS]}]=ON")
+        elif isinstance(ins, SetSignal):
+            # After a FINE move the robot has stopped before the next line runs (TP: FINE, a stop point).
+            mn.append(f"DO[{ins.number}:{ins.signal[:COMMENT_CHARS]}]={'ON' if ins.value else 'OFF'}")
         elif not isinstance(ins, Comment):
             raise ExportError(f"FANUC TP cannot write {type(ins).__name__}")
     appl = [] if gun is None else ["  SPOT : TRUE ; ", f"  SPOT Welding Equipment Number : {gun} ;"]

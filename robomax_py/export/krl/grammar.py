@@ -52,6 +52,11 @@ _UNSIMULATED = re.compile(r"^(CIRC|SPTP|SLIN|SCIRC|PTP_REL|LIN_REL|CIRC_REL|SPTP
 _KNOWN = re.compile(r"^(PTP|LIN|\$|spot_weld\s*\(|(grip|release)\s*\(|WAIT\s+(SEC|FOR)\b|SIGNAL\b|"
                     rf"DECL\s+({'|'.join(_DATA_TYPES)})\b|(TOOL|BASE)_DATA\s*\[|(PDAT|LDAT|FDAT)_ACT\b|BAS\s*\(|"
                     r"USERSPOT\s*\()", re.IGNORECASE)
+# The statements of a spline block (KSS 8.x "Spline motion type"): read by `read._Reader.on_spline`.
+_SPLINE = re.compile(r"^(SPLINE|ENDSPLINE|SPL|SLIN)\b", re.IGNORECASE)
+# The segment form robomax writes and reads: a named point, at most the segment's own CP speed.
+_SPLINE_SEGMENT = re.compile(r"^(SPL|SLIN)\s+([A-Za-z_][A-Za-z0-9_$]*)(\s+WITH\s+\$VEL\.CP\s*=\s*"
+                             r"([+-]?([0-9]+\.?[0-9]*|\.[0-9]+)))?$", re.IGNORECASE)
 # A motion to a named point or an aggregate; anything else (an array element, a system variable, an
 # expression) is not simulated.
 _PLAIN_MOTION = re.compile(r"^(PTP|LIN)\s+([A-Za-z_][A-Za-z0-9_$]*|\{.*\})(\s+C_(DIS|PTP|VEL|ORI))*$", re.IGNORECASE)

@@ -22,7 +22,7 @@ from robomax_py.export.krl.flow import (
     _not_resting,
     _routines,
 )
-from robomax_py.export.krl.grammar import _statement
+from robomax_py.export.krl.grammar import _SPLINE_SEGMENT, _statement
 from robomax_py.export.krl.reader import _DataReader
 from robomax_py.export.krl.write import _AXES, _DATA_TYPES, _NOTE, FRAMES_FILE
 from robomax_py.program import (
@@ -32,6 +32,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Wait,
     WaitFor,
 )
@@ -48,6 +49,8 @@ class _Reader(_DataReader):
         name, var, number = tree.children
         if str(var).upper() == "$IN":
             self.inputs[str(name).upper()] = int(float(str(number)))
+        elif str(var).upper() == "$OUT":
+            self.outputs[int(float(str(number)))] = str(name)
 
     def declare_frame(self, name: str, kind: str, node: Tree[Token], line: int, number: int = 0) -> None:
         """A frame's value as the program states it (missing components are 0, as in $NULLFRAME)."""
@@ -74,6 +77,9 @@ class _Reader(_DataReader):
         index = next((int(float(t)) for t in toks[1:-1] if t.type == "NUMBER"), None)
         rhs = tree.children[-1]
         number = float(rhs) if isinstance(rhs, Token) and rhs.type == "NUMBER" else None
+        if var == "$OUT" and index is not None and isinstance(rhs, Token) and str(rhs).upper() in ("TRUE", "FALSE"):
+            self.add(SetSignal(self.outputs.get(index, f"OUT_{index}"), index, str(rhs).upper() == "TRUE"), line)
+            return
         if var in ("$TOOL", "$BASE"):
             kind = "tool" if var == "$TOOL" else "base"
             if isinstance(rhs, Tree) and rhs.data == "aggregate":
@@ -154,6 +160,39 @@ class _Reader(_DataReader):
         zyx = tuple(self.last_pose[k] for k in "ABC")
         self.add(LinMove(xyz, zyx, config, self.vel_cp * 1000.0, comment=comment, flyby_mm=flyby_mm,
                          accel=self.lin_accel, tool=self.tool, base=self.base), line)
+
+    def on_spline(self, text: str, comment: str, line: int) -> None:
+        """`SPLINE`, `ENDSPLINE` and, between them, `SPL` / `SLIN` to a named point with at most its own
+        `WITH $VEL.CP = v` (m/s): the block's segments (`LinMove.spline`), simulated by
+        `rebuild.spline_block`. Another form (WITH on the block, C_SPL, a segment outside a block,
+        another WITH) is not simulated."""
+        word = text.split()[0].upper()
+        if word in ("SPLINE", "ENDSPLINE"):
+            if text.upper() != word or (word == "SPLINE") == self.spline_open:
+                self.unsimulated(text, line, "a spline block of another form than robomax writes")
+                return
+            self.spline_open = word == "SPLINE"
+            return
+        match = _SPLINE_SEGMENT.match(text)
+        if not self.spline_open or match is None:
+            self.unsimulated(text, line, "a spline segment outside a SPLINE block or of another form")
+            return
+        found = self.data.get(match[2].upper())
+        if found is None or found[0] not in ("E6POS", "POS"):
+            self.unsimulated(text, line, "a spline point not declared as a position in the program")
+            return
+        values = found[1]
+        self.last_pose.update({k: float(v) for k, v in values.items() if k in ("X", "Y", "Z", "A", "B", "C", "S", "T")})  # type: ignore[arg-type]
+        missing = [k for k in "XYZABC" if k not in self.last_pose]
+        if missing:
+            raise self.error(line, f"the first Cartesian target must give {', '.join(missing)}")
+        config = ""
+        if "S" in values and "T" in values:
+            config = str(ConfigIndicator(int(self.last_pose["S"]) & 7, int(self.last_pose["T"]) & 63))
+        speed = float(match[4]) if match[4] is not None else self.vel_cp
+        self.add(LinMove(tuple(self.last_pose[k] for k in "XYZ"), tuple(self.last_pose[k] for k in "ABC"), config,
+                         speed * 1000.0, comment=comment, accel=self.lin_accel, tool=self.tool, base=self.base,
+                         spline="slin" if match[1].upper() == "SLIN" else "spl"), line)
 
     def on_weld(self, tree: Tree[Token], comment: str, line: int) -> None:
         n, seconds = (float(str(t)) for t in tree.children)

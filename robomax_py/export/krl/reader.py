@@ -20,6 +20,7 @@ from robomax_py.export.krl.grammar import (
     _MOTION_FOLD,
     _PLAIN_MOTION,
     _PLAIN_WAIT_FOR,
+    _SPLINE,
     _TEMPLATE,
     _UNSIMULATED,
     _parser,
@@ -53,6 +54,7 @@ class _DataReader:
         self.tool, self.base = UNSET_FRAME, UNSET_FRAME    # in force: names of frames
         self.external_tcp = False              # $IPO_MODE = #TCP
         self.inputs: dict[str, int] = {}       # SIGNAL name -> $IN number
+        self.outputs: dict[int, str] = {}      # $OUT number -> its SIGNAL name
         self.vel_axis = [100.0] * 6            # %
         self.acc_axis = [100.0] * 6            # %
         self.vel_cp = DEF_VEL_CP_M_S           # m/s, KSS default $VEL.CP
@@ -64,6 +66,7 @@ class _DataReader:
         self.n_package = 0
         self.last_axes: dict[str, float] = {}
         self.last_pose: dict[str, float] = {}
+        self.spline_open = False               # inside SPLINE ... ENDSPLINE
 
     def error(self, line: int, problem: str) -> ProgramError:
         return ProgramError(self.file, f"line {line}", problem)
@@ -102,6 +105,10 @@ class _DataReader:
         self.instructions.append(ins)
         self.lines.append(line)
 
+    def on_spline(self, text: str, comment: str, line: int) -> None:
+        """A statement of a spline block (`read._Reader` reads them)."""
+        self.unsimulated(text, line)
+
     def unsimulated(self, text: str, line: int, why: str = "") -> None:
         self.ignored.append((line, text))
         self.add(Comment(f"not simulated: {text}" + (f" ({why})" if why else "")), line)
@@ -117,6 +124,9 @@ class _DataReader:
         if self.depth > 0 and (_UNSIMULATED.match(text) or _KNOWN.match(text)) and not text.upper().startswith("DECL"):
             # Inside IF / LOOP / WHILE / FOR / REPEAT / SWITCH: the reader does not follow control flow.
             self.unsimulated(text, line)
+            return
+        if _SPLINE.match(text):
+            self.on_spline(text, comment, line)
             return
         if _UNSIMULATED.match(text):
             self.unsimulated(text, line)

@@ -14,6 +14,7 @@ from robomax_py.export.dialect import (
     header_lines,
     numbered_frames,
     numbered_inputs,
+    numbered_outputs,
     percent,
     require_six_axes,
     spot_label,
@@ -31,6 +32,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -44,6 +46,8 @@ FRAMES_FILE = "_frames.src"
 FILE_ENCODING = "cp1252"
 # KSS 8.x declares TOOL_DATA[16] and BASE_DATA[32] ($config.dat), and 4096 digital inputs.
 TOOL_SLOTS, BASE_SLOTS, INPUTS = 16, 32, 4096
+# ... and 4096 digital outputs $OUT[1..4096] (KSS 8 system variables).
+OUTPUTS = 4096
 # $config.dat factory values (NAQIU KRC/R1/System/$config.dat 18-41) that BAS.SRC applies.
 DEF_VEL_CP_M_S = 2.0
 DEF_APO_CDIS_MM = 3.0
@@ -74,6 +78,7 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     require_six_axes(robot, "KRL")
     numbered_frames(planned.program, "KRL", TOOL_SLOTS, BASE_SLOTS)
     numbered_inputs(planned.program, "KRL", 1, INPUTS)
+    numbered_outputs(planned.program, "KRL", 1, OUTPUTS)
     names = tuple((frame_name(f), f.name) for f in planned.program.frames)
     program = with_frame_names(planned.program, frame_name)
     program = with_brand_configs(program, planned.joints, robot, "kuka")
@@ -176,6 +181,23 @@ class _Writer:
                         f"APO_DIST {_real(apo)},APO_FAC 50.0000,AXIS_VEL 100.000,AXIS_ACC 100.000,ORI_TYP #VAR,"
                         "CIRC_TYP #BASE,JERK_FAC 50.0000,GEAR_JERK 50.0000,EXAX_IGN 0}")
 
+    def spline_point(self, ins: LinMove, tool: int, base: int, first: bool, last: bool) -> None:
+        """One segment of a spline block (KSS 8.x, Operating and Programming Instructions for
+        System Integrators, "Spline motion type": `SPLINE ... ENDSPLINE` with `SPL` points and
+        `SLIN` straight segments; `WITH $VEL.CP` the segment's path speed in m/s; without
+        `C_SPL` the block ends at an exact stop): the frames selected before the block, the
+        point declared in the .dat."""
+        self.n_point += 1
+        p = f"P{self.n_point}"
+        if first:
+            self.src += [f"$TOOL = TOOL_DATA[{tool}]", f"$BASE = BASE_DATA[{base}]" if base else "$BASE = $NULLFRAME",
+                         "SPLINE"]
+        word = "SLIN" if ins.spline == "slin" else "SPL"
+        self.src.append(f"  {word} X{p} WITH $VEL.CP = {_plain(ins.speed_mm_s / 1000.0, 6)}")
+        self.dat.append(f"DECL E6POS X{p}={_pose(ins)}")
+        if last:
+            self.src.append("ENDSPLINE")
+
     @staticmethod
     def fdat(p: str, tool: int, base: int) -> str:
         return f'DECL FDAT F{p}={{TOOL_NO {tool},BASE_NO {base},IPO_FRAME #BASE,POINT2[] " ",TQ_STATE FALSE}}'
@@ -210,6 +232,7 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
              (f"; {_NOTE}: inline forms; mm, deg; PTP Vel %, LIN Vel m/s; blends C_DIS with the APO_DIST (mm) of "
               "each point's PDAT / LDAT")]
     w.src += [f"SIGNAL {sig} $IN[{k}]" for sig, k in _signals(program).items()]
+    w.src += [f"SIGNAL {sig} $OUT[{k}]" for sig, k in _outputs(program).items()]
     w.src += [";FOLD INI;%{PE}", "  ;FOLD BASISTECH INI", "    GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
               "    INTERRUPT ON 3 ", "    BAS (#INITMOV,0 )", "  ;ENDFOLD (BASISTECH INI)"]
     if package:
@@ -230,10 +253,18 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     frames = iter(_frames_in_force(program))
     n_call = n_spot = 0
     grips: dict[str, int] = {}
+    moves = [i for i in program.instructions if isinstance(i, (PtpMove, LinMove))]
+    in_block = [isinstance(m, LinMove) and bool(m.spline) for m in moves]
+    k = -1
     for ins in program.instructions:
         if isinstance(ins, Comment):
             w.src.append(f"; {ins.text}" if ins.text else ";")
+        elif isinstance(ins, LinMove) and ins.spline:
+            k += 1
+            w.spline_point(ins, *next(frames), not (k > 0 and in_block[k - 1]),
+                           not (k + 1 < len(moves) and in_block[k + 1]))
         elif isinstance(ins, (PtpMove, LinMove)):
+            k += 1
             w.point(ins, *next(frames))
         elif isinstance(ins, Spot) and ins.package:
             n_spot += 1
@@ -250,6 +281,11 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
             w.src.append(f"WAIT SEC {ins.seconds:.3f}")
         elif isinstance(ins, WaitFor):
             w.src.append(f"WAIT FOR {ins.signal}")
+        elif isinstance(ins, SetSignal):
+            # A plain $OUT assignment stops the advance run (KSS 8.x operating and programming
+            # instructions, inline form OUT: only CONT sets it in the advance run): the output is
+            # set once the motion before it has ended.
+            w.src.append(f"$OUT[{ins.number}]={'TRUE' if ins.value else 'FALSE'}")
         else:
             raise ExportError(f"KRL cannot write {type(ins).__name__}")
     w.src.append("END")
@@ -282,6 +318,15 @@ def _signals(program: Program) -> dict[str, int]:
     out: dict[str, int] = {}
     for ins in program.instructions:
         if isinstance(ins, WaitFor) and ins.signal not in out:
+            out[ins.signal] = int(ins.number or 0)
+    return out
+
+
+def _outputs(program: Program) -> dict[str, int]:
+    """Each set signal and its output number (`numbered_outputs` has checked there is one)."""
+    out: dict[str, int] = {}
+    for ins in program.instructions:
+        if isinstance(ins, SetSignal) and ins.signal not in out:
             out[ins.signal] = int(ins.number or 0)
     return out
 

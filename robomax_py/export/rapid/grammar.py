@@ -11,13 +11,15 @@ from lark import Lark
 # ================================================================================== reading
 
 _GRAMMAR = r"""
-?start: decl | move | velset | accset | waittime | waitdi | weld | gripper
+?start: decl | move | velset | accset | waittime | waitdi | setdo | setreset | weld | gripper
 decl: ("CONST"i | "PERS"i | "VAR"i) NAME NAME (":=" value)?
 move: MOVE arg ("," arg | opt)*
 velset: "VelSet"i NUMBER "," NUMBER
 accset: "AccSet"i NUMBER "," NUMBER ("\\" NAME ":=" NUMBER)?
 waittime: "WaitTime"i ("\\" NAME ",")? NUMBER
 waitdi: "WaitDI"i NAME "," NUMBER ("\\" NAME (":=" value)?)*
+setdo: "SetDO"i NAME "," NUMBER
+setreset: SETRESET NAME
 weld: "spot_weld"i NUMBER "," NUMBER
 gripper: GRIPPER NUMBER "," NUMBER
 ?arg: value | opt
@@ -26,6 +28,7 @@ opt: "\\" NAME (":=" value)?
 list: "[" [value ("," value)*] "]"
 MOVE.2: /(MoveAbsJ|MoveL|SpotL)\b/i
 GRIPPER.2: /(grip|release)\b/i
+SETRESET.2: /(Set|Reset)\b/i
 BOOL.2: /(TRUE|FALSE)\b/i
 NAME: /[A-Za-z_][A-Za-z0-9_]*/
 STRING: /"[^"]*"/
@@ -35,7 +38,11 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 
 _UNSIMULATED = re.compile(r"^(MoveJ|MoveC|MoveLDO|MoveJDO|MoveLSync|MoveJSync|MoveCSync|MoveExtJ|SearchL|SearchC|"
                           r"TriggL|TriggJ|TriggC|MoveLRel|MoveAbsJDO|MoveAbsJSync|SpotJ|SpotML|SpotMJ)\b", re.IGNORECASE)
-_KNOWN = re.compile(r"^(MoveAbsJ|MoveL|SpotL|VelSet|AccSet|WaitTime|WaitDI|spot_weld|grip|release)\b", re.IGNORECASE)
+_KNOWN = re.compile(r"^(MoveAbsJ|MoveL|SpotL|VelSet|AccSet|WaitTime|WaitDI|SetDO|Set|Reset|spot_weld|grip|release)\b",
+                    re.IGNORECASE)
+# SetDO with \SDelay (set later, in the background) or \Sync (waits for the output's acknowledgement):
+# not simulated.
+_TIMED_SET = re.compile(r"^SetDO\s*\\", re.IGNORECASE)
 # Lines that end a statement without ';': routine heads and ends, a routine's handler sections,
 # and control-flow lines.
 _HEADLINE = re.compile(r"^(MODULE|ENDMODULE|(LOCAL\s+)?PROC|ENDPROC|(LOCAL\s+)?FUNC|ENDFUNC|(LOCAL\s+)?TRAP|ENDTRAP|"

@@ -37,6 +37,7 @@ from robomax_py.export.rapid.grammar import (
     _OPENS,
     _PREDEFINED_SPEED,
     _PREDEFINED_ZONE,
+    _TIMED_SET,
     _UNSIMULATED,
     _parser,
     _statements,
@@ -55,6 +56,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Wait,
     WaitFor,
     pose_mm_zyx,
@@ -243,7 +245,7 @@ class _Reader:
             self.declare(self.tree(re.sub(r"^((LOCAL|TASK)\s+)*", "", text, flags=re.IGNORECASE), line), comment, line)
             return
         conditional = self.depth > 0 and (_KNOWN.match(text) or _UNSIMULATED.match(text))
-        if _UNSIMULATED.match(text) or conditional:
+        if _UNSIMULATED.match(text) or _TIMED_SET.match(text) or conditional:
             # A motion inside IF / WHILE / FOR / TEST: the reader does not follow control flow.
             self.ignored.append((line, text))
             self.add(Comment(f"not simulated: {text}"), line)
@@ -266,6 +268,15 @@ class _Reader:
                 self.add(Comment(f"not simulated: {text} (waits for the input to be 0)"), line)
             else:
                 self.add(WaitFor(str(tree.children[0])), line)
+        elif tree.data == "setdo":
+            # SetDO signal, value (RAPID instructions reference, SetDO): 1 sets, 0 resets.
+            name, value = str(tree.children[0]), float(str(tree.children[1]))
+            if value not in (0.0, 1.0):
+                raise self.error(line, f"SetDO {name}, {tree.children[1]}: a digital output is 0 or 1")
+            self.add(SetSignal(name, None, value == 1.0), line)
+        elif tree.data == "setreset":
+            # Set signal / Reset signal: SetDO signal, 1 / 0 (RAPID instructions reference, Set, Reset).
+            self.add(SetSignal(str(tree.children[1]), None, str(tree.children[0]).lower() == "set"), line)
         elif tree.data == "weld":
             n, seconds = (float(str(t)) for t in tree.children)
             self.add(read_spot_label(comment, int(n), seconds, self.file, line), line)

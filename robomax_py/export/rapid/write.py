@@ -26,6 +26,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -66,6 +67,11 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
             mapped = setup.input_of(ins.signal) or next((i for i in setup.inputs if identifier(i.signal) == ins.signal),
                                                         None)
             ins = WaitFor(mapped.name if mapped is not None and mapped.name else ins.signal)
+        elif isinstance(ins, SetSignal):
+            # SetDO names the output as the I/O configuration does: the cell's name for it, else the signal's.
+            given = setup.output_of(ins.signal) or next((o for o in setup.outputs if identifier(o.signal) == ins.signal),
+                                                        None)
+            ins = SetSignal(given.name if given is not None and given.name else ins.signal, None, ins.value)
         out.append(ins)
     # RAPID refers to data by name: the frames carry no slot number.
     frames = tuple(dataclasses.replace(f, number=0) for f in program.frames if (f.kind, f.name) not in existing)
@@ -226,6 +232,10 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
             body.append(f"    WaitTime {ins.seconds:.3f};")
         elif isinstance(ins, WaitFor):
             body.append(f"    WaitDI {ins.signal}, 1;")
+        elif isinstance(ins, SetSignal):
+            # SetDO Signal, Value (RAPID instructions reference): after a fine point the robot has
+            # stopped before the next instruction runs (zonedata fine: a stop point).
+            body.append(f"    SetDO {ins.signal}, {1 if ins.value else 0};")
         else:
             raise ExportError(f"RAPID cannot write {type(ins).__name__}")
     lines = ["%%%", "  VERSION:1", "  LANGUAGE:ENGLISH", "%%%", "", f"MODULE {program.name}"]

@@ -10,7 +10,10 @@ with the speeds capped at 100 %, as the program cannot move faster than the axes
 Semantics (docs/srcl.md, "Motion semantics"): the first PTP is the start; moves are grouped into
 chains at their FLYBY radii; a chain of one PTP is a jerk-limited joint move, every other chain is
 timed by toppra on its blended path with the LIN lines' TCP speeds; SPOT and WAIT hold at rest;
-`WAIT FOR <object>_clear` holds until the dynamic object `<object>` is absent. What the program
+`WAIT FOR <object>_clear` holds until the dynamic object `<object>` is absent. Between robots of
+a station (`station`: the signals the station's robots set), a wait for one of them and each
+`SetSignal` are recorded as `SignalEvent`s at rest and take no time here: the station replay
+(`verify_station`) holds the robot until another program has set the signal. What the program
 states that cannot be executed as stated (a LIN the arm cannot follow in its configuration, a
 SPOT while flying by, a LIN ending in another configuration than its CONFIG) is a problem of the
 program, reported with the time it happens; what makes the program unreadable for this cell
@@ -20,6 +23,6 @@ program, reported with the time it happens; what makes the program unreadable fo
 from __future__ import annotations
 
 from robomax_py.export.rebuild.builder import rebuild
-from robomax_py.export.rebuild.result import Problem, Rebuilt, Span
+from robomax_py.export.rebuild.result import Problem, Rebuilt, SignalEvent, Span
 
-__all__ = ["Problem", "Rebuilt", "Span", "rebuild"]
+__all__ = ["Problem", "Rebuilt", "SignalEvent", "Span", "rebuild"]

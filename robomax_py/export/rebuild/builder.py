@@ -17,10 +17,21 @@ from robomax_py.export.rebuild.result import (
     FRAME_TOL_DEG,
     FRAME_TOL_MM,
     TCP_SPEED_TOL_MM_S,
-    WELD_TIME_TOL_S,
     Problem,
     Rebuilt,
+    SignalEvent,
     Span,
+)
+from robomax_py.export.rebuild.signals import (
+    input_signal,
+    output_signal,
+    unmapped_output,
+)
+from robomax_py.export.rebuild.spline_block import SplinePoint, add_point, in_block
+from robomax_py.export.rebuild.welds import (
+    schedule_problem,
+    schedule_time,
+    weld_time_problem,
 )
 from robomax_py.plan.waiting import clear_wait, signal_of
 from robomax_py.program import (
@@ -32,6 +43,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -47,6 +59,7 @@ from robomax_py.timing import (
     LinMoveError,
     Segment,
     TimingError,
+    Trajectory,
     concatenate,
     dwell,
     resample,
@@ -57,7 +70,8 @@ from robomax_py.world.scene import clamps_near
 
 def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | str,
             lines: tuple[int, ...] | None = None, brand: str | None = None,
-            stored: tuple[FrameDef, ...] = (), controller: bool = False) -> Rebuilt:
+            stored: tuple[FrameDef, ...] = (), controller: bool = False,
+            station: frozenset[str] | None = None) -> Rebuilt:
     """Rebuild the motion; ProgramError when the program is not for this cell's robot.
 
     lines : the program line of each instruction (as the parser read them), for messages.
@@ -73,6 +87,9 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
         so the configuration a LIN ends in is stated from the controller's values of the joints the
         arm reaches (`solve.brand_text_of`) before it is compared with the written one. The
         program's joint targets are the URDF's here (`dialect.in_controller_joints` inverse).
+    station : the signals the robots of a station set (a station replay); a wait for one of them,
+        or for a signal the cell does not know, is then a `SignalEvent` that takes no time here.
+        None: a lone program, whose waits for unknown signals are problems.
     A program that does not name its robot (a header with robot "" and no joints, as
     programs written by others) is taken to be for the cell's robot, joints in URDF order.
     """
@@ -82,7 +99,7 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
     if header.joints and tuple(header.joints) != tuple(robot.joint_names):
         raise ProgramError(file, "AXES", f"expected {list(robot.joint_names)}, got {list(header.joints)}")
     builder = _Builder(cell, robot, brand or robot.controller.brand, {**_by_name(stored), **_by_name(program.frames)},
-                       controller)
+                       controller, station)
     numbered = [(ins, None if lines is None else lines[i]) for i, ins in enumerate(program.instructions)]
     moves = [(ins, line) for ins, line in numbered if not isinstance(ins, Comment)]
     if not moves or not isinstance(moves[0][0], PtpMove):
@@ -97,14 +114,14 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
         if isinstance(ins, PtpMove) and len(ins.target_deg) != robot.dof:
             builder.problems.append(Problem(builder.t, "format", f"a joint move gives {len(ins.target_deg)} axis "
                                             f"values, the robot has {robot.dof} joints", builder.line))
-            return Rebuilt(None, builder.spots, builder.problems, builder.spans)
+            return builder.result(None)
         if not builder.add(ins, moves[k + 1][0] if k + 1 < len(moves) else None, k):
-            return Rebuilt(None, builder.spots, builder.problems, builder.spans)
+            return builder.result(None)
     if builder.pending:
         builder.problems.append(Problem(builder.t, "flyby", "the program ends flying by: the last move has FLYBY",
                                         builder.line))
         if not builder.flush():
-            return Rebuilt(None, builder.spots, builder.problems, builder.spans)
+            return builder.result(None)
     traj = resample(concatenate(builder.segments))
     # Spot times from the trajectory's own weld phases (exactly on its samples), in program order.
     welds: dict[str, list[Any]] = {}
@@ -113,7 +130,7 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
     for spot in builder.spots:
         phase = welds[f"{spot['seam']}/{spot['name']}"].pop(0)
         spot["t_arrive"], spot["t_leave"] = float(phase.t_start), float(phase.t_end)
-    return Rebuilt(traj, builder.spots, builder.problems, builder.spans)
+    return builder.result(traj)
 
 
 def _by_name(frames: tuple[FrameDef, ...]) -> dict[tuple[str, str], FrameDef]:
@@ -122,7 +139,8 @@ def _by_name(frames: tuple[FrameDef, ...]) -> dict[tuple[str, str], FrameDef]:
 
 class _Builder:
     def __init__(self, cell: CellSpec, robot: RobotModel, brand: str,
-                 frames: dict[tuple[str, str], FrameDef], controller: bool = False) -> None:
+                 frames: dict[tuple[str, str], FrameDef], controller: bool = False,
+                 station: frozenset[str] | None = None) -> None:
         self.cell, self.robot, self.brand = cell, robot, brand
         self.controller = controller                       # configuration data in the controller's joint values
         self.frames = frames
@@ -141,12 +159,24 @@ class _Builder:
         self.spans: list[Span] = []
         self.waited: set[str] = set()                      # clamp inputs waited for so far
         self.after_action = False                          # a weld or gripper action since the last move
+        self.block: list[SplinePoint] = []                 # the spline block being read
+        self.station = station                             # signals the robots of a station set
+        self.events: list[SignalEvent] = []
+
+    def _problem(self, kind: str, detail: str | None) -> None:
+        if detail is not None:
+            self.problems.append(Problem(self.t, kind, detail, self.line))
+
+    def result(self, traj: Trajectory | None) -> Rebuilt:
+        return Rebuilt(traj, self.spots, self.problems, self.spans, self.events)
 
     def start(self, q: FloatArray) -> None:
         self.q = np.asarray(q, dtype=float)
         self.segments.append(dwell(self.q, 0.0, kind="wait", label="start"))
 
     def add(self, ins: Any, following: Any, index: int) -> bool:
+        if in_block(ins):
+            return add_point(self, ins, following, index)
         if isinstance(ins, (PtpMove, LinMove)):
             kind = self._kind(ins, following)
             self.after_action = False
@@ -167,7 +197,8 @@ class _Builder:
                 self.configs.append((len(self.pending) - 1, ins.config))
             return True if ins.flies else self.flush()
         if self.pending:
-            what = "weld" if isinstance(ins, Spot) else ("gripper action" if isinstance(ins, Gripper) else "wait")
+            what = "weld" if isinstance(ins, Spot) else ("gripper action" if isinstance(ins, Gripper) else
+                                                         "output" if isinstance(ins, SetSignal) else "wait")
             self.problems.append(Problem(self.t, "flyby", f"a {what} after a move that flies by (blended): the robot "
                                                           "is not at rest", self.line))
             if not self.flush():
@@ -177,10 +208,12 @@ class _Builder:
             if isinstance(ins, Spot):
                 self._check_interlocks(ins, label)
                 if not ins.package:
-                    self._check_weld_time(ins, label)
+                    self._problem("weld", weld_time_problem(self.cell, ins, label))
                 if ins.package:
-                    self._check_schedule(ins, label)
-                    ins = dataclasses.replace(ins, time_s=self._schedule_time(ins))
+                    self._problem("weld", schedule_problem(self.cell, ins, label))
+                    seconds, problem = schedule_time(self.cell, ins)
+                    self._problem("weld", problem)
+                    ins = dataclasses.replace(ins, time_s=seconds)
             self._check_action(ins, label)
             self.segments.append(dwell(self.q, ins.time_s, kind="weld", label=label))
             config = self.last_config or self.config_text(self.q)
@@ -194,6 +227,8 @@ class _Builder:
             self._hold(ins.seconds, "WAIT")
         elif isinstance(ins, WaitFor):
             self._wait_for(ins)
+        elif isinstance(ins, SetSignal):
+            self._set_signal(ins)
         return True
 
     def _kind(self, ins: PtpMove | LinMove, following: Any) -> str:
@@ -231,24 +266,6 @@ class _Builder:
         if isinstance(ins, PtpMove):
             return dataclasses.replace(ins, speed=min(ins.speed, 1.0), accel=min(ins.accel, 1.0))
         return dataclasses.replace(ins, accel=min(ins.accel, 1.0))
-
-    def _check_weld_time(self, spot: Spot, label: str) -> None:
-        """A weld call's time is the cell's weld time of that spot (the weld routine rests or
-        welds that long: another time is another weld)."""
-        from robomax_py.export.plan_program import identifier
-
-        seam = next((s for s in self.cell.seams if identifier(s.name) == spot.seam), None)
-        spec = next((p for p in seam.spots if identifier(p.name) == spot.name), None) if seam else None
-        if spec is None or spec.action is not None:
-            return
-        want = self.cell.process.weld_time_of(spec)
-        if abs(spot.time_s - want) <= WELD_TIME_TOL_S:
-            return
-        hint = ""
-        if want > 0 and abs(spot.time_s / want - 1000.0) < 1.0:
-            hint = " (a thousand times: written in ms?)"
-        self.problems.append(Problem(self.t, "weld", f"{label}: the program welds {spot.time_s:.3f} s, the cell's weld "
-                                                     f"time is {want:.3f} s{hint}", self.line))
 
     def _step(self, ins: PtpMove, following: Any, index: int) -> Step:
         return PtpStep(ptp_target(ins), speed=ins.speed, accel=ins.accel, flyby=math.radians(ins.flyby),
@@ -350,36 +367,6 @@ class _Builder:
             self.spans.append(Span(self.t, self.t + seconds, self.line))
             self.t += seconds
 
-    def _schedule_time(self, ins: Spot) -> float:
-        """The weld time of a process-package weld: its gun and schedule's, as the cell's spots
-        with that schedule take it (the controller's schedule table holds one time each); 0 with a
-        problem when the cell has no spot of that schedule or several times for it."""
-        process = self.cell.process
-        times = {process.weld_time_of(spot) for seam in self.cell.seams for spot in seam.spots
-                 if process.gun == ins.gun and process.schedule_of(spot) == ins.schedule}
-        if len(times) != 1:
-            what = "no spot of the cell" if not times else f"the cell's spots {sorted(times)} s"
-            self.problems.append(Problem(self.t, "weld", f"gun {ins.gun} schedule {ins.schedule}: {what} gives its weld "
-                                                         "time", self.line))
-            return 0.0
-        return times.pop()
-
-    def _check_schedule(self, spot: Spot, label: str) -> None:
-        """A process-package weld names the gun and schedule the controller welds with: those of
-        the cell's spot (a weld time alone does not tell a schedule's current from another's)."""
-        from robomax_py.export.plan_program import identifier
-
-        seam = next((s for s in self.cell.seams if identifier(s.name) == spot.seam), None)
-        spec = next((p for p in seam.spots if identifier(p.name) == spot.name), None) if seam else None
-        if spec is None:
-            return
-        process = self.cell.process
-        want = (process.gun, process.schedule_of(spec))
-        if (spot.gun, spot.schedule) != want:
-            self.problems.append(Problem(self.t, "weld", f"{label}: the program welds with gun {spot.gun} schedule "
-                                                         f"{spot.schedule}, the cell with gun {want[0]} schedule "
-                                                         f"{want[1]}", self.line))
-
     def _check_action(self, ins: Spot | Gripper, label: str) -> None:
         """A tending station gets its gripper action, a weld spot a weld."""
         from robomax_py.export.plan_program import identifier
@@ -409,30 +396,35 @@ class _Builder:
                                                                   f"waiting for its input {obj.signal}", self.line))
                 self.waited.add(identifier(str(obj.signal)))
 
+    def _set_signal(self, ins: SetSignal) -> None:
+        """An output set at rest: recorded for the station replay (no time here)."""
+        signal = output_signal(self.cell, ins)
+        if signal is None:
+            self.problems.append(Problem(self.t, "signal", unmapped_output(self.cell, ins), self.line))
+            return
+        self.events.append(SignalEvent(self.t, "set", signal, ins.value, self.line))
+
     def _wait_for(self, ins: WaitFor) -> None:
         """A wait on an input number means the cell signal mapped to that number (the controller
         knows numbers, not names); a wait by name, the cell signal of that name."""
         from robomax_py.export.plan_program import identifier
 
-        signal = ins.signal
-        if ins.number is not None:
-            mapped = next((i for i in self.cell.controller.inputs if i.number == ins.number), None)
-            if mapped is None:
-                known = ", ".join(f"{i.number} ({i.signal})" for i in self.cell.controller.inputs) or "none mapped"
-                self.problems.append(Problem(self.t, "signal", f"the program waits for input {ins.number}, which the "
-                                                               f"cell maps to no signal (robot.controller.inputs: {known})",
-                                             self.line))
-                return
-            signal = identifier(mapped.signal)
-        else:
-            # A name of the controller's I/O configuration the cell maps to one of its signals.
-            named = next((i for i in self.cell.controller.inputs if i.name and i.name.lower() == signal.lower()), None)
-            if named is not None:
-                signal = identifier(named.signal)
-        if any(obj.signal and identifier(obj.signal) == signal for obj in self.cell.objects):
+        signal = input_signal(self.cell, ins)
+        if signal is None:
+            known = ", ".join(f"{i.number} ({i.signal})" for i in self.cell.controller.inputs) or "none mapped"
+            self.problems.append(Problem(self.t, "signal", f"the program waits for input {ins.number}, which the "
+                                                           f"cell maps to no signal (robot.controller.inputs: {known})",
+                                         self.line))
+            return
+        if any(obj.signal and identifier(obj.signal) == signal for obj in self.cell.objects) and \
+                (self.station is None or signal not in self.station):
             self.waited.add(signal)           # a clamp input: set once the clamp is closed, no time planned
             return
         obstacle = next((d for d in self.cell.dynamic if signal_of(identifier(d.name), d.door) == signal), None)
+        if obstacle is None and self.station is not None:
+            # Another robot's signal (or one that no robot sets: the replay says it waits forever).
+            self.events.append(SignalEvent(self.t, "wait", signal, True, self.line))
+            return
         if obstacle is None:
             known = ", ".join([*(signal_of(identifier(d.name), d.door) for d in self.cell.dynamic),
                                *(identifier(str(o.signal)) for o in self.cell.objects if o.signal)]) or "none in this cell"

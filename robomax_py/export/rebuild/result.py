@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 from robomax_py.timing import Trajectory
 from robomax_py.tolerances import DEFAULT as TOL
@@ -38,6 +38,19 @@ class Span:
     line: int | None
 
 
+@dataclass(frozen=True, slots=True)
+class SignalEvent:
+    """A signal the program sets (`kind` "set", to `value`) or waits for (`kind` "wait") between
+    robots of a station, at time `t` of its own motion (s, the robot at rest): the cell's signal
+    name (an input or output number read through `robot.controller`)."""
+
+    t: float
+    kind: Literal["set", "wait"]
+    signal: str
+    value: bool = True
+    line: int | None = None
+
+
 @dataclass(slots=True)
 class Rebuilt:
     """The motion of a program: a trajectory (None when it could not be built to the end), the
@@ -47,6 +60,8 @@ class Rebuilt:
     spots: list[dict[str, Any]] = field(default_factory=list)
     problems: list[Problem] = field(default_factory=list)
     spans: list[Span] = field(default_factory=list)
+    # Waits for and settings of signals between robots, in program order (station replay).
+    events: list[SignalEvent] = field(default_factory=list)
 
     def line_at(self, t: float | None) -> int | None:
         """The program line whose statement commands the motion at time t (s)."""

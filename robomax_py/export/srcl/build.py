@@ -21,6 +21,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -137,13 +138,14 @@ class _Builder:
         if tree.data == "ptp":
             values = [self.number(t) for t in self.tokens(tree, "NUMBER")]
             return PtpMove(tuple(values[:-2]), values[-2], values[-1], flyby, self.note(tree))
-        if tree.data == "lin":
+        if tree.data in ("lin", "spl", "slin"):
             (config,) = self.tokens(tree, "STRING")
             speed, *accel = self.tokens(tree, "NUMBER")
             return LinMove(
                 self.triple(self.subtree(tree, "pos")), self.triple(self.subtree(tree, "ori")),
                 str(config)[1:-1], self.number(speed), flyby, self.note(tree),
                 accel=self.number(accel[0]) if accel else 1.0,
+                spline="spl" if tree.data == "spl" else "slin" if tree.data == "slin" else "",
             )
         if tree.data == "spot":
             name, seam = self.tokens(tree, "IDENT")
@@ -162,4 +164,9 @@ class _Builder:
             (signal,) = self.tokens(tree, "IDENT")
             number = self.tokens(tree, "NUMBER")
             return WaitFor(str(signal), self.whole(number[0], 0) if number else None)
+        if tree.data == "set_signal":
+            (signal,) = self.tokens(tree, "IDENT")
+            number = self.tokens(tree, "NUMBER")
+            on = any(isinstance(c, Tree) and c.data == "set_on" for c in tree.children)
+            return SetSignal(str(signal), self.whole(number[0], 0) if number else None, on)
         return Comment(self.note(tree))

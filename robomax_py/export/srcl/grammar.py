@@ -24,14 +24,19 @@ kind: "TOOL" -> tool_kind
 pos: "POS" "(" NUMBER "," NUMBER "," NUMBER ")"
 ori: "ORI" "(" NUMBER "," NUMBER "," NUMBER ")"
 
-_stmt: ptp | lin | spot | gripper | wait | wait_for | note
+_stmt: ptp | lin | spl | slin | spot | gripper | wait | wait_for | set_signal | note
 ptp: "MOVE" "PTP" "AXIS" "(" NUMBER ("," NUMBER)* ")" "SPEED" NUMBER "ACCEL" NUMBER flyby? COMMENT? ";"
 lin: "MOVE" "LIN" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S ("ACCEL" NUMBER)? flyby? COMMENT? ";"
+spl: "MOVE" "SPL" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S ("ACCEL" NUMBER)? COMMENT? ";"
+slin: "MOVE" "SLIN" pos ori "CONFIG" STRING "SPEED" NUMBER _MM_S ("ACCEL" NUMBER)? COMMENT? ";"
 flyby: FLYBY NUMBER
 spot: "SPOT" IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ("GUN" NUMBER "SCHEDULE" NUMBER)? ";"
 gripper: (GRIP | RELEASE) IDENT "SEAM" IDENT "TIME" NUMBER "SEC" ";"
 wait: "WAIT" NUMBER "SEC" ";"
 wait_for: "WAIT" "FOR" IDENT ("INPUT" NUMBER)? ";"
+set_signal: "SET" IDENT ("OUTPUT" NUMBER)? (set_on | set_off) ";"
+set_on: "TRUE"
+set_off: "FALSE"
 note: COMMENT
 
 FLYBY: "FLYBY"
@@ -51,7 +56,7 @@ _PLAIN_NUMBER = re.compile(r"[+-]?[0-9]+(\.[0-9]+)?")
 _CONTEXT = {
     "PROGRAM": "PROGRAM heading", "CELL": "CELL line", "ROBOT": "ROBOT line", "TOOL": "TOOL line",
     "CYCLE": "CYCLE line", "MOVE": "MOVE statement", "SPOT": "SPOT statement", "WAIT": "WAIT statement",
-    "GRIP": "GRIP statement", "RELEASE": "RELEASE statement", "ENDPROGRAM": "ENDPROGRAM",
+    "GRIP": "GRIP statement", "RELEASE": "RELEASE statement", "SET": "SET statement", "ENDPROGRAM": "ENDPROGRAM",
 }
 _NAMED = {
     "IDENT": "a name", "NUMBER": "a number", "STRING": "a quoted string", "COMMENT": "a comment",

@@ -93,7 +93,7 @@ def _describe(parser: Lark, text: str, exc: UnexpectedInput) -> tuple[int, int, 
     if "MOVE" in expected and "ENDPROGRAM" in expected and token.type != "SEMICOLON":
         hint = " (keywords are upper case)" if str(token).upper() in RESERVED else ""
         return line, column, (
-            f"unknown statement {got}{hint}; expected MOVE, SPOT, GRIP, RELEASE, WAIT, a {{ comment }} or ENDPROGRAM"
+            f"unknown statement {got}{hint}; expected MOVE, SPOT, GRIP, RELEASE, WAIT, SET, a {{ comment }} or ENDPROGRAM"
         )
     where, closed = _context(parser, text, pos)
     if where and not closed:

@@ -23,6 +23,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -34,7 +35,8 @@ DIALECT = "robomax SRCL/1"
 
 # Upper-case keywords; they cannot be used as names (names are case-sensitive, so `spot` is a name).
 RESERVED: frozenset[str] = frozenset(
-    ["PROGRAM", "CELL", "ROBOT", "AXES", "TOOL", "CYCLE", "SEC", "VAR", "FRAME", "BASE", "POS", "ORI", "BEGIN", "ENDPROGRAM", "MOVE", "PTP", "LIN", "AXIS", "SPEED", "ACCEL", "FLYBY", "CONFIG", "SPOT", "SEAM", "TIME", "WAIT", "FOR", "GUN", "SCHEDULE", "GRIP", "RELEASE", "INPUT"]
+    ["PROGRAM", "CELL", "ROBOT", "AXES", "TOOL", "CYCLE", "SEC", "VAR", "FRAME", "BASE", "POS", "ORI", "BEGIN", "ENDPROGRAM", "MOVE", "PTP", "LIN", "AXIS", "SPEED", "ACCEL", "FLYBY", "CONFIG", "SPOT", "SEAM", "TIME", "WAIT", "FOR", "GUN", "SCHEDULE", "GRIP", "RELEASE", "INPUT",
+     "SET", "OUTPUT", "TRUE", "FALSE", "SPL", "SLIN"]
 )
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -127,7 +129,7 @@ def _statement(ins: Instruction) -> str:
         )
     if isinstance(ins, LinMove):
         return (
-            f"MOVE LIN {_pose(ins.position_mm, ins.zyx_deg)} CONFIG '{ins.config}' "
+            f"MOVE {ins.spline.upper() or 'LIN'} {_pose(ins.position_mm, ins.zyx_deg)} CONFIG '{ins.config}' "
             f"SPEED {_num(ins.speed_mm_s, SPEED_DECIMALS)} MM/S"
             + (f" ACCEL {_num(ins.accel, SPEED_DECIMALS)}" if ins.accel < 1.0 else "") + _tail(ins.flyby, ins.comment)
         )
@@ -140,6 +142,9 @@ def _statement(ins: Instruction) -> str:
         return f"WAIT {_num(ins.seconds, TIME_DECIMALS)} SEC;"
     if isinstance(ins, WaitFor):
         return f"WAIT FOR {ins.signal}" + ("" if ins.number is None else f" INPUT {ins.number}") + ";"
+    if isinstance(ins, SetSignal):
+        number = "" if ins.number is None else f" OUTPUT {ins.number}"
+        return f"SET {ins.signal}{number} {'TRUE' if ins.value else 'FALSE'};"
     if isinstance(ins, Comment):
         return f"{{ {ins.text} }}" if ins.text else "{ }"
     raise ExportError(f"SRCL cannot write instruction {ins!r}")
@@ -161,7 +166,7 @@ def _check_text(where: str, text: str, forbidden: str) -> None:
 def _kind(ins: Instruction) -> str:
     return {
         PtpMove: "MOVE PTP", LinMove: "MOVE LIN", Spot: "SPOT", Gripper: "GRIP/RELEASE", Wait: "WAIT",
-        WaitFor: "WAIT FOR", Comment: "comment"
+        WaitFor: "WAIT FOR", SetSignal: "SET", Comment: "comment"
     }.get(type(ins), type(ins).__name__)
 
 
@@ -204,6 +209,10 @@ def _check_program(program: Program) -> None:
             _check_name(where + " signal", ins.signal)
             if ins.number is not None and ins.number < 0:
                 raise ExportError(f"{where}: input number {ins.number} is negative")
+        elif isinstance(ins, SetSignal):
+            _check_name(where + " signal", ins.signal)
+            if ins.number is not None and ins.number < 0:
+                raise ExportError(f"{where}: output number {ins.number} is negative")
         elif isinstance(ins, Comment):
             _check_text(where, ins.text, "{}")
         elif not isinstance(ins, (PtpMove, Wait)):

@@ -24,7 +24,8 @@ NUMBER: /[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?/
 %ignore /[ \t]+/
 """
 
-_CALLS = ("movej", "movel", "set_tcp", "sleep", "spot_weld", "grip", "release", "wait_for_signal")
+_CALLS = ("movej", "movel", "set_tcp", "sleep", "spot_weld", "grip", "release", "wait_for_signal",
+          "set_standard_digital_out")
 _UNSIMULATED = ("movep", "movec", "servoj", "servoc", "speedj", "speedl", "move_path", "movej_pose")
 
 

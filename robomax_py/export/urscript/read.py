@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import re
+from typing import Any
 
 from lark import Token, Tree
 from lark.exceptions import UnexpectedInput
@@ -37,6 +38,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Wait,
     WaitFor,
 )
@@ -91,7 +93,8 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         if _OPEN.match(stmt) or _MIDDLE.match(stmt) or stmt == "end":
             continue
         if step.conditional:
-            if re.match(r"^(move\w*|servo\w*|speed\w*|sleep|spot_weld|grip|release|wait_for_signal|set_tcp)\s*\(", stmt) \
+            if re.match(r"^(move\w*|servo\w*|speed\w*|sleep|spot_weld|grip|release|wait_for_signal|set_tcp|"
+                        r"set_standard_digital_out)\s*\(", stmt) \
                     or re.match(r"^(?:global\s+)?[A-Za-z_][A-Za-z0-9_]*\s*=\s*p\[", stmt):
                 # Inside while / if / for: whether, or how often, it runs depends on a condition.
                 ignored.append((number, stmt))
@@ -176,6 +179,8 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
         elif func == "wait_for_signal":
             k = int(_numbers(target, file, number)[0])
             add(WaitFor(comment or f"digital_in_{k}", k), number)
+        elif func == "set_standard_digital_out":
+            add(_set_out(args, comment, file, number), number)
     for routine in routines.values():
         if routine.name in _OWN:
             for line, text, why in _not_resting(routine):
@@ -184,3 +189,16 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
     header = read_header(header_comments)
     return Parsed(Program(name, header, tuple(frames), tuple(instructions)), tuple(where), "ur", tuple(ignored),
                   tuple(followed.problems))
+
+
+def _set_out(args: list[Any], comment: str, file: str, line: int) -> SetSignal:
+    """`set_standard_digital_out(n, b)`: output n in [0:7] to the level b, True or False (UR Script
+    Manual); anything else is not a program this reader runs."""
+    level = args[1] if len(args) == 2 else None
+    if not (isinstance(level, Token) and str(level) in ("True", "False")):
+        raise ProgramError(file, f"line {line}", "set_standard_digital_out(n, b) needs an output number and True "
+                                                 "or False")
+    k = int(_numbers(args[0], file, line)[0])
+    if not 0 <= k <= 7:
+        raise ProgramError(file, f"line {line}", f"standard digital output {k} does not exist (0..7)")
+    return SetSignal(comment or f"digital_out_{k}", k, str(level) == "True")

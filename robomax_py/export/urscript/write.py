@@ -12,6 +12,7 @@ from robomax_py.export.dialect import (
     gripper_label,
     header_lines,
     numbered_inputs,
+    numbered_outputs,
     require_six_axes,
     spot_label,
     with_brand_configs,
@@ -25,6 +26,7 @@ from robomax_py.program import (
     LinMove,
     Program,
     PtpMove,
+    SetSignal,
     Spot,
     Wait,
     WaitFor,
@@ -42,6 +44,9 @@ def reference_limits(robot: RobotModel) -> tuple[float, float]:
 
 # The controller's standard digital inputs, get_standard_digital_in(0..7).
 INPUTS = 7
+# Its standard digital outputs: set_standard_digital_out(n, b), n in [0:7] (UR Script Manual,
+# "set_standard_digital_out").
+OUTPUTS = 7
 
 
 def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
@@ -49,6 +54,7 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     pose variables, waits on standard digital inputs."""
     require_six_axes(robot, "URScript")
     numbered_inputs(planned.program, "URScript", 0, INPUTS)
+    numbered_outputs(planned.program, "URScript", 0, OUTPUTS)
     program = with_brand_configs(planned.program, planned.joints, robot, "ur")
     # URScript refers to poses by variable name: the frames carry no slot number.
     program = dataclasses.replace(program, frames=tuple(dataclasses.replace(f, number=0) for f in program.frames))
@@ -122,6 +128,9 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
             out.append(f"  sleep({ins.seconds:.3f})")
         elif isinstance(ins, WaitFor):
             out.append(f"  wait_for_signal({ins.number})  # {ins.signal}")
+        elif isinstance(ins, SetSignal):
+            # A movel / movej without blend radius returns when the robot has stopped at its target.
+            out.append(f"  set_standard_digital_out({ins.number}, {'True' if ins.value else 'False'})  # {ins.signal}")
         else:
             raise ExportError(f"URScript cannot write {type(ins).__name__}")
     out.append("end")

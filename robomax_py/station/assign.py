@@ -1,0 +1,205 @@
+"""Which robot welds which spot, for the makespan: a min-max multiple-TSP over estimated tour times
+(after Spensieri et al., IEEE T-ASE 2016, who pose assignment and sequencing of a station as one
+min-max problem), and the lower bound every station plan's makespan is measured against.
+
+The estimate: a robot's tour is home -> its spots -> home over the quickest of a few representative
+configurations per spot (`reach.cost_matrix`), ordered by nearest neighbour and 2-opt, plus the weld
+and approach lines of each spot. The search: regret insertion (the spot whose best and second best
+robot differ most is placed first), then moves and swaps of spots off the robot with the longest tour
+while the longest tour shortens. The real planner then sequences each robot's spots itself.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from robomax_py.spec_station import SpotKey
+from robomax_py.station.reach import RobotReach, box_gap_time, cost_matrix
+
+# A velocity limit may be exceeded by the planner's own check's slack (plan.pipeline PLAN_VELOCITY_RTOL
+# ~1e-5); the bound divides by a speed this much higher so that it stays a bound.
+BOUND_VELOCITY_SLACK = 1e-3
+MAX_LOCAL_ROUNDS = 400
+
+
+@dataclass(frozen=True, slots=True)
+class LowerBound:
+    """A lower bound on the makespan of any plan of the station whose motions keep the joint velocity
+    limits, every spot welded once by a robot allowed to and able to (collision-free candidate),
+    waits and robot-robot collisions ignored: the largest of `single` (the spot whose cheapest round
+    trip home -> spot -> home, its weld included, is longest) and `shared` (every spot's weld and
+    cheapest arrival, summed, shared evenly by the robots)."""
+
+    single: float
+    shared: float
+
+    @property
+    def value(self) -> float:
+        return max(self.single, self.shared)
+
+
+@dataclass(frozen=True, slots=True)
+class Assignment:
+    """Spots per robot in estimated tour order; `estimate` the estimated tour time of each, s."""
+
+    spots: Mapping[str, tuple[SpotKey, ...]]
+    estimate: Mapping[str, float]
+
+    @property
+    def makespan_estimate(self) -> float:
+        return max(self.estimate.values(), default=0.0)
+
+
+def lower_bound(reaches: Sequence[RobotReach], spots: Sequence[SpotKey]) -> LowerBound:
+    """The bound of `LowerBound` from each robot's boxes of weld configurations (`RobotReach.lo/hi`)."""
+    single = 0.0
+    shared = 0.0
+    for key in spots:
+        best_trip = np.inf
+        best_share = np.inf
+        for r in reaches:
+            i = r.index().get(key)
+            if i is None:
+                continue
+            v = r.velocity * (1 + BOUND_VELOCITY_SLACK)
+            home_gap = float(box_gap_time(r.home, r.home, r.lo[i], r.hi[i], v))
+            best_trip = min(best_trip, 2 * home_gap + r.dwell[i])
+            others = np.delete(np.arange(len(r.keys)), i)
+            arrive = home_gap
+            if len(others):
+                arrive = min(arrive, float(box_gap_time(r.lo[others], r.hi[others], r.lo[i], r.hi[i], v).min()))
+            best_share = min(best_share, r.dwell[i] + arrive)
+        single = max(single, float(best_trip))
+        shared += float(best_share)
+    return LowerBound(single, shared / max(len(reaches), 1))
+
+
+class _Tours:
+    """Each robot's estimated tour (node indices into its cost matrix, 0 = home) and its time."""
+
+    def __init__(self, reaches: Sequence[RobotReach], penalty: Mapping[tuple[str, SpotKey], float]) -> None:
+        self.reaches = list(reaches)
+        self.cost = [cost_matrix(r) for r in reaches]
+        self.service = [np.concatenate([[0.0], r.dwell + 2 * r.line_s]) for r in reaches]
+        for k, r in enumerate(reaches):
+            for i, key in enumerate(r.keys):
+                self.service[k][i + 1] += penalty.get((r.robot, key), 0.0)
+        self.node = [{key: i + 1 for i, key in enumerate(r.keys)} for r in reaches]
+        self.tour: list[list[int]] = [[0, 0] for _ in reaches]
+
+    def time(self, k: int, tour: Sequence[int] | None = None) -> float:
+        t = np.asarray(self.tour[k] if tour is None else tour)
+        return float(self.cost[k][t[:-1], t[1:]].sum() + self.service[k][t].sum())
+
+    def insertion(self, k: int, node: int) -> tuple[float, int]:
+        """The cheapest place to insert `node` in tour k: (added time, position)."""
+        t = np.asarray(self.tour[k])
+        c = self.cost[k]
+        delta = c[t[:-1], node] + c[node, t[1:]] - c[t[:-1], t[1:]]
+        j = int(np.argmin(delta))
+        return float(delta[j] + self.service[k][node]), j + 1
+
+    def removal(self, k: int, pos: int) -> float:
+        t = self.tour[k]
+        c = self.cost[k]
+        a, s, b = t[pos - 1], t[pos], t[pos + 1]
+        return float(c[a, s] + c[s, b] - c[a, b] + self.service[k][s])
+
+    def two_opt(self, k: int) -> None:
+        t = np.asarray(self.tour[k])
+        c = self.cost[k]
+        improved = True
+        while improved and len(t) > 4:
+            improved = False
+            for i in range(1, len(t) - 2):
+                a, b = t[i - 1], t[i]
+                cd = t[i + 1:-1], t[i + 2:]
+                gain = c[a, b] + c[cd[0], cd[1]] - c[a, cd[0]] - c[b, cd[1]]
+                j = int(np.argmax(gain))
+                if gain[j] > 1e-9:
+                    j += i + 1
+                    t[i:j + 1] = t[i:j + 1][::-1].copy()
+                    improved = True
+        self.tour[k] = [int(x) for x in t]
+
+
+def assign(reaches: Sequence[RobotReach], spots: Sequence[SpotKey], groups: Sequence[Sequence[SpotKey]] = (),
+           penalty: Mapping[tuple[str, SpotKey], float] | None = None) -> Assignment:
+    """Min-max assignment of `spots` to the robots of `reaches` (each spot to a robot that reaches it).
+
+    groups : spots that must go to one robot together (an ordered seam's), each a sequence of keys.
+    penalty : extra seconds a spot costs a robot (a wait the coordination found there).
+    """
+    tours = _Tours(reaches, penalty or {})
+    units = _units(spots, groups)
+    able = [[k for k in range(len(reaches)) if all(key in tours.node[k] for key in unit)] for unit in units]
+    left = set(range(len(units)))
+    while left:                                   # regret insertion
+        best: tuple[float, float, int, int] | None = None
+        for u in left:
+            options = sorted((_insert_cost(tours, k, units[u]), k) for k in able[u])
+            makespan = [max(tours.time(k) + add, _others(tours, k)) for add, k in options]
+            regret = (sorted(makespan)[1] - min(makespan)) if len(options) > 1 else np.inf
+            k = options[int(np.argmin(makespan))][1]
+            cand = (regret, -min(makespan), u, k)
+            if best is None or cand[:2] > best[:2]:
+                best = cand
+        assert best is not None
+        _, _, u, k = best
+        for key in units[u]:
+            add_pos = tours.insertion(k, tours.node[k][key])[1]
+            tours.tour[k].insert(add_pos, tours.node[k][key])
+        left.discard(u)
+    for k in range(len(reaches)):
+        tours.two_opt(k)
+    _local_search(tours, units, able)
+    out: dict[str, tuple[SpotKey, ...]] = {}
+    for k, r in enumerate(reaches):
+        out[r.robot] = tuple(r.keys[i - 1] for i in tours.tour[k][1:-1])
+    return Assignment(out, {r.robot: tours.time(k) for k, r in enumerate(reaches)})
+
+
+def _units(spots: Sequence[SpotKey], groups: Sequence[Sequence[SpotKey]]) -> list[tuple[SpotKey, ...]]:
+    grouped = {key for g in groups for key in g}
+    return [tuple(g) for g in groups] + [(key,) for key in spots if key not in grouped]
+
+
+def _insert_cost(tours: _Tours, k: int, unit: Sequence[SpotKey]) -> float:
+    return sum(tours.insertion(k, tours.node[k][key])[0] for key in unit)
+
+
+def _others(tours: _Tours, k: int) -> float:
+    return max((tours.time(j) for j in range(len(tours.tour)) if j != k), default=0.0)
+
+
+def _local_search(tours: _Tours, units: list[tuple[SpotKey, ...]], able: list[list[int]]) -> None:
+    """Move units off the robot with the longest tour while that lowers the longest tour."""
+    unit_of = {key: u for u, unit in enumerate(units) for key in unit}
+    for _ in range(MAX_LOCAL_ROUNDS):
+        times = [tours.time(k) for k in range(len(tours.tour))]
+        worst = int(np.argmax(times))
+        best: tuple[float, int, int] | None = None
+        keys = [tours.reaches[worst].keys[i - 1] for i in tours.tour[worst][1:-1]]
+        for u in dict.fromkeys(unit_of[key] for key in keys):
+            nodes = [tours.node[worst][key] for key in units[u]]
+            rest = [n for n in tours.tour[worst] if n not in nodes]
+            t_rest = tours.time(worst, rest)
+            for k in able[u]:
+                if k == worst:
+                    continue
+                new = max(t_rest, times[k] + _insert_cost(tours, k, units[u]),
+                          max((times[j] for j in range(len(times)) if j not in (k, worst)), default=0.0))
+                if new < times[worst] - 1e-6 and (best is None or new < best[0]):
+                    best = (new, u, k)
+        if best is None:
+            return
+        _, u, k = best
+        nodes = [tours.node[worst][key] for key in units[u]]
+        tours.tour[worst] = [n for n in tours.tour[worst] if n not in nodes]
+        for key in units[u]:
+            tours.tour[k].insert(tours.insertion(k, tours.node[k][key])[1], tours.node[k][key])
+        tours.two_opt(worst)
+        tours.two_opt(k)

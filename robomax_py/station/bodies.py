@@ -1,0 +1,212 @@
+"""Robot-robot collision on a shared clock: every link piece and the tool (body and tips) of one
+robot against every one of another, each posed by its own joint values, in the station's world.
+
+The pieces are the collision pieces the single-robot checks use (`RobotModel.collision_model`, the
+tool's pieces of `world.scene`), so "collide" means the same here as there. A shortcut culls most
+pairs before coal is asked: a sphere around each robot and around each piece (coal's local AABB
+radius about its centre, which holds the whole piece) - spheres that keep apart cannot hold pieces
+that touch, so the answer is the exact one (tests compare with every pair asked of coal).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import coal
+import numpy as np
+import pinocchio as pin
+
+from robomax_py._typing import BoolArray, FloatArray
+from robomax_py.robot import RobotModel
+from robomax_py.world.scene import Scene
+
+# Pairs of samples handed to the piece-level sphere test at once (memory: chunk x pieces^2 floats).
+CHUNK = 2048
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RobotBody:
+    """A robot's and its tool's collision pieces, each on its parent joint (-1: the flange)."""
+
+    name: str
+    robot: RobotModel
+    pieces: tuple[coal.CollisionGeometry, ...]
+    parent: tuple[int, ...]
+    T_parent_piece: FloatArray      # (p, 4, 4)
+    centre: FloatArray              # (p, 3) sphere centres in each piece's frame, m
+    radius: FloatArray              # (p,) m
+    T_world_base: FloatArray        # (4, 4)
+
+
+def robot_body(name: str, robot: RobotModel, scene: Scene) -> RobotBody:
+    pieces: list[coal.CollisionGeometry] = []
+    parent: list[int] = []
+    placement: list[FloatArray] = []
+    for g in robot.collision_model.geometryObjects:
+        pieces.append(g.geometry)
+        parent.append(int(g.parentJoint))
+        placement.append(g.placement.homogeneous)
+    for piece in (*scene.tool.body, *scene.tool.tips):
+        pieces.append(piece)
+        parent.append(-1)
+        placement.append(np.eye(4))
+    centre, radius = [], []
+    for piece in pieces:
+        piece.computeLocalAABB()
+        centre.append(np.asarray(piece.aabb_center, dtype=float))
+        radius.append(float(piece.aabb_radius))
+    return RobotBody(name, robot, tuple(pieces), tuple(parent), np.asarray(placement), np.asarray(centre),
+                     np.asarray(radius), np.asarray(scene.T_world_base, dtype=float))
+
+
+def body_poses(body: RobotBody, qs: FloatArray) -> FloatArray:
+    """(k, n) joint values -> (k, p, 4, 4) world poses of every piece."""
+    model = body.robot.model
+    data = model.createData()
+    flange = body.robot.flange_frame_id
+    out = np.empty((len(qs), len(body.pieces), 4, 4))
+    for i, q in enumerate(np.asarray(qs, dtype=float)):
+        pin.forwardKinematics(model, data, q)
+        pin.updateFramePlacement(model, data, flange)
+        frames = [data.oMf[flange].homogeneous if p < 0 else data.oMi[p].homogeneous for p in body.parent]
+        out[i] = body.T_world_base @ np.asarray(frames) @ body.T_parent_piece
+    return out
+
+
+def _spheres(body: RobotBody, poses: FloatArray) -> FloatArray:
+    """(k, p, 3) world sphere centres."""
+    out: FloatArray = np.einsum("kpij,pj->kpi", poses[:, :, :3, :3], body.centre) + poses[:, :, :3, 3]
+    return out
+
+
+def clash_map(a: RobotBody, poses_a: FloatArray, b: RobotBody, poses_b: FloatArray, margin: float,
+              prefilter: bool = True, slack_a: FloatArray | None = None, slack_b: FloatArray | None = None
+              ) -> BoolArray:
+    """(ka, kb) bool: True where robot a at sample i and robot b at sample j come closer than
+    `margin + slack_a[i] + slack_b[j]` (m; slacks default 0) - any piece of one within that of any
+    piece of the other. `prefilter=False` asks coal of every pair (the slow reference the tests
+    hold the shortcut to)."""
+    ka, kb = len(poses_a), len(poses_b)
+    sa = np.zeros(ka) if slack_a is None else np.asarray(slack_a, dtype=float)
+    sb = np.zeros(kb) if slack_b is None else np.asarray(slack_b, dtype=float)
+    out = np.zeros((ka, kb), dtype=bool)
+    ca, cb = _spheres(a, poses_a), _spheres(b, poses_b)
+    request = coal.CollisionRequest()
+    request.security_margin = margin
+    if not prefilter:
+        for i, j in np.argwhere(np.ones((ka, kb), dtype=bool)):
+            request.security_margin = margin + sa[i] + sb[j]
+            out[i, j] = any(_touch(a.pieces[u], poses_a[i, u], b.pieces[v], poses_b[j, v], request)
+                            for u in range(len(a.pieces)) for v in range(len(b.pieces)))
+        return out
+    # Whole-robot spheres first (most sample pairs of robots apart end here), then one sphere per
+    # link (its pieces' spheres inside it), then the pieces' own spheres, then coal.
+    Ca, Ra = _groups(ca, a.radius, np.zeros(len(a.pieces), dtype=int))
+    Cb, Rb = _groups(cb, b.radius, np.zeros(len(b.pieces), dtype=int))
+    ga, gb = _link_index(a), _link_index(b)
+    La, RLa = _groups(ca, a.radius, ga)
+    Lb, RLb = _groups(cb, b.radius, gb)
+    tf_a, tf_b = _transforms(poses_a), _transforms(poses_b)
+    rows = max(1, (1 << 22) // max(kb, 1))
+    pairs = np.concatenate([np.argwhere(_sq(Ca[r:r + rows, None, 0] - Cb[None, :, 0])
+                                        < (Ra[r:r + rows, None, 0] + Rb[None, :, 0] + margin + sa[r:r + rows, None]
+                                           + sb[None, :]) ** 2) + [r, 0]
+                            for r in range(0, ka, rows)] or [np.zeros((0, 2), dtype=int)])
+    for start in range(0, len(pairs), CHUNK):
+        chunk = pairs[start:start + CHUNK]
+        m = (margin + sa[chunk[:, 0]] + sb[chunk[:, 1]])[:, None, None]
+        links = _sq(La[chunk[:, 0], :, None] - Lb[chunk[:, 1], None, :]) \
+            < (RLa[chunk[:, 0], :, None] + RLb[chunk[:, 1], None, :] + m) ** 2
+        keep = links.any(axis=(1, 2))
+        chunk, links, m = chunk[keep], links[keep], m[keep]
+        if not len(chunk):
+            continue
+        d2 = _sq(ca[chunk[:, 0], :, None] - cb[chunk[:, 1], None, :])
+        reach = (a.radius[None, :, None] + b.radius[None, None, :] + m)
+        close = (d2 < reach ** 2) & links[:, ga][:, :, gb]
+        k, pa, pb = np.nonzero(close)
+        if not len(k):
+            continue
+        order = np.lexsort((d2[k, pa, pb] - reach[k, pa, pb] ** 2, k))   # per sample pair, the nearest first
+        k, pa, pb = k[order], pa[order], pb[order]
+        bounds = np.flatnonzero(np.diff(k)) + 1
+        for first, stop in zip(np.r_[0, bounds].tolist(), np.r_[bounds, len(k)].tolist(), strict=True):
+            i, j = chunk[k[first]].tolist()
+            request.security_margin = float(m[k[first], 0, 0])
+            for u, v in zip(pa[first:stop].tolist(), pb[first:stop].tolist(), strict=True):
+                result = coal.CollisionResult()
+                if coal.collide(a.pieces[u], tf_a(i, u), b.pieces[v], tf_b(j, v), request, result):
+                    out[i, j] = True
+                    break
+    return out
+
+
+def _transforms(poses: FloatArray) -> Callable[[int, int], coal.Transform3s]:
+    """coal's transform of piece p at sample i, made once when first asked for."""
+    made: dict[tuple[int, int], coal.Transform3s] = {}
+
+    def get(i: int, p: int) -> coal.Transform3s:
+        tf = made.get((i, p))
+        if tf is None:
+            T = poses[i, p]
+            tf = made[(i, p)] = coal.Transform3s(T[:3, :3], T[:3, 3])
+        return tf
+
+    return get
+
+
+def _sq(d: FloatArray) -> FloatArray:
+    out: FloatArray = np.einsum("...i,...i->...", d, d)
+    return out
+
+
+def _link_index(body: RobotBody) -> np.ndarray:
+    """Each piece's link, numbered 0.. (the tool's pieces one link, the flange's)."""
+    _, index = np.unique(np.asarray(body.parent), return_inverse=True)
+    return index
+
+
+def _groups(centres: FloatArray, radius: FloatArray, group: np.ndarray) -> tuple[FloatArray, FloatArray]:
+    """Per sample, a sphere around each group's piece spheres: centres (k, g, 3), radii (k, g)."""
+    n = int(group.max()) + 1
+    C = np.stack([centres[:, group == g].mean(axis=1) for g in range(n)], axis=1)
+    R = np.stack([(np.linalg.norm(centres[:, group == g] - C[:, g, None], axis=2) + radius[group == g]).max(axis=1)
+                  for g in range(n)], axis=1)
+    return C, R
+
+
+def sample_steps(body: RobotBody, poses: FloatArray) -> FloatArray:
+    """(k,) the farthest any point of any piece moves between sample i and its neighbours (i - 1,
+    i + 1), bounded as `sample_step` bounds it, m: between samples a piece is within half of this
+    of the nearest sample."""
+    if len(poses) < 2:
+        return np.zeros(len(poses))
+    c = _spheres(body, poses)
+    shift = np.linalg.norm(np.diff(c, axis=0), axis=2)
+    R0, R1 = poses[:-1, :, :3, :3], poses[1:, :, :3, :3]
+    angle = np.arccos(np.clip((np.einsum("kpij,kpij->kp", R0, R1) - 1.0) / 2.0, -1.0, 1.0))
+    step = (shift + angle * body.radius).max(axis=1)
+    out: FloatArray = np.maximum(np.r_[step, 0.0], np.r_[0.0, step])
+    return out
+
+
+def sample_step(body: RobotBody, poses: FloatArray) -> float:
+    """The farthest any point of any piece moves between two consecutive samples, bounded by its
+    sphere: the centre's displacement plus the radius times the rotation angle, m. Between samples
+    a piece is then within half this of where a sample has it."""
+    if len(poses) < 2:
+        return 0.0
+    c = _spheres(body, poses)
+    shift = np.linalg.norm(np.diff(c, axis=0), axis=2)
+    R0, R1 = poses[:-1, :, :3, :3], poses[1:, :, :3, :3]
+    cos = (np.einsum("kpij,kpij->kp", R0, R1) - 1.0) / 2.0
+    angle = np.arccos(np.clip(cos, -1.0, 1.0))
+    return float((shift + angle * body.radius).max())
+
+
+def _touch(ga: coal.CollisionGeometry, Ta: FloatArray, gb: coal.CollisionGeometry, Tb: FloatArray,
+           request: coal.CollisionRequest) -> bool:
+    result = coal.CollisionResult()
+    return bool(coal.collide(ga, coal.Transform3s(Ta[:3, :3], Ta[:3, 3]), gb, coal.Transform3s(Tb[:3, :3], Tb[:3, 3]),
+                             request, result))

@@ -1,0 +1,240 @@
+"""A station -> one plan per robot, coordinated on a shared clock for the makespan (no file I/O).
+
+Stages: what each robot can weld (`reach`), a min-max assignment of spots to robots (`assign`), each
+robot's spots planned by the single-robot planner (`plan.plan_cell` on the robot's cell narrowed
+to its spots), robot-robot collisions on the shared clock found (`bodies`) and ordered by interlocks
+(`coordinate`), and, where the waits cost more than a different assignment, the assignment searched
+again with the waits as costs and kept when the makespan shortens.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from robomax_py.plan import PlanOptions, PlanResult, plan_cell
+from robomax_py.robot import RobotModel
+from robomax_py.spec import CellSpec
+from robomax_py.spec_station import SpotKey, StationSpec, robot_view
+from robomax_py.station.assign import Assignment, LowerBound, assign, lower_bound
+from robomax_py.station.bodies import (
+    RobotBody,
+    body_poses,
+    clash_map,
+    robot_body,
+    sample_steps,
+)
+from robomax_py.station.coordinate import Coordination, PairMap, Timeline, coordinate
+from robomax_py.station.reach import RobotReach, robot_reach
+from robomax_py.timing.trajectory import evaluate
+from robomax_py.world.scene import build_scene
+
+Method = Literal["full", "minmax", "nearest"]
+# Own-clock step of the coordination diagrams, s; the margin kept between robots grows with the
+# distance a piece moves in half a step (`bodies.sample_step`), so a finer step waits less.
+DIAGRAM_DT_S = 0.03
+# Rounds of re-assignment with the waits as costs (method "full").
+REASSIGN_ROUNDS = 2
+
+
+@dataclass(frozen=True, slots=True)
+class StationOptions:
+    """method: "full" (min-max assignment, zone orders by look-ahead, re-assignment where waits
+    cost more), "minmax" (min-max assignment, zone orders by look-ahead, no re-assignment),
+    "nearest" (each spot to the nearest robot that reaches it, first come first served)."""
+
+    method: Method = "full"
+    dt: float = DIAGRAM_DT_S
+    plan: PlanOptions = PlanOptions()
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RobotPlan:
+    """One robot's plan: its cell narrowed to its spots, and the single-robot plan of it (None when
+    the robot welds nothing and stays home)."""
+
+    robot: str
+    cell: CellSpec
+    model: RobotModel
+    result: PlanResult | None
+
+    @property
+    def own_cycle(self) -> float:
+        traj = None if self.result is None else self.result.trajectory
+        return 0.0 if traj is None else traj.duration
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class StationPlan:
+    station: str
+    status: Literal["planned", "infeasible"]
+    message: str
+    robots: tuple[RobotPlan, ...]
+    assignment: Assignment
+    bound: LowerBound
+    coordination: Coordination | None
+    seconds: Mapping[str, float]
+    margin: float = 0.0          # m kept between robots on the diagrams, at most (where both move fastest)
+    rounds: int = 0              # re-assignments tried
+
+    @property
+    def makespan(self) -> float:
+        return np.inf if self.coordination is None else self.coordination.schedule.makespan
+
+
+def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
+                 options: StationOptions = StationOptions()) -> StationPlan:
+    """Plan every robot of a station; `models[name]` is each robot's model with its tool mounted."""
+    clock: dict[str, float] = {}
+    t0 = time.process_time()
+    reaches = [robot_reach(station, r.name, models[r.name]) for r in station.robots]
+    clock["reach"] = time.process_time() - t0
+    keys = [s.key for s in station.spots]
+    bound = lower_bound(reaches, keys)
+    nobody = [k for k in keys if not any(k in r.index() for r in reaches)]
+    if nobody:
+        names = ", ".join(f"{s}/{n}" for s, n in nobody[:10])
+        return StationPlan(station.name, "infeasible", f"{len(nobody)} spot(s) no robot allowed to weld them can "
+                           f"reach collision-free: {names}", (), Assignment({}, {}), bound, None, clock)
+    groups = _ordered_groups(station)
+    t0 = time.process_time()
+    chosen = _nearest(station, reaches, keys, groups) if options.method == "nearest" else assign(reaches, keys, groups)
+    clock["assignment"] = time.process_time() - t0
+    bodies = {r.name: robot_body(r.name, models[r.name], build_scene(r.cell, models[r.name])) for r in station.robots}
+    best = _realise(station, models, bodies, chosen, options, clock, bound)
+    if options.method != "full" or best.status != "planned":
+        return best
+    penalty: dict[tuple[str, SpotKey], float] = {}
+    rounds = 0
+    for _ in range(REASSIGN_ROUNDS):
+        assert best.coordination is not None
+        if not best.coordination.interlocks or best.coordination.schedule.makespan <= 0:
+            break
+        _add_wait_costs(penalty, best)
+        t0 = time.process_time()
+        again = assign(reaches, keys, groups, penalty)
+        clock["assignment"] += time.process_time() - t0
+        if dict(again.spots) == dict(best.assignment.spots):
+            break
+        rounds += 1
+        trial = _realise(station, models, bodies, again, options, clock, bound, previous=best)
+        if trial.status == "planned" and trial.makespan < best.makespan - 1e-6:
+            best = trial
+    return dataclasses.replace(best, seconds=clock, rounds=rounds)
+
+
+def _ordered_groups(station: StationSpec) -> list[tuple[SpotKey, ...]]:
+    """An ordered seam's spots go to one robot together (its order is one robot's)."""
+    cell = station.robots[0].cell
+    return [tuple((seam.name, s.name) for s in seam.spots) for seam in cell.seams if seam.ordered]
+
+
+def _nearest(station: StationSpec, reaches: Sequence[RobotReach], keys: Sequence[SpotKey],
+             groups: Sequence[Sequence[SpotKey]]) -> Assignment:
+    """The baseline: each spot to the robot whose base is nearest among those that reach it."""
+    xyz = {(seam.name, s.name): np.asarray(s.xyz) for seam in station.robots[0].cell.seams for s in seam.spots}
+    base = {r.name: np.asarray(r.cell.T_world_base)[:3, 3] for r in station.robots}
+    able = {r.robot: set(r.keys) for r in reaches}
+    out: dict[str, list[SpotKey]] = {r.robot: [] for r in reaches}
+    group_of = {k: tuple(g) for g in groups for k in g}
+    done: set[SpotKey] = set()
+    for k in keys:
+        if k in done:
+            continue
+        unit = group_of.get(k, (k,))
+        robots = [r for r in able if all(u in able[r] for u in unit)] or [r for r in able if k in able[r]]
+        r = min(robots, key=lambda name: float(np.linalg.norm(xyz[k] - base[name])))
+        out[r] += list(unit)
+        done.update(unit)
+    return Assignment({r: tuple(v) for r, v in out.items()}, {r: 0.0 for r in out})
+
+
+def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
+             chosen: Assignment, options: StationOptions, clock: dict[str, float], bound: LowerBound,
+             previous: StationPlan | None = None) -> StationPlan:
+    """Plan each robot's spots, then coordinate the robots."""
+    t0 = time.process_time()
+    plans: list[RobotPlan] = []
+    for r in station.robots:
+        spots = chosen.spots.get(r.name, ())
+        old = None if previous is None else next((p for p in previous.robots if p.robot == r.name), None)
+        if old is not None and set(spots) == {(s.seam, s.name) for s in (old.result.spots if old.result else ())}:
+            plans.append(old)
+            continue
+        cell = robot_view(station, r.name, spots)
+        result = plan_cell(cell, models[r.name], options.plan) if spots else None
+        if result is not None and result.status != "planned":
+            clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
+            return StationPlan(station.name, "infeasible", f"{r.name}: {result.message}", tuple(plans), chosen, bound,
+                               None, clock)
+        plans.append(RobotPlan(r.name, cell, models[r.name], result))
+    clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
+    t0 = time.process_time()
+    timelines, samples = [], {}
+    for p in plans:
+        timelines.append(_timeline(p))
+        samples[p.robot] = _samples(p, options.dt)
+    poses = {name: body_poses(bodies[name], qs) for name, qs in samples.items()}
+    # Each sample stands for the motion half a step either side of it: the margin there grows by
+    # half the farthest any point moves to its neighbours (slow near welds, fast between).
+    halves = {name: sample_steps(bodies[name], poses[name]) / 2 for name in poses}
+    clearance = max(r.cell.process.clearance for r in station.robots)
+    pairs = []
+    margin = 0.0
+    names = [p.robot for p in plans]
+    for i, a in enumerate(names):
+        for b in names[i + 1:]:
+            margin = max(margin, clearance + float(halves[a].max(initial=0.0)) + float(halves[b].max(initial=0.0)))
+            pairs.append(PairMap(a, b, options.dt, clash_map(bodies[a], poses[a], bodies[b], poses[b], clearance,
+                                                             slack_a=halves[a], slack_b=halves[b])))
+    clock["clash maps"] = clock.get("clash maps", 0.0) + time.process_time() - t0
+    t0 = time.process_time()
+    done = coordinate(timelines, pairs, fcfs=options.method == "nearest")
+    clock["coordination"] = clock.get("coordination", 0.0) + time.process_time() - t0
+    status: Literal["planned", "infeasible"] = "infeasible" if done.unresolved else "planned"
+    return StationPlan(station.name, status, done.unresolved or "planned", tuple(plans), chosen, bound, done, clock,
+                       margin=margin)
+
+
+def _timeline(p: RobotPlan) -> Timeline:
+    if p.result is None or p.result.trajectory is None:
+        return Timeline(p.robot, 0.0, (0.0,), (0.0,))
+    t0 = float(p.result.trajectory.t[0])
+    leave = tuple(s.t_leave - t0 for s in p.result.spots)
+    end = p.result.trajectory.duration
+    return Timeline(p.robot, end, (0.0, *leave), (*leave, end))
+
+
+def _samples(p: RobotPlan, dt: float) -> np.ndarray:
+    """(k, n) joint values every dt of the robot's own clock, to its end (home alone when idle)."""
+    traj = None if p.result is None else p.result.trajectory
+    if traj is None:
+        return np.asarray(p.cell.home, dtype=float)[None, :]
+    t = float(traj.t[0]) + np.arange(0.0, traj.duration + dt, dt)
+    t = np.minimum(t, float(traj.t[-1]))
+    return np.asarray(evaluate(traj, t).q)
+
+
+def _add_wait_costs(penalty: dict[tuple[str, SpotKey], float], plan: StationPlan) -> None:
+    """Each wait charged to the waiter's spots inside the zone it waited for (the spot after the
+    wait point when none is inside), so that the next assignment weighs them with the wait."""
+    assert plan.coordination is not None
+    waits = {r: dict(w) for r, w in plan.coordination.schedule.waits.items()}
+    for lock in plan.coordination.interlocks:
+        w = waits.get(lock.waiter, {}).get(lock.wait_at, 0.0)
+        if w <= 0:
+            continue
+        rp = next(p for p in plan.robots if p.robot == lock.waiter)
+        if rp.result is None or rp.result.trajectory is None:
+            continue
+        t0 = float(rp.result.trajectory.t[0])
+        inside = [s for s in rp.result.spots if lock.waiter_span[0] <= s.t_arrive - t0 <= lock.waiter_span[1]]
+        after = [s for s in rp.result.spots if s.t_arrive - t0 >= lock.wait_at][:1]
+        for s in inside or after:
+            key = (lock.waiter, (s.seam, s.name))
+            penalty[key] = penalty.get(key, 0.0) + w / max(len(inside or after), 1)

@@ -1,0 +1,98 @@
+"""Station files (docs/stations.md): read into a StationSpec, each robot a cell; bad input refused
+with one message naming the file and the station's key."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from robomax_py.errors import CellFileError
+from robomax_py.io.station import is_station_file, load_station
+from robomax_py.spec_station import robot_view
+
+STATION = Path(__file__).parents[1] / "data" / "station" / "two_robots.yaml"
+
+
+def _data() -> dict[str, Any]:
+    data = yaml.safe_load(STATION.read_text())
+    for obj in data["objects"]:
+        if "mesh" in obj:
+            obj["mesh"] = str((STATION.parent / obj["mesh"]).resolve())
+    return data
+
+
+def _write(tmp_path: Path, data: dict[str, Any]) -> Path:
+    path = tmp_path / "station.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_reads_robots_and_allowed_spots() -> None:
+    station = load_station(STATION)
+    assert station.robot_names == ("r1", "r2")
+    assert is_station_file(STATION)
+    r1, r2 = station.robots
+    assert r1.cell.name == "two_robots_r1" and r2.cell.name == "two_robots_r2"
+    assert r2.cell.T_world_base[0, 3] == pytest.approx(3.4)
+    assert r1.interlock_outputs.numbers() == range(101, 109)
+    allowed = {s.key: s.robots for s in station.spots}
+    assert allowed[("front_rail", "f1")] == ("r1",)            # the seam's list
+    assert allowed[("right_rail", "r4")] == ("r2",)            # a spot's list narrows it
+    assert allowed[("left_rail", "l1")] == ("r1", "r2")        # no list: any robot
+    view = robot_view(station, "r2", station.allowed("r2"))
+    assert [(seam.name, [s.name for s in seam.spots]) for seam in view.seams] == \
+        [("left_rail", ["l1", "l4"]), ("right_rail", ["r1", "r4"])]
+
+
+def test_single_robot_cell_is_not_a_station() -> None:
+    assert not is_station_file(Path(__file__).parents[2] / "cells" / "frame.yaml")
+
+
+def _robot_key(data: dict[str, Any], i: int, key: str, value: Any) -> dict[str, Any]:
+    data["robots"][i][key] = value
+    return data
+
+
+HOSTILE = [
+    ("unknown robot in a seam", lambda d: d["seams"][1].update(robots=["r9"]) or d, "seams[1].robots", "unknown robot 'r9'"),
+    ("spot widens its seam", lambda d: d["seams"][0]["spots"][0].update(robots=["r2"]) or d,
+     "seams[0].spots[0].robots", "narrows"),
+    ("duplicate robot name", lambda d: _robot_key(d, 1, "name", "r1"), "robots[1].name", "duplicate robot name"),
+    ("robot and robots", lambda d: d.update(robot={"model": "kr125", "home": [0] * 6}) or d, "robot", "robots"),
+    ("bad robot name", lambda d: _robot_key(d, 0, "name", "1st robot"), "robots[0].name", ""),
+    ("unknown model", lambda d: _robot_key(d, 1, "model", "kr999"), "robots[1].model", "unknown robot"),
+    ("home outside limits", lambda d: _robot_key(d, 1, "home", [0, -90, 90, 0, 500, 0]), "robots[1].home[4]", "limits"),
+    ("interlock range too small",
+     lambda d: d["robots"][0]["controller"].update(interlock_io={"inputs": [5, 5], "outputs": [1, 0]}) or d,
+     "robots[0].controller.interlock_io", ""),
+    ("interlock range missing", lambda d: d["robots"][1]["controller"].pop("interlock_io") and d,
+     "robots[1].controller.interlock_io", "required"),
+    ("brand differs", lambda d: d["robots"][0]["controller"].update(brand="abb") or d, "robots[0].controller.brand",
+     "kuka"),
+    ("unknown controller key", lambda d: d["robots"][0]["controller"].update(colour=3) or d,
+     "robots[0].controller.colour", ""),
+    ("bad spot", lambda d: d["seams"][2]["spots"][1].update(normal=[0, 0, 0]) or d, "seams[2].spots[1].normal", ""),
+]
+
+
+@pytest.mark.parametrize(("what", "edit", "key", "words"), HOSTILE, ids=[h[0] for h in HOSTILE])
+def test_bad_station_names_file_and_key(tmp_path: Path, what: str, edit: Any, key: str, words: str) -> None:
+    path = _write(tmp_path, edit(copy.deepcopy(_data())))
+    with pytest.raises(CellFileError) as err:
+        load_station(path)
+    assert err.value.file == str(path)
+    assert (err.value.key or "").startswith(key), str(err.value)
+    assert words in str(err.value)
+
+
+def test_interlock_range_clashing_with_an_input(tmp_path: Path) -> None:
+    data = _data()
+    data["objects"][1]["signal"] = "clamp_front"
+    data["robots"][0]["controller"]["inputs"] = {"clamp_front": 103}
+    with pytest.raises(CellFileError, match="clamp_front") as err:
+        load_station(_write(tmp_path, data))
+    assert err.value.key == "robots[0].controller.interlock_io.inputs"

@@ -1,0 +1,69 @@
+"""Interlock ordering on constructed coordination diagrams (no robots): the order chosen for the
+makespan, not first come first served; the shared clock keeps every pair outside its zones;
+interlocks that wait on each other are a deadlock."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from robomax_py.station.coordinate import (
+    Interlock,
+    PairMap,
+    Timeline,
+    _first_clash,
+    coordinate,
+    simulate,
+)
+
+DT = 0.1
+
+
+def _timeline(robot: str, end: float, points: list[float]) -> Timeline:
+    return Timeline(robot, end, (0.0, *points), (*points, end))
+
+
+def _crossing(a_zone: tuple[float, float], b_zone: tuple[float, float], end: float = 10.0) -> PairMap:
+    """Robots a and b collide while a is in a_zone and b in b_zone (own times, s)."""
+    t = np.arange(0.0, end + DT, DT)
+    in_a = (t >= a_zone[0]) & (t <= a_zone[1])
+    in_b = (t >= b_zone[0]) & (t <= b_zone[1])
+    return PairMap("a", "b", DT, in_a[:, None] & in_b[None, :])
+
+
+def test_picks_the_order_with_the_shorter_makespan() -> None:
+    # b reaches the zone first (2.0 s) but stays long (to 8 s); a passes it quickly (2.5-3 s).
+    # First come first served lets b go first and a waits ~6 s; a first costs b about 1 s.
+    lines = [_timeline("a", 10.0, [1.0, 2.0, 3.5, 5.0, 7.0]), _timeline("b", 10.0, [1.5, 8.5, 9.0])]
+    pair = _crossing((2.5, 3.0), (2.0, 8.0))
+    best = coordinate(lines, [pair])
+    fcfs = coordinate(lines, [pair], fcfs=True)
+    assert not best.unresolved and not fcfs.unresolved
+    assert [x.leader for x in best.interlocks] == ["a"]
+    assert [x.leader for x in fcfs.interlocks] == ["b"]
+    assert best.schedule.makespan < fcfs.schedule.makespan - 1.0
+    for done in (best, fcfs):
+        assert _first_clash([pair], done.schedule) is None      # the shared clock keeps them apart
+
+
+def test_no_interlock_where_the_paths_never_meet_in_time() -> None:
+    lines = [_timeline("a", 10.0, [2.0, 4.0]), _timeline("b", 10.0, [2.0, 4.0])]
+    pair = _crossing((1.0, 2.0), (6.0, 7.0))          # a's zone time long before b's
+    done = coordinate(lines, [pair])
+    assert done.interlocks == () and done.schedule.makespan == pytest.approx(10.0)
+
+
+def test_a_wait_is_as_long_as_the_leader_needs() -> None:
+    lines = [_timeline("a", 10.0, [4.0]), _timeline("b", 6.0, [1.0])]
+    lock = Interlock(("a", "b"), 0, "a", "b", 4.0, 1.0, (2.0, 3.5), (1.5, 3.0))
+    schedule = simulate(lines, [lock])
+    assert schedule.waits["b"] == ((1.0, pytest.approx(3.0)),)
+    assert schedule.ends["b"] == pytest.approx(9.0)
+    assert schedule.makespan == pytest.approx(10.0)
+
+
+def test_interlocks_waiting_on_each_other_are_a_deadlock() -> None:
+    lines = [_timeline("a", 10.0, [2.0, 6.0]), _timeline("b", 10.0, [2.0, 6.0])]
+    locks = [Interlock(("a", "b"), 0, "a", "b", 6.0, 2.0, (3.0, 5.0), (3.0, 5.0)),
+             Interlock(("a", "b"), 1, "b", "a", 6.0, 2.0, (3.0, 5.0), (3.0, 5.0))]
+    assert simulate(lines, locks).deadlock

@@ -1,0 +1,121 @@
+"""`robomax plan STATION` end to end on a small crossing station (each of two robots welds a spot on
+the other's side), planned once for the file's tests; and the lower bound held to real plans of
+small stations."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from typer.testing import CliRunner
+
+from robomax_py.app.cli import app
+from robomax_py.io.cell import load_cell_robot
+from robomax_py.io.station import load_station
+from robomax_py.program import SetSignal, WaitFor
+from robomax_py.station.pipeline import plan_station
+
+DATA = Path(__file__).parents[1] / "data" / "station"
+CROSSING = DATA / "crossing.yaml"
+TWO = DATA / "two_robots.yaml"
+
+
+@pytest.fixture(scope="module")
+def planned(shared_once: Callable[[str, Callable[[], Any]], Any], tmp_path_factory: pytest.TempPathFactory
+            ) -> dict[str, str]:
+    def run() -> dict[str, str]:
+        out = tmp_path_factory.mktemp("station")
+        done = CliRunner().invoke(app, ["plan", str(CROSSING), "-o", str(out), "--format", "native,srcl"])
+        assert done.exit_code == 0, done.output
+        return {p.name: p.read_text() for p in out.iterdir() if p.is_file()}
+
+    files: dict[str, str] = shared_once("station-crossing-cli:" + CROSSING.read_text(), run)
+    return files
+
+
+@pytest.mark.slow
+def test_writes_every_robots_programs_and_the_station(planned: dict[str, str]) -> None:
+    for robot in ("r1", "r2"):
+        for ext in (".src", ".dat", ".srcl", ".json"):
+            assert f"crossing_{robot}{ext}" in planned
+    summary = json.loads(planned["crossing.station.json"])
+    assert summary["format"] == "robomax.station/1"
+    assert summary["lower_bound"]["value"] <= summary["makespan"]
+    welded = sorted(s for r in summary["robots"] for s in r["spots"])
+    assert welded == sorted(f"{seam}/{spot}" for seam, spot in
+                            [("front_rail", "f1"), ("front_rail", "f4"), ("left_rail", "l1"), ("left_rail", "l4"),
+                             ("right_rail", "r1"), ("right_rail", "r4")])
+    spots = {r["name"]: set(r["spots"]) for r in summary["robots"]}
+    assert "left_rail/l1" in spots["r2"] and "left_rail/l4" in spots["r1"]     # as the file allows
+    for r in summary["robots"]:
+        traj = json.loads(planned[f"crossing_{r['name']}.json"])
+        assert traj["cycle_time"] == pytest.approx(r["own_cycle"], abs=1e-6)
+        waited = sum(w["seconds"] for w in traj["station"]["waits"])
+        assert waited == pytest.approx(r["waits"], abs=1e-5)
+        assert r["end"] == pytest.approx(r["own_cycle"] + r["waits"], abs=1e-5)
+    assert max(r["end"] for r in summary["robots"]) == pytest.approx(summary["makespan"], abs=1e-5)
+
+
+@pytest.mark.slow
+def test_interlocks_are_stated_in_both_programs(planned: dict[str, str]) -> None:
+    from robomax_py.export import DIALECTS
+
+    summary = json.loads(planned["crossing.station.json"])
+    assert summary["interlocks"], "the crossing station needs an interlock"
+    station = load_station(CROSSING)
+    for lock in summary["interlocks"]:
+        assert lock["signal"] == f"{lock['leader']}_{lock['zone']}_clear"
+        leader, waiter = station.robot(lock["leader"]), station.robot(lock["waiter"])
+        assert lock["leader_output"] in leader.interlock_outputs.numbers()
+        assert lock["waiter_input"] in waiter.interlock_inputs.numbers()
+        for robot, kind in ((lock["leader"], SetSignal), (lock["waiter"], WaitFor)):
+            name = f"crossing_{robot}.srcl"
+            model = load_cell_robot(station.robot(robot).cell)
+            program = DIALECTS["srcl"].parse({".srcl": planned[name]}, name, model).program
+            found = [i for i in program.instructions if isinstance(i, kind) and i.signal == lock["signal"]]
+            assert found, f"{kind.__name__} {lock['signal']} missing in {name}"
+        krl = planned[f"crossing_{lock['leader']}.src"]
+        assert f"$OUT[{lock['leader_output']}]=TRUE" in krl and f"$OUT[{lock['leader_output']}]=FALSE" in krl
+        assert f"SIGNAL {lock['signal']} $IN[{lock['waiter_input']}]" in planned[f"crossing_{lock['waiter']}.src"]
+
+
+def _small_station(tmp: Path, keep: list[str], only: dict[str, str]) -> Path:
+    data = yaml.safe_load(TWO.read_text())
+    for obj in data["objects"]:
+        if "mesh" in obj:
+            obj["mesh"] = str((TWO.parent / obj["mesh"]).resolve())
+    for seam in data["seams"]:
+        seam.pop("robots", None)
+        seam["spots"] = [dict(s, **({"robots": [only[s["name"]]]} if s["name"] in only else {}))
+                         for s in seam["spots"] if s["name"] in keep]
+        for s in seam["spots"]:
+            s.pop("robots", None) if s["name"] not in only else None
+    data["seams"] = [s for s in data["seams"] if s["spots"]]
+    path = tmp / "small.yaml"
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+SPOTS = ["f1", "f4", "l1", "l4", "r1", "r4"]
+
+
+@pytest.mark.slow
+@settings(max_examples=3, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(keep=st.lists(st.sampled_from(SPOTS), min_size=2, max_size=3, unique=True),
+       pin=st.dictionaries(st.sampled_from(["l1", "l4", "r1"]), st.sampled_from(["r1", "r2"]), max_size=1))
+def test_lower_bound_below_every_plan(tmp_path: Path, keep: list[str], pin: dict[str, str]) -> None:
+    only = {"f1": "r1", "f4": "r1", "r4": "r2", **pin}
+    station = load_station(_small_station(tmp_path, keep, only))
+    models = {r.name: load_cell_robot(r.cell) for r in station.robots}
+    plan = plan_station(station, models)
+    assert plan.status == "planned", plan.message
+    assert plan.bound.value <= plan.makespan
+    for p in plan.robots:                       # each robot's own tour: at least its spots' round trips
+        if p.result is not None:
+            assert p.own_cycle >= max(s.weld_time for s in p.result.spots)
