@@ -213,6 +213,44 @@ Shape = Box | Cylinder | Sphere | Capsule | MeshShape
 
 
 @dataclass(frozen=True, slots=True, eq=False)
+class PathMotion:
+    """A rigid object carried along timed poses (cell key `dynamic[i].path`): position linear and
+    rotation slerped between them, held at the end poses outside them while present.
+
+    t : (k,) s, strictly increasing; T_world_object : (k, 4, 4); repeat : s between passes (None:
+    one pass); count : passes; sweep : m, how far the object may move within the span one of its
+    sampled poses stands for (`world.moving`).
+    """
+
+    t: FloatArray
+    T_world_object: FloatArray
+    repeat: float | None = None
+    count: int = 1
+    sweep: float = 0.02
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class RobotMotion:
+    """Another robot replaying a trajectory file (cell key `dynamic[i].robot` + `trajectory`): its
+    links (and tool) follow q(t), linear in joint space between samples, held at the first sample
+    before it and at the last after it.
+
+    t : (k,) s from program start; q : (k, n) rad (m for a prismatic joint) in the order `joints`
+    names (checked against the model when the scene is built); key : where the cell states it.
+    """
+
+    robot: RobotSpec
+    T_world_base: FloatArray
+    tool: ToolSpec | None
+    joints: tuple[str, ...]
+    t: FloatArray
+    q: FloatArray
+    source: Path                             # the trajectory file
+    key: str
+    sweep: float = 0.02
+
+
+@dataclass(frozen=True, slots=True, eq=False)
 class ObjectSpec:
     """A static obstacle, or a dynamic one when `present` is not None."""
 
@@ -226,6 +264,9 @@ class ObjectSpec:
     signal: str | None = None
     # A machine's door (tending cells): present while closed; the program waits for `<name>_open`.
     door: bool = False
+    # A moving dynamic object (cell keys `dynamic[i].path`, `.robot`): its pose follows the motion
+    # while present; `shape` and `T_world_object` are then its shape and first pose (a robot: unused).
+    motion: PathMotion | RobotMotion | None = None
 
 
 @dataclass(frozen=True, slots=True, eq=False)

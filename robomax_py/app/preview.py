@@ -53,7 +53,9 @@ from robomax_py.app.preview_drawing import (
     _mesh_geometry,
     _node_poses,
     _pose_parts,
+    _safe,
 )
+from robomax_py.app.preview_moving import draw_moving, pose_moving
 from robomax_py.app.preview_overlay import inject, overlay_facts, overlay_html
 from robomax_py.app.preview_parts import carried_parts
 from robomax_py.app.preview_process import _close, _start_server, _stop
@@ -136,6 +138,9 @@ def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram,
     root.delete()
 
     objects = _draw_objects(root, cell, robot)
+    moving = draw_moving(root, cell, robot, _safe)
+    pose_moving(root, moving, float(program.t[0]), animated=False)
+    objects += [(node.path, "dynamic", palette.ROLE_COLOURS["dynamic"]) for node in moving]
     links = _link_nodes(robot)
     for node in links:
         root[node.path].set_object(_mesh_geometry(node.vertices, node.faces), g.MeshLambertMaterial(color=palette.ROBOT))
@@ -158,7 +163,8 @@ def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram,
     if len(frames):
         anim = mc_anim.Animation(default_framerate=fps)
         qs = program.q_at(program.t[0] + frames / fps)
-        dynamic = [(p, obj) for (p, role, _), obj in zip(objects, (*cell.objects, *cell.dynamic)) if role == "dynamic"]
+        standing = (*cell.objects, *(d for d in cell.dynamic if d.motion is None))
+        dynamic = [(p, obj) for (p, role, _), obj in zip(objects, standing) if role == "dynamic"]
         for frame, q in zip(frames, qs):
             at = anim.at_frame(root, float(frame))
             for path, T in _node_poses(robot, links, T_world_base, q).items():
@@ -166,6 +172,7 @@ def populate(vis: Any, cell: CellSpec, robot: RobotModel, program: ShownProgram,
             for path, obj in dynamic:
                 at[path].set_property("visible", "boolean", _present(obj.present, float(frame) / fps))
             _pose_parts(at, carried, parts, float(frame) / fps, T_world_base @ fk_tcp(robot, q), animated=True)
+            pose_moving(at, moving, float(frame) / fps, animated=True)
         vis.set_animation(anim, play=True, repetitions=1)
     _place_camera(vis, cell, robot)
     return PreviewContent(

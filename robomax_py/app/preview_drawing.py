@@ -6,7 +6,7 @@ frames, the TCP path by phase and the free-space voxels; and the links' poses at
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -53,10 +53,12 @@ def _mesh_geometry(vertices: FloatArray, faces: Any) -> Any:
 def _draw_objects(root: Any, cell: CellSpec, robot: RobotModel) -> list[tuple[str, str, int]]:
     import meshcat.geometry as g
 
-    scene = build_scene(cell, robot)
+    # Moving objects are drawn and animated by `preview_moving` (a scene holds them as many spans).
+    standing = tuple(d for d in cell.dynamic if d.motion is None)
+    scene = build_scene(replace(cell, dynamic=standing), robot)
     T_world_base = np.asarray(cell.T_world_base, dtype=float)
     drawn = []
-    for specs, posed, dynamic in ((cell.objects, scene.obstacles, False), (cell.dynamic, scene.dynamic, True)):
+    for specs, posed, dynamic in ((cell.objects, scene.obstacles, False), (standing, scene.dynamic, True)):
         for spec, obj in zip(specs, posed):
             role = palette.object_role(spec, dynamic=dynamic)
             colour = palette.ROLE_COLOURS[role]

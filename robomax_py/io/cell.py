@@ -41,6 +41,7 @@ from robomax_py.io.cell_limits import (
     _refuse_counts,
 )
 from robomax_py.io.cell_lint import library_hint, lint_cell
+from robomax_py.io.cell_moving import moving_object
 from robomax_py.io.cell_objects import _object, _pose
 from robomax_py.io.cell_problems import _located, _Problems
 from robomax_py.io.cell_rewrite import dump_cell_file, read_cell_file, read_cell_frames
@@ -186,7 +187,10 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
         triangles.append(_check_mesh_readable(mesh, RobotModelError(tool_file, key, f"cannot read mesh {mesh}"),
                                               triangles))
     objects = tuple(problems.attempt(_object, o, path, f"objects[{i}]", triangles) for i, o in enumerate(parsed.objects))
-    dynamic = tuple(problems.attempt(_object, o, path, f"dynamic[{i}]", triangles) for i, o in enumerate(parsed.dynamic))
+    cycles = parsed.tending.cycles if parsed.tending is not None else 1
+    dynamic = tuple(problems.attempt(moving_object, o, path, f"dynamic[{i}]", triangles, cycles)
+                    if o.path is not None or o.robot is not None else
+                    problems.attempt(_object, o, path, f"dynamic[{i}]", triangles) for i, o in enumerate(parsed.dynamic))
     parts = problems.attempt(_parts, parsed, path, robot_spec, triangles)
     home = problems.attempt(_home, parsed, robot_spec, path)
     problems.raise_found()

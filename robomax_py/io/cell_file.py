@@ -197,17 +197,87 @@ class ObjectFile(_Strict):
 
     @model_validator(mode="after")
     def _one_shape(self) -> ObjectFile:
-        given = [k for k in _SHAPE_KEYS if getattr(self, k) is not None]
-        if len(given) != 1:
-            got = ", ".join(given) if given else "none"
-            raise ValueError(f"exactly one of {', '.join(_SHAPE_KEYS)} is required, got {got}")
-        if (stray := misplaced_mesh_keys({k: getattr(self, k) for k in ("mesh", *MESH_ONLY_KEYS)})) is not None:
-            raise ValueError(stray)
+        _check_one_shape(self)
         return self
 
 
+def _check_one_shape(obj: ObjectFile) -> None:
+    given = [k for k in _SHAPE_KEYS if getattr(obj, k) is not None]
+    if len(given) != 1:
+        got = ", ".join(given) if given else "none"
+        raise ValueError(f"exactly one of {', '.join(_SHAPE_KEYS)} is required, got {got}")
+    if (stray := misplaced_mesh_keys({k: getattr(obj, k) for k in ("mesh", *MESH_ONLY_KEYS)})) is not None:
+        raise ValueError(stray)
+
+
+class PathPoseFile(_Strict):
+    """One timed pose of a moving object (`dynamic[i].path`), in the world frame."""
+
+    t: WindowTime                             # s from program start
+    xyz: Vec3                                 # m
+    rpy: Vec3 = [0.0, 0.0, 0.0]               # deg
+
+
+class OtherRobotFile(_Strict):
+    """Another robot in the cell (`dynamic[i].robot`): which one, where it stands, its tool."""
+
+    model: Reference                          # folder name in robots/, or a path to a robot.yaml
+    base: PoseFile = PoseFile()
+    tool: Reference | None = None             # folder name in robots/tools/, or a path to a tool.yaml
+
+
+# m: how far a moving object may move within the time one of its sampled poses stands for (world.moving)
+Sweep = Annotated[float, Field(gt=0, le=0.2, allow_inf_nan=False)]
+
+
 class DynamicObjectFile(ObjectFile):
-    present: Annotated[list[Annotated[list[WindowTime], Field(min_length=2, max_length=2)]], Field(min_length=1)]
+    present: Annotated[list[Annotated[list[WindowTime], Field(min_length=2, max_length=2)]], Field(min_length=1)] | None = None
+    # Extensions (docs/cell-extensions.md, "Moving objects"): a rigid object carried along timed
+    # poses, or another robot replaying a trajectory file.
+    path: Annotated[list[PathPoseFile], Field(min_length=2, max_length=10_000)] | None = None
+    repeat: Positive | None = None            # s between passes of the path (a conveyor's next part)
+    count: Annotated[int, Field(ge=1, le=10_000)] | None = None   # passes; default: the tending cycles, else 1
+    robot: OtherRobotFile | None = None
+    trajectory: Reference | None = None       # a robomax.trajectory/1 file, relative to this file
+    sweep: Sweep | None = None                # m; default 0.02
+
+    @model_validator(mode="after")
+    def _one_shape(self) -> DynamicObjectFile:
+        if self.robot is None:
+            _check_one_shape(self)
+            if self.trajectory is not None:
+                raise ValueError("trajectory: only with robot (another robot replaying it)")
+        else:
+            given = [k for k in (*_SHAPE_KEYS, *MESH_ONLY_KEYS, "path", "repeat", "count") if getattr(self, k) is not None]
+            if given or self.pose != PoseFile() or self.frame is not None or self.workpiece:
+                raise ValueError(f"a robot has no {', '.join(given) or 'pose, frame or workpiece'}: its links are its "
+                                 "shape, robot.base its place, the trajectory its motion")
+            if self.trajectory is None:
+                raise ValueError("trajectory: required with robot (a robomax.trajectory/1 file)")
+        if self.path is not None and (self.pose != PoseFile() or self.frame is not None):
+            raise ValueError("pose, frame: not with path (the path's poses place it, in the world frame)")
+        if self.path is None and self.robot is None:
+            if self.present is None:
+                raise ValueError("present: required (the windows in which the object is there), unless it moves "
+                                 "(path or robot)")
+            extra = [k for k in ("repeat", "count", "sweep") if getattr(self, k) is not None]
+            if extra:
+                raise ValueError(f"{', '.join(extra)}: only for a moving object (path)")
+        if self.count is not None and self.repeat is None:
+            raise ValueError("count: only with repeat (the number of passes)")
+        if self.repeat is not None and self.present is not None:
+            raise ValueError("present: not with repeat (each pass is there from its first to its last pose)")
+        return self
+
+    @field_validator("path")
+    @classmethod
+    def _times_increase(cls, poses: list[PathPoseFile] | None) -> list[PathPoseFile] | None:
+        for i in range(1, len(poses or ())):
+            assert poses is not None
+            if not poses[i].t > poses[i - 1].t:
+                raise ValueError(f"[{i}].t = {poses[i].t:g} s: times must increase strictly "
+                                 f"(after {poses[i - 1].t:g} s)")
+        return poses
 
     @field_validator("signal")
     @classmethod
@@ -218,8 +288,9 @@ class DynamicObjectFile(ObjectFile):
 
     @field_validator("present")
     @classmethod
-    def _windows_in_order(cls, windows: list[list[float]]) -> list[list[float]]:
-        for i, (t0, t1) in enumerate(windows):
+    def _windows_in_order(cls, windows: list[list[float]] | None) -> list[list[float]] | None:
+        for i, (t0, t1) in enumerate(windows or ()):
+            assert windows is not None
             if not t0 < t1:
                 raise ValueError(f"window {i} [{t0}, {t1}]: start must be before end")
             if i and t0 < windows[i - 1][1]:

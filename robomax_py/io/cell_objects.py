@@ -49,7 +49,7 @@ def _object(obj: ObjectFile, path: Path, key: str, triangles: list[int]) -> Obje
         triangles.append(_check_mesh_readable(shape, CellFileError(path, f"{key}.mesh", f"cannot read mesh {mesh}"),
                                               triangles))
     present = None
-    if isinstance(obj, DynamicObjectFile):
+    if isinstance(obj, DynamicObjectFile) and obj.present is not None:
         present = tuple((float(t0), float(t1)) for t0, t1 in obj.present)
     return ObjectSpec(
         name=obj.name, shape=shape, T_world_object=frozen_array(_pose(obj.pose)),

@@ -76,7 +76,9 @@ class PlanOptions:
     - `detour_tcp_speed`: m/s on the LIN lines of detours, before the override; None takes the
       cell's `planner.detour_tcp_speed` (default 1.0).
     - `dynamic`: how dynamic objects are planned around: "timed" (time-aware moves) or "rest"
-      (waits at rest); None takes the cell's `planner.dynamic`.
+      (waits at rest); None takes the cell's `planner.dynamic`. "astar" is the paper's classical
+      A* as a baseline (docs/paper-001.md): the time-aware search's graph with time ignored, then a
+      stop at rest wherever its route meets a dynamic object at its time.
     - `transfers`: how a pick-and-place cell's carried moves are planned: "moves" (as every other
       move: straight, or a detour where that is blocked) or "associative" (Diane and Anikina's
       table, k-NN graph, Dijkstra route and Jacobian interpolation, `plan.associative`); None

@@ -92,7 +92,8 @@ def dynamic_boxes(scene: Scene) -> tuple[tuple[FloatArray, FloatArray, Windows],
     out = []
     for obj in scene.dynamic:
         pts = np.vstack([support_points(g, np.asarray(obj.T_base_object)) for g in obj.pieces])
-        out.append((pts.min(axis=0), pts.max(axis=0), tuple(obj.present or ((0.0, math.inf),))))
+        grow = obj.margin                  # a moving object's span counts larger (`world.moving`)
+        out.append((pts.min(axis=0) - grow, pts.max(axis=0) + grow, tuple(obj.present or ((0.0, math.inf),))))
     return tuple(out)
 
 

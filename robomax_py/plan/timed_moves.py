@@ -45,10 +45,15 @@ from robomax_py.plan.timed_search import (
     merge_windows,
     timed_astar,
 )
-from robomax_py.plan.waiting import WaitingError, first_dynamic_hit, wait_at_rest
+from robomax_py.plan.waiting import (
+    WaitingError,
+    ceil_ms,
+    first_dynamic_hit,
+    wait_at_rest,
+)
 from robomax_py.program import as_written_joints
 from robomax_py.robot import RobotModel, fk_tcp
-from robomax_py.spec import CellSpec, ObjectSpec
+from robomax_py.spec import CellSpec
 from robomax_py.timing import Segment, dwell, ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.scene import build_scene
@@ -56,32 +61,32 @@ from robomax_py.world.scene import build_scene
 
 class DynamicConflicts:
     """Which dynamic obstacles a configuration or a straight joint move touches (any time), and the
-    windows in which that matters. One collision world per obstacle, robot-against-obstacle pairs only."""
+    windows in which that matters. One collision world of them all, robot-against-obstacle pairs
+    only; a moving object is there as its spans (`world.moving`), each with its own window, so a
+    node or an edge is blocked only while the moving object is where it touches it."""
 
     def __init__(self, cell: CellSpec, robot: RobotModel) -> None:
-        self.windows = tuple(d.present if d.present is not None else ((0.0, math.inf),) for d in cell.dynamic)
-        def world(objects: tuple[ObjectSpec, ...]) -> CollisionWorld:
-            return CollisionWorld(robot, build_scene(replace(cell, objects=(), dynamic=objects), robot),
-                                  cell.process.clearance).restricted(obstacles=True, self_pairs=False)
-
-        # All of them first: most moves touch none, and then one check answers.
-        self._all = world(cell.dynamic)
-        self._worlds = [world((d,)) for d in cell.dynamic] if len(cell.dynamic) > 1 else [self._all]
+        scene = build_scene(replace(cell, objects=()), robot)
+        self.windows = tuple(d.present if d.present is not None else ((0.0, math.inf),) for d in scene.dynamic)
+        self._all = CollisionWorld(robot, scene, cell.process.clearance).restricted(obstacles=True, self_pairs=False)
 
     def point(self, q: FloatArray) -> frozenset[int]:
+        # Most configurations touch none, and then one check answers.
         if self._all.is_free(q):
             return frozenset()
-        return frozenset(i for i, w in enumerate(self._worlds) if not w.is_free(q))
+        return self._all.obstacles_touched(np.asarray(q, dtype=float)[None])
 
     def segment(self, qa: FloatArray, qb: FloatArray) -> frozenset[int]:
         if self._all.check_segment(qa, qb).free:
             return frozenset()
-        return frozenset(i for i, w in enumerate(self._worlds) if not w.check_segment(qa, qb).free)
+        return self._all.obstacles_touched(self._all.segment_states(qa, qb))
 
     def windows_of(self, objects: frozenset[int]) -> Windows:
         return merge_windows([w for i in sorted(objects) for w in self.windows[i]])
 
 
+# Searches again from later when a route waits where the retract ends (see `staged_junction`).
+MAX_HELD_SEARCHES = 2
 # (junction, corner) radii tried for a staged junction's pieces, deg: the largest first, then stops.
 STAGED_RADII_DEG = ((JUNCTION_RADII_DEG[0], DETOUR_RADII_DEG[0]), (JUNCTION_RADII_DEG[0], DETOUR_RADII_DEG[-1]),
                     (JUNCTION_RADII_DEG[-1], 0.0), (0.0, 0.0))
@@ -97,6 +102,7 @@ class StagedJunction:
     junction_radius: float           # rad, as `Junction`
     corner_radius: float
     extension: Extension
+    pre_wait: float = 0.0            # s at rest at q_rest before the segments (a moving object passing)
 
 
 @dataclass(frozen=True, slots=True)
@@ -115,6 +121,10 @@ class JunctionContext:
     jerk_limited: bool
     max_wait: float
     tcp: TcpSpace | None = None      # the TCP's free voxels: a route through them is one more way
+    moving: frozenset[str] = frozenset()   # moving objects: `windows` holds their spans' windows
+    # The classical A* of the paper (a baseline): the same graph, heuristic and timing, every node
+    # and edge free at all times; the route is timed as if nothing moved (the caller checks it).
+    ignore_time: bool = False
 
 
 class _StageFailed(RobomaxError):
@@ -123,10 +133,11 @@ class _StageFailed(RobomaxError):
 
 def staged_junction(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray, waypoints: FloatArray,
                     kind: str, label: str, before: WeldEnd | None, after: WeldEnd | None, baseline: Sequence[Segment],
-                    action_s: float, q_action: FloatArray | None) -> StagedJunction | NoRoute:
+                    action_s: float, q_action: FloatArray | None, depth: int = 0) -> StagedJunction | NoRoute:
     """Junction `index` searched and timed with its dynamic obstacles' windows, starting at rest at
     q_rest at t_block; `baseline` is its timing without them (for the retract and approach times).
-    q_action: the configuration of the action after it (None: the way home)."""
+    q_action: the configuration of the action after it (None: the way home). The junction found may
+    start after a wait at rest (`pre_wait`)."""
     retract_s = sum(s.duration for s in baseline if s.kind == "retract")
     approach_s = sum(s.duration for s in baseline if s.kind == "approach")
     # The goal is held for the approach, the action and the retract after it.
@@ -147,8 +158,18 @@ def staged_junction(ctx: JunctionContext, index: int, t_block: float, q_rest: Fl
     found = timed_astar(graph, start, goal, t_block + retract_s, ctx.max_wait)
     if isinstance(found, NoRoute):
         return found
-    if found.steps[0].depart - found.steps[0].arrive > 1e-6:
-        return NoRoute("no_gain", "the route waits where the retract ends: no better than waiting at rest", 0)
+    held = found.steps[0].depart - found.steps[0].arrive
+    if held > 1e-6:
+        # It waits where the retract ends: the same wait at rest before the retract (the caller
+        # checks the robot is not hit there), then the junction searched again from then. For a
+        # door this is waiting at rest; a moving object may clear the way long before its last
+        # window ends, which is when waiting at rest for it ends.
+        if depth >= MAX_HELD_SEARCHES or not ctx.moving:
+            return NoRoute("no_gain", "the route waits where the retract ends: no better than waiting at rest", 0)
+        pre = ceil_ms(held)
+        later = staged_junction(ctx, index, t_block + pre, q_rest, waypoints, kind, label, before, after, baseline,
+                                action_s, q_action, depth + 1)
+        return replace(later, pre_wait=pre + later.pre_wait) if isinstance(later, StagedJunction) else later
     try:
         return _timed(ctx, index, t_block, q_rest, found, points, kind, label, before, after, action_s, q_action)
     except RobomaxError as exc:             # a piece that cannot be timed (TimingError) or checked
@@ -196,6 +217,11 @@ def _graph(ctx: JunctionContext, waypoints: FloatArray, q_action: FloatArray | N
         return out + [(v, duration(u, v)) for v in sorted(links.get(u, ())) + ends.get(u, [])]
 
     def edge_windows(u: int, v: int) -> Windows | None:
+        if ctx.ignore_time:
+            return edge_static(u, v)
+        return edge_timed(u, v)
+
+    def edge_static(u: int, v: int) -> Windows | None:
         key = (min(u, v), max(u, v))
         if key not in static:
             if key in known_free:
@@ -204,13 +230,19 @@ def _graph(ctx: JunctionContext, waypoints: FloatArray, q_action: FloatArray | N
                 static[key] = roadmap.edge_free(u, v)
             else:
                 static[key] = ctx.world.check_segment(points[u], points[v]).free
-        if not static[key]:
+        return () if static[key] else None
+
+    def edge_timed(u: int, v: int) -> Windows | None:
+        if edge_static(u, v) is None:
             return None
+        key = (min(u, v), max(u, v))
         if key not in dynamic:
             dynamic[key] = ctx.conflicts.segment(points[u], points[v])
         return ctx.conflicts.windows_of(dynamic[key])
 
     def node_windows(u: int) -> Windows:
+        if ctx.ignore_time:
+            return ()
         if u == goal and q_action is not None:
             objs = ctx.conflicts.segment(points[goal], q_action)
             # Arriving at t holds the goal until t + tail: blocked from a window's start - tail.
@@ -245,7 +277,7 @@ def _timed(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray,
         raise _StageFailed("the pieces cannot be timed")
     segments, stages, t, extension = timed
     waypoints = [pieces[0][0], *(q for piece in pieces for q in piece[1:])]
-    if q_action is not None:
+    if q_action is not None and not ctx.ignore_time:
         # The retract after the action leaves along the approach line: nothing may close on it then.
         t_out = t + action_s
         retract_s = sum(s.duration for s in segments if s.kind == "approach")
@@ -278,14 +310,14 @@ def _pieces(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray
                          else [])
         if p > 0:
             try:
-                w = wait_at_rest(ctx.dynamic_world, check, t, ctx.windows, index, ctx.doors)
+                w = wait_at_rest(ctx.dynamic_world, check, t, ctx.windows, index, ctx.doors, ctx.moving)
             except WaitingError:
                 return None
             if w is not None:
                 segments.append(dwell(q_now, w.seconds, kind="wait", label=f"wait for {w.obstacle}"))
                 stages.append(Stage(at, w))
                 t += w.seconds
-        elif first_dynamic_hit(ctx.dynamic_world, check, t) is not None:
+        elif not ctx.ignore_time and first_dynamic_hit(ctx.dynamic_world, check, t) is not None:
             return None                       # the first piece meets a dynamic obstacle as timed
         segments.extend(block)
         t += sum(s.duration for s in block)

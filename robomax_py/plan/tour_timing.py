@@ -57,6 +57,7 @@ from robomax_py.plan.waiting import (
     WaitingError,
     WaitPlan,
     ceil_ms,
+    first_dynamic_hit,
     trapped,
     wait_at_rest,
 )
@@ -289,13 +290,18 @@ def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, road
     A robot that would be trapped where a junction starts (a door closing on it while it waits at
     rest, in a machine it has just served) makes the junction before start later, after that
     door's window: it then enters in the next opening (`Trapped`, at most MAX_WAITS times)."""
-    dynamic_world = CollisionWorld(robot, build_scene(replace(cell, objects=()), robot), cell.process.clearance)
+    dynamic_scene = build_scene(replace(cell, objects=()), robot)
+    dynamic_world = CollisionWorld(robot, dynamic_scene, cell.process.clearance)
     windows = {d.name: d.present if d.present is not None else ((0.0, float("inf")),) for d in cell.dynamic}
+    # A moving object waits span by span (`world.moving`), not until its last window ends.
+    moving = frozenset(d.name for d in cell.dynamic if d.motion is not None)
+    windows |= {name: tuple(sorted(w for o in dynamic_scene.dynamic if o.name == name for w in o.present or ()))
+                for name in moving}
     doors = frozenset(d.name for d in cell.dynamic if d.door)
     ctx = None if options.dynamic == "rest" else JunctionContext(
         robot, world, dynamic_world, DynamicConflicts(cell, robot), roadmap, windows, doors,
         tcp_speed=written_tcp_speed(options.tcp_speed * options.speed), speed=written_speed(options.speed),
-        jerk_limited=options.jerk_limited, max_wait=cell.planner.max_wait, tcp=_tcp_space(cell, robot))
+        jerk_limited=options.jerk_limited, max_wait=cell.planner.max_wait, tcp=_tcp_space(cell, robot), moving=moving)
     out_blocks: list[list[Segment]] = []
     out_timed: list[Transition] = []
     starts: list[float] = []
@@ -312,9 +318,9 @@ def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, road
         # Held back here, the robot may itself be hit while it waits: then the block before starts later.
         caught = trapped(dynamic_world, np.asarray(block[0].q[0]), t, pre, windows, doors) if pre > 0 else None
         chosen = caught if caught is not None else _next_block(ctx, options, dynamic_world, windows, doors, k, t + pre,
-                                                               block, trans, ends, weld_times)
+                                                               block, trans, ends, weld_times, moving)
         if isinstance(chosen, WaitingError):
-            if isinstance(chosen, Trapped) and k > 0 and backtracks < MAX_WAITS:
+            if isinstance(chosen, Trapped) and k > 0 and backtracks < MAX_WAITS and math.isfinite(chosen.window_end):
                 backtracks += 1
                 k -= 1
                 holds[k] = chosen
@@ -339,11 +345,11 @@ def _with_dynamic(cell: CellSpec, robot: RobotModel, world: CollisionWorld, road
 def _next_block(ctx: JunctionContext | None, options: ResolvedOptions, dynamic_world: CollisionWorld,
                 windows: dict[str, tuple[tuple[float, float], ...]], doors: frozenset[str], k: int, t: float,
                 block: list[Segment], trans: Transition, ends: list[WeldEnd], weld_times: list[float],
-                ) -> tuple[list[Segment], Transition] | WaitingError:
+                moving: frozenset[str] = frozenset()) -> tuple[list[Segment], Transition] | WaitingError:
     """Block k started at t: as it is, after a wait at rest, or time-aware (ctx given), whichever
     finishes first; the reason when none can."""
     try:
-        rest = wait_at_rest(dynamic_world, block, t, windows, k, doors)
+        rest = wait_at_rest(dynamic_world, block, t, windows, k, doors, moving)
         rest_error: WaitingError | None = None
     except WaitingError as exc:
         rest, rest_error = None, exc
@@ -351,6 +357,9 @@ def _next_block(ctx: JunctionContext | None, options: ResolvedOptions, dynamic_w
         return block, trans
     rest_end = math.inf if rest is None else t + rest.seconds + sum(s.duration for s in block)
     staged: StagedJunction | NoRoute | None = None
+    if ctx is not None and options.dynamic == "astar" and trans.lin_targets is None:
+        return _classical_block(ctx, options, dynamic_world, windows, doors, k, t, block, trans, ends, weld_times,
+                                moving, rest, rest_error)
     # A detour of TCP lines keeps its lines and waits at rest: the time-aware search plans joint moves.
     if ctx is not None and trans.lin_targets is None:
         has_action = k < len(ends)
@@ -360,16 +369,24 @@ def _next_block(ctx: JunctionContext | None, options: ResolvedOptions, dynamic_w
             trans.label, ends[k - 1] if k else None, ends[k] if has_action else None,
             block[:-1] if has_action else block, weld_times[k] if has_action else 0.0,
             np.asarray(block[-1].q[0]) if has_action else None)
+        if isinstance(staged, StagedJunction) and staged.pre_wait > 0 and trapped(
+                dynamic_world, np.asarray(block[0].q[0]), t, staged.pre_wait, windows, doors) is not None:
+            staged = NoRoute("trapped", "the robot would be hit waiting at rest before it", 0)
         if isinstance(staged, StagedJunction):
             action = block[-1]
             new_block = staged.segments + ([dwell(staged.segments[-1].q[-1], action.duration, kind=action.kind,
                                                    label=action.label)] if has_action else [])
-            if t + sum(s.duration for s in new_block) < rest_end - 1e-9:
+            pre = staged.pre_wait
+            if t + pre + sum(s.duration for s in new_block) < rest_end - 1e-9:
                 ext = staged.extension
-                return (new_block, replace(trans, waypoints=staged.waypoints, stages=staged.stages,
-                                           blend_radius=staged.corner_radius, flyby_radius=staged.junction_radius,
-                                           retract_T=ext.retract_T, retract_q=ext.retract_q,
-                                           approach_q=ext.approach_q))
+                hit = first_dynamic_hit(dynamic_world, block, t) if pre > 0 else None
+                wait = WaitPlan(k, pre, hit[0] if hit else "dynamic objects", False) if pre > 0 else trans.wait
+                lead = [dwell(block[0].q[0], pre, kind="wait", label=f"wait for {wait.obstacle}")] \
+                    if pre > 0 and wait is not None else []
+                return ([*lead, *new_block], replace(trans, waypoints=staged.waypoints, stages=staged.stages,
+                                                     blend_radius=staged.corner_radius,
+                                                     flyby_radius=staged.junction_radius, retract_T=ext.retract_T,
+                                                     retract_q=ext.retract_q, approach_q=ext.approach_q, wait=wait))
     if rest is not None:
         return ([dwell(block[0].q[0], rest.seconds, kind="wait", label=f"wait for {rest.obstacle}"), *block],
                 replace(trans, wait=rest))
@@ -379,3 +396,44 @@ def _next_block(ctx: JunctionContext | None, options: ResolvedOptions, dynamic_w
     why = staged.detail if isinstance(staged, NoRoute) else "its way finishes no sooner"
     return WaitingError(f"{trans.label}: waiting at rest fails ({rest_error}), and so does the time-aware "
                               f"search ({why}): the schedule cannot be met")
+
+
+def _classical_block(ctx: JunctionContext, options: ResolvedOptions, dynamic_world: CollisionWorld,
+                     windows: dict[str, tuple[tuple[float, float], ...]], doors: frozenset[str], k: int, t: float,
+                     block: list[Segment], trans: Transition, ends: list[WeldEnd], weld_times: list[float],
+                     moving: frozenset[str], rest: WaitPlan | None, rest_error: WaitingError | None,
+                     ) -> tuple[list[Segment], Transition] | WaitingError:
+    """`planner.dynamic: astar`, the paper's classical A* as a baseline: a junction that meets a
+    dynamic object takes the A* route over the same graph the time-aware search uses, time ignored;
+    where that route meets a dynamic object at its time, the robot stops at rest before it until it
+    is clear (`transition.wait`: each is one of the paper's dangerous situations). Without a route
+    it waits at rest on its own path, as `rest` does."""
+    has_action = k < len(ends)
+    speed = options.speed * (options.detour_speed if trans.kind == "detour" else 1.0)
+    staged = staged_junction(
+        replace(ctx, speed=written_speed(speed), ignore_time=True), k, t, np.asarray(block[0].q[0]), trans.waypoints,
+        trans.kind, trans.label, ends[k - 1] if k else None, ends[k] if has_action else None,
+        block[:-1] if has_action else block, weld_times[k] if has_action else 0.0,
+        np.asarray(block[-1].q[0]) if has_action else None)
+    if isinstance(staged, StagedJunction):
+        action = block[-1]
+        routed = staged.segments + ([dwell(staged.segments[-1].q[-1], action.duration, kind=action.kind,
+                                           label=action.label)] if has_action else [])
+        ext = staged.extension
+        new_trans = replace(trans, waypoints=staged.waypoints, stages=staged.stages, blend_radius=staged.corner_radius,
+                            flyby_radius=staged.junction_radius, retract_T=ext.retract_T, retract_q=ext.retract_q,
+                            approach_q=ext.approach_q)
+        try:
+            stop = wait_at_rest(dynamic_world, routed, t, windows, k, doors, moving)
+        except WaitingError as exc:
+            return exc
+        if stop is None:
+            return routed, new_trans
+        return ([dwell(routed[0].q[0], stop.seconds, kind="wait", label=f"wait for {stop.obstacle}"), *routed],
+                replace(new_trans, wait=stop))
+    if rest is not None:
+        return ([dwell(block[0].q[0], rest.seconds, kind="wait", label=f"wait for {rest.obstacle}"), *block],
+                replace(trans, wait=rest))
+    assert rest_error is not None
+    return rest_error
+

@@ -82,9 +82,12 @@ signal_of = dynamic_signal
 
 def wait_at_rest(world: CollisionWorld, block: Sequence[Segment], t: float,
                  windows: dict[str, tuple[tuple[float, float], ...]], index: int,
-                 doors: frozenset[str] = frozenset()) -> WaitPlan | None:
+                 doors: frozenset[str] = frozenset(), moving: frozenset[str] = frozenset()) -> WaitPlan | None:
     """The shortest wait at rest before `block` (starting at t) that keeps it clear of the dynamic
-    obstacles, None when it needs none; WaitingError when waiting cannot help."""
+    obstacles, None when it needs none; WaitingError when waiting cannot help.
+
+    A moving object's `windows` are those of its spans (`world.moving`): the wait is lengthened span
+    by span until the block is clear, and written as a time (no input says where it is)."""
     wait: WaitPlan | None = None
     q_rest = np.asarray(block[0].q[0], dtype=float)
     for _ in range(MAX_WAITS):
@@ -96,13 +99,15 @@ def wait_at_rest(world: CollisionWorld, block: Sequence[Segment], t: float,
         if hit is None:
             return wait
         name, t_hit = hit
+        # The first window to end (a moving object's spans overlap where they meet; what stands
+        # still for good is among them): waiting longer is checked again.
         ends = [w1 for w0, w1 in windows[name] if w0 <= t_hit <= w1]
-        if not ends or not math.isfinite(ends[0]):
+        if not ends or not math.isfinite(min(ends)):
             raise WaitingError(f"{name} is in the way at t = {t_hit:.3f} s and its window does not end")
-        needed = ceil_ms(ends[0] - t) + TIME_STEP_S
+        needed = ceil_ms(min(ends) - t) + TIME_STEP_S
         if needed <= seconds:
             raise WaitingError(f"{name} is in the way at t = {t_hit:.3f} s even after waiting {seconds:.3f} s")
-        for_signal = clear_wait(t, windows[name]) == needed
+        for_signal = name not in moving and clear_wait(t, windows[name]) == needed
         wait = WaitPlan(index, needed, name, for_signal, name in doors)
     raise WaitingError(f"more than {MAX_WAITS} windows in the way of one move")
 
@@ -112,16 +117,15 @@ def trapped(world: CollisionWorld, q_rest: FloatArray, t: float, seconds: float,
     """Whether the robot at rest at q_rest over [t, t + seconds] is hit by a dynamic obstacle
     (checked where each window that meets the span begins): the error saying which, and until
     when its window lasts; None when it is not."""
-    for spans in windows.values():
-        for w0, w1 in spans:
-            if w0 <= t + seconds and w1 >= t:
-                t_in = max(w0, t)
-                contact = world.first_contact(q_rest, t_in)
-                if contact is not None and contact.kind_b == KIND_DYNAMIC:
-                    name = contact.body_b
-                    end = max((b for a, b in windows.get(name, ()) if a <= t_in <= b), default=w1)
-                    return Trapped(f"the robot would be hit while waiting at rest ({contact.describe()}) "
-                                   f"at t = {t_in:.3f} s", name, end, name in doors)
+    # Where the rest begins, and wherever an obstacle appears during it (a moving object appears
+    # in every span of its motion: `world.moving`).
+    for t_in in [t, *world.window_starts(t, t + seconds)]:
+        contact = world.first_contact(q_rest, t_in)
+        if contact is not None and contact.kind_b == KIND_DYNAMIC:
+            name = contact.body_b
+            end = min((b for a, b in windows.get(name, ()) if a <= t_in <= b), default=t_in)
+            return Trapped(f"the robot would be hit while waiting at rest ({contact.describe()}) "
+                           f"at t = {t_in:.3f} s", name, end, name in doors)
     return None
 
 

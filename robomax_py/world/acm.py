@@ -132,6 +132,8 @@ def _classify_pairs(robot: RobotModel, scene: Scene, pieces: list[Piece], obstac
     n_geom = len(pieces)
     for a in range(n_geom):
         pa = pieces[a]
+        if pa.kind in OBSTACLE_KINDS:
+            continue  # obstacles come last (`_pieces`) and are never paired with each other
         for b in range(a + 1, n_geom):
             pb = pieces[b]
             if pa.kind in OBSTACLE_KINDS and pb.kind in OBSTACLE_KINDS:
@@ -172,7 +174,7 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
     model = robot.model
     gm, pieces, obstacles = _pieces(robot, scene)
     n_geom = len(pieces)
-    rules = _classify_pairs(robot, scene, pieces, obstacles, _out_of_reach(model, gm, pieces, max(clearance, 0.0)))
+    rules = _classify_pairs(robot, scene, pieces, obstacles, _out_of_reach(model, gm, pieces, max(clearance, 0.0) + max((o.margin for o in obstacles), default=0.0)))
     disabled, obstacle_pairs, self_candidates = rules.disabled, rules.obstacle_pairs, rules.self_candidates
     flange_candidates, base_obstacle = rules.flange_candidates, rules.base_obstacle
 
@@ -230,16 +232,18 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
         held, obstacle = (pa, pb) if pa.kind == KIND_HELD else (pb, pa)
         if held.kind == KIND_HELD and obstacles[obstacle.obstacle].name in supports:
             return -HELD_SUPPORT_PENETRATION_M
-        return clearance
+        # A moving object's span counts larger by its sweep margin (`world.moving`).
+        other = pb if pb.kind in OBSTACLE_KINDS else pa
+        return clearance + float(obstacles[other.obstacle].margin)
 
     pair_margin = np.array([margin(a, b) for a, b in ordered], dtype=float)
     dynamic_ids = np.array([o for o, obj in enumerate(obstacles) if obj.dynamic], dtype=np.int64)
-    dynamic_pairs = tuple(
-        np.array(
-            [p for p, (a, b) in enumerate(ordered) if pieces[a].obstacle == o or pieces[b].obstacle == o], dtype=np.int64
-        )
-        for o in dynamic_ids
-    )
+    pair_obstacle = np.array([max(pieces[a].obstacle, pieces[b].obstacle) for a, b in ordered], dtype=np.int64)
+    # Grouped once (a moving object is hundreds of obstacles: `world.moving`).
+    by_obstacle = np.argsort(pair_obstacle, kind="stable")
+    first = np.searchsorted(pair_obstacle[by_obstacle], dynamic_ids, side="left")
+    last = np.searchsorted(pair_obstacle[by_obstacle], dynamic_ids, side="right")
+    dynamic_pairs = tuple(np.sort(by_obstacle[a:b]).astype(np.int64) for a, b in zip(first, last))
     acm = AllowedCollisions(
         disabled=tuple(disabled),
         enabled=tuple((pieces[a].name, pieces[b].name) for a, b in ordered),
@@ -257,6 +261,7 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
         obstacles=obstacles,
         dynamic_ids=dynamic_ids,
         dynamic_pairs=dynamic_pairs,
+        pair_obstacle=pair_obstacle,
         lever=bounds.lever_arms(gm, moving),
         clearance=clearance,
         options=options,

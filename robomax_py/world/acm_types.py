@@ -82,6 +82,7 @@ class SharedGeometry:
     obstacles: tuple[SceneObject, ...]       # static then dynamic
     dynamic_ids: IntArray                    # (d,) obstacle indices of dynamic obstacles
     dynamic_pairs: tuple[IntArray, ...]      # per dynamic obstacle: its pair indices
+    pair_obstacle: IntArray                  # (p,) the obstacle of each enabled pair, -1 for a self pair
     lever: FloatArray                        # (n,) m per rad (m per m for prismatic joints)
     clearance: float
     options: CollisionOptions

@@ -73,6 +73,7 @@ import pinocchio as pin
 
 from robomax_py._typing import BoolArray, FloatArray, IntArray
 from robomax_py.robot import RobotModel
+from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.acm import (
     KIND_DYNAMIC,
     KIND_LINK,
@@ -313,6 +314,42 @@ class CollisionWorld(SweptChecks):
         s = self._s
         kinds = [(s.pieces[int(a)].kind, s.pieces[int(b)].kind) for a, b in zip(s.pair_a, s.pair_b)]
         return np.array([1.0 if KIND_OBJECT in pair else 2.0 for pair in kinds])
+
+    def obstacles_touched(self, qs: FloatArray) -> frozenset[int]:
+        """Every obstacle some configuration of qs (k, n) collides with (clearance and margins
+        applied), every dynamic obstacle present: indices into the scene's obstacles then its
+        dynamic obstacles. Unlike `is_free` it does not stop at the first contact; self pairs are
+        not looked at."""
+        qs = np.ascontiguousarray(np.atleast_2d(qs), dtype=np.float64)
+        self._set_presence(None, None)
+        s = self._s
+        owner = s.pair_obstacle
+        active = self._active & (owner >= 0)
+        if self._pf is not None:
+            offsets, pairs = self._pf.uncleared(qs, active)
+        else:
+            every = np.flatnonzero(active)
+            offsets, pairs = np.arange(len(qs) + 1) * len(every), np.tile(every, len(qs))
+        hit: set[int] = set()
+        gm, gd = s.geom_model, self._gdata
+        for i in range(len(qs)):
+            left = [int(p) for p in pairs[offsets[i]:offsets[i + 1]] if int(owner[p]) not in hit]
+            if not left:
+                continue
+            pin.updateGeometryPlacements(s.model, self._data, gm, gd, qs[i])
+            for p in left:
+                if int(owner[p]) not in hit and pin.computeCollision(gm, gd, p):
+                    hit.add(int(owner[p]))
+        return frozenset(hit)
+
+    def segment_states(self, q0: FloatArray, q1: FloatArray, max_step: float = TOL.sweep_step_m) -> FloatArray:
+        """(m + 1, n): the states `check_segment` checks on q0 -> q1, in order from q0."""
+        q0 = np.asarray(q0, dtype=np.float64)
+        q1 = np.asarray(q1, dtype=np.float64)
+        m = max(1, math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12))
+        states = q0 + (np.arange(m + 1) / m)[:, None] * (q1 - q0)
+        states[-1] = q1
+        return states
 
     def window_starts(self, ta: float, tb: float) -> list[float]:
         """Times in (ta, tb] at which a dynamic obstacle appears, in order."""

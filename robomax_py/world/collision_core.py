@@ -12,7 +12,6 @@ import pinocchio as pin
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.world.acm import SharedGeometry, configure_requests
 from robomax_py.world.collision_results import Contact, SegmentCheck
-from robomax_py.world.scene import SceneObject
 
 _FIRST_CHUNK = 8     # states the first pre-filter call of a scan covers (blocked moves stop early)
 
@@ -20,7 +19,8 @@ _FIRST_CHUNK = 8     # states the first pre-filter call of a scan covers (blocke
 class CollisionWorldCore:
     """Scratch, pair activation and exact tests of one collision world (the base of `CollisionWorld`)."""
 
-    __slots__ = ("_active", "_active_before", "_allowed", "_callback", "_data", "_gdata", "_manager", "_pf", "_present", "_s")
+    __slots__ = ("_active", "_active_before", "_allowed", "_callback", "_data", "_gdata", "_manager", "_pf", "_present",
+                 "_s", "_windows")
 
     # ----------------------------------------------------------------------------------- set-up
 
@@ -34,7 +34,12 @@ class CollisionWorldCore:
         if shared.options.broad_phase:
             self._manager = pin.BroadPhaseManager_NaiveCollisionManager(shared.model, shared.geom_model, self._gdata)
             self._callback = pin.CollisionCallBackDefault(shared.geom_model, self._gdata, True)
-        self._present: tuple[bool, ...] = tuple(True for _ in shared.dynamic_ids)
+        self._present = np.ones(len(shared.dynamic_ids), dtype=bool)
+        # Every window of every dynamic obstacle, flat: (start, end, index into dynamic_ids), so the
+        # presence of hundreds of them (a moving object's spans) is one vectorised test.
+        spans = [(float(w0), float(w1), k) for k, i in enumerate(shared.dynamic_ids)
+                 for w0, w1 in (shared.obstacles[int(i)].present or ((-np.inf, np.inf),))]
+        self._windows = np.array(spans, dtype=float).reshape(-1, 3)
         self._active_before = np.arange(len(shared.pair_a) + 1, dtype=np.int64)
         self._active = np.ones(len(shared.pair_a), dtype=bool)
         self._allowed = np.ones(len(shared.pair_a), dtype=bool)     # pairs this world checks at all
@@ -66,12 +71,11 @@ class CollisionWorldCore:
         present during the time between its neighbouring steps, so the states are scanned in runs
         that share one presence, each with the pairs active then, stopping at the first collision."""
         windows = [(start + max(int(step) - 1, 0) / m * span, start + min(int(step) + 1, m) / m * span) for step in order]
-        dynamic = [self._s.obstacles[int(i)] for i in self._s.dynamic_ids]
-        presence = [tuple(_present_during(o, min(a, b), max(a, b)) for o in dynamic) for a, b in windows]
+        presence = [self._presence(min(a, b), max(a, b)) for a, b in windows]
         tests, k0 = 0, 0
         while k0 < len(order):
             k1 = k0 + 1
-            while k1 < len(order) and presence[k1] == presence[k0]:
+            while k1 < len(order) and np.array_equal(presence[k1], presence[k0]):
                 k1 += 1
             a, b = windows[k0]
             self._set_presence(min(a, b), max(a, b))
@@ -128,21 +132,29 @@ class CollisionWorldCore:
         s = self._s
         if not s.dynamic_ids.size:
             return
-        present = tuple(
-            True if ta is None or tb is None else _present_during(s.obstacles[int(i)], ta, tb) for i in s.dynamic_ids
-        )
-        if present == self._present:
+        present = self._presence(ta, tb)
+        changed = np.flatnonzero(present != self._present)
+        if not changed.size:
             return
-        for on_now, on_before, pairs in zip(present, self._present, s.dynamic_pairs):
-            if on_now == on_before:
-                continue
-            for p in pairs:
+        for k in changed.tolist():
+            on_now, pairs = bool(present[k]), s.dynamic_pairs[k]
+            for p in pairs.tolist():
                 if on_now and self._allowed[p]:
-                    self._gdata.activateCollisionPair(int(p))
+                    self._gdata.activateCollisionPair(p)
                 else:
-                    self._gdata.deactivateCollisionPair(int(p))
+                    self._gdata.deactivateCollisionPair(p)
+            self._active[pairs] = on_now & self._allowed[pairs]
         self._present = present
-        self._refresh_active()
+        self._active_before = np.concatenate([[0], np.cumsum(self._active)]).astype(np.int64)
+
+    def _presence(self, ta: float | None, tb: float | None) -> np.ndarray:
+        """(d,) bool: which dynamic obstacles are present at some time in [ta, tb] (None: all)."""
+        n = len(self._s.dynamic_ids)
+        if ta is None or tb is None:
+            return np.ones(n, dtype=bool)
+        w = self._windows
+        meets = (w[:, 0] <= tb) & (w[:, 1] >= ta)
+        return np.bincount(w[meets, 2].astype(np.int64), minlength=n) > 0
 
     def _refresh_active(self) -> None:
         active = np.fromiter(self._gdata.activeCollisionPairs, dtype=bool, count=len(self._s.pair_a))
@@ -153,9 +165,3 @@ class CollisionWorldCore:
         s = self._s
         a, b = s.pieces[int(s.pair_a[pair])], s.pieces[int(s.pair_b[pair])]
         return Contact(body_a=a.body, kind_a=a.kind, body_b=b.body, kind_b=b.kind, piece_a=a.name, piece_b=b.name)
-
-
-def _present_during(obj: SceneObject, ta: float, tb: float) -> bool:
-    if obj.present is None:
-        return True
-    return any(w0 <= tb and w1 >= ta for w0, w1 in obj.present)

@@ -46,6 +46,8 @@ from robomax_py.spec import (
     MeshShape,
     ObjectSpec,
     PartSpec,
+    PathMotion,
+    RobotMotion,
     Shape,
     Sphere,
     frozen_array,
@@ -87,6 +89,8 @@ class SceneObject:
     workpiece: bool
     representation: str
     present: tuple[tuple[float, float], ...] | None = None
+    # m: a moving object's span counts this much larger (`world.moving`): every check grows by it.
+    margin: float = 0.0
 
     @property
     def dynamic(self) -> bool:
@@ -186,8 +190,9 @@ def build_scene(cell: CellSpec, robot: RobotModel, held: PartSpec | None = None)
         _scene_object(obj, T_base_world, cell.source, f"objects[{i}]") for i, obj in enumerate(cell.objects)
     )
     dynamic = tuple(
-        _scene_object(obj, T_base_world, cell.source, f"dynamic[{i}]", dynamic=True)
-        for i, obj in enumerate(cell.dynamic)
+        posed for i, obj in enumerate(cell.dynamic)
+        for posed in ((_scene_object(obj, T_base_world, cell.source, f"dynamic[{i}]", dynamic=True),)
+                      if obj.motion is None else _moving_objects(obj, T_base_world, cell.source, f"dynamic[{i}]"))
     )
     body, body_repr = _mesh_pieces(cell.tool.body, RobotModelError, cell.tool.source, "body")
     tips, tips_repr = _mesh_pieces(cell.tool.tips, RobotModelError, cell.tool.source, "tips")
@@ -242,6 +247,34 @@ def _scene_object(obj: ObjectSpec, T_base_world: FloatArray, source: Path, key: 
         representation=representation,
         present=None if present is None else tuple((float(a), float(b)) for a, b in present),
     )
+
+
+def _moving_objects(obj: ObjectSpec, T_base_world: FloatArray, source: Path, key: str) -> tuple[SceneObject, ...]:
+    """A moving object as obstacles standing still in short windows (`world.moving`), all named as
+    the object, so contacts and waits name it."""
+    from robomax_py.world import moving
+
+    motion = obj.motion
+    if isinstance(motion, PathMotion):
+        pieces, representation = shape_pieces(obj.shape, source, f"{key}.mesh")
+        body = moving.path_body(obj, pieces)
+        runs = [(body, s, moving.path_windows(motion, s))
+                for w in (((float(motion.t[0]), float(motion.t[-1])),) if motion.repeat is not None else obj.present or ())
+                for s in moving.spans(body, w, motion.sweep)]
+    else:
+        assert isinstance(motion, RobotMotion)
+        representation = REPRESENTATION_CONVEX
+        bodies = moving.robot_bodies(obj, source, lambda mesh, part: _mesh_pieces(mesh, CellFileError, source,
+                                                                                  f"{key}.robot.tool")[0])
+        runs = [(b, s, ((s.t0, s.t1),)) for b in bodies for w in obj.present or ((0.0, np.inf),)
+                for s in moving.spans(b, w, motion.sweep)]
+    if len(runs) > moving.MAX_SPANS:
+        raise CellFileError(source, f"{key}.sweep", f"the motion of '{obj.name}' needs {len(runs)} spans of at most "
+                            f"{motion.sweep * 1000:g} mm of sweep, more than {moving.MAX_SPANS}: a larger sweep, please")
+    return tuple(SceneObject(name=obj.name, pieces=body.pieces,
+                             T_base_object=frozen_array(T_base_world @ np.asarray(span.T_world_body)),
+                             workpiece=False, representation=representation, present=windows, margin=span.margin)
+                 for body, span, windows in runs)
 
 
 def _mesh_pieces(

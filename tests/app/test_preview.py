@@ -288,3 +288,35 @@ def test_voxels_are_drawn_as_the_blocked_leaves(planned: tuple[Path, Path], tmp_
     assert "blocked voxels" in result.output and (tmp_path / "v.html").is_file()
     refused = runner.invoke(app, ["preview", str(cell_path), "--voxels", "0", "--html", str(tmp_path / "w.html")])
     assert refused.exit_code == 2 and not (tmp_path / "w.html").exists()
+
+
+def test_a_moving_part_is_animated_along_its_path_on_the_programs_clock(planned: tuple[Path, Path]) -> None:
+    """A part carried from x 1 to x 2 between 0.5 s and 1.5 s (cell key dynamic[i].path): drawn
+    where the path puts it at each frame's program time, and shown only while present."""
+    import dataclasses
+
+    from robomax_py.spec import Box, ObjectSpec, PathMotion, frozen_array
+    from robomax_py.transforms import pose_matrix
+    from robomax_py.world.moving import path_poses
+
+    cell_path, _ = planned
+    cell = load_cell(cell_path)
+    poses = np.stack([pose_matrix([1.0, 0.0, 2.0], [0, 0, 0]), pose_matrix([2.0, 0.0, 2.0], [0, 0, 0])])
+    motion = PathMotion(frozen_array([0.5, 1.5]), frozen_array(poses))
+    part = ObjectSpec("part", Box((0.1, 0.1, 0.1)), frozen_array(poses[0]), present=((0.5, 1.5),), motion=motion)
+    cell = dataclasses.replace(cell, dynamic=(part,))
+    robot = load_cell_robot(cell)
+    t = np.linspace(0.0, 2.0, 201)
+    q = np.repeat(np.asarray(cell.home)[None, :], len(t), axis=0)
+    rec = Recorder()
+    content = populate(meshcat.Visualizer(window=rec), cell, robot, ShownProgram("still", t, q, (), ()), fps=10)
+    assert ("robomax/cell/dynamic/part", "dynamic", palette.ROLE_COLOURS["dynamic"]) in content.objects
+    (anim,) = [c for c in rec.commands if c["type"] == "set_animation"]
+    (clip,) = [a["clip"] for a in anim["animations"] if a["path"] == "/meshcat/robomax/cell/dynamic/part"]
+    tracks = {tr["name"]: tr for tr in clip["tracks"]}
+    shown = {round(k["time"] / 10, 6): k["value"] for k in tracks[".visible"]["keys"]}
+    assert [s for s, v in sorted(shown.items()) if v] == [0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.4, 1.5]
+    placed = {round(k["time"] / 10, 6): k["value"] for k in tracks[".position"]["keys"]}
+    for s, xyz in placed.items():
+        np.testing.assert_allclose(xyz, path_poses(motion, np.array([s]))[0, :3, 3], atol=1e-6)
+    assert sorted(placed) == [0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.4, 1.5]

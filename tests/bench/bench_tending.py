@@ -7,8 +7,11 @@ Plans the tending cell (default `cells/tending.yaml`) three ways in the same pro
   the roadmap, waiting in front of a door or going round it;
 - `rest`: today's way, the dynamic obstacles planned as absent, then waiting at rest before a move
   that would meet one (`planner.dynamic: rest`);
-- `absent`: the dynamic obstacles ignored altogether (the "classical A*" of the paper), only to
-  count the hazards it would run into; it is no program anyone should run.
+- `astar`: the classical A* of the paper (`PlanOptions(dynamic="astar")`): the time-aware
+  search's graph with time ignored, then a stop at rest wherever its route meets a door at its
+  time (docs/paper-001.md);
+- `absent`: the dynamic obstacles ignored altogether, only to count the hazards it would run into;
+  it is no program anyone should run.
 
 For each it prints the cycle time, the CPU seconds of planning, each machine's wait for the robot
 (from its door opening to the robot's arrival at its station, summed over the openings the robot
@@ -179,7 +182,7 @@ def main() -> None:
           + ", ".join(f"{m.name} closed {list(m.windows)}" for m in cell.machines))
     print(f"{'planner':8s} {'status':10s} {'cycle s':>8s} {'CPU s':>6s} {'hazards':>8s} {'least m':>8s}  machine waits for the robot")
     cycles = {}
-    for mode in ("timed", "rest", "absent"):
+    for mode in ("timed", "rest", "astar", "absent"):
         result, cpu = plan(cell, robot, mode)
         if result.status != "planned":
             print(f"{mode:8s} {result.status:10s} {result.message[:100]}")

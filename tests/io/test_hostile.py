@@ -153,7 +153,8 @@ def _tree_mutants(rng: np.random.Generator, base: dict[str, Any], cell: str, n: 
             if "seams" in data:
                 lists += [(("seams",), "name")] + [(("seams", i, "spots"), "name") for i in range(len(data["seams"]))]
             if "tending" in data:
-                lists += [(("tending", "stations"), "name"), (("tending", "machines"), "name")]
+                lists += [(("tending", "stations"), "name")]
+                lists += [(("tending", "machines"), "name")] if data["tending"].get("machines") else []
             if "pick_place" in data:
                 lists += [(("pick_place", "parts"), "name"), (("pick_place", "locations"), "name")]
             where, key = lists[int(rng.integers(len(lists)))]
@@ -269,7 +270,7 @@ def _name_mutants(base: dict[str, Any], cell: str) -> list[Mutant]:
             if "seams" in data:
                 data["seams"][0]["name"] = v
             elif "tending" in data:
-                data["tending"]["machines"][0]["name"] = v
+                data["tending"]["machines" if data["tending"].get("machines") else "stations"][0]["name"] = v
             else:
                 data["pick_place"]["parts"][0]["name"] = v
         if k == "unicode_spot":
