@@ -16,19 +16,29 @@ from robomax_py.verify_station import StationMember, StationReport, verify_stati
 
 def station_programs(station: StationSpec, given: list[Path]) -> list[dict[str, Path]]:
     """The program sets to verify: the files named (one per robot, `<station>_<robot>.<ext>`), or
-    in the one folder given, every dialect whose program every robot has there (one set each)."""
-    from robomax_py.export import DIALECTS
+    in the one folder given, every dialect whose program every robot has there (one set each), and
+    the robots' own controllers' programs (`plan --format native`: a KUKA and a FANUC robot in one
+    station each run their own dialect) where they are not one dialect's set already."""
+    from robomax_py.export import DIALECTS, Dialect, native_dialect
+
+    def program_file(folder: Path, robot: str, d: Dialect) -> Path:
+        # FANUC names its files after the program (CROSSING_R1.ls): the dialect's own name for it.
+        stem = d.program_name or (lambda n: n)
+        return folder / f"{stem(f'{station.name}_{robot}')}{d.extensions[0]}"
 
     robots = station.robot_names
     if len(given) == 1 and given[0].is_dir():
         folder = given[0]
         sets = []
         for d in DIALECTS.values():
-            # FANUC names its files after the program (CROSSING_R1.ls): the dialect's own name for it.
-            stem = d.program_name or (lambda n: n)
-            found = {r: folder / f"{stem(f'{station.name}_{r}')}{d.extensions[0]}" for r in robots}
+            found = {r: program_file(folder, r, d) for r in robots}
             if all(p.is_file() for p in found.values()):
                 sets.append(found)
+        natives = {r: native_dialect(station.robot(r).cell.robot.controller.brand) for r in robots}
+        if all(n is not None for n in natives.values()) and len({*natives.values()}) > 1:
+            mixed = {r: program_file(folder, r, DIALECTS[str(n)]) for r, n in natives.items()}
+            if all(p.is_file() for p in mixed.values()):
+                sets.append(mixed)
         if not sets:
             raise ProgramError(folder, None, f"no program set of station {station.name} here: expected "
                                              f"{', '.join(f'{station.name}_{r}.<ext>' for r in robots)}")
