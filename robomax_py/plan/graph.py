@@ -20,13 +20,17 @@ from robomax_py.plan.graph_detours import (
     WITHDRAW_DIRECTIONS,
     WITHDRAW_M,
     WITHDRAW_PAIRS,
-    SequencerDetours,
 )
 from robomax_py.plan.graph_knowledge import (
     DETOUR_PRIOR,
     MAX_BLOCKED_LEGS,
     MAX_BLOCKED_STRAIGHT,
     MAX_FAILED_DETOURS,
+)
+from robomax_py.plan.graph_lookahead import (
+    LOOKAHEAD_FROM_ROUND,
+    LOOKAHEAD_ORDERS,
+    SequencerLookahead,
 )
 from robomax_py.plan.results import Transition
 from robomax_py.plan.sequence import (
@@ -91,7 +95,7 @@ class _TourCheck:
 
 
 
-class Sequencer(SequencerDetours):
+class Sequencer(SequencerLookahead):
     """Spot order and candidates with lazily verified straight moves and roadmap detours.
 
     Knowledge grows round by round: straight moves found blocked, detours found between two spots
@@ -176,6 +180,7 @@ class Sequencer(SequencerDetours):
             self._probe_pairs()
             self._probed = ({k: dict(v) for k, v in self.straight.items()}, set(self.detour_only), self.checks)
         previous: tuple[tuple[int, ...], ...] = ()
+        runners_up: tuple[tuple[int, ...], ...] = ()
         for _ in range(self.options.max_rounds):
             self.rounds += 1
             # Rounds end when a tour's legs are all known free; the bar shows rounds so far.
@@ -190,8 +195,10 @@ class Sequencer(SequencerDetours):
                 exact = order_count(blocks) <= EXACT_ORDERS
                 found, stats = optimise(blocks, self.full_cost if exact else self.cost,
                                         self.node if exact else self.node_reps, rng=self.rng,
-                                        max_evaluations=budget, exact_limit=EXACT_ORDERS, starts=previous)
+                                        max_evaluations=budget, exact_limit=EXACT_ORDERS, starts=previous,
+                                        runners_up=LOOKAHEAD_ORDERS)
                 self.dp_evaluations += stats.dp_evaluations
+                runners_up = stats.runners_up
                 previous = (found.order,)
                 # Every candidate for the order found; full matrices only of this order's moves.
                 moves = _moves_of(found.order)
@@ -211,6 +218,8 @@ class Sequencer(SequencerDetours):
                 self.progress("sequencing", self.rounds, self.rounds)
                 return SequencingOutcome("found", tour, verified.transitions)
             self._repair(tour.order)
+            if self.rounds >= LOOKAHEAD_FROM_ROUND:
+                self._look_ahead(runners_up)
         worst = ", ".join(f"{label} ({n} rounds)" for label, n in self.unresolved.most_common(5))
         return SequencingOutcome("not_converged", message=f"sequencing did not converge in {self.options.max_rounds} "
                                  f"rounds; moves left without a verified connection most often: {worst}")
@@ -351,31 +360,12 @@ class Sequencer(SequencerDetours):
         known = self.straight.get((i, j), {}).get((a, b))
         if known is not None:
             return known
-        res = self.world_from(i).check_segment(self.q(i)[a], self.q(j)[b])
-        self.checks += res.checks
-        self._record_straight(i, a, j, b, res.free)
-        if res.free:
-            return True
-        # Blocked: try the cheapest other straight moves between these two spots right away.
-        est = self.estimate(i, j)
-        known_pairs = self.straight.get((i, j), {})
-        tried = sum(1 for free in known_pairs.values() if not free)
-        for flat in np.argsort(est, axis=None, kind="stable"):
-            if tried >= self.options.straight_tries:
-                break
-            aa, bb = np.unravel_index(int(flat), est.shape)
-            if (int(aa), int(bb)) in known_pairs:
-                continue
-            r = self.world_from(i).check_segment(self.q(i)[aa], self.q(j)[bb])
-            self.checks += r.checks
-            self._record_straight(i, int(aa), j, int(bb), r.free)
-            if r.free:
-                return False          # a free alternative exists; let the optimiser weigh it
-            tried += 1
-        self.detour_only.add((min(i, j), max(i, j)))
-        self._forget(i, j)
-        self._new_detour(i, a, j, b)
-        return False
+        # Blocked: the cheapest other straight moves between these two spots are tried right away;
+        # all blocked, a detour is searched.
+        verdict = self._learn_straight(i, a, j, b)
+        if verdict == "detour_only":
+            self._new_detour(i, a, j, b)
+        return verdict == "free"
 
     def _check_via(self, i: int, a: int, j: int, b: int, v: int) -> FloatArray | None:
         wp = self.vias_for(i, j)[v].waypoints
