@@ -29,7 +29,6 @@ from robomax_py.plan.graph_knowledge import (
 )
 from robomax_py.plan.graph_lookahead import (
     LOOKAHEAD_FROM_ROUND,
-    LOOKAHEAD_ORDERS,
     SequencerLookahead,
 )
 from robomax_py.plan.results import Transition
@@ -180,9 +179,9 @@ class Sequencer(SequencerLookahead):
             self._probe_pairs()
             self._probed = ({k: dict(v) for k, v in self.straight.items()}, set(self.detour_only), self.checks)
         previous: tuple[tuple[int, ...], ...] = ()
-        runners_up: tuple[tuple[int, ...], ...] = ()
         for _ in range(self.options.max_rounds):
             self.rounds += 1
+            self.left_open = ()
             # Rounds end when a tour's legs are all known free; the bar shows rounds so far.
             self.progress("sequencing", self.rounds - 1, self.rounds)
             if self.options.baseline or self.options.given_order:
@@ -195,10 +194,8 @@ class Sequencer(SequencerLookahead):
                 exact = order_count(blocks) <= EXACT_ORDERS
                 found, stats = optimise(blocks, self.full_cost if exact else self.cost,
                                         self.node if exact else self.node_reps, rng=self.rng,
-                                        max_evaluations=budget, exact_limit=EXACT_ORDERS, starts=previous,
-                                        runners_up=LOOKAHEAD_ORDERS)
+                                        max_evaluations=budget, exact_limit=EXACT_ORDERS, starts=previous)
                 self.dp_evaluations += stats.dp_evaluations
-                runners_up = stats.runners_up
                 previous = (found.order,)
                 # Every candidate for the order found; full matrices only of this order's moves.
                 moves = _moves_of(found.order)
@@ -219,7 +216,7 @@ class Sequencer(SequencerLookahead):
                 return SequencingOutcome("found", tour, verified.transitions)
             self._repair(tour.order)
             if self.rounds >= LOOKAHEAD_FROM_ROUND:
-                self._look_ahead(runners_up)
+                self._look_around(self.left_open)
         worst = ", ".join(f"{label} ({n} rounds)" for label, n in self.unresolved.most_common(5))
         return SequencingOutcome("not_converged", message=f"sequencing did not converge in {self.options.max_rounds} "
                                  f"rounds; moves left without a verified connection most often: {worst}")
@@ -336,16 +333,19 @@ class Sequencer(SequencerLookahead):
                 else:
                     complete = False
                     self.unresolved[label] += 1
+                    self.left_open += ((i, j),)
                 continue
             if best_v < 0 or not np.isfinite(via_costs[best_v]):
                 self._new_detour(i, a, j, b)
                 complete = False
                 self.unresolved[label] += 1
+                self.left_open += ((i, j),)
                 continue
             path = self._check_via(i, a, j, b, best_v)
             if path is None:
                 complete = False
                 self.unresolved[label] += 1
+                self.left_open += ((i, j),)
                 continue
             via = self.vias_for(i, j)[best_v]
             if via.poses is not None:

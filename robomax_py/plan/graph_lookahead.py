@@ -11,18 +11,18 @@ searched: a detour is searched when a verified tour needs it, as before.
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Sequence
 from typing import Literal
 
 import numpy as np
 
 from robomax_py.plan.graph_detours import SequencerDetours
-from robomax_py.plan.sequence import HOME, choice_for_order
 from robomax_py.timing import ptp_time_estimate
 
-# Runners-up of each round's order search whose straight moves are checked (`Sequencer.run`).
-LOOKAHEAD_ORDERS = 8
+# Nearest spots of each end of a move left open whose moves are checked (`_look_around`).
+LOOKAROUND_SPOTS = 6
+
+
 # The round from which they are: a cell that has not found its tour in this many rounds is one
 # where each round finds a new batch of blocked moves; one that does (every shipped cell) never
 # pays for the extra checks, and plans as it did.
@@ -33,6 +33,9 @@ StraightVerdict = Literal["free", "other_free", "detour_only"]
 
 class SequencerLookahead(SequencerDetours):
     """Straight moves learnt in batches (the base of `Sequencer`)."""
+
+    _near: dict[int, list[int]] | None = None
+    left_open: tuple[tuple[int, int], ...] = ()       # the moves `_verify` left open this round (spot pairs)
 
     def _learn_straight(self, i: int, a: int, j: int, b: int) -> StraightVerdict:
         """Check the straight move from candidate a of i to b of j and record it. Blocked: the
@@ -63,26 +66,70 @@ class SequencerLookahead(SequencerDetours):
         self._forget(i, j)
         return "detour_only"
 
-    def _look_ahead(self, orders: Sequence[tuple[int, ...]]) -> int:
-        """Check the unchecked straight moves of each order's best tour over the candidates the
-        order search sees (its representatives, costed with what is known now), where that tour
-        takes a straight move rather than a known detour. Returns how many were found blocked."""
+    def _look_around(self, legs: Sequence[tuple[int, int]]) -> int:
+        """For each move (i, j) a verified tour left open, the moves the next order search would
+        swap in: from i to each of j's LOOKAROUND_SPOTS nearest spots, and from each of i's nearest
+        to j, at their cheapest pair of the candidates the search sees, each checked as `_verify`
+        would take it (`_learn_move`). Returns how many were found blocked."""
+        near = self._nearest_spots()
+        moves: dict[tuple[int, int], None] = {}
+        for i, j in legs:
+            for jj in near.get(j, ()):
+                if jj != i:
+                    moves[(i, jj)] = None
+            for ii in near.get(i, ()):
+                if ii != j:
+                    moves[(ii, j)] = None
         blocked = 0
-        for order in orders:
-            choice, cost = choice_for_order(order, self.cost, self.node_reps)
-            if not np.isfinite(cost):
+        for i, j in moves:
+            est = self.cost(i, j)
+            if not np.isfinite(est).any():
                 continue
-            stops = [(HOME, 0), *((s, int(self._rows(s)[c])) for s, c in zip(order, choice)), (HOME, 0)]
-            for (i, a), (j, b) in itertools.pairwise(stops):
-                if (min(i, j), max(i, j)) in self.detour_only or self._verified_straight_only(i, j):
-                    continue
-                if (a, b) in self.straight.get((i, j), {}):
-                    continue
-                qa, qb = self.q(i)[a], self.q(j)[b]
-                straight = float(ptp_time_estimate(qa, qb, self.limits, self.options.speed))
-                pa, pb = self._positions(i, self._rows(i))[a], self._positions(j, self._rows(j))[b]
-                if self.cost(i, j)[pa, pb] < straight - 1e-12:
-                    continue              # the tour goes round by a known detour there
-                if self._learn_straight(i, a, j, b) != "free":
-                    blocked += 1
+            r, c = np.unravel_index(int(np.argmin(est)), est.shape)
+            if not self._learn_move(i, int(self._rows(i)[r]), j, int(self._rows(j)[c])):
+                blocked += 1
         return blocked
+
+    def _nearest_spots(self) -> dict[int, list[int]]:
+        """Each spot's LOOKAROUND_SPOTS nearest spots (TCP positions of the spots), made once."""
+        if self._near is None:
+            xyz = np.array([self.cell.seams[c.seam_index].spots[c.spot_index].xyz for c in self.spots])
+            gap = np.linalg.norm(xyz[:, None, :] - xyz[None, :, :], axis=2)
+            np.fill_diagonal(gap, np.inf)
+            k = min(LOOKAROUND_SPOTS, len(self.spots) - 1)
+            order = np.argsort(gap, axis=1, kind="stable")[:, :k]
+            self._near = {i: [int(x) for x in row] for i, row in enumerate(order)}
+        return self._near
+
+    def _learn_move(self, i: int, a: int, j: int, b: int) -> bool:
+        """The move from candidate a of i to b of j checked as `_verify` takes it: the straight move
+        where it is offered and cheapest (a blocked one with its batch of alternatives), else the
+        enter and leave legs of the cheapest known detour. Searches nothing; False if found blocked."""
+        qa, qb = self.q(i)[a], self.q(j)[b]
+        straight_ok = (min(i, j), max(i, j)) not in self.detour_only and \
+            self.straight.get((i, j), {}).get((a, b), not self._verified_straight_only(i, j))
+        straight = float(ptp_time_estimate(qa, qb, self.limits, self.options.speed)) if straight_ok else np.inf
+        via_costs = self._pair_via_costs(i, a, j, b)
+        v = int(np.argmin(via_costs)) if len(via_costs) else -1
+        if straight_ok and (v < 0 or straight <= via_costs[v]):
+            if (a, b) in self.straight.get((i, j), {}):
+                return True
+            return self._learn_straight(i, a, j, b) == "free"
+        if v < 0 or not np.isfinite(via_costs[v]) or (a, b, v) in self.legs_ok.get((i, j), set()):
+            return True
+        return self._legs_free(i, a, j, b, v)
+
+    def _legs_free(self, i: int, a: int, j: int, b: int, v: int) -> bool:
+        """Check and record the enter and leave legs of known detour v from candidate a of i to b of
+        j (as `Sequencer._check_via` does, but searching no new detour when one is blocked)."""
+        wp = self.vias_for(i, j)[v].waypoints
+        for p, r in ((self.q(i)[a], wp[0]), (wp[-1], self.q(j)[b])):
+            if np.allclose(p, r):
+                continue
+            res = self.world_from(i).check_segment(p, r)
+            self.checks += res.checks
+            if not res.free:
+                self._record_leg(i, a, j, b, v, False)
+                return False
+        self._record_leg(i, a, j, b, v, True)
+        return True
