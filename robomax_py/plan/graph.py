@@ -48,7 +48,7 @@ from robomax_py.world.collision import bisection_order
 
 # The tuning constants of the knowledge and detour modules stay importable from here.
 __all__ = [
-    "DEAD_END_DETOURS", "DEAD_END_STRAIGHT", "DETOUR_PRIOR", "LIFT_HEIGHTS_M", "MAX_BLOCKED_LEGS",
+    "DEAD_END_DETOURS", "DEAD_END_STRAIGHT", "DETOUR_PRIOR", "LIFT_HEIGHTS_M", "LOOKAHEAD_FROM_ROUND", "MAX_BLOCKED_LEGS",
     "MAX_BLOCKED_STRAIGHT", "MAX_FAILED_DETOURS", "PROBE_STATES", "REPAIRS_PER_ROUND", "WITHDRAW_DIRECTIONS",
     "WITHDRAW_M", "WITHDRAW_PAIRS", "Sequencer", "SequencingOutcome",
 ]

@@ -68,13 +68,9 @@ class Tour:
 
 @dataclass(frozen=True, slots=True)
 class SearchStats:
-    """What one search did. `runners_up`: the cheapest other orders it evaluated, cheapest first
-    (as many as `optimise`'s `runners_up` asked; none from an exact enumeration)."""
-
     dp_evaluations: int
     moves_screened: int
     improvements: int
-    runners_up: tuple[tuple[int, ...], ...] = ()
 
 
 class _Costs:
@@ -221,7 +217,6 @@ def optimise(
     screen: int = 12,
     exact_limit: int = EXACT_ORDERS,
     starts: Sequence[tuple[int, ...]] = (),
-    runners_up: int = 0,
 ) -> tuple[Tour, SearchStats]:
     """Best tour: exact when few orders are admissible, else construction + iterated local search.
 
@@ -233,8 +228,6 @@ def optimise(
     then the best tour is perturbed (a random segment of a free seam reversed and moved) and
     improved again until `max_evaluations` DP evaluations are spent. Deterministic for a given rng.
     `starts` adds admissible orders to start from (e.g. the previous best, when costs changed).
-    `runners_up` asks for that many of the cheapest other orders evaluated (in `SearchStats`): the
-    orders a search would turn to next, read from what it evaluated anyway (the search is the same).
     """
     rng = rng if rng is not None else np.random.default_rng(0)
     costs = _Costs(edge, node)
@@ -327,9 +320,7 @@ def optimise(
             best, best_cost = cand, cand_cost
     flat = _flatten(best)
     choice, cost = best_choice(flat, costs)
-    others = sorted((c, o) for o, c in seen.items() if o != flat and np.isfinite(c))[:runners_up] if runners_up else []
-    stats = SearchStats(counter["evaluations"], counter["screened"], counter["improvements"],
-                        tuple(o for _, o in others))
+    stats = SearchStats(counter["evaluations"], counter["screened"], counter["improvements"])
     return Tour(flat, choice, cost), stats
 
 
