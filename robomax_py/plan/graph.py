@@ -2,7 +2,8 @@
 estimated motion times; straight moves verified lazily, blocked ones replaced by detours (a lift over
 the obstacle, else a path through the roadmap), rounds repeated until every move of the best tour is
 known free. What the sequencer knows and its costs are in `graph_knowledge`, its detour searches in
-`graph_detours`."""
+`graph_detours`, the moves round those a round left open (checked from the sixth round on) in
+`graph_lookahead`."""
 
 from __future__ import annotations
 

@@ -1,12 +1,19 @@
-"""What the sequencer (`plan.graph.Sequencer`) learns beyond the tour it verifies: the straight moves
-of the orders its search ranked next (the runners-up), checked before the next round searches again.
+"""What the sequencer (`plan.graph.Sequencer`) learns beyond the tour it verifies: the moves round
+those a round left open, checked before the next round searches again (`_look_around`).
 
-On a cell with a field of clamps each round's best tour leans on moves nobody has checked yet
-(a skip over a clamp, another candidate pair across it); verifying it finds a few dozen of them
-blocked, and the next search turns to the runners-up, which lean on the next few dozen. Checking
-the straight moves those orders would use, at the candidates the search sees, takes what the next
-rounds would have found one round at a time. Only straight moves are checked here, never a detour
-searched: a detour is searched when a verified tour needs it, as before.
+On a cell with a field of clamps the late rounds each find one or two moves blocked next to a clamp
+(a spot's move past the clamp to another spot, or a known detour's leave leg to it), and the next
+search swaps in the same spot's move to a neighbour of that other spot, unchecked and as cheap: one
+round per neighbour. After a round that left moves open, the moves from each open move's first spot
+to its second spot's nearest spots, and from the first spot's nearest to the second, are checked as
+`_verify` would take them (at the cheapest pair of the candidates the search sees): a straight move,
+or the enter and leave legs of the cheapest known detour. Nothing is searched here: a detour is
+searched when a verified tour needs it, as before.
+
+The runners-up of the order search (the cheapest other orders it evaluated) were tried first and
+dropped: they differ from its best order by one move far from the open ones, and checking their
+moves cut no round on the clamped scale cells (33 rounds against 37 at 240 spots, 10 against 10 at
+60) while the tour got 0.2-0.5 % longer.
 """
 
 from __future__ import annotations
@@ -21,8 +28,6 @@ from robomax_py.timing import ptp_time_estimate
 
 # Nearest spots of each end of a move left open whose moves are checked (`_look_around`).
 LOOKAROUND_SPOTS = 6
-
-
 # The round from which they are: a cell that has not found its tour in this many rounds is one
 # where each round finds a new batch of blocked moves; one that does (every shipped cell) never
 # pays for the extra checks, and plans as it did.
@@ -32,7 +37,7 @@ StraightVerdict = Literal["free", "other_free", "detour_only"]
 
 
 class SequencerLookahead(SequencerDetours):
-    """Straight moves learnt in batches (the base of `Sequencer`)."""
+    """Straight moves learnt in batches and the look round open moves (the base of `Sequencer`)."""
 
     _near: dict[int, list[int]] | None = None
     left_open: tuple[tuple[int, int], ...] = ()       # the moves `_verify` left open this round (spot pairs)
