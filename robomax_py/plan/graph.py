@@ -2,7 +2,8 @@
 estimated motion times; straight moves verified lazily, blocked ones replaced by detours (a lift over
 the obstacle, else a path through the roadmap), rounds repeated until every move of the best tour is
 known free. What the sequencer knows and its costs are in `graph_knowledge`, its detour searches in
-`graph_detours`."""
+`graph_detours`, the moves round those a round left open (checked from the sixth round on) in
+`graph_lookahead`."""
 
 from __future__ import annotations
 
@@ -20,13 +21,16 @@ from robomax_py.plan.graph_detours import (
     WITHDRAW_DIRECTIONS,
     WITHDRAW_M,
     WITHDRAW_PAIRS,
-    SequencerDetours,
 )
 from robomax_py.plan.graph_knowledge import (
     DETOUR_PRIOR,
     MAX_BLOCKED_LEGS,
     MAX_BLOCKED_STRAIGHT,
     MAX_FAILED_DETOURS,
+)
+from robomax_py.plan.graph_lookahead import (
+    LOOKAHEAD_FROM_ROUND,
+    SequencerLookahead,
 )
 from robomax_py.plan.results import Transition
 from robomax_py.plan.sequence import (
@@ -45,7 +49,7 @@ from robomax_py.world.collision import bisection_order
 
 # The tuning constants of the knowledge and detour modules stay importable from here.
 __all__ = [
-    "DEAD_END_DETOURS", "DEAD_END_STRAIGHT", "DETOUR_PRIOR", "LIFT_HEIGHTS_M", "MAX_BLOCKED_LEGS",
+    "DEAD_END_DETOURS", "DEAD_END_STRAIGHT", "DETOUR_PRIOR", "LIFT_HEIGHTS_M", "LOOKAHEAD_FROM_ROUND", "MAX_BLOCKED_LEGS",
     "MAX_BLOCKED_STRAIGHT", "MAX_FAILED_DETOURS", "PROBE_STATES", "REPAIRS_PER_ROUND", "WITHDRAW_DIRECTIONS",
     "WITHDRAW_M", "WITHDRAW_PAIRS", "Sequencer", "SequencingOutcome",
 ]
@@ -91,7 +95,7 @@ class _TourCheck:
 
 
 
-class Sequencer(SequencerDetours):
+class Sequencer(SequencerLookahead):
     """Spot order and candidates with lazily verified straight moves and roadmap detours.
 
     Knowledge grows round by round: straight moves found blocked, detours found between two spots
@@ -178,6 +182,7 @@ class Sequencer(SequencerDetours):
         previous: tuple[tuple[int, ...], ...] = ()
         for _ in range(self.options.max_rounds):
             self.rounds += 1
+            self.left_open = ()
             # Rounds end when a tour's legs are all known free; the bar shows rounds so far.
             self.progress("sequencing", self.rounds - 1, self.rounds)
             if self.options.baseline or self.options.given_order:
@@ -211,6 +216,8 @@ class Sequencer(SequencerDetours):
                 self.progress("sequencing", self.rounds, self.rounds)
                 return SequencingOutcome("found", tour, verified.transitions)
             self._repair(tour.order)
+            if self.rounds >= LOOKAHEAD_FROM_ROUND:
+                self._look_around(self.left_open)
         worst = ", ".join(f"{label} ({n} rounds)" for label, n in self.unresolved.most_common(5))
         return SequencingOutcome("not_converged", message=f"sequencing did not converge in {self.options.max_rounds} "
                                  f"rounds; moves left without a verified connection most often: {worst}")
@@ -327,16 +334,19 @@ class Sequencer(SequencerDetours):
                 else:
                     complete = False
                     self.unresolved[label] += 1
+                    self.left_open += ((i, j),)
                 continue
             if best_v < 0 or not np.isfinite(via_costs[best_v]):
                 self._new_detour(i, a, j, b)
                 complete = False
                 self.unresolved[label] += 1
+                self.left_open += ((i, j),)
                 continue
             path = self._check_via(i, a, j, b, best_v)
             if path is None:
                 complete = False
                 self.unresolved[label] += 1
+                self.left_open += ((i, j),)
                 continue
             via = self.vias_for(i, j)[best_v]
             if via.poses is not None:
@@ -351,31 +361,12 @@ class Sequencer(SequencerDetours):
         known = self.straight.get((i, j), {}).get((a, b))
         if known is not None:
             return known
-        res = self.world_from(i).check_segment(self.q(i)[a], self.q(j)[b])
-        self.checks += res.checks
-        self._record_straight(i, a, j, b, res.free)
-        if res.free:
-            return True
-        # Blocked: try the cheapest other straight moves between these two spots right away.
-        est = self.estimate(i, j)
-        known_pairs = self.straight.get((i, j), {})
-        tried = sum(1 for free in known_pairs.values() if not free)
-        for flat in np.argsort(est, axis=None, kind="stable"):
-            if tried >= self.options.straight_tries:
-                break
-            aa, bb = np.unravel_index(int(flat), est.shape)
-            if (int(aa), int(bb)) in known_pairs:
-                continue
-            r = self.world_from(i).check_segment(self.q(i)[aa], self.q(j)[bb])
-            self.checks += r.checks
-            self._record_straight(i, int(aa), j, int(bb), r.free)
-            if r.free:
-                return False          # a free alternative exists; let the optimiser weigh it
-            tried += 1
-        self.detour_only.add((min(i, j), max(i, j)))
-        self._forget(i, j)
-        self._new_detour(i, a, j, b)
-        return False
+        # Blocked: the cheapest other straight moves between these two spots are tried right away;
+        # all blocked, a detour is searched.
+        verdict = self._learn_straight(i, a, j, b)
+        if verdict == "detour_only":
+            self._new_detour(i, a, j, b)
+        return verdict == "free"
 
     def _check_via(self, i: int, a: int, j: int, b: int, v: int) -> FloatArray | None:
         wp = self.vias_for(i, j)[v].waypoints
