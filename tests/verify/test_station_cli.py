@@ -115,3 +115,31 @@ def test_station_preview_page(tmp_path: Path, station: Path) -> None:
     replay = json.loads(runner.invoke(app, ["verify", str(station), str(tmp_path), "--json"]).output)["sets"][0]
     assert data["robots"] == ["r1", "r2"] and abs(data["duration"] - replay["makespan"]) <= 1e-4
     assert "<html" in page.read_text(encoding="utf-8").lower()
+
+
+def test_the_robots_own_dialects_are_a_program_set(tmp_path: Path) -> None:
+    """`plan STATION --format native` on a KUKA and a UR robot writes a KRL and a URScript program:
+    the folder holds no one dialect's set, and the robots' own programs are the set verified."""
+    from robomax_py.app.station_verify import station_programs
+
+    source = Path(__file__).resolve().parents[1] / "data" / "station" / "two_robots.yaml"
+    # Its meshes are named relative to its own folder: made absolute for the copy.
+    text = source.read_text().replace("mesh: ../../../", f"mesh: {source.parents[3].as_posix()}/")
+    first, rest = text.split("  - name: r2", 1)
+    rest = rest.replace("model: kr125", "model: ur10", 1).replace("tool: spot_gun_c", "tool: spot_gun_light", 1)
+    rest = rest.replace("home: [60, -90, 90, 0, 0, 0]", "home: [0, -90, 90, -90, -90, 0]", 1)
+    rest = rest.replace("controller: {interlock_io: {inputs: [201, 208], outputs: [201, 208]}}",
+                        "controller: {brand: ur, interlock_io: {inputs: [0, 3], outputs: [0, 3]}}", 1)
+    path = tmp_path / "two_robots.yaml"
+    path.write_text(first + "  - name: r2" + rest)
+    spec = load_station(path)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "two_robots_r1.src").write_text("")
+    (out / "two_robots_r2.script").write_text("")
+    (out / "two_robots_r1.json").write_text("{}")
+    sets = station_programs(spec, [out])
+    assert [{r: p.name for r, p in s.items()} for s in sets] == [{"r1": "two_robots_r1.src", "r2": "two_robots_r2.script"}]
+    (out / "two_robots_r2.script").unlink()
+    with pytest.raises(Exception, match="no program set"):
+        station_programs(spec, [out])
