@@ -216,6 +216,9 @@ def validation_error(
     for err in exc.errors(include_url=False):
         # Pydantic names a validator wrapping a value ('function-after[...]') in locations; drop it.
         loc = tuple(p for p in err["loc"] if not (isinstance(p, str) and p.startswith("function-")))
+        if err["type"] == "extra_forbidden" and loc:
+            # The unknown key is the file's own, whatever its spelling ('Robot' is no member tag).
+            loc = (*loc[:-1], _FileKey(loc[-1]))
         entries.append((loc, err))
     return several([error(path, key_path(loc) or None, _problem(err, schema, loc))
                     for loc, err in _fitting_members(entries)], path)
@@ -224,10 +227,17 @@ def validation_error(
 _TYPE_TAGS = frozenset({"int", "float", "str", "bool", "list", "dict", "none"})
 
 
+class _FileKey(str):
+    """A key as the file spells it, where pydantic's location holds it (an unknown key): never
+    taken for a union member's tag, which a capital or a '-' would otherwise make it."""
+
+    __slots__ = ()
+
+
 def _is_member_tag(part: int | str) -> bool:
     """A union member's name pydantic inserts in a location ('constrained-int', 'InputFile', 'str',
     'list[...]'); file keys are lower-case words without '-'."""
-    return isinstance(part, str) and ("-" in part or "[" in part or part[:1].isupper() or part in _TYPE_TAGS)
+    return isinstance(part, str) and not isinstance(part, _FileKey) and ("-" in part or "[" in part or part[:1].isupper() or part in _TYPE_TAGS)
 
 
 def _value_loc(loc: tuple[int | str, ...]) -> tuple[int | str, ...]:

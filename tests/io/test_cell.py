@@ -100,6 +100,11 @@ def _append_object(obj: dict[str, Any], key: str = "objects") -> Callable[[dict[
 BROKEN_CELLS: list[tuple[str, Callable[[dict[str, Any]], None], str, str]] = [
     ("unknown key", _set("seams.0.tolerence", {"alpha": 5}), "seams[0].tolerence", "did you mean 'tolerance'"),
     ("unknown top key", _set("proces", {}), "proces", "did you mean 'process'"),
+    # Capitals and '-' mark pydantic's union member tags in its locations: a key of the file so
+    # spelt is still named and matched.
+    ("capitalised key", _set("Robot", {}), "Robot", "did you mean 'robot'"),
+    ("one capital", _set("A", 1), "A", "known keys: robomax"),
+    ("dashed key", _set("seams.0.tol-erance", {}), "seams[0].tol-erance", "did you mean 'tolerance'"),
     ("wrong type", _set("seams.0.grid", "five"), "seams[0].grid", "valid integer"),
     ("wrong type list", _set("objects.0.box", "big"), "objects[0].box", "valid list"),
     ("missing key", _delete("seams.0.spots.3.normal"), "seams[0].spots[3].normal", "required key is missing"),
