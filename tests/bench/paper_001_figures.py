@@ -35,8 +35,10 @@ SLICE_Y = 0.0
 XY_VIEW = ((-1.5, 2.1), (-1.5, 2.1))
 XZ_VIEW = ((-1.5, 2.1), (0.0, 2.2))
 # The junction drawn in the route figure: the second cycle's conveyor -> CNC 1 (its door closed
-# when the robot gets there: the time-aware plan waits in front of it, the classical A* stops).
-JUNCTION = ("c2_conveyor_pick", "c2_cnc1_load")
+# when the robot gets there: the time-aware plan waits in front of it, the classical A* stops);
+# the first cycle's in a job of one cycle.
+JUNCTION = ("conveyor_pick", "cnc1_load")
+JUNCTION_CYCLE = 2
 # A part is "at the pick station" while its centre is within this of the station in plan (m): the
 # box's half width plus the open gripper's half span, about.
 AT_STATION_M = 0.25
@@ -179,8 +181,15 @@ def _segment(result: PlanResult, junction: tuple[str, str]) -> tuple[int, int, l
     return start.i_end, end.i_end, waits
 
 
+def _junction(result: PlanResult) -> tuple[str, str]:
+    names = {s.name for s in result.spots}
+    cycle = max(c for c in range(1, JUNCTION_CYCLE + 1) if f"c{c}_{JUNCTION[0]}" in names)
+    return f"c{cycle}_{JUNCTION[0]}", f"c{cycle}_{JUNCTION[1]}"
+
+
 def route_figure(out: Path, plans: Plans, space: TcpSpace) -> Path:
     plt = _pyplot()
+    junction = _junction(plans.results["timed"])
     fig, axes = plt.subplots(1, 2, figsize=(11.0, 5.0), dpi=DPI, gridspec_kw={"width_ratios": [1.0, 1.05]})
     _slice(axes[0], space, plans.cell, 2, SLICE_Z, XY_VIEW, fade=0.35)
     _slice(axes[1], space, plans.cell, 1, SLICE_Y, XZ_VIEW, fade=0.35)
@@ -189,7 +198,7 @@ def route_figure(out: Path, plans: Plans, space: TcpSpace) -> Path:
         result = plans.results[mode]
         traj = result.trajectory
         assert traj is not None
-        i0, i1, waits = _segment(result, JUNCTION)
+        i0, i1, waits = _segment(result, junction)
         tcp = fk_tcp(plans.robot, traj.q[i0:i1 + 1])[:, :3, 3]
         t0, t1 = traj.t[i0], traj.t[i1]
         for ax, shown in ((axes[0], [0, 1]), (axes[1], [0, 2])):
@@ -206,7 +215,7 @@ def route_figure(out: Path, plans: Plans, space: TcpSpace) -> Path:
     axes[0].legend(loc="upper left", fontsize=7, framealpha=0.9)
     axes[0].set_title(f"TCP paths seen from above, over the slice z = {SLICE_Z} m", fontsize=9)
     axes[1].set_title(f"seen from the side, over the slice y = {SLICE_Y} m", fontsize=9)
-    fig.suptitle(f"junction {JUNCTION[0]} -> {JUNCTION[1]} through CNC 1's door (circle: start, square: "
+    fig.suptitle(f"junction {junction[0]} -> {junction[1]} through CNC 1's door (circle: start, square: "
                  "goal); the door is closed when the robot gets there", fontsize=9)
     fig.subplots_adjust(top=0.88, left=0.06, right=0.97, wspace=0.15)
     return _save(fig, out / "paper_001_route.png")
