@@ -2,7 +2,7 @@
 cell: a 6-axis arm, two CNC machines with doors, a conveyor) on the shipped tending cell, with the
 paper's table beside ours (a script, not a test):
 
-    python tests/bench/bench_paper_001.py [CELL] [--runs 3] [--cycles N]
+    python tests/bench/bench_paper_001.py [CELL] [--runs 3] [--cycles N] [--figures DIR]
 
 Two scenarios, as the paper's:
 - static: the same cell with its dynamic objects absent (no doors, nothing moving); the
@@ -23,6 +23,9 @@ Planned four ways in one process (CPU seconds of planning, median of --runs):
 For each: the cycle time over the job's cycles, parts per hour (cycles / cycle time), the stops or
 hazards, and the machines' idle time waiting for the robot (door open to the robot's arrival at the
 machine's station, summed over the openings served, as a share of the cycle).
+
+With --figures DIR it also draws the figures of docs/paper-001.md from the dynamic scenario's
+plans into DIR (`paper_001_figures.py`: the voxel grid, one junction's routes, the timelines).
 """
 
 from __future__ import annotations
@@ -97,8 +100,12 @@ def measured(cell: CellSpec, robot: RobotModel, mode: str, runs: int) -> tuple[P
     return result, statistics.median(cpu)
 
 
-def row(cell: CellSpec, robot: RobotModel, scenario: str, mode: str, runs: int) -> dict[str, float] | None:
+def row(cell: CellSpec, robot: RobotModel, scenario: str, mode: str, runs: int,
+        keep: dict[str, PlanResult] | None = None) -> dict[str, float] | None:
+    """Print the row of one plan; the plan is put in `keep` under its mode where given."""
     result, cpu = measured(cell, robot, mode, runs)
+    if keep is not None:
+        keep[mode] = result
     if result.status != "planned":
         print(f"{scenario:8s} {mode:7s} {result.status}: {result.message[:160]}")
         return None
@@ -116,12 +123,25 @@ def row(cell: CellSpec, robot: RobotModel, scenario: str, mode: str, runs: int) 
     return {"cycle": result.cycle_time, "danger": danger, "idle": idle, "per_hour": per_hour}
 
 
+def figures(out: Path, cell: CellSpec, robot: RobotModel, kept: dict[str, PlanResult]) -> None:
+    from paper_001_figures import Plans, draw_all
+
+    if any(kept[m].status != "planned" for m in ("timed", "astar", "rest")):
+        print("figures: not drawn, a plan of the dynamic scenario failed")
+        return
+    for path in draw_all(out, Plans(cell, robot, kept)):
+        print(f"figure: {path} ({path.stat().st_size / 1024:.0f} KB)")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0] if __doc__ else None)
     parser.add_argument("cell", nargs="?", type=Path, default=REPO / "cells" / "tending.yaml")
     parser.add_argument("--runs", type=int, default=3, help="plans per row; the CPU column is their median")
     parser.add_argument("--cycles", type=int, default=None, help="the job's cycles (default: the cell's)")
+    parser.add_argument("--figures", type=Path, default=None, metavar="DIR",
+                        help="also draw the paper page's figures (PNG) of the dynamic scenario into DIR")
     args = parser.parse_args()
+    kept: dict[str, PlanResult] = {}
     with tempfile.TemporaryDirectory() as tmp:
         path = dynamic_cell(args.cell, Path(tmp), args.cycles)
         dynamic = load_cell(path)
@@ -135,7 +155,9 @@ def main() -> None:
         for mode in ("timed", "astar"):
             ours["static"][mode] = row(static, robot, "static", mode, args.runs)
         for mode in ("timed", "astar", "rest", "absent"):
-            ours["dynamic"][mode] = row(dynamic, robot, "dynamic", mode, args.runs)
+            ours["dynamic"][mode] = row(dynamic, robot, "dynamic", mode, args.runs, kept)
+        if args.figures is not None:
+            figures(args.figures, dynamic, robot, kept)
     print("\nbeside the paper (classical A* -> time-aware):")
     for scenario, paper in PAPER.items():
         a, b = ours[scenario].get("astar"), ours[scenario].get("timed")
