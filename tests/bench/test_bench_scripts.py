@@ -36,6 +36,7 @@ SMOKE: dict[str, list[str]] = {
     "bench_import.py": ["--runs", "1", "--poses", "20"],
     "bench_pick_place.py": ["--quick", "--out", OUT],
     "bench_plan.py": ["--runs", "1", "--resolutions", "20"],
+    "bench_paper_001.py": ["--runs", "1", "--cycles", "1", "--figures", OUT],
     "bench_replan.py": ["--quick"],
     "bench_scale.py": ["--sizes", "8", "--families", "open", "--runs", "1"],
     "bench_station.py": ["--quick"],
