@@ -141,7 +141,7 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
                 emit(q, PtpMove(tuple(np.degrees(q)), speed, trans.accel, flyby=math.degrees(radius),
                                 comment=note.strip(", ")))
             for stage in trans.stages:
-                if stage.index == w:
+                if stage.index == w and stage.wait is not None:
                     emit(q, *_wait(stage.wait, setup))
         if not approach_follows:
             break

@@ -191,10 +191,15 @@ class SpotFailure:
 
 @dataclass(frozen=True, slots=True, eq=False)
 class Stage:
-    """A stop inside a transition: the robot halts at waypoint `index` and waits there."""
+    """A stop inside a transition: the robot halts at waypoint `index` and waits there.
+
+    wait None: it halts and goes on at once. A time-aware route is timed in pieces that stop where
+    its search waits (`timed_moves`); where the stop alone lets the way clear, no wait is added, but
+    the robot still stops there, and the program must say so (no fly-by), or it runs another motion.
+    """
 
     index: int
-    wait: WaitPlan
+    wait: WaitPlan | None
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -208,7 +213,7 @@ class Transition:
     blend_radius: float = 0.0        # rad: detour corners passed on G2 blends of this radius; 0: stops at each
     flyby_radius: float = 0.0        # rad: the retract -> move and move -> approach joins flown by; 0: stops
     wait: WaitPlan | None = None     # a wait at rest before it, for a dynamic obstacle to clear
-    stages: tuple[Stage, ...] = ()   # stops inside it where the robot waits (time-aware planning)
+    stages: tuple[Stage, ...] = ()   # stops inside it, where the robot waits or halts (time-aware planning)
     # Where a fly-by's lines end beyond the approach points (junction.Extension); None: there.
     retract_T: FloatArray | None = None     # (4, 4) the retract's target, robot base frame
     retract_q: FloatArray | None = None     # the configuration there

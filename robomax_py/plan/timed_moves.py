@@ -315,8 +315,10 @@ def _pieces(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray
                 return None
             if w is not None:
                 segments.append(dwell(q_now, w.seconds, kind="wait", label=f"wait for {w.obstacle}"))
-                stages.append(Stage(at, w))
                 t += w.seconds
+            # The pieces stop here (timed from rest to rest), waiting or not: a stage either way,
+            # so the program stops here too instead of flying by.
+            stages.append(Stage(at, w))
         elif not ctx.ignore_time and first_dynamic_hit(ctx.dynamic_world, check, t) is not None:
             return None                       # the first piece meets a dynamic obstacle as timed
         segments.extend(block)
