@@ -235,3 +235,26 @@ def with_pulses(robot):  # type: ignore[no-untyped-def]
 
     return dataclasses.replace(robot, controller=dataclasses.replace(robot.controller,
                                                                       pulses_per_degree=TEST_PULSES_PER_DEGREE))
+
+
+CROSSING_STATION = Path(__file__).resolve().parent / "data" / "station" / "crossing.yaml"
+
+
+@pytest.fixture(scope="module")
+def crossing_station_plan(shared_once: Callable[[str, Callable[[], Any]], Any],
+                          tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
+    """The files `robomax plan tests/data/station/crossing.yaml --format native,srcl` writes, by
+    name (the two-robot crossing station; planned once per test run, for the planner's tests and
+    the station replay's)."""
+    from typer.testing import CliRunner
+
+    from robomax_py.app.cli import app
+
+    def run() -> dict[str, str]:
+        out = tmp_path_factory.mktemp("station")
+        done = CliRunner().invoke(app, ["plan", str(CROSSING_STATION), "-o", str(out), "--format", "native,srcl"])
+        assert done.exit_code == 0, done.output
+        return {p.name: p.read_text() for p in out.iterdir() if p.is_file()}
+
+    files: dict[str, str] = shared_once("station-crossing-cli:" + CROSSING_STATION.read_text(), run)
+    return files

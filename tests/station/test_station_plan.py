@@ -5,17 +5,13 @@ small stations."""
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from typer.testing import CliRunner
 
-from robomax_py.app.cli import app
 from robomax_py.io.cell import load_cell_robot
 from robomax_py.io.station import load_station
 from robomax_py.program import SetSignal, WaitFor
@@ -27,16 +23,8 @@ TWO = DATA / "two_robots.yaml"
 
 
 @pytest.fixture(scope="module")
-def planned(shared_once: Callable[[str, Callable[[], Any]], Any], tmp_path_factory: pytest.TempPathFactory
-            ) -> dict[str, str]:
-    def run() -> dict[str, str]:
-        out = tmp_path_factory.mktemp("station")
-        done = CliRunner().invoke(app, ["plan", str(CROSSING), "-o", str(out), "--format", "native,srcl"])
-        assert done.exit_code == 0, done.output
-        return {p.name: p.read_text() for p in out.iterdir() if p.is_file()}
-
-    files: dict[str, str] = shared_once("station-crossing-cli:" + CROSSING.read_text(), run)
-    return files
+def planned(crossing_station_plan: dict[str, str]) -> dict[str, str]:
+    return crossing_station_plan
 
 
 @pytest.mark.slow

@@ -6,9 +6,7 @@ by the replay; the same programs without r1's wait make the arms touch."""
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import pytest
 from typer.testing import CliRunner
@@ -23,17 +21,8 @@ runner = CliRunner()
 
 
 @pytest.fixture(scope="module")
-def planned(shared_once: Callable[[str, Callable[[], Any]], Any], tmp_path_factory: pytest.TempPathFactory
-            ) -> dict[str, str]:
-    """The plan tests/station/test_station_plan.py makes (shared: planned once per session)."""
-    def run() -> dict[str, str]:
-        out = tmp_path_factory.mktemp("station")
-        done = CliRunner().invoke(app, ["plan", str(CROSSING), "-o", str(out), "--format", "native,srcl"])
-        assert done.exit_code == 0, done.output
-        return {p.name: p.read_text() for p in out.iterdir() if p.is_file()}
-
-    files: dict[str, str] = shared_once("station-crossing-cli:" + CROSSING.read_text(), run)
-    return files
+def planned(crossing_station_plan: dict[str, str]) -> dict[str, str]:
+    return crossing_station_plan
 
 
 def _folder(tmp_path: Path, files: dict[str, str]) -> Path:
