@@ -243,8 +243,8 @@ CROSSING_STATION = Path(__file__).resolve().parent / "data" / "station" / "cross
 @pytest.fixture(scope="module")
 def crossing_station_plan(shared_once: Callable[[str, Callable[[], Any]], Any],
                           tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
-    """The files `robomax plan tests/data/station/crossing.yaml --format native,srcl` writes, by
-    name (the two-robot crossing station; planned once per test run, for the planner's tests and
+    """The files `robomax plan tests/data/station/crossing.yaml --format native,srcl --plot`
+    writes, by name (the two-robot crossing station; planned once per test run, for the planner's tests and
     the station replay's)."""
     from typer.testing import CliRunner
 
@@ -252,9 +252,12 @@ def crossing_station_plan(shared_once: Callable[[str, Callable[[], Any]], Any],
 
     def run() -> dict[str, str]:
         out = tmp_path_factory.mktemp("station")
-        done = CliRunner().invoke(app, ["plan", str(CROSSING_STATION), "-o", str(out), "--format", "native,srcl"])
+        done = CliRunner().invoke(app, ["plan", str(CROSSING_STATION), "-o", str(out), "--format", "native,srcl",
+                                        "--plot"])
         assert done.exit_code == 0, done.output
-        return {p.name: p.read_text() for p in out.iterdir() if p.is_file()}
+        # The Gantt charts of --plot are images: their first bytes stand for them (hex).
+        return {p.name: p.read_bytes()[:8].hex() if p.suffix == ".png" else p.read_text()
+                for p in out.iterdir() if p.is_file()}
 
     files: dict[str, str] = shared_once("station-crossing-cli:" + CROSSING_STATION.read_text(), run)
     return files

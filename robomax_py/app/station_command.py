@@ -11,6 +11,7 @@ from pathlib import Path
 from robomax_py.app.commands.base import (
     EXIT_INFEASIBLE,
     EXIT_OK,
+    EXIT_VIOLATIONS,
     _print_json,
     _warn,
     err,
@@ -19,7 +20,7 @@ from robomax_py.app.commands.base import (
 
 
 def plan_station_files(path: Path, out_dir: Path, formats: str, speed: float | None, as_json: bool,
-                       stamp: str) -> int:
+                       stamp: str, plot: bool = False) -> int:
     from robomax_py.app.station_files import (
         allocate,
         interlock_edit,
@@ -65,14 +66,25 @@ def plan_station_files(path: Path, out_dir: Path, formats: str, speed: float | N
     files[f"{station.name}.station.json"] = station_summary(plan, interlocks)
     committed = commit_set(out_dir, station.name, files, station.digest, SHARED_FILES)
     cpu = time.process_time() - t0
+    # --plot: the written programs replayed together as the controllers run them (as `verify
+    # STATION DIR` does), each set's Gantt chart beside them; a replay that is not clean fails the
+    # command, never a chart of a station that would not run as planned.
+    replay_clean, charts = True, list[Path]()
+    if plot:
+        from robomax_py.app.station_report import replay_charts
+
+        replay_clean, charts = replay_charts(path, out_dir)
+    code = EXIT_OK if replay_clean else EXIT_VIOLATIONS
     schedule = plan.coordination.schedule
     gap = (plan.makespan - plan.bound.value) / plan.makespan if plan.makespan > 0 else 0.0
     if as_json:
         _print_json("plan", True, {"station": station.name, "makespan": round(plan.makespan, 4),
                                    "lower_bound": round(plan.bound.value, 4), "gap": round(gap, 4),
                                    "interlocks": len(interlocks), "cpu_s": round(cpu, 2),
-                                   "files": [str(f) for f in (*committed.paths, committed.manifest)]})
-        return EXIT_OK
+                                   "files": [str(f) for f in (*committed.paths, committed.manifest)],
+                                   **({"replay_clean": replay_clean, "charts": [str(c) for c in charts]}
+                                      if plot else {})})
+        return code
     out.print(f"station {station.name}: makespan {plan.makespan:.3f} s, lower bound {plan.bound.value:.3f} s "
               f"(gap {gap:.1%}), {len(interlocks)} interlock(s), {cpu:.1f} s CPU", markup=False, highlight=False)
     for p in plan.robots:
@@ -84,4 +96,9 @@ def plan_station_files(path: Path, out_dir: Path, formats: str, speed: float | N
                   markup=False, highlight=False)
     for f in (*committed.paths, committed.manifest):
         out.print(f"  wrote {f}", markup=False, highlight=False, soft_wrap=True)
-    return EXIT_OK
+    for c in charts:
+        out.print(f"  wrote {c} (the programs replayed together)", markup=False, highlight=False, soft_wrap=True)
+    if not replay_clean:
+        err.print(f"[bold red]violations:[/] the programs replayed together are not clean: robomax verify {path} {out_dir}",
+                  soft_wrap=True)
+    return code

@@ -79,12 +79,26 @@ def _print_set(programs: dict[str, Path], report: StationReport) -> None:
         out.print("[red]violations[/]")
 
 
-def _write_charts(name: str, results: list[tuple[dict[str, Path], StationReport]]) -> None:
+def replay_charts(station_file: Path, folder: Path) -> tuple[bool, list[Path]]:
+    """The programs `plan` just wrote into `folder` replayed together as the controllers run them
+    (`plan STATION --plot`): whether every set is clean, and the Gantt charts written of them."""
+    from robomax_py.app.station_verify import verify_station_files
+    from robomax_py.io.station import load_station
+
+    results = [(programs, report) for programs, _, report in verify_station_files(station_file, [folder])]
+    return all(r.clean for _, r in results), _write_charts(load_station(station_file).name, results)
+
+
+def _write_charts(name: str, results: list[tuple[dict[str, Path], StationReport]]) -> list[Path]:
     """`<station>.gantt.png` (one per dialect set after the first: `<station>.<ext>.gantt.png`) beside the programs."""
     from robomax_py.app.station_chart import render_station_png, station_chart
     from robomax_py.io.atomic import write_atomic_bytes
 
+    written = []
     for k, (programs, report) in enumerate(results):
         first = next(iter(programs.values()))
         stem = name if k == 0 else f"{name}.{first.suffix.lstrip('.')}"
-        write_atomic_bytes(first.parent / f"{stem}.gantt.png", render_station_png(station_chart(name, report)))
+        path = first.parent / f"{stem}.gantt.png"
+        write_atomic_bytes(path, render_station_png(station_chart(name, report)))
+        written.append(path)
+    return written

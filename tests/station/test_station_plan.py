@@ -107,3 +107,12 @@ def test_lower_bound_below_every_plan(tmp_path: Path, keep: list[str], pin: dict
     for p in plan.robots:                       # each robot's own tour: at least its spots' round trips
         if p.result is not None:
             assert p.own_cycle >= max(s.weld_time for s in p.result.spots)
+
+
+def test_plot_replays_the_written_programs_into_a_gantt_chart(planned: dict[str, str]) -> None:
+    """`--plot` on a station: the programs just written replayed together (one chart per dialect
+    set: SRCL's, then `<station>.<ext>` for the next, KRL here), the command's exit 0 saying the
+    replay was clean."""
+    png = "89504e470d0a1a0a"
+    charts = {name: head for name, head in planned.items() if name.endswith(".gantt.png")}
+    assert charts == {"crossing.gantt.png": png, "crossing.src.gantt.png": png}

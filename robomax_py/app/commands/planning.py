@@ -36,7 +36,7 @@ def plan(
     as_json: JsonFlag = False,
     speed: Annotated[float | None, typer.Option("--speed", min=0.01, max=1.0, help="override of every programmed speed, fraction in (0, 1] (default: the cell's planner.speed, else 1)")] = None,
     verbose: Annotated[bool, typer.Option("-v", "--verbose", help="debug logging: stage sizes, counts and times")] = False,
-    plot: Annotated[bool, typer.Option("--plot", help="also write DIR/<name>.png: a cycle-time Gantt chart, one row per spot")] = False,
+    plot: Annotated[bool, typer.Option("--plot", help="also write DIR/<name>.png: a cycle-time Gantt chart, one row per spot (a station: the programs replayed together, DIR/<station>.gantt.png, one row per robot)")] = False,
     formats: Annotated[str, typer.Option("--format", help="program dialects, comma-separated: srcl, krl, rapid, fanuc, urscript, inform, as, native (the robot's controller brand) or all (every dialect the robot file has the data for; the others are named in a warning)")] = "srcl",
     stamp: Annotated[bool, typer.Option("--stamp", help="write the date into each program's header (otherwise the same cell gives the same bytes)")] = False,
 ) -> None:
@@ -74,13 +74,13 @@ def plan(
         if is_station_file(cell):
             from robomax_py.app.station_command import plan_station_files
 
-            if method != "optimised" or plot:
+            if method != "optimised":
                 from robomax_py.errors import CellFileError
 
-                raise CellFileError(cell, "robots", "--baseline and --plot plan single-robot cells; a station "
+                raise CellFileError(cell, "robots", "--baseline plans single-robot cells; a station "
                                     "compares its methods in tests/bench/bench_station.py")
             return plan_station_files(cell, out_dir, formats, speed, as_json,
-                                      datetime.date.today().isoformat() if stamp else "")
+                                      datetime.date.today().isoformat() if stamp else "", plot)
         t0 = time.perf_counter()
         spec = load_cell(cell)
         _warn([str(n) for n in spec.notices])
