@@ -21,13 +21,14 @@ from robomax_py._typing import FloatArray
 from robomax_py.robot import JointLimits, RobotModel
 from robomax_py.spec import frozen_array
 from robomax_py.timing._common import DEFAULT_DT_S, LinMoveError, TimingError
-from robomax_py.timing._lin_track import Line, Tracker, off_line
+from robomax_py.timing._lin_track import Line, Tracker
 from robomax_py.timing.lin import (
     LIN_MAX_JOINT_STEP_RAD,
     LIN_PATH_TOL_M,
-    LIN_REFINE_ROUNDS,
+    Unrefined,
     _default_ik,
     _follow,
+    refine,
 )
 from robomax_py.timing.paths import GeometricPath, spline_path
 from robomax_py.timing.space_bezier import SpacePath
@@ -78,22 +79,11 @@ def curve_path(robot: RobotModel, curve: SpacePath, q_start: FloatArray, step: f
     followed = _follow(tracker, np.linspace(0.0, 1.0, count), q0)
     if not isinstance(followed, tuple):
         raise followed.error()
-    u, q = followed
-    for _ in range(LIN_REFINE_ROUNDS):
-        bad = off_line(robot, line, u, q, LIN_PATH_TOL_M)
-        if not np.any(bad):
-            break
-        mids = 0.5 * (u[:-1][bad] + u[1:][bad])
-        table = tracker.solve(mids)
-        new_q = []
-        for j, i in enumerate(np.nonzero(bad)[0]):
-            q_mid = tracker.follow(table, j, q[i])
-            if q_mid is None:
-                raise LinMoveError("discontinuous", int(i), float(mids[j]), "the joint path cannot be refined to follow the spline")
-            new_q.append(q_mid)
-        order = np.argsort(np.concatenate([u, mids]), kind="stable")
-        u = np.concatenate([u, mids])[order]
-        q = np.concatenate([q, np.array(new_q)])[order]
+    refined = refine(tracker, *followed, LIN_PATH_TOL_M)
+    if isinstance(refined, Unrefined):
+        raise LinMoveError("discontinuous", refined.index, refined.fraction,
+                           "the joint path cannot be refined to follow the spline")
+    u, q = refined
     return CurvePath(frozen_array(u * curve.length), frozen_array(q))
 
 

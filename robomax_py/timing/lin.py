@@ -182,9 +182,30 @@ def lin_path(
     followed = _follow(tracker, np.linspace(0.0, 1.0, count), q0)
     if isinstance(followed, LinPath):
         return followed
-    u, q = followed
+    refined = refine(tracker, *followed, path_tol)
+    if isinstance(refined, Unrefined):
+        detail = "the joint path cannot be refined to follow the line"
+        return _failed(line, "discontinuous", detail, refined.fraction, list(refined.u), list(refined.q))
+    u, q = refined
+    return LinPath(True, "", "", -1, 1.0, frozen_array(u * line.length), frozen_array(q), line.tcp_length, line.tcp_angle)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Unrefined:
+    """Where refining found no joint step in the branch: the path's fraction between samples
+    `index` and `index + 1`, and the samples (fractions `u`, configurations `q`) up to `index`."""
+
+    index: int
+    fraction: float
+    u: FloatArray
+    q: FloatArray
+
+
+def refine(tracker: Tracker, u: FloatArray, q: FloatArray, path_tol: float) -> tuple[FloatArray, FloatArray] | Unrefined:
+    """Samples (u, q) of a followed path with a sample added midway wherever the TCP leaves the
+    path by more than `path_tol` between two (up to LIN_REFINE_ROUNDS times), or where that fails."""
     for _ in range(LIN_REFINE_ROUNDS):
-        bad = off_line(robot, line, u, q, path_tol)
+        bad = off_line(tracker.robot, tracker.line, u, q, path_tol)
         if not np.any(bad):
             break
         mids = 0.5 * (u[:-1][bad] + u[1:][bad])
@@ -193,13 +214,12 @@ def lin_path(
         for j, i in enumerate(np.nonzero(bad)[0]):
             q_mid = tracker.follow(table, j, q[i])
             if q_mid is None:
-                detail = "the joint path cannot be refined to follow the line"
-                return _failed(line, "discontinuous", detail, float(mids[j]), list(u[: i + 1]), list(q[: i + 1]))
+                return Unrefined(int(i), float(mids[j]), u[: i + 1], q[: i + 1])
             new_q.append(q_mid)
         order = np.argsort(np.concatenate([u, mids]), kind="stable")
         u = np.concatenate([u, mids])[order]
         q = np.concatenate([q, np.array(new_q)])[order]
-    return LinPath(True, "", "", -1, 1.0, frozen_array(u * line.length), frozen_array(q), line.tcp_length, line.tcp_angle)
+    return u, q
 
 
 def _follow(tracker: Tracker, grid: FloatArray, q0: FloatArray) -> tuple[FloatArray, FloatArray] | LinPath:
