@@ -148,6 +148,13 @@ class _Reader(_DataReader):
         if kind == "PTP":
             self.unsimulated(text, line, "a PTP to a Cartesian point")
             return
+        xyz, zyx, config = self._cartesian(values, line)
+        self.add(LinMove(xyz, zyx, config, self.vel_cp * 1000.0, comment=comment, flyby_mm=flyby_mm,
+                         accel=self.lin_accel, tool=self.tool, base=self.base), line)
+
+    def _cartesian(self, values: dict[str, object], line: int) -> tuple[tuple[float, ...], tuple[float, ...], str]:
+        """A Cartesian target's X, Y, Z (mm), A, B, C (deg) and configuration: the components it
+        gives over the last target's (KRL keeps the rest), all six needed by the first."""
         self.last_pose.update({k: float(v) for k, v in values.items() if k in ("X", "Y", "Z", "A", "B", "C", "S", "T")})  # type: ignore[arg-type]
         missing = [k for k in "XYZABC" if k not in self.last_pose]
         if missing:
@@ -156,10 +163,7 @@ class _Reader(_DataReader):
         if "S" in values and "T" in values:
             # KSS 8 sets S bit 4 in taught points (vendor_research §1.5): the configuration is bits 0-2.
             config = str(ConfigIndicator(int(self.last_pose["S"]) & 7, int(self.last_pose["T"]) & 63))
-        xyz = tuple(self.last_pose[k] for k in "XYZ")
-        zyx = tuple(self.last_pose[k] for k in "ABC")
-        self.add(LinMove(xyz, zyx, config, self.vel_cp * 1000.0, comment=comment, flyby_mm=flyby_mm,
-                         accel=self.lin_accel, tool=self.tool, base=self.base), line)
+        return tuple(self.last_pose[k] for k in "XYZ"), tuple(self.last_pose[k] for k in "ABC"), config
 
     def on_spline(self, text: str, comment: str, line: int) -> None:
         """`SPLINE`, `ENDSPLINE` and, between them, `SPL` / `SLIN` to a named point with at most its own
@@ -181,17 +185,9 @@ class _Reader(_DataReader):
         if found is None or found[0] not in ("E6POS", "POS"):
             self.unsimulated(text, line, "a spline point not declared as a position in the program")
             return
-        values = found[1]
-        self.last_pose.update({k: float(v) for k, v in values.items() if k in ("X", "Y", "Z", "A", "B", "C", "S", "T")})  # type: ignore[arg-type]
-        missing = [k for k in "XYZABC" if k not in self.last_pose]
-        if missing:
-            raise self.error(line, f"the first Cartesian target must give {', '.join(missing)}")
-        config = ""
-        if "S" in values and "T" in values:
-            config = str(ConfigIndicator(int(self.last_pose["S"]) & 7, int(self.last_pose["T"]) & 63))
+        xyz, zyx, config = self._cartesian(found[1], line)
         speed = float(match[4]) if match[4] is not None else self.vel_cp
-        self.add(LinMove(tuple(self.last_pose[k] for k in "XYZ"), tuple(self.last_pose[k] for k in "ABC"), config,
-                         speed * 1000.0, comment=comment, accel=self.lin_accel, tool=self.tool, base=self.base,
+        self.add(LinMove(xyz, zyx, config, speed * 1000.0, comment=comment, accel=self.lin_accel, tool=self.tool, base=self.base,
                          spline="slin" if match[1].upper() == "SLIN" else "spl"), line)
 
     def on_weld(self, tree: Tree[Token], comment: str, line: int) -> None:
