@@ -322,13 +322,8 @@ class Sequencer(SequencerLookahead):
         for (i, a), (j, b) in itertools.pairwise(stops):
             qa, qb = self.q(i)[a], self.q(j)[b]
             label = f"{self._name(i)} -> {self._name(j)}"
-            # As `_costs` offers it: an unchecked straight move is tried only where it is offered.
-            straight_ok = (min(i, j), max(i, j)) not in self.detour_only and \
-                self.straight.get((i, j), {}).get((a, b), not self._verified_straight_only(i, j))
-            straight_cost = float(ptp_time_estimate(qa, qb, self.limits, self.options.speed)) if straight_ok else np.inf
-            via_costs = self._pair_via_costs(i, a, j, b)
-            best_v = int(np.argmin(via_costs)) if len(via_costs) else -1
-            if straight_ok and (best_v < 0 or straight_cost <= via_costs[best_v]):
+            straight, best_v, via_costs = self._way(i, a, j, b)
+            if straight:
                 if self._check_straight(i, a, j, b):
                     out.append(Transition("move", np.array([qa, qb]), label))
                 else:

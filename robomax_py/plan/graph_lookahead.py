@@ -23,6 +23,7 @@ from typing import Literal
 
 import numpy as np
 
+from robomax_py._typing import FloatArray
 from robomax_py.plan.graph_detours import SequencerDetours
 from robomax_py.timing import ptp_time_estimate
 
@@ -106,17 +107,25 @@ class SequencerLookahead(SequencerDetours):
             self._near = {i: [int(x) for x in row] for i, row in enumerate(order)}
         return self._near
 
-    def _learn_move(self, i: int, a: int, j: int, b: int) -> bool:
-        """The move from candidate a of i to b of j checked as `_verify` takes it: the straight move
-        where it is offered and cheapest (a blocked one with its batch of alternatives), else the
-        enter and leave legs of the cheapest known detour. Searches nothing; False if found blocked."""
+    def _way(self, i: int, a: int, j: int, b: int) -> tuple[bool, int, FloatArray]:
+        """How a tour takes the move from candidate a of i to b of j, as `_costs` offers it (an
+        unchecked straight move is tried only where it is offered): (straight, v, via_costs), with
+        `straight` True where the straight move is offered and no dearer than the cheapest known
+        detour, v that detour's index in via_costs (-1: none known)."""
         qa, qb = self.q(i)[a], self.q(j)[b]
         straight_ok = (min(i, j), max(i, j)) not in self.detour_only and \
             self.straight.get((i, j), {}).get((a, b), not self._verified_straight_only(i, j))
         straight = float(ptp_time_estimate(qa, qb, self.limits, self.options.speed)) if straight_ok else np.inf
         via_costs = self._pair_via_costs(i, a, j, b)
         v = int(np.argmin(via_costs)) if len(via_costs) else -1
-        if straight_ok and (v < 0 or straight <= via_costs[v]):
+        return straight_ok and (v < 0 or straight <= via_costs[v]), v, via_costs
+
+    def _learn_move(self, i: int, a: int, j: int, b: int) -> bool:
+        """The move from candidate a of i to b of j checked as `_verify` takes it: the straight move
+        where it is offered and cheapest (a blocked one with its batch of alternatives), else the
+        enter and leave legs of the cheapest known detour. Searches nothing; False if found blocked."""
+        straight, v, via_costs = self._way(i, a, j, b)
+        if straight:
             if (a, b) in self.straight.get((i, j), {}):
                 return True
             return self._learn_straight(i, a, j, b) == "free"
