@@ -23,7 +23,7 @@ from scipy.sparse.csgraph import dijkstra
 from robomax_py._typing import FloatArray
 from robomax_py.cspace.grid import nearest_cell
 from robomax_py.plan.roadmap import Detour
-from robomax_py.plan.shortcut import greedy_shortcut
+from robomax_py.plan.shortcut import swept_shortcut
 from robomax_py.robot import JointLimits
 from robomax_py.timing import polyline_time_estimate, ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
@@ -68,7 +68,8 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
     while path[-1] != flat(start):
         path.append(int(pred[path[-1]]))
     waypoints = np.vstack([qa, configs[path[::-1]], qb])
-    short, spent = _shortcut(world, waypoints)
+    # The map checked only cell centres: every consecutive pair is checked too.
+    short, spent = swept_shortcut(world, waypoints, check_neighbours=True)
     checks += spent
     if short is None:
         return None, checks
@@ -88,18 +89,3 @@ def local_grid(qa: FloatArray, qb: FloatArray, lower: FloatArray, upper: FloatAr
     denom = float(span @ span)
     frac = np.clip((cells - qa[:3]) @ span / denom, 0.0, 1.0) if denom > 1e-12 else np.zeros(len(cells))
     return axes, np.hstack([cells, qa[3:] + frac[:, None] * (qb[3:] - qa[3:])])
-
-
-def _shortcut(world: CollisionWorld, waypoints: FloatArray) -> tuple[FloatArray | None, int]:
-    """Greedy shortcutting (each kept waypoint joined to the farthest later one reachable by a free
-    swept move); None when some consecutive pair is not free (the map only checked cell centres)."""
-    checks = 0
-
-    def free(i: int, j: int) -> bool:
-        nonlocal checks
-        res = world.check_segment(waypoints[i], waypoints[j])
-        checks += res.checks
-        return res.free
-
-    keep = greedy_shortcut(len(waypoints), free, check_neighbours=True)
-    return (None if keep is None else waypoints[keep]), checks

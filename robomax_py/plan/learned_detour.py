@@ -60,7 +60,7 @@ from robomax_py.cspace.learned import COARSE_TRAINING, LearnedModel, TrainingSet
 from robomax_py.plan.candidates import SpotCandidates
 from robomax_py.plan.results import LearnedMapReport
 from robomax_py.plan.roadmap import Detour
-from robomax_py.plan.shortcut import greedy_shortcut
+from robomax_py.plan.shortcut import swept_shortcut
 from robomax_py.robot import JointLimits, RobotModel
 from robomax_py.spec import CellSpec, LearnedMapSpec
 from robomax_py.timing import polyline_time_estimate, ptp_time_estimate
@@ -218,7 +218,9 @@ class LearnedDetours:
             self.counts["gave_up"] += 1
             return None, checks
         waypoints = np.vstack([qa, self.configs[cells], qb])
-        short, spent = _shortcut(world, waypoints)
+        # Consecutive waypoints are known free (each segment was checked): only shortcuts are.
+        short, spent = swept_shortcut(world, waypoints)
+        assert short is not None             # neighbours are not re-checked, so never None
         checks += spent
         self.counts["found"] += 1
         return Detour(short, polyline_time_estimate(short, self.limits), checks), checks
@@ -331,19 +333,3 @@ class LearnedDetours:
                     return int(cells[n]), checks
                 self.counts["refused_entries"] += 1
         return None, checks
-
-
-def _shortcut(world: CollisionWorld, waypoints: FloatArray) -> tuple[FloatArray, int]:
-    """The checked path shortened greedily: each kept waypoint joined to the farthest later one a
-    free swept move reaches (consecutive waypoints are known free already)."""
-    checks = 0
-
-    def free(i: int, j: int) -> bool:
-        nonlocal checks
-        res = world.check_segment(waypoints[i], waypoints[j])
-        checks += res.checks
-        return res.free
-
-    keep = greedy_shortcut(len(waypoints), free)
-    assert keep is not None                  # neighbours are not re-checked, so never None
-    return waypoints[keep], checks

@@ -20,7 +20,7 @@ from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from robomax_py._typing import FloatArray
-from robomax_py.plan.shortcut import greedy_shortcut
+from robomax_py.plan.shortcut import swept_shortcut
 from robomax_py.robot import JointLimits
 from robomax_py.timing import polyline_time_estimate, ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
@@ -240,17 +240,9 @@ class Roadmap:
         return [-1 if u == S else (-2 if u == G else u) for u in reversed(path)]
 
     def _shortcut(self, waypoints: FloatArray) -> tuple[FloatArray, int]:
-        """Greedy (`greedy_shortcut`): each kept waypoint joined to the farthest later one reachable
+        """Greedy (`swept_shortcut`): each kept waypoint joined to the farthest later one reachable
         straight; the collision checks it took."""
-        checks = 0
-
-        def free(i: int, j: int) -> bool:
-            nonlocal checks
-            res = self._world.check_segment(waypoints[i], waypoints[j])
-            checks += res.checks
-            return res.free
-
-        kept = greedy_shortcut(len(waypoints), free)
+        kept, checks = swept_shortcut(self._world, waypoints)
         assert kept is not None                       # neighbours are not checked: always a path
-        return waypoints[kept], checks
+        return kept, checks
 

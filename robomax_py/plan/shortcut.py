@@ -8,6 +8,11 @@ free voxels, no new dynamic obstacle touched).
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from robomax_py._typing import FloatArray
+    from robomax_py.world.collision import CollisionWorld
 
 
 def greedy_shortcut(n: int, reachable: Callable[[int, int], bool], *, check_neighbours: bool = False) -> list[int] | None:
@@ -28,3 +33,20 @@ def greedy_shortcut(n: int, reachable: Callable[[int, int], bool], *, check_neig
         kept.append(j)
         i = j
     return kept
+
+
+def swept_shortcut(world: CollisionWorld, waypoints: FloatArray, *,
+                   check_neighbours: bool = False) -> tuple[FloatArray | None, int]:
+    """A joint-space path shortened greedily by swept collision checks (each kept waypoint joined
+    to the farthest later one a free swept move reaches), and the checks spent. Consecutive
+    waypoints are taken as free unless `check_neighbours`; then a blocked pair gives None."""
+    checks = 0
+
+    def free(i: int, j: int) -> bool:
+        nonlocal checks
+        res = world.check_segment(waypoints[i], waypoints[j])
+        checks += res.checks
+        return res.free
+
+    keep = greedy_shortcut(len(waypoints), free, check_neighbours=check_neighbours)
+    return (None if keep is None else waypoints[keep]), checks
