@@ -111,6 +111,7 @@ def station_summary(plan: StationPlan, interlocks: Sequence[StationInterlock]) -
         "format": STATION_FORMAT, "station": plan.station, "makespan": round(makespan, 6),
         "lower_bound": {"value": round(bound, 6), "single_spot_round_trip": round(plan.bound.single, 6),
                         "shared_work": round(plan.bound.shared, 6),
+                        "partition": round(plan.bound.partition, 6),
                         "gap": round((makespan - bound) / makespan, 6) if makespan > 0 else 0.0},
         "robots": robots,
         "interlocks": [{"zone": x.zone, "leader": x.leader, "waiter": x.waiter, "signal": x.signal,

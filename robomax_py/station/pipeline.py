@@ -21,7 +21,7 @@ from robomax_py.plan import PlanOptions, PlanResult, plan_cell
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.spec_station import SpotKey, StationSpec, robot_view
-from robomax_py.station.assign import Assignment, LowerBound, assign, lower_bound
+from robomax_py.station.assign import Assignment, assign
 from robomax_py.station.bodies import (
     RobotBody,
     body_poses,
@@ -29,6 +29,7 @@ from robomax_py.station.bodies import (
     robot_body,
     sample_steps,
 )
+from robomax_py.station.bound import LowerBound, half_line_time, lower_bound, spot_work
 from robomax_py.station.coordinate import Coordination, PairMap, Timeline, coordinate
 from robomax_py.station.reach import RobotReach, robot_reach
 from robomax_py.timing.trajectory import evaluate
@@ -102,13 +103,16 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     reaches = [robot_reach(station, r.name, models[r.name]) for r in station.robots]
     clock["reach"] = time.process_time() - t0
     keys = [s.key for s in station.spots]
-    bound = lower_bound(reaches, keys)
+    groups = _ordered_groups(station)
+    t0 = time.process_time()
+    bound = lower_bound([spot_work(reach, half_line_time(r.cell, options.plan)) for r, reach in
+                         zip(station.robots, reaches, strict=True)], keys, groups)
+    clock["bound"] = time.process_time() - t0
     nobody = [k for k in keys if not any(k in r.index() for r in reaches)]
     if nobody:
         names = ", ".join(f"{s}/{n}" for s, n in nobody[:10])
         return StationPlan(station.name, "infeasible", f"{len(nobody)} spot(s) no robot allowed to weld them can "
                            f"reach collision-free: {names}", (), Assignment({}, {}), bound, None, clock)
-    groups = _ordered_groups(station)
     t0 = time.process_time()
     prior = _side_prior(station, reaches)
     chosen = _nearest(station, reaches, keys, groups) if options.method == "nearest" \
