@@ -3,9 +3,9 @@
 Stages: what each robot can weld (`reach`), a min-max assignment of spots to robots (`assign`), each
 robot's spots planned by the single-robot planner (`plan.plan_cell` on the robot's cell narrowed
 to its spots), robot-robot collisions on the shared clock found (`bodies`) and ordered by interlocks
-(`coordinate`), and, where the waits cost more than a different assignment, the assignment searched
-again with the waits as costs and kept when the makespan shortens; then, where the robot that ends
-last still waits, another spot order (`reorder`) kept when the makespan shortens.
+(`coordinate`); where the robot that ends last waits, another spot order (`reorder`) kept when the
+makespan shortens; and, where the waits cost more than a different assignment, the assignment
+searched again with the waits as costs and kept when the makespan shortens.
 """
 
 from __future__ import annotations
@@ -55,8 +55,8 @@ SIDE_PRIOR_S_PER_M = 0.5
 
 @dataclass(frozen=True, slots=True)
 class StationOptions:
-    """method: "full" (min-max assignment, zone orders by look-ahead, re-assignment where waits
-    cost more, then another spot order where the robot that ends last waits), "minmax" (min-max
+    """method: "full" (min-max assignment, zone orders by look-ahead, another spot order where the
+    robot that ends last waits, then re-assignment where waits cost more), "minmax" (min-max
     assignment, zone orders by look-ahead, neither of those), "nearest" (each spot to the nearest
     robot that reaches it, first come first served)."""
 
@@ -128,6 +128,14 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     best = _realise(station, models, bodies, chosen, options, clock, bound)
     if options.method != "full" or best.status != "planned":
         return best
+    # Another spot order instead of waiting, where the robot that ends last waits; before the
+    # re-assignment, whose new tours are each robot's own best again (on a generated station of four
+    # KR 125-class arms the other way round ended 15 % later: 18.10 s against 15.79 s).
+    ordered = [g for g in groups if len(g) > 1]
+    robot_plans: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None] = {}
+    best, tried, kept = improve_orders(
+        best, lambda p: p.makespan, _orders, lambda p: _order_candidates(p, ordered),
+        lambda p, change: _with_order(station, models, bodies, p, change, options, clock, bound, robot_plans))
     penalty: dict[tuple[str, SpotKey], float] = dict(prior)
     rounds = 0
     for _ in range(REASSIGN_ROUNDS):
@@ -144,12 +152,6 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         trial = _realise(station, models, bodies, again, options, clock, bound, previous=best)
         if trial.status == "planned" and trial.makespan < best.makespan - 1e-6:
             best = trial
-    # Then another spot order instead of waiting, where the robot that ends last waits.
-    ordered = [g for g in groups if len(g) > 1]
-    robot_plans: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None] = {}
-    best, tried, kept = improve_orders(
-        best, lambda p: p.makespan, _orders, lambda p: _order_candidates(p, ordered),
-        lambda p, change: _with_order(station, models, bodies, p, change, options, clock, bound, robot_plans))
     return dataclasses.replace(best, seconds=clock, rounds=rounds, orders_tried=tried, order_changes=tuple(kept))
 
 
