@@ -111,6 +111,7 @@ def station_summary(plan: StationPlan, interlocks: Sequence[StationInterlock]) -
         "format": STATION_FORMAT, "station": plan.station, "makespan": round(makespan, 6),
         "lower_bound": {"value": round(bound, 6), "single_spot_round_trip": round(plan.bound.single, 6),
                         "shared_work": round(plan.bound.shared, 6),
+                        "partition": round(plan.bound.partition, 6),
                         "gap": round((makespan - bound) / makespan, 6) if makespan > 0 else 0.0},
         "robots": robots,
         "interlocks": [{"zone": x.zone, "leader": x.leader, "waiter": x.waiter, "signal": x.signal,
@@ -118,6 +119,9 @@ def station_summary(plan: StationPlan, interlocks: Sequence[StationInterlock]) -
                         "wait_at": round(x.wait_at, 6), "leader_span": [round(v, 6) for v in x.leader_span],
                         "waiter_span": [round(v, 6) for v in x.waiter_span]} for x in interlocks],
         "robot_margin_m": round(plan.margin, 6), "reassignments": plan.rounds,
+        "orders_tried": plan.orders_tried,
+        "order_changes": [{"robot": c.robot, "spots": [f"{seam}/{name}" for seam, name in c.order], "why": c.why}
+                          for c in plan.order_changes],
     }
     return json.dumps(data, indent=2) + "\n"
 

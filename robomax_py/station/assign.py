@@ -1,6 +1,6 @@
 """Which robot welds which spot, for the makespan: a min-max multiple-TSP over estimated tour times
 (after Spensieri et al., IEEE T-ASE 2016, who pose assignment and sequencing of a station as one
-min-max problem), and the lower bound every station plan's makespan is measured against.
+min-max problem). The lower bound every plan is measured against is `bound`'s.
 
 The estimate: a robot's tour is home -> its spots -> home over the quickest of a few representative
 configurations per spot (`reach.cost_matrix`), ordered by nearest neighbour and 2-opt, plus the weld
@@ -17,28 +17,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomax_py.spec_station import SpotKey
-from robomax_py.station.reach import RobotReach, box_gap_time, cost_matrix
+from robomax_py.station.reach import RobotReach, cost_matrix
 
-# A velocity limit may be exceeded by the planner's own check's slack (plan.pipeline PLAN_VELOCITY_RTOL
-# ~1e-5); the bound divides by a speed this much higher so that it stays a bound.
-BOUND_VELOCITY_SLACK = 1e-3
 MAX_LOCAL_ROUNDS = 400
-
-
-@dataclass(frozen=True, slots=True)
-class LowerBound:
-    """A lower bound on the makespan of any plan of the station whose motions keep the joint velocity
-    limits, every spot welded once by a robot allowed to and able to (collision-free candidate),
-    waits and robot-robot collisions ignored: the largest of `single` (the spot whose cheapest round
-    trip home -> spot -> home, its weld included, is longest) and `shared` (every spot's weld and
-    cheapest arrival, summed, shared evenly by the robots)."""
-
-    single: float
-    shared: float
-
-    @property
-    def value(self) -> float:
-        return max(self.single, self.shared)
 
 
 @dataclass(frozen=True, slots=True)
@@ -51,30 +32,6 @@ class Assignment:
     @property
     def makespan_estimate(self) -> float:
         return max(self.estimate.values(), default=0.0)
-
-
-def lower_bound(reaches: Sequence[RobotReach], spots: Sequence[SpotKey]) -> LowerBound:
-    """The bound of `LowerBound` from each robot's boxes of weld configurations (`RobotReach.lo/hi`)."""
-    single = 0.0
-    shared = 0.0
-    for key in spots:
-        best_trip = np.inf
-        best_share = np.inf
-        for r in reaches:
-            i = r.index().get(key)
-            if i is None:
-                continue
-            v = r.velocity * (1 + BOUND_VELOCITY_SLACK)
-            home_gap = float(box_gap_time(r.home, r.home, r.lo[i], r.hi[i], v))
-            best_trip = min(best_trip, 2 * home_gap + r.dwell[i])
-            others = np.delete(np.arange(len(r.keys)), i)
-            arrive = home_gap
-            if len(others):
-                arrive = min(arrive, float(box_gap_time(r.lo[others], r.hi[others], r.lo[i], r.hi[i], v).min()))
-            best_share = min(best_share, r.dwell[i] + arrive)
-        single = max(single, float(best_trip))
-        shared += float(best_share)
-    return LowerBound(single, shared / max(len(reaches), 1))
 
 
 class _Tours:

@@ -3,8 +3,9 @@
 Stages: what each robot can weld (`reach`), a min-max assignment of spots to robots (`assign`), each
 robot's spots planned by the single-robot planner (`plan.plan_cell` on the robot's cell narrowed
 to its spots), robot-robot collisions on the shared clock found (`bodies`) and ordered by interlocks
-(`coordinate`), and, where the waits cost more than a different assignment, the assignment searched
-again with the waits as costs and kept when the makespan shortens.
+(`coordinate`); where the robot that ends last waits, another spot order (`reorder`) kept when the
+makespan shortens; and, where the waits cost more than a different assignment, the assignment
+searched again with the waits as costs and kept when the makespan shortens.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from robomax_py.plan import PlanOptions, PlanResult, plan_cell
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.spec_station import SpotKey, StationSpec, robot_view
-from robomax_py.station.assign import Assignment, LowerBound, assign, lower_bound
+from robomax_py.station.assign import Assignment, assign
 from robomax_py.station.bodies import (
     RobotBody,
     body_poses,
@@ -29,8 +30,11 @@ from robomax_py.station.bodies import (
     robot_body,
     sample_steps,
 )
+from robomax_py.station.bound import LowerBound, half_line_time, lower_bound, spot_work
 from robomax_py.station.coordinate import Coordination, PairMap, Timeline, coordinate
 from robomax_py.station.reach import RobotReach, robot_reach
+from robomax_py.station.reorder import OrderChange, improve_orders, ordered_view
+from robomax_py.station.reorder import candidates as order_candidates
 from robomax_py.timing.trajectory import evaluate
 from robomax_py.world.scene import build_scene
 
@@ -51,9 +55,10 @@ SIDE_PRIOR_S_PER_M = 0.5
 
 @dataclass(frozen=True, slots=True)
 class StationOptions:
-    """method: "full" (min-max assignment, zone orders by look-ahead, re-assignment where waits
-    cost more), "minmax" (min-max assignment, zone orders by look-ahead, no re-assignment),
-    "nearest" (each spot to the nearest robot that reaches it, first come first served)."""
+    """method: "full" (min-max assignment, zone orders by look-ahead, another spot order where the
+    robot that ends last waits, then re-assignment where waits cost more), "minmax" (min-max
+    assignment, zone orders by look-ahead, neither of those), "nearest" (each spot to the nearest
+    robot that reaches it, first come first served)."""
 
     method: Method = "full"
     dt: float = DIAGRAM_DT_S
@@ -88,6 +93,8 @@ class StationPlan:
     seconds: Mapping[str, float]
     margin: float = 0.0          # m kept between robots on the diagrams, at most (where both move fastest)
     rounds: int = 0              # re-assignments tried
+    orders_tried: int = 0        # spot orders planned instead of waiting (`reorder`)
+    order_changes: tuple[OrderChange, ...] = ()    # those kept, in order
 
     @property
     def makespan(self) -> float:
@@ -102,13 +109,16 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     reaches = [robot_reach(station, r.name, models[r.name]) for r in station.robots]
     clock["reach"] = time.process_time() - t0
     keys = [s.key for s in station.spots]
-    bound = lower_bound(reaches, keys)
+    groups = _ordered_groups(station)
+    t0 = time.process_time()
+    bound = lower_bound([spot_work(reach, half_line_time(r.cell, options.plan)) for r, reach in
+                         zip(station.robots, reaches, strict=True)], keys, groups)
+    clock["bound"] = time.process_time() - t0
     nobody = [k for k in keys if not any(k in r.index() for r in reaches)]
     if nobody:
         names = ", ".join(f"{s}/{n}" for s, n in nobody[:10])
         return StationPlan(station.name, "infeasible", f"{len(nobody)} spot(s) no robot allowed to weld them can "
                            f"reach collision-free: {names}", (), Assignment({}, {}), bound, None, clock)
-    groups = _ordered_groups(station)
     t0 = time.process_time()
     prior = _side_prior(station, reaches)
     chosen = _nearest(station, reaches, keys, groups) if options.method == "nearest" \
@@ -118,6 +128,14 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     best = _realise(station, models, bodies, chosen, options, clock, bound)
     if options.method != "full" or best.status != "planned":
         return best
+    # Another spot order instead of waiting, where the robot that ends last waits; before the
+    # re-assignment, whose new tours are each robot's own best again (on a generated station of four
+    # KR 125-class arms the other way round ended 15 % later: 18.10 s against 15.79 s).
+    ordered = [g for g in groups if len(g) > 1]
+    robot_plans: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None] = {}
+    best, tried, kept = improve_orders(
+        best, lambda p: p.makespan, _orders, lambda p: _order_candidates(p, ordered),
+        lambda p, change: _with_order(station, models, bodies, p, change, options, clock, bound, robot_plans))
     penalty: dict[tuple[str, SpotKey], float] = dict(prior)
     rounds = 0
     for _ in range(REASSIGN_ROUNDS):
@@ -134,7 +152,42 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         trial = _realise(station, models, bodies, again, options, clock, bound, previous=best)
         if trial.status == "planned" and trial.makespan < best.makespan - 1e-6:
             best = trial
-    return dataclasses.replace(best, seconds=clock, rounds=rounds)
+    return dataclasses.replace(best, seconds=clock, rounds=rounds, orders_tried=tried, order_changes=tuple(kept))
+
+
+def _orders(plan: StationPlan) -> dict[str, tuple[SpotKey, ...]]:
+    """Each robot's spots in its planned order."""
+    return {p.robot: tuple((s.seam, s.name) for s in (p.result.spots if p.result else ())) for p in plan.robots}
+
+
+def _order_candidates(plan: StationPlan, ordered: Sequence[Sequence[SpotKey]]) -> list[OrderChange]:
+    assert plan.coordination is not None
+    schedule = plan.coordination.schedule
+    return order_candidates(_orders(plan), schedule.ends, schedule.waits, plan.coordination.interlocks, ordered)
+
+
+def _with_order(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
+                plan: StationPlan, change: OrderChange, options: StationOptions, clock: dict[str, float],
+                bound: LowerBound, known: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None]) -> StationPlan | None:
+    """The station with `change.robot` planned in `change.order` (the published method's given order;
+    `known` holds the robots planned so, by order) and coordinated again; None where that robot or
+    the station does not plan."""
+    key = (change.robot, change.order)
+    if key not in known:
+        t0 = time.process_time()
+        model = models[change.robot]
+        cell = station.robot(change.robot).cell
+        result = plan_cell(ordered_view(cell, change.order), model, dataclasses.replace(options.plan, given_order=True))
+        clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
+        # The program is proven against the robot's cell as its programs are read (file order).
+        known[key] = RobotPlan(change.robot, robot_view(station, change.robot, change.order), model, result) \
+            if result.status == "planned" else None
+    mine = known[key]
+    if mine is None:
+        return None
+    trial = _realise(station, models, bodies, plan.assignment, options, clock, bound, previous=plan,
+                     given={change.robot: mine})
+    return trial if trial.status == "planned" else None
 
 
 def _side_prior(station: StationSpec, reaches: Sequence[RobotReach]) -> dict[tuple[str, SpotKey], float]:
@@ -179,11 +232,14 @@ def _nearest(station: StationSpec, reaches: Sequence[RobotReach], keys: Sequence
 
 def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
              chosen: Assignment, options: StationOptions, clock: dict[str, float], bound: LowerBound,
-             previous: StationPlan | None = None) -> StationPlan:
-    """Plan each robot's spots, then coordinate the robots."""
+             previous: StationPlan | None = None, given: Mapping[str, RobotPlan] | None = None) -> StationPlan:
+    """Plan each robot's spots (`given`: robots planned already), then coordinate the robots."""
     t0 = time.process_time()
     plans: list[RobotPlan] = []
     for r in station.robots:
+        if given and r.name in given:
+            plans.append(given[r.name])
+            continue
         spots = chosen.spots.get(r.name, ())
         old = None if previous is None else next((p for p in previous.robots if p.robot == r.name), None)
         if old is not None and set(spots) == {(s.seam, s.name) for s in (old.result.spots if old.result else ())}:

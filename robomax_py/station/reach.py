@@ -1,7 +1,7 @@
 """What each robot of a station can weld, and what it costs: the collision-free candidates of every
 spot it may weld (the single-robot planner's own, `plan.candidates`), reduced to what the assignment
-needs: a few representative approach configurations per spot for the tour estimate, and the box
-of all its weld configurations for the lower bound."""
+needs: a few representative approach configurations per spot for the tour estimate, and every
+candidate's weld and approach configuration (and their box) for the lower bound."""
 
 from __future__ import annotations
 
@@ -30,6 +30,8 @@ class RobotReach:
     unreachable : the spots it may weld but has no candidate for.
     reps : (len(keys), REPRESENTATIVES, n) float, rad: approach configurations (repeated when fewer).
     lo, hi : (len(keys), n) float, rad: the box of every candidate's weld configuration.
+    weld_q, app_q : per spot (c, n) float, rad: every candidate's weld and approach configuration
+        (row k of both one candidate), for the lower bound.
     home : (n,) rad. velocity, acceleration : (n,) joint limits.
     dwell : (len(keys),) s, the weld time of each spot.
     line_s : s per approach or retract line (at the planner's TCP speed), for the estimate only.
@@ -46,6 +48,8 @@ class RobotReach:
     acceleration: FloatArray
     dwell: FloatArray
     line_s: float
+    weld_q: tuple[FloatArray, ...] = ()
+    app_q: tuple[FloatArray, ...] = ()
 
     def index(self) -> dict[SpotKey, int]:
         return {k: i for i, k in enumerate(self.keys)}
@@ -61,7 +65,7 @@ def robot_reach(station: StationSpec, name: str, model: RobotModel) -> RobotReac
     home = np.asarray(cell.home, dtype=float)
     keys: list[SpotKey] = []
     unreachable: list[SpotKey] = [k for k in allowed if k in far]
-    reps, lo, hi, dwell = [], [], [], []
+    reps, lo, hi, dwell, weld_q, app_q = [], [], [], [], [], []
     for s, seam in enumerate(cell.seams):
         found, _ = seam_candidates(cell, model, world, s)
         for c in found:
@@ -73,6 +77,8 @@ def robot_reach(station: StationSpec, name: str, model: RobotModel) -> RobotReac
             reps.append(_representatives(c.q_app, home))
             lo.append(c.q_spot.min(axis=0))
             hi.append(c.q_spot.max(axis=0))
+            weld_q.append(np.ascontiguousarray(c.q_spot, dtype=float))
+            app_q.append(np.ascontiguousarray(c.q_app, dtype=float))
             dwell.append(cell.process.weld_time_of(seam.spots[c.spot_index]))
     n = model.dof
     line_s = cell.process.approach / max(cell.planner.tcp_speed * cell.planner.speed, 1e-6)
@@ -80,7 +86,7 @@ def robot_reach(station: StationSpec, name: str, model: RobotModel) -> RobotReac
                       np.asarray(reps).reshape(len(keys), REPRESENTATIVES, n),
                       np.asarray(lo).reshape(len(keys), n), np.asarray(hi).reshape(len(keys), n), home,
                       np.asarray(model.limits.velocity, dtype=float), np.asarray(model.limits.acceleration, dtype=float),
-                      np.asarray(dwell, dtype=float), float(line_s))
+                      np.asarray(dwell, dtype=float), float(line_s), tuple(weld_q), tuple(app_q))
 
 
 def _representatives(q: FloatArray, home: FloatArray) -> FloatArray:
@@ -117,11 +123,3 @@ def cost_matrix(reach: RobotReach) -> FloatArray:
     np.fill_diagonal(out, 0.0)
     return out
 
-
-def box_gap_time(lo_a: FloatArray, hi_a: FloatArray, lo_b: FloatArray, hi_b: FloatArray,
-                 velocity: FloatArray) -> FloatArray:
-    """A lower bound on the time to move from any configuration in box a to any in box b with every
-    joint within its velocity limit: the largest per-joint gap between the boxes over its speed."""
-    gap = np.maximum(0.0, np.maximum(lo_a - hi_b, lo_b - hi_a))
-    out: FloatArray = (gap / velocity).max(axis=-1)
-    return out

@@ -1,0 +1,124 @@
+"""Another spot order instead of waiting (`station.reorder`), without planning: the cell a given
+order is planned in, the candidates the interlocks suggest, and the search that keeps a change only
+when the makespan shortens."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import pytest
+
+from robomax_py.io.station import load_station
+from robomax_py.spec_station import SpotKey
+from robomax_py.station.coordinate import Interlock
+from robomax_py.station.reorder import (
+    ORDER_CANDIDATES,
+    ORDER_ROUNDS,
+    OrderChange,
+    candidates,
+    improve_orders,
+    ordered_view,
+)
+
+TWO = Path(__file__).parents[1] / "data" / "station" / "two_robots.yaml"
+
+
+def test_the_ordered_view_lists_the_spots_in_the_order_given() -> None:
+    cell = load_station(TWO).robot("r1").cell
+    order = [("right_rail", "r1"), ("front_rail", "f4"), ("front_rail", "f1"), ("left_rail", "l1")]
+    view = ordered_view(cell, order)
+    assert [(seam.name, s.name) for seam in view.seams for s in seam.spots] == order
+    # Runs of one seam keep that seam's settings; consecutive spots of one seam stay one run.
+    assert [seam.name for seam in view.seams] == ["right_rail", "front_rail", "left_rail"]
+    by_name = {seam.name: seam for seam in cell.seams}
+    for seam in view.seams:
+        whole = by_name[seam.name]
+        assert (seam.ordered, seam.alpha_max, seam.beta_max, seam.gamma_range, seam.grid) == \
+            (whole.ordered, whole.alpha_max, whole.beta_max, whole.gamma_range, whole.grid)
+
+
+def _keys(*names: str) -> tuple[SpotKey, ...]:
+    return tuple(("s", n) for n in names)
+
+
+def _lock(leader: str, waiter: str, leader_segment: int, waiter_segment: int) -> Interlock:
+    """An interlock between a and b (the pair's order) of the given segments; the times do not matter here."""
+    zone = (leader_segment, waiter_segment) if leader == "a" else (waiter_segment, leader_segment)
+    return Interlock(("a", "b"), zone, leader, waiter, 5.0, 1.0, (3.0, 5.0), (1.0, 2.0))
+
+
+ORDER = {"a": _keys("a1", "a2", "a3"), "b": _keys("b1", "b2", "b3")}
+
+
+def test_no_candidate_unless_the_robot_that_ends_last_waits() -> None:
+    # b waits 2 s but a still ends last: no order of b can shorten the makespan.
+    ends = {"a": 12.0, "b": 11.0}
+    waits = {"a": (), "b": ((1.0, 2.0),)}
+    assert candidates(ORDER, ends, waits, [_lock("a", "b", 2, 0)], ()) == []
+
+
+def test_the_waiters_zone_spot_moves_and_the_leader_leaves_sooner() -> None:
+    # b ends last after waiting at its start for a's third segment (a2 -> a3): b's first segment
+    # goes to b1, a's to a3.
+    ends = {"a": 10.0, "b": 14.0}
+    waits = {"a": (), "b": ((1.0, 5.0),)}
+    got = candidates(ORDER, ends, waits, [_lock("a", "b", 2, 0)], ())
+    assert [(c.robot, c.order) for c in got] == [
+        ("b", _keys("b2", "b3", "b1")),            # b's zone spot last
+        ("b", _keys("b3", "b2", "b1")),            # b's tour reversed
+        ("a", _keys("a3", "a1", "a2")),            # a's zone spot first: a leaves the zone sooner
+    ]                                              # (b1 first: b's order already)
+    assert all(c.why for c in got)
+
+
+def test_an_ordered_seam_keeps_its_order() -> None:
+    ends = {"a": 10.0, "b": 14.0}
+    waits = {"a": (), "b": ((1.0, 5.0),)}
+    got = candidates(ORDER, ends, waits, [_lock("a", "b", 2, 0)], [_keys("b1", "b2")])
+    assert all(c.order.index(("s", "b1")) < c.order.index(("s", "b2")) for c in got if c.robot == "b")
+    assert [c.robot for c in got] == ["a"]
+
+
+@dataclasses.dataclass(frozen=True)
+class _Station:
+    """A stand-in for a station plan: the robots' orders and a makespan made up from them."""
+
+    orders: dict[str, tuple[SpotKey, ...]]
+
+    @property
+    def makespan(self) -> float:
+        # Made-up rule: b's tour is quickest when b3 comes first, and a's reversal helps a bit more.
+        t = 14.0 - (3.0 if self.orders["b"][0] == ("s", "b3") else 0.0)
+        return t - (0.5 if self.orders["a"] == _keys("a3", "a2", "a1") else 0.0)
+
+
+def _propose(plan: _Station) -> list[OrderChange]:
+    return [OrderChange("b", plan.orders["b"][::-1], "b reversed"), OrderChange("a", plan.orders["a"][::-1], "a reversed"),
+            OrderChange("b", plan.orders["b"][1:] + plan.orders["b"][:1], "b rotated"),
+            OrderChange("a", plan.orders["a"][1:] + plan.orders["a"][:1], "a rotated")]
+
+
+def test_the_search_keeps_only_changes_that_shorten_the_makespan() -> None:
+    planned: list[frozenset[tuple[str, tuple[SpotKey, ...]]]] = []
+
+    def trial(plan: _Station, change: OrderChange) -> _Station | None:
+        planned.append(frozenset({**plan.orders, change.robot: change.order}.items()))
+        if change.why == "b rotated":
+            return None                               # that order does not plan
+        return _Station({**plan.orders, change.robot: change.order})
+
+    start = _Station(dict(ORDER))
+    best, tried, kept = improve_orders(start, lambda p: p.makespan, lambda p: p.orders, _propose, trial)
+    assert best.makespan == pytest.approx(10.5)
+    assert [c.why for c in kept] == ["b reversed", "a reversed"]
+    assert tried == len(planned) <= ORDER_ROUNDS * ORDER_CANDIDATES
+    # No station is planned twice, nor the one started from (b reversed twice is b's first order).
+    assert len(set(planned)) == len(planned) and frozenset(ORDER.items()) not in planned
+
+
+def test_the_search_stops_where_nothing_is_shorter() -> None:
+    start = _Station({"a": _keys("a3", "a2", "a1"), "b": _keys("b3", "b2", "b1")})
+    best, tried, kept = improve_orders(start, lambda p: p.makespan, lambda p: p.orders,
+                                       _propose, lambda p, c: _Station({**p.orders, c.robot: c.order}))
+    assert best is start and kept == [] and tried == ORDER_CANDIDATES
