@@ -1,7 +1,8 @@
 """The configuration graph and detour learner: spot order and candidates by DP and local search on
 estimated motion times; straight moves verified lazily, blocked ones replaced by detours (a lift over
 the obstacle, else a path through the roadmap), rounds repeated until every move of the best tour is
-known free. What the sequencer knows and its costs are in `graph_knowledge`, its detour searches in
+known free, or (from the sixth round) until a tour known free is within KNOWN_TOUR_MARGIN of it.
+What the sequencer knows and its costs are in `graph_knowledge`, its detour searches in
 `graph_detours`, the moves round those a round left open (checked from the sixth round on) in
 `graph_lookahead`."""
 
