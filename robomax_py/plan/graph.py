@@ -1,7 +1,8 @@
 """The configuration graph and detour learner: spot order and candidates by DP and local search on
 estimated motion times; straight moves verified lazily, blocked ones replaced by detours (a lift over
 the obstacle, else a path through the roadmap), rounds repeated until every move of the best tour is
-known free. What the sequencer knows and its costs are in `graph_knowledge`, its detour searches in
+known free, or (from the sixth round) until a tour known free is within KNOWN_TOUR_MARGIN of it.
+What the sequencer knows and its costs are in `graph_knowledge`, its detour searches in
 `graph_detours`, the moves round those a round left open (checked from the sixth round on) in
 `graph_lookahead`."""
 
@@ -49,7 +50,7 @@ from robomax_py.world.collision import bisection_order
 
 # The tuning constants of the knowledge and detour modules stay importable from here.
 __all__ = [
-    "DEAD_END_DETOURS", "DEAD_END_STRAIGHT", "DETOUR_PRIOR", "LIFT_HEIGHTS_M", "LOOKAHEAD_FROM_ROUND", "MAX_BLOCKED_LEGS",
+    "DEAD_END_DETOURS", "DEAD_END_STRAIGHT", "DETOUR_PRIOR", "KNOWN_TOUR_MARGIN", "LIFT_HEIGHTS_M", "LOOKAHEAD_FROM_ROUND", "MAX_BLOCKED_LEGS",
     "MAX_BLOCKED_STRAIGHT", "MAX_FAILED_DETOURS", "PROBE_STATES", "REPAIRS_PER_ROUND", "WITHDRAW_DIRECTIONS",
     "WITHDRAW_M", "WITHDRAW_PAIRS", "Sequencer", "SequencingOutcome",
 ]
@@ -65,6 +66,13 @@ PROBE_STATES = 9
 # random trees of `rrt_detour` the last resort), before the cell is called disconnected.
 DEAD_END_STRAIGHT = 48
 DEAD_END_DETOURS = 3
+# From LOOKAHEAD_FROM_ROUND on, the cheapest tour found known free (by `_repair`) ends the rounds
+# once its estimated cost is at most this fraction above the round's best tour, whose unchecked moves
+# are priced as if free. Estimates this close are not trusted to rank two tours (the planner times
+# the file's order against the searched tour when its estimate is up to 1 % above,
+# `pipeline.GIVEN_ORDER_MARGIN`); on four panels of 60 spots each further round found one more
+# unchecked move between two panels blocked while the tour known free stayed about 1 % dearer.
+KNOWN_TOUR_MARGIN = 0.01
 
 
 def _moves_of(order: tuple[int, ...]) -> set[tuple[int, int]]:
@@ -91,6 +99,14 @@ class SequencingOutcome:
 class _TourCheck:
     complete: bool                         # every leg of the tour is known free
     transitions: tuple[Transition, ...]    # the legs known free so far, in tour order
+
+
+@dataclass(frozen=True, slots=True)
+class _KnownTour:
+    """A tour whose every leg was found free, and those legs (what `_repair` may find)."""
+
+    tour: Tour
+    transitions: tuple[Transition, ...]
 
 
 
@@ -180,6 +196,7 @@ class Sequencer(SequencerLookahead):
             self._probe_pairs()
             self._probed = ({k: dict(v) for k, v in self.straight.items()}, set(self.detour_only), self.checks)
         previous: tuple[tuple[int, ...], ...] = ()
+        known: _KnownTour | None = None          # the cheapest tour the repairs found known free
         for _ in range(self.options.max_rounds):
             self.rounds += 1
             self.left_open = ()
@@ -215,9 +232,22 @@ class Sequencer(SequencerLookahead):
             if verified.complete:
                 self.progress("sequencing", self.rounds, self.rounds)
                 return SequencingOutcome("found", tour, verified.transitions)
-            self._repair(tour.order)
+            repaired = self._repair(tour.order)
+            if repaired is not None and (known is None or repaired.tour.cost < known.tour.cost):
+                known = repaired
             if self.rounds >= LOOKAHEAD_FROM_ROUND:
+                if known is not None and known.tour.cost <= tour.cost * (1.0 + KNOWN_TOUR_MARGIN):
+                    log.debug("sequencing: the tour known free (%.3f s) is within %.0f %% of round %d's (%.3f s)",
+                              known.tour.cost, 100 * KNOWN_TOUR_MARGIN, self.rounds, tour.cost)
+                    self.progress("sequencing", self.rounds, self.rounds)
+                    return SequencingOutcome("found", known.tour, known.transitions)
                 self._look_around(self.left_open)
+                if repaired is not None and not (self.options.baseline or self.options.given_order):
+                    self._show_to_search(repaired.tour.order, repaired.tour.choice)
+        if known is not None:
+            # Out of rounds: each found another unchecked move blocked; the best tour known free stands.
+            log.debug("sequencing: out of rounds, the tour known free (%.3f s) taken", known.tour.cost)
+            return SequencingOutcome("found", known.tour, known.transitions)
         worst = ", ".join(f"{label} ({n} rounds)" for label, n in self.unresolved.most_common(5))
         return SequencingOutcome("not_converged", message=f"sequencing did not converge in {self.options.max_rounds} "
                                  f"rounds; moves left without a verified connection most often: {worst}")
@@ -239,18 +269,24 @@ class Sequencer(SequencerLookahead):
         other._roadmaps.update({part: r.fresh() for part, r in self._roadmaps.items() if part is not None})
         return other
 
-    def _repair(self, order: tuple[int, ...]) -> None:
+    def _repair(self, order: tuple[int, ...]) -> _KnownTour | None:
         """The candidates of one order re-chosen (the exact DP, cheap next to an order search) and
         checked again, up to REPAIRS_PER_ROUND times, until every leg is known free or the order
         has no finite tour. A blocked move between two spots with many near-equal candidates
         (other wrist turns of one pose, of the same joint time where a big axis sets it) otherwise
         costs a round per candidate pair: the order search proposes the same order with the next
-        unchecked pair. Nothing is returned from here: the next round's order search weighs what
-        was learnt, and a tour is taken only as a round's optimum."""
+        unchecked pair. Returns the tour whose every leg it found free, if it found one: the next
+        round's order search weighs what was learnt, and that tour is taken only when no round finds
+        one cheaper by more than KNOWN_TOUR_MARGIN (`run`)."""
         for _ in range(REPAIRS_PER_ROUND):
             choice, cost = choice_for_order(order, self.full_cost, self.node)
-            if not np.isfinite(cost) or self._verify(Tour(order, choice, cost)).complete:
-                return
+            if not np.isfinite(cost):
+                return None
+            tour = Tour(order, choice, cost)
+            checked = self._verify(tour)
+            if checked.complete:
+                return _KnownTour(tour, checked.transitions)
+        return None
 
     def _open_dead_end(self, order: tuple[int, ...]) -> bool:
         """Whether something new joins the first move of `order` that no reached candidate can make

@@ -282,6 +282,24 @@ class SequencerKnowledge:
                 est[pi[a], pj[b]] = np.inf
         return est
 
+    def _show_to_search(self, order: tuple[int, ...], choice: tuple[int, ...]) -> None:
+        """The candidates of a tour known free (`choice`, one per spot of `order`) joined to the
+        representatives the order search sees, so that the search can find that tour again: where
+        its free moves join candidates the thinning left out, the search prices its order by the
+        representatives' moves, found blocked, and keeps turning to orders whose unchecked moves
+        look cheaper. Matrices of the spots whose representatives grew are recomputed when asked."""
+        grown: set[int] = set()
+        for i, a in zip(order, choice):
+            rows = self.reps[i]
+            k = int(np.searchsorted(rows, a))
+            if k < len(rows) and rows[k] == a:
+                continue
+            self.reps[i] = np.insert(rows, k, a)            # ascending, as `representatives` gives them
+            self.node_reps[i] = self.node[i][self.reps[i]]
+            grown.add(i)
+        for key in [key for key in self._matrices if key[0] in grown or key[1] in grown]:
+            del self._matrices[key]
+
     def _verified_straight_only(self, i: int, j: int) -> bool:
         """Whether only straight moves known to be free are offered between spots i and j: many
         found blocked, or the pair given up (no detour found MAX_FAILED_DETOURS times), where
