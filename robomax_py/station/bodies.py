@@ -3,9 +3,10 @@ robot against every one of another, each posed by its own joint values, in the s
 
 The pieces are the collision pieces the single-robot checks use (`RobotModel.collision_model`, the
 tool's pieces of `world.scene`), so "collide" means the same here as there. A shortcut culls most
-pairs before coal is asked: a sphere around each robot and around each piece (coal's local AABB
-radius about its centre, which holds the whole piece) - spheres that keep apart cannot hold pieces
-that touch, so the answer is the exact one (tests compare with every pair asked of coal).
+pairs before coal is asked: spheres around each link over a block of consecutive samples, then
+around each link and each piece at a sample (coal's local AABB radius about its centre, which holds
+the whole piece) - spheres that keep apart cannot hold pieces that touch, so the answer is the exact
+one (tests compare with every pair asked of coal).
 """
 
 from __future__ import annotations
@@ -19,10 +20,15 @@ import pinocchio as pin
 
 from robomax_py._typing import BoolArray, FloatArray
 from robomax_py.robot import RobotModel
+from robomax_py.station.clash_kernels import near_pieces
 from robomax_py.world.scene import Scene
 
-# Pairs of samples handed to the piece-level sphere test at once (memory: chunk x pieces^2 floats).
-CHUNK = 2048
+# Consecutive samples bounded together (`clash_map`): larger blocks cull fewer pairs per test,
+# smaller ones need more tests; 16 samples are 0.64 s of motion at the diagrams' 40 ms.
+BLOCK = 16
+# Added to every sphere test's reach, m: the spheres' own arithmetic rounds, and coal's convex
+# distance has a tolerance; a culled pair is then farther apart than any rounding could hide.
+ROUNDING_M = 1e-6
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -81,12 +87,12 @@ def _spheres(body: RobotBody, poses: FloatArray) -> FloatArray:
 
 
 def clash_map(a: RobotBody, poses_a: FloatArray, b: RobotBody, poses_b: FloatArray, margin: float,
-              prefilter: bool = True, slack_a: FloatArray | None = None, slack_b: FloatArray | None = None
-              ) -> BoolArray:
+              prefilter: bool = True, slack_a: FloatArray | None = None, slack_b: FloatArray | None = None,
+              block: int = BLOCK) -> BoolArray:
     """(ka, kb) bool: True where robot a at sample i and robot b at sample j come closer than
     `margin + slack_a[i] + slack_b[j]` (m; slacks default 0) - any piece of one within that of any
     piece of the other. `prefilter=False` asks coal of every pair (the slow reference the tests
-    hold the shortcut to)."""
+    hold the shortcut to); `block`: samples bounded together by the shortcut."""
     ka, kb = len(poses_a), len(poses_b)
     sa = np.zeros(ka) if slack_a is None else np.asarray(slack_a, dtype=float)
     sb = np.zeros(kb) if slack_b is None else np.asarray(slack_b, dtype=float)
@@ -100,46 +106,53 @@ def clash_map(a: RobotBody, poses_a: FloatArray, b: RobotBody, poses_b: FloatArr
             out[i, j] = any(_touch(a.pieces[u], poses_a[i, u], b.pieces[v], poses_b[j, v], request)
                             for u in range(len(a.pieces)) for v in range(len(b.pieces)))
         return out
-    # Whole-robot spheres first (most sample pairs of robots apart end here), then one sphere per
-    # link (its pieces' spheres inside it), then the pieces' own spheres, then coal.
-    Ca, Ra = _groups(ca, a.radius, np.zeros(len(a.pieces), dtype=int))
-    Cb, Rb = _groups(cb, b.radius, np.zeros(len(b.pieces), dtype=int))
+    # Per block of `block` consecutive samples and per link, one sphere around that link's spheres
+    # over the block (each grown by its sample's slack); block pairs whose link spheres keep apart
+    # are done, the rest descend to each sample pair's link spheres, then its pieces' spheres
+    # (compiled: `clash_kernels.near_pieces`), and coal decides what is left.
     ga, gb = _link_index(a), _link_index(b)
     La, RLa = _groups(ca, a.radius, ga)
     Lb, RLb = _groups(cb, b.radius, gb)
+    rows, gaps = near_pieces(block, *_blocks(La, RLa, sa, block), *_blocks(Lb, RLb, sb, block), La, RLa, Lb, RLb,
+                             ca, a.radius, *_members(ga), cb, b.radius, *_members(gb), sa, sb,
+                             margin + ROUNDING_M)
+    if not len(rows):
+        return out
+    # Per sample pair, the nearest piece pair first: a pair that touches mostly touches there.
+    order = np.lexsort((gaps, rows[:, 1], rows[:, 0]))
+    rows = rows[order]
+    bounds = np.flatnonzero(np.any(np.diff(rows[:, :2], axis=0) != 0, axis=1)) + 1
     tf_a, tf_b = _transforms(poses_a), _transforms(poses_b)
-    rows = max(1, (1 << 22) // max(kb, 1))
-    pairs = np.concatenate([np.argwhere(_sq(Ca[r:r + rows, None, 0] - Cb[None, :, 0])
-                                        < (Ra[r:r + rows, None, 0] + Rb[None, :, 0] + margin + sa[r:r + rows, None]
-                                           + sb[None, :]) ** 2) + [r, 0]
-                            for r in range(0, ka, rows)] or [np.zeros((0, 2), dtype=int)])
-    for start in range(0, len(pairs), CHUNK):
-        chunk = pairs[start:start + CHUNK]
-        m = (margin + sa[chunk[:, 0]] + sb[chunk[:, 1]])[:, None, None]
-        links = _sq(La[chunk[:, 0], :, None] - Lb[chunk[:, 1], None, :]) \
-            < (RLa[chunk[:, 0], :, None] + RLb[chunk[:, 1], None, :] + m) ** 2
-        keep = links.any(axis=(1, 2))
-        chunk, links, m = chunk[keep], links[keep], m[keep]
-        if not len(chunk):
-            continue
-        d2 = _sq(ca[chunk[:, 0], :, None] - cb[chunk[:, 1], None, :])
-        reach = (a.radius[None, :, None] + b.radius[None, None, :] + m)
-        close = (d2 < reach ** 2) & links[:, ga][:, :, gb]
-        k, pa, pb = np.nonzero(close)
-        if not len(k):
-            continue
-        order = np.lexsort((d2[k, pa, pb] - reach[k, pa, pb] ** 2, k))   # per sample pair, the nearest first
-        k, pa, pb = k[order], pa[order], pb[order]
-        bounds = np.flatnonzero(np.diff(k)) + 1
-        for first, stop in zip(np.r_[0, bounds].tolist(), np.r_[bounds, len(k)].tolist(), strict=True):
-            i, j = chunk[k[first]].tolist()
-            request.security_margin = float(m[k[first], 0, 0])
-            for u, v in zip(pa[first:stop].tolist(), pb[first:stop].tolist(), strict=True):
-                result = coal.CollisionResult()
-                if coal.collide(a.pieces[u], tf_a(i, u), b.pieces[v], tf_b(j, v), request, result):
-                    out[i, j] = True
-                    break
+    for first, stop in zip(np.r_[0, bounds].tolist(), np.r_[bounds, len(rows)].tolist(), strict=True):
+        i, j = rows[first, :2].tolist()
+        request.security_margin = margin + sa[i] + sb[j]
+        for u, v in rows[first:stop, 2:].tolist():
+            result = coal.CollisionResult()
+            if coal.collide(a.pieces[u], tf_a(i, u), b.pieces[v], tf_b(j, v), request, result):
+                out[i, j] = True
+                break
     return out
+
+
+def _blocks(centres: FloatArray, radius: FloatArray, slack: FloatArray, block: int
+            ) -> tuple[FloatArray, FloatArray]:
+    """Per block of `block` samples, a sphere around each group's spheres over the block, each grown
+    by its sample's slack (and the rounding allowance): centres (nb, g, 3), radii (nb, g)."""
+    k = len(centres)
+    pad = -k % block
+    C = np.concatenate([centres, np.repeat(centres[-1:], pad, axis=0)]).reshape(-1, block, *centres.shape[1:])
+    R = np.concatenate([radius + slack[:, None], np.repeat(radius[-1:] + slack[-1], pad, axis=0)])
+    R = R.reshape(-1, block, radius.shape[1])
+    mid = (C.min(axis=1) + C.max(axis=1)) / 2
+    out = (np.linalg.norm(C - mid[:, None], axis=3) + R).max(axis=1) + ROUNDING_M
+    return mid, out
+
+
+def _members(group: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The pieces of each group: group g's are members[start[g]:start[g + 1]]."""
+    members = np.argsort(group, kind="stable")
+    start = np.r_[0, np.cumsum(np.bincount(group))]
+    return start.astype(np.int64), members.astype(np.int64)
 
 
 def _transforms(poses: FloatArray) -> Callable[[int, int], coal.Transform3s]:

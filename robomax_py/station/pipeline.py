@@ -12,11 +12,12 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
 
+from robomax_py._typing import FloatArray
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
@@ -94,6 +95,16 @@ class StationPlan:
         return np.inf if self.coordination is None else self.coordination.schedule.makespan
 
 
+@dataclass(frozen=True, slots=True)
+class _Diagrams:
+    """The sampled motions (piece poses, half steps) and pair diagrams made so far in one
+    `plan_station`, by the robot plans they are of: a re-assignment round plans again only the robots
+    whose spots changed, and the diagram of two unchanged plans is the one already made."""
+
+    motion: dict[RobotPlan, tuple[FloatArray, FloatArray]] = field(default_factory=dict)
+    pairs: dict[tuple[RobotPlan, RobotPlan], PairMap] = field(default_factory=dict)
+
+
 def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
                  options: StationOptions = StationOptions()) -> StationPlan:
     """Plan every robot of a station; `models[name]` is each robot's model with its tool mounted."""
@@ -115,7 +126,8 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         else assign(reaches, keys, groups, prior)
     clock["assignment"] = time.process_time() - t0
     bodies = {r.name: robot_body(r.name, models[r.name], build_scene(r.cell, models[r.name])) for r in station.robots}
-    best = _realise(station, models, bodies, chosen, options, clock, bound)
+    made = _Diagrams()
+    best = _realise(station, models, bodies, chosen, options, clock, bound, made)
     if options.method != "full" or best.status != "planned":
         return best
     penalty: dict[tuple[str, SpotKey], float] = dict(prior)
@@ -131,7 +143,7 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         if dict(again.spots) == dict(best.assignment.spots):
             break
         rounds += 1
-        trial = _realise(station, models, bodies, again, options, clock, bound, previous=best)
+        trial = _realise(station, models, bodies, again, options, clock, bound, made, previous=best)
         if trial.status == "planned" and trial.makespan < best.makespan - 1e-6:
             best = trial
     return dataclasses.replace(best, seconds=clock, rounds=rounds)
@@ -179,7 +191,7 @@ def _nearest(station: StationSpec, reaches: Sequence[RobotReach], keys: Sequence
 
 def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
              chosen: Assignment, options: StationOptions, clock: dict[str, float], bound: LowerBound,
-             previous: StationPlan | None = None) -> StationPlan:
+             made: _Diagrams, previous: StationPlan | None = None) -> StationPlan:
     """Plan each robot's spots, then coordinate the robots."""
     t0 = time.process_time()
     plans: list[RobotPlan] = []
@@ -198,23 +210,25 @@ def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Map
         plans.append(RobotPlan(r.name, cell, models[r.name], result))
     clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
     t0 = time.process_time()
-    timelines, samples = [], {}
+    timelines = [_timeline(p) for p in plans]
     for p in plans:
-        timelines.append(_timeline(p))
-        samples[p.robot] = _samples(p, options.dt)
-    poses = {name: body_poses(bodies[name], qs) for name, qs in samples.items()}
-    # Each sample stands for the motion half a step either side of it: the margin there grows by
-    # half the farthest any point moves to its neighbours (slow near welds, fast between).
-    halves = {name: sample_steps(bodies[name], poses[name]) / 2 for name in poses}
+        if p not in made.motion:
+            poses = body_poses(bodies[p.robot], _samples(p, options.dt))
+            # Each sample stands for the motion half a step either side of it: the margin there grows
+            # by half the farthest any point moves to its neighbours (slow near welds, fast between).
+            made.motion[p] = (poses, sample_steps(bodies[p.robot], poses) / 2)
     clearance = max(r.cell.process.clearance for r in station.robots)
     pairs = []
     margin = 0.0
-    names = [p.robot for p in plans]
-    for i, a in enumerate(names):
-        for b in names[i + 1:]:
-            margin = max(margin, clearance + float(halves[a].max(initial=0.0)) + float(halves[b].max(initial=0.0)))
-            pairs.append(PairMap(a, b, options.dt, clash_map(bodies[a], poses[a], bodies[b], poses[b], clearance,
-                                                             slack_a=halves[a], slack_b=halves[b])))
+    for i, pa in enumerate(plans):
+        for pb in plans[i + 1:]:
+            (poses_a, half_a), (poses_b, half_b) = made.motion[pa], made.motion[pb]
+            margin = max(margin, clearance + float(half_a.max(initial=0.0)) + float(half_b.max(initial=0.0)))
+            if (pa, pb) not in made.pairs:
+                a, b = pa.robot, pb.robot
+                made.pairs[(pa, pb)] = PairMap(a, b, options.dt, clash_map(bodies[a], poses_a, bodies[b], poses_b,
+                                                                           clearance, slack_a=half_a, slack_b=half_b))
+            pairs.append(made.pairs[(pa, pb)])
     clock["clash maps"] = clock.get("clash maps", 0.0) + time.process_time() - t0
     t0 = time.process_time()
     done = coordinate(timelines, pairs, fcfs=options.method == "nearest")
