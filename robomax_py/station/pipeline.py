@@ -10,6 +10,7 @@ again with the waits as costs and kept when the makespan shortens.
 from __future__ import annotations
 
 import dataclasses
+import logging
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -34,6 +35,8 @@ from robomax_py.station.coordinate import Coordination, PairMap, Timeline, coord
 from robomax_py.station.reach import RobotReach, robot_reach
 from robomax_py.timing.trajectory import evaluate
 from robomax_py.world.scene import build_scene
+
+log = logging.getLogger(__name__)
 
 Method = Literal["full", "minmax", "nearest"]
 # Own-clock step of the coordination diagrams, s; the margin kept between robots grows with the
@@ -132,6 +135,7 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         return best
     penalty: dict[tuple[str, SpotKey], float] = dict(prior)
     rounds = 0
+    tried = {_frozen(chosen)}
     for _ in range(REASSIGN_ROUNDS):
         assert best.coordination is not None
         if not best.coordination.interlocks or best.coordination.schedule.makespan <= 0:
@@ -143,10 +147,22 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         if dict(again.spots) == dict(best.assignment.spots):
             break
         rounds += 1
-        trial = _realise(station, models, bodies, again, options, clock, bound, made, previous=best)
+        seen = _frozen(again)
+        if seen in tried:            # planned before and not kept: the same plans again
+            continue
+        tried.add(seen)
+        # The makespan is at least every robot's own cycle: a trial is given up as soon as one of its
+        # robots, kept or planned again (longest estimate first), is no shorter than the best makespan.
+        trial = _realise(station, models, bodies, again, options, clock, bound, made, previous=best,
+                         beat=best.makespan - 1e-6)
         if trial.status == "planned" and trial.makespan < best.makespan - 1e-6:
             best = trial
     return dataclasses.replace(best, seconds=clock, rounds=rounds)
+
+
+def _frozen(chosen: Assignment) -> frozenset[tuple[str, frozenset[SpotKey]]]:
+    """An assignment as which robot welds which spots (its order aside)."""
+    return frozenset((r, frozenset(spots)) for r, spots in chosen.spots.items())
 
 
 def _side_prior(station: StationSpec, reaches: Sequence[RobotReach]) -> dict[tuple[str, SpotKey], float]:
@@ -191,23 +207,41 @@ def _nearest(station: StationSpec, reaches: Sequence[RobotReach], keys: Sequence
 
 def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
              chosen: Assignment, options: StationOptions, clock: dict[str, float], bound: LowerBound,
-             made: _Diagrams, previous: StationPlan | None = None) -> StationPlan:
-    """Plan each robot's spots, then coordinate the robots."""
+             made: _Diagrams, previous: StationPlan | None = None, beat: float = np.inf) -> StationPlan:
+    """Plan each robot's spots (a robot whose spots are those it had in `previous` keeps its plan),
+    then coordinate the robots. `beat`: given up (status "infeasible") when a robot's own cycle
+    reaches it, the station's makespan then being no shorter."""
     t0 = time.process_time()
-    plans: list[RobotPlan] = []
+    kept: dict[str, RobotPlan] = {}
+    todo = []
     for r in station.robots:
         spots = chosen.spots.get(r.name, ())
         old = None if previous is None else next((p for p in previous.robots if p.robot == r.name), None)
         if old is not None and set(spots) == {(s.seam, s.name) for s in (old.result.spots if old.result else ())}:
-            plans.append(old)
-            continue
-        cell = robot_view(station, r.name, spots)
-        result = plan_cell(cell, models[r.name], options.plan) if spots else None
-        if result is not None and result.status != "planned":
+            kept[r.name] = old
+        else:
+            todo.append(r.name)
+    planned: dict[str, RobotPlan] = {}
+    longest = max(kept.values(), key=lambda p: p.own_cycle, default=None)
+    if longest is not None and longest.own_cycle >= beat:
+        return StationPlan(station.name, "infeasible", f"{longest.robot}'s own cycle {longest.own_cycle:.2f} s, kept, "
+                           f"is no shorter than {beat:.2f} s", tuple(kept.values()), chosen, bound, None, clock)
+    for name in todo if beat == np.inf else sorted(todo, key=lambda n: -chosen.estimate.get(n, 0.0)):
+        spots = chosen.spots.get(name, ())
+        cell = robot_view(station, name, spots)
+        t1 = time.process_time()
+        result = plan_cell(cell, models[name], options.plan) if spots else None
+        plan = RobotPlan(name, cell, models[name], result)
+        log.debug("%s: %d spots planned in %.1f s CPU, own cycle %.2f s (to beat: %.2f s)", name, len(spots),
+                  time.process_time() - t1, plan.own_cycle, beat)
+        message = f"{name}: {result.message}" if result is not None and result.status != "planned" else \
+            f"{name}'s own cycle {plan.own_cycle:.2f} s is no shorter than {beat:.2f} s" if plan.own_cycle >= beat else ""
+        if message:
             clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
-            return StationPlan(station.name, "infeasible", f"{r.name}: {result.message}", tuple(plans), chosen, bound,
-                               None, clock)
-        plans.append(RobotPlan(r.name, cell, models[r.name], result))
+            so_far = tuple(p for r in station.robots if (p := kept.get(r.name) or planned.get(r.name)) is not None)
+            return StationPlan(station.name, "infeasible", message, so_far, chosen, bound, None, clock)
+        planned[name] = plan
+    plans = [kept.get(r.name) or planned[r.name] for r in station.robots]
     clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
     t0 = time.process_time()
     timelines = [_timeline(p) for p in plans]
