@@ -2,7 +2,7 @@
 
 Stages: what each robot can weld (`reach`), a min-max assignment of spots to robots (`assign`), each
 robot's spots planned by the single-robot planner (`plan.plan_cell` on the robot's cell narrowed
-to its spots), robot-robot collisions on the shared clock found (`bodies`) and ordered by interlocks
+to its spots, with the candidates `reach` found), robot-robot collisions on the shared clock found (`bodies`) and ordered by interlocks
 (`coordinate`), and, where the waits cost more than a different assignment, the assignment searched
 again with the waits as costs and kept when the makespan shortens.
 """
@@ -130,7 +130,8 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     clock["assignment"] = time.process_time() - t0
     bodies = {r.name: robot_body(r.name, models[r.name], build_scene(r.cell, models[r.name])) for r in station.robots}
     made = _Diagrams()
-    best = _realise(station, models, bodies, chosen, options, clock, bound, made)
+    by_robot = {r.robot: r for r in reaches}
+    best = _realise(station, models, bodies, by_robot, chosen, options, clock, bound, made)
     if options.method != "full" or best.status != "planned":
         return best
     penalty: dict[tuple[str, SpotKey], float] = dict(prior)
@@ -153,7 +154,7 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         tried.add(seen)
         # The makespan is at least every robot's own cycle: a trial is given up as soon as one of its
         # robots, kept or planned again (longest estimate first), is no shorter than the best makespan.
-        trial = _realise(station, models, bodies, again, options, clock, bound, made, previous=best,
+        trial = _realise(station, models, bodies, by_robot, again, options, clock, bound, made, previous=best,
                          beat=best.makespan - 1e-6)
         if trial.status == "planned" and trial.makespan < best.makespan - 1e-6:
             best = trial
@@ -206,10 +207,10 @@ def _nearest(station: StationSpec, reaches: Sequence[RobotReach], keys: Sequence
 
 
 def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
-             chosen: Assignment, options: StationOptions, clock: dict[str, float], bound: LowerBound,
+             reaches: Mapping[str, RobotReach], chosen: Assignment, options: StationOptions, clock: dict[str, float], bound: LowerBound,
              made: _Diagrams, previous: StationPlan | None = None, beat: float = np.inf) -> StationPlan:
-    """Plan each robot's spots (a robot whose spots are those it had in `previous` keeps its plan),
-    then coordinate the robots. `beat`: given up (status "infeasible") when a robot's own cycle
+    """Plan each robot's spots (a robot whose spots are those it had in `previous` keeps its plan; the
+    candidates are those its reach found), then coordinate the robots. `beat`: given up (status "infeasible") when a robot's own cycle
     reaches it, the station's makespan then being no shorter."""
     t0 = time.process_time()
     kept: dict[str, RobotPlan] = {}
@@ -230,7 +231,7 @@ def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Map
         spots = chosen.spots.get(name, ())
         cell = robot_view(station, name, spots)
         t1 = time.process_time()
-        result = plan_cell(cell, models[name], options.plan) if spots else None
+        result = plan_cell(cell, models[name], options.plan, known=reaches[name].candidates) if spots else None
         plan = RobotPlan(name, cell, models[name], result)
         log.debug("%s: %d spots planned in %.1f s CPU, own cycle %.2f s (to beat: %.2f s)", name, len(spots),
                   time.process_time() - t1, plan.own_cycle, beat)
