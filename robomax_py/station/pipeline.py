@@ -246,13 +246,27 @@ def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Map
     clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
     t0 = time.process_time()
     timelines = [_timeline(p) for p in plans]
+    clearance = max(r.cell.process.clearance for r in station.robots)
+    pairs, margin = _diagrams(plans, bodies, made, clearance, options.dt)
+    clock["clash maps"] = clock.get("clash maps", 0.0) + time.process_time() - t0
+    t0 = time.process_time()
+    done = coordinate(timelines, pairs, fcfs=options.method == "nearest")
+    clock["coordination"] = clock.get("coordination", 0.0) + time.process_time() - t0
+    status: Literal["planned", "infeasible"] = "infeasible" if done.unresolved else "planned"
+    return StationPlan(station.name, status, done.unresolved or "planned", tuple(plans), chosen, bound, done, clock,
+                       margin=margin)
+
+
+def _diagrams(plans: Sequence[RobotPlan], bodies: Mapping[str, RobotBody], made: _Diagrams, clearance: float,
+              dt: float) -> tuple[list[PairMap], float]:
+    """Every pair's diagram, sampled every dt of each robot's own clock (one made before for the same
+    two plans is taken from `made`), and the largest margin kept between two robots, m."""
     for p in plans:
         if p not in made.motion:
-            poses = body_poses(bodies[p.robot], _samples(p, options.dt))
+            poses = body_poses(bodies[p.robot], _samples(p, dt))
             # Each sample stands for the motion half a step either side of it: the margin there grows
             # by half the farthest any point moves to its neighbours (slow near welds, fast between).
             made.motion[p] = (poses, sample_steps(bodies[p.robot], poses) / 2)
-    clearance = max(r.cell.process.clearance for r in station.robots)
     pairs = []
     margin = 0.0
     for i, pa in enumerate(plans):
@@ -261,16 +275,10 @@ def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Map
             margin = max(margin, clearance + float(half_a.max(initial=0.0)) + float(half_b.max(initial=0.0)))
             if (pa, pb) not in made.pairs:
                 a, b = pa.robot, pb.robot
-                made.pairs[(pa, pb)] = PairMap(a, b, options.dt, clash_map(bodies[a], poses_a, bodies[b], poses_b,
-                                                                           clearance, slack_a=half_a, slack_b=half_b))
+                made.pairs[(pa, pb)] = PairMap(a, b, dt, clash_map(bodies[a], poses_a, bodies[b], poses_b, clearance,
+                                                                   slack_a=half_a, slack_b=half_b))
             pairs.append(made.pairs[(pa, pb)])
-    clock["clash maps"] = clock.get("clash maps", 0.0) + time.process_time() - t0
-    t0 = time.process_time()
-    done = coordinate(timelines, pairs, fcfs=options.method == "nearest")
-    clock["coordination"] = clock.get("coordination", 0.0) + time.process_time() - t0
-    status: Literal["planned", "infeasible"] = "infeasible" if done.unresolved else "planned"
-    return StationPlan(station.name, status, done.unresolved or "planned", tuple(plans), chosen, bound, done, clock,
-                       margin=margin)
+    return pairs, margin
 
 
 def _timeline(p: RobotPlan) -> Timeline:
