@@ -3,10 +3,11 @@ robot against every one of another, each posed by its own joint values, in the s
 
 The pieces are the collision pieces the single-robot checks use (`RobotModel.collision_model`, the
 tool's pieces of `world.scene`), so "collide" means the same here as there. A shortcut culls most
-pairs before coal is asked: spheres around each link over a block of consecutive samples, then
-around each link and each piece at a sample (coal's local AABB radius about its centre, which holds
-the whole piece) - spheres that keep apart cannot hold pieces that touch, so the answer is the exact
-one (tests compare with every pair asked of coal).
+pairs before coal is asked: spheres around each link (a gun: each few of its pieces) over a block of
+consecutive samples, then around each link and each piece at a sample (coal's local AABB radius about its centre, which holds
+the whole piece), then each piece's box (that AABB, placed with the piece) - volumes that keep apart
+cannot hold pieces that touch, so the answer is the exact one (tests compare with every pair asked
+of coal).
 """
 
 from __future__ import annotations
@@ -26,9 +27,11 @@ from robomax_py.world.scene import Scene
 # Consecutive samples bounded together (`clash_map`): larger blocks cull fewer pairs per test,
 # smaller ones need more tests; 16 samples are 0.64 s of motion at the diagrams' 40 ms.
 BLOCK = 16
-# Added to every sphere test's reach, m: the spheres' own arithmetic rounds, and coal's convex
-# distance has a tolerance; a culled pair is then farther apart than any rounding could hide.
-ROUNDING_M = 1e-6
+# Added to every sphere and box test's reach, m: the volumes' own arithmetic rounds, and coal's
+# convex distance has a tolerance; a culled pair is then farther apart than either could hide.
+ALLOWANCE_M = 1e-4
+# Pieces per sphere above the pieces' own (`_clusters`): a link's pieces, a gun's split into a few.
+CLUSTER = 3
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -40,8 +43,9 @@ class RobotBody:
     pieces: tuple[coal.CollisionGeometry, ...]
     parent: tuple[int, ...]
     T_parent_piece: FloatArray      # (p, 4, 4)
-    centre: FloatArray              # (p, 3) sphere centres in each piece's frame, m
+    centre: FloatArray              # (p, 3) sphere and box centres in each piece's frame, m
     radius: FloatArray              # (p,) m
+    half: FloatArray                # (p, 3) box half extents along the piece's axes, m
     T_world_base: FloatArray        # (4, 4)
 
 
@@ -57,13 +61,15 @@ def robot_body(name: str, robot: RobotModel, scene: Scene) -> RobotBody:
         pieces.append(piece)
         parent.append(-1)
         placement.append(np.eye(4))
-    centre, radius = [], []
+    centre, radius, half = [], [], []
     for piece in pieces:
         piece.computeLocalAABB()
         centre.append(np.asarray(piece.aabb_center, dtype=float))
         radius.append(float(piece.aabb_radius))
+        box = piece.aabb_local
+        half.append((np.asarray(box.max_, dtype=float) - np.asarray(box.min_, dtype=float)) / 2)
     return RobotBody(name, robot, tuple(pieces), tuple(parent), np.asarray(placement), np.asarray(centre),
-                     np.asarray(radius), np.asarray(scene.T_world_base, dtype=float))
+                     np.asarray(radius), np.asarray(half), np.asarray(scene.T_world_base, dtype=float))
 
 
 def body_poses(body: RobotBody, qs: FloatArray) -> FloatArray:
@@ -106,16 +112,17 @@ def clash_map(a: RobotBody, poses_a: FloatArray, b: RobotBody, poses_b: FloatArr
             out[i, j] = any(_touch(a.pieces[u], poses_a[i, u], b.pieces[v], poses_b[j, v], request)
                             for u in range(len(a.pieces)) for v in range(len(b.pieces)))
         return out
-    # Per block of `block` consecutive samples and per link, one sphere around that link's spheres
-    # over the block (each grown by its sample's slack); block pairs whose link spheres keep apart
-    # are done, the rest descend to each sample pair's link spheres, then its pieces' spheres
-    # (compiled: `clash_kernels.near_pieces`), and coal decides what is left.
-    ga, gb = _link_index(a), _link_index(b)
+    # Per block of `block` consecutive samples and per cluster of pieces (a link's; the gun's split
+    # in a few), one sphere around that cluster's spheres over the block (each grown by its
+    # sample's slack); block pairs whose cluster spheres keep apart are done, the rest descend to
+    # each sample pair's cluster spheres, then its pieces' spheres and boxes (compiled:
+    # `clash_kernels.near_pieces`), and coal decides what is left.
+    ga, gb = _clusters(a), _clusters(b)
     La, RLa = _groups(ca, a.radius, ga)
     Lb, RLb = _groups(cb, b.radius, gb)
     rows, gaps = near_pieces(block, *_blocks(La, RLa, sa, block), *_blocks(Lb, RLb, sb, block), La, RLa, Lb, RLb,
-                             ca, a.radius, *_members(ga), cb, b.radius, *_members(gb), sa, sb,
-                             margin + ROUNDING_M)
+                             ca, a.radius, *_members(ga), poses_a, a.half, cb, b.radius, *_members(gb), poses_b,
+                             b.half, sa, sb, margin + ALLOWANCE_M)
     if not len(rows):
         return out
     # Per sample pair, the nearest piece pair first: a pair that touches mostly touches there.
@@ -144,7 +151,7 @@ def _blocks(centres: FloatArray, radius: FloatArray, slack: FloatArray, block: i
     R = np.concatenate([radius + slack[:, None], np.repeat(radius[-1:] + slack[-1], pad, axis=0)])
     R = R.reshape(-1, block, radius.shape[1])
     mid = (C.min(axis=1) + C.max(axis=1)) / 2
-    out = (np.linalg.norm(C - mid[:, None], axis=3) + R).max(axis=1) + ROUNDING_M
+    out = (np.linalg.norm(C - mid[:, None], axis=3) + R).max(axis=1) + ALLOWANCE_M
     return mid, out
 
 
@@ -174,10 +181,26 @@ def _sq(d: FloatArray) -> FloatArray:
     return out
 
 
-def _link_index(body: RobotBody) -> np.ndarray:
-    """Each piece's link, numbered 0.. (the tool's pieces one link, the flange's)."""
-    _, index = np.unique(np.asarray(body.parent), return_inverse=True)
-    return index
+def _clusters(body: RobotBody, most: int = CLUSTER) -> np.ndarray:
+    """Each piece's cluster, numbered 0..: the pieces of one link (the tool's: the flange's), split
+    where there are more than `most` at the median of their centres along the axis they spread most
+    on (in the link's frame, where they do not move), until none has more; a gun of many pieces is
+    then several spheres, not one around all of it."""
+    centre = np.einsum("pij,pj->pi", body.T_parent_piece[:, :3, :3], body.centre) + body.T_parent_piece[:, :3, 3]
+    out = np.zeros(len(body.pieces), dtype=np.int64)
+    todo = [np.flatnonzero(np.asarray(body.parent) == p) for p in sorted(set(body.parent))]
+    n = 0
+    while todo:
+        members = todo.pop()
+        if len(members) <= most:
+            out[members] = n
+            n += 1
+            continue
+        pts = centre[members]
+        axis = int(np.argmax(pts.max(axis=0) - pts.min(axis=0)))
+        order = members[np.argsort(pts[:, axis], kind="stable")]
+        todo += [order[:len(order) // 2], order[len(order) // 2:]]
+    return out
 
 
 def _groups(centres: FloatArray, radius: FloatArray, group: np.ndarray) -> tuple[FloatArray, FloatArray]:
