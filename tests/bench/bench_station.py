@@ -125,9 +125,11 @@ def growth(rows: list[dict[str, object]]) -> None:
             print(f"\n{method}, {fixed} {other}: {axis:>6} {'cpu s':>8} {'makespan s':>11}")
             for varied, cpu, span in pts:
                 print(f"{'':>{len(method) + len(str(fixed)) + len(other) + 4}}{varied:>6} {cpu:>8.1f} {span:>11.2f}")
-            if axis == "spots":
-                x, y = np.log([p[0] for p in pts]), np.log([p[1] for p in pts])
-                print(f"  CPU ~ spots^{np.polyfit(x, y, 1)[0]:.2f} (least squares on log-log, {len(pts)} sizes)")
+            planned = [p for p in pts if math.isfinite(p[2])]
+            if axis == "spots" and len(planned) >= 2:
+                x, y = np.log([p[0] for p in planned]), np.log([p[1] for p in planned])
+                print(f"  CPU ~ spots^{np.polyfit(x, y, 1)[0]:.2f} (least squares on log-log over the "
+                      f"{len(planned)} planned sizes)")
 
 
 if __name__ == "__main__":
