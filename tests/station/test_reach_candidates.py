@@ -29,4 +29,5 @@ def test_the_reach_candidates_plan_as_the_planner_own() -> None:
     assert own.trajectory is not None and known.trajectory is not None
     np.testing.assert_array_equal(known.trajectory.q, own.trajectory.q)
     assert [(s.seam, s.name) for s in known.spots] == [(s.seam, s.name) for s in own.spots]
+    assert known.stats is not None and own.stats is not None
     assert known.stats.candidate_checks == 0 < own.stats.candidate_checks   # not found again
