@@ -106,11 +106,13 @@ class StationPlan:
 
 
 @dataclass(frozen=True, slots=True)
-class _Diagrams:
-    """The sampled motions (piece poses, half steps) and pair diagrams made so far in one
-    `plan_station`, by the robot plans they are of: a re-assignment round plans again only the robots
-    whose spots changed, and the diagram of two unchanged plans is the one already made."""
+class _Made:
+    """What one `plan_station` has made so far: each robot's plans by the spots they weld (planning
+    is deterministic, so a robot given spots it was planned for before keeps that plan, in any
+    re-assignment round), and the sampled motions (piece poses, half steps) and pair diagrams by the
+    robot plans they are of (the diagram of two unchanged plans is the one already made)."""
 
+    plans: dict[tuple[str, frozenset[SpotKey]], RobotPlan] = field(default_factory=dict)
     motion: dict[RobotPlan, tuple[FloatArray, FloatArray]] = field(default_factory=dict)
     pairs: dict[tuple[RobotPlan, RobotPlan], PairMap] = field(default_factory=dict)
 
@@ -139,7 +141,7 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         else assign(reaches, keys, groups, prior)
     clock["assignment"] = time.process_time() - t0
     bodies = {r.name: robot_body(r.name, models[r.name], build_scene(r.cell, models[r.name])) for r in station.robots}
-    made = _Diagrams()
+    made = _Made()
     by_robot = {r.robot: r for r in reaches}
     best = _realise(station, models, bodies, by_robot, chosen, options, clock, bound, made)
     if options.method != "full" or best.status != "planned":
@@ -173,7 +175,7 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         assignments.add(seen)
         # The makespan is at least every robot's own cycle: a trial is given up as soon as one of its
         # robots, kept or planned again (longest estimate first), is no shorter than the best makespan.
-        trial = _realise(station, models, bodies, by_robot, again, options, clock, bound, made, previous=best,
+        trial = _realise(station, models, bodies, by_robot, again, options, clock, bound, made,
                          beat=best.makespan - 1e-6)
         if trial.status == "planned" and trial.makespan < best.makespan - 1e-6:
             best = trial
@@ -193,7 +195,7 @@ def _order_candidates(plan: StationPlan, ordered: Sequence[Sequence[SpotKey]]) -
 
 def _with_order(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
                 reaches: Mapping[str, RobotReach], plan: StationPlan, change: OrderChange, options: StationOptions,
-                clock: dict[str, float], bound: LowerBound, made: _Diagrams,
+                clock: dict[str, float], bound: LowerBound, made: _Made,
                 known: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None]) -> StationPlan | None:
     """The station with `change.robot` planned in `change.order` (the published method's given order;
     `known` holds the robots planned so, by order) and coordinated again; None where that robot or
@@ -211,8 +213,10 @@ def _with_order(station: StationSpec, models: Mapping[str, RobotModel], bodies: 
     mine = known[key]
     if mine is None:
         return None
-    trial = _realise(station, models, bodies, reaches, plan.assignment, options, clock, bound, made, previous=plan,
-                     given={change.robot: mine})
+    # The other robots keep the plans of `plan` (with any order change kept before), not only the
+    # plans made for their spots.
+    trial = _realise(station, models, bodies, reaches, plan.assignment, options, clock, bound, made,
+                     given={**{p.robot: p for p in plan.robots}, change.robot: mine})
     return trial if trial.status == "planned" else None
 
 
@@ -262,13 +266,13 @@ def _nearest(station: StationSpec, reaches: Sequence[RobotReach], keys: Sequence
 
 
 def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
-             reaches: Mapping[str, RobotReach], chosen: Assignment, options: StationOptions, clock: dict[str, float],
-             bound: LowerBound, made: _Diagrams, previous: StationPlan | None = None, beat: float = np.inf,
+             reaches: Mapping[str, RobotReach], chosen: Assignment, options: StationOptions,
+             clock: dict[str, float], bound: LowerBound, made: _Made, beat: float = np.inf,
              given: Mapping[str, RobotPlan] | None = None) -> StationPlan:
-    """Plan each robot's spots (`given`: robots planned already; a robot whose spots are those it had
-    in `previous` keeps its plan; the candidates are those its reach found), then coordinate the
-    robots. `beat`: given up (status "infeasible") when a robot's own cycle reaches it, the station's
-    makespan then being no shorter."""
+    """Plan each robot's spots (`given`: robots planned already, kept as they are; a robot given spots
+    it was planned for before keeps that plan; the candidates are those its reach found), then
+    coordinate the robots. `beat`: given up (status "infeasible") when a robot's own cycle reaches
+    it, the station's makespan then being no shorter."""
     t0 = time.process_time()
     kept: dict[str, RobotPlan] = {}
     todo = []
@@ -276,9 +280,8 @@ def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Map
         if given and r.name in given:
             kept[r.name] = given[r.name]
             continue
-        spots = chosen.spots.get(r.name, ())
-        old = None if previous is None else next((p for p in previous.robots if p.robot == r.name), None)
-        if old is not None and set(spots) == {(s.seam, s.name) for s in (old.result.spots if old.result else ())}:
+        old = made.plans.get((r.name, frozenset(chosen.spots.get(r.name, ()))))
+        if old is not None:
             kept[r.name] = old
         else:
             todo.append(r.name)
@@ -301,7 +304,7 @@ def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Map
             clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
             so_far = tuple(p for r in station.robots if (p := kept.get(r.name) or planned.get(r.name)) is not None)
             return StationPlan(station.name, "infeasible", message, so_far, chosen, bound, None, clock)
-        planned[name] = plan
+        planned[name] = made.plans[(name, frozenset(spots))] = plan
     plans = [kept.get(r.name) or planned[r.name] for r in station.robots]
     clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
     t0 = time.process_time()
@@ -317,7 +320,7 @@ def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Map
                        margin=margin)
 
 
-def _diagrams(plans: Sequence[RobotPlan], bodies: Mapping[str, RobotBody], made: _Diagrams, clearance: float,
+def _diagrams(plans: Sequence[RobotPlan], bodies: Mapping[str, RobotBody], made: _Made, clearance: float,
               dt: float) -> tuple[list[PairMap], float]:
     """Every pair's diagram, sampled every dt of each robot's own clock (one made before for the same
     two plans is taken from `made`), and the largest margin kept between two robots, m."""

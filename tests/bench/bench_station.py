@@ -43,8 +43,8 @@ from robomax_py.station.pipeline import StationOptions, plan_station
 from tests.bench.station_cells import station, write
 
 METHODS = ("nearest", "minmax", "full")
-# The growth study: spots 40-300 at 4 robots, robots 2-6 at 120 spots (and 6 robots at 300).
-GROWTH = "4x40,4x80,4x120,4x200,4x300,2x120,6x120,6x300"
+# The growth study: spots 40-300 at 4 robots and 120-300 at 6, robots 2-6 at 120 spots.
+GROWTH = "4x40,4x80,4x120,4x200,4x300,2x120,6x120,6x200,6x300"
 
 
 def run(path: Path, methods: tuple[str, ...]) -> list[dict[str, object]]:

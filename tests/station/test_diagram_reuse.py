@@ -13,7 +13,7 @@ from robomax_py.io.cell import load_cell_robot
 from robomax_py.io.station import load_station
 from robomax_py.station import pipeline
 from robomax_py.station.bodies import clash_map, robot_body
-from robomax_py.station.pipeline import RobotPlan, _Diagrams, _diagrams
+from robomax_py.station.pipeline import RobotPlan, _diagrams, _Made
 from robomax_py.world.scene import build_scene
 
 STATION = Path(__file__).parents[1] / "data" / "station" / "two_robots.yaml"
@@ -37,7 +37,7 @@ def test_a_pair_of_unchanged_plans_keeps_its_diagram(monkeypatch: pytest.MonkeyP
     plans = [RobotPlan(first.name, first.cell, models[first.name], None),
              RobotPlan(second.name, second.cell, models[second.name], None),
              RobotPlan("r3", first.cell, models[first.name], None)]
-    cache = _Diagrams()
+    cache = _Made()
     pairs, margin = _diagrams(plans, bodies, cache, 0.005, 0.04)
     assert len(made) == 3 and [(p.a, p.b) for p in pairs] == [("r1", "r2"), ("r1", "r3"), ("r2", "r3")]
     assert margin == pytest.approx(0.005)             # robots at rest: the clearance alone
