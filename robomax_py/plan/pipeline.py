@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 import time
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -60,12 +60,18 @@ PLAN_VELOCITY_RTOL = TOL.plan_velocity_rtol
 
 def plan_cell(
     cell: CellSpec, robot: RobotModel, options: PlanOptions = PlanOptions(), progress: Progress = _no_progress,
+    known: Mapping[tuple[str, str], SpotCandidates] | None = None,
 ) -> PlanResult:
-    """Plan a cell whose robot (with its tool mounted) is given; `progress` hears of each stage's advance."""
-    return _plan(cell, robot, resolved_options(cell, options), progress)
+    """Plan a cell whose robot (with its tool mounted) is given; `progress` hears of each stage's advance.
+    `known`: candidates already found for spots of this cell (by seam and spot name) against this
+    cell's objects with the same robot, home and process, as `seam_candidates` finds them (a station
+    finds every robot's once for all the spots it may weld); a seam with a spot missing from it, or
+    carrying a load, is found here."""
+    return _plan(cell, robot, resolved_options(cell, options), progress, known or {})
 
 
-def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress: Progress) -> PlanResult:
+def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress: Progress,
+          known: Mapping[tuple[str, str], SpotCandidates]) -> PlanResult:
     check_ik_work(cell, robot)              # before anything large is built
     clock: dict[str, float] = {}
     t0 = time.perf_counter()
@@ -95,6 +101,13 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
     progress("candidates", 0, n_spots)
     loads = Loads.of(cell, robot)
     for s in range(len(cell.seams)):
+        had = [known.get((cell.seams[s].name, spot.name)) for spot in cell.seams[s].spots]
+        if loads is None and not cell.dynamic and all(c is not None for c in had):
+            for j, c in enumerate(had):
+                assert c is not None
+                spots.append(replace(c, seam_index=s, spot_index=j))
+                progress("candidates", next(done), n_spots)
+            continue
         offset = sum(len(seam.spots) for seam in cell.seams[:s])
         line_world = None if loads is None else (lambda j, offset=offset: loads.line_world(offset + j, world))
         found, stats = seam_candidates(cell, robot, world, s,

@@ -3,9 +3,11 @@ robot against every one of another, each posed by its own joint values, in the s
 
 The pieces are the collision pieces the single-robot checks use (`RobotModel.collision_model`, the
 tool's pieces of `world.scene`), so "collide" means the same here as there. A shortcut culls most
-pairs before coal is asked: a sphere around each robot and around each piece (coal's local AABB
-radius about its centre, which holds the whole piece) - spheres that keep apart cannot hold pieces
-that touch, so the answer is the exact one (tests compare with every pair asked of coal).
+pairs before coal is asked: spheres around each link (a gun: each few of its pieces) over a block of
+consecutive samples, then around each link and each piece at a sample (coal's local AABB radius about its centre, which holds
+the whole piece), then each piece's box (that AABB, placed with the piece) - volumes that keep apart
+cannot hold pieces that touch, so the answer is the exact one (tests compare with every pair asked
+of coal).
 """
 
 from __future__ import annotations
@@ -19,10 +21,17 @@ import pinocchio as pin
 
 from robomax_py._typing import BoolArray, FloatArray
 from robomax_py.robot import RobotModel
+from robomax_py.station.clash_kernels import near_pieces
 from robomax_py.world.scene import Scene
 
-# Pairs of samples handed to the piece-level sphere test at once (memory: chunk x pieces^2 floats).
-CHUNK = 2048
+# Consecutive samples bounded together (`clash_map`): larger blocks cull fewer pairs per test,
+# smaller ones need more tests; 16 samples are 0.64 s of motion at the diagrams' 40 ms.
+BLOCK = 16
+# Added to every sphere and box test's reach, m: the volumes' own arithmetic rounds, and coal's
+# convex distance has a tolerance; a culled pair is then farther apart than either could hide.
+ALLOWANCE_M = 1e-4
+# Pieces per sphere above the pieces' own (`_clusters`): a link's pieces, a gun's split into a few.
+CLUSTER = 3
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -34,8 +43,9 @@ class RobotBody:
     pieces: tuple[coal.CollisionGeometry, ...]
     parent: tuple[int, ...]
     T_parent_piece: FloatArray      # (p, 4, 4)
-    centre: FloatArray              # (p, 3) sphere centres in each piece's frame, m
+    centre: FloatArray              # (p, 3) sphere and box centres in each piece's frame, m
     radius: FloatArray              # (p,) m
+    half: FloatArray                # (p, 3) box half extents along the piece's axes, m
     T_world_base: FloatArray        # (4, 4)
 
 
@@ -51,13 +61,15 @@ def robot_body(name: str, robot: RobotModel, scene: Scene) -> RobotBody:
         pieces.append(piece)
         parent.append(-1)
         placement.append(np.eye(4))
-    centre, radius = [], []
+    centre, radius, half = [], [], []
     for piece in pieces:
         piece.computeLocalAABB()
         centre.append(np.asarray(piece.aabb_center, dtype=float))
         radius.append(float(piece.aabb_radius))
+        box = piece.aabb_local
+        half.append((np.asarray(box.max_, dtype=float) - np.asarray(box.min_, dtype=float)) / 2)
     return RobotBody(name, robot, tuple(pieces), tuple(parent), np.asarray(placement), np.asarray(centre),
-                     np.asarray(radius), np.asarray(scene.T_world_base, dtype=float))
+                     np.asarray(radius), np.asarray(half), np.asarray(scene.T_world_base, dtype=float))
 
 
 def body_poses(body: RobotBody, qs: FloatArray) -> FloatArray:
@@ -81,12 +93,12 @@ def _spheres(body: RobotBody, poses: FloatArray) -> FloatArray:
 
 
 def clash_map(a: RobotBody, poses_a: FloatArray, b: RobotBody, poses_b: FloatArray, margin: float,
-              prefilter: bool = True, slack_a: FloatArray | None = None, slack_b: FloatArray | None = None
-              ) -> BoolArray:
+              prefilter: bool = True, slack_a: FloatArray | None = None, slack_b: FloatArray | None = None,
+              block: int = BLOCK) -> BoolArray:
     """(ka, kb) bool: True where robot a at sample i and robot b at sample j come closer than
     `margin + slack_a[i] + slack_b[j]` (m; slacks default 0) - any piece of one within that of any
     piece of the other. `prefilter=False` asks coal of every pair (the slow reference the tests
-    hold the shortcut to)."""
+    hold the shortcut to); `block`: samples bounded together by the shortcut."""
     ka, kb = len(poses_a), len(poses_b)
     sa = np.zeros(ka) if slack_a is None else np.asarray(slack_a, dtype=float)
     sb = np.zeros(kb) if slack_b is None else np.asarray(slack_b, dtype=float)
@@ -100,46 +112,54 @@ def clash_map(a: RobotBody, poses_a: FloatArray, b: RobotBody, poses_b: FloatArr
             out[i, j] = any(_touch(a.pieces[u], poses_a[i, u], b.pieces[v], poses_b[j, v], request)
                             for u in range(len(a.pieces)) for v in range(len(b.pieces)))
         return out
-    # Whole-robot spheres first (most sample pairs of robots apart end here), then one sphere per
-    # link (its pieces' spheres inside it), then the pieces' own spheres, then coal.
-    Ca, Ra = _groups(ca, a.radius, np.zeros(len(a.pieces), dtype=int))
-    Cb, Rb = _groups(cb, b.radius, np.zeros(len(b.pieces), dtype=int))
-    ga, gb = _link_index(a), _link_index(b)
+    # Per block of `block` consecutive samples and per cluster of pieces (a link's; the gun's split
+    # in a few), one sphere around that cluster's spheres over the block (each grown by its
+    # sample's slack); block pairs whose cluster spheres keep apart are done, the rest descend to
+    # each sample pair's cluster spheres, then its pieces' spheres and boxes (compiled:
+    # `clash_kernels.near_pieces`), and coal decides what is left.
+    ga, gb = _clusters(a), _clusters(b)
     La, RLa = _groups(ca, a.radius, ga)
     Lb, RLb = _groups(cb, b.radius, gb)
+    rows, gaps = near_pieces(block, *_blocks(La, RLa, sa, block), *_blocks(Lb, RLb, sb, block), La, RLa, Lb, RLb,
+                             ca, a.radius, *_members(ga), poses_a, a.half, cb, b.radius, *_members(gb), poses_b,
+                             b.half, sa, sb, margin + ALLOWANCE_M)
+    if not len(rows):
+        return out
+    # Per sample pair, the nearest piece pair first: a pair that touches mostly touches there.
+    order = np.lexsort((gaps, rows[:, 1], rows[:, 0]))
+    rows = rows[order]
+    bounds = np.flatnonzero(np.any(np.diff(rows[:, :2], axis=0) != 0, axis=1)) + 1
     tf_a, tf_b = _transforms(poses_a), _transforms(poses_b)
-    rows = max(1, (1 << 22) // max(kb, 1))
-    pairs = np.concatenate([np.argwhere(_sq(Ca[r:r + rows, None, 0] - Cb[None, :, 0])
-                                        < (Ra[r:r + rows, None, 0] + Rb[None, :, 0] + margin + sa[r:r + rows, None]
-                                           + sb[None, :]) ** 2) + [r, 0]
-                            for r in range(0, ka, rows)] or [np.zeros((0, 2), dtype=int)])
-    for start in range(0, len(pairs), CHUNK):
-        chunk = pairs[start:start + CHUNK]
-        m = (margin + sa[chunk[:, 0]] + sb[chunk[:, 1]])[:, None, None]
-        links = _sq(La[chunk[:, 0], :, None] - Lb[chunk[:, 1], None, :]) \
-            < (RLa[chunk[:, 0], :, None] + RLb[chunk[:, 1], None, :] + m) ** 2
-        keep = links.any(axis=(1, 2))
-        chunk, links, m = chunk[keep], links[keep], m[keep]
-        if not len(chunk):
-            continue
-        d2 = _sq(ca[chunk[:, 0], :, None] - cb[chunk[:, 1], None, :])
-        reach = (a.radius[None, :, None] + b.radius[None, None, :] + m)
-        close = (d2 < reach ** 2) & links[:, ga][:, :, gb]
-        k, pa, pb = np.nonzero(close)
-        if not len(k):
-            continue
-        order = np.lexsort((d2[k, pa, pb] - reach[k, pa, pb] ** 2, k))   # per sample pair, the nearest first
-        k, pa, pb = k[order], pa[order], pb[order]
-        bounds = np.flatnonzero(np.diff(k)) + 1
-        for first, stop in zip(np.r_[0, bounds].tolist(), np.r_[bounds, len(k)].tolist(), strict=True):
-            i, j = chunk[k[first]].tolist()
-            request.security_margin = float(m[k[first], 0, 0])
-            for u, v in zip(pa[first:stop].tolist(), pb[first:stop].tolist(), strict=True):
-                result = coal.CollisionResult()
-                if coal.collide(a.pieces[u], tf_a(i, u), b.pieces[v], tf_b(j, v), request, result):
-                    out[i, j] = True
-                    break
+    for first, stop in zip(np.r_[0, bounds].tolist(), np.r_[bounds, len(rows)].tolist(), strict=True):
+        i, j = rows[first, :2].tolist()
+        request.security_margin = margin + sa[i] + sb[j]
+        for u, v in rows[first:stop, 2:].tolist():
+            result = coal.CollisionResult()
+            if coal.collide(a.pieces[u], tf_a(i, u), b.pieces[v], tf_b(j, v), request, result):
+                out[i, j] = True
+                break
     return out
+
+
+def _blocks(centres: FloatArray, radius: FloatArray, slack: FloatArray, block: int
+            ) -> tuple[FloatArray, FloatArray]:
+    """Per block of `block` samples, a sphere around each group's spheres over the block, each grown
+    by its sample's slack (and the rounding allowance): centres (nb, g, 3), radii (nb, g)."""
+    k = len(centres)
+    pad = -k % block
+    C = np.concatenate([centres, np.repeat(centres[-1:], pad, axis=0)]).reshape(-1, block, *centres.shape[1:])
+    R = np.concatenate([radius + slack[:, None], np.repeat(radius[-1:] + slack[-1], pad, axis=0)])
+    R = R.reshape(-1, block, radius.shape[1])
+    mid = (C.min(axis=1) + C.max(axis=1)) / 2
+    out = (np.linalg.norm(C - mid[:, None], axis=3) + R).max(axis=1) + ALLOWANCE_M
+    return mid, out
+
+
+def _members(group: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The pieces of each group: group g's are members[start[g]:start[g + 1]]."""
+    members = np.argsort(group, kind="stable")
+    start = np.r_[0, np.cumsum(np.bincount(group))]
+    return start.astype(np.int64), members.astype(np.int64)
 
 
 def _transforms(poses: FloatArray) -> Callable[[int, int], coal.Transform3s]:
@@ -161,10 +181,26 @@ def _sq(d: FloatArray) -> FloatArray:
     return out
 
 
-def _link_index(body: RobotBody) -> np.ndarray:
-    """Each piece's link, numbered 0.. (the tool's pieces one link, the flange's)."""
-    _, index = np.unique(np.asarray(body.parent), return_inverse=True)
-    return index
+def _clusters(body: RobotBody, most: int = CLUSTER) -> np.ndarray:
+    """Each piece's cluster, numbered 0..: the pieces of one link (the tool's: the flange's), split
+    where there are more than `most` at the median of their centres along the axis they spread most
+    on (in the link's frame, where they do not move), until none has more; a gun of many pieces is
+    then several spheres, not one around all of it."""
+    centre = np.einsum("pij,pj->pi", body.T_parent_piece[:, :3, :3], body.centre) + body.T_parent_piece[:, :3, 3]
+    out = np.zeros(len(body.pieces), dtype=np.int64)
+    todo = [np.flatnonzero(np.asarray(body.parent) == p) for p in sorted(set(body.parent))]
+    n = 0
+    while todo:
+        members = todo.pop()
+        if len(members) <= most:
+            out[members] = n
+            n += 1
+            continue
+        pts = centre[members]
+        axis = int(np.argmax(pts.max(axis=0) - pts.min(axis=0)))
+        order = members[np.argsort(pts[:, axis], kind="stable")]
+        todo += [order[:len(order) // 2], order[len(order) // 2:]]
+    return out
 
 
 def _groups(centres: FloatArray, radius: FloatArray, group: np.ndarray) -> tuple[FloatArray, FloatArray]:

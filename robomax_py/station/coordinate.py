@@ -91,19 +91,29 @@ class Coordination:
 
 def simulate(timelines: Sequence[Timeline], interlocks: Sequence[Interlock]) -> Schedule:
     """The shared clock under the interlocks: each wait as long as its leader's signal requires
-    (a signal is set on arriving at its point, before any wait there), found as the least fixed point."""
+    (a signal is set on arriving at its point, before any wait there), as the programs run.
+
+    Each wait point's wait is computed again from the others until none changes: a wait depends
+    only on the waiter's earlier waits and the leader's waits before its signal, so without a
+    deadlock this settles within one sweep per wait point; a wait made shorter by an earlier one
+    (the robot already held there long enough) is made shorter, not kept. With a deadlock the waits
+    grow every sweep."""
     waits: dict[str, dict[float, float]] = {t.robot: {} for t in timelines}
     ends = {t.robot: t.end for t in timelines}
+    points: dict[tuple[str, float], list[Interlock]] = {}
+    for lock in interlocks:
+        points.setdefault((lock.waiter, lock.wait_at), []).append(lock)
 
     def arrive(robot: str, own: float) -> float:
         return own + sum(w for at, w in waits[robot].items() if at < own - TIME_EPS)
 
-    for _ in range(len(interlocks) + 2):
+    for _ in range(len(points) + 2):
         changed = False
-        for lock in interlocks:
-            need = max(0.0, arrive(lock.leader, lock.signal_at) - arrive(lock.waiter, lock.wait_at))
-            if need > waits[lock.waiter].get(lock.wait_at, 0.0) + TIME_EPS:
-                waits[lock.waiter][lock.wait_at] = need
+        for (waiter, at), locks in points.items():
+            reach = arrive(waiter, at)
+            need = max(0.0, *(arrive(lock.leader, lock.signal_at) - reach for lock in locks))
+            if abs(need - waits[waiter].get(at, 0.0)) > TIME_EPS:
+                waits[waiter][at] = need
                 changed = True
         if not changed:
             finish = {r: ends[r] + sum(waits[r].values()) for r in ends}

@@ -2,22 +2,24 @@
 
 Stages: what each robot can weld (`reach`), a min-max assignment of spots to robots (`assign`), each
 robot's spots planned by the single-robot planner (`plan.plan_cell` on the robot's cell narrowed
-to its spots), robot-robot collisions on the shared clock found (`bodies`) and ordered by interlocks
-(`coordinate`); where the robot that ends last waits, another spot order (`reorder`) kept when the
-makespan shortens; and, where the waits cost more than a different assignment, the assignment
-searched again with the waits as costs and kept when the makespan shortens.
+to its spots, with the candidates `reach` found), robot-robot collisions on the shared clock found
+(`bodies`) and ordered by interlocks (`coordinate`); where the robot that ends last waits, another spot
+order (`reorder`) kept when the makespan shortens; and, where the waits cost more than a different
+assignment, the assignment searched again with the waits as costs and kept when the makespan shortens.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import logging
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
 
+from robomax_py._typing import FloatArray
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
@@ -37,6 +39,8 @@ from robomax_py.station.reorder import OrderChange, improve_orders, ordered_view
 from robomax_py.station.reorder import candidates as order_candidates
 from robomax_py.timing.trajectory import evaluate
 from robomax_py.world.scene import build_scene
+
+log = logging.getLogger(__name__)
 
 Method = Literal["full", "minmax", "nearest"]
 # Own-clock step of the coordination diagrams, s; the margin kept between robots grows with the
@@ -101,6 +105,18 @@ class StationPlan:
         return np.inf if self.coordination is None else self.coordination.schedule.makespan
 
 
+@dataclass(frozen=True, slots=True)
+class _Made:
+    """What one `plan_station` has made so far: each robot's plans by the spots they weld (planning
+    is deterministic, so a robot given spots it was planned for before keeps that plan, in any
+    re-assignment round), and the sampled motions (piece poses, half steps) and pair diagrams by the
+    robot plans they are of (the diagram of two unchanged plans is the one already made)."""
+
+    plans: dict[tuple[str, frozenset[SpotKey]], RobotPlan] = field(default_factory=dict)
+    motion: dict[RobotPlan, tuple[FloatArray, FloatArray]] = field(default_factory=dict)
+    pairs: dict[tuple[RobotPlan, RobotPlan], PairMap] = field(default_factory=dict)
+
+
 def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
                  options: StationOptions = StationOptions()) -> StationPlan:
     """Plan every robot of a station; `models[name]` is each robot's model with its tool mounted."""
@@ -125,7 +141,9 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         else assign(reaches, keys, groups, prior)
     clock["assignment"] = time.process_time() - t0
     bodies = {r.name: robot_body(r.name, models[r.name], build_scene(r.cell, models[r.name])) for r in station.robots}
-    best = _realise(station, models, bodies, chosen, options, clock, bound)
+    made = _Made()
+    by_robot = {r.robot: r for r in reaches}
+    best = _realise(station, models, bodies, by_robot, chosen, options, clock, bound, made)
     if options.method != "full" or best.status != "planned":
         return best
     # Another spot order instead of waiting, where the robot that ends last waits; before the
@@ -135,9 +153,11 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     robot_plans: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None] = {}
     best, tried, kept = improve_orders(
         best, lambda p: p.makespan, _orders, lambda p: _order_candidates(p, ordered),
-        lambda p, change: _with_order(station, models, bodies, p, change, options, clock, bound, robot_plans))
+        lambda p, change: _with_order(station, models, bodies, by_robot, p, change, options, clock, bound, made,
+                                      robot_plans))
     penalty: dict[tuple[str, SpotKey], float] = dict(prior)
     rounds = 0
+    assignments = {_frozen(chosen)}
     for _ in range(REASSIGN_ROUNDS):
         assert best.coordination is not None
         if not best.coordination.interlocks or best.coordination.schedule.makespan <= 0:
@@ -149,7 +169,14 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         if dict(again.spots) == dict(best.assignment.spots):
             break
         rounds += 1
-        trial = _realise(station, models, bodies, again, options, clock, bound, previous=best)
+        seen = _frozen(again)
+        if seen in assignments:      # planned before and not kept: the same plans again
+            continue
+        assignments.add(seen)
+        # The makespan is at least every robot's own cycle: a trial is given up as soon as one of its
+        # robots, kept or planned again (longest estimate first), is no shorter than the best makespan.
+        trial = _realise(station, models, bodies, by_robot, again, options, clock, bound, made,
+                         beat=best.makespan - 1e-6)
         if trial.status == "planned" and trial.makespan < best.makespan - 1e-6:
             best = trial
     return dataclasses.replace(best, seconds=clock, rounds=rounds, orders_tried=tried, order_changes=tuple(kept))
@@ -167,8 +194,9 @@ def _order_candidates(plan: StationPlan, ordered: Sequence[Sequence[SpotKey]]) -
 
 
 def _with_order(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
-                plan: StationPlan, change: OrderChange, options: StationOptions, clock: dict[str, float],
-                bound: LowerBound, known: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None]) -> StationPlan | None:
+                reaches: Mapping[str, RobotReach], plan: StationPlan, change: OrderChange, options: StationOptions,
+                clock: dict[str, float], bound: LowerBound, made: _Made,
+                known: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None]) -> StationPlan | None:
     """The station with `change.robot` planned in `change.order` (the published method's given order;
     `known` holds the robots planned so, by order) and coordinated again; None where that robot or
     the station does not plan."""
@@ -185,9 +213,16 @@ def _with_order(station: StationSpec, models: Mapping[str, RobotModel], bodies: 
     mine = known[key]
     if mine is None:
         return None
-    trial = _realise(station, models, bodies, plan.assignment, options, clock, bound, previous=plan,
-                     given={change.robot: mine})
+    # The other robots keep the plans of `plan` (with any order change kept before), not only the
+    # plans made for their spots.
+    trial = _realise(station, models, bodies, reaches, plan.assignment, options, clock, bound, made,
+                     given={**{p.robot: p for p in plan.robots}, change.robot: mine})
     return trial if trial.status == "planned" else None
+
+
+def _frozen(chosen: Assignment) -> frozenset[tuple[str, frozenset[SpotKey]]]:
+    """An assignment as which robot welds which spots (its order aside)."""
+    return frozenset((r, frozenset(spots)) for r, spots in chosen.spots.items())
 
 
 def _side_prior(station: StationSpec, reaches: Sequence[RobotReach]) -> dict[tuple[str, SpotKey], float]:
@@ -231,46 +266,51 @@ def _nearest(station: StationSpec, reaches: Sequence[RobotReach], keys: Sequence
 
 
 def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
-             chosen: Assignment, options: StationOptions, clock: dict[str, float], bound: LowerBound,
-             previous: StationPlan | None = None, given: Mapping[str, RobotPlan] | None = None) -> StationPlan:
-    """Plan each robot's spots (`given`: robots planned already), then coordinate the robots."""
+             reaches: Mapping[str, RobotReach], chosen: Assignment, options: StationOptions,
+             clock: dict[str, float], bound: LowerBound, made: _Made, beat: float = np.inf,
+             given: Mapping[str, RobotPlan] | None = None) -> StationPlan:
+    """Plan each robot's spots (`given`: robots planned already, kept as they are; a robot given spots
+    it was planned for before keeps that plan; the candidates are those its reach found), then
+    coordinate the robots. `beat`: given up (status "infeasible") when a robot's own cycle reaches
+    it, the station's makespan then being no shorter."""
     t0 = time.process_time()
-    plans: list[RobotPlan] = []
+    kept: dict[str, RobotPlan] = {}
+    todo = []
     for r in station.robots:
         if given and r.name in given:
-            plans.append(given[r.name])
+            kept[r.name] = given[r.name]
             continue
-        spots = chosen.spots.get(r.name, ())
-        old = None if previous is None else next((p for p in previous.robots if p.robot == r.name), None)
-        if old is not None and set(spots) == {(s.seam, s.name) for s in (old.result.spots if old.result else ())}:
-            plans.append(old)
-            continue
-        cell = robot_view(station, r.name, spots)
-        result = plan_cell(cell, models[r.name], options.plan) if spots else None
-        if result is not None and result.status != "planned":
+        old = made.plans.get((r.name, frozenset(chosen.spots.get(r.name, ()))))
+        if old is not None:
+            kept[r.name] = old
+        else:
+            todo.append(r.name)
+    planned: dict[str, RobotPlan] = {}
+    longest = max(kept.values(), key=lambda p: p.own_cycle, default=None)
+    if longest is not None and longest.own_cycle >= beat:
+        return StationPlan(station.name, "infeasible", f"{longest.robot}'s own cycle {longest.own_cycle:.2f} s, kept, "
+                           f"is no shorter than {beat:.2f} s", tuple(kept.values()), chosen, bound, None, clock)
+    for name in todo if beat == np.inf else sorted(todo, key=lambda n: -chosen.estimate.get(n, 0.0)):
+        spots = chosen.spots.get(name, ())
+        cell = robot_view(station, name, spots)
+        t1 = time.process_time()
+        result = plan_cell(cell, models[name], options.plan, known=reaches[name].candidates) if spots else None
+        plan = RobotPlan(name, cell, models[name], result)
+        log.debug("%s: %d spots planned in %.1f s CPU, own cycle %.2f s (to beat: %.2f s)", name, len(spots),
+                  time.process_time() - t1, plan.own_cycle, beat)
+        message = f"{name}: {result.message}" if result is not None and result.status != "planned" else \
+            f"{name}'s own cycle {plan.own_cycle:.2f} s is no shorter than {beat:.2f} s" if plan.own_cycle >= beat else ""
+        if message:
             clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
-            return StationPlan(station.name, "infeasible", f"{r.name}: {result.message}", tuple(plans), chosen, bound,
-                               None, clock)
-        plans.append(RobotPlan(r.name, cell, models[r.name], result))
+            so_far = tuple(p for r in station.robots if (p := kept.get(r.name) or planned.get(r.name)) is not None)
+            return StationPlan(station.name, "infeasible", message, so_far, chosen, bound, None, clock)
+        planned[name] = made.plans[(name, frozenset(spots))] = plan
+    plans = [kept.get(r.name) or planned[r.name] for r in station.robots]
     clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
     t0 = time.process_time()
-    timelines, samples = [], {}
-    for p in plans:
-        timelines.append(_timeline(p))
-        samples[p.robot] = _samples(p, options.dt)
-    poses = {name: body_poses(bodies[name], qs) for name, qs in samples.items()}
-    # Each sample stands for the motion half a step either side of it: the margin there grows by
-    # half the farthest any point moves to its neighbours (slow near welds, fast between).
-    halves = {name: sample_steps(bodies[name], poses[name]) / 2 for name in poses}
+    timelines = [_timeline(p) for p in plans]
     clearance = max(r.cell.process.clearance for r in station.robots)
-    pairs = []
-    margin = 0.0
-    names = [p.robot for p in plans]
-    for i, a in enumerate(names):
-        for b in names[i + 1:]:
-            margin = max(margin, clearance + float(halves[a].max(initial=0.0)) + float(halves[b].max(initial=0.0)))
-            pairs.append(PairMap(a, b, options.dt, clash_map(bodies[a], poses[a], bodies[b], poses[b], clearance,
-                                                             slack_a=halves[a], slack_b=halves[b])))
+    pairs, margin = _diagrams(plans, bodies, made, clearance, options.dt)
     clock["clash maps"] = clock.get("clash maps", 0.0) + time.process_time() - t0
     t0 = time.process_time()
     done = coordinate(timelines, pairs, fcfs=options.method == "nearest")
@@ -278,6 +318,30 @@ def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Map
     status: Literal["planned", "infeasible"] = "infeasible" if done.unresolved else "planned"
     return StationPlan(station.name, status, done.unresolved or "planned", tuple(plans), chosen, bound, done, clock,
                        margin=margin)
+
+
+def _diagrams(plans: Sequence[RobotPlan], bodies: Mapping[str, RobotBody], made: _Made, clearance: float,
+              dt: float) -> tuple[list[PairMap], float]:
+    """Every pair's diagram, sampled every dt of each robot's own clock (one made before for the same
+    two plans is taken from `made`), and the largest margin kept between two robots, m."""
+    for p in plans:
+        if p not in made.motion:
+            poses = body_poses(bodies[p.robot], _samples(p, dt))
+            # Each sample stands for the motion half a step either side of it: the margin there grows
+            # by half the farthest any point moves to its neighbours (slow near welds, fast between).
+            made.motion[p] = (poses, sample_steps(bodies[p.robot], poses) / 2)
+    pairs = []
+    margin = 0.0
+    for i, pa in enumerate(plans):
+        for pb in plans[i + 1:]:
+            (poses_a, half_a), (poses_b, half_b) = made.motion[pa], made.motion[pb]
+            margin = max(margin, clearance + float(half_a.max(initial=0.0)) + float(half_b.max(initial=0.0)))
+            if (pa, pb) not in made.pairs:
+                a, b = pa.robot, pb.robot
+                made.pairs[(pa, pb)] = PairMap(a, b, dt, clash_map(bodies[a], poses_a, bodies[b], poses_b, clearance,
+                                                                   slack_a=half_a, slack_b=half_b))
+            pairs.append(made.pairs[(pa, pb)])
+    return pairs, margin
 
 
 def _timeline(p: RobotPlan) -> Timeline:

@@ -5,12 +5,13 @@ candidate's weld and approach configuration (and their box) for the lower bound.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
 from robomax_py._typing import FloatArray
-from robomax_py.plan.candidates import seam_candidates
+from robomax_py.plan.candidates import SpotCandidates, seam_candidates
 from robomax_py.plan.reach import reach_report
 from robomax_py.robot import RobotModel
 from robomax_py.spec_station import SpotKey, StationSpec, robot_view
@@ -35,6 +36,7 @@ class RobotReach:
     home : (n,) rad. velocity, acceleration : (n,) joint limits.
     dwell : (len(keys),) s, the weld time of each spot.
     line_s : s per approach or retract line (at the planner's TCP speed), for the estimate only.
+    candidates : each key's candidates, as the single-robot planner finds them (`plan_cell(known=)`).
     """
 
     robot: str
@@ -48,6 +50,7 @@ class RobotReach:
     acceleration: FloatArray
     dwell: FloatArray
     line_s: float
+    candidates: Mapping[SpotKey, SpotCandidates]
     weld_q: tuple[FloatArray, ...] = ()
     app_q: tuple[FloatArray, ...] = ()
 
@@ -66,6 +69,7 @@ def robot_reach(station: StationSpec, name: str, model: RobotModel) -> RobotReac
     keys: list[SpotKey] = []
     unreachable: list[SpotKey] = [k for k in allowed if k in far]
     reps, lo, hi, dwell, weld_q, app_q = [], [], [], [], [], []
+    candidates: dict[SpotKey, SpotCandidates] = {}
     for s, seam in enumerate(cell.seams):
         found, _ = seam_candidates(cell, model, world, s)
         for c in found:
@@ -74,6 +78,7 @@ def robot_reach(station: StationSpec, name: str, model: RobotModel) -> RobotReac
                 unreachable.append(key)
                 continue
             keys.append(key)
+            candidates[key] = c
             reps.append(_representatives(c.q_app, home))
             lo.append(c.q_spot.min(axis=0))
             hi.append(c.q_spot.max(axis=0))
@@ -86,7 +91,7 @@ def robot_reach(station: StationSpec, name: str, model: RobotModel) -> RobotReac
                       np.asarray(reps).reshape(len(keys), REPRESENTATIVES, n),
                       np.asarray(lo).reshape(len(keys), n), np.asarray(hi).reshape(len(keys), n), home,
                       np.asarray(model.limits.velocity, dtype=float), np.asarray(model.limits.acceleration, dtype=float),
-                      np.asarray(dwell, dtype=float), float(line_s), tuple(weld_q), tuple(app_q))
+                      np.asarray(dwell, dtype=float), float(line_s), candidates, tuple(weld_q), tuple(app_q))
 
 
 def _representatives(q: FloatArray, home: FloatArray) -> FloatArray:

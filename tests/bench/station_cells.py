@@ -7,7 +7,7 @@ light gun), each station a valid station file.
 
     python tests/bench/station_cells.py OUT_DIR [--robots 4] [--spots 120] [--seed 0] [--count 1]
 
-The shipped example: `--robots 4 --spots 48 --arms kr125,kr125,ur10,ur10 --name side_frame`.
+The shipped example: `--robots 4 --spots 120 --arms kr125,kr125,ur10,ur10 --name side_frame`.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ ARMS: dict[str, dict[str, Any]] = {
     "kr16": {"tool": "spot_gun_light", "reach": 1.0, "z": 0.2, "home": [0, -110, 110, 0, 50, 0],
              "io": ([101, 116], [101, 116]), "clamps": 11},
     "ur10": {"tool": "spot_gun_light", "reach": 0.45, "z": 0.6, "home": [0, -90, 90, -90, -90, 0],
-             "io": ([4, 7], [4, 7]), "clamps": 0},
+             "io": ([2, 7], [0, 7]), "clamps": 0},
 }
 PREFIX = {"front": "f", "right": "r", "rear": "b", "left": "l"}   # spot names: f1, r1, b1, l1, ...
 RIM_Z = 0.75            # m, the sheet's top

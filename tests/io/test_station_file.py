@@ -125,4 +125,4 @@ def test_shipped_station_is_valid() -> None:
     shipped = Path(__file__).parents[2] / "cells" / "stations" / "side_frame.yaml"
     done = CliRunner().invoke(app, ["check", str(shipped)])
     assert done.exit_code == 0, done.output
-    assert "4 robots, 40 spots" in done.output
+    assert "4 robots, 120 spots" in done.output

@@ -33,7 +33,7 @@ def _reach(rng: np.random.Generator, spots: int, per_spot: int, name: str = "r")
     return RobotReach(name, tuple(("s", f"p{i}") for i in range(spots)), (),
                       np.repeat(np.stack([q[:1] for q in qs]), REPRESENTATIVES, axis=1),
                       np.stack([q.min(axis=0) for q in qs]), np.stack([q.max(axis=0) for q in qs]),
-                      np.zeros(N), VELOCITY, ACCELERATION, np.full(spots, DWELL), 0.0, tuple(qs), tuple(qs))
+                      np.zeros(N), VELOCITY, ACCELERATION, np.full(spots, DWELL), 0.0, {}, tuple(qs), tuple(qs))
 
 
 @settings(max_examples=30, deadline=None, derandomize=True)

@@ -78,3 +78,20 @@ def test_a_wait_implied_by_a_later_signal_is_dropped() -> None:
     assert not done.unresolved
     assert len([x for x in done.interlocks if x.waiter == "b" and x.wait_at == 0.0]) <= 1
     assert _first_clash([PairMap("a", "b", DT, clash)], done.schedule) is None
+
+
+def test_a_wait_already_held_long_enough_by_an_earlier_one_is_no_wait() -> None:
+    """b waits at 1 s for a's signal at 6 s, and at 2 s for a's signal at 4 s: held at 1 s until a's
+    6 s, b reaches its 2 s point at 7 s, after a's 4 s signal, and waits no more there (as the
+    programs run: the signal is long set)."""
+    lines = [_timeline("a", 10.0, [4.0, 6.0]), _timeline("b", 10.0, [1.0, 2.0])]
+
+    def lock(signal_at: float, wait_at: float) -> Interlock:
+        return Interlock(("a", "b"), (0, 0), "a", "b", signal_at, wait_at, (0.0, signal_at), (wait_at, wait_at + 1))
+
+    schedule = simulate(lines, [lock(4.0, 2.0), lock(6.0, 1.0)])
+    assert not schedule.deadlock
+    assert len(schedule.waits["b"]) == 1                 # none at 2 s
+    at, waited = schedule.waits["b"][0]
+    assert at == 1.0 and waited == pytest.approx(5.0)
+    assert schedule.ends["b"] == pytest.approx(15.0) and schedule.makespan == pytest.approx(15.0)
