@@ -15,6 +15,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from robomax_py.world.prefilter_kernels import separated
+
 
 @njit(cache=True, nogil=True)
 def _grow(buf: Any, n: int) -> Any:
@@ -26,37 +28,16 @@ def _grow(buf: Any, n: int) -> Any:
 
 @njit(cache=True, nogil=True)
 def _boxes_apart(Ta: Any, ca: Any, ha: Any, Tb: Any, cb: Any, hb: Any, margin: float) -> bool:
-    """Whether two boxes are farther apart than `margin`: a separating axis (the 15 of the
-    separating-axis test for boxes, Gottschalk et al., SIGGRAPH 1996; Ericson, Real-Time Collision
-    Detection 4.4.1) along which the gap exceeds it. Ta, Tb: (4, 4) poses whose rotation columns are
-    the boxes' axes; ca, cb: (3,) box centres in the world; ha, hb: (3,) half extents, m."""
+    """Whether two boxes are farther apart than `margin` along a separating axis
+    (`world.prefilter_kernels.separated`). Ta, Tb: (4, 4) poses whose rotation columns are the boxes'
+    axes; ca, cb: (3,) box centres in the world; ha, hb: (3,) half extents, m."""
     R = np.empty((3, 3))
-    absR = np.empty((3, 3))
     t = np.empty(3)
     for i in range(3):
         t[i] = (cb[0] - ca[0]) * Ta[0, i] + (cb[1] - ca[1]) * Ta[1, i] + (cb[2] - ca[2]) * Ta[2, i]
         for j in range(3):
             R[i, j] = Ta[0, i] * Tb[0, j] + Ta[1, i] * Tb[1, j] + Ta[2, i] * Tb[2, j]
-            absR[i, j] = abs(R[i, j]) + 1e-9       # near-parallel axes: the cross axes stay conservative
-    for i in range(3):                                # a's axes
-        if abs(t[i]) > ha[i] + hb[0] * absR[i, 0] + hb[1] * absR[i, 1] + hb[2] * absR[i, 2] + margin:
-            return True
-    for j in range(3):                                # b's axes
-        tj = t[0] * R[0, j] + t[1] * R[1, j] + t[2] * R[2, j]
-        if abs(tj) > ha[0] * absR[0, j] + ha[1] * absR[1, j] + ha[2] * absR[2, j] + hb[j] + margin:
-            return True
-    for i in range(3):                                # a's axis i x b's axis j, not normalised
-        i1, i2 = (i + 1) % 3, (i + 2) % 3
-        for j in range(3):
-            j1, j2 = (j + 1) % 3, (j + 2) % 3
-            length = np.sqrt(max(0.0, 1.0 - R[i, j] * R[i, j]))
-            if length < 1e-6:
-                continue
-            ra = ha[i1] * absR[i2, j] + ha[i2] * absR[i1, j]
-            rb = hb[j1] * absR[i, j2] + hb[j2] * absR[i, j1]
-            if abs(t[i2] * R[i1, j] - t[i1] * R[i2, j]) > ra + rb + margin * length:
-                return True
-    return False
+    return separated(R, t, ha, hb, margin)
 
 
 @njit(cache=True, nogil=True)

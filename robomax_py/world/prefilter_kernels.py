@@ -227,13 +227,11 @@ def _place_box(rot: Any, trans: Any, j: int, local_c: Any, local_r: Any, g: int,
 @njit(cache=True, nogil=True)
 def _boxes_apart(ca: Any, ra: Any, ha: Any, a: int, cb: Any, rb: Any, hb: Any, b: int, gap: float) -> bool:
     """Whether oriented box a (centre ca[a], axes the columns of ra[a], half extents ha[a]) and box b
-    are more than `gap` apart along one of the 15 separating axes (Gottschalk's test; a cross-product
-    axis's gap scaled by its length). False proves nothing."""
+    are more than `gap` apart along one of the 15 separating axes (`separated`). False proves nothing."""
     ea, eb = ha[a], hb[b]
     if not (np.isfinite(ea[0]) and np.isfinite(eb[0])):
         return False
     R = np.empty((3, 3))
-    AbsR = np.empty((3, 3))
     t = np.empty(3)
     for i in range(3):
         t[i] = 0.0
@@ -244,7 +242,19 @@ def _boxes_apart(ca: Any, ra: Any, ha: Any, a: int, cb: Any, rb: Any, hb: Any, b
             for k in range(3):
                 v += ra[a, k, i] * rb[b, k, j]
             R[i, j] = v
-            AbsR[i, j] = abs(v) + 1e-9          # near-parallel edges: no false separation
+    return separated(R, t, ea, eb, gap)
+
+
+@njit(cache=True, nogil=True)
+def separated(R: Any, t: Any, ea: Any, eb: Any, gap: float) -> bool:
+    """Whether two oriented boxes are more than `gap` apart along one of the 15 separating axes
+    (Gottschalk et al., SIGGRAPH 1996; Ericson, Real-Time Collision Detection 4.4.1; a cross-product
+    axis's gap scaled by its length). R (3, 3): box b's axes in box a's frame; t (3,): b's centre
+    less a's in a's frame; ea, eb (3,): half extents, m. False proves nothing."""
+    AbsR = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            AbsR[i, j] = abs(R[i, j]) + 1e-9    # near-parallel edges: no false separation
     for i in range(3):
         if abs(t[i]) > ea[i] + eb[0] * AbsR[i, 0] + eb[1] * AbsR[i, 1] + eb[2] * AbsR[i, 2] + gap:
             return True
