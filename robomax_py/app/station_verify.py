@@ -45,6 +45,8 @@ def station_programs(station: StationSpec, given: list[Path]) -> list[dict[str, 
         return sets
     named: dict[str, Path] = {}
     for path in given:
+        if not path.exists():
+            raise ProgramError(path, None, "no such file or folder")
         robot = next((r for r in robots if path.stem.lower() == f"{station.name}_{r}".lower()), None)
         if robot is None:
             raise ProgramError(path, None, f"not a program of station {station.name}'s robots "

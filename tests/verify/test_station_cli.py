@@ -82,7 +82,7 @@ def test_without_interlocks_the_contact_is_reported(tmp_path: Path, station: Pat
     assert "collision" in result.output and "r1 and r2 touch" in result.output
 
 
-@pytest.mark.parametrize("case", ["stranger", "one_missing", "empty_folder"])
+@pytest.mark.parametrize("case", ["stranger", "one_missing", "empty_folder", "no_such_folder"])
 def test_bad_input_exits_two(tmp_path: Path, station: Path, case: str) -> None:
     paths = _write(tmp_path, station, {"r1": ((), (), "srcl"), "r2": ((), (), "srcl")})
     if case == "stranger":
@@ -91,12 +91,16 @@ def test_bad_input_exits_two(tmp_path: Path, station: Path, case: str) -> None:
         args = [str(paths[0]), str(stranger)]
     elif case == "one_missing":
         args = [str(paths[0])]
-    else:
+    elif case == "empty_folder":
         (tmp_path / "empty").mkdir()
         args = [str(tmp_path / "empty")]
+    else:
+        args = [str(tmp_path / "never_written")]
     result = runner.invoke(app, ["verify", str(station), *args])
     assert result.exit_code == EXIT_BAD_INPUT, result.output
     assert "Traceback" not in result.output
+    if case == "no_such_folder":
+        assert "no such file or folder" in result.output
 
 
 def test_station_preview_needs_its_folder(tmp_path: Path, station: Path) -> None:
