@@ -3,7 +3,8 @@
 four support bars of a fixture, its outer edge overhanging them) with spots along the rim's outer
 edge in CAD order (rail by rail), clamps with signals on the rim, and 2-6 robots on the two long
 sides, arms of the shipped library (KR 125-class with the C gun, KR 16-class and UR10 with the
-light gun), each station a valid station file.
+light gun) or imported from ROS-Industrial packages (KR 120 R2500 pro, IRB 2400), each station a
+valid station file.
 
     python tests/bench/station_cells.py OUT_DIR [--robots 4] [--spots 120] [--seed 0] [--count 1]
 
@@ -29,7 +30,14 @@ ARMS: dict[str, dict[str, Any]] = {
              "io": ([101, 116], [101, 116]), "clamps": 11},
     "ur10": {"tool": "spot_gun_light", "reach": 0.45, "z": 0.6, "home": [0, -90, 90, -90, -90, 0],
              "io": ([2, 7], [0, 7]), "clamps": 0},
+    # Imported from the ROS-Industrial support packages under tests/data/rosi (`robomax import-urdf`,
+    # as tests/bench/corpus_cells.py imports them, into the station's folder): a KUKA and an ABB arm.
+    "kr120": {"tool": "spot_gun_c", "reach": 1.7, "z": 0.0, "home": [0, -115, 115, 0, 50, 0],
+              "io": ([101, 116], [101, 116]), "clamps": 11, "imported": True},
+    "irb2400": {"tool": "spot_gun_light", "reach": 0.9, "z": 0.2, "home": [0, 20, -20, 0, 50, 0],
+                "io": ([101, 116], [101, 116]), "clamps": 11, "imported": True},
 }
+SHIPPED = ("kr125", "kr16", "ur10")     # the arms a seed draws from
 PREFIX = {"front": "f", "right": "r", "rear": "b", "left": "l"}   # spot names: f1, r1, b1, l1, ...
 RIM_Z = 0.75            # m, the sheet's top
 RIM_W = 0.12            # m, width of the rim's sheet
@@ -42,7 +50,7 @@ def station(robots: int, spots: int, seed: int, arms: list[str] | None = None, n
             ) -> dict[str, Any]:
     """A station file's data (as YAML reads it)."""
     rng = np.random.default_rng(seed)
-    arms = arms or [str(a) for a in rng.choice(list(ARMS), size=robots)]
+    arms = arms or [str(a) for a in rng.choice(list(SHIPPED), size=robots)]
     front = math.ceil(robots / 2)
     L = PITCH * front
     W = 1.0
@@ -96,7 +104,8 @@ def station(robots: int, spots: int, seed: int, arms: list[str] | None = None, n
             objects.append({"name": f"pedestal_{i + 1}", "box": [0.3, 0.3, round(spec["z"] - 0.005, 4)],
                             "pose": {"xyz": [round(x, 4), round(y, 4), round((spec["z"] - 0.005) / 2, 4)]}})
         inputs = {f"{c}_closed": spec["clamps"] + j for j, (c, _, _) in enumerate(clamps)}
-        out_robots.append({"name": f"r{i + 1}", "model": arm, "tool": spec["tool"],
+        model = f"robots/{arm}/robot.yaml" if spec.get("imported") else arm   # beside the station file (`write`)
+        out_robots.append({"name": f"r{i + 1}", "model": model, "tool": spec["tool"],
                            "base": {"xyz": [round(x, 4), round(y, 4), spec["z"]], "rpy": [0, 0, yaw]},
                            "home": list(spec["home"]),
                            "controller": {"inputs": inputs,
@@ -108,7 +117,12 @@ def station(robots: int, spots: int, seed: int, arms: list[str] | None = None, n
 
 
 def write(folder: Path, data: dict[str, Any]) -> Path:
+    """The station file in `folder`, with the imported arms it names under `folder/robots`."""
     folder.mkdir(parents=True, exist_ok=True)
+    if any(str(r["model"]).startswith("robots/") for r in data["robots"]):
+        from tests.bench.corpus_cells import import_arms
+
+        import_arms(folder / "robots")
     path = folder / f"{data['name']}.yaml"
     path.write_text(yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=140))
     return path
