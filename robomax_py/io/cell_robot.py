@@ -6,11 +6,12 @@ from __future__ import annotations
 import math
 import re
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
 from robomax_py.errors import CellFileError
-from robomax_py.io.cell_file import CellFile, RobotControllerFile
+from robomax_py.io.cell_file import CellFile, InputFile, OutputFile, RobotControllerFile
 from robomax_py.io.cell_objects import _pose
 from robomax_py.spec import (
     CellSpec,
@@ -51,12 +52,7 @@ def _controller(ctrl: RobotControllerFile, cell: CellSpec, path: Path) -> Contro
             raise CellFileError(path, f"{key}.inputs.{signal}", f"the cell has no signal '{signal}' (its signals: "
                                 f"{', '.join(signals) or 'none'}; clamps name theirs, dynamic objects wait for "
                                 "<name>_clear, machine doors for <machine>_open)")
-        entry = ControllerInput(signal, given, None) if isinstance(given, int) else \
-            ControllerInput(signal, given.number, given.name)
-        twin = next((i for i in inputs if i.number == entry.number), None)
-        if twin is not None:
-            raise CellFileError(path, f"{key}.inputs.{signal}", f"input {entry.number} is also {twin.signal}'s")
-        inputs.append(entry)
+        inputs.append(_numbered(ControllerInput, signal, given, inputs, path, f"{key}.inputs.{signal}", "input"))
     return ControllerSetup(tool=tool, frame=frame, position_registers=tuple(ctrl.registers.position),
                            numeric_registers=tuple(ctrl.registers.numeric), inputs=tuple(inputs), weld=ctrl.weld,
                            outputs=_outputs(ctrl, path))
@@ -68,13 +64,23 @@ def _outputs(ctrl: RobotControllerFile, path: Path) -> tuple[ControllerOutput, .
     must be unique, as inputs' are."""
     outputs: list[ControllerOutput] = []
     for signal, given in ctrl.outputs.items():
-        entry = ControllerOutput(signal, given, None) if isinstance(given, int) else \
-            ControllerOutput(signal, given.number, given.name)
-        twin = next((o for o in outputs if o.number == entry.number), None)
-        if twin is not None:
-            raise CellFileError(path, f"robot.controller.outputs.{signal}", f"output {entry.number} is also {twin.signal}'s")
-        outputs.append(entry)
+        outputs.append(_numbered(ControllerOutput, signal, given, outputs, path, f"robot.controller.outputs.{signal}",
+                                 "output"))
     return tuple(outputs)
+
+
+_Numbered = TypeVar("_Numbered", ControllerInput, ControllerOutput)
+
+
+def _numbered(kind: type[_Numbered], signal: str, given: int | InputFile | OutputFile, taken: list[_Numbered],
+              path: Path, key: str, word: str) -> _Numbered:
+    """One input or output as the file gives it (a number, or a number and a RAPID name), its number
+    not already one of `taken`'s."""
+    entry = kind(signal, given, None) if isinstance(given, int) else kind(signal, given.number, given.name)
+    twin = next((x for x in taken if x.number == entry.number), None)
+    if twin is not None:
+        raise CellFileError(path, key, f"{word} {entry.number} is also {twin.signal}'s")
+    return entry
 
 
 def _home(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray:
