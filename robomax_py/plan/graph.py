@@ -402,20 +402,12 @@ class Sequencer(SequencerLookahead):
     def _check_via(self, i: int, a: int, j: int, b: int, v: int) -> FloatArray | None:
         wp = self.vias_for(i, j)[v].waypoints
         qa, qb = self.q(i)[a], self.q(j)[b]
-        if (a, b, v) not in self.legs_ok.get((i, j), set()):
-            for p, r in ((qa, wp[0]), (wp[-1], qb)):
-                if np.allclose(p, r):
-                    continue
-                res = self.world_from(i).check_segment(p, r)
-                self.checks += res.checks
-                if not res.free:
-                    self._record_leg(i, a, j, b, v, False)
-                    # A pair given up (MAX_FAILED_DETOURS searches found nothing) is not searched
-                    # again for every blocked leg: it keeps the legs known free.
-                    if (min(i, j), max(i, j)) not in self.unconnected:
-                        self._new_detour(i, a, j, b)
-                    return None
-            self._record_leg(i, a, j, b, v, True)
+        if (a, b, v) not in self.legs_ok.get((i, j), set()) and not self._legs_free(i, a, j, b, v):
+            # A pair given up (MAX_FAILED_DETOURS searches found nothing) is not searched again for
+            # every blocked leg: it keeps the legs known free.
+            if (min(i, j), max(i, j)) not in self.unconnected:
+                self._new_detour(i, a, j, b)
+            return None
         path = np.vstack([qa[None, :], wp, qb[None, :]])
         keep = [0] + [k for k in range(1, len(path)) if not np.allclose(path[k], path[k - 1])]
         return path[keep]

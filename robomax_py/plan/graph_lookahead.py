@@ -135,7 +135,8 @@ class SequencerLookahead(SequencerDetours):
 
     def _legs_free(self, i: int, a: int, j: int, b: int, v: int) -> bool:
         """Check and record the enter and leave legs of known detour v from candidate a of i to b of
-        j (as `Sequencer._check_via` does, but searching no new detour when one is blocked)."""
+        j (searching nothing: the look round takes a blocked leg as it is, `Sequencer._check_via`
+        searches a new detour)."""
         wp = self.vias_for(i, j)[v].waypoints
         for p, r in ((self.q(i)[a], wp[0]), (wp[-1], self.q(j)[b])):
             if np.allclose(p, r):
