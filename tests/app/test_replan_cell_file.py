@@ -135,3 +135,34 @@ def test_a_start_within_limits_is_where_programs_start(tmp_path: Path, write_sma
     cell = load_cell(path)
     assert cell.start is not None
     np.testing.assert_allclose(np.degrees(cell.q_start), [10, -80, 95, 0, 20, 0], atol=1e-9)
+
+
+def _tending_with(tmp_path: Path, edit: Any) -> Path:
+    data = yaml.safe_load((REPO / "cells" / "tending.yaml").read_text())
+    edit(data)
+    path = tmp_path / "tending.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def test_a_continuation_loads_as_the_work_left_in_its_own_clock(tmp_path: Path) -> None:
+    whole = load_cell(REPO / "cells" / "tending.yaml")
+    visits = [s.name for s in whole.seams[0].spots]
+    path = _tending_with(tmp_path, lambda d: d.update(continuation={"at": 20.0, "done": [f"tending/{v}" for v in
+                                                                                          visits[:2]]}))
+    cell = load_cell(path)
+    assert [s.name for s in cell.seams[0].spots] == visits[2:]
+    door = next(d for d in cell.dynamic if d.name == "cnc1_door")
+    assert door.present == ((0.0, 5.0), (12.0, 21.0))        # [16, 25], [32, 41] of the program's clock, from 20 s
+
+
+def test_a_machine_door_takes_its_windows_as_they_are_or_a_schedule_not_both(tmp_path: Path) -> None:
+    windows = [[0.0, 9.0], [16.0, 25.0], [32.0, 44.0]]
+    path = _tending_with(tmp_path, lambda d: d["tending"]["machines"][0].update(schedule=None, windows=windows)
+                         or d["tending"]["machines"][0].pop("schedule"))
+    door = next(d for d in load_cell(path).dynamic if d.name == "cnc1_door")
+    assert door.present == tuple(tuple(w) for w in windows)
+    both = _tending_with(tmp_path, lambda d: d["tending"]["machines"][0].update(windows=windows))
+    result = runner.invoke(app, ["check", str(both)])
+    text = " ".join(result.output.split())
+    assert result.exit_code == EXIT_BAD_INPUT and "tending.machines[0]" in text and "exactly one of schedule" in text
