@@ -157,8 +157,11 @@ def _rebased(ref: str, src_dir: Path, dst_dir: Path) -> str:
 def _relocated(cell: CellFile, source: Path, out_dir: Path) -> CellFile:
     """Every relative reference of the flat cell rewritten relative to `out_dir` (a library robot
     or tool name stays as it is)."""
-    src_dir, dst_dir = source.resolve().parent, out_dir.resolve()
-    here, there = source.resolve(), dst_dir / source.name
+    # The folder the cell file is named in, as the loader takes it (a set's file is a symbolic link
+    # into the set's folder: its target's folder is not the one its paths are relative to).
+    here = Path(os.path.abspath(source))
+    src_dir, dst_dir = here.parent, out_dir.resolve()
+    there = dst_dir / source.name
 
     def obj(o: Any) -> Any:
         update: dict[str, Any] = {}

@@ -20,6 +20,7 @@ from robomax_py.app.commands.base import (
     err,
     out,
 )
+from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.io.files import signals_held
 
 EVENT_HELP = ("what changed (repeatable; times in s from the program's start, m, deg): "
@@ -77,7 +78,10 @@ def replan(
                 import yaml
 
                 out_dir.mkdir(parents=True, exist_ok=True)      # its relative paths resolve from there
-                cell_from_mapping(yaml.safe_load(written_cell.text), out_dir)
+                try:
+                    cell_from_mapping(yaml.safe_load(written_cell.text), out_dir)
+                except (CellFileError, RobotModelError) as exc:  # named as the file it would be
+                    raise type(exc)(cell_file, exc.key, exc.problem) from None
                 files[cell_file.name] = written_cell.text
                 digest = hashlib.sha256(written_cell.text.encode("utf-8")).hexdigest()   # as load_cell takes it
             _honour_signals()
