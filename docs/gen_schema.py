@@ -53,10 +53,19 @@ DESCRIPTIONS: dict[str, str] = {
     "SpotListFile.grid": "The `grid` of every seam the list gives.",
     "CellFile.tending": "A machine-tending job instead of seams.",
     "CellFile.pick_place": "A pick-and-place job instead of seams.",
+    "CellFile.continuation": "This cell is where a program's continuation runs (robomax replan writes it): times in "
+                             "the continued program's clock, its actions done left out.",
+    "ContinuationFile.cell": "The cell whose program this continues (for people reading the file).",
+    "ContinuationFile.at": "s of the continued program's clock at which this program starts (where the robot stopped); "
+                           "every window in the file moves to a clock starting here.",
+    "ContinuationFile.done": "Actions the continued program completed, as seam/spot (a tending visit: tending/<visit>); "
+                             "left out of this program.",
     "RobotRefFile.model": "Robot folder name in the library, or a path to a robot.yaml.",
     "RobotRefFile.base": "Where the robot's URDF root stands in the cell.",
     "RobotRefFile.frame": "The frame (or object) base is given in; the world when absent.",
     "RobotRefFile.home": "Start and end posture: one value per joint, deg (m for a prismatic joint).",
+    "RobotRefFile.start": "Where programs start, at rest, when not at home (a continuation): one value per joint, deg "
+                          "(m for a prismatic joint); they still end at home.",
     "RobotRefFile.controller": "Numbers the integrator's controller already holds (tool, user frame, inputs).",
     "PoseFile.xyz": "Position, m.",
     "PoseFile.rpy": "Roll, pitch, yaw in deg about the fixed X, Y, Z axes (R = Rz(yaw)·Ry(pitch)·Rx(roll)).",
@@ -162,7 +171,9 @@ DESCRIPTIONS: dict[str, str] = {
     "GripperFile.release": "Seconds at rest to open the gripper.",
     "MachineFile.name": "Machine name.",
     "MachineFile.door": "The door as an object: its shape and pose when closed.",
-    "MachineFile.schedule": "When the door is closed.",
+    "MachineFile.schedule": "When the door is closed: a fixed period (or give windows).",
+    "MachineFile.windows": "Or the door's closed windows as they are, [start, end] s from program start, in order "
+                           "([]: never closed).",
     "ScheduleFile.start": "First machining start (door closes), s.",
     "ScheduleFile.machining": "Seconds the door stays closed per part.",
     "ScheduleFile.period": "Seconds from one machining start to the next.",

@@ -169,6 +169,11 @@ def _with_set(cell: CellSpec, path: Path, read: tuple[Path, ...], report: Verify
     if check.cell_sha256 and check.cell_sha256 != cell.digest:
         other = (f"planned from another version of the cell file (sha256 {check.cell_sha256[:12]}..., "
                  f"this one {cell.digest[:12]}...)")
+        if check.cell_file:
+            # A continuation starts where the robot stopped and welds what was left, in the cell as
+            # it changed: against any other cell, that shows as violations; name the one it runs in.
+            other = (f"this program runs in the cell {path.parent / check.cell_file} beside it (a continuation "
+                     f"written by robomax replan), not in this one: verify it against that file")
         notes = (*notes, other)
     return dataclasses.replace(report, violations=found + report.violations, notes=notes)
 

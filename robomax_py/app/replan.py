@@ -20,22 +20,20 @@ from typing import Any, Literal
 import numpy as np
 
 from robomax_py.errors import ProgramError
+from robomax_py.io.cell_continuation import continued, spot_label
+from robomax_py.io.continuation_file import ContinuationText, continuation_cell_text
 from robomax_py.io.replan_events import Event, apply_events, parse_event
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell
-from robomax_py.plan.replan import (
-    Action,
-    ReplanInputError,
-    Stop,
-    continuation_cell,
-    stop_at,
-)
-from robomax_py.robot import RobotModel
+from robomax_py.plan.replan import Action, ReplanInputError, Stop, stop_at
+from robomax_py.program import as_written_joints
+from robomax_py.robot import RobotModel, prismatic_mask
 from robomax_py.spec import CellSpec
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.motion import check_motion
 from robomax_py.world.scene import build_scene
 
-__all__ = ["PlannedMotion", "ReplanOutcome", "continuation_name", "planned_motion", "replan"]
+__all__ = ["PlannedMotion", "ReplanOutcome", "continuation_cell", "continuation_file", "continuation_name", "planned_motion",
+           "replan"]
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -161,6 +159,33 @@ def replan(cell: CellSpec, robot: RobotModel, program: Path, at: float, events: 
     if result.status != "planned":
         return outcome("infeasible", result.message, result, cont)
     return replace(outcome("planned", "planned", result, cont), as_it_stands=_as_it_stands(changed, robot, program) if compare else None)
+
+
+def continuation_cell(changed: CellSpec, stop: Stop, name: str) -> CellSpec:
+    """The cell the rest of the work is planned in (`io.cell_continuation`): `changed` (the events
+    applied) from the stop on, its start the stop configuration as the programs write it.
+    ReplanInputError when nothing is left to do."""
+    cont = continued(changed, stop.t_stop, {(a.seam, a.name) for a in stop.done})
+    if not cont.seams:
+        raise ReplanInputError(f"nothing left to do after the stop at t = {stop.t_stop:.3f} s: every "
+                               f"{'station' if changed.tending else 'spot'} is done")
+    return replace(cont, name=name, start=as_written_joints(stop.q))
+
+
+def continuation_file(source: Path, out_dir: Path, cell: CellSpec, robot: RobotModel,
+                      o: ReplanOutcome) -> ContinuationText:
+    """The cell file of a planned continuation (`io.continuation_file`), to be written as
+    `out_dir/<name>.cell.yaml`: `cell` read from `source`, with `o`'s events, stop and work done."""
+    assert o.cell is not None and o.cell.start is not None      # planned
+    changed = apply_events(cell, o.events, o.stop.t_request)
+    start = np.where(prismatic_mask(robot.model), o.cell.start, np.degrees(o.cell.start))
+    done = [spot_label(a.seam, a.name) for a in o.stop.done]
+    header = (f"{o.name}: the cell the continuation of {cell.name}'s program runs in (robomax replan)\n"
+              f"stop at t = {o.stop.t_stop:.3f} s of that program ({o.stop.how}); events:\n"
+              + "\n".join(f"  {e.text}" for e in o.events)
+              + "\nverify its programs against this file: robomax verify THIS_FILE PROGRAM")
+    return continuation_cell_text(source, out_dir, o.name, cell, changed, o.stop.t_stop, done,
+                                  [float(v) for v in start], header)
 
 
 def _as_it_stands(changed: CellSpec, robot: RobotModel, program: Path) -> tuple[bool, float, str] | None:

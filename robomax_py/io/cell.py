@@ -23,6 +23,7 @@ from pydantic import (
 )
 
 from robomax_py.errors import CellFileError, RobotModelError
+from robomax_py.io.cell_continuation import file_continuation
 from robomax_py.io.cell_file import (
     CELL_LIMITS,
     MAX_CELL_NAME_CHARS,
@@ -45,7 +46,7 @@ from robomax_py.io.cell_moving import moving_object
 from robomax_py.io.cell_objects import _object, _pose
 from robomax_py.io.cell_problems import _located, _Problems
 from robomax_py.io.cell_rewrite import dump_cell_file, read_cell_file, read_cell_frames
-from robomax_py.io.cell_robot import _controller, _home
+from robomax_py.io.cell_robot import _controller, _home, _start
 from robomax_py.io.cell_spot_lists import _with_spot_lists, spot_list_seams
 from robomax_py.io.frames import resolve_frames
 from robomax_py.io.includes import Expansion, expand_includes
@@ -193,6 +194,7 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
                     problems.attempt(_object, o, path, f"dynamic[{i}]", triangles) for i, o in enumerate(parsed.dynamic))
     parts = problems.attempt(_parts, parsed, path, robot_spec, triangles)
     home = problems.attempt(_home, parsed, robot_spec, path)
+    start = problems.attempt(_start, parsed, robot_spec, path)
     problems.raise_found()
     assert parts is not None and home is not None
     if sum(triangles) > CELL_LIMITS.cell_triangles:
@@ -229,7 +231,10 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
         machines=machines,
         parts=parts,
         tcp_limits=_tcp_limits(parsed.pick_place.unloaded) if parsed.pick_place is not None else None,
+        start=None if start is None else frozen_array(start),
     )
+    if parsed.continuation is not None:
+        cell = file_continuation(cell, parsed.continuation, path)
     cell = dataclasses.replace(cell, controller=_controller(parsed.robot.controller, cell, path))
     return dataclasses.replace(cell, notices=listed + tuple(map(expansion.relocated_notice, lint_cell(parsed, cell, path))))
 

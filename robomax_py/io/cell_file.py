@@ -165,6 +165,9 @@ class RobotRefFile(_Strict):
     base: PoseFile = PoseFile()
     frame: Name | None = None        # base given in this frame (docs/frames.md); default: the world
     home: list[Finite]               # deg (m for a prismatic joint)
+    # Where the program starts, at rest, when not at home (a continuation, `robomax replan`); it
+    # still ends at home. Checked as home is.
+    start: list[Finite] | None = None
     controller: RobotControllerFile = RobotControllerFile()
 
 
@@ -230,8 +233,21 @@ class OtherRobotFile(_Strict):
 Sweep = Annotated[float, Field(gt=0, le=0.2, allow_inf_nan=False)]
 
 
+Window = Annotated[list[WindowTime], Field(min_length=2, max_length=2)]
+
+
+def _windows_in_order(windows: list[list[float]] | None) -> list[list[float]] | None:
+    for i, (t0, t1) in enumerate(windows or ()):
+        assert windows is not None
+        if not t0 < t1:
+            raise ValueError(f"window {i} [{t0}, {t1}]: start must be before end")
+        if i and t0 < windows[i - 1][1]:
+            raise ValueError(f"window {i} starts at {t0}, before window {i - 1} ends at {windows[i - 1][1]}")
+    return windows
+
+
 class DynamicObjectFile(ObjectFile):
-    present: Annotated[list[Annotated[list[WindowTime], Field(min_length=2, max_length=2)]], Field(min_length=1)] | None = None
+    present: Annotated[list[Window], Field(min_length=1)] | None = None
     # Extensions (docs/cell-extensions.md, "Moving objects"): a rigid object carried along timed
     # poses, or another robot replaying a trajectory file.
     path: Annotated[list[PathPoseFile], Field(min_length=2, max_length=10_000)] | None = None
@@ -288,14 +304,8 @@ class DynamicObjectFile(ObjectFile):
 
     @field_validator("present")
     @classmethod
-    def _windows_in_order(cls, windows: list[list[float]] | None) -> list[list[float]] | None:
-        for i, (t0, t1) in enumerate(windows or ()):
-            assert windows is not None
-            if not t0 < t1:
-                raise ValueError(f"window {i} [{t0}, {t1}]: start must be before end")
-            if i and t0 < windows[i - 1][1]:
-                raise ValueError(f"window {i} starts at {t0}, before window {i - 1} ends at {windows[i - 1][1]}")
-        return windows
+    def _present_in_order(cls, windows: list[list[float]] | None) -> list[list[float]] | None:
+        return _windows_in_order(windows)
 
 
 class ToleranceFile(_Strict):
@@ -434,7 +444,21 @@ class ScheduleFile(_Strict):
 class MachineFile(_Strict):
     name: Name
     door: ObjectFile                          # the door's shape and pose when closed
-    schedule: ScheduleFile
+    schedule: ScheduleFile | None = None
+    # Or the door's closed windows as they are (s from program start), when they keep no period
+    # (a machine running late: `robomax replan` writes them so); [] the door never closes.
+    windows: list[Window] | None = None
+
+    @model_validator(mode="after")
+    def _one_timing(self) -> MachineFile:
+        if (self.schedule is None) == (self.windows is None):
+            raise ValueError("give exactly one of schedule (a fixed period) or windows (the door's closed windows)")
+        return self
+
+    @field_validator("windows")
+    @classmethod
+    def _ordered(cls, windows: list[list[float]] | None) -> list[list[float]] | None:
+        return _windows_in_order(windows)
 
 
 class GripperFile(_Strict):
@@ -503,6 +527,16 @@ class FrameFile(_Strict):
     parent: Name | None = None                # default: the world
 
 
+class ContinuationFile(_Strict):
+    """The cell a program's continuation runs in (`robomax replan` writes it; docs/cell-files.md,
+    "Continuations"): every time in the file is in the clock of the program continued, which this
+    one takes up at `at`; the actions that program had done are left out."""
+
+    cell: Name | None = None                  # the cell whose program this continues (for people)
+    at: WindowTime                            # s of that program's clock at which this one starts
+    done: list[Annotated[str, Field(min_length=1, max_length=2 * MAX_NAME_CHARS + 1)]] = []   # `seam/spot`
+
+
 IncludePath = Annotated[str, Field(min_length=1, max_length=4096), AfterValidator(_printable_name)]
 
 
@@ -521,6 +555,7 @@ class CellFile(_Strict):
     dynamic: list[DynamicObjectFile] = []
     tending: TendingFile | None = None
     pick_place: PickPlaceFile | None = None
+    continuation: ContinuationFile | None = None
 
 
 class IncludeFile(_Strict):

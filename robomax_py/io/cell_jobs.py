@@ -132,10 +132,14 @@ def _machines(parsed: CellFile, path: Path, triangles: list[int]) -> tuple[tuple
     machines, doors = [], []
     for i, m in enumerate(parsed.tending.machines):
         sched = m.schedule
-        count = sched.count or parsed.tending.cycles
-        windows = tuple((sched.start + k * sched.period, sched.start + k * sched.period + sched.machining)
-                        for k in range(count))
-        if windows[-1][1] > MAX_WINDOW_S:
+        if sched is None:                   # the windows as they are (checked in order by the schema)
+            assert m.windows is not None
+            windows = tuple((float(a), float(b)) for a, b in m.windows)
+        else:
+            count = sched.count or parsed.tending.cycles
+            windows = tuple((sched.start + k * sched.period, sched.start + k * sched.period + sched.machining)
+                            for k in range(count))
+        if windows and windows[-1][1] > MAX_WINDOW_S:
             raise CellFileError(path, f"tending.machines[{i}].schedule", f"the last machining ends at "
                                 f"{windows[-1][1]:g} s, beyond a day ({MAX_WINDOW_S:g} s) of program time")
         door = _object(m.door, path, f"tending.machines[{i}].door", triangles)

@@ -85,23 +85,35 @@ def _numbered(kind: type[_Numbered], signal: str, given: int | InputFile | Outpu
 
 def _home(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray:
     """`robot.home` in SI, checked against the URDF: deg -> rad, prismatic joints stay in metres."""
+    return _joint_values(parsed.robot.home, "robot.home", robot, path)
+
+
+def _start(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray | None:
+    """`robot.start` (where the program starts, when not at home) in SI, checked as home is."""
+    given = parsed.robot.start
+    return None if given is None else _joint_values(given, "robot.start", robot, path)
+
+
+def _joint_values(values: list[float], key: str, robot: RobotSpec, path: Path) -> np.ndarray:
+    """A configuration as a cell file gives it (deg, m for a prismatic joint) in SI, one value per
+    joint of the URDF, each within its limits; CellFileError naming `key` otherwise."""
     from robomax_py.robot import active_joints, kinematic_model, prismatic_mask
 
     model = kinematic_model(robot)
-    given = np.asarray(parsed.robot.home, dtype=float)
+    given = np.asarray(values, dtype=float)
     if len(given) != model.nq:
-        raise CellFileError(path, "robot.home", f"expected {model.nq} joint values for {robot.name}, got {len(given)}")
+        raise CellFileError(path, key, f"expected {model.nq} joint values for {robot.name}, got {len(given)}")
     prismatic = prismatic_mask(model)
-    home = np.where(prismatic, given, np.radians(given))
+    q = np.where(prismatic, given, np.radians(given))
     lower, upper = np.asarray(model.lowerPositionLimit), np.asarray(model.upperPositionLimit)
     tol = 1e-9
-    outside = (home < lower - tol) | (home > upper + tol)
+    outside = (q < lower - tol) | (q > upper + tol)
     if outside.any():
         i = int(np.flatnonzero(outside)[0])
         unit, scale = ("m", 1.0) if prismatic[i] else ("deg", 180 / math.pi)
         raise CellFileError(
-            path, f"robot.home[{i}]",
+            path, f"{key}[{i}]",
             f"{model.names[active_joints(model)[i]]} = {given[i]:.3f} {unit} is outside its limits "
             f"[{lower[i] * scale:.3f}, {upper[i] * scale:.3f}] {unit}",
         )
-    return home
+    return q

@@ -14,6 +14,8 @@ from robomax_py.errors import ProgramError
 from robomax_py.io.plan_set import MANIFEST_FORMAT, MANIFEST_SUFFIX, _listed
 from robomax_py.safe_files import LIMITS, read_text
 
+# A set's own cell file (`robomax replan` writes the cell a continuation runs in beside its programs).
+CELL_FILE_SUFFIX = ".cell.yaml"
 
 @dataclass(frozen=True, slots=True)
 class SetCheck:
@@ -24,12 +26,15 @@ class SetCheck:
         an edited one, or one the manifest does not list), naming it.
     cell_sha256 : the cell digest the manifest names ("" without a manifest).
     plan : the plan id the manifest names ("" without a manifest).
+    cell_file : the name of the cell file the set holds itself (`<name>.cell.yaml`: a
+        continuation's, which runs in that cell), "" when it holds none.
     """
 
     manifest: Path | None
     mismatched: tuple[str, ...] = ()
     cell_sha256: str = ""
     plan: str = ""
+    cell_file: str = ""          # the cell file the set holds (a continuation's, `robomax replan`), "" if none
 
     @property
     def whole(self) -> bool:
@@ -87,4 +92,5 @@ def check_set(path: Path, read: Sequence[Path] = ()) -> SetCheck:
         elif want != got:
             bad.append(f"{file.name} is not the file of plan {plan[:12]} that {manifest.name} lists (sha256 "
                        f"{got[:12]}..., the manifest's {want[:12]}...): another plan's, or edited")
-    return SetCheck(manifest, tuple(bad), cell, plan)
+    cell_file = next((n for n in listed if n.endswith(CELL_FILE_SUFFIX)), "")
+    return SetCheck(manifest, tuple(bad), cell, plan, cell_file)

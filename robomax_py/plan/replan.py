@@ -16,28 +16,27 @@ path-maintaining stop); continuing to the next exact stop instead can run much f
 program flies by its corners from one station to the next, often through a door), and a door
 opening late closes across exactly that path.
 
-The continuation's cell: the cell with the events applied (`io.replan_events`), the actions done
-by the stop removed, every window moved to the continuation's clock (which starts at the stop:
-windows are seconds from the original program's start), and the stop configuration as `start`.
+The continuation's cell (`io.cell_continuation`): the cell with the events applied
+(`io.replan_events`), the actions done by the stop removed, every window moved to the
+continuation's clock (which starts at the stop: windows are seconds from the original program's
+start), and the stop configuration as `start`.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import RobomaxError
-from robomax_py.program import as_written_joints
 from robomax_py.robot import JointLimits
-from robomax_py.spec import CellSpec, MachineSpec, ObjectSpec
 from robomax_py.world.motion import rate_violations
 
-__all__ = ["Action", "ReplanInputError", "Stop", "StopHow", "continuation_cell", "shifted_windows", "stop_at"]
+__all__ = ["Action", "ReplanInputError", "Stop", "StopHow", "stop_at"]
 
 # The slowing-down motion's pieces are split no finer than the program's sample step, at most this (s).
 STOP_SAMPLE_S = 0.010
@@ -200,34 +199,3 @@ def stop_at(t: FloatArray, q: FloatArray, actions: Sequence[Action], T: float, l
     if arriving is not None:
         return follow(arriving.t_leave, "action")      # at the station: its action is the next statement
     return follow(rest, "program stop")
-
-
-def shifted_windows(windows: tuple[tuple[float, float], ...], t0: float) -> tuple[tuple[float, float], ...]:
-    """Windows (s from program start) in a clock starting at t0: those over before t0 dropped, one
-    in progress at t0 starting at 0."""
-    return tuple((max(0.0, a - t0), b - t0) for a, b in windows if b - t0 >= 0.0)
-
-
-def continuation_cell(cell: CellSpec, stop: Stop, name: str) -> CellSpec:
-    """The cell the rest of the work is planned in (see the module's docstring); `cell` has the
-    events applied already. ReplanInputError when nothing is left to do."""
-    done = {(a.seam, a.name) for a in stop.done}
-    seams = []
-    for seam in cell.seams:
-        left = tuple(s for s in seam.spots if (seam.name, s.name) not in done)
-        if left:
-            seams.append(replace(seam, spots=left))
-    if not seams:
-        raise ReplanInputError(f"nothing left to do after the stop at t = {stop.t_stop:.3f} s: every "
-                               f"{'station' if cell.tending else 'spot'} is done")
-    dynamic: list[ObjectSpec] = []
-    for d in cell.dynamic:
-        if d.present is None:
-            dynamic.append(d)
-            continue
-        moved = shifted_windows(d.present, stop.t_stop)
-        if moved:
-            dynamic.append(replace(d, present=moved))
-    machines = tuple(MachineSpec(m.name, m.door, shifted_windows(m.windows, stop.t_stop)) for m in cell.machines)
-    return replace(cell, name=name, seams=tuple(seams), dynamic=tuple(dynamic), machines=machines,
-                   start=as_written_joints(stop.q))

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from typer.testing import CliRunner
 
 from robomax_py.app.cli import EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_OK, app
@@ -52,7 +53,7 @@ def test_a_door_opening_late_is_waited_for_and_the_continuation_verifies(tmp_pat
     assert name == "tending_from_36"
     assert {Path(p).name for p in report["written"]} >= {f"{name}.json", f"{name}.srcl", f"{name}.src"}
     # The door closed at T now opens `late` s later, in the program's clock.
-    _, w1 = next(w for w in _door_windows("cnc1_door") if w[0] <= T_AT <= w[1])
+    w0, w1 = next(w for w in _door_windows("cnc1_door") if w[0] <= T_AT <= w[1])
     opens = w1 + late
     trajectory = json.loads((out / f"{name}.json").read_text())
     t_stop = report["stop"]["t"]
@@ -63,6 +64,14 @@ def test_a_door_opening_late_is_waited_for_and_the_continuation_verifies(tmp_pat
     assert "start at the stop configuration" in (out / f"{name}.srcl").read_text()
     assert report["new_finish"] == pytest.approx(t_stop + trajectory["cycle_time"], abs=1e-3)
     assert report["new_finish"] > report["old_finish"]
+    # The cell it runs in, written beside it: cnc1's door windows as they now are (no longer its
+    # schedule's period), in the program's clock; its programs verify against it.
+    cell_file = out / f"{name}.cell.yaml"
+    assert report["verify"]["cell"] == str(cell_file)
+    machine = next(m for m in yaml.safe_load(cell_file.read_text())["tending"]["machines"] if m["name"] == "cnc1")
+    assert "schedule" not in machine and [w0, opens] in machine["windows"]
+    verified = runner.invoke(app, ["verify", str(cell_file), str(out / f"{name}.src")])
+    assert verified.exit_code == EXIT_OK, verified.output
 
 
 def test_an_object_on_a_station_left_is_infeasible_named_and_nothing_written(tmp_path: Path, program: Path) -> None:

@@ -13,14 +13,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from robomax_py.app.replan import continuation_cell
 from robomax_py.io.cell import load_cell
-from robomax_py.plan.replan import (
-    Action,
-    ReplanInputError,
-    continuation_cell,
-    shifted_windows,
-    stop_at,
-)
+from robomax_py.io.cell_continuation import shifted_windows
+from robomax_py.plan.replan import Action, ReplanInputError, stop_at
 from robomax_py.robot import JointLimits
 from robomax_py.tolerances import DEFAULT as TOL
 

@@ -20,6 +20,7 @@ from robomax_py.app.commands.base import (
     err,
     out,
 )
+from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.io.files import signals_held
 
 EVENT_HELP = ("what changed (repeatable; times in s from the program's start, m, deg): "
@@ -40,14 +41,16 @@ def replan(
 ) -> None:
     """Plan the rest of a running program after its cell changed: the robot stops on its planned
     path (an action in progress completed), and the work left is planned from there with the
-    events applied; writes DIR/<name>_from_<T>.* (only when planned and proven)."""
+    events applied; writes DIR/<name>_from_<T>.* (only when planned and proven), among them
+    <name>_from_<T>.cell.yaml, the cell the continuation runs in: verify its programs against it."""
 
     def run() -> int:
         with signals_held():
+            from robomax_py.app.replan import continuation_file, summary
             from robomax_py.app.replan import replan as replan_program
-            from robomax_py.app.replan import summary
             from robomax_py.export import SHARED_FILES, choose_formats
-            from robomax_py.io.cell import load_cell, load_cell_robot
+            from robomax_py.io.cell import cell_from_mapping, load_cell, load_cell_robot
+            from robomax_py.io.continuation_file import CONTINUATION_SUFFIX
             from robomax_py.io.files import commit_set
             from robomax_py.publish import publish
             from robomax_py.verify import verify_program
@@ -64,11 +67,32 @@ def replan(
         if outcome.status == "planned":
             assert outcome.result is not None and outcome.cell is not None
             texts, _ = publish(outcome.result, outcome.cell, robot, chosen.names)   # all proven before any write
+            files, digest = dict(texts), spec.digest
+            # The cell the continuation runs in, as a file beside its programs (one set with them),
+            # so that `robomax verify` checks them against it: it must load from there first.
+            cell_file = out_dir / f"{outcome.name}{CONTINUATION_SUFFIX}"
+            written_cell = continuation_file(cell, out_dir, spec, robot, outcome)
+            if written_cell.text is not None:
+                import hashlib
+
+                import yaml
+
+                out_dir.mkdir(parents=True, exist_ok=True)      # its relative paths resolve from there
+                try:
+                    cell_from_mapping(yaml.safe_load(written_cell.text), out_dir)
+                except (CellFileError, RobotModelError) as exc:  # named as the file it would be
+                    raise type(exc)(cell_file, exc.key, exc.problem) from None
+                files[cell_file.name] = written_cell.text
+                digest = hashlib.sha256(written_cell.text.encode("utf-8")).hexdigest()   # as load_cell takes it
             _honour_signals()
-            committed = commit_set(out_dir, outcome.name, dict(texts), spec.digest, SHARED_FILES)
+            committed = commit_set(out_dir, outcome.name, files, digest, SHARED_FILES)
             written = [str(p) for p in (*committed.paths, committed.manifest)]
-            check = verify_program(outcome.cell, robot, out_dir / f"{outcome.name}.json")
-            report["verify"] = {"clean": check.clean, "violations": [f"{v.kind}: {v.detail}" for v in check.violations]}
+            against = load_cell(cell_file) if written_cell.text is not None else outcome.cell
+            check = verify_program(against, robot, out_dir / f"{outcome.name}.json")
+            report["verify"] = {"clean": check.clean, "violations": [f"{v.kind}: {v.detail}" for v in check.violations],
+                                "cell": str(cell_file) if written_cell.text is not None else None}
+            if written_cell.text is None:
+                report["verify"]["no_cell_file"] = written_cell.reason
         report["written"] = written
         if as_json:
             _print_json("replan", outcome.status == "planned", report)
@@ -93,8 +117,11 @@ def replan(
             for path in written:
                 out.print(f"wrote {path}", markup=False)
             if "verify" in report:
-                out.print("verify: clean (against the changed cell, from the stop)" if report["verify"]["clean"]
-                          else f"verify: {report['verify']['violations']}", markup=False, soft_wrap=True)
+                v = report["verify"]
+                said = (f"against {v['cell']}, the cell it runs in" if v["cell"] else
+                        f"against the changed cell, from the stop; no cell file written: {v['no_cell_file']}")
+                out.print(f"verify: clean ({said})" if v["clean"] else f"verify ({said}): {v['violations']}",
+                          markup=False, soft_wrap=True)
         if outcome.status != "planned":
             from rich.markup import escape
 
