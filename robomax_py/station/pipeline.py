@@ -205,7 +205,11 @@ def _with_order(station: StationSpec, models: Mapping[str, RobotModel], bodies: 
         t0 = time.process_time()
         model = models[change.robot]
         cell = station.robot(change.robot).cell
-        result = plan_cell(ordered_view(cell, change.order), model, dataclasses.replace(options.plan, given_order=True))
+        # With the candidates the robot's reach found, as its own order is planned: a candidate depends
+        # on its spot, seam settings, objects and home only, not on the order
+        # (tests/station/test_reach_candidates.py).
+        result = plan_cell(ordered_view(cell, change.order), model, dataclasses.replace(options.plan, given_order=True),
+                           known=reaches[change.robot].candidates)
         clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
         # The program is proven against the robot's cell as its programs are read (file order).
         known[key] = RobotPlan(change.robot, robot_view(station, change.robot, change.order), model, result) \
