@@ -194,8 +194,10 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
                          beat=best.makespan - 1e-6)
         if trial.status == "planned" and trial.makespan < best.makespan - 1e-6:
             best = trial
+    # A re-assignment that won plans each robot in its own best order again: the changes kept before
+    # are not in its programs.
     return dataclasses.replace(best, seconds=clock, rounds=rounds, orders_tried=search.tried,
-                               orders_skipped=search.skipped, order_changes=search.kept)
+                               orders_skipped=search.skipped, order_changes=search.kept if best is search.best else ())
 
 
 def _orders(plan: StationPlan) -> dict[str, tuple[SpotKey, ...]]:
