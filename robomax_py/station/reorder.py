@@ -14,7 +14,7 @@ candidates, detours and timing), so the cost of a candidate is one robot's plan 
 
 That plan can cost more than the change can gain: a candidate re-plans one robot and keeps every
 other robot's plan, so the station cannot end before the longest own cycle among the others, nor
-before the re-planned robot's own cycle (`most_gain`). A candidate whose most gain is below
+before the re-planned robot's new own cycle, at least its tour's lower bound (`most_gain`). A candidate whose most gain is below
 MIN_GAIN_SHARE of the makespan is not planned, the rest are planned the most gain first, and a
 round stops once the best trial reaches what every candidate left could reach.
 """
@@ -43,9 +43,9 @@ ORDER_CANDIDATES = 3
 # A change is kept when the makespan shortens by more than this, s.
 MAKESPAN_EPS_S = 1e-3
 # A candidate is planned only when it could shorten the makespan by at least this share of it. A
-# candidate costs one robot's plan (1-2 s of CPU for a KR 125 with 10-30 spots, 6-18 s for a UR10
-# whose straight moves are often blocked); the changes kept on the measured stations gained 1.5-27 %
-# (docs/stations.md), the shipped example's 0.02 %.
+# candidate costs one robot's plan (about 1 s of CPU for a KR 125 with 10 spots, 5-10 s for a robot
+# of 30-50 spots); each change kept on the generated stations and the crossing station gained
+# 1.4-23 % (docs/stations.md), so this stays well below what the order change is for.
 MIN_GAIN_SHARE = 0.005
 
 
