@@ -119,7 +119,7 @@ def station_summary(plan: StationPlan, interlocks: Sequence[StationInterlock]) -
                         "wait_at": round(x.wait_at, 6), "leader_span": [round(v, 6) for v in x.leader_span],
                         "waiter_span": [round(v, 6) for v in x.waiter_span]} for x in interlocks],
         "robot_margin_m": round(plan.margin, 6), "reassignments": plan.rounds,
-        "orders_tried": plan.orders_tried,
+        "orders_tried": plan.orders_tried, "orders_skipped": plan.orders_skipped,
         "order_changes": [{"robot": c.robot, "spots": [f"{seam}/{name}" for seam, name in c.order], "why": c.why}
                           for c in plan.order_changes],
     }

@@ -32,10 +32,21 @@ from robomax_py.station.bodies import (
     robot_body,
     sample_steps,
 )
-from robomax_py.station.bound import LowerBound, half_line_time, lower_bound, spot_work
+from robomax_py.station.bound import (
+    LowerBound,
+    SpotWork,
+    half_line_time,
+    lower_bound,
+    spot_work,
+)
 from robomax_py.station.coordinate import Coordination, PairMap, Timeline, coordinate
 from robomax_py.station.reach import RobotReach, robot_reach
-from robomax_py.station.reorder import OrderChange, improve_orders, ordered_view
+from robomax_py.station.reorder import (
+    OrderChange,
+    improve_orders,
+    most_gain,
+    ordered_view,
+)
 from robomax_py.station.reorder import candidates as order_candidates
 from robomax_py.timing.trajectory import evaluate
 from robomax_py.world.scene import build_scene
@@ -98,6 +109,7 @@ class StationPlan:
     margin: float = 0.0          # m kept between robots on the diagrams, at most (where both move fastest)
     rounds: int = 0              # re-assignments tried
     orders_tried: int = 0        # spot orders planned instead of waiting (`reorder`)
+    orders_skipped: int = 0      # spot orders not planned: they could not gain enough (`reorder.most_gain`)
     order_changes: tuple[OrderChange, ...] = ()    # those kept, in order
 
     @property
@@ -127,8 +139,9 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     keys = [s.key for s in station.spots]
     groups = _ordered_groups(station)
     t0 = time.process_time()
-    bound = lower_bound([spot_work(reach, half_line_time(r.cell, options.plan)) for r, reach in
-                         zip(station.robots, reaches, strict=True)], keys, groups)
+    works = {r.name: spot_work(reach, half_line_time(r.cell, options.plan))
+             for r, reach in zip(station.robots, reaches, strict=True)}
+    bound = lower_bound(list(works.values()), keys, groups)
     clock["bound"] = time.process_time() - t0
     nobody = [k for k in keys if not any(k in r.index() for r in reaches)]
     if nobody:
@@ -151,10 +164,12 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     # KR 125-class arms the other way round ended 15 % later: 18.10 s against 15.79 s).
     ordered = [g for g in groups if len(g) > 1]
     robot_plans: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None] = {}
-    best, tried, kept = improve_orders(
+    search = improve_orders(
         best, lambda p: p.makespan, _orders, lambda p: _order_candidates(p, ordered),
         lambda p, change: _with_order(station, models, bodies, by_robot, p, change, options, clock, bound, made,
-                                      robot_plans))
+                                      robot_plans),
+        lambda p, change: _most_gain(p, change, works))
+    best = search.best
     penalty: dict[tuple[str, SpotKey], float] = dict(prior)
     rounds = 0
     assignments = {_frozen(chosen)}
@@ -179,7 +194,10 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
                          beat=best.makespan - 1e-6)
         if trial.status == "planned" and trial.makespan < best.makespan - 1e-6:
             best = trial
-    return dataclasses.replace(best, seconds=clock, rounds=rounds, orders_tried=tried, order_changes=tuple(kept))
+    # A re-assignment that won plans each robot in its own best order again: the changes kept before
+    # are not in its programs.
+    return dataclasses.replace(best, seconds=clock, rounds=rounds, orders_tried=search.tried,
+                               orders_skipped=search.skipped, order_changes=search.kept if best is search.best else ())
 
 
 def _orders(plan: StationPlan) -> dict[str, tuple[SpotKey, ...]]:
@@ -191,6 +209,13 @@ def _order_candidates(plan: StationPlan, ordered: Sequence[Sequence[SpotKey]]) -
     assert plan.coordination is not None
     schedule = plan.coordination.schedule
     return order_candidates(_orders(plan), schedule.ends, schedule.waits, plan.coordination.interlocks, ordered)
+
+
+def _most_gain(plan: StationPlan, change: OrderChange, works: Mapping[str, SpotWork]) -> float:
+    """The most `change` can shorten the plan's makespan (`reorder.most_gain`), the re-planned robot's
+    own cycle taken at least its tour's lower bound (`bound.SpotWork.tour_bound`)."""
+    own = {p.robot: p.own_cycle for p in plan.robots}
+    return most_gain(plan.makespan, own, change.robot, works[change.robot].tour_bound(change.order))
 
 
 def _with_order(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
@@ -205,7 +230,11 @@ def _with_order(station: StationSpec, models: Mapping[str, RobotModel], bodies: 
         t0 = time.process_time()
         model = models[change.robot]
         cell = station.robot(change.robot).cell
-        result = plan_cell(ordered_view(cell, change.order), model, dataclasses.replace(options.plan, given_order=True))
+        # With the candidates the robot's reach found, as its own order is planned: a candidate depends
+        # on its spot, seam settings, objects and home only, not on the order
+        # (tests/station/test_reach_candidates.py).
+        result = plan_cell(ordered_view(cell, change.order), model, dataclasses.replace(options.plan, given_order=True),
+                           known=reaches[change.robot].candidates)
         clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
         # The program is proven against the robot's cell as its programs are read (file order).
         known[key] = RobotPlan(change.robot, robot_view(station, change.robot, change.order), model, result) \

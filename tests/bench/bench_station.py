@@ -9,9 +9,10 @@
 
 Per station and method: makespan, total waits, interlocks written, planning CPU (and per stage:
 reach, assignment, robots' plans, diagrams, coordination), gap to the lower bound (`station.bound`),
-the order changes tried and kept; then the growth: CPU and makespan against spots at a fixed number
-of robots (with the exponent of CPU in spots, a least-squares fit of log CPU on log spots) and
-against robots at a fixed number of spots.
+the order changes tried, skipped for what they could gain at most (`reorder.most_gain`) and kept;
+then the growth: CPU and makespan against spots at a fixed number of robots (with the exponent of
+CPU in spots, a least-squares fit of log CPU on log spots) and against robots at a fixed number of
+spots.
 
     PYTHONPATH=. python tests/bench/bench_station.py [--quick] [--sizes 2x40,4x120] [--methods full]
         [--seeds 1] [--first-seed 0] [--arms shipped|drawn|kr125,ur10] [--json FILE]
@@ -66,7 +67,8 @@ def run(path: Path, methods: tuple[str, ...]) -> list[dict[str, object]]:
             row.update(makespan_s=round(plan.makespan, 3), waits_s=round(sum(sched.waited(r) for r in sched.ends), 3),
                        interlocks=len(plan.coordination.interlocks),
                        gap=round((plan.makespan - plan.bound.value) / plan.makespan, 3), reassigned=plan.rounds,
-                       orders_tried=plan.orders_tried, orders_kept=[c.why for c in plan.order_changes])
+                       orders_tried=plan.orders_tried, orders_skipped=plan.orders_skipped,
+                       orders_kept=[c.why for c in plan.order_changes])
         else:
             row["message"] = plan.message
         rows.append(row)

@@ -8,16 +8,20 @@ import dataclasses
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from robomax_py.io.station import load_station
 from robomax_py.spec_station import SpotKey
-from robomax_py.station.coordinate import Interlock
+from robomax_py.station.coordinate import Interlock, Timeline, simulate
 from robomax_py.station.reorder import (
+    MIN_GAIN_SHARE,
     ORDER_CANDIDATES,
     ORDER_ROUNDS,
     OrderChange,
     candidates,
     improve_orders,
+    most_gain,
     ordered_view,
 )
 
@@ -109,16 +113,102 @@ def test_the_search_keeps_only_changes_that_shorten_the_makespan() -> None:
         return _Station({**plan.orders, change.robot: change.order})
 
     start = _Station(dict(ORDER))
-    best, tried, kept = improve_orders(start, lambda p: p.makespan, lambda p: p.orders, _propose, trial)
-    assert best.makespan == pytest.approx(10.5)
-    assert [c.why for c in kept] == ["b reversed", "a reversed"]
-    assert tried == len(planned) <= ORDER_ROUNDS * ORDER_CANDIDATES
+    got = improve_orders(start, lambda p: p.makespan, lambda p: p.orders, _propose, trial)
+    assert got.best.makespan == pytest.approx(10.5)
+    assert [c.why for c in got.kept] == ["b reversed", "a reversed"]
+    assert got.tried == len(planned) <= ORDER_ROUNDS * ORDER_CANDIDATES and got.skipped == 0
     # No station is planned twice, nor the one started from (b reversed twice is b's first order).
     assert len(set(planned)) == len(planned) and frozenset(ORDER.items()) not in planned
 
 
 def test_the_search_stops_where_nothing_is_shorter() -> None:
     start = _Station({"a": _keys("a3", "a2", "a1"), "b": _keys("b3", "b2", "b1")})
-    best, tried, kept = improve_orders(start, lambda p: p.makespan, lambda p: p.orders,
-                                       _propose, lambda p, c: _Station({**p.orders, c.robot: c.order}))
-    assert best is start and kept == [] and tried == ORDER_CANDIDATES
+    got = improve_orders(start, lambda p: p.makespan, lambda p: p.orders,
+                         _propose, lambda p, c: _Station({**p.orders, c.robot: c.order}))
+    assert got.best is start and got.kept == () and got.tried == ORDER_CANDIDATES
+
+
+def test_the_most_gain_is_bounded_by_the_other_robots_own_cycles() -> None:
+    # b ends last (14 s) after waiting 5 s for a; c's own cycle is 12 s.
+    own = {"a": 10.0, "b": 9.0, "c": 12.0}
+    # b re-ordered: a and c keep their plans, c ends at 12 s at the soonest.
+    assert most_gain(14.0, own, "b", floor=6.0) == pytest.approx(2.0)
+    # ... or at b's own cycle, when b's new order cannot be quicker than 13 s.
+    assert most_gain(14.0, own, "b", floor=13.0) == pytest.approx(1.0)
+    # The leader a re-ordered: b keeps its 9 s, c its 12 s.
+    assert most_gain(14.0, own, "a", floor=6.0) == pytest.approx(2.0)
+    # Nothing to gain where another robot's own cycle is the makespan.
+    assert most_gain(12.0, own, "b", floor=0.0) == 0.0
+
+
+@given(st.lists(st.floats(1.0, 20.0), min_size=2, max_size=4),
+       st.lists(st.tuples(st.integers(0, 3), st.integers(0, 3), st.floats(0.0, 1.0), st.floats(0.0, 1.0)), max_size=6),
+       st.floats(0.5, 20.0), st.integers(0, 3))
+@settings(max_examples=60, deadline=None)
+def test_no_new_order_and_interlocks_beat_the_most_gain(ends: list[float], locks: list[tuple[int, int, float, float]],
+                                                      new_end: float, moved: int) -> None:
+    """Whatever interlocks a coordination sets, the station re-planned with one robot's new own cycle
+    (at least `floor`) ends no sooner than the makespan less the most gain."""
+    names = [f"r{i}" for i in range(len(ends))]
+    robot = names[moved % len(names)]
+
+    def lines(cycle: dict[str, float]) -> list[Timeline]:
+        return [Timeline(r, cycle[r], (0.0, cycle[r] / 2), (cycle[r] / 2, cycle[r])) for r in names]
+
+    def interlocks(cycle: dict[str, float]) -> list[Interlock]:
+        out = []
+        for i, j, at, sig in locks:
+            a, b = names[i % len(names)], names[j % len(names)]
+            if a != b:
+                out.append(Interlock((a, b), (0, 0), a, b, sig * cycle[a], at * cycle[b], (0.0, cycle[a]),
+                                     (0.0, cycle[b])))
+        return out
+
+    own = dict(zip(names, ends, strict=True))
+    before = simulate(lines(own), interlocks(own))
+    if before.deadlock:
+        return
+    floor = min(new_end, own[robot])
+    after_own = {**own, robot: new_end}
+    after = simulate(lines(after_own), interlocks(after_own))
+    assert after.deadlock or after.makespan >= before.makespan - most_gain(before.makespan, own, robot, floor) - 1e-9
+
+
+def test_a_change_that_cannot_gain_enough_is_not_planned() -> None:
+    # The makespan is 14 s; a change of b could gain at most 0.02 s (0.14 %), of a 3 s.
+    planned: list[str] = []
+
+    def trial(plan: _Station, change: OrderChange) -> _Station | None:
+        planned.append(change.why)
+        return _Station({**plan.orders, change.robot: change.order})
+
+    def gain(plan: _Station, change: OrderChange) -> float:
+        return 0.02 if change.robot == "b" else 3.0
+
+    start = _Station(dict(ORDER))
+    assert 0.02 < MIN_GAIN_SHARE * start.makespan < 3.0
+    got = improve_orders(start, lambda p: p.makespan, lambda p: p.orders, _propose, trial, gain)
+    assert "b reversed" not in planned and "b rotated" not in planned
+    assert planned[0] == "a reversed"
+    assert [c.why for c in got.kept] == ["a reversed"] and got.tried == len(planned) and got.skipped >= 2
+    # No change could gain anything: nothing is planned.
+    planned.clear()
+    got = improve_orders(start, lambda p: p.makespan, lambda p: p.orders, _propose, trial, lambda p, c: 0.0)
+    assert planned == [] and got.best is start and got.tried == 0 and got.skipped == len(_propose(start))
+
+
+def test_a_round_stops_once_no_change_left_can_end_sooner() -> None:
+    # b reversed ends at 11 s; a's changes could reach 11 s at best (gain 3 s): not planned.
+    planned: list[str] = []
+
+    def trial(plan: _Station, change: OrderChange) -> _Station | None:
+        planned.append(change.why)
+        return _Station({**plan.orders, change.robot: change.order})
+
+    def gain(plan: _Station, change: OrderChange) -> float:
+        return 4.0 if change.robot == "b" else plan.makespan - 11.0
+
+    got = improve_orders(_Station(dict(ORDER)), lambda p: p.makespan, lambda p: p.orders, _propose, trial, gain)
+    assert planned[:2] == ["b reversed", "b rotated"]     # the most gain first
+    assert "a reversed" not in planned                    # third in the round, and a's gain left is 0 after
+    assert got.kept[0].why == "b reversed"

@@ -171,6 +171,10 @@ def test_another_order_beats_waiting_on_the_crossing_station(planned: dict[str, 
     waiting = shared_once("station-crossing-minmax:" + CROSSING.read_text(), waiting_only)
     summary = json.loads(planned["crossing.station.json"])
     assert summary["order_changes"], "the full method kept no order change"
+    # The changes listed are those the programs weld: each robot's last change is its program's order.
+    programs = {r["name"]: r["spots"] for r in summary["robots"]}
+    assert all(programs[c["robot"]] == c["spots"] for c in {c["robot"]: c for c in summary["order_changes"]}.values())
+    assert isinstance(summary["orders_skipped"], int) and summary["orders_tried"] >= 1
     assert summary["makespan"] < 0.9 * waiting        # 14.29 s waiting, 11.00 s reordered when written
     assert summary["lower_bound"]["value"] <= summary["makespan"]
 
