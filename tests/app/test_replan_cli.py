@@ -105,6 +105,20 @@ def test_bad_input_exits_2_names_the_problem_and_writes_nothing(tmp_path: Path, 
     assert not out.exists()
 
 
+def test_a_station_file_is_refused_by_name_and_nothing_written(tmp_path: Path, program: Path) -> None:
+    """A station's robots wait on each other's signals: replan says so instead of reading the
+    station as a one-robot cell (which named its `robot` and `tool` keys missing)."""
+    out = tmp_path / "out"
+    station = REPO / "cells" / "stations" / "side_frame.yaml"
+    result = runner.invoke(app, ["replan", str(station), str(program), "--at", str(T_AT), "--event", "remove:x",
+                                 "-o", str(out)])
+    assert result.exit_code == EXIT_BAD_INPUT, result.output
+    text = " ".join(result.output.split())
+    assert "side_frame.yaml" in text and "robots" in text and "a station file" in text and "Traceback" not in text
+    assert "required key is missing" not in text
+    assert not out.exists()
+
+
 @pytest.mark.slow
 def test_a_trajectory_file_is_replanned_through_the_api(tmp_path: Path, program: Path) -> None:
     """The continuation's own trajectory file (.json) is a program `replan_program` reads: replanned

@@ -55,6 +55,13 @@ def replan(
             from robomax_py.publish import publish
             from robomax_py.verify import verify_program
         _honour_signals()
+        from robomax_py.io.station import is_station_file
+
+        if is_station_file(cell):
+            # A station's robots wait on each other's signals: one robot's rest planned alone would
+            # leave the others' interlocks waiting for it, so a station is planned again whole.
+            raise CellFileError(cell, "robots", "a station file: replan takes one robot's cell; plan the station "
+                                "again with `robomax plan` after the change")
         spec = load_cell(cell)
         _warn([str(n) for n in spec.notices])
         robot = load_cell_robot(spec)
