@@ -4,7 +4,8 @@ The sequencer plans every tour from home to home (`plan.sequence.HOME`, one conf
 ends). A continuation (`CellSpec.start`, `robomax replan`) starts elsewhere: its tour is sequenced
 as usual and its first transition, home to the first approach point, is then made again from the
 start: the straight joint move where it is free of the static obstacles, else a path through the
-plan's roadmap (whose anchors include the start). The order and the candidates were chosen for a
+plan's roadmap (whose anchors include the start), else the start joined straight to the tour's own
+first move where it sees one of its waypoints. The order and the candidates were chosen for a
 start at home; on the ordered jobs that replanning serves (a tending cycle's station visits) only
 the candidate of the first stop could differ, and it is still a valid one.
 """
@@ -34,7 +35,7 @@ def lead_in(world: CollisionWorld, roadmap: Roadmap | None, start: np.ndarray,
     """The transitions with the first one starting at `start` (n,) rad instead of home.
 
     world : the static obstacles (the plan's world); roadmap : the plan's detour roadmap.
-    LeadInError when neither the straight move nor a roadmap path is free."""
+    LeadInError when neither the straight move, a roadmap path nor a join to the first move is free."""
     if not transitions:
         return transitions
     first = transitions[0]
@@ -45,11 +46,28 @@ def lead_in(world: CollisionWorld, roadmap: Roadmap | None, start: np.ndarray,
     if world.check_segment(q0, goal).free:
         moved = replace(first, kind="move", waypoints=np.vstack([q0, goal]), checks=0, lin_targets=None,
                         lin_configs=(), lin_speed=0.0)
-    else:
-        detour = roadmap.query(q0, goal) if roadmap is not None else None
-        if detour is None:
-            raise LeadInError(f"no collision-free move from the stop configuration to the first stop of the rest "
-                              f"({first.label})")
+        return [moved, *transitions[1:]]
+    detour = roadmap.query(q0, goal) if roadmap is not None else None
+    if detour is not None:
         moved = replace(first, kind="detour", waypoints=as_written_joints(detour.waypoints), checks=detour.checks,
                         lin_targets=None, lin_configs=(), lin_speed=0.0)
+        return [moved, *transitions[1:]]
+    joined = _joined(world, q0, np.asarray(first.waypoints, dtype=float))
+    if joined is None:
+        raise LeadInError(f"no collision-free move from the stop configuration to the first stop of the rest "
+                          f"({first.label})")
+    moved = replace(first, kind="detour", waypoints=as_written_joints(joined), checks=0, lin_targets=None,
+                    lin_configs=(), lin_speed=0.0)
     return [moved, *transitions[1:]]
+
+
+def _joined(world: CollisionWorld, q0: np.ndarray, waypoints: np.ndarray) -> np.ndarray | None:
+    """The start joined straight to the latest waypoint of the tour's own first move it reaches free,
+    that move followed from there: a robot stopped beside a clamp (a move cut short on its detour)
+    often sees the detour's later waypoints, where the approach point itself is behind the clamp and
+    the roadmap, sampled for moves between spots, has no node it sees. The first move's waypoints
+    were checked free when the tour was sequenced; from home, the first is home itself."""
+    for k in range(len(waypoints) - 2, 0, -1):
+        if world.check_segment(q0, waypoints[k]).free:
+            return np.vstack([q0[None, :], waypoints[k:]])
+    return None

@@ -120,6 +120,21 @@ def test_a_station_file_is_refused_by_name_and_nothing_written(tmp_path: Path, p
 
 
 @pytest.mark.slow
+def test_a_robot_stopped_on_a_detour_beside_a_clamp_continues(tmp_path: Path) -> None:
+    """cells/frame.yaml stopped at 5 s rests on its move from l1 towards the pillar, where neither
+    the straight move nor the roadmap reaches p1's approach point from the stop: the continuation
+    joins the tour's own first move where the stop sees it, and its program verifies clean."""
+    cell, program, out = REPO / "cells" / "frame.yaml", tmp_path / "frame.srcl", tmp_path / "out"
+    shutil.copyfile(REPO / "tests" / "golden" / "shipped" / "frame.srcl", program)
+    result = runner.invoke(app, ["replan", str(cell), str(program), "--at", "5", "--event",
+                                 "appear:post box=0.1,0.1,0.3 xyz=5,5,0.15", "-o", str(out), "--json"])
+    assert result.exit_code == EXIT_OK, result.output
+    report = json.loads(result.stdout)
+    assert report["status"] == "planned" and report["verify"]["clean"], report
+    assert (out / "frame_from_5.cell.yaml").exists()
+
+
+@pytest.mark.slow
 def test_a_trajectory_file_is_replanned_through_the_api(tmp_path: Path, program: Path) -> None:
     """The continuation's own trajectory file (.json) is a program `replan_program` reads: replanned
     again, with no event, where the robot is moving; the second continuation is written and verified
