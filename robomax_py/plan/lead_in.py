@@ -5,7 +5,7 @@ ends). A continuation (`CellSpec.start`, `robomax replan`) starts elsewhere: its
 as usual and its first transition, home to the first approach point, is then made again from the
 start: the straight joint move where it is free of the static obstacles, else a path through the
 plan's roadmap (whose anchors include the start), else the start joined straight to the tour's own
-first move where it sees one of its waypoints. The order and the candidates were chosen for a
+first move where it sees one of its waypoints, else the random trees of `plan.rrt_detour`. The order and the candidates were chosen for a
 start at home; on the ordered jobs that replanning serves (a tending cycle's station visits) only
 the candidate of the first stop could differ, and it is still a valid one.
 """
@@ -19,7 +19,9 @@ import numpy as np
 from robomax_py.errors import RobomaxError
 from robomax_py.plan.results import Transition
 from robomax_py.plan.roadmap import Roadmap
+from robomax_py.plan.rrt_detour import rrt_detour
 from robomax_py.program import as_written_joints
+from robomax_py.robot import JointLimits
 from robomax_py.world.collision import CollisionWorld
 
 # The first move of a continuation is labelled `stop -> <first stop>` (a whole program's: `home -> ...`).
@@ -31,11 +33,14 @@ class LeadInError(RobomaxError):
 
 
 def lead_in(world: CollisionWorld, roadmap: Roadmap | None, start: np.ndarray,
-            transitions: list[Transition]) -> list[Transition]:
+            transitions: list[Transition], limits: JointLimits, rng: np.random.Generator) -> list[Transition]:
     """The transitions with the first one starting at `start` (n,) rad instead of home.
 
     world : the static obstacles (the plan's world); roadmap : the plan's detour roadmap.
-    LeadInError when neither the straight move, a roadmap path nor a join to the first move is free."""
+    limits, rng : the robot's joint limits and the plan's random generator, for the last resort, the
+    random trees of `plan.rrt_detour` (as between two spots no other detour joins).
+    LeadInError when neither the straight move, a roadmap path, a join to the first move nor the
+    random trees within their budget of checks is free."""
     if not transitions:
         return transitions
     first = transitions[0]
@@ -54,8 +59,11 @@ def lead_in(world: CollisionWorld, roadmap: Roadmap | None, start: np.ndarray,
         return [moved, *transitions[1:]]
     joined = _joined(world, q0, np.asarray(first.waypoints, dtype=float))
     if joined is None:
-        raise LeadInError(f"no collision-free move from the stop configuration to the first stop of the rest "
-                          f"({first.label})")
+        searched, _ = rrt_detour(world, limits, q0, goal, rng)
+        if searched is None:
+            raise LeadInError(f"no collision-free move from the stop configuration to the first stop of the rest "
+                              f"({first.label})")
+        joined = searched.waypoints
     moved = replace(first, kind="detour", waypoints=as_written_joints(joined), checks=0, lin_targets=None,
                     lin_configs=(), lin_speed=0.0)
     return [moved, *transitions[1:]]

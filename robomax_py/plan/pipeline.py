@@ -363,7 +363,8 @@ def _timed_tours(cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots
     junction, and an earlier arrival can meet a door that a later one would not. A continuation
     (`cell.start`) has its first move made again from its start (`plan.lead_in`)."""
     if cell.start is not None:
-        transitions = lead_in(world, roadmap, np.asarray(cell.start), transitions)
+        transitions = lead_in(world, roadmap, np.asarray(cell.start), transitions, robot.limits,
+                              np.random.default_rng(cell.planner.seed))
     if not cell.dynamic or options.dynamic != "timed":
         return [time_tour(cell, robot, world, spots, tour, transitions, options, progress, roadmap, loads)]
     out = []

@@ -120,18 +120,21 @@ def test_a_station_file_is_refused_by_name_and_nothing_written(tmp_path: Path, p
 
 
 @pytest.mark.slow
-def test_a_robot_stopped_on_a_detour_beside_a_clamp_continues(tmp_path: Path) -> None:
-    """cells/frame.yaml stopped at 5 s rests on its move from l1 towards the pillar, where neither
-    the straight move nor the roadmap reaches p1's approach point from the stop: the continuation
-    joins the tour's own first move where the stop sees it, and its program verifies clean."""
-    cell, program, out = REPO / "cells" / "frame.yaml", tmp_path / "frame.srcl", tmp_path / "out"
-    shutil.copyfile(REPO / "tests" / "golden" / "shipped" / "frame.srcl", program)
-    result = runner.invoke(app, ["replan", str(cell), str(program), "--at", "5", "--event",
+@pytest.mark.parametrize(("name", "at"), [("frame", 5), ("ur10_tray", 8)])
+def test_a_robot_stopped_where_no_roadmap_node_is_seen_continues(tmp_path: Path, name: str, at: int) -> None:
+    """Stopped there, neither the straight move nor the roadmap reaches the first approach point
+    of the rest from the stop (both continuations were refused): cells/frame.yaml at 5 s rests on
+    its move from l1 towards the pillar and joins the tour's own first move where it sees it;
+    cells/ur10_tray.yaml at 8 s sees none of it and the random trees find the way. Each program
+    verifies clean against the cell it runs in."""
+    cell, program, out = REPO / "cells" / f"{name}.yaml", tmp_path / f"{name}.srcl", tmp_path / "out"
+    shutil.copyfile(REPO / "tests" / "golden" / "shipped" / f"{name}.srcl", program)
+    result = runner.invoke(app, ["replan", str(cell), str(program), "--at", str(at), "--event",
                                  "appear:post box=0.1,0.1,0.3 xyz=5,5,0.15", "-o", str(out), "--json"])
     assert result.exit_code == EXIT_OK, result.output
     report = json.loads(result.stdout)
     assert report["status"] == "planned" and report["verify"]["clean"], report
-    assert (out / "frame_from_5.cell.yaml").exists()
+    assert (out / f"{name}_from_{at}.cell.yaml").exists()
 
 
 @pytest.mark.slow
