@@ -85,10 +85,12 @@ from robomax_py.world.scene import build_scene, clamps_near
 def time_tour(
     cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots: list[SpotCandidates], tour: Tour,
     transitions: list[Transition], options: ResolvedOptions, progress: Progress = _no_progress,
-    roadmap: Roadmap | None = None, loads: Loads | None = None,
+    roadmap: Roadmap | None = None, loads: Loads | None = None, exact: frozenset[int] = frozenset(),
 ) -> tuple[Trajectory, list[SpotPlan], list[Transition]]:
     """Junction by junction (retract, move or detour, approach; `junction.time_junction`) and dwells.
-    A junction carrying a part (`loads`) is checked with it and slowed to its limits."""
+    A junction carrying a part (`loads`) is checked with it and slowed to its limits. The junctions
+    numbered in `exact` (k: the one into the tour's k-th spot) stop at every corner, without fly-by
+    blends, whatever `options.blend` says."""
     grids = [orientation_grid(seam) for seam in cell.seams]
     ends: list[WeldEnd] = []
     welded: list[tuple[int, int, FloatArray, FloatArray]] = []
@@ -121,7 +123,7 @@ def time_tour(
             junction = time_junction(
                 robot, checked, robot.limits, q_start, waypoints, trans.kind, trans.label, before, after,
                 tcp_speed=load.tcp_speed, speed=load.speed, accel=load.accel, jerk_limited=options.jerk_limited,
-                flyby=options.blend, lin_targets=lin_targets, lin_speed=lin_speed,
+                flyby=options.blend and k not in exact, lin_targets=lin_targets, lin_speed=lin_speed,
             )
             # Splines join two spots in a static world: a junction timed around dynamic objects keeps
             # the motion its windows were searched for.

@@ -316,30 +316,61 @@ def test_optimiser_beats_baseline_on_reference_cell() -> None:
     assert optimised.cycle_time < baseline.cycle_time
 
 
-def test_a_blended_timing_that_fails_its_check_is_replaced_by_the_unblended_one(
-    tmp_path: Path, write_small_cell: Any, monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    """Two generated cells (a KR 120 frame and flange) failed with 'the timed program failed its own
-    check: collision: tool_body vs part' at a fly-by blend, though the same tour timed without
-    blends is free. Here the check of every blended timing is made to fail."""
+def _failing_checks(monkeypatch: pytest.MonkeyPatch, failures: int) -> list[bool]:
+    """verify_trajectory made to report a collision at the motion's second sample for its first
+    `failures` calls (as if a blend grazed an object); the real verdicts of every call, in order."""
     from robomax_py.plan import pipeline
 
-    cell = load_cell(write_small_cell(tmp_path, "small"))
-    robot = load_cell_robot(cell)
     real = pipeline.verify_trajectory
     seen: list[bool] = []
 
     def check(world: Any, robot: Any, traj: Any, *args: Any, **kwargs: Any) -> Any:
         got = real(world, robot, traj, *args, **kwargs)
         seen.append(got.clean)
-        if len(seen) == 1:                          # the blended timing: as if it grazed an object
+        if len(seen) <= failures:
             return type(got)((_violation(traj),), got.checks)
         return got
 
     monkeypatch.setattr(pipeline, "verify_trajectory", check)
+    return seen
+
+
+def test_a_blended_junction_that_fails_its_check_is_timed_again_stopping_at_its_corners(
+    tmp_path: Path, write_small_cell: Any, monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Two generated cells (a KR 120 frame and flange) failed with 'the timed program failed its own
+    check: collision: tool_body vs part' at a fly-by blend, though the same tour timed without
+    blends is free. Only the junction the violation falls in (the first: home to the first
+    approach point) is timed again without fly-by; the others keep theirs."""
+    cell = load_cell(write_small_cell(tmp_path, "small"))
+    robot = load_cell_robot(cell)
+    blended = plan_cell(cell, robot, PlanOptions())
+    seen = _failing_checks(monkeypatch, 1)
     result = plan_cell(cell, robot, PlanOptions())
     assert result.status == "planned", result.message
-    assert len(seen) == 2 and result.options.blend is False
+    assert len(seen) == 2 and result.options.blend is True
+    first, *rest = result.transitions
+    assert first.flyby_radius == 0.0 and first.blend_radius == 0.0
+    assert [(t.flyby_radius, t.blend_radius) for t in rest] == [(t.flyby_radius, t.blend_radius)
+                                                                for t in blended.transitions[1:]]
+    assert any(t.flyby_radius > 0.0 for t in rest), "no fly-by left to keep: the test shows nothing"
+    assert verify_trajectory(world_of(cell, robot), robot, result.trajectory).clean  # type: ignore[arg-type]
+
+
+def test_a_tour_whose_junctions_keep_failing_is_timed_without_blends(
+    tmp_path: Path, write_small_cell: Any, monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """When the junctions stopped at their corners still fail (here: every retiming's check made
+    to fail), the whole tour is timed without blends, the straight moves the sequencer proved free."""
+    from robomax_py.plan.pipeline import EXACT_JUNCTION_ROUNDS
+
+    cell = load_cell(write_small_cell(tmp_path, "small"))
+    robot = load_cell_robot(cell)
+    seen = _failing_checks(monkeypatch, 1 + EXACT_JUNCTION_ROUNDS)
+    result = plan_cell(cell, robot, PlanOptions())
+    assert result.status == "planned", result.message
+    assert len(seen) == 2 + EXACT_JUNCTION_ROUNDS and result.options.blend is False
+    assert all(t.flyby_radius == 0.0 and t.blend_radius == 0.0 for t in result.transitions)
     assert verify_trajectory(world_of(cell, robot), robot, result.trajectory).clean  # type: ignore[arg-type]
 
 
