@@ -101,11 +101,17 @@ def test_open_side_detour_geometry(boxed: tuple[Sequencer, Any, tuple[int, int]]
     assert seq._open_side_detour(HOME, 0, 1, b) is None and seq._open_side_detour(0, a, HOME, 0) is None
 
 
-def test_without_the_clamp_above_the_lift_clears_it(tmp_path: Path) -> None:
+def test_without_the_clamp_above_the_lift_clears_it(boxed: tuple[Sequencer, Any, tuple[int, int]],
+                                                    tmp_path: Path) -> None:
+    """The same two configurations, the clamp above taken away: the lift over the clamp is free."""
+    seq, _, (a, b) = boxed
     data = yaml.safe_load(CELL.read_text())
     data["objects"] = [o for o in data["objects"] if not o["name"].startswith("clamp_above")]
     path = tmp_path / "one_clamp.yaml"
     path.write_text(yaml.safe_dump(data, sort_keys=False))
-    seq, _ = _sequencer(path)
-    a, b = _first_blocked(seq)
-    assert seq._lift_detour(0, a, 1, b) is not None
+    alone, _ = _sequencer(path)
+    # The clamp above rules out some candidates at the spots: find the same two among the others.
+    a1 = int(np.flatnonzero((alone.q(0) == seq.q(0)[a]).all(axis=1))[0])
+    b1 = int(np.flatnonzero((alone.q(1) == seq.q(1)[b]).all(axis=1))[0])
+    assert not alone._try_straight(0, a1, 1, b1)
+    assert alone._lift_detour(0, a1, 1, b1) is not None
