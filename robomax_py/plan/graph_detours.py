@@ -266,6 +266,15 @@ class SequencerDetours(SequencerKnowledge):
         self.checks += checks
         return None
 
+    def _faster(self, first: Detour | None, second: Detour | None) -> Detour | None:
+        """The detour of the lower time estimate (the second where equal); the other's checks are
+        counted as spent (a detour taken carries its own)."""
+        if first is None or second is None:
+            return first or second
+        best, other = (first, second) if first.time_estimate < second.time_estimate else (second, first)
+        self.checks += other.checks
+        return best
+
     def _searched_detour(self, i: int, qa: FloatArray, qb: FloatArray) -> Detour | None:
         """The roadmap's detour, the local C-space map's, the faster of both, or the learned C-space
         map's (`planner.detours`)."""
@@ -315,8 +324,15 @@ class SequencerDetours(SequencerKnowledge):
             # `planner.detour_moves: lin`: straight TCP lines first (paper 003's detours), joint-space
             # detours only where none is found.
             det = self._tcp_detour(i, a, j, b) if self.options.detour_moves == "lin" else None
-            det = (det or self._lift_detour(i, a, j, b) or self._open_side_detour(i, a, j, b)
-                   or self._searched_detour(i, self.q(i)[a], self.q(j)[b]) or self._withdrawn_detour(i, a, j, b))
+            det = det or self._lift_detour(i, a, j, b)
+            if det is None:
+                # Where the lift is blocked, the open side is found cheaply where the roadmap often
+                # finds nothing (a clamp with another above it), but where the roadmap finds a way
+                # it may be the faster one: both are asked and the faster taken, so a cell whose
+                # detours the roadmap found plans as it did.
+                det = self._faster(self._open_side_detour(i, a, j, b),
+                                   self._searched_detour(i, self.q(i)[a], self.q(j)[b]))
+            det = det or self._withdrawn_detour(i, a, j, b)
         if det is None and last_resort and not learned_only:
             # A tour with no other way on (`_open_dead_end`): trees grown between the two ends find
             # narrow ways out that the shared roadmap samples too thinly (a few CPU seconds at most).
