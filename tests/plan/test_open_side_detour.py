@@ -9,6 +9,7 @@ the only kind that finds a way for the first of them; without the clamp above, t
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 from typing import Any
 
@@ -21,7 +22,7 @@ from robomax_py.plan import PlanOptions, resolved_options
 from robomax_py.plan.candidates import seam_candidates
 from robomax_py.plan.graph import Sequencer
 from robomax_py.plan.graph_detours import OPEN_SIDE_M, WITHDRAW_M
-from robomax_py.plan.roadmap import Roadmap
+from robomax_py.plan.roadmap import Detour, Roadmap
 from robomax_py.plan.sequence import HOME
 from robomax_py.robot import fk_tcp
 from robomax_py.spec import Box
@@ -71,7 +72,7 @@ def test_only_the_open_side_clears_a_clamp_with_a_clamp_above(boxed: tuple[Seque
     wp = det.waypoints
     np.testing.assert_array_equal(wp[0], seq.q(0)[a])
     np.testing.assert_array_equal(wp[-1], seq.q(1)[b])
-    for q0, q1 in zip(wp[:-1], wp[1:], strict=True):   # checked again here, independently of the search
+    for q0, q1 in itertools.pairwise(wp):          # checked again here, independently of the search
         assert seq.world.check_segment(q0, q1).free
 
 
@@ -115,3 +116,18 @@ def test_without_the_clamp_above_the_lift_clears_it(boxed: tuple[Sequencer, Any,
     b1 = int(np.flatnonzero((alone.q(1) == seq.q(1)[b]).all(axis=1))[0])
     assert not alone._try_straight(0, a1, 1, b1)
     assert alone._lift_detour(0, a1, 1, b1) is not None
+
+
+def test_faster_takes_the_lower_estimate_and_counts_the_other(boxed: tuple[Sequencer, Any, tuple[int, int]]) -> None:
+    """Where the lift fails, the open side's and the roadmap's detours are both asked: the faster
+    estimate is taken (the second where equal), the other's checks counted as spent."""
+    seq, _, _ = boxed
+    wp = np.zeros((2, 6))
+    slow, fast = Detour(wp, 2.0, 100), Detour(wp, 1.0, 7)
+    before = seq.checks
+    assert seq._faster(slow, fast) is fast and seq.checks == before + 100
+    assert seq._faster(fast, slow) is fast and seq.checks == before + 200
+    assert seq._faster(None, slow) is slow and seq._faster(fast, None) is fast and seq._faster(None, None) is None
+    equal = Detour(wp, 1.0, 3)
+    assert seq._faster(fast, equal) is equal
+    assert seq.checks == before + 207
