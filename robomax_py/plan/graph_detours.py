@@ -328,8 +328,8 @@ class SequencerDetours(SequencerKnowledge):
             if det is None:
                 # Where the lift is blocked, the open side is found cheaply where the roadmap often
                 # finds nothing (a clamp with another above it), but where the roadmap finds a way
-                # it may be the faster one: both are asked and the faster taken, so a cell whose
-                # detours the roadmap found plans as it did.
+                # it may be the faster one: both are asked and the faster estimate taken, so where
+                # the roadmap's detours are the faster a cell plans as it did.
                 det = self._faster(self._open_side_detour(i, a, j, b),
                                    self._searched_detour(i, self.q(i)[a], self.q(j)[b]))
             det = det or self._withdrawn_detour(i, a, j, b)
