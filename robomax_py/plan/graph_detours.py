@@ -34,6 +34,11 @@ LIFT_HEIGHTS_M = (0.08, 0.15, 0.25, 0.4)
 WITHDRAW_DIRECTIONS = 8
 WITHDRAW_M = (0.06, 0.12)
 WITHDRAW_PAIRS = 6
+# Stepping round a clamp on the flange's other side (`Sequencer._open_side_detour`): how far (m) the
+# gun, once off the flange, moves along its electrode axis before it crosses. A toggle clamp's jaw
+# stands a few centimetres proud of the flange and the C reaches past its tips: the shortest step
+# that clears both is of the lift heights' order, tried in 5 cm steps (longer ones for deeper tools).
+OPEN_SIDE_M = (0.1, 0.15, 0.2, 0.25, 0.3, 0.4)
 
 
 def _distinct(path: FloatArray) -> FloatArray:
@@ -207,6 +212,69 @@ class SequencerDetours(SequencerKnowledge):
         self.checks += checks
         return None
 
+    def _open_side_detour(self, i: int, a: int, j: int, b: int) -> Detour | None:
+        """Off the flange, out to the side of the part opposite the approach, across, back in.
+
+        A clamp that grips the flange edge blocks the straight move along the row; the lift over it
+        is blocked too where another clamp stands above (stacked rows of flange: lifting the gun
+        lifts the forearm into the clamp of the row above), and the lift's "back" runs along the
+        approach line, the side the clamps' arms and posts may occupy. A programmer slides the C off
+        the edge (`_exits`), steps it along the electrode axis to the other side of the flange, in
+        front of the clamp's jaw, moves across there and comes back the same way. The step goes
+        against the approach line (-TCP z at each end; +z is the lift's "back"), for rising distances
+        of OPEN_SIDE_M, through at most WITHDRAW_PAIRS exit pairs, fastest first. Not from or to
+        home: home is a joint posture, not on a flange."""
+        if HOME in (i, j):
+            return None
+        qa, qb = self.q(i)[a], self.q(j)[b]
+        starts, goals = self._exits(i, a), self._exits(j, b)
+        if not starts or not goals:
+            return None
+        sa, sb = np.array(starts), np.array(goals)
+        sp = 1.0 if self.options.speed is None else self.options.speed
+        est = (np.asarray(ptp_time_estimate(qa[None, :], sa, self.limits, sp))[:, None]
+               + np.asarray(ptp_time_estimate(sa[:, None, :], sb[None, :, :], self.limits, sp))
+               + np.asarray(ptp_time_estimate(sb, qb[None, :], self.limits, sp))[None, :])
+        pairs = np.argsort(est, axis=None, kind="stable")[:WITHDRAW_PAIRS]
+        steps = -np.array(OPEN_SIDE_M)[:, None]            # against the approach line, rising
+        sides: dict[tuple[int, int], FloatArray] = {}     # (end, exit) -> (k, n) stepped configurations
+        legs: dict[tuple[int, ...], bool] = {}            # a leg's verdict, for the exit pairs sharing it
+        checks = 0
+
+        def free(key: tuple[int, ...], p0: FloatArray, p1: FloatArray) -> bool:
+            nonlocal checks
+            if key not in legs:
+                res = self.world_from(i).check_segment(p0, p1)
+                checks += res.checks
+                legs[key] = res.free
+            return legs[key]
+
+        for x, y in ((int(u), int(v)) for u, v in (np.unravel_index(int(flat), est.shape) for flat in pairs)):
+            ea, eb = sa[x], sb[y]
+            for end, e, idx, col in ((0, x, i, a), (1, y, j, b)):
+                if (end, e) not in sides:
+                    q_exit = (sa if end == 0 else sb)[e]
+                    sides[(end, e)] = self._moved(idx, col, q_exit, steps * fk_tcp(self.robot, q_exit)[:3, 2][None, :])
+            for k, (ra, rb) in enumerate(zip(sides[(0, x)], sides[(1, y)], strict=True)):
+                if np.isnan(ra).any() or np.isnan(rb).any():
+                    continue
+                # Cheapest verdicts first: the short legs each end shares with other exit pairs.
+                if (free((0, x), qa, ea) and free((1, y), eb, qb) and free((0, x, k), ea, ra)
+                        and free((1, y, k), rb, eb) and free((2, x, y, k), ra, rb)):
+                    wp = _distinct(np.array([qa, ea, ra, rb, eb, qb]))
+                    return Detour(wp, polyline_time_estimate(wp, self.limits), checks)
+        self.checks += checks
+        return None
+
+    def _faster(self, first: Detour | None, second: Detour | None) -> Detour | None:
+        """The detour of the lower time estimate (the second where equal); the other's checks are
+        counted as spent (a detour taken carries its own)."""
+        if first is None or second is None:
+            return first or second
+        best, other = (first, second) if first.time_estimate < second.time_estimate else (second, first)
+        self.checks += other.checks
+        return best
+
     def _searched_detour(self, i: int, qa: FloatArray, qb: FloatArray) -> Detour | None:
         """The roadmap's detour, the local C-space map's, the faster of both, or the learned C-space
         map's (`planner.detours`)."""
@@ -256,8 +324,15 @@ class SequencerDetours(SequencerKnowledge):
             # `planner.detour_moves: lin`: straight TCP lines first (paper 003's detours), joint-space
             # detours only where none is found.
             det = self._tcp_detour(i, a, j, b) if self.options.detour_moves == "lin" else None
-            det = (det or self._lift_detour(i, a, j, b) or self._searched_detour(i, self.q(i)[a], self.q(j)[b])
-                   or self._withdrawn_detour(i, a, j, b))
+            det = det or self._lift_detour(i, a, j, b)
+            if det is None:
+                # Where the lift is blocked, the open side is found cheaply where the roadmap often
+                # finds nothing (a clamp with another above it), but where the roadmap finds a way
+                # it may be the faster one: both are asked and the faster estimate taken, so where
+                # the roadmap's detours are the faster a cell plans as it did.
+                det = self._faster(self._open_side_detour(i, a, j, b),
+                                   self._searched_detour(i, self.q(i)[a], self.q(j)[b]))
+            det = det or self._withdrawn_detour(i, a, j, b)
         if det is None and last_resort and not learned_only:
             # A tour with no other way on (`_open_dead_end`): trees grown between the two ends find
             # narrow ways out that the shared roadmap samples too thinly (a few CPU seconds at most).

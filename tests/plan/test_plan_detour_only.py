@@ -74,6 +74,7 @@ def _sequencer(cell: CellSpec, robot: Any, world: Any, spots: list[SpotCandidate
                      np.random.default_rng(0))
     seq._lift_detour = lambda i, a, j, b: None  # type: ignore[method-assign]   # no way over the "clamp"
     seq._withdrawn_detour = lambda i, a, j, b: None  # type: ignore[method-assign]   # nor off the flange
+    seq._open_side_detour = lambda i, a, j, b: None  # type: ignore[method-assign]   # nor round its open side
     return seq
 
 
