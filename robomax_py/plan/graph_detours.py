@@ -172,12 +172,10 @@ class SequencerDetours(SequencerKnowledge):
         self._exit_cache[key] = out
         return out
 
-    def _withdrawn_detour(self, i: int, a: int, j: int, b: int) -> Detour | None:
-        """Off the flange, (up,) across, (down,) onto the flange: each end leaves its approach point
-        perpendicular to the electrode axis (`_exits`), then the straight move between the two exits,
-        else both exits raised by h (world up) for rising h. This is how the gun is turned over a
-        flange between two faces of a part: the C slid off one edge, turned clear of the part, slid
-        onto the other edge. At most WITHDRAW_PAIRS exit pairs are tried, fastest first."""
+    def _exit_pairs(self, i: int, a: int, j: int, b: int) -> tuple[FloatArray, FloatArray, list[tuple[int, int]]] | None:
+        """Both ends' exits off the flange (`_exits`) and at most WITHDRAW_PAIRS (start exit, goal
+        exit) index pairs, fastest first by the rest-to-rest estimate leave + across + arrive;
+        None where either end has no exit."""
         qa, qb = self.q(i)[a], self.q(j)[b]
         starts, goals = self._exits(i, a), self._exits(j, b)
         if not starts or not goals:
@@ -188,12 +186,24 @@ class SequencerDetours(SequencerKnowledge):
         across = np.asarray(ptp_time_estimate(sa[:, None, :], sb[None, :, :], self.limits, sp))
         arrive = np.asarray(ptp_time_estimate(sb, qb[None, :], self.limits, sp))
         est = leave[:, None] + across + arrive[None, :]
+        ranked = np.argsort(est, axis=None, kind="stable")[:WITHDRAW_PAIRS]
+        return sa, sb, [(int(x), int(y)) for x, y in (np.unravel_index(int(flat), est.shape) for flat in ranked)]
+
+    def _withdrawn_detour(self, i: int, a: int, j: int, b: int) -> Detour | None:
+        """Off the flange, (up,) across, (down,) onto the flange: each end leaves its approach point
+        perpendicular to the electrode axis (`_exits`), then the straight move between the two exits,
+        else both exits raised by h (world up) for rising h. This is how the gun is turned over a
+        flange between two faces of a part: the C slid off one edge, turned clear of the part, slid
+        onto the other edge. At most WITHDRAW_PAIRS exit pairs are tried, fastest first."""
+        qa, qb = self.q(i)[a], self.q(j)[b]
+        exits = self._exit_pairs(i, a, j, b)
+        if exits is None:
+            return None
+        sa, sb, pairs = exits
         up = self._up()
         checks = 0
-        pairs = np.argsort(est, axis=None, kind="stable")[:WITHDRAW_PAIRS]
         for heights in ((0.0,), LIFT_HEIGHTS_M):
-            for flat in pairs:
-                x, y = np.unravel_index(int(flat), est.shape)
+            for x, y in pairs:
                 ea, eb = sa[x], sb[y]
                 for h in heights:
                     if h == 0.0:
@@ -227,15 +237,10 @@ class SequencerDetours(SequencerKnowledge):
         if HOME in (i, j):
             return None
         qa, qb = self.q(i)[a], self.q(j)[b]
-        starts, goals = self._exits(i, a), self._exits(j, b)
-        if not starts or not goals:
+        exits = self._exit_pairs(i, a, j, b)
+        if exits is None:
             return None
-        sa, sb = np.array(starts), np.array(goals)
-        sp = 1.0 if self.options.speed is None else self.options.speed
-        est = (np.asarray(ptp_time_estimate(qa[None, :], sa, self.limits, sp))[:, None]
-               + np.asarray(ptp_time_estimate(sa[:, None, :], sb[None, :, :], self.limits, sp))
-               + np.asarray(ptp_time_estimate(sb, qb[None, :], self.limits, sp))[None, :])
-        pairs = np.argsort(est, axis=None, kind="stable")[:WITHDRAW_PAIRS]
+        sa, sb, pairs = exits
         steps = -np.array(OPEN_SIDE_M)[:, None]            # against the approach line, rising
         sides: dict[tuple[int, int], FloatArray] = {}     # (end, exit) -> (k, n) stepped configurations
         legs: dict[tuple[int, ...], bool] = {}            # a leg's verdict, for the exit pairs sharing it
@@ -249,7 +254,7 @@ class SequencerDetours(SequencerKnowledge):
                 legs[key] = res.free
             return legs[key]
 
-        for x, y in ((int(u), int(v)) for u, v in (np.unravel_index(int(flat), est.shape) for flat in pairs)):
+        for x, y in pairs:
             ea, eb = sa[x], sb[y]
             for end, e, idx, col in ((0, x, i, a), (1, y, j, b)):
                 if (end, e) not in sides:
