@@ -293,22 +293,13 @@ class SequencerDetours(SequencerKnowledge):
             if det is None:
                 self.checks += spent           # a found detour's checks are counted with it
             return det
-        found: list[Detour] = []
-        if kind in ("roadmap", "both"):
-            det = self.roadmap_from(i).query(qa, qb)
-            if det is not None:
-                found.append(det)
+        on_roadmap = self.roadmap_from(i).query(qa, qb) if kind in ("roadmap", "both") else None
+        on_map: Detour | None = None
         if kind in ("cspace", "both"):
-            det, spent = grid_detour(self.world_from(i), self.limits, qa, qb)
-            if det is None:
+            on_map, spent = grid_detour(self.world_from(i), self.limits, qa, qb)
+            if on_map is None:
                 self.checks += spent           # a found detour's checks are counted with it
-            else:
-                found.append(det)
-        if not found:
-            return None
-        best = min(found, key=lambda d: d.time_estimate)
-        self.checks += sum(d.checks for d in found if d is not best)
-        return best
+        return self._faster(on_map, on_roadmap)  # the roadmap's where both estimate the same
 
     def _back_direction(self, idx: int, col: int) -> FloatArray:
         """Unit vector (base frame) from the spot to its approach point: away from the part."""
