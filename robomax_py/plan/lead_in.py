@@ -17,7 +17,7 @@ from dataclasses import replace
 import numpy as np
 
 from robomax_py.errors import RobomaxError
-from robomax_py.plan.results import Transition
+from robomax_py.plan.results import Transition, TransitionKind
 from robomax_py.plan.roadmap import Roadmap
 from robomax_py.plan.rrt_detour import rrt_detour
 from robomax_py.program import as_written_joints
@@ -48,15 +48,18 @@ def lead_in(world: CollisionWorld, roadmap: Roadmap | None, start: np.ndarray,
     goal = np.asarray(first.waypoints[-1], dtype=float)
     label = f"{START_LABEL} ->" + first.label.partition("->")[2] if "->" in first.label else first.label
     first = replace(first, label=label)
-    if world.check_segment(q0, goal).free:
-        moved = replace(first, kind="move", waypoints=np.vstack([q0, goal]), checks=0, lin_targets=None,
-                        lin_configs=(), lin_speed=0.0)
+
+    def led(kind: TransitionKind, waypoints: np.ndarray, checks: int) -> list[Transition]:
+        # Joint moves from the start: a TCP line detour's lines were for a start at home.
+        moved = replace(first, kind=kind, waypoints=waypoints, checks=checks, lin_targets=None, lin_configs=(),
+                        lin_speed=0.0)
         return [moved, *transitions[1:]]
+
+    if world.check_segment(q0, goal).free:
+        return led("move", np.vstack([q0, goal]), 0)
     detour = roadmap.query(q0, goal) if roadmap is not None else None
     if detour is not None:
-        moved = replace(first, kind="detour", waypoints=as_written_joints(detour.waypoints), checks=detour.checks,
-                        lin_targets=None, lin_configs=(), lin_speed=0.0)
-        return [moved, *transitions[1:]]
+        return led("detour", as_written_joints(detour.waypoints), detour.checks)
     joined = _joined(world, q0, np.asarray(first.waypoints, dtype=float))
     if joined is None:
         searched, _ = rrt_detour(world, limits, q0, goal, rng)
@@ -64,9 +67,7 @@ def lead_in(world: CollisionWorld, roadmap: Roadmap | None, start: np.ndarray,
             raise LeadInError(f"no collision-free move from the stop configuration to the first stop of the rest "
                               f"({first.label})")
         joined = searched.waypoints
-    moved = replace(first, kind="detour", waypoints=as_written_joints(joined), checks=0, lin_targets=None,
-                    lin_configs=(), lin_speed=0.0)
-    return [moved, *transitions[1:]]
+    return led("detour", as_written_joints(joined), 0)
 
 
 def _joined(world: CollisionWorld, q0: np.ndarray, waypoints: np.ndarray) -> np.ndarray | None:
