@@ -175,12 +175,15 @@ def improve_orders(start: Plan, makespan: Callable[[Plan], float], orders: Calla
         now = dict(orders(best))
         span = makespan(best)
         fresh = [c for c in propose(best) if _state({**now, c.robot: c.order}) not in seen]
-        bounded = [(math.inf if gain is None else gain(best, c), c) for c in fresh]
-        worth = sorted(((g, c) for g, c in bounded if g >= MIN_GAIN_SHARE * span), key=lambda gc: -gc[0])
-        for g, change in bounded:
-            if g < MIN_GAIN_SHARE * span:
+        worth: list[tuple[float, OrderChange]] = []
+        for change in fresh:
+            g = math.inf if gain is None else gain(best, change)
+            if g >= MIN_GAIN_SHARE * span:
+                worth.append((g, change))
+            else:
+                skipped += 1
                 log.debug("order change %s not planned: it could gain %.3f s at most", change.why, g)
-        skipped += len(bounded) - len(worth)
+        worth.sort(key=lambda gc: -gc[0])
         for g, change in worth[:ORDER_CANDIDATES]:
             if found is not None and makespan(found[0]) <= span - g + MAKESPAN_EPS_S:
                 # No change left (the most gain first) could end sooner than the one found.
