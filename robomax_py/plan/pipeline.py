@@ -370,7 +370,7 @@ def _given_order(sequencer: Sequencer, tour: Tour, searched: _Timed, cell: CellS
     log.debug("given order: estimate %.3f s against the searched tour's %.3f s (%.4f)", outcome.tour.cost, tour.cost,
               ratio)
     if searched_cycle is not None and ratio >= 1.0 + GIVEN_ORDER_MARGIN:
-        longer = "the same" if ratio < 1.0 + 1e-9 else f"{100 * (ratio - 1):.1f} % longer"
+        longer = "the same" if ratio < 1.0 - GIVEN_ORDER_MARGIN else f"{100 * (ratio - 1):.1f} % longer"
         note = f"the file's order is estimated {longer}"
         return OrderChoice("searched", searched_cycle, None, note), None, published.checks
     # Silent: the stages' progress bars have finished for the searched tour.
