@@ -34,6 +34,7 @@ from robomax_py.io.cell_file import (
 )
 from robomax_py.io.cell_rewrite import _read_resolved, dump_cell_file
 from robomax_py.io.cell_spot_lists import _with_spot_lists
+from robomax_py.io.includes import rebased_reference
 from robomax_py.io.plan_set_check import CELL_FILE_SUFFIX
 from robomax_py.io.robot import resolve_robot_file, resolve_tool_file
 from robomax_py.spec import Box, CellSpec, Cylinder, ObjectSpec, Sphere, dynamic_signal
@@ -171,25 +172,20 @@ def _relocated(cell: CellFile, source: Path, out_dir: Path) -> CellFile:
             update["trajectory"] = _rebased(o.trajectory, src_dir, dst_dir)
         if getattr(o, "robot", None) is not None:
             r = o.robot
-            robot_update: dict[str, Any] = {"model": _reference(r.model, here, there, dst_dir, resolve_robot_file)}
+            robot_update: dict[str, Any] = {"model": rebased_reference(r.model, here, there, resolve_robot_file)}
             if r.tool is not None:
-                robot_update["tool"] = _reference(r.tool, here, there, dst_dir, resolve_tool_file)
+                robot_update["tool"] = rebased_reference(r.tool, here, there, resolve_tool_file)
             update["robot"] = r.model_copy(update=robot_update)
         return o.model_copy(update=update) if update else o
 
     update: dict[str, Any] = {"objects": [obj(o) for o in cell.objects]}
     if cell.dynamic:
         update["dynamic"] = [obj(o) for o in cell.dynamic]
-    update["robot"] = cell.robot.model_copy(update={"model": _reference(cell.robot.model, here, there, dst_dir,
-                                                                        resolve_robot_file)})
-    update["tool"] = _reference(cell.tool, here, there, dst_dir, resolve_tool_file)
+    update["robot"] = cell.robot.model_copy(update={"model": rebased_reference(cell.robot.model, here, there,
+                                                                             resolve_robot_file)})
+    update["tool"] = rebased_reference(cell.tool, here, there, resolve_tool_file)
     if cell.tending is not None:
         machines = [m.model_copy(update={"door": obj(m.door)}) for m in cell.tending.machines]
         update["tending"] = cell.tending.model_copy(update={"machines": machines})
     return cell.model_copy(update=update)
 
-
-def _reference(ref: str, here: Path, there: Path, dst_dir: Path, resolve: Any) -> str:
-    """A robot or tool as the cell names it: kept when it names the same file from `there`."""
-    found = resolve(ref, here)
-    return ref if found == resolve(ref, there) else Path(os.path.relpath(found, dst_dir)).as_posix()

@@ -179,9 +179,9 @@ def _merge(included: dict[str, Any], file: Path, merged: dict[str, Any], out: Ex
         out.given_in[key] = file
         value = included[key]
         if key == "robot" and isinstance(value.get("model"), str):
-            value = {**value, "model": _rebased_reference(value["model"], file, out.cell, resolve_robot_file)}
+            value = {**value, "model": rebased_reference(value["model"], file, out.cell, resolve_robot_file)}
         elif key == "tool":
-            value = _rebased_reference(value, file, out.cell, resolve_tool_file)
+            value = rebased_reference(value, file, out.cell, resolve_tool_file)
         merged[key] = value
 
 
@@ -204,7 +204,9 @@ def _rebased_path(named: str, file: Path, cell: Path) -> str:
     return Path(os.path.relpath(file.parent / named, cell.parent)).as_posix()
 
 
-def _rebased_reference(ref: str, file: Path, cell: Path, resolve: Any) -> str:
-    """A robot or tool reference of an included file: a library name stays, a path is rebased."""
+def rebased_reference(ref: str, file: Path, cell: Path, resolve: Any) -> str:
+    """A robot or tool reference as named in `file`, named from `cell` instead (an included file's
+    in its including cell; a cell's in a copy written elsewhere): kept where it names the same file
+    from both (a library name), else the path relative to `cell`'s folder."""
     there = resolve(ref, file)
     return ref if there == resolve(ref, cell) else Path(os.path.relpath(there, cell.parent)).as_posix()
