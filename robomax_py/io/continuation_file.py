@@ -35,14 +35,12 @@ from robomax_py.io.cell_file import (
 from robomax_py.io.cell_rewrite import _read_resolved, dump_cell_file
 from robomax_py.io.cell_spot_lists import _with_spot_lists
 from robomax_py.io.includes import rebased_reference
-from robomax_py.io.plan_set_check import CELL_FILE_SUFFIX
 from robomax_py.io.robot import resolve_robot_file, resolve_tool_file
 from robomax_py.spec import Box, CellSpec, Cylinder, ObjectSpec, Sphere, dynamic_signal
 from robomax_py.transforms import rpy_from_matrix
 
-__all__ = ["CONTINUATION_SUFFIX", "ContinuationText", "continuation_cell_text"]
+__all__ = ["ContinuationText", "continuation_cell_text"]
 
-CONTINUATION_SUFFIX = CELL_FILE_SUFFIX
 DECIMALS = 9                 # m, deg and s written: far below every tolerance verify applies
 
 

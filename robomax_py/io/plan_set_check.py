@@ -17,6 +17,7 @@ from robomax_py.safe_files import LIMITS, read_text
 # A set's own cell file (`robomax replan` writes the cell a continuation runs in beside its programs).
 CELL_FILE_SUFFIX = ".cell.yaml"
 
+
 @dataclass(frozen=True, slots=True)
 class SetCheck:
     """Whether a program file is one of the files of the plan's set beside it.

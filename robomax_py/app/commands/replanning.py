@@ -50,8 +50,8 @@ def replan(
             from robomax_py.app.replan import replan as replan_program
             from robomax_py.export import SHARED_FILES, choose_formats
             from robomax_py.io.cell import cell_from_mapping, load_cell, load_cell_robot
-            from robomax_py.io.continuation_file import CONTINUATION_SUFFIX
             from robomax_py.io.files import commit_set
+            from robomax_py.io.plan_set_check import CELL_FILE_SUFFIX
             from robomax_py.publish import publish
             from robomax_py.verify import verify_program
         _honour_signals()
@@ -77,7 +77,7 @@ def replan(
             files, digest = dict(texts), spec.digest
             # The cell the continuation runs in, as a file beside its programs (one set with them),
             # so that `robomax verify` checks them against it: it must load from there first.
-            cell_file = out_dir / f"{outcome.name}{CONTINUATION_SUFFIX}"
+            cell_file = out_dir / f"{outcome.name}{CELL_FILE_SUFFIX}"
             written_cell = continuation_file(cell, out_dir, spec, robot, outcome)
             if written_cell.text is not None:
                 import hashlib
