@@ -30,6 +30,7 @@ import numpy as np
 
 from robomax_py.io.cell import dump_cell_file, load_cell, read_cell_file
 from robomax_py.io.cell_file import CellFile, ObjectFile, SeamFile
+from robomax_py.io.includes import rebased_reference
 from robomax_py.io.robot import resolve_robot_file, resolve_tool_file
 
 DECIMALS = 6                          # written values: µm, µdeg, 1e-6 of a unit vector
@@ -171,13 +172,12 @@ def _relocated(cell: CellFile, cell_path: Path, out_dir: Path) -> CellFile:
     update: dict[str, object] = {"objects": objects, "dynamic": dynamic}
     # A robot or tool named by a relative path (not a library name) is referenced from out_dir.
     here, there = cell_path.resolve(), dst_dir / cell_path.name
-    robot_file = resolve_robot_file(cell.robot.model, here)
-    if robot_file != resolve_robot_file(cell.robot.model, there):
-        model = Path(os.path.relpath(robot_file, dst_dir)).as_posix()
+    model = rebased_reference(cell.robot.model, here, there, resolve_robot_file)
+    if model != cell.robot.model:
         update["robot"] = cell.robot.model_copy(update={"model": model})
-    tool_file = resolve_tool_file(cell.tool, here)
-    if tool_file != resolve_tool_file(cell.tool, there):
-        update["tool"] = Path(os.path.relpath(tool_file, dst_dir)).as_posix()
+    tool = rebased_reference(cell.tool, here, there, resolve_tool_file)
+    if tool != cell.tool:
+        update["tool"] = tool
     return cell.model_copy(update=update)
 
 
