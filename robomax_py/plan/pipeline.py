@@ -40,7 +40,7 @@ from robomax_py.plan.results import (
 )
 from robomax_py.plan.roadmap import Roadmap
 from robomax_py.plan.sequence import Tour, choice_for_order
-from robomax_py.plan.tour_timing import time_tour
+from robomax_py.plan.tour_timing import JunctionMemo, time_tour
 from robomax_py.plan.waiting import WaitingError
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
@@ -267,8 +267,14 @@ def _checked_timing(cell: CellSpec, robot: RobotModel, world: CollisionWorld, fu
                     spots: list[SpotCandidates], tour: Tour, found: Sequence[Transition], options: ResolvedOptions,
                     progress: Progress, roadmap: Roadmap, loads: Loads | None) -> _Timed:
     """`_time_and_check` once the transitions are final."""
+    memo: JunctionMemo = {}
     try:
-        timings = _timed_tours(cell, robot, world, spots, tour, list(found), options, progress, roadmap, loads)
+        if cell.start is not None:
+            # A continuation's first move is made again from its start, once for every timing below.
+            found = lead_in(world, roadmap, np.asarray(cell.start), list(found), robot.limits,
+                            np.random.default_rng(cell.planner.seed))
+        timings = _timed_tours(cell, robot, world, spots, tour, list(found), options, progress, roadmap, loads,
+                               memo=memo)
     except TimingError as exc:
         return _Timed(None, [], [], options, 0, 0.0, f"timing failed: {exc}")
     except WaitingError as exc:
@@ -303,7 +309,7 @@ def _checked_timing(cell: CellSpec, robot: RobotModel, world: CollisionWorld, fu
         t1 = time.perf_counter()
         try:
             retimed = _timed_tours(cell, robot, world, spots, tour, list(found), options, progress, roadmap, loads,
-                                   exact)
+                                   exact, memo)
         except (TimingError, WaitingError):
             break
         t0 += time.perf_counter() - t1        # timing, not checking
@@ -318,7 +324,7 @@ def _checked_timing(cell: CellSpec, robot: RobotModel, world: CollisionWorld, fu
         t1 = time.perf_counter()
         try:
             unblended = _timed_tours(cell, robot, world, spots, tour, list(found),
-                                     replace(options, blend=False), progress, roadmap, loads)
+                                     replace(options, blend=False), progress, roadmap, loads, memo=memo)
         except (TimingError, WaitingError):
             unblended = []
         t0 += time.perf_counter() - t1        # timing, not checking
@@ -386,16 +392,17 @@ def _given_order(sequencer: Sequencer, tour: Tour, searched: _Timed, cell: CellS
 
 def _timed_tours(cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots: list[SpotCandidates], tour: Tour,
                  transitions: list[Transition], options: ResolvedOptions, progress: Progress,
-                 roadmap: Roadmap, loads: Loads | None = None,
-                 exact: frozenset[int] = frozenset()) -> list[tuple[Trajectory, list[SpotPlan], list[Transition]]]:
+                 roadmap: Roadmap, loads: Loads | None = None, exact: frozenset[int] = frozenset(),
+                 memo: JunctionMemo | None = None) -> list[tuple[Trajectory, list[SpotPlan], list[Transition]]]:
     """The tour timed, best first. With dynamic objects planned in time (`planner.dynamic: timed`)
     it is also timed waiting at rest, shorter first: the time-aware choice is made junction by
-    junction, and an earlier arrival can meet a door that a later one would not. A continuation
-    (`cell.start`) has its first move made again from its start (`plan.lead_in`)."""
-    if cell.start is not None:
-        transitions = lead_in(world, roadmap, np.asarray(cell.start), transitions, robot.limits,
-                              np.random.default_rng(cell.planner.seed))
-    if not cell.dynamic or options.dynamic != "timed":
+    junction, and an earlier arrival can meet a door that a later one would not. `memo` keeps the
+    junctions timed across calls for the same tour (`tour_timing.JunctionMemo`), without dynamic
+    objects only."""
+    if not cell.dynamic:
+        return [time_tour(cell, robot, world, spots, tour, transitions, options, progress, roadmap, loads, exact,
+                          memo)]
+    if options.dynamic != "timed":
         return [time_tour(cell, robot, world, spots, tour, transitions, options, progress, roadmap, loads, exact)]
     out = []
     failure: WaitingError | None = None

@@ -81,16 +81,25 @@ from robomax_py.transforms import invert
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.scene import build_scene, clamps_near
 
+# Junctions already timed for one tour, its transitions and options: junction k from a start
+# configuration (its bytes), with fly-by or stopping at every corner. A junction starts at rest
+# where the one before it ended, so a tour timed again with only some junctions changed (`exact`)
+# times those alone: on a 240-spot cell each timing of the whole tour cost about 17 s.
+JunctionMemo = dict[tuple[int, bool, bytes], tuple[list[Segment], Transition]]
+
 
 def time_tour(
     cell: CellSpec, robot: RobotModel, world: CollisionWorld, spots: list[SpotCandidates], tour: Tour,
     transitions: list[Transition], options: ResolvedOptions, progress: Progress = _no_progress,
     roadmap: Roadmap | None = None, loads: Loads | None = None, exact: frozenset[int] = frozenset(),
+    memo: JunctionMemo | None = None,
 ) -> tuple[Trajectory, list[SpotPlan], list[Transition]]:
     """Junction by junction (retract, move or detour, approach; `junction.time_junction`) and dwells.
     A junction carrying a part (`loads`) is checked with it and slowed to its limits. The junctions
     numbered in `exact` (k: the one into the tour's k-th spot) stop at every corner, without fly-by
-    blends, whatever `options.blend` says."""
+    blends, whatever `options.blend` says. A `memo` given for the same tour, transitions and options
+    (`blend` aside) keeps the junctions timed and is read before timing one again; not with dynamic
+    objects, whose waits depend on the time a junction starts."""
     grids = [orientation_grid(seam) for seam in cell.seams]
     ends: list[WeldEnd] = []
     welded: list[tuple[int, int, FloatArray, FloatArray]] = []
@@ -104,7 +113,18 @@ def time_tour(
     spec_of = [cell.seams[spots[i].seam_index].spots[spots[i].spot_index] for i in tour.order]
     weld_times = [written_seconds(cell.process.weld_time_of(spot)) for spot in spec_of]
     def junction_block(k: int, q_start: FloatArray) -> tuple[list[Segment], Transition]:
-        """Junction k timed from q_start, and the action after it."""
+        """Junction k timed from q_start, and the action after it (from `memo` where it holds it)."""
+        flyby = options.blend and k not in exact
+        key = (k, flyby, np.asarray(q_start, dtype=float).tobytes())
+        if memo is None or key not in memo:
+            got = _junction_block(k, q_start, flyby)
+            if memo is None:
+                return got
+            memo[key] = got
+        block, trans = memo[key]
+        return list(block), trans             # the caller's list: a memo's block is never edited
+
+    def _junction_block(k: int, q_start: FloatArray, flyby: bool) -> tuple[list[Segment], Transition]:
         before = ends[k - 1] if k > 0 else None
         after = ends[k] if k < len(ends) else None
         waypoints = as_written_joints(transitions[k].waypoints)      # the first row: where the retract ends
@@ -123,7 +143,7 @@ def time_tour(
             junction = time_junction(
                 robot, checked, robot.limits, q_start, waypoints, trans.kind, trans.label, before, after,
                 tcp_speed=load.tcp_speed, speed=load.speed, accel=load.accel, jerk_limited=options.jerk_limited,
-                flyby=options.blend and k not in exact, lin_targets=lin_targets, lin_speed=lin_speed,
+                flyby=flyby, lin_targets=lin_targets, lin_speed=lin_speed,
             )
             # Splines join two spots in a static world: a junction timed around dynamic objects keeps
             # the motion its windows were searched for.

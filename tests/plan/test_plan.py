@@ -342,13 +342,25 @@ def test_a_blended_junction_that_fails_its_check_is_timed_again_stopping_at_its_
     check: collision: tool_body vs part' at a fly-by blend, though the same tour timed without
     blends is free. Only the junction the violation falls in (the first: home to the first
     approach point) is timed again without fly-by; the others keep theirs."""
+    from robomax_py.plan import tour_timing
+
     cell = load_cell(write_small_cell(tmp_path, "small"))
     robot = load_cell_robot(cell)
     blended = plan_cell(cell, robot, PlanOptions())
     seen = _failing_checks(monkeypatch, 1)
+    timed_after: list[int] = []               # per junction timed: the checks made before it
+    real_time_junction = tour_timing.time_junction
+
+    def counted(*args: Any, **kwargs: Any) -> Any:
+        timed_after.append(len(seen))
+        return real_time_junction(*args, **kwargs)
+
+    monkeypatch.setattr(tour_timing, "time_junction", counted)
     result = plan_cell(cell, robot, PlanOptions())
     assert result.status == "planned", result.message
     assert len(seen) == 2 and result.options.blend is True
+    # The re-timing between the two checks times the changed junction alone; the others are kept.
+    assert timed_after.count(0) >= len(result.transitions) and timed_after.count(1) == 1
     first, *rest = result.transitions
     assert first.flyby_radius == 0.0 and first.blend_radius == 0.0
     assert [(t.flyby_radius, t.blend_radius) for t in rest] == [(t.flyby_radius, t.blend_radius)
