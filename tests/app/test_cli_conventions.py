@@ -159,3 +159,17 @@ def test_examples_refuse_to_overwrite(tmp_path: Path) -> None:
     assert result.exit_code == EXIT_OK, result.output
     assert edited.read_bytes() == (examples_dir() / "frame.yaml").read_bytes()
     assert load_cell(folder / "cabin_flange.yaml").name == "cabin_flange"   # its mesh came along
+
+
+@pytest.mark.parametrize("program", ["cell.src", "cell.srcl", "cell.json", "cell.ls"])
+def test_verify_with_program_and_cell_swapped_says_so(tmp_path: Path, write_small_cell: SmallCell,
+                                                      program: str) -> None:
+    """The cell comes first; given the other way round, the program would be read as a YAML cell
+    and fail on its first statement. The message names the order instead, before any file is read."""
+    cell = write_small_cell(tmp_path, "small")
+    written = tmp_path / program
+    written.write_text("DEF cell( )\nPTP {A1 0}\nEND\n")
+    result = runner.invoke(app, ["verify", str(written), str(cell)])
+    assert result.exit_code == EXIT_BAD_INPUT
+    assert "takes the cell first" in result.output and "Traceback" not in result.output
+    assert f"robomax verify {cell} {written}" in " ".join(result.output.split())

@@ -186,10 +186,16 @@ def verify(
 
     def run() -> int:
         from robomax_py.errors import ProgramError
+        from robomax_py.export import dialect_for_file
         from robomax_py.io.cell import load_cell, load_cell_robot
         from robomax_py.io.station import is_station_file
         from robomax_py.verify import verify_program
 
+        swapped = [p for p in programs if p.suffix.lower() in (".yaml", ".yml")]
+        if swapped and (cell.suffix.lower() == ".json" or dialect_for_file(cell.suffix) is not None):
+            # Read as a cell, a program fails as YAML on its first statement: name the mix-up instead.
+            raise ProgramError(cell, None, f"a program where the cell is expected: `robomax verify` takes the cell "
+                               f"first (robomax verify {swapped[0]} {cell})")
         if is_station_file(cell):
             from robomax_py.app.station_report import print_station_verify
 
