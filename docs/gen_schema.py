@@ -1,6 +1,6 @@
 """JSON Schemas of the files people write (cell, robot.yaml, tool.yaml), from the pydantic models.
 
-The models in `robomax_py/io/cell_file.py` and `robomax_py/io/robot.py` are what robomax accepts; this
+The models in `robomax_py/io/cell_file*.py` and `robomax_py/io/robot.py` are what robomax accepts; this
 script turns them into JSON Schema for editors (YAML completion and checking as you type) and into
 the key tables of the documentation, with a one-line description of every key from DESCRIPTIONS
 below. A key the models gain without a description here makes `python docs/gen_schema.py` fail, and
@@ -19,7 +19,7 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from robomax_py.io.cell import CellFile
+from robomax_py.io.cell_file import CellFile
 from robomax_py.io.robot import RobotFile, ToolFile
 
 SCHEMA_DIR = Path(__file__).resolve().parent / "schema"

@@ -3,10 +3,10 @@
 Every user mistake becomes one CellFileError naming the file, the key path (e.g.
 `seams[0].spots[3].normal`) and the problem; nothing here prints. This module reads the file and
 puts the cell together; its parts are built by the modules beside it, the only ones that know
-cell-file keys: the schema (`cell_file`), the size limits (`cell_limits`), objects
-(`cell_objects`), the job's seams (`cell_jobs`), the robot's home and controller (`cell_robot`),
-spot lists (`cell_spot_lists`), likely mistakes (`cell_lint`) and how errors are reported
-(`cell_problems`). Tools that rewrite cells read and write them through `cell_rewrite`.
+cell-file keys: the schema (`cell_file`, with `cell_file_values`, `cell_file_dynamic` and
+`cell_file_jobs`), the size limits (`cell_limits`), objects (`cell_objects`), the job's seams
+(`cell_jobs`), the robot's home and controller (`cell_robot`), spot lists (`cell_spot_lists`),
+likely mistakes (`cell_lint`) and how errors are reported (`cell_problems`). Tools that rewrite cells read and write them through `cell_rewrite`.
 """
 
 from __future__ import annotations
@@ -24,14 +24,12 @@ from pydantic import (
 
 from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.io.cell_continuation import file_continuation
-from robomax_py.io.cell_file import (
+from robomax_py.io.cell_file import CellFile, IncludeFile
+from robomax_py.io.cell_file_jobs import PICK_PLACE_SEAM, TENDING_SEAM
+from robomax_py.io.cell_file_values import (
     CELL_LIMITS,
     MAX_CELL_NAME_CHARS,
-    PICK_PLACE_SEAM,
     SUPPORTED_VERSIONS,
-    TENDING_SEAM,
-    CellFile,
-    IncludeFile,
 )
 from robomax_py.io.cell_jobs import _job_seams, _machines, _parts, _tcp_limits
 from robomax_py.io.cell_limits import (

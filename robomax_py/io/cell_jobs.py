@@ -9,18 +9,14 @@ from pathlib import Path
 import numpy as np
 
 from robomax_py.errors import CellFileError
-from robomax_py.io.cell_file import (
-    MAX_WINDOW_S,
-    MIN_DIRECTION_SINE,
+from robomax_py.io.cell_file import CellFile, SeamFile, SpotFile, ToleranceFile
+from robomax_py.io.cell_file_jobs import (
     PICK_PLACE_SEAM,
     TENDING_SEAM,
-    CellFile,
     PickPlaceFile,
-    SeamFile,
-    SpotFile,
     TcpLimitsFile,
-    ToleranceFile,
 )
+from robomax_py.io.cell_file_values import MAX_WINDOW_S, MIN_DIRECTION_SINE
 from robomax_py.io.cell_objects import _object, _pose
 from robomax_py.io.cell_problems import _Problems
 from robomax_py.spec import (

@@ -9,7 +9,8 @@ from pathlib import Path
 from typing import Any
 
 from robomax_py.errors import CellFileError, RobotModelError
-from robomax_py.io.cell_file import CELL_LIMITS, SAME_ORIENTATION_RAD, CellFile
+from robomax_py.io.cell_file import CellFile
+from robomax_py.io.cell_file_values import CELL_LIMITS, SAME_ORIENTATION_RAD
 from robomax_py.robot.geometry import load_mesh, mesh_shape_trimesh
 from robomax_py.safe_files import LIMITS
 from robomax_py.spec import MeshShape

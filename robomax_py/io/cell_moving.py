@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from robomax_py.errors import CellFileError
-from robomax_py.io.cell_file import DynamicObjectFile, PoseFile
+from robomax_py.io.cell_file_dynamic import DynamicObjectFile
+from robomax_py.io.cell_file_values import PoseFile
 from robomax_py.io.cell_objects import _object, _pose
 from robomax_py.io.robot import load_robot_spec, load_tool_spec
 from robomax_py.io.robot_paths import resolve_robot_file, resolve_tool_file

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from robomax_py.errors import CellFileError
-from robomax_py.io.cell_file import DynamicObjectFile, ObjectFile, PoseFile
+from robomax_py.io.cell_file_dynamic import DynamicObjectFile
+from robomax_py.io.cell_file_values import ObjectFile, PoseFile
 from robomax_py.io.cell_limits import _check_mesh_readable
 from robomax_py.io.mesh_keys import mesh_shape
 from robomax_py.safe_files import LIMITS, checked_file, named_by

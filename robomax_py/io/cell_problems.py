@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from robomax_py.errors import CellFileError
-from robomax_py.io.cell_file import T
+from robomax_py.io.cell_file_values import T
 from robomax_py.io.includes import Expansion
 from robomax_py.io.yaml_files import MAX_LISTED_PROBLEMS, several
 

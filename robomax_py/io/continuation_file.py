@@ -25,13 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from robomax_py.io.cell_file import (
-    MAX_WINDOW_S,
-    CellFile,
-    ContinuationFile,
-    DynamicObjectFile,
-    ObjectFile,
-)
+from robomax_py.io.cell_file import CellFile, ContinuationFile
+from robomax_py.io.cell_file_dynamic import DynamicObjectFile
+from robomax_py.io.cell_file_values import MAX_WINDOW_S, ObjectFile
 from robomax_py.io.cell_rewrite import _read_resolved, dump_cell_file
 from robomax_py.io.cell_spot_lists import _with_spot_lists
 from robomax_py.io.includes import rebased_reference

@@ -23,7 +23,8 @@ from robomax_py.errors import CellFileError
 from robomax_py.transforms import pose_matrix, rpy_from_matrix
 
 if TYPE_CHECKING:
-    from robomax_py.io.cell_file import CellFile, PoseFile
+    from robomax_py.io.cell_file import CellFile
+    from robomax_py.io.cell_file_values import PoseFile
 
 # The frame everything else is placed in; no frame or object may take its name as a frame.
 WORLD = "world"

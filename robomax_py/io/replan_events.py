@@ -25,7 +25,7 @@ import re
 from dataclasses import dataclass, replace
 
 from robomax_py.errors import EventError
-from robomax_py.io.cell_file import MAX_WINDOW_S
+from robomax_py.io.cell_file_values import MAX_WINDOW_S
 from robomax_py.spec import (
     Box,
     CellSpec,

@@ -37,7 +37,7 @@ from robomax_py.robot.geometry import shape_trimesh
 from robomax_py.safe_files import LIMITS, checked_file, read_text
 from robomax_py.spec import ObjectSpec
 
-# Rows of one list: as many as a cell may have spots (io.cell.CELL_LIMITS.spots).
+# Rows of one list: as many as a cell may have spots (io.cell_file_values.CELL_LIMITS.spots).
 MAX_ROWS = 2_000
 UNITS = {"m": 1.0, "mm": 0.001}
 DEFAULT_MAX_DISTANCE = 0.002        # m: a spot further from the part's surface is an error

@@ -19,10 +19,10 @@ from pydantic import Field, ValidationError, model_validator
 
 from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.io.cell import _cell_from_data
-from robomax_py.io.cell_file import (
+from robomax_py.io.cell_file import IncludeFile
+from robomax_py.io.cell_file_values import (
     SUPPORTED_VERSIONS,
     CellName,
-    IncludeFile,
     PoseFile,
     Reference,
     _Strict,

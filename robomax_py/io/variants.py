@@ -29,7 +29,8 @@ from pathlib import Path
 import numpy as np
 
 from robomax_py.io.cell import dump_cell_file, load_cell, read_cell_file
-from robomax_py.io.cell_file import CellFile, ObjectFile, SeamFile
+from robomax_py.io.cell_file import CellFile, SeamFile
+from robomax_py.io.cell_file_values import ObjectFile
 from robomax_py.io.includes import rebased_reference
 from robomax_py.io.robot import resolve_robot_file, resolve_tool_file
 

@@ -21,7 +21,8 @@ from robomax_py.app.cli import EXIT_BAD_INPUT, app
 from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.io import cell as cell_io
 from robomax_py.io import cell_limits
-from robomax_py.io.cell import CELL_LIMITS, load_cell, load_cell_robot
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.io.cell_file_values import CELL_LIMITS
 from robomax_py.io.yaml_files import count_items
 from robomax_py.plan import candidates
 from robomax_py.plan.candidates import check_ik_work, seam_candidates

@@ -15,7 +15,8 @@ from pydantic import ValidationError
 from scipy.spatial.transform import Rotation
 
 from robomax_py.errors import CellFileError
-from robomax_py.io.cell import CellFile, dump_cell_file, load_cell, read_cell_file
+from robomax_py.io.cell import dump_cell_file, load_cell, read_cell_file
+from robomax_py.io.cell_file import CellFile
 from robomax_py.io.frames import resolve_frames
 from tests.conftest import SmallCell
 

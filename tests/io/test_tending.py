@@ -14,7 +14,8 @@ from typer.testing import CliRunner
 
 from robomax_py.app.cli import EXIT_BAD_INPUT, app
 from robomax_py.errors import CellFileError
-from robomax_py.io.cell import TENDING_SEAM, load_cell
+from robomax_py.io.cell import load_cell
+from robomax_py.io.cell_file_jobs import TENDING_SEAM
 from robomax_py.plan.poses import orientation_grid, spot_poses
 from robomax_py.transforms import pose_matrix
 

@@ -15,7 +15,8 @@ from robomax_py.errors import CellFileError
 from robomax_py.export.plan_program import program_from_plan
 from robomax_py.export.rebuild import rebuild
 from robomax_py.export.srcl import parse_program, write_program
-from robomax_py.io.cell import PICK_PLACE_SEAM, load_cell, load_cell_robot
+from robomax_py.io.cell import load_cell, load_cell_robot
+from robomax_py.io.cell_file_jobs import PICK_PLACE_SEAM
 from robomax_py.plan import PlanOptions, plan_cell
 from robomax_py.plan.loads import (
     Loads,
