@@ -9,7 +9,7 @@ arc length (rad) for polylines and blends, metres of TCP travel for Cartesian li
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.interpolate import BPoly, CubicSpline
@@ -35,6 +35,10 @@ class GeometricPath:
 
     breaks: FloatArray
     control_points: FloatArray
+    # The scipy polynomial that evaluates the path, built on the first evaluation and kept: a path
+    # is evaluated many times (a blend's cut is found by bisection, a timing samples its grid), and
+    # building the polynomial cost more than evaluating it. Derived from the two fields above only.
+    _poly: BPoly | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         b = np.asarray(self.breaks, dtype=float)
@@ -72,7 +76,10 @@ class GeometricPath:
     def __call__(self, s: FloatArray | float, order: int = 0) -> FloatArray:
         """d^order q / ds^order at s, clipped into [0, length]: (n,) for a scalar s, else (..., n)."""
         s_arr = np.clip(np.asarray(s, dtype=float), 0.0, self.length)
-        poly = BPoly(np.transpose(self.control_points, (1, 0, 2)), self.breaks)
+        poly = self._poly
+        if poly is None:
+            poly = BPoly(np.transpose(self.control_points, (1, 0, 2)), self.breaks)
+            object.__setattr__(self, "_poly", poly)
         return np.asarray(poly(s_arr, nu=order) if order else poly(s_arr))
 
     def sample(self, max_step: float) -> FloatArray:
