@@ -286,10 +286,16 @@ def _cut_at_distance(path: GeometricPath, point: FloatArray, radius: float, *, f
         return half
     k = int(beyond[0])
     lo, hi = float(s[k - 1]), float(s[k])        # dist(lo) < radius <= dist(hi)
+    lo_tested = hi_tested = False                # set by this loop's own test (not the grid's)
     for _ in range(60):
         mid = 0.5 * (lo + hi)
         if np.linalg.norm(path(mid) - point) < radius:
-            lo = mid
+            lo, lo_tested = mid, True
         else:
-            hi = mid
+            hi, hi_tested = mid, True
+        # Once the next midpoint is an end this loop has tested (lo and hi adjacent floats), every
+        # remaining step tests it again with the same outcome: stop, with the same result.
+        after = 0.5 * (lo + hi)
+        if (after == lo and lo_tested) or (after == hi and hi_tested):
+            break
     return hi
