@@ -19,8 +19,10 @@ program rebuilt from its statements follows the path that was planned and checke
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections import OrderedDict
+from collections.abc import Hashable, Sequence
+from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -43,6 +45,8 @@ JOIN_TCP_SAFETY = 1.05
 MIN_TCP_CHORD_M = 1e-3
 # Stands for "no limit" in the path speed limit toppra receives (it needs finite values).
 UNLIMITED_PATH_SPEED = 1e9
+# Chains kept built and timed (`chain_path`, `time_chain`), each; the oldest go first.
+CHAIN_MEMO_SIZE = 256
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -117,6 +121,43 @@ def chain_path(
     if not steps:
         raise TimingError("a chain needs at least one move")
     q = np.asarray(q_start, dtype=float).reshape(-1)
+    key = (id(robot), id(ik), q.tobytes(), tuple(_step_key(step) for step in steps))
+    hit = _PATHS.get(key)
+    if hit is not None and hit[0] is robot and hit[1] is ik:
+        _PATHS.move_to_end(key)
+        return hit[2]
+    chain = _build_chain_path(robot, q, steps, ik, lin_cache)
+    _remember(_PATHS, key, (robot, ik, chain))
+    return chain
+
+
+# Chains built and timed in this process, by everything each depends on. Both are pure functions
+# of those inputs, and the same chain comes back: the planner builds and times a junction's
+# exact-stop lines again in every fly-by variant it tries, and the proof of a written program
+# rebuilds and times each chain from the joint values, poses and radii the planner used (the
+# program states them exactly), so each distinct chain is built and timed once. A chain that
+# differs in any bit (a writer's mistake) is a new entry, built and timed afresh. Entries hold the
+# robot, solver and chain whose ids their keys use, so no other object takes that id while they
+# live. Bounded (CHAIN_MEMO_SIZE); the oldest go first.
+_PATHS: OrderedDict[tuple[Hashable, ...], tuple[RobotModel, IkSolver | None, ChainPath]] = OrderedDict()
+_TIMED: OrderedDict[tuple[Hashable, ...], tuple[ChainPath, tuple[Segment, ...]]] = OrderedDict()
+
+
+def _remember(memo: OrderedDict[tuple[Hashable, ...], Any], key: tuple[Hashable, ...], value: Any) -> None:
+    memo[key] = value
+    if len(memo) > CHAIN_MEMO_SIZE:
+        memo.popitem(last=False)
+
+
+def _step_key(step: Step) -> tuple[Hashable, ...]:
+    """Everything of a step that its chain's path depends on."""
+    if isinstance(step, PtpStep):
+        return ("ptp", np.asarray(step.q, dtype=float).tobytes(), step.flyby, step.flyby_tcp)
+    return ("lin", np.asarray(step.T, dtype=float).tobytes(), step.tcp_speed, step.column, step.flyby, step.flyby_tcp)
+
+
+def _build_chain_path(robot: RobotModel, q: FloatArray, steps: Sequence[Step], ik: IkSolver | None,
+                      lin_cache: dict[bytes, LinPath] | None) -> ChainPath:
     pieces: list[GeometricPath | None] = []
     tcp_rate: list[float | None] = []             # per step: largest ds/dt from its TCP speed
     targets = []
@@ -239,6 +280,24 @@ def time_chain(
 
     speed : global override in (0, 1] applied on top of each move's own speed.
     """
+    # The steps' kinds and labels only name the segments: a chain timed under other names (the
+    # proof reads a detour's moves back as plain moves) takes the timing and is named anew.
+    key = (id(chain), speed, jerk_limited, dt, *(np.asarray(a, dtype=float).tobytes() for a in (
+        limits.lower, limits.upper, limits.velocity, limits.acceleration, limits.jerk)),
+        tuple((isinstance(s, PtpStep), s.speed if isinstance(s, PtpStep) else 1.0, s.accel) for s in steps))
+    hit = _TIMED.get(key)
+    if hit is not None and hit[0] is chain:
+        _TIMED.move_to_end(key)
+        return [seg if (seg.kind, seg.label) == (step.kind, step.label) else
+                replace(seg, kind=step.kind, label=step.label) for seg, step in zip(hit[1], steps)]
+    segments = _time_chain(chain, steps, limits, speed, jerk_limited, dt)
+    if len(segments) == len(steps):
+        _remember(_TIMED, key, (chain, tuple(segments)))
+    return segments
+
+
+def _time_chain(chain: ChainPath, steps: Sequence[Step], limits: JointLimits, speed: float, jerk_limited: bool,
+                dt: float) -> list[Segment]:
     ptp = [s for s in steps if isinstance(s, PtpStep)]
     if len(steps) == 1 and ptp and jerk_limited:
         step = ptp[0]
