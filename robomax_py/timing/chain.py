@@ -121,6 +121,11 @@ def chain_path(
     if not steps:
         raise TimingError("a chain needs at least one move")
     q = np.asarray(q_start, dtype=float).reshape(-1)
+    if _PATHS and next(iter(_PATHS.values()))[0] is not robot:
+        # One robot's chains at a time: a robot model holds its meshes, and a batch worker plans
+        # cell after cell, each loading its own.
+        _PATHS.clear()
+        _TIMED.clear()
     key = (id(robot), id(ik), q.tobytes(), tuple(_step_key(step) for step in steps))
     hit = _PATHS.get(key)
     if hit is not None and hit[0] is robot and hit[1] is ik:
@@ -138,7 +143,8 @@ def chain_path(
 # program states them exactly), so each distinct chain is built and timed once. A chain that
 # differs in any bit (a writer's mistake) is a new entry, built and timed afresh. Entries hold the
 # robot, solver and chain whose ids their keys use, so no other object takes that id while they
-# live. Bounded (CHAIN_MEMO_SIZE); the oldest go first.
+# live. Bounded (CHAIN_MEMO_SIZE); the oldest go first, and all of them when another robot's
+# chain is built.
 _PATHS: OrderedDict[tuple[Hashable, ...], tuple[RobotModel, IkSolver | None, ChainPath]] = OrderedDict()
 _TIMED: OrderedDict[tuple[Hashable, ...], tuple[ChainPath, tuple[Segment, ...]]] = OrderedDict()
 

@@ -99,3 +99,15 @@ def test_a_chain_timed_under_other_names_takes_the_timing_and_the_names(kr125: R
                                                 ("move", "statement 3")]
     for a, b in zip(got, fresh, strict=True):
         assert all(np.array_equal(getattr(a, f), getattr(b, f)) for f in ("t", "q", "qd", "qdd"))
+
+
+def test_another_robot_s_chain_empties_the_memo(kr125: RobotModel, counted: dict[str, int]) -> None:
+    """A robot model holds its meshes: the memo keeps one robot's chains at a time, so a process
+    planning cell after cell does not keep every robot it loaded."""
+    q0, steps = _steps(kr125)
+    time_chain(chain_path(kr125, q0, steps), steps, kr125.limits)
+    other = load_cell_robot(load_cell(REPO / "cells" / "cabin_flange.yaml"))     # the same arm, loaded again
+    time_chain(chain_path(other, q0, steps), steps, other.limits)
+    assert all(entry[0] is other for entry in chain_module._PATHS.values())
+    assert len(chain_module._PATHS) == 1 and len(chain_module._TIMED) == 1
+    assert counted == {"built": 2, "timed": 2}
