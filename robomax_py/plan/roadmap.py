@@ -19,7 +19,7 @@ from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
-from robomax_py._typing import FloatArray
+from robomax_py._typing import FloatArray, IntArray
 from robomax_py.plan.shortcut import swept_shortcut
 from robomax_py.robot import JointLimits
 from robomax_py.timing import polyline_time_estimate, ptp_time_estimate
@@ -113,6 +113,7 @@ class Roadmap:
         # Every edge's check result, shared with `fresh` copies (which do not know them yet).
         self._checked: dict[tuple[int, int], bool] = {}
         self.edge_checks = 0
+        self._csr: tuple[IntArray, IntArray, FloatArray, IntArray] | None = None   # `_both_ways`
 
     def fresh(self) -> Roadmap:
         """This roadmap as it was built, before any edge was known: its queries find what a new
@@ -214,30 +215,53 @@ class Roadmap:
         goal G = -2, skipping edges known to be blocked; the path as node indices, S and G included.
 
         The roadmap holds every spot candidate as a node (tens of thousands on a large cell), which
-        a Python heap search walked one dict look-up at a time.
+        a Python heap search walked one dict look-up at a time. A lazy query searches again after
+        each blocked edge it meets: the graph's arrays are made once (`_both_ways`), a blocked
+        edge weighs infinity (scipy never relaxes it), the start is one row appended, and the goal
+        is reached through whichever of its links ends the shortest way (no node of its own).
         """
         n = len(self.nodes)
-        S, G = n, n + 1
-        keep = ~self._edge_blocked
-        rows = [self._pairs[keep, 0]]
-        cols = [self._pairs[keep, 1]]
-        data = [self._pair_weight[keep]]
-        for links, weights, end in ((start_links, start_w, S), (goal_links, goal_w, G)):
-            label = -1 if end == S else -2
-            ok = np.array([extra_free.get((min(label, v), max(label, v))) is not False for v in links], dtype=bool)
-            rows.append(np.full(int(ok.sum()), end, dtype=np.int64))
-            cols.append(np.asarray(links, dtype=np.int64)[ok])
-            data.append(np.asarray(weights, dtype=float)[ok])
+        indptr, indices, weights, slots = self._both_ways()
+        blocked = np.flatnonzero(self._edge_blocked)
+        if len(blocked):
+            weights = weights.copy()
+            weights[slots[blocked]] = np.inf
+            weights[slots[blocked + len(self._pairs)]] = np.inf
+
+        def usable(links: list[int], label: int) -> FloatArray:
+            return np.array([extra_free.get((min(label, v), max(label, v))) is not False for v in links], dtype=bool)
+
+        s_ok = usable(start_links, -1)
+        s_links = np.asarray(start_links, dtype=np.int64)[s_ok]
         # csgraph reads a stored zero as no edge: coinciding configurations get the least positive weight.
-        weight = np.maximum(np.concatenate(data), np.finfo(float).tiny)
-        graph = csr_matrix((weight, (np.concatenate(rows), np.concatenate(cols))), shape=(n + 2, n + 2))
-        dist, pred = dijkstra(graph, directed=False, indices=S, return_predecessors=True)
-        if not np.isfinite(dist[G]):
+        s_w = np.maximum(np.asarray(start_w, dtype=float)[s_ok], np.finfo(float).tiny)
+        graph = csr_matrix((np.concatenate([weights, s_w]), np.concatenate([indices, s_links]),
+                            np.append(indptr, indptr[-1] + len(s_links))), shape=(n + 1, n + 1))
+        dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True)
+        g_ok = usable(goal_links, -2)
+        total = np.where(g_ok, dist[np.asarray(goal_links, dtype=np.int64)] + np.asarray(goal_w, dtype=float), np.inf)
+        if not len(total) or not np.isfinite(np.min(total)):
             return None
-        path = [G]
-        while path[-1] != S:
+        path = [goal_links[int(np.argmin(total))]]
+        while path[-1] != n:
             path.append(int(pred[path[-1]]))
-        return [-1 if u == S else (-2 if u == G else u) for u in reversed(path)]
+        return [-1 if u == n else u for u in reversed(path)] + [-2]
+
+    def _both_ways(self) -> tuple[IntArray, IntArray, FloatArray, IntArray]:
+        """The roadmap's edges stored both ways as CSR arrays of its n rows (the start's row is
+        appended by `_shortest`): indptr (n + 1,), indices, weights, and where each direction of edge e is stored
+        (slots[e] from the lower node, slots[e + edges] from the higher). Made once per roadmap."""
+        if self._csr is None:
+            n, m = len(self.nodes), len(self._pairs)
+            rows = np.concatenate([self._pairs[:, 0], self._pairs[:, 1]])
+            cols = np.concatenate([self._pairs[:, 1], self._pairs[:, 0]])
+            order = np.lexsort((cols, rows))
+            slots = np.empty(2 * m, dtype=np.int64)
+            slots[order] = np.arange(2 * m)
+            indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))]).astype(np.int64)
+            weight = np.maximum(np.concatenate([self._pair_weight, self._pair_weight]), np.finfo(float).tiny)
+            self._csr = (indptr, cols[order].astype(np.int64), weight[order], slots)
+        return self._csr
 
     def _shortcut(self, waypoints: FloatArray) -> tuple[FloatArray, int]:
         """Greedy (`swept_shortcut`): each kept waypoint joined to the farthest later one reachable
