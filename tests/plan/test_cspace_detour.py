@@ -72,3 +72,27 @@ def test_the_cell_key_chooses_the_back_end(tmp_path: Path) -> None:
     path.write_text(yaml.safe_dump(data, sort_keys=False))
     with pytest.raises(CellFileError, match="planner.detours"):
         load_cell(path)
+
+
+class _WallAtStart:
+    """A stand-in world: every configuration whose first three joints lie within `radius` (rad, any
+    of them) of `centre` is blocked, the rest free; counts the configurations it was asked about."""
+
+    def __init__(self, centre: np.ndarray, radius: float) -> None:
+        self.centre, self.radius, self.asked = centre, radius, 0
+
+    def are_free(self, configs: np.ndarray) -> np.ndarray:
+        self.asked += len(configs)
+        return np.asarray(np.max(np.abs(configs[:, :3] - self.centre[:3]), axis=1) > self.radius)
+
+
+def test_a_map_whose_start_cell_is_blocked_is_not_checked_further(reference) -> None:  # type: ignore[no-untyped-def]
+    """The cell nearest qa blocked (qa itself free, next to an obstacle): no way through the map,
+    found by checking the two end cells alone, not the whole grid."""
+    _, robot, _ = reference
+    qa = np.radians([0.0, -90.0, 90.0, 0.0, 0.0, 0.0])
+    qb = qa + np.array([0.6, 0.3, -0.2, 0.1, 0.0, 0.0])
+    world = _WallAtStart(qa, 0.05)        # the grid's cells lie ~0.07 rad apart: the nearest one is within
+    det, checks = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
+    assert det is None
+    assert checks == world.asked == 2
