@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass
 from itertools import pairwise
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -35,6 +35,9 @@ from robomax_py.transforms import rot_x, rot_y, rot_z
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.motion import Clearance, Violation, check_motion, min_clearance
 from robomax_py.world.scene import build_scene
+
+if TYPE_CHECKING:
+    from robomax_py.export.rebuild import Rebuilt
 
 HOME_TOL_RAD = TOL.home_tol_rad
 REST_TOL_RAD = TOL.rest_tol_rad
@@ -75,12 +78,9 @@ def verify_read(cell: CellSpec, robot: RobotModel, path: Path, read: tuple[Any, 
                 station: frozenset[str] | None = None) -> tuple[VerifyReport, Any]:
     """Verify a program read by `read_program_files`, and its rebuilt motion (`export.rebuild.Rebuilt`;
     None when no motion runs). `station`: the signals the robots of a station set (`rebuild`)."""
-    from robomax_py.export import controller_frames
-    from robomax_py.export.dialect import in_controller_joints
-    from robomax_py.export.rebuild import rebuild
     from robomax_py.program import LinMove, PtpMove
 
-    dialect, main, parsed, files = read
+    _, _, parsed, files = read
     unsimulated = tuple(Violation(None, "unsupported", f"{text} is not simulated: the program cannot be verified", line)
                         for line, text in _not_simulated(parsed))
     stated = tuple(Violation(None, kind, detail, line) for line, kind, detail in parsed.problems)
@@ -94,13 +94,26 @@ def verify_read(cell: CellSpec, robot: RobotModel, path: Path, read: tuple[Any, 
                       for seam in cell.seams for spot in seam.spots)
         return _with_set(cell, path, files, VerifyReport(str(path), 0, float("nan"), 0,
                                                          unsimulated + stated + nowhere + never, ignored)), None
-    # A controller's joint targets count its joints its way (robot.yaml controller.joint_signs/zeros).
-    joint_program = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
-    rebuilt = rebuild(joint_program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
-                      controller=bool(dialect.brand), station=station)
+    rebuilt = rebuild_read(cell, robot, read, station)
     report = verify_rebuilt(cell, robot, str(path), rebuilt)
     report = dataclasses.replace(report, violations=unsimulated + stated + report.violations, ignored=ignored)
     return _with_set(cell, path, files, report), rebuilt
+
+
+def rebuild_read(cell: CellSpec, robot: RobotModel, read: tuple[Any, Path, Any, tuple[Path, ...]],
+                 station: frozenset[str] | None = None) -> Rebuilt:
+    """The motion of a program read by `read_program_files`, as its controller runs it
+    (`export.rebuild.Rebuilt`): its joint targets counted the controller's way, its frames those
+    the controller composes (`export.controller_frames`)."""
+    from robomax_py.export import controller_frames
+    from robomax_py.export.dialect import in_controller_joints
+    from robomax_py.export.rebuild import rebuild
+
+    dialect, main, parsed, _ = read
+    # A controller's joint targets count its joints its way (robot.yaml controller.joint_signs/zeros).
+    joint_program = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
+    return rebuild(joint_program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
+                   controller=bool(dialect.brand), station=station)
 
 
 def read_program(robot: RobotModel, path: Path) -> tuple[Any, Path, Any]:

@@ -4,6 +4,9 @@
 
 - `.srcl`: parsed and rebuilt (`rebuild.rebuild`, the motion `verify` checks); the phases are the
   rebuilt segments' kinds, and a PTP run the program comments as a detour is drawn as "detour".
+- a controller program (KRL `.src`, RAPID `.mod`, FANUC `.ls`, URScript, INFORM, AS): read and
+  rebuilt as `verify` reads it (`verify.rebuild_read`: the controller's joint counting and frames),
+  its phases as for `.srcl`.
 - `.json` (docs/cell-files.md, "The trajectory file"): the file holds samples and spots, not phases, so phases are recovered:
   "weld" during each spot's [t_arrive, t_leave]; "approach" / "retract" while the TCP is within the
   approach distance of the spot just before / after it; "wait" where the robot stands still outside
@@ -18,7 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -30,6 +33,9 @@ from robomax_py.spec import CellSpec, frozen_array
 from robomax_py.timing.trajectory import Phase
 from robomax_py.tolerances import DEFAULT as TOL
 
+if TYPE_CHECKING:
+    from robomax_py.export.rebuild import Rebuilt
+
 # A move straying further than this (rad, any joint) from its joint-space chord is a detour.
 DETOUR_DEVIATION_RAD = 0.05
 # A stand-still outside welds shorter than this (s) is a stop between moves, not a wait.
@@ -39,7 +45,6 @@ REST_TOL_RAD = TOL.preview_rest_tol_rad
 # Slack (m) on the approach distance when recovering approach/retract phases of a .json file.
 APPROACH_SLACK_M = 1e-4
 
-PROGRAM_SUFFIXES = (".json", ".srcl")
 
 
 @dataclass(frozen=True, slots=True)
@@ -103,14 +108,20 @@ def load_program(path: Path, cell: CellSpec, robot: RobotModel) -> ShownProgram:
         Missing or unreadable file, another extension, a program of another cell or robot, or a
         `.srcl` program whose motion cannot be rebuilt.
     """
+    from robomax_py.export import DIALECTS, dialect_for_file
+
     suffix = path.suffix.lower()
-    if suffix not in PROGRAM_SUFFIXES:
-        raise ProgramError(path, None, f"expected a trajectory file (.json) or an SRCL program (.srcl), got '{path.suffix}'")
+    if suffix != ".json" and dialect_for_file(suffix) is None:
+        known = ", ".join(sorted({e for d in DIALECTS.values() for e in d.extensions}))
+        raise ProgramError(path, None, f"expected a trajectory file (.json) or a program ({known}), got "
+                           f"'{path.suffix}'")
     if not path.is_file():
         raise ProgramError(path, None, "program file not found")
     if suffix == ".json":
         return _load_json(path, cell, robot)
-    return _load_srcl(path, cell, robot)
+    if suffix == ".srcl":
+        return _load_srcl(path, cell, robot)
+    return _load_controller_program(path, cell, robot)
 
 
 def _load_json(path: Path, cell: CellSpec, robot: RobotModel) -> ShownProgram:
@@ -151,7 +162,19 @@ def _load_srcl(path: Path, cell: CellSpec, robot: RobotModel) -> ShownProgram:
                                       max_lines=LIMITS.program_lines), path)
     if program.header.cell != cell.name:
         raise ProgramError(path, "CELL", f"program is for cell {program.header.cell!r}, not {cell.name!r}")
-    rebuilt = rebuild(program, cell, robot, path)
+    return _shown(path, rebuild(program, cell, robot, path))
+
+
+def _load_controller_program(path: Path, cell: CellSpec, robot: RobotModel) -> ShownProgram:
+    from robomax_py.verify import read_program_files, rebuild_read
+
+    # A KRL program comments a move on the line before it, so its rebuilt moves are named by their
+    # statements alone: a detour is told by its via points instead.
+    return _shown(path, rebuild_read(cell, robot, read_program_files(robot, path)), via_points=True)
+
+
+def _shown(path: Path, rebuilt: Rebuilt, via_points: bool = False) -> ShownProgram:
+    """A rebuilt program's motion (`export.rebuild.Rebuilt`) as shown, or why it has none."""
     if rebuilt.trajectory is None:
         first = rebuilt.problems[0] if rebuilt.problems else None
         why = "" if first is None else f": {first.kind}: {first.detail}"
@@ -160,7 +183,7 @@ def _load_srcl(path: Path, cell: CellSpec, robot: RobotModel) -> ShownProgram:
     t0 = float(traj.t[0])
     phases = _mark_detours(tuple(
         Phase(p.kind, p.label, p.t_start - t0, p.t_end - t0, p.i_start, p.i_end) for p in traj.phases
-    ))
+    ), via_points)
     spots = tuple(
         ShownSpot(str(s["seam"]), str(s["name"]), float(s["t_arrive"]) - t0, float(s["t_leave"]) - t0)
         for s in rebuilt.spots
@@ -168,8 +191,10 @@ def _load_srcl(path: Path, cell: CellSpec, robot: RobotModel) -> ShownProgram:
     return ShownProgram(str(path), frozen_array(traj.t - t0), frozen_array(traj.q), phases, spots)
 
 
-def _mark_detours(phases: tuple[Phase, ...]) -> tuple[Phase, ...]:
-    """PTP runs ("move"/"blend" phases in a row) whose comment names a detour become "detour"."""
+def _mark_detours(phases: tuple[Phase, ...], via_points: bool = False) -> tuple[Phase, ...]:
+    """PTP runs ("move"/"blend" phases in a row) whose comment names a detour become "detour"; with
+    `via_points`, also those of more than one move (the planner joins two spots directly by one
+    move, and goes round through via points, each a move of its own)."""
     out = list(phases)
     i = 0
     while i < len(out):
@@ -179,7 +204,8 @@ def _mark_detours(phases: tuple[Phase, ...]) -> tuple[Phase, ...]:
         j = i
         while j < len(out) and out[j].kind in ("move", "blend"):
             j += 1
-        if any("detour" in p.label for p in out[i:j]):
+        if any("detour" in p.label for p in out[i:j]) or (
+                via_points and sum(p.kind == "move" for p in out[i:j]) > 1):
             for k in range(i, j):
                 p = out[k]
                 out[k] = Phase("detour", p.label, p.t_start, p.t_end, p.i_start, p.i_end)

@@ -47,7 +47,7 @@ def planned(tmp_path_factory: pytest.TempPathFactory, write_small_cell: SmallCel
     folder = tmp_path_factory.mktemp("preview")
     cell = write_small_cell(folder, "small_cell")
     out = folder / "programs"
-    result = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
+    result = runner.invoke(app, ["plan", str(cell), "-o", str(out), "--format", "srcl,krl,rapid"])
     assert result.exit_code == EXIT_OK, result.output
     return cell, out
 
@@ -167,7 +167,7 @@ def test_bad_program_exits_2_with_one_message(planned: tuple[Path, Path], tmp_pa
     elif case == "extension":
         program = tmp_path / "p.txt"
         program.write_text("x")
-        want = "expected a trajectory file (.json) or an SRCL program (.srcl)"
+        want = "expected a trajectory file (.json) or a program (.as, "
     elif case == "other_cell":
         program.write_text(json.dumps({**data, "cell": "door_l"}))
         want = "program is for cell 'door_l'"
@@ -212,6 +212,26 @@ def test_json_phases_match_the_rebuilt_programs(planned: tuple[Path, Path]) -> N
         assert abs(a - b) <= (0.0101 * 2 if kind == "weld" else 0.06), (kind, a, b)
     covered = sum(p.duration for p in from_json.phases)
     assert abs(covered - from_json.duration) < TIME_TOL_S
+
+
+@pytest.mark.parametrize("program", ["small_cell.src", "small_cell.mod"])
+def test_a_controller_program_is_shown_as_its_controller_runs_it(planned: tuple[Path, Path], program: str) -> None:
+    """A KRL or RAPID program is rebuilt as `verify` rebuilds it: the same motion as the SRCL
+    program's (the plan proves each within 0.001 mm and 1 ms of it), the same welds and detours."""
+    cell_path, out = planned
+    cell = load_cell(cell_path)
+    robot = load_cell_robot(cell)
+    from_srcl = load_program(out / "small_cell.srcl", cell, robot)
+    shown = load_program(out / program, cell, robot)
+    assert abs(shown.duration - from_srcl.duration) <= 1e-3
+    assert [(s.seam, s.name) for s in shown.spots] == [(s.seam, s.name) for s in from_srcl.spots]
+    for a, b in zip(shown.spots, from_srcl.spots, strict=True):
+        assert abs(a.t_arrive - b.t_arrive) <= 1e-3 and abs(a.t_leave - b.t_leave) <= 1e-3
+    for kind in ("weld", "detour"):
+        assert abs(sum(p.duration for p in shown.phases if p.kind == kind)
+                   - sum(p.duration for p in from_srcl.phases if p.kind == kind)) <= 1e-3, kind
+    times = np.linspace(0.0, shown.duration, 50)
+    assert np.max(np.abs(shown.q_at(times) - from_srcl.q_at(times))) <= np.radians(0.01)
 
 
 def test_serve_announces_its_url_and_ends_cleanly_on_ctrl_c(planned: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch) -> None:

@@ -49,7 +49,7 @@ def _preview_station(station: Path, programs: Path | None, html: Path | None, as
 @_command()
 def preview(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
-    program: Annotated[Path | None, typer.Argument(help="program written by plan (.json or .srcl); without it the robot stands at home; for a station, its output folder (with --html)")] = None,
+    program: Annotated[Path | None, typer.Argument(help="program written by plan (.json, .srcl or a controller program: .src, .mod, .ls, .script ...); without it the robot stands at home; for a station, its output folder (with --html)")] = None,
     html: Annotated[Path | None, typer.Option("--html", help="write one self-contained HTML page instead of serving")] = None,
     voxels: Annotated[float | None, typer.Option("--voxels", min=0.005, max=0.5, metavar="PRECISION",
                                                  help="also draw the voxel map of the static objects (blocked leaves) "
