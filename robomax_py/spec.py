@@ -398,7 +398,8 @@ class Notice:
     message: str
 
     def __str__(self) -> str:
-        return f"{self.file}: {self.key}: {self.message}"
+        # A robot file's warning names no key (`app.batch_cell.robot_notices`).
+        return f"{self.file}: {self.key}: {self.message}" if self.key else f"{self.file}: {self.message}"
 
 
 @dataclass(frozen=True, slots=True, eq=False)

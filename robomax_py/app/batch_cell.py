@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:                     # numpy and the specs are not imported for `robomax batch -h`
+    from robomax_py.robot import RobotModel
     from robomax_py.spec import Notice
 
 PLANNED = "planned"
@@ -113,11 +114,25 @@ def plan_cell_file(file: str, settings: PlanSettings) -> CellOutcome:
     if result.status != PLANNED:
         reasons = "; ".join(f"{f.seam}/{f.name}: {f.reason} ({f.detail})" for f in result.failures)
         return CellOutcome(file, spec.name, INFEASIBLE, seconds, spots=n_spots, reasons=reasons or result.message,
-                           warnings=spec.notices)
+                           warnings=spec.notices + robot_notices(robot))
     detours = sum(1 for t in result.transitions if t.kind == "detour")
     return CellOutcome(file, spec.name, PLANNED, seconds, cycle_time=result.cycle_time, spots=n_spots,
                        detours=detours, programs=programs, cell_sha256=spec.digest, inputs=file_digests(reads),
-                       notes="; ".join(s.message for s in chosen.skipped), warnings=spec.notices)
+                       notes="; ".join(s.message for s in chosen.skipped),
+                       warnings=spec.notices + robot_notices(robot))
+
+
+def robot_notices(robot: RobotModel) -> tuple[Notice, ...]:
+    """The robot's warnings at load (each 'FILE: message', as `check` and `plan` print them, e.g.
+    limits derived from the URDF), as notices of that file: a batch counts and prints them with the
+    cell file's."""
+    from robomax_py.spec import Notice
+
+    out = []
+    for warning in robot.warnings:
+        file, sep, message = warning.partition(": ")
+        out.append(Notice(file, "", message) if sep else Notice(str(robot.source), "", warning))
+    return tuple(out)
 
 
 def file_digests(paths: list[str] | tuple[str, ...]) -> tuple[tuple[str, str], ...]:

@@ -227,3 +227,34 @@ def test_ray_reports_crashed_and_timed_out_tasks_and_finishes_the_others(tmp_pat
     assert "exited with code 7" in outcomes[1].reasons and "20 s" in outcomes[2].reasons
     assert [o.attempts for o in outcomes] == [1, 1, 1, 1]      # (the sleeping cell would be planned, not timed out,
                                                                # had its worker not been killed)
+
+
+def test_batch_counts_and_prints_the_robot_file_s_warnings(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    """A robot file without accelerations and jerks (as `import-urdf` writes one where the URDF has
+    none): `check` and `plan` warn that they are derived; the batch counts that warning with the
+    cell file's and prints the same line."""
+    import shutil
+
+    import yaml
+
+    from robomax_py.io.robot_paths import shipped_robots_dir
+
+    robot_dir = tmp_path / "kr125_derived"
+    shutil.copytree(shipped_robots_dir() / "kr125", robot_dir)
+    data = yaml.safe_load((robot_dir / "robot.yaml").read_text())
+    del data["limits"]
+    data["name"] = robot_dir.name
+    (robot_dir / "robot.yaml").write_text(yaml.safe_dump(data, sort_keys=False))
+    cell = write_small_cell(tmp_path, "derived")
+    cell_data = yaml.safe_load(cell.read_text())
+    cell_data["robot"]["model"] = str(robot_dir)
+    cell.write_text(yaml.safe_dump(cell_data, sort_keys=False))
+    checked = " ".join(runner.invoke(app, ["check", str(cell)]).output.split())
+    warning = f"warning: {robot_dir / 'robot.yaml'}: limits.acceleration and limits.jerk not given; derived"
+    assert warning in checked
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["batch", str(cell), "-j", "1", "-o", str(out), "--format", "srcl"])
+    assert result.exit_code == EXIT_OK, result.output
+    assert warning in " ".join(result.output.split())
+    (row,) = read_summary(out)
+    assert row["warnings"] == str(len(_notices(str(cell))) + 1)
