@@ -177,7 +177,7 @@ def _build_chain_path(robot: RobotModel, q: FloatArray, steps: Sequence[Step], i
             tcp_rate.append(None)
             q = target
         else:
-            key = q.tobytes() + np.asarray(step.T, dtype=float).tobytes() + str(step.column).encode()
+            key = lin_key(q, step.T, step.column)
             lp = None if lin_cache is None else lin_cache.get(key)
             if lp is None:
                 column = step.column if step.column is not None else column_of(robot, q, ik)
@@ -233,6 +233,12 @@ def _build_chain_path(robot: RobotModel, q: FloatArray, steps: Sequence[Step], i
                 limits.append((lo, hi, _tcp_rate_bound(robot, blended.path, lo, hi, steps[k])))
     return ChainPath(blended.path, frozen_array(ranges), frozen_array(radii), frozen_array(np.array(targets)),
                      frozen_array(cuts), tuple(limits))
+
+
+def lin_key(q_start: FloatArray, T: FloatArray, column: int | None) -> bytes:
+    """A LIN move's key in a `chain_path` lin_cache: where it starts, its target and the column asked for
+    (None: the start's own, `column_of`)."""
+    return np.asarray(q_start, dtype=float).tobytes() + np.asarray(T, dtype=float).tobytes() + str(column).encode()
 
 
 def tcp_flyby_radius(robot: RobotModel, q_from: FloatArray, q_to: FloatArray, distance_m: float) -> float:
