@@ -21,6 +21,7 @@ the end of a Cartesian retract into the next joint move).
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -37,6 +38,10 @@ from robomax_py.timing.paths import (
     elevate,
 )
 
+# Bisection steps finding where a blend cuts into a path (the bracket is then two adjacent floats),
+# and how many of them are evaluated at once (2 ** levels - 1 midpoints per call of the path).
+MAX_CUT_BISECTIONS = 60
+CUT_LOOKAHEAD_LEVELS = 4
 # Turning angles above this (rad) are not blended: near a reversal the corner curve would have to
 # turn on the spot; the move stops at the waypoint instead.
 MAX_BLEND_TURN_RAD = np.deg2rad(175.0)
@@ -287,15 +292,32 @@ def _cut_at_distance(path: GeometricPath, point: FloatArray, radius: float, *, f
     k = int(beyond[0])
     lo, hi = float(s[k - 1]), float(s[k])        # dist(lo) < radius <= dist(hi)
     lo_tested = hi_tested = False                # set by this loop's own test (not the grid's)
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if np.linalg.norm(path(mid) - point) < radius:
-            lo, lo_tested = mid, True
-        else:
-            hi, hi_tested = mid, True
-        # Once the next midpoint is an end this loop has tested (lo and hi adjacent floats), every
-        # remaining step tests it again with the same outcome: stop, with the same result.
-        after = 0.5 * (lo + hi)
-        if (after == lo and lo_tested) or (after == hi and hi_tested):
-            break
+    steps = 0
+    while steps < MAX_CUT_BISECTIONS:
+        # The midpoints the next levels of the bisection can visit, as a heap (node j's children
+        # are 2j + 1, taken when its midpoint is at least `radius` away, and 2j + 2), evaluated
+        # in one call: a call of the path costs far more than a point. Each midpoint is computed
+        # as the plain bisection computes it, and a point of a vector call is the scalar call's.
+        levels = min(CUT_LOOKAHEAD_LEVELS, MAX_CUT_BISECTIONS - steps)
+        brackets = [(lo, hi)]
+        mids: list[float] = []
+        for a, b in itertools.islice(brackets, 2 ** levels - 1):
+            mid = 0.5 * (a + b)
+            mids.append(mid)
+            brackets += ((a, mid), (mid, b))
+        gaps = path(np.array(mids)) - point
+        j = 0
+        for _ in range(levels):
+            g = gaps[j]
+            # np.linalg.norm of a vector, without its checks: the square root of its dot product.
+            if math.sqrt(g.dot(g)) < radius:
+                lo, lo_tested, j = mids[j], True, 2 * j + 2
+            else:
+                hi, hi_tested, j = mids[j], True, 2 * j + 1
+            steps += 1
+            # Once the next midpoint is an end this loop has tested (lo and hi adjacent floats),
+            # every remaining step tests it again with the same outcome: stop, with the same result.
+            after = 0.5 * (lo + hi)
+            if (after == lo and lo_tested) or (after == hi and hi_tested):
+                return hi
     return hi

@@ -21,7 +21,7 @@ re-orientation: ROT_LENGTH_M per radian), so the TCP speed limit is a constant b
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -91,6 +91,10 @@ class LinPath:
     q: FloatArray
     tcp_length: float
     tcp_angle: float
+    # The joint path, built on first use and kept: a line in a junction's LIN cache joins the
+    # chains of several fly-by variants, and the spline (and its polynomial, `GeometricPath`)
+    # cost more than the lookups. Derived from `s` and `q` only.
+    _path: GeometricPath | None = field(default=None, init=False, repr=False, compare=False)
 
     @property
     def length(self) -> float:
@@ -104,7 +108,10 @@ class LinPath:
             raise self.error()
         if len(self.s) < 2:
             raise TimingError("a LIN path without motion has no geometric path")
-        return spline_path(self.s, self.q)
+        if self._path is None:
+            object.__setattr__(self, "_path", spline_path(self.s, self.q))
+        assert self._path is not None
+        return self._path
 
     def error(self) -> LinMoveError:
         """The failure as an exception (for ok paths: a TimingError saying so)."""
