@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import BPoly, CubicSpline
 
-from robomax_py._typing import FloatArray
+from robomax_py._typing import FloatArray, IntArray
 from robomax_py.spec import frozen_array
 from robomax_py.timing._common import ZERO_MOVE, TimingError
 from robomax_py.tolerances import DEFAULT as TOL
@@ -136,7 +136,7 @@ class GeometricPath:
         return GeometricPath(breaks=np.array(breaks), control_points=np.stack(pieces))
 
 
-def piecewise_linspace(breaks: FloatArray, counts: FloatArray) -> FloatArray:
+def piecewise_linspace(breaks: FloatArray, counts: IntArray) -> FloatArray:
     """np.linspace(breaks[i], breaks[i + 1], counts[i] + 1)[:-1] for every piece i, and the last
     break: (sum(counts) + 1,) float.
 

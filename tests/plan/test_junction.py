@@ -129,6 +129,24 @@ def test_exact_stop_bound_is_below_its_time_and_changes_no_choice(monkeypatch: p
     assert _duration(forced) == _duration(flown)
 
 
+def test_a_flyby_competing_with_the_exact_stop_is_timed_only_where_its_path_is_free(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    # Where every cut corner collides, no fly-by variant is timed: its path is checked first.
+    timed: list[float] = []
+    real = junction_module._time_shape
+
+    def spy(shape: Any, *rest: Any) -> Any:
+        timed.append(max(float(np.max(p.radii, initial=0.0)) for p in shape.paths))
+        return real(shape, *rest)
+
+    monkeypatch.setattr(junction_module, "_time_shape", spy)
+    stop = _detour(StrictWorld())
+    assert stop.corner_radius == 0.0 and timed == [0.0]               # the exact-stop motion alone
+    timed.clear()
+    flown = _detour(OpenWorld())
+    assert flown.corner_radius > 0.0 and timed and max(timed) > 0.0
+
+
 def test_exact_stop_bound_changes_no_plan(monkeypatch: pytest.MonkeyPatch, small_plan: Any) -> None:
     cell, robot, result = small_plan
     monkeypatch.setattr(junction_module, "_exact_lower_bound", lambda *args: 0.0)

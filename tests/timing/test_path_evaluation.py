@@ -1,5 +1,7 @@
-"""Paths evaluated many times give the values of their first evaluation, and a blend's cut found
-with fewer bisection steps is the cut of the full bisection, bit for bit."""
+"""Paths evaluated many times give the values of their first evaluation, a blend's cut found
+with fewer bisection steps (and fewer calls of the path) is the cut of the full bisection, and a
+path's grid and a stack's degree elevation computed at once are those computed piece by piece, bit
+for bit."""
 
 from __future__ import annotations
 
@@ -9,7 +11,13 @@ from hypothesis import strategies as st
 
 from robomax_py.timing import GeometricPath
 from robomax_py.timing.blend import _cut_at_distance
-from robomax_py.timing.paths import polyline_path
+from robomax_py.timing.paths import (
+    concatenate_paths,
+    elevate,
+    piecewise_linspace,
+    polyline_path,
+    spline_path,
+)
 
 N = 6
 
@@ -65,3 +73,27 @@ def test_a_path_evaluated_again_gives_its_first_values_bit_for_bit() -> None:
     fresh = GeometricPath(path.breaks, path.control_points)
     for a, b, c, order in zip(first, again, (fresh(s, o) for o in (0, 1, 2)), (0, 1, 2)):
         assert np.array_equal(a, b) and np.array_equal(a, c), order
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), pieces=st.integers(1, 40), scale=st.sampled_from([1e-6, 1e-3, 1.0, 100.0]),
+       most=st.integers(1, 30))
+def test_grid_of_all_pieces_is_linspace_piece_by_piece(seed: int, pieces: int, scale: float, most: int) -> None:
+    rng = np.random.default_rng(seed)
+    breaks = np.concatenate([[0.0], np.cumsum(rng.uniform(1e-3, 1.0, pieces) * scale)])
+    counts = rng.integers(1, most + 1, pieces)
+    each = [np.linspace(a, b, k + 1)[:-1] for a, b, k in zip(breaks[:-1], breaks[1:], counts)]
+    assert np.array_equal(piecewise_linspace(breaks, counts), np.concatenate([*each, breaks[-1:]]))
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), samples=st.integers(3, 30), degree=st.integers(3, 7))
+def test_elevating_a_stack_elevates_each_curve_as_on_its_own(seed: int, samples: int, degree: int) -> None:
+    rng = np.random.default_rng(seed)
+    path = spline_path(np.cumsum(rng.uniform(1e-3, 0.1, samples)), rng.normal(size=(samples, N)))
+    stacked = elevate(path.control_points, degree)
+    assert np.array_equal(stacked, np.stack([elevate(c, degree) for c in path.control_points]))
+    line = polyline_path(np.stack([path.end, path.end + 1.0, path.end - 1.0]))
+    joined = concatenate_paths([path, line])           # the line's pieces raised to the spline's degree 3
+    assert np.array_equal(joined.control_points[len(path.breaks) - 1:], np.stack([elevate(c, 3) for c in
+                                                                                  line.control_points]))
