@@ -15,7 +15,7 @@ ends beyond the approach distance, and `_straight` checks that it does.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
@@ -206,9 +206,9 @@ def time_junction(
                 trial = timed_shape(shape)
                 if trial is None or not faster(trial):
                     continue
-            free, used = _path_free(world, shape.paths)
+            free, used = _path_free(world, shape)
             checks += used
-            if not free or not (rj == 0 or _straight(robot, shape.paths, before, after)):
+            if not free or not (rj == 0 or _straight(robot, shape, before, after)):
                 continue
             if trial is None:
                 trial = timed_shape(shape)
@@ -242,8 +242,8 @@ def time_junction_at(
         shape = _chain_paths(robot, q_start, steps, lin_cache)
     except TimingError:
         return None
-    free, used = _path_free(world, shape.paths)
-    if not free or (junction_radius > 0 and not _straight(robot, shape.paths, before, after)):
+    free, used = _path_free(world, shape)
+    if not free or (junction_radius > 0 and not _straight(robot, shape, before, after)):
         return None
     try:
         _, _, segments = _time_shape(shape, limits, jerk_limited)
@@ -330,12 +330,13 @@ def _extension(robot: RobotModel, q_start: FloatArray, waypoints: FloatArray, be
     return Extension(retract_T, retract_q, approach_q)
 
 
-def _straight(robot: RobotModel, paths: list[ChainPath], before: WeldEnd | None, after: WeldEnd | None) -> bool:
+def _straight(robot: RobotModel, shape: _Shape, before: WeldEnd | None, after: WeldEnd | None) -> bool:
     """Whether the TCP stays on the electrode axis, on the approach side, over the approach
     distance: from the spot the junction leaves (the start of its first chain) or reaches (the
     end of its last) until it is the approach distance up the axis (within STRAIGHT_TOL_M)."""
-    for end, chain, reverse in ((before, paths[0] if paths else None, False), (after, paths[-1] if paths else None, True)):
-        if end is None or chain is None:
+    last = len(shape.paths) - 1
+    for end, k, reverse in ((before, 0, False), (after, last, True)):
+        if end is None or last < 0:
             continue
         origin = np.asarray(end.T_spot, dtype=float)[:3, 3]
         axis = np.asarray(end.T_app, dtype=float)[:3, 3] - origin
@@ -343,7 +344,7 @@ def _straight(robot: RobotModel, paths: list[ChainPath], before: WeldEnd | None,
         if approach <= 0.0:
             continue
         axis /= approach
-        tcp = fk_tcp(robot, chain.path.sample(CHECK_STEP_RAD))[:, :3, 3]
+        tcp = shape.tcp(robot, k)
         for p in (tcp[::-1] if reverse else tcp):
             rel = p - origin
             along = float(rel @ axis)
@@ -370,6 +371,23 @@ class _Shape:
 
     chains: list[list[Step]]
     paths: list[ChainPath]
+    # Chain k's path sampled for the checks (CHECK_STEP_RAD apart) and the TCP positions there,
+    # made on first use: the collision check and both ends' straightness check (one chain, where
+    # the junction flies by all of it) read the same samples.
+    _points: dict[int, FloatArray] = field(default_factory=dict)
+    _tcp: dict[int, FloatArray] = field(default_factory=dict)
+
+    def points(self, k: int) -> FloatArray:
+        """(m, n) samples of chain k's path, rad."""
+        if k not in self._points:
+            self._points[k] = self.paths[k].path.sample(CHECK_STEP_RAD)
+        return self._points[k]
+
+    def tcp(self, robot: RobotModel, k: int) -> FloatArray:
+        """(m, 3) TCP positions at `points(k)`, m (robot base frame)."""
+        if k not in self._tcp:
+            self._tcp[k] = fk_tcp(robot, self.points(k))[:, :3, 3]
+        return self._tcp[k]
 
 
 def _chain_paths(robot: RobotModel, q_start: FloatArray, steps: list[Step], lin_cache: dict[bytes, LinPath]) -> _Shape:
@@ -398,14 +416,14 @@ def _time_steps(
     return _time_shape(_chain_paths(robot, q_start, steps, lin_cache), limits, jerk_limited)
 
 
-def _path_free(world: PathChecks, paths: list[ChainPath]) -> tuple[bool, int]:
+def _path_free(world: PathChecks, shape: _Shape) -> tuple[bool, int]:
     """Whether every chain's geometric path is free (checked between samples CHECK_STEP_RAD apart);
     the collision checks it took."""
     checks = 0
-    for chain in paths:
+    for k, chain in enumerate(shape.paths):
         if not np.any(chain.radii > 0):
             continue                       # an exact-stop chain is the checked polyline / line itself
-        res = world.check_path(chain.path.sample(CHECK_STEP_RAD))
+        res = world.check_path(shape.points(k))
         checks += res.checks
         if not res.free:
             return False, checks
