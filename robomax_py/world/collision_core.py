@@ -14,6 +14,9 @@ from robomax_py.world.acm import SharedGeometry, configure_requests
 from robomax_py.world.collision_results import Contact, SegmentCheck
 
 _FIRST_CHUNK = 8     # states the first pre-filter call of a scan covers (blocked moves stop early)
+# A near scan (`_scan`) of fewer states tests every pair: finding the pairs to leave out costs about
+# one state's test.
+_NEAR_STATES = 8
 
 
 class CollisionWorldCore:
@@ -86,14 +89,20 @@ class CollisionWorldCore:
             k0 = k1
         return SegmentCheck(True, len(order), m + 1, tests, None)
 
-    def _scan(self, states: FloatArray, fractions: FloatArray, n_states: int) -> SegmentCheck:
-        """Check `states` in the given order, stopping at the first collision (pre-filter on)."""
+    def _scan(self, states: FloatArray, fractions: FloatArray, n_states: int, near: bool = False) -> SegmentCheck:
+        """Check `states` in the given order, stopping at the first collision (pre-filter on).
+
+        near: the states lie close together (a short path); the pre-filter's pairs cleared at every
+        state of their joint-space box are then found once and left out of each state's test."""
         assert self._pf is not None
         tests = 0
         start, chunk = 0, _FIRST_CHUNK
+        blocks, active = None, self._active
+        if near and len(states) >= _NEAR_STATES:
+            blocks, active = self._pf.near(states, self._active)
         while start < len(states):
             block = states[start:start + chunk]
-            offsets, pairs = self._pf.uncleared(block, self._active)
+            offsets, pairs = self._pf.uncleared(block, active, blocks)
             for i in np.flatnonzero(np.diff(offsets)):
                 free, n = self._exact(block[i], pairs[offsets[i]:offsets[i + 1]])
                 tests += n

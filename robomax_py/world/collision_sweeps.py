@@ -112,13 +112,14 @@ class SweptChecks(CollisionWorldCore):
                 return SegmentCheck(False, checks, m + 1, tests, float(fractions[k]))
         return SegmentCheck(True, checks, m + 1, tests, None)
 
-    def check_path(self, points: FloatArray, max_step: float = TOL.sweep_step_m) -> SegmentCheck:
+    def check_path(self, points: FloatArray, max_step: float = TOL.sweep_step_m, near: bool = False) -> SegmentCheck:
         """Check the joint-space polyline through `points` (k, n), every dynamic obstacle present.
 
         Exactly the states `check_segment` checks on each segment, a state shared by two segments
         once, in coarse-to-fine order over the whole polyline (a blocked path is found early); the
         polyline is free iff every `check_segment` of its segments is. s_contact is the colliding
-        state's fraction of the states, start to end.
+        state's fraction of the states, start to end. near: the polyline is short (an approach
+        line), so the pairs clear of the whole of it are found once, beforehand (the same result).
         """
         if not max_step > 0:
             raise ValueError(f"max_step must be > 0 m, got {max_step}")
@@ -138,7 +139,7 @@ class SweptChecks(CollisionWorldCore):
         last = len(states) - 1
         order = bisection_order(last)
         if self._pf is not None:
-            return self._scan(states[order], order / last if last else np.zeros(len(order)), len(states))
+            return self._scan(states[order], order / last if last else np.zeros(len(order)), len(states), near)
         tests = 0
         for k, idx in enumerate(order):
             hit = self._collides(states[idx])

@@ -36,6 +36,7 @@ import pinocchio as pin
 from robomax_py._typing import BoolArray, FloatArray, IntArray
 from robomax_py.world.bounds import support_points, triangles
 from robomax_py.world.prefilter_kernels import (
+    _near,
     _placements,
     _uncleared,
 )
@@ -56,6 +57,7 @@ class Prefilter:
 
     floats: FloatArray           # every float table, packed (see `_pack`)
     ints: IntArray               # every integer table and the offsets of both, packed
+    every_block: BoolArray       # (blocks,) all True: `uncleared` without `blocks`
 
     @staticmethod
     def of(model: pin.Model, gm: pin.GeometryModel, obstacle: list[bool], pair_a: IntArray, pair_b: IntArray,
@@ -145,24 +147,40 @@ class Prefilter:
              block_kind, block_a, block_b, block_end, block_pairs, ch_start, ch_end, ch_skip],
             len(flat),
         )
-        return Prefilter(floats=floats, ints=ints)
+        return Prefilter(floats=floats, ints=ints, every_block=np.ones(len(keys), dtype=bool))
 
-    def uncleared(self, qs: FloatArray, active: BoolArray) -> tuple[IntArray, IntArray]:
+    def uncleared(self, qs: FloatArray, active: BoolArray, blocks: BoolArray | None = None) -> tuple[IntArray, IntArray]:
         """For each configuration of qs (k, n), the active pairs it does not clear.
 
+        blocks: which blocks to test (`near`: the others are cleared at every configuration of qs, and
+        skipped: the same answer with fewer tests); None: every block.
         Returns (offsets (k + 1,), pairs): configuration i's pairs are pairs[offsets[i]:offsets[i + 1]],
         in pair order.
         """
-        # Always a read-only view: numba compiles one specialisation per array type, and a writable
-        # and a read-only batch are two (each about half the kernel's compile time on a first plan).
-        batch = np.ascontiguousarray(qs, dtype=np.float64).view()
-        batch.flags.writeable = False
-        counts, pairs = _uncleared(batch, self.floats, self.ints, active)
+        counts, pairs = _uncleared(_read_only(qs), self.floats, self.ints, active,
+                                   self.every_block if blocks is None else blocks)
         return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), pairs
+
+    def near(self, qs: FloatArray, active: BoolArray) -> tuple[BoolArray, BoolArray]:
+        """(blocks (b,) bool, pairs (p,) bool): the blocks, and the pairs of `active`, that a
+        configuration in the joint-space box spanned by qs (k, n) may not clear; the others are
+        cleared at every configuration of the box, so `uncleared(q, pairs, blocks)` of any q in it
+        gives what `uncleared(q, active)` gives (`prefilter_kernels._near`)."""
+        blocks, pairs = _near(_read_only(qs), self.floats, self.ints, active)
+        return blocks, pairs
 
     def joint_placements(self, q: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(J, 3, 3) rotations and (J, 3) translations of every joint frame at q (as Pinocchio's oMi)."""
         return _placements(np.ascontiguousarray(q, dtype=np.float64), self.floats, self.ints)  # type: ignore[no-any-return]
+
+
+def _read_only(qs: FloatArray) -> FloatArray:
+    """qs as a contiguous float64 read-only view: numba compiles one specialisation per array type,
+    and a writable and a read-only batch are two (each about half a kernel's compile time on a
+    first plan)."""
+    batch = np.ascontiguousarray(qs, dtype=np.float64).view()
+    batch.flags.writeable = False
+    return batch
 
 
 @dataclass(frozen=True, slots=True, eq=False)

@@ -85,7 +85,9 @@ def _placements(q: Any, F: Any, I: Any) -> Any:
 
 
 @njit(cache=True, nogil=True)
-def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
+def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any) -> Any:
+    """For each configuration of qs, the active pairs it does not clear, in pair order; blocks
+    whose `blocks` entry is False are known cleared (`_near_blocks`) and skipped."""
     J, G, P, NG, NB, C = I[0], I[1], I[2], I[3], I[4], I[5]
     fo, io = _offsets(I)
     parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
@@ -120,13 +122,26 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
     box_c = np.empty((G, 3))
     box_r = np.empty((G, 3, 3))
     placed = np.zeros(G, dtype=np.bool_)     # world box of the piece computed for this configuration
+    scratch = np.empty((7, 3))               # `_boxes_apart`'s, allocated once
     counts = np.zeros(n_cfg, dtype=np.int64)
     out = np.empty(n_cfg * P, dtype=np.int64)
     filled = 0
+    # Pieces on the base (every obstacle) are where they are at any configuration: placed once.
+    rot[0, :, :] = 0.0
+    rot[0, 0, 0] = rot[0, 1, 1] = rot[0, 2, 2] = 1.0
+    trans[0, :] = 0.0
+    moving = np.empty(G, dtype=np.int64)
+    n_moving = 0
+    for g in range(G):
+        if piece_joint[g] == 0:
+            _place(rot, trans, 0, centre, g, world)
+        else:
+            moving[n_moving] = g
+            n_moving += 1
     for i in range(n_cfg):
         _forward(qs[i], parent, kind, axis, jrot, jtrans, jq, rot, trans)
-        for g in range(G):
-            _place(rot, trans, piece_joint[g], centre, g, world)
+        for m in range(n_moving):
+            _place(rot, trans, piece_joint[moving[m]], centre, moving[m], world)
         for g in range(NG):
             _place(rot, trans, group_joint[g], g_centre, g, g_world)
         placed[:] = False
@@ -134,6 +149,9 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
         begin = 0
         for blk in range(NB):
             stop = b_end[blk]
+            if not blocks[blk]:
+                begin = stop
+                continue
             ga, gb = b_a[blk], b_b[blk]
             if b_kind[blk] == 0:
                 cleared = _sphere_box(g_world, ga, g_radius[ga] + b_margin[blk], box_lo, box_hi, gb)
@@ -155,7 +173,7 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
                             c = ch_start[b]
                             while c < ch_end[b]:          # the chunk tree, pre-order, without a stack
                                 if _sphere_point(world, a, ch_c, c, radius[a] + ch_rad[c] + margin[k]) or \
-                                        _boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, margin[k]):
+                                        _boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, margin[k], scratch):
                                     c = ch_skip[c]        # cleared: past its subtree
                                 elif ch_skip[c] == c + 1:
                                     ok = False            # a leaf it cannot clear
@@ -169,7 +187,7 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
                                 if not placed[g]:
                                     _place_box(rot, trans, piece_joint[g], obb_c, obb_r, g, box_c, box_r)
                                     placed[g] = True
-                            ok = _boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b, margin[k])
+                            ok = _boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b, margin[k], scratch)
                     if not ok:
                         out[filled] = k
                         filled += 1
@@ -183,6 +201,109 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any) -> Any:
             out[m + 1] = k
         counts[i] = filled - first
     return counts, out[:filled]
+
+
+@njit(cache=True, nogil=True)
+def _near(qs: Any, F: Any, I: Any, active: Any) -> Any:
+    """(blocks (NB,) bool, pairs (P,) bool): the blocks, and the active pairs, that `_uncleared`'s
+    tests may fail to clear at some configuration of the joint-space box spanned by qs (k, n);
+    the others are cleared at every configuration of the box.
+
+    The tests are `_uncleared`'s sphere tests at the box's centre, each sphere grown by how far its
+    centre can move within the box: a point on joint j's link moves at |dp/ds| <= sum_i |dq_i|
+    |p - o_i| over the revolute joints i from j back to the base (o_i on axis i), and |p - o_i| is at
+    most the joint-origin offsets from i to j plus the point's distance from o_j (rotations keep
+    lengths); along the straight line from the centre to any configuration of the box its centre
+    so moves at most sum_i (half range_i) * that bound. A chain with a prismatic joint, or a
+    configuration with a NaN, gets no bound (every block and active pair kept)."""
+    J, G, P, NG, NB = I[0], I[1], I[2], I[3], I[4]
+    fo, io = _offsets(I)
+    parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
+    centre = F[fo[3]:fo[3] + 3 * G].reshape((G, 3))
+    radius = F[fo[4]:fo[4] + G]
+    box_lo = F[fo[5]:fo[5] + 3 * G].reshape((G, 3))
+    box_hi = F[fo[6]:fo[6] + 3 * G].reshape((G, 3))
+    margin = F[fo[7]:fo[7] + P]
+    g_centre = F[fo[8]:fo[8] + 3 * NG].reshape((NG, 3))
+    g_radius = F[fo[9]:fo[9] + NG]
+    b_margin = F[fo[10]:fo[10] + NB]
+    piece_joint = I[io[3]:io[3] + G]
+    pair_a, pair_b, pair_obstacle = I[io[4]:io[4] + P], I[io[5]:io[5] + P], I[io[6]:io[6] + P]
+    group_joint = I[io[7]:io[7] + NG]
+    b_kind, b_a, b_b, b_end = I[io[8]:io[8] + NB], I[io[9]:io[9] + NB], I[io[10]:io[10] + NB], I[io[11]:io[11] + NB]
+    b_pairs = I[io[12]:io[12] + P]
+    keep = np.ones(NB, dtype=np.bool_)
+    live = active.copy()
+    for j in range(1, J):
+        if kind[j] != 0:
+            return keep, live
+    n = qs.shape[1]
+    lo = np.empty(n)
+    hi = np.empty(n)
+    for c in range(n):
+        lo[c] = hi[c] = qs[0, c]
+        for i in range(qs.shape[0]):
+            x = qs[i, c]
+            if not math.isfinite(x):
+                return keep, live
+            lo[c] = min(lo[c], x)
+            hi[c] = max(hi[c], x)
+    mid = (lo + hi) / 2.0
+    rot = np.empty((J, 3, 3))
+    trans = np.empty((J, 3))
+    _forward(mid, parent, kind, axis, jrot, jtrans, jq, rot, trans)
+    g_world = np.empty((NG, 3))
+    g_grow = np.empty(NG)
+    for g in range(NG):
+        _place(rot, trans, group_joint[g], g_centre, g, g_world)
+        g_grow[g] = _growth(g_centre, g, group_joint[g], lo, hi, parent, jtrans, jq)
+    world = np.empty((G, 3))
+    grow = np.full(G, -1.0)                   # not yet computed
+    begin = 0
+    for blk in range(NB):
+        stop = b_end[blk]
+        ga, gb = b_a[blk], b_b[blk]
+        if b_kind[blk] == 0:
+            cleared = _sphere_box(g_world, ga, g_radius[ga] + b_margin[blk] + g_grow[ga], box_lo, box_hi, gb)
+        else:
+            cleared = _sphere_point(g_world, ga, g_world, gb, g_radius[ga] + g_radius[gb] + b_margin[blk]
+                                    + g_grow[ga] + g_grow[gb])
+        any_live = False
+        for m in range(begin, stop):
+            k = b_pairs[m]
+            if not live[k]:
+                continue
+            if cleared:
+                live[k] = False
+                continue
+            a, b = pair_a[k], pair_b[k]
+            for p in (a, b):
+                if grow[p] < 0.0 and not (pair_obstacle[k] and p == b):
+                    _place(rot, trans, piece_joint[p], centre, p, world)
+                    grow[p] = _growth(centre, p, piece_joint[p], lo, hi, parent, jtrans, jq)
+            if pair_obstacle[k]:
+                live[k] = not _sphere_box(world, a, radius[a] + margin[k] + grow[a], box_lo, box_hi, b)
+            else:
+                live[k] = not _sphere_point(world, a, world, b, radius[a] + radius[b] + margin[k] + grow[a] + grow[b])
+            any_live = any_live or live[k]
+        keep[blk] = any_live             # a block without a live pair adds nothing
+        begin = stop
+    return keep, live
+
+
+@njit(cache=True, nogil=True)
+def _growth(local: Any, g: int, j: int, lo: Any, hi: Any, parent: Any, jtrans: Any, jq: Any) -> float:
+    """How far point local[g] of joint j's link can move from where it is at the centre of the box
+    [lo, hi] of a revolute chain's configurations (`_near`), m; grown by a micrometre so that the
+    round-off of the two tests it separates cannot tell them apart."""
+    arm = math.sqrt(local[g, 0] ** 2 + local[g, 1] ** 2 + local[g, 2] ** 2)
+    moved = 0.0
+    k = j
+    while k > 0:
+        moved += (hi[jq[k]] - lo[jq[k]]) / 2.0 * arm
+        arm += math.sqrt(jtrans[k, 0] ** 2 + jtrans[k, 1] ** 2 + jtrans[k, 2] ** 2)
+        k = parent[k]
+    return moved * (1.0 + 1e-9) + 1e-6
 
 
 @njit(cache=True, nogil=True)
@@ -225,14 +346,15 @@ def _place_box(rot: Any, trans: Any, j: int, local_c: Any, local_r: Any, g: int,
 
 
 @njit(cache=True, nogil=True)
-def _boxes_apart(ca: Any, ra: Any, ha: Any, a: int, cb: Any, rb: Any, hb: Any, b: int, gap: float) -> bool:
+def _boxes_apart(ca: Any, ra: Any, ha: Any, a: int, cb: Any, rb: Any, hb: Any, b: int, gap: float, scratch: Any) -> bool:
     """Whether oriented box a (centre ca[a], axes the columns of ra[a], half extents ha[a]) and box b
-    are more than `gap` apart along one of the 15 separating axes (`separated`). False proves nothing."""
+    are more than `gap` apart along one of the 15 separating axes (`separated`). False proves nothing.
+    scratch: (7, 3) float the tests work in (allocated by the caller: this runs in inner loops)."""
     ea, eb = ha[a], hb[b]
     if not (np.isfinite(ea[0]) and np.isfinite(eb[0])):
         return False
-    R = np.empty((3, 3))
-    t = np.empty(3)
+    R = scratch[0:3]
+    t = scratch[3]
     for i in range(3):
         t[i] = 0.0
         for k in range(3):
@@ -242,7 +364,7 @@ def _boxes_apart(ca: Any, ra: Any, ha: Any, a: int, cb: Any, rb: Any, hb: Any, b
             for k in range(3):
                 v += ra[a, k, i] * rb[b, k, j]
             R[i, j] = v
-    return separated(R, t, ea, eb, gap)
+    return _separated(R, t, ea, eb, gap, scratch[4:7])
 
 
 @njit(cache=True, nogil=True)
@@ -251,7 +373,12 @@ def separated(R: Any, t: Any, ea: Any, eb: Any, gap: float) -> bool:
     (Gottschalk et al., SIGGRAPH 1996; Ericson, Real-Time Collision Detection 4.4.1; a cross-product
     axis's gap scaled by its length). R (3, 3): box b's axes in box a's frame; t (3,): b's centre
     less a's in a's frame; ea, eb (3,): half extents, m. False proves nothing."""
-    AbsR = np.empty((3, 3))
+    return _separated(R, t, ea, eb, gap, np.empty((3, 3)))
+
+
+@njit(cache=True, nogil=True)
+def _separated(R: Any, t: Any, ea: Any, eb: Any, gap: float, AbsR: Any) -> bool:
+    """`separated`, working in AbsR (3, 3)."""
     for i in range(3):
         for j in range(3):
             AbsR[i, j] = abs(R[i, j]) + 1e-9    # near-parallel edges: no false separation
