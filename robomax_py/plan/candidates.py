@@ -25,13 +25,14 @@ from robomax_py.plan.poses import (
 )
 from robomax_py.robot import RobotModel, prismatic_mask
 from robomax_py.robot.ik import same_config
-from robomax_py.robot.ik.turns import wrap_to_pi
+from robomax_py.robot.ik.config import turn_bits
+from robomax_py.robot.ik.turns import expand, variant_of, wrap_to_pi
 from robomax_py.robot.solve import (
-    IkTable,
+    Branches,
     config_text,
     ik_columns,
     ik_table_bytes,
-    solve_all,
+    solve_branches,
 )
 from robomax_py.spec import CellSpec, SeamSpec
 from robomax_py.transforms import invert
@@ -128,16 +129,18 @@ def seam_candidates(
         spots = seam.spots[first:first + batch]
         T_spot = T_base_world @ spot_poses(spots, grid)                     # (S, m, 4, 4)
         T_line = np.stack([approach_poses(T_spot, cell.process.approach * f) for f in fractions], axis=2)
-        table = solve_all(robot, T_line)                                    # (S, m, L, B, n)
+        # The IK branches of every pose; each spot expands the turn variants it needs (`_spot_candidates`).
+        branches = solve_branches(robot, T_line)                            # (S, m, L, K, n)
+        branch_of_column = np.repeat(np.arange(branches.q.shape[-2]), branches.variants.count)
         for row in range(len(spots)):
             s = first + row
             result, used = _spot_candidates(robot, world if line_world is None else line_world(s), seam, grid, s,
-                                            table, seam_index, row)
+                                            branches, seam_index, row)
             checks += used
-            out.append(_nearest_variants(result, table.branch, np.asarray(cell.home), robot, max_variants))
+            out.append(_nearest_variants(result, branch_of_column, np.asarray(cell.home), robot, max_variants))
             if on_spot is not None:
                 on_spot()
-        del table, T_line
+        del branches, T_line
     return out, CandidateStats(ik_poses=len(seam.spots) * len(grid.angles) * n_line, collision_checks=checks)
 
 
@@ -167,15 +170,19 @@ def check_ik_work(cell: CellSpec, robot: RobotModel) -> None:
 
 def _spot_candidates(
     robot: RobotModel, world: CollisionWorld, seam: SeamSpec, grid: OrientationGrid,
-    s: int, table: IkTable, seam_index: int, row: int | None = None,
+    s: int, branches: Branches, seam_index: int, row: int | None = None,
 ) -> tuple[SpotCandidates, int]:
-    """Spot s of the seam, row `row` of its batch's IK table (default: row s, a table of the whole seam)."""
+    """Spot s of the seam, row `row` of its batch's IK branches (default: row s, branches of the whole seam).
+
+    The tests are those of the IK table `solve_all` makes (column = branch * V + turn variant), but
+    only the spot's own row of it is expanded into every turn variant: an approach line is needed
+    only for the columns valid at the spot (`turns.variant_of`, the same values as the table's)."""
     row = s if row is None else row
-    q = table.q[row]                           # (m, L, B, n)
-    valid = table.valid[row]                   # (m, L, B)
-    status = table.status[row]
-    turn = table.turn[row]
-    reachable = table.reachable[row]           # a branch exists before limit filtering
+    variants = branches.variants
+    n_var = variants.count
+    base_q = branches.q[row]                   # (m, L, K, n)
+    base_valid = branches.valid[row]           # (m, L, K): the branch exists before limit filtering
+    q_at, valid_at = expand(base_q[:, -1], base_valid[:, -1], variants)   # (m, B, n), (m, B): the spot's table
     limits = robot.limits
     revolute = ~prismatic_mask(robot.model)
     rejected: Counter[Rejection] = Counter()
@@ -183,12 +190,13 @@ def _spot_candidates(
     lines: dict[tuple[int, int], FloatArray] = {}
     checks = 0
     verdicts: dict[tuple[int, ...], LineVerdict] = {}   # wrapped spot q -> its line's verdict
-    _, n_line, n_col = valid.shape
+    n_line = base_q.shape[1]
+    n_col = valid_at.shape[1]
     # The cheap tests for every (orientation, column) at once; collision checks only for survivors.
     # IK columns are fixed 2 pi shifts of wrapped values, so a joint crossing +-180 deg along the
     # line jumps within its column: unwrap revolute joints towards the spot value.
-    at_spot = reachable[:, -1, :]
-    within = at_spot & valid[:, -1, :]                               # (m, B)
+    at_spot = np.repeat(base_valid[:, -1], n_var, axis=-1)          # (m, B): reachable at the spot
+    within = at_spot & valid_at                                      # (m, B)
     spot = seam.spots[s]
     pinned = pinned_index(grid, spot)
     if pinned is not None:                                           # only the pinned orientation
@@ -199,11 +207,12 @@ def _spot_candidates(
     if spot.config is not None:                                      # only the pinned configuration
         ok = np.zeros_like(within)
         for o, k in zip(*np.nonzero(within)):
-            ok[o, k] = same_config(spot.config, config_text(robot, q[o, -1, k]))
+            ok[o, k] = same_config(spot.config, config_text(robot, q_at[o, k]))
         n_config = int((within & ~ok).sum())
         within = ok
     oo, kk = np.nonzero(within)                                      # in scan order
-    sub = q[oo, :, kk]                                               # (c, L, n) their lines
+    bb = kk // n_var                                                 # their IK branches
+    sub, _ = variant_of(base_q[oo, :, bb], base_valid[oo, :, bb], variants, (kk % n_var)[:, None])  # (c, L, n)
     spot_q = sub[:, -1:, :]
     # Samples without a solution within the limits are NaN, and stay NaN (the line then fails the
     # limit test below); they are wrapped as zeros, since np.mod of NaN is very slow.
@@ -213,7 +222,7 @@ def _spot_candidates(
     sub = np.where(missing, np.nan, filled)
     with np.errstate(invalid="ignore"):
         jump = np.abs(np.diff(sub, axis=1)).max(axis=(1, 2)) if len(sub) else np.zeros(0)
-    branch_ok = reachable[oo, :, kk].all(axis=1) & ~(jump > BRANCH_JUMP_RAD)
+    branch_ok = base_valid[oo, :, bb].all(axis=1) & ~(jump > BRANCH_JUMP_RAD)
     inside = limits.contains(sub).all(axis=1)
     position = oo * n_col + kk                                       # of each line in the scan
     # Reasons are counted in the order an (orientation, column) scan first meets them, so reports
@@ -229,7 +238,7 @@ def _spot_candidates(
         found[Rejection("pinned_orientation")] = (-2.0, n_other)
     if spot.config is not None and n_config:
         found[Rejection("pinned_config", spot.config)] = (-1.0, n_config)
-    count(Rejection("joint_limit"), (at_spot & ~valid[:, -1, :]).reshape(-1), np.arange(at_spot.size))
+    count(Rejection("joint_limit"), (at_spot & ~valid_at).reshape(-1), np.arange(at_spot.size))
     count(Rejection("approach_branch"), ~branch_ok, position)
     count(Rejection("approach_joint_limit"), branch_ok & ~inside, position)
     no_branch = ~at_spot.any(axis=1)
@@ -260,8 +269,9 @@ def _spot_candidates(
         seam_index=seam_index, spot_index=s, name=spot.name,
         orient=idx_o, angles=grid.angles[idx_o] if keep else np.zeros((0, 3)), column=idx_k,
         q_spot=paths[:, -1] if keep else np.zeros((0, n)), q_app=paths[:, 0] if keep else np.zeros((0, n)),
-        app_path=paths, status=status[idx_o, -1, idx_k] if keep else np.zeros(0, dtype=np.int64),
-        turn=turn[idx_o, -1, idx_k] if keep else np.zeros(0, dtype=np.int64), rejected=rejected,
+        app_path=paths,
+        status=branches.status[row][idx_o, -1, idx_k // n_var].astype(np.int64) if keep else np.zeros(0, dtype=np.int64),
+        turn=turn_bits(q_at[idx_o, idx_k]) if keep else np.zeros(0, dtype=np.int64), rejected=rejected,
     ), checks
 
 
@@ -309,5 +319,5 @@ def _line_verdict(world: CollisionWorld, line: FloatArray) -> LineVerdict:
     if not check.free:
         what = check.contact.describe() if check.contact is not None else "collision"
         return LineVerdict(False, Rejection("collision", what), 1)
-    res = world.check_path(line)
+    res = world.check_path(line, near=True)
     return LineVerdict(res.free, Rejection("approach_blocked"), 1 + res.checks)

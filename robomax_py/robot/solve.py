@@ -28,7 +28,7 @@ from robomax_py.robot.ik.config import (
 from robomax_py.robot.ik.numeric import NumericIkParams, numeric_ik
 from robomax_py.robot.ik.opw import OpwParams, opw_ik
 from robomax_py.robot.ik.pose_table import TableIkParams, table_ik
-from robomax_py.robot.ik.turns import expand, turn_shifts, wrap_to_pi
+from robomax_py.robot.ik.turns import TurnVariants, expand, turn_shifts, wrap_to_pi
 from robomax_py.robot.ik.ur import UrParams, ur_ik
 from robomax_py.robot.model import RobotModel
 from robomax_py.transforms import invert
@@ -63,6 +63,26 @@ class IkTable:
     branch: IntArray
 
 
+@dataclass(frozen=True, slots=True, eq=False)
+class Branches:
+    """Every IK branch of a batch of poses, before the turn variants: `solve_all`'s first half.
+
+    q : (..., K, n) float
+        Joint values, rad (m for prismatic joints), revolute angles in (-pi, pi]; NaN rows where not valid.
+    valid : (..., K) bool
+        The branch exists for the pose (joint limits not yet applied).
+    status : (..., K) int
+        KUKA status bits (see `config`); -1 where not valid.
+    variants : TurnVariants
+        The turn variants `solve_all` expands every branch into (`turns.expand`).
+    """
+
+    q: FloatArray
+    valid: BoolArray
+    status: IntArray
+    variants: TurnVariants
+
+
 def solve_all(
     robot: RobotModel,
     T_base_tcp: FloatArray,
@@ -92,6 +112,36 @@ def solve_all(
         q : (..., B, n) with B = branches * V (opw, ur: 8 * V; numeric: 8 * V or `solutions` * V).
         Column k means the same branch and turn variant for every pose.
     """
+    return expand_branches(solve_branches(robot, T_base_tcp, q_hint, rng, expand_turns=expand_turns))
+
+
+def expand_branches(b: Branches) -> IkTable:
+    """The IK table of every branch's turn variants (`solve_all`'s second half)."""
+    n_var = b.variants.count
+    q_all, valid_all = expand(b.q, b.valid, b.variants)
+    reachable = np.repeat(b.valid, n_var, axis=-1)
+    status_all = np.where(valid_all, np.repeat(b.status, n_var, axis=-1), -1)
+    turn_all = np.where(valid_all, turn_bits(q_all), -1)
+    return IkTable(
+        q=q_all,
+        valid=valid_all,
+        status=status_all.astype(np.int64),
+        turn=turn_all.astype(np.int64),
+        reachable=reachable,
+        branch=np.repeat(np.arange(b.q.shape[-2]), n_var),
+    )
+
+
+def solve_branches(
+    robot: RobotModel,
+    T_base_tcp: FloatArray,
+    q_hint: FloatArray | None = None,
+    rng: np.random.Generator | None = None,
+    *,
+    expand_turns: bool = True,
+) -> Branches:
+    """`solve_all` before the turn variants are expanded (same arguments): a caller that needs the
+    variants of only a few branches (`plan.candidates`) expands those alone (`turns.variant_of`)."""
     T = np.asarray(T_base_tcp, dtype=float)
     T_base_flange = T @ invert(np.asarray(robot.T_flange_tcp, dtype=float))
     model = robot.model
@@ -135,19 +185,7 @@ def solve_all(
         raise RobotModelError(robot.source, "ik.solver", f"unknown IK solver {solver!r}; expected one of {', '.join(SOLVERS)}")
 
     variants = turn_shifts(lower, upper, rev) if expand_turns else turn_shifts(lower, upper, np.zeros(n, dtype=bool))
-    n_var = variants.count
-    q_all, valid_all = expand(q, valid, variants)
-    reachable = np.repeat(valid, n_var, axis=-1)
-    status_all = np.where(valid_all, np.repeat(status, n_var, axis=-1), -1)
-    turn_all = np.where(valid_all, turn_bits(q_all), -1)
-    return IkTable(
-        q=q_all,
-        valid=valid_all,
-        status=status_all.astype(np.int64),
-        turn=turn_all.astype(np.int64),
-        reachable=reachable,
-        branch=np.repeat(np.arange(q.shape[-2]), n_var),
-    )
+    return Branches(q=q, valid=np.asarray(valid, dtype=bool), status=status, variants=variants)
 
 
 # Bytes `solve_all` may hold for one table column of one pose, per joint value and per flag: the

@@ -139,6 +139,37 @@ def expand(q: FloatArray, valid: BoolArray, variants: TurnVariants) -> tuple[Flo
     return out.reshape(shape + (n,)), ok.reshape(shape)
 
 
+def variant_of(q: FloatArray, valid: BoolArray, variants: TurnVariants, v: IntArray) -> tuple[FloatArray, BoolArray]:
+    """Turn variant v of each solution: what `expand` puts in column b * V + v for branch b, for a
+    few solutions instead of every variant of every one (the same arithmetic, so the same values).
+
+    Parameters
+    ----------
+    q : (..., n) float
+        Solutions with revolute angles in (-pi, pi], rad; invalid rows may be NaN.
+    valid : (...) bool
+    v : (...) int
+        The variant of each solution, an index into `variants.shifts`.
+
+    Returns
+    -------
+    q : (..., n) float, clamped onto the limits when within LIMIT_SLACK of them; NaN rows where invalid.
+    valid : (...) bool — the solution is valid and its variant lies within the limits.
+    """
+    q = np.asarray(q, dtype=float)
+    ok = np.array(valid, dtype=bool, copy=True)
+    v = np.asarray(v, dtype=np.int64)
+    out = np.empty(q.shape)
+    with np.errstate(invalid="ignore"):
+        for j in range(q.shape[-1]):
+            vals = q[..., j] + variants.joint_shifts[j][variants.index[v, j]]
+            lo, hi = variants.lower[j], variants.upper[j]
+            ok &= (vals >= lo - LIMIT_SLACK) & (vals <= hi + LIMIT_SLACK)
+            out[..., j] = np.clip(vals, lo, hi)
+    out[~ok] = np.nan
+    return out, ok
+
+
 def filter_limits(q: FloatArray, valid: BoolArray, lower: FloatArray, upper: FloatArray) -> BoolArray:
     """valid & every joint within [lower, upper] (LIMIT_SLACK allowed), for (..., B, n) solutions."""
     q = np.asarray(q, dtype=float)
