@@ -244,11 +244,14 @@ def _spot_candidates(
     no_branch = ~at_spot.any(axis=1)
     if no_branch.any():            # counted after its orientation's columns
         found[Rejection("unreachable")] = (int(np.argmax(no_branch)) * n_col + n_col - 0.5, n_col * int(np.sum(no_branch)))
-    for r in np.flatnonzero(branch_ok & inside):
+    tested = np.flatnonzero(branch_ok & inside)
+    # Turn variants (q +- 2 pi) share their geometry: check each wrapped line once.
+    ends = sub[tested, -1]
+    keys = np.round(np.where(revolute, wrap_to_pi(ends), ends), 9)
+    for r, key_row in zip(tested.tolist(), keys):
         o, k = int(oo[r]), int(kk[r])
         line = sub[r]
-        # Turn variants (q +- 2 pi) share their geometry: check each wrapped line once.
-        key = tuple(np.round(np.where(revolute, wrap_to_pi(line[-1]), line[-1]), 9))
+        key = tuple(key_row)
         if key not in verdicts:
             verdicts[key] = _line_verdict(world, line)
             checks += verdicts[key].checks

@@ -59,15 +59,17 @@ def orientation_grid(seam: SeamSpec) -> OrientationGrid:
     pins = [np.array(spot.angles) for spot in seam.spots if spot.angles is not None]
     if pins:
         combos = np.vstack([combos, *pins])
-    kept_angles: list[FloatArray] = []
-    kept_R: list[FloatArray] = []
-    for a, b, g in combos:
-        R = rot_x(a) @ rot_y(b) @ rot_z(g)
-        if any(np.abs(R - other).max() < SAME_ORIENTATION_RAD for other in kept_R):
+    Rs = np.array([rot_x(a) @ rot_y(b) @ rot_z(g) for a, b, g in combos]).reshape(-1, 3, 3)
+    kept = np.zeros(len(combos), dtype=bool)
+    kept_R = np.empty_like(Rs)                # the kept rotations so far, compared in one step
+    n = 0
+    for i, R in enumerate(Rs):
+        if n and np.abs(kept_R[:n] - R).max(axis=(1, 2)).min() < SAME_ORIENTATION_RAD:
             continue
-        kept_angles.append(np.array([a, b, g]))
-        kept_R.append(R)
-    return OrientationGrid(angles=np.array(kept_angles), R_offset=np.array(kept_R))
+        kept[i] = True
+        kept_R[n] = R
+        n += 1
+    return OrientationGrid(angles=combos[kept].astype(float), R_offset=kept_R[:n].copy())
 
 
 def pinned_index(grid: OrientationGrid, spot: SpotSpec) -> int | None:
