@@ -1,5 +1,7 @@
-"""Candidate filtering: the vectorised tests give what a plain scan over every orientation and IK
-column gives — the same candidates, and the same rejection counts in the same order."""
+"""Candidate filtering: the vectorised tests, which expand the turn variants of only the spot's IK
+row and of the approach lines valid there, give what a plain scan over every orientation and column
+of the whole IK table (`solve_all`) gives — the same candidates with the table's own values, and
+the same rejection counts in the same order."""
 
 from __future__ import annotations
 
@@ -20,7 +22,7 @@ from robomax_py.plan.candidates import (
 from robomax_py.plan.poses import approach_poses, orientation_grid, spot_poses
 from robomax_py.robot import prismatic_mask
 from robomax_py.robot.ik.turns import wrap_to_pi
-from robomax_py.robot.solve import solve_all
+from robomax_py.robot.solve import expand_branches, solve_branches
 from robomax_py.transforms import invert
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.scene import build_scene
@@ -75,10 +77,19 @@ def test_filter_equals_a_plain_scan(cell_path: Path, spot: int) -> None:
     grid = orientation_grid(seam)
     T_spot = invert(np.asarray(cell.T_world_base)) @ spot_poses(seam.spots, grid)
     T_line = np.stack([approach_poses(T_spot, cell.process.approach * f) for f in np.linspace(1, 0, 4)], axis=2)
-    table = solve_all(robot, T_line)
-    got, _ = _spot_candidates(robot, world, seam, grid, 0, table, 0)
+    branches = solve_branches(robot, T_line)
+    table = expand_branches(branches)                   # what solve_all returns: every variant of every pose
+    got, _ = _spot_candidates(robot, world, seam, grid, 0, branches, 0)
     keep, rejected = _scan(robot, world, table.q[0], table.valid[0], table.reachable[0])
     assert list(zip(got.orient.tolist(), got.column.tolist())) == keep
     assert list(got.rejected.items()) == list(rejected.items())
+    o, k = got.orient, got.column
+    np.testing.assert_array_equal(got.q_spot, table.q[0, o, -1, k])    # the table's values
+    assert got.status.tolist() == table.status[0, o, -1, k].tolist()
+    assert got.turn.tolist() == table.turn[0, o, -1, k].tolist()
+    revolute = ~prismatic_mask(robot.model)
+    line = table.q[0, o, :, k]                                          # (c, L, n), unwrapped towards the spot
+    line[..., revolute] = line[:, -1:, revolute] + wrap_to_pi(line[..., revolute] - line[:, -1:, revolute])
+    np.testing.assert_array_equal(got.app_path, line)
     assert Rejection("joint_limit") in rejected and any(r.kind == "collision" and r.detail for r in rejected)
     assert {"approach_joint_limit", "approach_blocked"} & {r.kind for r in rejected}      # line tests exercised

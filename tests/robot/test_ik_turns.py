@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from robomax_py.robot.ik.turns import (
@@ -11,6 +13,7 @@ from robomax_py.robot.ik.turns import (
     expand,
     filter_limits,
     turn_shifts,
+    variant_of,
     wrap_to_pi,
 )
 
@@ -102,3 +105,29 @@ def test_wrap_to_pi_half_open_interval() -> None:
     assert np.all((w > -np.pi) & (w <= np.pi))
     assert_allclose(np.exp(1j * w), np.exp(1j * x), atol=1e-12)
     assert w[0] == np.pi and w[1] == np.pi
+
+
+# Solutions as solvers return them: wrapped angles, exact limit values, signed zeros, NaN rows.
+_ANGLE = st.one_of(st.floats(-np.pi, np.pi, allow_nan=False), st.sampled_from([-0.0, 0.0, np.pi, -np.pi + 1e-13]),
+                   st.sampled_from([float(v) for v in (*KR_LOWER, *KR_UPPER)]), st.just(float("nan")))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.lists(_ANGLE, min_size=6, max_size=6), min_size=1, max_size=8),
+       st.lists(st.booleans(), min_size=8, max_size=8), st.sampled_from(["kr", "ur", "one_sided"]), st.data())
+def test_variant_of_is_the_expanded_column_bit_for_bit(rows: list[list[float]], valid: list[bool], arm: str,
+                                                       data: st.DataObject) -> None:
+    """A chosen variant of each solution is exactly expand's column for it: the same values (bit for
+    bit: -0.0 and clamping included), the same NaN rows, the same validity."""
+    lower, upper = {"kr": (KR_LOWER, KR_UPPER), "ur": (np.full(6, -2 * np.pi), np.full(6, 2 * np.pi)),
+                    "one_sided": (np.array([-10, -190, -120, -10, -125, -350]) * DEG,
+                                  np.array([350, 45, 156, 350, 125, 10]) * DEG)}[arm]
+    variants = turn_shifts(lower, upper)
+    q = np.array(rows)                                                       # (B, 6)
+    ok = np.array(valid[:len(rows)]) & ~np.isnan(q).any(axis=1)
+    v = np.array(data.draw(st.lists(st.integers(0, variants.count - 1), min_size=len(rows), max_size=len(rows))))
+    table_q, table_valid = expand(q[None], ok[None], variants)              # (1, B * V, 6)
+    columns = np.arange(len(rows)) * variants.count + v
+    got_q, got_valid = variant_of(q, ok, variants, v)
+    np.testing.assert_array_equal(got_valid, table_valid[0, columns])
+    assert got_q.tobytes() == table_q[0, columns].tobytes()

@@ -164,3 +164,34 @@ def test_timed_segments_are_the_same_with_and_without_the_filter(
             (theirs.free, theirs.checks, theirs.states, theirs.s_contact)
         outcomes.add(mine.free)
     assert outcomes == {True, False}          # both verdicts were exercised
+
+
+def test_pairs_cleared_near_a_short_path_are_cleared_at_each_of_its_states(
+    reference: tuple[CellSpec, RobotModel, CollisionWorld], rng: np.random.Generator
+) -> None:
+    """`near` of a short path's states (an approach line: a few cm of TCP motion, here random
+    steps near a contact and near nothing) leaves out only pairs every state clears: each state's
+    uncleared pairs are the same with and without it, and a near check_path gives the same result.
+    It does leave out most of the blocks of pairs."""
+    _, robot, world = reference
+    filt = world._s.prefilter
+    assert filt is not None
+    active = np.ones(world.n_pairs, dtype=bool)
+    starts = _configs(world, robot, rng, 40)
+    left_out = 0
+    for start in starts:
+        path = start + np.cumsum(rng.normal(0.0, 0.01, size=(6, robot.dof)), axis=0)
+        path = np.clip(path, robot.limits.lower, robot.limits.upper)
+        blocks, live = filt.near(path, active)
+        assert not (live & ~active).any()
+        plain = filt.uncleared(path, active)
+        near = filt.uncleared(path, live, blocks)
+        np.testing.assert_array_equal(plain[0], near[0])
+        np.testing.assert_array_equal(plain[1], near[1])
+        mine, theirs = world.check_path(path, near=True), world.check_path(path)
+        assert (mine.free, mine.checks, mine.states, mine.s_contact) == \
+            (theirs.free, theirs.checks, theirs.states, theirs.s_contact)
+        left_out += int((~blocks).sum())
+    assert left_out > 0.5 * len(starts) * len(filt.every_block)
+    nan_path = np.vstack([starts[0], np.full(robot.dof, np.nan)])
+    assert filt.near(nan_path, active)[0].all()                    # no box, no bound: every block kept
