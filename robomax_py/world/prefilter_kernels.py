@@ -277,13 +277,15 @@ def _near(qs: Any, F: Any, I: Any, active: Any) -> Any:
                 live[k] = False
                 continue
             a, b = pair_a[k], pair_b[k]
-            for p in (a, b):
-                if grow[p] < 0.0 and not (pair_obstacle[k] and p == b):
-                    _place(rot, trans, piece_joint[p], centre, p, world)
-                    grow[p] = _growth(centre, p, piece_joint[p], lo, hi, parent, jtrans, jq)
+            if grow[a] < 0.0:
+                _place(rot, trans, piece_joint[a], centre, a, world)
+                grow[a] = _growth(centre, a, piece_joint[a], lo, hi, parent, jtrans, jq)
             if pair_obstacle[k]:
                 live[k] = not _sphere_box(world, a, radius[a] + margin[k] + grow[a], box_lo, box_hi, b)
             else:
+                if grow[b] < 0.0:
+                    _place(rot, trans, piece_joint[b], centre, b, world)
+                    grow[b] = _growth(centre, b, piece_joint[b], lo, hi, parent, jtrans, jq)
                 live[k] = not _sphere_point(world, a, world, b, radius[a] + radius[b] + margin[k] + grow[a] + grow[b])
             any_live = any_live or live[k]
         keep[blk] = any_live             # a block without a live pair adds nothing
