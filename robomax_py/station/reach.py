@@ -5,7 +5,7 @@ candidate's weld and approach configuration (and their box) for the lower bound.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -127,4 +127,12 @@ def cost_matrix(reach: RobotReach) -> FloatArray:
         out[i] = t.reshape(m + 1, -1).min(axis=1)
     np.fill_diagonal(out, 0.0)
     return out
+
+
+def tour_legs(reach: RobotReach, cost: FloatArray, order: Sequence[SpotKey]) -> float:
+    """The estimated time of the moves of the tour home -> `order` -> home, s (`cost`: the robot's
+    `cost_matrix`)."""
+    index = reach.index()
+    nodes = np.array([0, *(index[k] + 1 for k in order), 0])
+    return float(cost[nodes[:-1], nodes[1:]].sum())
 

@@ -17,6 +17,12 @@ other robot's plan, so the station cannot end before the longest own cycle among
 before the re-planned robot's new own cycle, at least its tour's lower bound (`most_gain`). A candidate whose most gain is below
 MIN_GAIN_SHARE of the makespan is not planned, the rest are planned the most gain first, and a
 round stops once the best trial reaches what every candidate left could reach.
+
+Candidates of one robot often could gain the same: the other robots' own cycles bound them all
+(the robot's tour bound does not depend on the order). Among those the one whose tour is estimated
+to grow least is planned first (a reversed tour keeps its legs; a spot moved to the other end adds
+a detour): it is the likelier to keep the robot's own cycle and reach the bound, and once one
+reaches it the round plans none of the others.
 """
 
 from __future__ import annotations
@@ -157,7 +163,8 @@ class OrderSearch(Generic[Plan]):
 
 def improve_orders(start: Plan, makespan: Callable[[Plan], float], orders: Callable[[Plan], Mapping[str, Order]],
                    propose: Callable[[Plan], list[OrderChange]], trial: Callable[[Plan, OrderChange], Plan | None],
-                   gain: Callable[[Plan, OrderChange], float] | None = None) -> OrderSearch[Plan]:
+                   gain: Callable[[Plan, OrderChange], float] | None = None,
+                   growth: Callable[[Plan, OrderChange], float] | None = None) -> OrderSearch[Plan]:
     """ORDER_ROUNDS rounds, each planning up to ORDER_CANDIDATES of `propose`'s changes to the best
     plan so far by `trial` (None where the change does not plan) and keeping the one with the
     shortest makespan when it is shorter. A station whose robots' orders (`orders`) were all
@@ -165,8 +172,11 @@ def improve_orders(start: Plan, makespan: Callable[[Plan], float], orders: Calla
 
     `gain`: the most a change can shorten the makespan (`most_gain`; none given: no limit). A
     change that could gain less than MIN_GAIN_SHARE of the makespan is not planned; the others are
-    planned the most gain first (`propose`'s order among equals), and a round stops once its best
-    trial is as short as the change left could make the station."""
+    planned the most gain first, and a round stops once its best trial is as short as the change
+    left could make the station.
+
+    `growth`: how much a change is estimated to lengthen its robot's tour, s; among changes of equal
+    most gain, the least growth first (none given, or equal: `propose`'s order)."""
     best, tried, skipped = start, 0, 0
     kept: list[OrderChange] = []
     seen = {_state(orders(start))}
@@ -175,16 +185,18 @@ def improve_orders(start: Plan, makespan: Callable[[Plan], float], orders: Calla
         now = dict(orders(best))
         span = makespan(best)
         fresh = [c for c in propose(best) if _state({**now, c.robot: c.order}) not in seen]
-        worth: list[tuple[float, OrderChange]] = []
+        worth: list[tuple[float, float, OrderChange]] = []
         for change in fresh:
             g = math.inf if gain is None else gain(best, change)
             if g >= MIN_GAIN_SHARE * span:
-                worth.append((g, change))
+                worth.append((g, 0.0 if growth is None else growth(best, change), change))
             else:
                 skipped += 1
                 log.debug("order change %s not planned: it could gain %.3f s at most", change.why, g)
-        worth.sort(key=lambda gc: -gc[0])
-        for g, change in worth[:ORDER_CANDIDATES]:
+        for g, grown, change in worth:
+            log.debug("order change %s: could gain %.3f s at most, tour estimated %+.3f s", change.why, g, grown)
+        worth.sort(key=lambda gc: (-gc[0], gc[1]))
+        for g, _, change in worth[:ORDER_CANDIDATES]:
             if found is not None and makespan(found[0]) <= span - g + MAKESPAN_EPS_S:
                 # No change left (the most gain first) could end sooner than the one found.
                 skipped += 1

@@ -212,3 +212,32 @@ def test_a_round_stops_once_no_change_left_can_end_sooner() -> None:
     assert planned[:2] == ["b reversed", "b rotated"]     # the most gain first
     assert "a reversed" not in planned                    # third in the round, and a's gain left is 0 after
     assert got.kept[0].why == "b reversed"
+
+
+def test_among_equal_gains_the_least_tour_growth_is_planned_first() -> None:
+    # Both changes of b could reach 11 s at best (the others' own cycles bound them alike); b rotated
+    # comes first but its tour is estimated 2 s longer, b reversed keeps its legs and reaches 11 s:
+    # it is planned first and b rotated is then not planned.
+    planned: list[str] = []
+
+    def propose(plan: _Station) -> list[OrderChange]:
+        b = plan.orders["b"]
+        return [OrderChange("b", b[1:] + b[:1], "b rotated"), OrderChange("b", b[::-1], "b reversed")]
+
+    def trial(plan: _Station, change: OrderChange) -> _Station | None:
+        planned.append(change.why)
+        return _Station({**plan.orders, change.robot: change.order})
+
+    def growth(plan: _Station, change: OrderChange) -> float:
+        return 2.0 if change.why == "b rotated" else 0.0
+
+    start = _Station(dict(ORDER))
+    got = improve_orders(start, lambda p: p.makespan, lambda p: p.orders, propose, trial,
+                         lambda p, c: p.makespan - 11.0, growth)
+    assert planned == ["b reversed"] and got.tried == 1
+    assert got.best.makespan == pytest.approx(11.0) and [c.why for c in got.kept] == ["b reversed"]
+    # Equal growth: `propose`'s order, and b rotated (14 s) leaves b reversed to be planned too.
+    planned.clear()
+    improve_orders(start, lambda p: p.makespan, lambda p: p.orders, propose, trial, lambda p, c: p.makespan - 11.0,
+                   lambda p, c: 0.0)
+    assert planned == ["b rotated", "b reversed"]
