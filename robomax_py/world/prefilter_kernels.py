@@ -75,6 +75,22 @@ def _chain_tables(F: Any, I: Any) -> Any:
 
 
 @njit(cache=True, nogil=True)
+def _sphere_tables(F: Any, I: Any) -> Any:
+    """The tables the sphere tests read (`_uncleared`, `_near`): per piece centre, radius and
+    obstacle box corners, per pair margin, per group centre and radius, per block margin; then per
+    piece its joint, per pair its pieces and whether b is an obstacle, per group its joint, per
+    block its kind, groups and end, and the pairs in block order."""
+    G, P, NG, NB = I[1], I[2], I[3], I[4]
+    fo, io = _offsets(I)
+    return (F[fo[3]:fo[3] + 3 * G].reshape((G, 3)), F[fo[4]:fo[4] + G], F[fo[5]:fo[5] + 3 * G].reshape((G, 3)),
+            F[fo[6]:fo[6] + 3 * G].reshape((G, 3)), F[fo[7]:fo[7] + P], F[fo[8]:fo[8] + 3 * NG].reshape((NG, 3)),
+            F[fo[9]:fo[9] + NG], F[fo[10]:fo[10] + NB],
+            I[io[3]:io[3] + G], I[io[4]:io[4] + P], I[io[5]:io[5] + P], I[io[6]:io[6] + P], I[io[7]:io[7] + NG],
+            I[io[8]:io[8] + NB], I[io[9]:io[9] + NB], I[io[10]:io[10] + NB], I[io[11]:io[11] + NB],
+            I[io[12]:io[12] + P])
+
+
+@njit(cache=True, nogil=True)
 def _placements(q: Any, F: Any, I: Any) -> Any:
     J = I[0]
     parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
@@ -87,18 +103,12 @@ def _placements(q: Any, F: Any, I: Any) -> Any:
 @njit(cache=True, nogil=True)
 def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any) -> Any:
     """For each configuration of qs, the active pairs it does not clear, in pair order; blocks
-    whose `blocks` entry is False are known cleared (`_near_blocks`) and skipped."""
+    whose `blocks` entry is False are known cleared (`_near`) and skipped."""
     J, G, P, NG, NB, C = I[0], I[1], I[2], I[3], I[4], I[5]
     fo, io = _offsets(I)
     parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
-    centre = F[fo[3]:fo[3] + 3 * G].reshape((G, 3))
-    radius = F[fo[4]:fo[4] + G]
-    box_lo = F[fo[5]:fo[5] + 3 * G].reshape((G, 3))
-    box_hi = F[fo[6]:fo[6] + 3 * G].reshape((G, 3))
-    margin = F[fo[7]:fo[7] + P]
-    g_centre = F[fo[8]:fo[8] + 3 * NG].reshape((NG, 3))
-    g_radius = F[fo[9]:fo[9] + NG]
-    b_margin = F[fo[10]:fo[10] + NB]
+    (centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin, piece_joint, pair_a, pair_b, pair_obstacle,
+     group_joint, b_kind, b_a, b_b, b_end, b_pairs) = _sphere_tables(F, I)
     obb_c = F[fo[11]:fo[11] + 3 * G].reshape((G, 3))
     obb_r = F[fo[12]:fo[12] + 9 * G].reshape((G, 3, 3))
     obb_h = F[fo[13]:fo[13] + 3 * G].reshape((G, 3))
@@ -107,11 +117,6 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any) -> Any:
     ch_bc = F[fo[16]:fo[16] + 3 * C].reshape((C, 3))
     ch_br = F[fo[17]:fo[17] + 9 * C].reshape((C, 3, 3))
     ch_h = F[fo[18]:fo[18] + 3 * C].reshape((C, 3))
-    piece_joint = I[io[3]:io[3] + G]
-    pair_a, pair_b, pair_obstacle = I[io[4]:io[4] + P], I[io[5]:io[5] + P], I[io[6]:io[6] + P]
-    group_joint = I[io[7]:io[7] + NG]
-    b_kind, b_a, b_b, b_end = I[io[8]:io[8] + NB], I[io[9]:io[9] + NB], I[io[10]:io[10] + NB], I[io[11]:io[11] + NB]
-    b_pairs = I[io[12]:io[12] + P]
     ch_start, ch_end, ch_skip = I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C]
 
     n_cfg = qs.shape[0]
@@ -216,22 +221,10 @@ def _near(qs: Any, F: Any, I: Any, active: Any) -> Any:
     lengths); along the straight line from the centre to any configuration of the box its centre
     so moves at most sum_i (half range_i) * that bound. A chain with a prismatic joint, or a
     configuration with a NaN, gets no bound (every block and active pair kept)."""
-    J, G, P, NG, NB = I[0], I[1], I[2], I[3], I[4]
-    fo, io = _offsets(I)
+    J, G, NG, NB = I[0], I[1], I[3], I[4]
     parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
-    centre = F[fo[3]:fo[3] + 3 * G].reshape((G, 3))
-    radius = F[fo[4]:fo[4] + G]
-    box_lo = F[fo[5]:fo[5] + 3 * G].reshape((G, 3))
-    box_hi = F[fo[6]:fo[6] + 3 * G].reshape((G, 3))
-    margin = F[fo[7]:fo[7] + P]
-    g_centre = F[fo[8]:fo[8] + 3 * NG].reshape((NG, 3))
-    g_radius = F[fo[9]:fo[9] + NG]
-    b_margin = F[fo[10]:fo[10] + NB]
-    piece_joint = I[io[3]:io[3] + G]
-    pair_a, pair_b, pair_obstacle = I[io[4]:io[4] + P], I[io[5]:io[5] + P], I[io[6]:io[6] + P]
-    group_joint = I[io[7]:io[7] + NG]
-    b_kind, b_a, b_b, b_end = I[io[8]:io[8] + NB], I[io[9]:io[9] + NB], I[io[10]:io[10] + NB], I[io[11]:io[11] + NB]
-    b_pairs = I[io[12]:io[12] + P]
+    (centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin, piece_joint, pair_a, pair_b, pair_obstacle,
+     group_joint, b_kind, b_a, b_b, b_end, b_pairs) = _sphere_tables(F, I)
     keep = np.ones(NB, dtype=np.bool_)
     live = active.copy()
     for j in range(1, J):
