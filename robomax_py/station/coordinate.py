@@ -10,8 +10,9 @@ segment's start is in that segment, so a rest posture in the other's way is orde
 
 Which segments need an interlock depends on the waits already set, so collisions are resolved one
 at a time, the earliest on the shared clock first. Per collision both orders are tried, each followed
-by a greedy completion of the rest (the order with the shorter makespan at every later zone); the
-order whose completed makespan is shorter is kept: a rollout, not first come first served (which
+by a greedy completion of the rest (the order with the shorter makespan at every later zone, the
+other order tried where that one ends in a deadlock or a collision no order resolves); the order
+whose completed makespan is shorter is kept: a rollout, not first come first served (which
 `fcfs=True` gives, the baseline). A cycle of interlocks (a deadlock) rules an order out.
 """
 
@@ -27,6 +28,11 @@ from robomax_py._typing import BoolArray, FloatArray
 
 # Zones resolved per station at most (each resolution adds one interlock); beyond it the plan fails.
 MAX_INTERLOCKS = 400
+# Orders taken back per greedy completion at most, where the shorter order at a zone led to a
+# deadlock: a robot whose move sweeps through the other's path at every rest point but one (a
+# generated two-robot station: a KR 125-class arm's move across the UR10's home) can pass only while
+# the other rests there, which the greedy order, shorter at the zone itself, gives up a zone earlier.
+MAX_BACKTRACKS = 64
 TIME_EPS = 1e-9
 
 
@@ -142,7 +148,8 @@ def _first_clash(pairs: Sequence[PairMap], schedule: Schedule) -> tuple[PairMap,
     time, shared time)."""
     best: tuple[PairMap, float, float, float] | None = None
     for p in pairs:
-        stop = min(schedule.ends[p.a], schedule.ends[p.b])
+        # To the later end: a robot that has ended stands at home, where the other may still reach it.
+        stop = max(schedule.ends[p.a], schedule.ends[p.b])
         shared = np.arange(0.0, stop + p.dt, p.dt / 2)
         ta, tb = own_time(schedule, p.a, shared), own_time(schedule, p.b, shared)
         i = np.clip(np.rint(ta / p.dt).astype(int), 0, p.clash.shape[0] - 1)
@@ -199,33 +206,51 @@ def coordinate(timelines: Sequence[Timeline], pairs: Sequence[PairMap], fcfs: bo
     by_name = {t.robot: t for t in timelines}
 
     def run(locks: list[Interlock], mode: str) -> Coordination:
+        # The greedy completion's zones where another order is left to try: (interlocks before, orders).
+        untried: list[tuple[list[Interlock], list[Interlock]]] = []
+        backtracks = 0
+        failed: Coordination | None = None
         while True:
             schedule = simulate(timelines, locks)
             if schedule.deadlock:
-                return Coordination(tuple(locks), schedule, "the interlocks wait on each other (deadlock)")
-            hit = _first_clash(pairs, schedule)
-            if hit is None:
+                stuck = Coordination(tuple(locks), schedule, "the interlocks wait on each other (deadlock)")
+            elif (hit := _first_clash(pairs, schedule)) is None:
                 return Coordination(tuple(locks), schedule)
-            if len(locks) >= MAX_INTERLOCKS:
+            elif len(locks) >= MAX_INTERLOCKS:
                 return Coordination(tuple(locks), schedule, f"more than {MAX_INTERLOCKS} interlocks needed")
-            p, ta, tb, t = hit
-            options = [o for o in (_option(p, (ta, tb), True, by_name, locks),
-                                   _option(p, (ta, tb), False, by_name, locks)) if o is not None]
-            if not options:
-                return Coordination(tuple(locks), schedule, f"{p.a} and {p.b} collide at {t:.2f} s on the shared "
-                                    f"clock ({p.a} at {ta:.2f} s, {p.b} at {tb:.2f} s of their own) whichever "
-                                    "goes first")
-            if mode == "fcfs":
-                # First come first served, passing over an order that would deadlock.
-                live = [o for o in options if not simulate(timelines, [*locks, o]).deadlock] or options
-                choice = min(live, key=lambda o: _entry(schedule, o.leader, o.leader_span[0]))
-            elif mode == "greedy":
-                choice = min(options, key=lambda o: simulate(timelines, [*locks, o]).makespan)
             else:
-                done = [run([*locks, o], "greedy") for o in options]
-                k = min(range(len(done)), key=lambda k: (bool(done[k].unresolved), done[k].schedule.makespan))
-                choice = options[k]
-            locks = [*locks, choice]
+                p, ta, tb, t = hit
+                options = [o for o in (_option(p, (ta, tb), True, by_name, locks),
+                                       _option(p, (ta, tb), False, by_name, locks)) if o is not None]
+                if not options:
+                    stuck = Coordination(tuple(locks), schedule, f"{p.a} and {p.b} collide at {t:.2f} s on the "
+                                         f"shared clock ({p.a} at {ta:.2f} s, {p.b} at {tb:.2f} s of their own) "
+                                         "whichever goes first")
+                elif mode == "fcfs":
+                    # First come first served, passing over an order that would deadlock.
+                    live = [o for o in options if not simulate(timelines, [*locks, o]).deadlock] or options
+                    locks = [*locks, min(live, key=lambda o: _entry(schedule, o.leader, o.leader_span[0]))]
+                    continue
+                elif mode == "greedy":
+                    ranked = sorted(options, key=lambda o: simulate(timelines, [*locks, o]).makespan)
+                    untried.append((locks, ranked[1:]))
+                    locks = [*locks, ranked[0]]
+                    continue
+                else:
+                    done = [run([*locks, o], "greedy") for o in options]
+                    k = min(range(len(done)), key=lambda k: (bool(done[k].unresolved), done[k].schedule.makespan))
+                    locks = [*locks, options[k]]
+                    continue
+            # Stuck: the greedy completion takes back its latest order with another left to try; the
+            # first way it got stuck is the answer when none completes.
+            failed = failed or stuck
+            while untried and not untried[-1][1]:
+                untried.pop()
+            if mode != "greedy" or not untried or backtracks >= MAX_BACKTRACKS:
+                return failed
+            backtracks += 1
+            before, others = untried[-1]
+            locks = [*before, others.pop(0)]
 
     done = run([], "fcfs" if fcfs else ("lookahead" if lookahead else "greedy"))
     return Coordination(_without_implied(done.interlocks), done.schedule, done.unresolved)
