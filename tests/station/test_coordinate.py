@@ -10,9 +10,11 @@ import pytest
 from robomax_py.station.coordinate import (
     Interlock,
     PairMap,
+    Schedule,
     Timeline,
     _first_clash,
     coordinate,
+    own_time,
     simulate,
 )
 
@@ -95,3 +97,45 @@ def test_a_wait_already_held_long_enough_by_an_earlier_one_is_no_wait() -> None:
     at, waited = schedule.waits["b"][0]
     assert at == 1.0 and waited == pytest.approx(5.0)
     assert schedule.ends["b"] == pytest.approx(15.0) and schedule.makespan == pytest.approx(15.0)
+
+
+def _clashes_to_the_end(pair: PairMap, schedule: Schedule) -> int:
+    """Samples of the shared clock, to the later robot's end, where the pair collides (checked here
+    on its own, not by `_first_clash`)."""
+    shared = np.arange(0.0, schedule.makespan + DT, DT / 2)
+    i = np.clip(np.rint(own_time(schedule, pair.a, shared) / DT).astype(int), 0, pair.clash.shape[0] - 1)
+    j = np.clip(np.rint(own_time(schedule, pair.b, shared) / DT).astype(int), 0, pair.clash.shape[1] - 1)
+    return int(pair.clash[i, j].sum())
+
+
+def test_a_robot_passes_while_the_other_rests_at_its_one_clear_point() -> None:
+    """a's move from 4 to 5 s sweeps through b's path everywhere but around b's rest at 7 s (home
+    included), as a KR 125-class arm's move across a UR10 on a generated two-robot station: a may
+    pass only while b rests at 7 s. At b's 5-6 s segment the order "a first" waits less at that zone
+    (b waits at 5 s, where it is itself in a's way), a dead end the greedy completion must take
+    back, not a deadlock."""
+    lines = [_timeline("a", 8.0, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]),
+             _timeline("b", 10.0, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])]
+    t = np.arange(0.0, 10.0 + DT, DT)
+    in_a = (t > 4.05) & (t < 4.95)
+    in_b = (t < 6.55) | (t > 7.45)
+    pair = PairMap("a", "b", DT, in_a[:, None] & in_b[None, :])
+    done = coordinate(lines, [pair])
+    assert not done.unresolved
+    assert _clashes_to_the_end(pair, done.schedule) == 0
+    # a waits at 4 s for b to reach its 7 s rest; b waits there until a is through (5 s).
+    assert {(x.waiter, x.wait_at, x.signal_at) for x in done.interlocks} == {("a", 4.0, 7.0), ("b", 7.0, 5.0)}
+
+
+def test_a_robot_that_has_ended_stands_at_home_in_the_others_way() -> None:
+    """b is home again at 5 s; a's move from 6 to 7 s sweeps through b's home posture: b must wait
+    at its last weld until a is through, though b would end long before a moves there."""
+    lines = [_timeline("a", 10.0, [2.0, 4.0, 6.0, 7.0, 8.0]), _timeline("b", 5.0, [1.0, 2.0, 3.0, 4.0])]
+    t = np.arange(0.0, 10.0 + DT, DT)
+    in_a = (t > 6.15) & (t < 6.85)
+    at_home_b = (t < 0.45) | (t > 4.55)
+    pair = PairMap("a", "b", DT, in_a[:, None] & at_home_b[None, :])
+    done = coordinate(lines, [pair])
+    assert not done.unresolved
+    assert _clashes_to_the_end(pair, done.schedule) == 0
+    assert [(x.waiter, x.wait_at, x.signal_at) for x in done.interlocks] == [("b", 4.0, 7.0)]
