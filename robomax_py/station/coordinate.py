@@ -148,8 +148,7 @@ def _first_clash(pairs: Sequence[PairMap], schedule: Schedule) -> tuple[PairMap,
     time, shared time)."""
     best: tuple[PairMap, float, float, float] | None = None
     for p in pairs:
-        # To the later end: a robot that has ended stands at home, where the other may still reach it.
-        stop = max(schedule.ends[p.a], schedule.ends[p.b])
+        stop = min(schedule.ends[p.a], schedule.ends[p.b])
         shared = np.arange(0.0, stop + p.dt, p.dt / 2)
         ta, tb = own_time(schedule, p.a, shared), own_time(schedule, p.b, shared)
         i = np.clip(np.rint(ta / p.dt).astype(int), 0, p.clash.shape[0] - 1)
