@@ -154,11 +154,8 @@ def time_junction(
             return None
 
     def timed(rj: float, rd: float) -> tuple[float, list[ChainPath], list[Segment]] | None:
-        steps = steps_of(rj, rd)
-        try:
-            return None if steps is None else _time_steps(robot, limits, q_start, steps, jerk_limited, lin_cache)
-        except TimingError:
-            return None
+        shape = shaped(rj, rd)
+        return None if shape is None else timed_shape(shape)
 
     exact: tuple[float, list[ChainPath], list[Segment]] | None = None
 
@@ -407,13 +404,6 @@ def _time_shape(shape: _Shape, limits: JointLimits, jerk_limited: bool) -> tuple
     for chain, path in zip(shape.chains, shape.paths):
         segments.extend(time_chain(path, chain, limits, jerk_limited=jerk_limited))
     return sum(s.duration for s in segments), shape.paths, segments
-
-
-def _time_steps(
-    robot: RobotModel, limits: JointLimits, q_start: FloatArray, steps: list[Step],
-    jerk_limited: bool, lin_cache: dict[bytes, LinPath],
-) -> tuple[float, list[ChainPath], list[Segment]]:
-    return _time_shape(_chain_paths(robot, q_start, steps, lin_cache), limits, jerk_limited)
 
 
 def _path_free(world: PathChecks, shape: _Shape) -> tuple[bool, int]:

@@ -111,14 +111,14 @@ def test_exact_stop_bound_is_below_its_time_and_changes_no_choice(monkeypatch: p
         return bounds[-1]
 
     exact_timings = []
-    real_time_steps = junction_module._time_steps
+    real_time_shape = junction_module._time_shape
 
-    def count(robot: Any, limits: Any, q: Any, steps: Any, *rest: Any) -> Any:
-        exact_timings.extend([1] if all(step.flyby == 0.0 for step in steps) else [])
-        return real_time_steps(robot, limits, q, steps, *rest)
+    def count(shape: Any, *rest: Any) -> Any:
+        exact_timings.extend([1] if all(step.flyby == 0.0 for chain in shape.chains for step in chain) else [])
+        return real_time_shape(shape, *rest)
 
     monkeypatch.setattr(junction_module, "_exact_lower_bound", spy)
-    monkeypatch.setattr(junction_module, "_time_steps", count)
+    monkeypatch.setattr(junction_module, "_time_shape", count)
     flown = _detour(OpenWorld())
     assert bounds and max(bounds) <= _duration(stop)
     assert not exact_timings                                     # the bound spared timing it
