@@ -5,6 +5,7 @@ when the makespan shortens."""
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -174,14 +175,20 @@ def test_no_new_order_and_interlocks_beat_the_most_gain(ends: list[float], locks
     assert after.deadlock or after.makespan >= before.makespan - most_gain(before.makespan, own, robot, floor) - 1e-9
 
 
-def test_a_change_that_cannot_gain_enough_is_not_planned() -> None:
-    # The makespan is 14 s; a change of b could gain at most 0.02 s (0.14 %), of a 3 s.
-    planned: list[str] = []
-
+def _recording(planned: list[str]) -> Callable[[_Station, OrderChange], _Station | None]:
+    """A trial that plans every change (the station in the changed order) and records its name."""
     def trial(plan: _Station, change: OrderChange) -> _Station | None:
         planned.append(change.why)
         return _Station({**plan.orders, change.robot: change.order})
 
+    return trial
+
+
+def test_a_change_that_cannot_gain_enough_is_not_planned() -> None:
+    # The makespan is 14 s; a change of b could gain at most 0.02 s (0.14 %), of a 3 s.
+    planned: list[str] = []
+
+    trial = _recording(planned)
     def gain(plan: _Station, change: OrderChange) -> float:
         return 0.02 if change.robot == "b" else 3.0
 
@@ -201,10 +208,7 @@ def test_a_round_stops_once_no_change_left_can_end_sooner() -> None:
     # b reversed ends at 11 s; a's changes could reach 11 s at best (gain 3 s): not planned.
     planned: list[str] = []
 
-    def trial(plan: _Station, change: OrderChange) -> _Station | None:
-        planned.append(change.why)
-        return _Station({**plan.orders, change.robot: change.order})
-
+    trial = _recording(planned)
     def gain(plan: _Station, change: OrderChange) -> float:
         return 4.0 if change.robot == "b" else plan.makespan - 11.0
 
@@ -224,10 +228,7 @@ def test_among_equal_gains_the_least_tour_growth_is_planned_first() -> None:
         b = plan.orders["b"]
         return [OrderChange("b", b[1:] + b[:1], "b rotated"), OrderChange("b", b[::-1], "b reversed")]
 
-    def trial(plan: _Station, change: OrderChange) -> _Station | None:
-        planned.append(change.why)
-        return _Station({**plan.orders, change.robot: change.order})
-
+    trial = _recording(planned)
     def growth(plan: _Station, change: OrderChange) -> float:
         return 2.0 if change.why == "b rotated" else 0.0
 
