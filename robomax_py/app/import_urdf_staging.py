@@ -94,8 +94,8 @@ def _make_folders(folder: Path) -> list[Path]:
 
 def clean_stale_staging(parent: Path) -> list[Path]:
     """Remove the staging folders in `parent` left by imports that were killed (their process has
-    ended): recognised by their name (`_STAGING`) and their marker file, or empty (killed before the
-    marker was written). A folder a killed replacement had moved aside (`old`) is put back first
+    ended): recognised by their name (`_STAGING`) and their marker file, or holding nothing but a
+    marker cut short (killed before or while the marker was written). A folder a killed replacement had moved aside (`old`) is put back first
     when its place is still empty. Returns the folders removed."""
     removed: list[Path] = []
     try:
@@ -109,11 +109,13 @@ def clean_stale_staging(parent: Path) -> list[Path]:
         folder = Path(entry.path)
         out_name = _marked(folder / STAGING_MARKER)
         if out_name is None:
-            try:
-                folder.rmdir()           # only ever an empty folder
-                removed.append(folder)
-            except OSError:
-                pass
+            if _half_marked(folder, m["name"]):
+                try:
+                    (folder / STAGING_MARKER).unlink(missing_ok=True)
+                    folder.rmdir()       # only ever an empty folder
+                    removed.append(folder)
+                except OSError:
+                    pass
             continue
         old, target = folder / "old", parent / out_name
         if old.is_dir() and not old.is_symlink() and not os.path.lexists(target):
@@ -138,6 +140,26 @@ def _marked(marker: Path) -> str | None:
         return None
     m = re.fullmatch(rf"out ({_NAME})\n", text[len(MARKER_TEXT):])
     return None if m is None else m.group(1)
+
+
+def _half_marked(folder: Path, name: str) -> bool:
+    """True when `folder` holds nothing or only a marker cut short by a kill while it was written
+    (its text a prefix of the marker `_staging` writes for `name`): the states before the robot
+    folder is made, so removing them loses nothing."""
+    try:
+        entries = os.listdir(folder)
+    except OSError:
+        return False
+    if not entries:
+        return True
+    marker = folder / STAGING_MARKER
+    if entries != [STAGING_MARKER] or marker.is_symlink() or not marker.is_file():
+        return False
+    try:
+        text = marker.read_bytes()[:4097]
+    except OSError:
+        return False
+    return f"{MARKER_TEXT}out {name}\n".encode().startswith(text)
 
 
 def _alive(pid: int) -> bool:

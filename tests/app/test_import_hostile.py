@@ -578,6 +578,15 @@ def test_stale_staging_is_cleaned_and_nothing_else(tmp_path: Path) -> None:
     (stale / STAGING_MARKER).write_text(f"{MARKER_TEXT}out m20ia\n")
     empty = out.parent / f".m20ia.robomax-import-{pid}-efgh5678"       # killed before its marker
     empty.mkdir()
+    half = out.parent / f".m20ia.robomax-import-{pid}-uvwx3456"       # killed while writing its marker
+    half.mkdir()
+    (half / STAGING_MARKER).write_text(MARKER_TEXT[:20])
+    blank = out.parent / f".m20ia.robomax-import-{pid}-yzab7890"      # killed right after creating it
+    blank.mkdir()
+    (blank / STAGING_MARKER).write_text("")
+    foreign = out.parent / f".m20ia.robomax-import-{pid}-cdef1357"    # a marker that is not a prefix of ours
+    foreign.mkdir()
+    (foreign / STAGING_MARKER).write_text("a note of the user's\n")
     unmarked = out.parent / f".m20ia.robomax-import-{pid}-ijkl9012"   # no marker, not empty: not ours
     (unmarked / "keep").mkdir(parents=True)
     alive = out.parent / f".m20ia.robomax-import-{os.getpid()}-mnop3456"   # a running import's
@@ -586,7 +595,8 @@ def test_stale_staging_is_cleaned_and_nothing_else(tmp_path: Path) -> None:
     lookalike = out.parent / "m20ia.robomax-import-1-abcd1234"        # no leading dot
     lookalike.mkdir()
     import_urdf(ROSI / "fanuc_m20ia_support/urdf/m20ia.xacro", out, (ROSI,))
-    assert sorted(p.name for p in out.parent.iterdir()) == sorted(["m20ia", unmarked.name, alive.name, lookalike.name])
+    assert sorted(p.name for p in out.parent.iterdir()) == sorted(["m20ia", unmarked.name, alive.name, lookalike.name,
+                                                                  foreign.name])
 
 
 def test_a_replacement_killed_between_its_renames_is_put_back(tmp_path: Path) -> None:
