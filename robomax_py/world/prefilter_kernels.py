@@ -143,8 +143,14 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any) -> Any:
         else:
             moving[n_moving] = g
             n_moving += 1
+    # Each configuration is copied to a writable row first: `_forward` then has the one
+    # specialisation `_near` and `_placements` also use (a read-only row would compile it again,
+    # about 0.4 s of a first plan).
+    q = np.empty(qs.shape[1])
     for i in range(n_cfg):
-        _forward(qs[i], parent, kind, axis, jrot, jtrans, jq, rot, trans)
+        for c in range(q.shape[0]):          # a loop: slice assignment compiles its shape checks
+            q[c] = qs[i, c]
+        _forward(q, parent, kind, axis, jrot, jtrans, jq, rot, trans)
         for m in range(n_moving):
             _place(rot, trans, piece_joint[moving[m]], centre, moving[m], world)
         for g in range(NG):
