@@ -20,11 +20,13 @@ def station_programs(station: StationSpec, given: list[Path]) -> list[dict[str, 
     the robots' own controllers' programs (`plan --format native`: a KUKA and a FANUC robot in one
     station each run their own dialect) where they are not one dialect's set already."""
     from robomax_py.export import DIALECTS, Dialect, native_dialect
+    from robomax_py.export.plan_program import identifier
 
     def program_file(folder: Path, robot: str, d: Dialect) -> Path:
-        # FANUC names its files after the program (CROSSING_R1.ls): the dialect's own name for it.
-        stem = d.program_name or (lambda n: n)
-        return folder / f"{stem(f'{station.name}_{robot}')}{d.extensions[0]}"
+        # FANUC, KRL and RAPID name their files after the program (CROSSING_R1.ls): the dialect's
+        # own name for the program's, which is the identifier of the robot's plan name.
+        name = f"{station.name}_{robot}"
+        return folder / f"{d.program_name(identifier(name)) if d.program_name else name}{d.extensions[0]}"
 
     robots = station.robot_names
     if len(given) == 1 and given[0].is_dir():

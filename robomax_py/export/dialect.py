@@ -12,6 +12,7 @@ text gives back the adapted program and that its rebuilt motion is the planned o
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import math
 import re
 from collections.abc import Callable, Sequence
@@ -103,6 +104,31 @@ def controller_identifier(name: str, *, upper: bool, max_chars: int, reserved: S
         ident = first + ident
     ident = ident[:max_chars]
     return ident + suffix if ident in reserved else ident
+
+def fitted_identifier(name: str, *, max_chars: int, reserved: Sequence[str] = (), keep: Sequence[str] = ()) -> str:
+    """A program's name as a controller that ties the file to it takes it (KRL's DEF and file,
+    RAPID's MODULE and file): letters of either case, digits and `_`, a letter first (`P` put in
+    front otherwise), at most `max_chars`. A longer name is cut and given `_` and 4 hexadecimal
+    digits of its SHA-256, so that two long names stay two programs; an ending in `keep` (a
+    baseline's `_teach_in`) stays on. A name in `reserved` (case-insensitively: the dialect's own
+    routines and keywords) gets `_prog` after it.
+
+    >>> fitted_identifier("7 door-L", max_chars=17), fitted_identifier("spot_weld", max_chars=17, reserved=["SPOT_WELD"])
+    ('P7_door_L', 'spot_weld_prog')
+    >>> fitted_identifier("cabin_flange_rear_left_teach_in", max_chars=17, keep=["_teach_in"])
+    'cab_5E67_teach_in'
+    """
+    ident = re.sub(r"[^A-Za-z0-9_]", "_", name) or "P"
+    if not ("A" <= ident[0] <= "Z" or "a" <= ident[0] <= "z"):
+        ident = "P" + ident
+    if ident.upper() in {r.upper() for r in reserved}:
+        ident += "_prog"
+    if len(ident) > max_chars:
+        kept = next((k for k in keep if ident.endswith(k)), "")
+        digest = hashlib.sha256(name.encode()).hexdigest()[:4].upper()
+        ident = ident[:max_chars - len(kept) - 5] + "_" + digest + kept
+    return ident
+
 
 def own_name(frame: FrameDef) -> str:
     """A frame's name as the program states it, for dialects that refer to frames by name."""

@@ -14,9 +14,9 @@ __all__ = ["AS", "FANUC", "INFORM", "KRL", "RAPID", "SHIPPED", "SRCL", "URSCRIPT
 
 SRCL = Dialect("srcl", (".srcl",), "", srcl.adapt, srcl.write, srcl.parse, splines=True)
 KRL = Dialect("krl", (".src", ".dat"), "kuka", krl.adapt, krl.write, krl.parse, krl.frame_name,
-              (krl.FRAMES_FILE,), krl.FILE_ENCODING, splines=True)
+              (krl.FRAMES_FILE,), krl.FILE_ENCODING, program_name=krl.program_name, splines=True)
 RAPID = Dialect("rapid", (".mod",), "abb", rapid.adapt, rapid.write, rapid.parse, companions=(rapid.FRAMES_FILE,),
-                named_frames_only=True)
+                program_name=rapid.program_name, named_frames_only=True)
 FANUC = Dialect("fanuc", (".ls",), "fanuc", fanuc.adapt, fanuc.write, fanuc.parse, fanuc.frame_name,
                 (fanuc.FRAMES_FILE,), program_name=fanuc.program_name,
                 shared=tuple(f"{name}.ls" for name in fanuc.ROUTINES))

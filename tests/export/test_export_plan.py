@@ -117,7 +117,12 @@ def test_baseline_files_are_named_apart(small: dict[str, Any]) -> None:
     for method, suffix in (("published", "_published"), ("teach-in", "_teach_in")):
         files, _ = publish(small["result"], small["cell"], small["robot"], ("srcl", "krl"), method=method)
         name = "small_cell" + suffix
-        assert sorted(files) == [f"{name}.dat", f"{name}.json", f"{name}.src", f"{name}.srcl", f"{name}_frames.src"]
+        # KRL's files carry the DEF's name, a KRL name of 24 characters at most with `_frames`
+        # after it: "small_cell_published" is cut, the baseline's suffix kept.
+        krl = next(f[:-4] for f in files if f.endswith(".src") and not f.endswith("_frames.src"))
+        assert krl.endswith(suffix) and len(krl + "_frames") <= 24 and krl != name
+        assert sorted(files) == [f"{krl}.dat", f"{krl}.src", f"{krl}_frames.src", f"{name}.json", f"{name}.srcl"]
+        assert f"DEF {krl}( )" in files[f"{krl}.src"] and f"DEFDAT  {krl}" in files[f"{krl}.dat"]
 
 
 @pytest.mark.parametrize(("name", "ident"), [("door-L 2", "door_L_2"), ("7up", "_7up"), ("s1", "s1")])

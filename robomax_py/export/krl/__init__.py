@@ -106,7 +106,8 @@ from robomax_py.export.krl.write import (
     FRAMES_FILE,
     adapt,
     frame_name,
+    program_name,
     write,
 )
 
-__all__ = ["FILE_ENCODING", "FRAMES_FILE", "adapt", "frame_name", "parse", "write"]
+__all__ = ["FILE_ENCODING", "FRAMES_FILE", "adapt", "frame_name", "parse", "program_name", "write"]

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 from robomax_py.errors import ExportError
 from robomax_py.export.dialect import (
     PlannedProgram,
+    fitted_identifier,
     gripper_label,
     header_lines,
     numbered_frames,
@@ -65,6 +66,34 @@ _EXTERNAL = ",".join(f"E{i} 0.0" for i in range(1, 7))
 _DATA_TYPES = ("E6AXIS", "AXIS", "E6POS", "POS", "FRAME", "FDAT", "PDAT", "LDAT", "SPOT_TYPE")
 
 
+# KSS names (KSS 8.x Operating and Programming Instructions for System Integrators, "Names in
+# KRL", as restated in Hungsiu/WtRobotTraining @ c92b8435 03_Syntax.md, "naming and variables"): at most 24
+# characters, letters, digits, `_` and `$`, not a digit first, not a keyword. A module's file and
+# its DEF (and DEFDAT) have one name: KSS selects `<name>.src` by running its DEF `<name>`, and
+# RoboDK's KUKA post names the file after the DEF it writes (ros-industrial-attic/
+# robodk_postprocessors @ d7e6c1c0 KUKA_KRC4.py 146-188). So the program's name is the files'
+# stem, short enough that the setup program `<name>_frames` is a name too.
+PROGRAM_CHARS = _NAME_CHARS - len("_frames")
+# The routines the program defines after its own DEF, and the keywords of the statements robomax
+# reads and writes (a DEF so named would not compile).
+_RESERVED = ("spot_weld", "grip", "release", "DEF", "END", "DEFDAT", "ENDDAT", "DEFFCT", "ENDFCT", "DECL", "GLOBAL",
+             "PTP", "LIN", "CIRC", "SPLINE", "ENDSPLINE", "SPL", "SLIN", "SCIRC", "WAIT", "FOR", "SEC", "IF", "THEN",
+             "ELSE", "ENDIF", "LOOP", "ENDLOOP", "WHILE", "ENDWHILE", "REPEAT", "UNTIL", "SWITCH", "CASE", "DEFAULT",
+             "ENDSWITCH", "GOTO", "HALT", "RETURN", "EXIT", "INTERRUPT", "TRIGGER", "SIGNAL", "INT", "REAL", "BOOL",
+             "CHAR", "TRUE", "FALSE", "AND", "OR", "NOT", "EXOR", "CONTINUE", "BRAKE", "INI")
+_BASELINES = ("_published", "_teach_in")
+
+
+def program_name(name: str) -> str:
+    """The DEF and file name a cell's program `name` becomes (`PROGRAM_CHARS` at most; see
+    `dialect.fitted_identifier`).
+
+    >>> program_name("Kabine Flansch"), program_name("7up"), program_name("lin")
+    ('Kabine_Flansch', 'P7up', 'lin_prog')
+    """
+    return fitted_identifier(name, max_chars=PROGRAM_CHARS, reserved=_RESERVED, keep=_BASELINES)
+
+
 def frame_name(frame: FrameDef) -> str:
     """How KRL refers to a stored frame: `TOOL_DATA[n]` or `BASE_DATA[n]`."""
     return f"{'TOOL' if frame.kind == 'tool' else 'BASE'}_DATA[{frame.number}]"
@@ -98,7 +127,7 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
             ins = dataclasses.replace(ins, accel=percent(ins.accel) / 100)
         out.append(ins)
     setup = dataclasses.replace(program.setup, frame_names=names)
-    return dataclasses.replace(program, instructions=tuple(out), setup=setup)
+    return dataclasses.replace(program, name=program_name(program.name), instructions=tuple(out), setup=setup)
 
 
 # ================================================================================== writing

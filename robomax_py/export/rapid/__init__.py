@@ -109,6 +109,6 @@ from __future__ import annotations
 
 from robomax_py.export.dialect import Parsed as Parsed
 from robomax_py.export.rapid.read import parse
-from robomax_py.export.rapid.write import FRAMES_FILE, adapt, write
+from robomax_py.export.rapid.write import FRAMES_FILE, adapt, program_name, write
 
-__all__ = ["FRAMES_FILE", "adapt", "parse", "write"]
+__all__ = ["FRAMES_FILE", "adapt", "parse", "program_name", "write"]

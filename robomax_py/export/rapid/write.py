@@ -8,6 +8,7 @@ import dataclasses
 from robomax_py.errors import ControllerSetupError, ExportError
 from robomax_py.export.dialect import (
     PlannedProgram,
+    fitted_identifier,
     gripper_label,
     header_lines,
     require_six_axes,
@@ -35,6 +36,27 @@ from robomax_py.robot import RobotModel
 
 # The data module declaring the program's tooldata and wobjdata (a companion of `<name>.mod`).
 FRAMES_FILE = "_frames.mod"
+# RAPID identifiers name modules, routines and data: a letter first, then letters, digits and `_`,
+# at most 32 characters (ABB Technical reference manual, RAPID kernel, 3HAC050946-001,
+# "Identifiers"); reserved words are not identifiers. The module is saved as `<MODULE name>.mod`,
+# as RobotStudio saves a module, and `<name>_frames` must be an identifier too.
+PROGRAM_CHARS = 32 - len("_frames")
+_RESERVED = ("main", "spot_weld", "grip", "release", "MODULE", "ENDMODULE", "PROC", "ENDPROC", "FUNC", "ENDFUNC",
+             "TRAP", "ENDTRAP", "CONST", "PERS", "VAR", "LOCAL", "TASK", "IF", "THEN", "ELSE", "ELSEIF", "ENDIF", "FOR",
+             "FROM", "TO", "STEP", "DO", "ENDFOR", "WHILE", "ENDWHILE", "TEST", "CASE", "DEFAULT", "ENDTEST", "RETURN",
+             "GOTO", "RAISE", "RETRY", "TRYNEXT", "ERROR", "BACKWARD", "UNDO", "AND", "OR", "XOR", "NOT", "DIV",
+             "MOD", "TRUE", "FALSE", "WITH", "ALIAS", "RECORD", "ENDRECORD", "CONNECT", "NOSTEPIN", "NOVIEW",
+             "READONLY", "SYSMODULE", "VIEWONLY", "INOUT", "OPTIONAL")
+
+
+def program_name(name: str) -> str:
+    """The MODULE and file name a cell's program `name` becomes (`PROGRAM_CHARS` at most; see
+    `dialect.fitted_identifier`).
+
+    >>> program_name("Kabine Flansch"), program_name("_7_door"), program_name("main")
+    ('Kabine_Flansch', 'P_7_door', 'main_prog')
+    """
+    return fitted_identifier(name, max_chars=PROGRAM_CHARS, reserved=_RESERVED, keep=("_published", "_teach_in"))
 
 _NOTE = "RAPID module"
 _EAX = "[9E9, 9E9, 9E9, 9E9, 9E9, 9E9]"
@@ -78,6 +100,7 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     program = with_package_welds(dataclasses.replace(program, frames=frames, instructions=tuple(out)), "RAPID")
     _check_weld_data_names(program)
     program = with_brand_configs(program, planned.joints, robot, "abb")
+    program = dataclasses.replace(program, name=program_name(program.name))
     return with_tcp_blends(dataclasses.replace(planned, program=_without_approach_notes(program)), robot)
 
 

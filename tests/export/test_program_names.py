@@ -1,0 +1,83 @@
+"""Program names where the controller ties the file to the program: KRL's DEF and DEFDAT carry
+the name of their `.src` / `.dat`, RAPID's MODULE that of its `.mod` (as RobotStudio saves it).
+The rules are checked as the vendors state them, not with the writer's code:
+- KRL names: at most 24 characters, letters, digits, `_` and `$`, not a digit first (KSS 8.x
+  "Names in KRL"; Hungsiu/WtRobotTraining @ c92b8435 03_Syntax.md), so the setup program
+  `<name>_frames` must fit as well;
+- RAPID identifiers: a letter first, then letters, digits and `_`, at most 32 characters (ABB
+  RAPID kernel reference, "Identifiers")."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from hypothesis import given
+from hypothesis import strategies as st
+from typer.testing import CliRunner
+
+from robomax_py.app.cli import app
+from robomax_py.export import krl, rapid
+from robomax_py.export.plan_program import identifier
+
+KRL_NAME = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]{0,23}")
+RAPID_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,31}")
+KRL_WORDS = {"DEF", "END", "PTP", "LIN", "CIRC", "WAIT", "IF", "FOR", "LOOP", "SPOT_WELD", "GRIP", "RELEASE"}
+RAPID_WORDS = {"MODULE", "PROC", "MAIN", "IF", "FOR", "TRUE", "SPOT_WELD", "GRIP", "RELEASE"}
+
+
+@given(st.text(min_size=0, max_size=60))
+def test_krl_names_follow_kss_rules(name: str) -> None:
+    ident = krl.program_name(identifier(name))
+    assert KRL_NAME.fullmatch(ident) and KRL_NAME.fullmatch(ident + "_frames")
+    assert ident.upper() not in KRL_WORDS
+
+
+@given(st.text(min_size=0, max_size=60))
+def test_rapid_names_follow_the_identifier_rules(name: str) -> None:
+    ident = rapid.program_name(identifier(name))
+    assert RAPID_NAME.fullmatch(ident) and RAPID_NAME.fullmatch(ident + "_frames")
+    assert ident.upper() not in RAPID_WORDS
+
+
+def test_long_names_cut_stay_apart() -> None:
+    """Two long names alike in their first characters stay two programs (4 hexadecimal digits of
+    each whole name), and a baseline's suffix stays on."""
+    a, b = "side_frame_station_robot_left", "side_frame_station_robot_right"
+    assert krl.program_name(a) != krl.program_name(b) and rapid.program_name(a) != rapid.program_name(b)
+    assert krl.program_name(a + "_teach_in").endswith("_teach_in")
+
+
+def test_short_names_are_kept() -> None:
+    assert krl.program_name("small_cell") == "small_cell" and rapid.program_name("small_cell") == "small_cell"
+
+
+def test_a_cell_named_as_people_name_it_gives_files_its_controllers_load(tmp_path: Path, write_small_cell) -> None:  # type: ignore[no-untyped-def]
+    """A cell named with spaces, umlauts, a digit first and 44 characters: the KRL and RAPID files
+    are named as their DEF / DEFDAT / MODULE, each a valid name; the trajectory file keeps the
+    cell's name; `verify` of each program is clean."""
+    cell = write_small_cell(tmp_path, name="7 Kabine Flansch Rückwand links Variante 2")
+    out = tmp_path / "out"
+    runner = CliRunner()
+    done = runner.invoke(app, ["plan", str(cell), "--out", str(out), "--format", "krl,rapid"])
+    assert done.exit_code == 0, done.output
+    src = [p for p in out.glob("*.src") if not p.stem.endswith("_frames")]
+    mod = [p for p in out.glob("*.mod") if not p.stem.endswith("_frames")]
+    assert len(src) == 1 and len(mod) == 1
+    stem = src[0].stem
+    text = src[0].read_text(encoding="cp1252")
+    assert KRL_NAME.fullmatch(stem) and KRL_NAME.fullmatch(stem + "_frames")
+    assert re.search(rf"^DEF {re.escape(stem)}\(", text, re.MULTILINE)
+    assert re.search(rf"^DEFDAT\s+{re.escape(stem)}\s*$", (out / f"{stem}.dat").read_text(encoding="cp1252"),
+                     re.MULTILINE)
+    frames = (out / f"{stem}_frames.src").read_text(encoding="cp1252")
+    assert re.search(rf"^DEF {re.escape(stem)}_frames\(", frames, re.MULTILINE)
+    module = mod[0].stem
+    assert RAPID_NAME.fullmatch(module) and RAPID_NAME.fullmatch(module + "_frames")
+    assert re.search(rf"^MODULE {re.escape(module)}\s*$", mod[0].read_text(), re.MULTILINE)
+    assert re.search(rf"^MODULE {re.escape(module)}_frames\s*$", (out / f"{module}_frames.mod").read_text(),
+                     re.MULTILINE)
+    assert (out / "7 Kabine Flansch Rückwand links Variante 2.json").is_file()
+    for program in (src[0], mod[0]):
+        verified = runner.invoke(app, ["verify", str(cell), str(program)])
+        assert verified.exit_code == 0 and "clean" in verified.output, verified.output
