@@ -48,6 +48,7 @@ from robomax_py.station.reorder import (
     ordered_view,
 )
 from robomax_py.station.reorder import candidates as order_candidates
+from robomax_py.station.unload import bottleneck, unloads
 from robomax_py.timing.trajectory import evaluate
 from robomax_py.world.scene import build_scene
 
@@ -167,8 +168,8 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     costs: dict[str, FloatArray] = {}
     search = improve_orders(
         best, lambda p: p.makespan, _orders, lambda p: _order_candidates(p, ordered),
-        lambda p, change: _with_order(station, models, bodies, by_robot, p, change, options, clock, bound, made,
-                                      robot_plans),
+        lambda p, change: _with_orders(station, models, bodies, by_robot, p, (change,), options, clock, bound, made,
+                                       robot_plans),
         lambda p, change: _most_gain(p, change, works), lambda p, change: _tour_growth(p, change, by_robot, costs))
     best = search.best
     penalty: dict[tuple[str, SpotKey], float] = dict(prior)
@@ -197,8 +198,14 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
             best = trial
     # A re-assignment that won plans each robot in its own best order again: the changes kept before
     # are not in its programs.
-    return dataclasses.replace(best, seconds=clock, rounds=rounds, orders_tried=search.tried,
-                               orders_skipped=search.skipped, order_changes=search.kept if best is search.best else ())
+    kept = search.kept if best is search.best else ()
+    # Where the station now ends at one robot's own cycle with no wait, the waits charge nothing: spots
+    # moved away from that robot instead, each trial judged with its interlocks.
+    fixed = frozenset(k for g in ordered for k in g)
+    best, moved, unloaded = _unload(station, models, bodies, by_robot, best, options, clock, bound, made, robot_plans,
+                                    prior, fixed, costs)
+    return dataclasses.replace(best, seconds=clock, rounds=rounds, orders_tried=search.tried + unloaded,
+                               orders_skipped=search.skipped, order_changes=(*kept, *moved))
 
 
 def _orders(plan: StationPlan) -> dict[str, tuple[SpotKey, ...]]:
@@ -230,35 +237,81 @@ def _tour_growth(plan: StationPlan, change: OrderChange, reaches: Mapping[str, R
     return tour_legs(reach, cost, change.order) - tour_legs(reach, cost, _orders(plan)[change.robot])
 
 
-def _with_order(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
-                reaches: Mapping[str, RobotReach], plan: StationPlan, change: OrderChange, options: StationOptions,
-                clock: dict[str, float], bound: LowerBound, made: _Made,
-                known: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None]) -> StationPlan | None:
-    """The station with `change.robot` planned in `change.order` (the published method's given order;
-    `known` holds the robots planned so, by order) and coordinated again; None where that robot or
-    the station does not plan."""
-    key = (change.robot, change.order)
-    if key not in known:
-        t0 = time.process_time()
-        model = models[change.robot]
-        cell = station.robot(change.robot).cell
-        # With the candidates the robot's reach found, as its own order is planned: a candidate depends
-        # on its spot, seam settings, objects and home only, not on the order
-        # (tests/station/test_reach_candidates.py).
-        result = plan_cell(ordered_view(cell, change.order), model, dataclasses.replace(options.plan, given_order=True),
-                           known=reaches[change.robot].candidates)
-        clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
-        # The program is proven against the robot's cell as its programs are read (file order).
-        known[key] = RobotPlan(change.robot, robot_view(station, change.robot, change.order), model, result) \
-            if result.status == "planned" else None
-    mine = known[key]
-    if mine is None:
-        return None
+def _with_orders(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
+                 reaches: Mapping[str, RobotReach], plan: StationPlan, changes: Sequence[OrderChange],
+                 options: StationOptions, clock: dict[str, float], bound: LowerBound, made: _Made,
+                 known: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None]) -> StationPlan | None:
+    """The station with each change's robot planned in its order (the published method's given order;
+    `known` holds the robots planned so, by order) and coordinated again; None where one of those
+    robots or the station does not plan. A change may give a robot other spots than `plan`'s."""
+    mine: dict[str, RobotPlan] = {}
+    for change in changes:
+        key = (change.robot, change.order)
+        if key not in known:
+            t0 = time.process_time()
+            model = models[change.robot]
+            cell = station.robot(change.robot).cell
+            # With the candidates the robot's reach found, as its own order is planned: a candidate depends
+            # on its spot, seam settings, objects and home only, not on the order
+            # (tests/station/test_reach_candidates.py).
+            result = plan_cell(ordered_view(cell, change.order), model,
+                               dataclasses.replace(options.plan, given_order=True),
+                               known=reaches[change.robot].candidates) if change.order else None
+            clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
+            # The program is proven against the robot's cell as its programs are read (file order).
+            known[key] = RobotPlan(change.robot, robot_view(station, change.robot, change.order), model, result) \
+                if result is None or result.status == "planned" else None
+        got = known[key]
+        if got is None:
+            return None
+        mine[change.robot] = got
     # The other robots keep the plans of `plan` (with any order change kept before), not only the
     # plans made for their spots.
-    trial = _realise(station, models, bodies, reaches, plan.assignment, options, clock, bound, made,
-                     given={**{p.robot: p for p in plan.robots}, change.robot: mine})
+    chosen = Assignment({**_orders(plan), **{c.robot: c.order for c in changes}}, plan.assignment.estimate)
+    trial = _realise(station, models, bodies, reaches, chosen, options, clock, bound, made,
+                     given={**{p.robot: p for p in plan.robots}, **mine})
     return trial if trial.status == "planned" else None
+
+
+def _unload(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
+            reaches: Mapping[str, RobotReach], plan: StationPlan, options: StationOptions,
+            clock: dict[str, float], bound: LowerBound, made: _Made,
+            known: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None], prior: Mapping[tuple[str, SpotKey], float],
+            fixed: frozenset[SpotKey], costs: dict[str, FloatArray]) -> tuple[StationPlan, tuple[OrderChange, ...], int]:
+    """Where the station ends at one robot's own cycle with no wait, spots moved from that robot to
+    others that reach them (`unload`), each trial judged by its coordinated makespan: the best plan,
+    the order changes that make it (none when no trial is shorter), the trials planned."""
+    assert plan.coordination is not None
+    own = {p.robot: p.own_cycle for p in plan.robots}
+    giver = bottleneck(own, plan.coordination.schedule.ends)
+    if giver is None:
+        return plan, (), 0
+
+    def tour_time(robot: str, order: tuple[SpotKey, ...]) -> float:
+        reach = reaches[robot]
+        if robot not in costs:
+            costs[robot] = cost_matrix(reach)
+        index = reach.index()
+        work = sum(float(reach.dwell[index[k]]) + 2 * reach.line_s + prior.get((robot, k), 0.0) for k in order)
+        return tour_legs(reach, costs[robot], order) + work
+
+    able: dict[SpotKey, list[str]] = {}
+    for reach in reaches.values():
+        for k in reach.keys:
+            able.setdefault(k, []).append(reach.robot)
+    best, kept, tried = plan, (), 0
+    for trial in unloads(_orders(plan), own, giver, able, tour_time, fixed):
+        if trial.predicted >= best.makespan - 1e-6:
+            continue
+        tried += 1
+        changes = tuple(OrderChange(r, o, trial.why[r]) for r, o in trial.orders.items())
+        got = _with_orders(station, models, bodies, reaches, plan, changes, options, clock, bound, made, known)
+        log.debug("unload %s: makespan %s (best %.3f s, predicted %.3f s)", trial.why[giver],
+                  "not planned" if got is None else f"{got.makespan:.3f} s", best.makespan, trial.predicted)
+        if got is not None and got.makespan < best.makespan - 1e-6:
+            # The first trial that shortens the makespan is kept: each costs two or three robots' plans.
+            return got, changes, tried
+    return best, kept, tried
 
 
 def _frozen(chosen: Assignment) -> frozenset[tuple[str, frozenset[SpotKey]]]:
