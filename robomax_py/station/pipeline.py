@@ -4,8 +4,10 @@ Stages: what each robot can weld (`reach`), a min-max assignment of spots to rob
 robot's spots planned by the single-robot planner (`plan.plan_cell` on the robot's cell narrowed
 to its spots, with the candidates `reach` found), robot-robot collisions on the shared clock found
 (`bodies`) and ordered by interlocks (`coordinate`); where the robot that ends last waits, another spot
-order (`reorder`) kept when the makespan shortens; and, where the waits cost more than a different
-assignment, the assignment searched again with the waits as costs and kept when the makespan shortens.
+order (`reorder`) kept when the makespan shortens; where the waits cost more than a different
+assignment, the assignment searched again with the waits as costs and kept when the makespan shortens;
+and where the station then ends at one robot's own cycle with no wait, spots moved from that robot to
+others (`unload`), kept when the coordinated makespan shortens.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from robomax_py.plan import PlanOptions, PlanResult, plan_cell
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.spec_station import SpotKey, StationSpec, robot_view
-from robomax_py.station.assign import Assignment, assign
+from robomax_py.station.assign import Assignment, assign, nearest, side_prior
 from robomax_py.station.bodies import (
     RobotBody,
     body_poses,
@@ -150,8 +152,8 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         return StationPlan(station.name, "infeasible", f"{len(nobody)} spot(s) no robot allowed to weld them can "
                            f"reach collision-free: {names}", (), Assignment({}, {}), bound, None, clock)
     t0 = time.process_time()
-    prior = _side_prior(station, reaches)
-    chosen = _nearest(station, reaches, keys, groups) if options.method == "nearest" \
+    prior = side_prior(station, reaches, SIDE_PRIOR_S_PER_M)
+    chosen = nearest(station, reaches, keys, groups) if options.method == "nearest" \
         else assign(reaches, keys, groups, prior)
     clock["assignment"] = time.process_time() - t0
     bodies = {r.name: robot_body(r.name, models[r.name], build_scene(r.cell, models[r.name])) for r in station.robots}
@@ -319,44 +321,10 @@ def _frozen(chosen: Assignment) -> frozenset[tuple[str, frozenset[SpotKey]]]:
     return frozenset((r, frozenset(spots)) for r, spots in chosen.spots.items())
 
 
-def _side_prior(station: StationSpec, reaches: Sequence[RobotReach]) -> dict[tuple[str, SpotKey], float]:
-    """SIDE_PRIOR_S_PER_M per metre a robot's base is farther from a spot than the nearest base of a
-    robot that reaches it."""
-    xyz = {(seam.name, s.name): np.asarray(s.xyz) for seam in station.robots[0].cell.seams for s in seam.spots}
-    base = {r.name: np.asarray(r.cell.T_world_base)[:3, 3] for r in station.robots}
-    out: dict[tuple[str, SpotKey], float] = {}
-    for key, p in xyz.items():
-        d = {r.robot: float(np.linalg.norm(p[:2] - base[r.robot][:2])) for r in reaches if key in r.index()}
-        nearest = min(d.values(), default=0.0)
-        for robot, dist in d.items():
-            out[(robot, key)] = SIDE_PRIOR_S_PER_M * (dist - nearest)
-    return out
-
-
 def _ordered_groups(station: StationSpec) -> list[tuple[SpotKey, ...]]:
     """An ordered seam's spots go to one robot together (its order is one robot's)."""
     cell = station.robots[0].cell
     return [tuple((seam.name, s.name) for s in seam.spots) for seam in cell.seams if seam.ordered]
-
-
-def _nearest(station: StationSpec, reaches: Sequence[RobotReach], keys: Sequence[SpotKey],
-             groups: Sequence[Sequence[SpotKey]]) -> Assignment:
-    """The baseline: each spot to the robot whose base is nearest among those that reach it."""
-    xyz = {(seam.name, s.name): np.asarray(s.xyz) for seam in station.robots[0].cell.seams for s in seam.spots}
-    base = {r.name: np.asarray(r.cell.T_world_base)[:3, 3] for r in station.robots}
-    able = {r.robot: set(r.keys) for r in reaches}
-    out: dict[str, list[SpotKey]] = {r.robot: [] for r in reaches}
-    group_of = {k: tuple(g) for g in groups for k in g}
-    done: set[SpotKey] = set()
-    for k in keys:
-        if k in done:
-            continue
-        unit = group_of.get(k, (k,))
-        robots = [r for r in able if all(u in able[r] for u in unit)] or [r for r in able if k in able[r]]
-        r = min(robots, key=lambda name: float(np.linalg.norm(xyz[k] - base[name])))
-        out[r] += list(unit)
-        done.update(unit)
-    return Assignment({r: tuple(v) for r, v in out.items()}, {r: 0.0 for r in out})
 
 
 def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
