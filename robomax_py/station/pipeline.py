@@ -242,12 +242,16 @@ def _tour_growth(plan: StationPlan, change: OrderChange, reaches: Mapping[str, R
 def _with_orders(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
                  reaches: Mapping[str, RobotReach], plan: StationPlan, changes: Sequence[OrderChange],
                  options: StationOptions, clock: dict[str, float], bound: LowerBound, made: _Made,
-                 known: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None]) -> StationPlan | None:
+                 known: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None], beat: float = np.inf
+                 ) -> StationPlan | None:
     """The station with each change's robot planned in its order (the published method's given order;
     `known` holds the robots planned so, by order) and coordinated again; None where one of those
-    robots or the station does not plan. A change may give a robot other spots than `plan`'s."""
+    robots or the station does not plan, or as soon as one of them has an own cycle no shorter than
+    `beat` (the makespan is at least every robot's own cycle): the robots planned so before first, so
+    that a trial sharing such a robot with one tried before costs nothing. A change may give a robot
+    other spots than `plan`'s."""
     mine: dict[str, RobotPlan] = {}
-    for change in changes:
+    for change in sorted(changes, key=lambda c: (c.robot, c.order) not in known):
         key = (change.robot, change.order)
         if key not in known:
             t0 = time.process_time()
@@ -264,12 +268,15 @@ def _with_orders(station: StationSpec, models: Mapping[str, RobotModel], bodies:
             known[key] = RobotPlan(change.robot, robot_view(station, change.robot, change.order), model, result) \
                 if result is None or result.status == "planned" else None
         got = known[key]
-        if got is None:
+        if got is None or got.own_cycle >= beat:
             return None
         mine[change.robot] = got
     # The other robots keep the plans of `plan` (with any order change kept before), not only the
     # plans made for their spots.
-    chosen = Assignment({**_orders(plan), **{c.robot: c.order for c in changes}}, plan.assignment.estimate)
+    # An order change keeps the assignment; a change of spots is the assignment's too.
+    moved = any(set(c.order) != set(plan.assignment.spots.get(c.robot, ())) for c in changes)
+    chosen = Assignment({**plan.assignment.spots, **{c.robot: c.order for c in changes}},
+                        plan.assignment.estimate) if moved else plan.assignment
     trial = _realise(station, models, bodies, reaches, chosen, options, clock, bound, made,
                      given={**{p.robot: p for p in plan.robots}, **mine})
     return trial if trial.status == "planned" else None
@@ -307,12 +314,16 @@ def _unload(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapp
             continue
         tried += 1
         changes = tuple(OrderChange(r, o, trial.why[r]) for r, o in trial.orders.items())
-        got = _with_orders(station, models, bodies, reaches, plan, changes, options, clock, bound, made, known)
-        log.debug("unload %s: makespan %s (best %.3f s, predicted %.3f s)", trial.why[giver],
-                  "not planned" if got is None else f"{got.makespan:.3f} s", best.makespan, trial.predicted)
+        got = _with_orders(station, models, bodies, reaches, plan, changes, options, clock, bound, made, known,
+                           beat=best.makespan - 1e-6)
+        log.debug("unload %s: makespan %s (best %.3f s, predicted %.3f s), own cycles %s", trial.why[giver],
+                  "not planned" if got is None else f"{got.makespan:.3f} s", best.makespan, trial.predicted,
+                  "" if got is None else ", ".join(f"{p.robot} {p.own_cycle:.3f} s" for p in got.robots))
         if got is not None and got.makespan < best.makespan - 1e-6:
             # The first trial that shortens the makespan is kept: each costs two or three robots' plans.
-            return got, changes, tried
+            # A robot planned in its own best order instead of the given one keeps that order.
+            planned = _orders(got)
+            return got, tuple(dataclasses.replace(c, order=planned[c.robot]) for c in changes), tried
     return best, kept, tried
 
 
