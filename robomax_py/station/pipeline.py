@@ -313,7 +313,10 @@ def _unload(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapp
         if trial.predicted >= best.makespan - 1e-6:
             continue
         tried += 1
-        changes = tuple(OrderChange(r, o, trial.why[r]) for r, o in trial.orders.items())
+        # The takers first: a spot inserted where the estimate puts it is likelier to cost a detour the
+        # prediction does not know than a spot taken out, and a trial is given up at the first robot
+        # no shorter than the best makespan.
+        changes = tuple(OrderChange(r, o, trial.why[r]) for r, o in sorted(trial.orders.items(), key=lambda ro: ro[0] == giver))
         got = _with_orders(station, models, bodies, reaches, plan, changes, options, clock, bound, made, known,
                            beat=best.makespan - 1e-6)
         log.debug("unload %s: makespan %s (best %.3f s, predicted %.3f s), own cycles %s", trial.why[giver],
