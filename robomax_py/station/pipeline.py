@@ -50,7 +50,7 @@ from robomax_py.station.reorder import (
     ordered_view,
 )
 from robomax_py.station.reorder import candidates as order_candidates
-from robomax_py.station.unload import bottleneck, unloads
+from robomax_py.station.unload import bottleneck, tour_estimator, unloads
 from robomax_py.timing.trajectory import evaluate
 from robomax_py.world.scene import build_scene
 
@@ -111,7 +111,7 @@ class StationPlan:
     seconds: Mapping[str, float]
     margin: float = 0.0          # m kept between robots on the diagrams, at most (where both move fastest)
     rounds: int = 0              # re-assignments tried
-    orders_tried: int = 0        # spot orders planned instead of waiting (`reorder`)
+    orders_tried: int = 0        # spot orders planned instead of waiting (`reorder`) and spot moves' trials (`unload`)
     orders_skipped: int = 0      # spot orders not planned: they could not gain enough (`reorder.most_gain`)
     order_changes: tuple[OrderChange, ...] = ()    # those kept, in order
 
@@ -296,38 +296,29 @@ def _unload(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapp
     if giver is None:
         return plan, (), 0
 
-    def tour_time(robot: str, order: tuple[SpotKey, ...]) -> float:
-        reach = reaches[robot]
-        if robot not in costs:
-            costs[robot] = cost_matrix(reach)
-        index = reach.index()
-        work = sum(float(reach.dwell[index[k]]) + 2 * reach.line_s + prior.get((robot, k), 0.0) for k in order)
-        return tour_legs(reach, costs[robot], order) + work
-
     able: dict[SpotKey, list[str]] = {}
     for reach in reaches.values():
         for k in reach.keys:
             able.setdefault(k, []).append(reach.robot)
-    best, kept, tried = plan, (), 0
-    for trial in unloads(_orders(plan), own, giver, able, tour_time, fixed):
-        if trial.predicted >= best.makespan - 1e-6:
+    tried = 0
+    for trial in unloads(_orders(plan), own, giver, able, tour_estimator(reaches, prior, costs), fixed):
+        if trial.predicted >= plan.makespan - 1e-6:
             continue
         tried += 1
         # The takers first: a spot inserted where the estimate puts it is likelier to cost a detour the
         # prediction does not know than a spot taken out, and a trial is given up at the first robot
         # no shorter than the best makespan.
-        changes = tuple(OrderChange(r, o, trial.why[r]) for r, o in sorted(trial.orders.items(), key=lambda ro: ro[0] == giver))
+        takers_first = sorted(trial.orders.items(), key=lambda item: item[0] == giver)
+        changes = tuple(OrderChange(r, o, trial.why[r]) for r, o in takers_first)
         got = _with_orders(station, models, bodies, reaches, plan, changes, options, clock, bound, made, known,
-                           beat=best.makespan - 1e-6)
+                           beat=plan.makespan - 1e-6)
         log.debug("unload %s: makespan %s (best %.3f s, predicted %.3f s), own cycles %s", trial.why[giver],
-                  "not planned" if got is None else f"{got.makespan:.3f} s", best.makespan, trial.predicted,
+                  "not planned" if got is None else f"{got.makespan:.3f} s", plan.makespan, trial.predicted,
                   "" if got is None else ", ".join(f"{p.robot} {p.own_cycle:.3f} s" for p in got.robots))
-        if got is not None and got.makespan < best.makespan - 1e-6:
+        if got is not None and got.makespan < plan.makespan - 1e-6:
             # The first trial that shortens the makespan is kept: each costs two or three robots' plans.
-            # A robot planned in its own best order instead of the given one keeps that order.
-            planned = _orders(got)
-            return got, tuple(dataclasses.replace(c, order=planned[c.robot]) for c in changes), tried
-    return best, kept, tried
+            return got, changes, tried
+    return plan, (), tried
 
 
 def _frozen(chosen: Assignment) -> frozenset[tuple[str, frozenset[SpotKey]]]:

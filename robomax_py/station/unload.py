@@ -24,7 +24,9 @@ import logging
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
+from robomax_py._typing import FloatArray
 from robomax_py.spec_station import SpotKey
+from robomax_py.station.reach import RobotReach, cost_matrix, tour_estimate
 
 log = logging.getLogger(__name__)
 
@@ -102,6 +104,17 @@ def unloads(orders: Mapping[str, Order], own: Mapping[str, float], giver: str,
         steps.append(Unload(changed, _why(giver, why), top))
     steps.sort(key=lambda u: u.predicted)
     return steps[:UNLOAD_TRIALS]
+
+
+def tour_estimator(reaches: Mapping[str, RobotReach], penalty: Mapping[tuple[str, SpotKey], float],
+                   costs: dict[str, FloatArray]) -> Callable[[str, Order], float]:
+    """A robot's estimated tour in an order, s, as the assignment counts it (`reach.tour_estimate`;
+    `costs` holds each robot's `reach.cost_matrix`, made once)."""
+    def tour_time(robot: str, order: Order) -> float:
+        if robot not in costs:
+            costs[robot] = cost_matrix(reaches[robot])
+        return tour_estimate(reaches[robot], costs[robot], order, penalty)
+    return tour_time
 
 
 def _why(giver: str, given: Mapping[str, Sequence[str]]) -> dict[str, str]:
