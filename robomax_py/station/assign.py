@@ -7,6 +7,7 @@ configurations per spot (`reach.cost_matrix`), ordered by nearest neighbour and 
 and approach lines of each spot. The search: regret insertion (the spot whose best and second best
 robot differ most is placed first), then moves of spots between robots while the longest tour shortens,
 or stays and the sum of all tours shortens. The real planner then sequences each robot's spots itself.
+Also here: the side prior the assignment is given, and the nearest-robot baseline.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomax_py.spec_station import SpotKey
+from robomax_py.spec_station import SpotKey, StationSpec
 from robomax_py.station.reach import RobotReach, cost_matrix
 
 MAX_LOCAL_ROUNDS = 400
@@ -166,3 +167,38 @@ def _local_search(tours: _Tours, units: list[tuple[SpotKey, ...]], able: list[li
             tours.tour[k].insert(tours.insertion(k, tours.node[k][key])[1], tours.node[k][key])
         tours.two_opt(src)
         tours.two_opt(k)
+
+
+def side_prior(station: StationSpec, reaches: Sequence[RobotReach],
+               side_prior_s_per_m: float) -> dict[tuple[str, SpotKey], float]:
+    """`side_prior_s_per_m` s per metre a robot's base is farther from a spot than the nearest base of a
+    robot that reaches it."""
+    xyz = {(seam.name, s.name): np.asarray(s.xyz) for seam in station.robots[0].cell.seams for s in seam.spots}
+    base = {r.name: np.asarray(r.cell.T_world_base)[:3, 3] for r in station.robots}
+    out: dict[tuple[str, SpotKey], float] = {}
+    for key, p in xyz.items():
+        d = {r.robot: float(np.linalg.norm(p[:2] - base[r.robot][:2])) for r in reaches if key in r.index()}
+        nearest = min(d.values(), default=0.0)
+        for robot, dist in d.items():
+            out[(robot, key)] = side_prior_s_per_m * (dist - nearest)
+    return out
+
+
+def nearest(station: StationSpec, reaches: Sequence[RobotReach], keys: Sequence[SpotKey],
+             groups: Sequence[Sequence[SpotKey]]) -> Assignment:
+    """The baseline: each spot to the robot whose base is nearest among those that reach it."""
+    xyz = {(seam.name, s.name): np.asarray(s.xyz) for seam in station.robots[0].cell.seams for s in seam.spots}
+    base = {r.name: np.asarray(r.cell.T_world_base)[:3, 3] for r in station.robots}
+    able = {r.robot: set(r.keys) for r in reaches}
+    out: dict[str, list[SpotKey]] = {r.robot: [] for r in reaches}
+    group_of = {k: tuple(g) for g in groups for k in g}
+    done: set[SpotKey] = set()
+    for k in keys:
+        if k in done:
+            continue
+        unit = group_of.get(k, (k,))
+        robots = [r for r in able if all(u in able[r] for u in unit)] or [r for r in able if k in able[r]]
+        r = min(robots, key=lambda name: float(np.linalg.norm(xyz[k] - base[name])))
+        out[r] += list(unit)
+        done.update(unit)
+    return Assignment({r: tuple(v) for r, v in out.items()}, {r: 0.0 for r in out})

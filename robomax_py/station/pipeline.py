@@ -4,8 +4,10 @@ Stages: what each robot can weld (`reach`), a min-max assignment of spots to rob
 robot's spots planned by the single-robot planner (`plan.plan_cell` on the robot's cell narrowed
 to its spots, with the candidates `reach` found), robot-robot collisions on the shared clock found
 (`bodies`) and ordered by interlocks (`coordinate`); where the robot that ends last waits, another spot
-order (`reorder`) kept when the makespan shortens; and, where the waits cost more than a different
-assignment, the assignment searched again with the waits as costs and kept when the makespan shortens.
+order (`reorder`) kept when the makespan shortens; where the waits cost more than a different
+assignment, the assignment searched again with the waits as costs and kept when the makespan shortens;
+and where the station then ends at one robot's own cycle with no wait, spots moved from that robot to
+others (`unload`), kept when the coordinated makespan shortens.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from robomax_py.plan import PlanOptions, PlanResult, plan_cell
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.spec_station import SpotKey, StationSpec, robot_view
-from robomax_py.station.assign import Assignment, assign
+from robomax_py.station.assign import Assignment, assign, nearest, side_prior
 from robomax_py.station.bodies import (
     RobotBody,
     body_poses,
@@ -48,6 +50,7 @@ from robomax_py.station.reorder import (
     ordered_view,
 )
 from robomax_py.station.reorder import candidates as order_candidates
+from robomax_py.station.unload import bottleneck, tour_estimator, unloads
 from robomax_py.timing.trajectory import evaluate
 from robomax_py.world.scene import build_scene
 
@@ -108,7 +111,7 @@ class StationPlan:
     seconds: Mapping[str, float]
     margin: float = 0.0          # m kept between robots on the diagrams, at most (where both move fastest)
     rounds: int = 0              # re-assignments tried
-    orders_tried: int = 0        # spot orders planned instead of waiting (`reorder`)
+    orders_tried: int = 0        # spot orders planned instead of waiting (`reorder`) and spot moves' trials (`unload`)
     orders_skipped: int = 0      # spot orders not planned: they could not gain enough (`reorder.most_gain`)
     order_changes: tuple[OrderChange, ...] = ()    # those kept, in order
 
@@ -149,8 +152,8 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         return StationPlan(station.name, "infeasible", f"{len(nobody)} spot(s) no robot allowed to weld them can "
                            f"reach collision-free: {names}", (), Assignment({}, {}), bound, None, clock)
     t0 = time.process_time()
-    prior = _side_prior(station, reaches)
-    chosen = _nearest(station, reaches, keys, groups) if options.method == "nearest" \
+    prior = side_prior(station, reaches, SIDE_PRIOR_S_PER_M)
+    chosen = nearest(station, reaches, keys, groups) if options.method == "nearest" \
         else assign(reaches, keys, groups, prior)
     clock["assignment"] = time.process_time() - t0
     bodies = {r.name: robot_body(r.name, models[r.name], build_scene(r.cell, models[r.name])) for r in station.robots}
@@ -167,8 +170,8 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     costs: dict[str, FloatArray] = {}
     search = improve_orders(
         best, lambda p: p.makespan, _orders, lambda p: _order_candidates(p, ordered),
-        lambda p, change: _with_order(station, models, bodies, by_robot, p, change, options, clock, bound, made,
-                                      robot_plans),
+        lambda p, change: _with_orders(station, models, bodies, by_robot, p, (change,), options, clock, bound, made,
+                                       robot_plans),
         lambda p, change: _most_gain(p, change, works), lambda p, change: _tour_growth(p, change, by_robot, costs))
     best = search.best
     penalty: dict[tuple[str, SpotKey], float] = dict(prior)
@@ -197,8 +200,14 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
             best = trial
     # A re-assignment that won plans each robot in its own best order again: the changes kept before
     # are not in its programs.
-    return dataclasses.replace(best, seconds=clock, rounds=rounds, orders_tried=search.tried,
-                               orders_skipped=search.skipped, order_changes=search.kept if best is search.best else ())
+    kept = search.kept if best is search.best else ()
+    # Where the station now ends at one robot's own cycle with no wait, the waits charge nothing: spots
+    # moved away from that robot instead, each trial judged with its interlocks.
+    fixed = frozenset(k for g in ordered for k in g)
+    best, moved, unloaded = _unload(station, models, bodies, by_robot, best, options, clock, bound, made, robot_plans,
+                                    prior, fixed, costs)
+    return dataclasses.replace(best, seconds=clock, rounds=rounds, orders_tried=search.tried + unloaded,
+                               orders_skipped=search.skipped, order_changes=(*kept, *moved))
 
 
 def _orders(plan: StationPlan) -> dict[str, tuple[SpotKey, ...]]:
@@ -230,35 +239,86 @@ def _tour_growth(plan: StationPlan, change: OrderChange, reaches: Mapping[str, R
     return tour_legs(reach, cost, change.order) - tour_legs(reach, cost, _orders(plan)[change.robot])
 
 
-def _with_order(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
-                reaches: Mapping[str, RobotReach], plan: StationPlan, change: OrderChange, options: StationOptions,
-                clock: dict[str, float], bound: LowerBound, made: _Made,
-                known: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None]) -> StationPlan | None:
-    """The station with `change.robot` planned in `change.order` (the published method's given order;
-    `known` holds the robots planned so, by order) and coordinated again; None where that robot or
-    the station does not plan."""
-    key = (change.robot, change.order)
-    if key not in known:
-        t0 = time.process_time()
-        model = models[change.robot]
-        cell = station.robot(change.robot).cell
-        # With the candidates the robot's reach found, as its own order is planned: a candidate depends
-        # on its spot, seam settings, objects and home only, not on the order
-        # (tests/station/test_reach_candidates.py).
-        result = plan_cell(ordered_view(cell, change.order), model, dataclasses.replace(options.plan, given_order=True),
-                           known=reaches[change.robot].candidates)
-        clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
-        # The program is proven against the robot's cell as its programs are read (file order).
-        known[key] = RobotPlan(change.robot, robot_view(station, change.robot, change.order), model, result) \
-            if result.status == "planned" else None
-    mine = known[key]
-    if mine is None:
-        return None
+def _with_orders(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
+                 reaches: Mapping[str, RobotReach], plan: StationPlan, changes: Sequence[OrderChange],
+                 options: StationOptions, clock: dict[str, float], bound: LowerBound, made: _Made,
+                 known: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None], beat: float = np.inf
+                 ) -> StationPlan | None:
+    """The station with each change's robot planned in its order (the published method's given order;
+    `known` holds the robots planned so, by order) and coordinated again; None where one of those
+    robots or the station does not plan, or as soon as one of them has an own cycle no shorter than
+    `beat` (the makespan is at least every robot's own cycle): the robots planned so before first, so
+    that a trial sharing such a robot with one tried before costs nothing. A change may give a robot
+    other spots than `plan`'s."""
+    mine: dict[str, RobotPlan] = {}
+    for change in sorted(changes, key=lambda c: (c.robot, c.order) not in known):
+        key = (change.robot, change.order)
+        if key not in known:
+            t0 = time.process_time()
+            model = models[change.robot]
+            cell = station.robot(change.robot).cell
+            # With the candidates the robot's reach found, as its own order is planned: a candidate depends
+            # on its spot, seam settings, objects and home only, not on the order
+            # (tests/station/test_reach_candidates.py).
+            result = plan_cell(ordered_view(cell, change.order), model,
+                               dataclasses.replace(options.plan, given_order=True),
+                               known=reaches[change.robot].candidates) if change.order else None
+            clock["robots"] = clock.get("robots", 0.0) + time.process_time() - t0
+            # The program is proven against the robot's cell as its programs are read (file order).
+            known[key] = RobotPlan(change.robot, robot_view(station, change.robot, change.order), model, result) \
+                if result is None or result.status == "planned" else None
+        got = known[key]
+        if got is None or got.own_cycle >= beat:
+            return None
+        mine[change.robot] = got
     # The other robots keep the plans of `plan` (with any order change kept before), not only the
     # plans made for their spots.
-    trial = _realise(station, models, bodies, reaches, plan.assignment, options, clock, bound, made,
-                     given={**{p.robot: p for p in plan.robots}, change.robot: mine})
+    # An order change keeps the assignment; a change of spots is the assignment's too.
+    moved = any(set(c.order) != set(plan.assignment.spots.get(c.robot, ())) for c in changes)
+    chosen = Assignment({**plan.assignment.spots, **{c.robot: c.order for c in changes}},
+                        plan.assignment.estimate) if moved else plan.assignment
+    trial = _realise(station, models, bodies, reaches, chosen, options, clock, bound, made,
+                     given={**{p.robot: p for p in plan.robots}, **mine})
     return trial if trial.status == "planned" else None
+
+
+def _unload(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],
+            reaches: Mapping[str, RobotReach], plan: StationPlan, options: StationOptions,
+            clock: dict[str, float], bound: LowerBound, made: _Made,
+            known: dict[tuple[str, tuple[SpotKey, ...]], RobotPlan | None], prior: Mapping[tuple[str, SpotKey], float],
+            fixed: frozenset[SpotKey], costs: dict[str, FloatArray]) -> tuple[StationPlan, tuple[OrderChange, ...], int]:
+    """Where the station ends at one robot's own cycle with no wait, spots moved from that robot to
+    others that reach them (`unload`), each trial judged by its coordinated makespan: the best plan,
+    the order changes that make it (none when no trial is shorter), the trials planned."""
+    assert plan.coordination is not None
+    own = {p.robot: p.own_cycle for p in plan.robots}
+    giver = bottleneck(own, plan.coordination.schedule.ends)
+    if giver is None:
+        return plan, (), 0
+
+    able: dict[SpotKey, list[str]] = {}
+    for reach in reaches.values():
+        for k in reach.keys:
+            able.setdefault(k, []).append(reach.robot)
+    tried = 0
+    for trial in unloads(_orders(plan), own, giver, able, tour_estimator(reaches, prior, costs), fixed):
+        if trial.predicted >= plan.makespan - 1e-6:
+            continue
+        tried += 1
+        # The takers first: a spot inserted where the estimate puts it is likelier to cost a detour the
+        # prediction does not know than a spot taken out, and a trial is given up at the first robot
+        # no shorter than the best makespan.
+        takers_first = sorted(trial.orders.items(), key=lambda item: item[0] == giver)
+        changes = tuple(OrderChange(r, o, trial.why[r]) for r, o in takers_first)
+        got = _with_orders(station, models, bodies, reaches, plan, changes, options, clock, bound, made, known,
+                           beat=plan.makespan - 1e-6)
+        log.debug("unload %s: makespan %s (best %.3f s, predicted %.3f s), own cycles %s", trial.why[giver],
+                  "not planned" if got is None else f"{got.makespan:.3f} s", plan.makespan, trial.predicted,
+                  "" if got is None else ", ".join(f"{p.robot} {p.own_cycle:.3f} s" for p in got.robots))
+        if got is not None and got.makespan < plan.makespan - 1e-6:
+            # The first trial that shortens the makespan is kept: each costs two or three robots' plans.
+            return got, changes, tried
+    return plan, (), tried
 
 
 def _frozen(chosen: Assignment) -> frozenset[tuple[str, frozenset[SpotKey]]]:
@@ -266,44 +326,10 @@ def _frozen(chosen: Assignment) -> frozenset[tuple[str, frozenset[SpotKey]]]:
     return frozenset((r, frozenset(spots)) for r, spots in chosen.spots.items())
 
 
-def _side_prior(station: StationSpec, reaches: Sequence[RobotReach]) -> dict[tuple[str, SpotKey], float]:
-    """SIDE_PRIOR_S_PER_M per metre a robot's base is farther from a spot than the nearest base of a
-    robot that reaches it."""
-    xyz = {(seam.name, s.name): np.asarray(s.xyz) for seam in station.robots[0].cell.seams for s in seam.spots}
-    base = {r.name: np.asarray(r.cell.T_world_base)[:3, 3] for r in station.robots}
-    out: dict[tuple[str, SpotKey], float] = {}
-    for key, p in xyz.items():
-        d = {r.robot: float(np.linalg.norm(p[:2] - base[r.robot][:2])) for r in reaches if key in r.index()}
-        nearest = min(d.values(), default=0.0)
-        for robot, dist in d.items():
-            out[(robot, key)] = SIDE_PRIOR_S_PER_M * (dist - nearest)
-    return out
-
-
 def _ordered_groups(station: StationSpec) -> list[tuple[SpotKey, ...]]:
     """An ordered seam's spots go to one robot together (its order is one robot's)."""
     cell = station.robots[0].cell
     return [tuple((seam.name, s.name) for s in seam.spots) for seam in cell.seams if seam.ordered]
-
-
-def _nearest(station: StationSpec, reaches: Sequence[RobotReach], keys: Sequence[SpotKey],
-             groups: Sequence[Sequence[SpotKey]]) -> Assignment:
-    """The baseline: each spot to the robot whose base is nearest among those that reach it."""
-    xyz = {(seam.name, s.name): np.asarray(s.xyz) for seam in station.robots[0].cell.seams for s in seam.spots}
-    base = {r.name: np.asarray(r.cell.T_world_base)[:3, 3] for r in station.robots}
-    able = {r.robot: set(r.keys) for r in reaches}
-    out: dict[str, list[SpotKey]] = {r.robot: [] for r in reaches}
-    group_of = {k: tuple(g) for g in groups for k in g}
-    done: set[SpotKey] = set()
-    for k in keys:
-        if k in done:
-            continue
-        unit = group_of.get(k, (k,))
-        robots = [r for r in able if all(u in able[r] for u in unit)] or [r for r in able if k in able[r]]
-        r = min(robots, key=lambda name: float(np.linalg.norm(xyz[k] - base[name])))
-        out[r] += list(unit)
-        done.update(unit)
-    return Assignment({r: tuple(v) for r, v in out.items()}, {r: 0.0 for r in out})
 
 
 def _realise(station: StationSpec, models: Mapping[str, RobotModel], bodies: Mapping[str, RobotBody],

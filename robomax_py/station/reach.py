@@ -136,3 +136,12 @@ def tour_legs(reach: RobotReach, cost: FloatArray, order: Sequence[SpotKey]) -> 
     nodes = np.array([0, *(index[k] + 1 for k in order), 0])
     return float(cost[nodes[:-1], nodes[1:]].sum())
 
+
+def tour_estimate(reach: RobotReach, cost: FloatArray, order: Sequence[SpotKey],
+                  penalty: Mapping[tuple[str, SpotKey], float]) -> float:
+    """The estimated time of the tour home -> `order` -> home as the assignment counts it, s: the
+    moves (`tour_legs`), each spot's weld and approach and retract lines, and `penalty` (extra
+    seconds a spot costs the robot: the side prior)."""
+    index = reach.index()
+    work = sum(float(reach.dwell[index[k]]) + 2 * reach.line_s + penalty.get((reach.robot, k), 0.0) for k in order)
+    return tour_legs(reach, cost, order) + work

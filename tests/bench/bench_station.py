@@ -4,8 +4,9 @@
   (a) nearest: each spot to the nearest robot that reaches it, each robot sequenced alone, collisions
       resolved by waiting, first come first served;
   (b) minmax: the min-max assignment, zone orders by look-ahead, no re-assignment;
-  (c) full: (b), re-assignment where waits cost more than another assignment, then another spot
-      order where the robot that ends last waits (`station.reorder`).
+  (c) full: (b), another spot order where the robot that ends last waits (`station.reorder`),
+      re-assignment where waits cost more than another assignment, then spots moved away from the
+      robot whose own cycle is the makespan where it waits for nobody (`station.unload`).
 
 Per station and method: makespan, total waits, interlocks written, planning CPU (and per stage:
 reach, assignment, robots' plans, diagrams, coordination), gap to the lower bound (`station.bound`),
