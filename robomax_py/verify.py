@@ -134,6 +134,7 @@ def read_program_files(robot: RobotModel, path: Path) -> tuple[Any, Path, Any, t
     if dialect is None:
         known = ", ".join(sorted({e for d in DIALECTS.values() for e in d.extensions}))
         raise ProgramError(path, None, f"expected a trajectory file (.json) or a program ({known})")
+    _not_a_setup_file(dialect, path)
     texts = {}
     read = []
     if dialect.any_extension:
@@ -165,6 +166,22 @@ def read_program_files(robot: RobotModel, path: Path) -> tuple[Any, Path, Any, t
             texts[name] = read_text(routine, LIMITS.program, ProgramError, "program file",
                                     fallback=dialect.fallback_encoding, max_lines=LIMITS.program_lines)
     return dialect, main, dialect.parse(texts, str(main), robot), tuple(read)
+
+
+def _not_a_setup_file(dialect: Any, path: Path) -> None:
+    """A ProgramError naming the program to verify where `path` is one a program reads, not one the
+    controller runs as the job: a frames setup program beside its program (`<name>_frames.src`),
+    or a routine every program calls (FANUC's SPOT_WELD.ls). Verified alone, it welds no spot."""
+    name = path.name.lower()
+    for key in dialect.companions:
+        if name.endswith(key.lower()):
+            main = path.with_name(path.name[:-len(key)] + dialect.extensions[0])
+            if main.is_file():
+                raise ProgramError(path, None, f"is the frames setup program of {main.name}: verify {main.name}, "
+                                   "which reads its frames from it")
+    if name in {r.lower() for r in dialect.shared}:
+        raise ProgramError(path, None, "is the routine the programs call at each weld: verify the program "
+                           "that calls it (it is read with it)")
 
 
 def _with_set(cell: CellSpec, path: Path, read: tuple[Path, ...], report: VerifyReport) -> VerifyReport:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from typer.testing import CliRunner
@@ -52,15 +53,23 @@ def test_short_names_are_kept() -> None:
     assert krl.program_name("small_cell") == "small_cell" and rapid.program_name("small_cell") == "small_cell"
 
 
-def test_a_cell_named_as_people_name_it_gives_files_its_controllers_load(tmp_path: Path, write_small_cell) -> None:  # type: ignore[no-untyped-def]
-    """A cell named with spaces, umlauts, a digit first and 44 characters: the KRL and RAPID files
-    are named as their DEF / DEFDAT / MODULE, each a valid name; the trajectory file keeps the
-    cell's name; `verify` of each program is clean."""
-    cell = write_small_cell(tmp_path, name="7 Kabine Flansch Rückwand links Variante 2")
-    out = tmp_path / "out"
-    runner = CliRunner()
-    done = runner.invoke(app, ["plan", str(cell), "--out", str(out), "--format", "krl,rapid"])
+@pytest.fixture(scope="module")
+def awkward(tmp_path_factory: pytest.TempPathFactory, write_small_cell) -> tuple[Path, Path]:  # type: ignore[no-untyped-def]
+    """The small cell named with spaces, umlauts, a digit first and 44 characters, planned to KRL,
+    RAPID and FANUC: (cell file, output folder)."""
+    tmp = tmp_path_factory.mktemp("awkward")
+    cell = write_small_cell(tmp, name="7 Kabine Flansch Rückwand links Variante 2")
+    out = tmp / "out"
+    done = CliRunner().invoke(app, ["plan", str(cell), "--out", str(out), "--format", "krl,rapid,fanuc"])
     assert done.exit_code == 0, done.output
+    return cell, out
+
+
+def test_a_cell_named_as_people_name_it_gives_files_its_controllers_load(awkward: tuple[Path, Path]) -> None:
+    """The KRL and RAPID files are named as their DEF / DEFDAT / MODULE, each a valid name; the
+    trajectory file keeps the cell's name; `verify` of each program is clean."""
+    cell, out = awkward
+    runner = CliRunner()
     src = [p for p in out.glob("*.src") if not p.stem.endswith("_frames")]
     mod = [p for p in out.glob("*.mod") if not p.stem.endswith("_frames")]
     assert len(src) == 1 and len(mod) == 1
@@ -81,3 +90,18 @@ def test_a_cell_named_as_people_name_it_gives_files_its_controllers_load(tmp_pat
     for program in (src[0], mod[0]):
         verified = runner.invoke(app, ["verify", str(cell), str(program)])
         assert verified.exit_code == 0 and "clean" in verified.output, verified.output
+
+
+def test_verify_of_a_setup_file_names_the_program(awkward: tuple[Path, Path]) -> None:
+    """A frames setup program or the weld routine given to verify: one message naming the program
+    to verify, exit 2 (verified alone it would report every spot unwelded)."""
+    cell, out = awkward
+    setups = [p for p in out.iterdir() if p.stem.lower().endswith("_frames")] + [out / "SPOT_WELD.ls"]
+    assert len(setups) == 4
+    for setup in setups:
+        got = CliRunner().invoke(app, ["verify", str(cell), str(setup)])
+        text = " ".join(got.output.split())
+        assert got.exit_code == 2 and "verify" in text and ("setup program of" in text or "at each weld" in text), text
+        if "setup program of" in text:
+            main = setup.name[:-len("_frames") - len(setup.suffix)] + setup.suffix
+            assert f"verify {main}" in text
