@@ -11,6 +11,7 @@ import numpy as np
 
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.plan.candidates import SpotCandidates
+from robomax_py.plan.choice_memo import ChoiceMemo
 from robomax_py.plan.learned_detour import LearnedDetours
 from robomax_py.plan.loads import Loads
 from robomax_py.plan.results import Progress, ResolvedOptions, _no_progress
@@ -99,6 +100,10 @@ class SequencerKnowledge:
         # it was before any round: a sequencer of the given order starts from them (`given_order`).
         self._probed: tuple[dict[tuple[int, int], dict[tuple[int, int], bool]], set[tuple[int, int]], int] | None = None
         self._rng_at_start = copy.deepcopy(rng)
+        # The exact DP of one order over every candidate (`full_cost`), its layers kept between calls.
+        self.choose = ChoiceMemo(self.full_cost, self.node)
+        # `vias_for` per spot pair: (detours seen, the list), extended as detours are appended.
+        self._vias: dict[tuple[int, int], tuple[int, list[Detour]]] = {}
 
     # ------------------------------------------------------------------ knowledge and costs
 
@@ -146,9 +151,15 @@ class SequencerKnowledge:
     def vias_for(self, i: int, j: int) -> list[Detour]:
         """Known detours usable from spot i to spot j, oriented i -> j: those found between i and j,
         and those leaving i or reaching j (another leg then joins their far end to the other spot).
-        Indices are stable: new detours are only appended."""
-        out: list[Detour] = []
-        for di, dj, det in self.detours:
+        Indices are stable: new detours are only appended, so the list is kept per spot pair and
+        only extended by the detours found since (it was rebuilt over every detour for every matrix
+        and every leg checked: detours x legs grows with the square of the spots). Callers read it,
+        never change it."""
+        seen, out = self._vias.get((i, j), (0, []))
+        if seen == len(self.detours):
+            return out
+        out = list(out)
+        for di, dj, det in self.detours[seen:]:
             if self._load(di) != self._load(i):
                 out.append(_UNUSABLE)            # found for another load: not checked for this one
             elif di == i or dj == j:
@@ -157,6 +168,7 @@ class SequencerKnowledge:
                 out.append(det.reversed())
             else:
                 out.append(_UNUSABLE)
+        self._vias[(i, j)] = (len(self.detours), out)
         return out
 
     def _via_costs(self, i: int, j: int, vias: list[Detour], rows: IntArray, cols: IntArray, pi: IntArray,
