@@ -120,14 +120,16 @@ class _BoundTable:
         arr = np.asarray(orders, dtype=np.int64)
         home = np.full((len(arr), 1), self.size)
         padded = np.concatenate([home, arr, home], axis=1)
-        a, b = padded[:, :-1], padded[:, 1:]
-        values = self.table[a, b]
+        # Flat indices into the table: one gather, not a two-index one (rows x spots per neighbourhood).
+        codes = padded[:, :-1] * (self.size + 1) + padded[:, 1:]
+        flat = self.table.reshape(-1)
+        values = flat[codes]
         missing = np.isnan(values)
         if missing.any():
-            for code in np.unique(a[missing] * (self.size + 1) + b[missing]).tolist():
+            for code in np.unique(codes[missing]).tolist():
                 x, y = divmod(code, self.size + 1)
                 self.table[x, y] = self.costs.lower_bound(self._id(x), self._id(y))
-            values = self.table[a, b]
+            values = flat[codes]
         total: FloatArray = values.sum(axis=1)
         return total
 
