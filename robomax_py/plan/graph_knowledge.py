@@ -346,19 +346,52 @@ class SequencerKnowledge:
         res = self.world_from(i).check_segment(self.q(i)[a], self.q(j)[b])
         self.checks += res.checks
         self._record_straight(i, a, j, b, res.free)
-        if res.free:
-            self.detour_only.discard((min(i, j), max(i, j)))
+        pair = (min(i, j), max(i, j))
+        if res.free and pair in self.detour_only:
+            self.detour_only.discard(pair)
+            self._forget(i, j)                   # the pair's costs are no longer a detour's
         return bool(res.free)
 
     def _record_straight(self, i: int, a: int, j: int, b: int, free: bool) -> None:
-        self.straight.setdefault((i, j), {})[(a, b)] = free
+        keys = [(i, j, a, b)]
         if self._load(i) == self._load(j):       # else the way back is checked in another world
-            self.straight.setdefault((j, i), {})[(b, a)] = free
-        self._forget(i, j)
+            keys.append((j, i, b, a))
+        # The cost matrices are dropped only where this verdict can change them (`_costs`): every
+        # move a tour verifies free was recorded, and the next choice of that order then built
+        # the full matrices of all those moves again, equal to the last.
+        changes = any(self._straight_changes_costs(x, y, c, d, free) for x, y, c, d in keys)
+        for x, y, c, d in keys:
+            self.straight.setdefault((x, y), {})[(c, d)] = free
+        if changes:
+            self._forget(i, j)
+
+    def _straight_changes_costs(self, i: int, j: int, a: int, b: int, free: bool) -> bool:
+        """Whether recording the straight move a of i -> b of j as `free` can change `_costs(i, j)`:
+        a blocked verdict, a changed one, or any where only moves known free are offered (before or
+        after it); not a new free move where blocked ones are priced and free ones are estimated,
+        nor any between a detour-only pair (priced by its detours)."""
+        known = self.straight.get((i, j), {})
+        before = known.get((a, b))
+        if before is not None and before == free:
+            return False
+        if not free or before is not None:
+            return True
+        if (min(i, j), max(i, j)) in self.detour_only:
+            return False
+        blocked = sum(1 for f in known.values() if not f)
+        unconnected = (min(i, j), max(i, j)) in self.unconnected
+        verified_after = blocked >= MAX_BLOCKED_STRAIGHT or (unconnected and blocked >= len(known) + 1 - blocked)
+        return self._verified_straight_only(i, j) or verified_after
 
     def _record_leg(self, i: int, a: int, j: int, b: int, v: int, ok: bool) -> None:
         table = self.legs_ok if ok else self.legs_bad
-        table.setdefault((i, j), set()).add((a, b, v))
+        keys = [(i, j, (a, b, v))]
         if self._load(i) == self._load(j):
-            table.setdefault((j, i), set()).add((b, a, v))
-        self._forget(i, j)
+            keys.append((j, i, (b, a, v)))
+        # A leg known free changes `_via_costs` only where verified legs alone are offered.
+        changes = any(not ok or len(self.legs_bad.get((x, y), ())) >= MAX_BLOCKED_LEGS for x, y, _ in keys)
+        changes = changes and any(leg not in table.get((x, y), ()) for x, y, leg in keys)
+        for x, y, leg in keys:
+            table.setdefault((x, y), set()).add(leg)
+        if changes:
+            self._forget(i, j)
