@@ -16,6 +16,7 @@ same bit for bit.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -29,7 +30,10 @@ from robomax_py.plan.sequence import HOME, EdgeCosts, choice_for_order
 class _Layer:
     prev: int               # the stop before (HOME for the first layer)
     spot: int
-    matrix: FloatArray      # the cost matrix prev -> spot the layer was computed with (identity compared)
+    # The cost matrix prev -> spot the layer was computed with, compared by identity; held weakly,
+    # so that the memo keeps no matrix alive that the sequencer has dropped (one that is gone
+    # cannot be the one asked with).
+    matrix: weakref.ref[FloatArray]
     value: FloatArray       # (C_spot,) best cost of the tour so far ending at each candidate of spot
     arg: IntArray | None    # (C_spot,) the best candidate of prev for each of spot's (None: first layer)
 
@@ -60,7 +64,7 @@ class ChoiceMemo:
             matrix = np.asarray(self._edge(prev, spot), dtype=float)
             old = self._layers[k] if k < len(self._layers) else None
             if (old is not None and inputs_same and old.prev == prev and old.spot == spot
-                    and old.matrix is matrix):
+                    and old.matrix() is matrix):
                 layers.append(old)
                 value = old.value
                 continue
@@ -74,7 +78,7 @@ class ChoiceMemo:
                 value = total[arg, np.arange(total.shape[1])] + self._node[spot]
             self.layers_computed += 1
             assert value is not None
-            layers.append(_Layer(prev, spot, matrix, value, arg))
+            layers.append(_Layer(prev, spot, weakref.ref(matrix), value, arg))
             inputs_same = old is not None and old.spot == spot and _same_bits(value, old.value)
         self._layers = layers
         assert value is not None
