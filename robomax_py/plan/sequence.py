@@ -360,7 +360,8 @@ def _insertion_start(blocks: Sequence[SeamBlock], costs: _Costs) -> Blocks:
             tour: list[int] = [block.spots[0]]
             for spot in block.spots[1:]:
                 options = [tuple(tour[:k] + [spot] + tour[k:]) for k in range(len(tour) + 1)]
-                tour = list(min(options, key=bound))
+                best: tuple[int, ...] = min(options, key=bound)
+                tour = list(best)
             placed = tuple(tour)
         out.append((seam, placed))
         edges.extend(costs.lower_bound(a, b) for a, b in itertools.pairwise((last, *placed)))
