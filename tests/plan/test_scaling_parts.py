@@ -68,6 +68,10 @@ class _CountingWorld:
         self.states += 1
         return False
 
+    def are_free(self, qs: np.ndarray, t: float | None = None) -> np.ndarray:
+        self.states += len(qs)
+        return np.zeros(len(qs), dtype=bool)
+
     def __getattr__(self, name: str) -> Any:
         return getattr(self._world, name)
 
