@@ -46,6 +46,8 @@ MAX_FAILED_DETOURS = 6
 # A detour of TCP lines starts and ends in the configurations it was found between: another
 # candidate this close (rad, any joint) is that configuration (`plan.tcp_detour.GOAL_TOL_RAD`).
 JOIN_TOL_RAD = 1e-6
+# Detours priced together in one array by `_via_costs` (bounds its rows x detours x cols memory).
+VIA_CHUNK = 16
 
 
 def _same(a: FloatArray, b: FloatArray) -> np.ndarray:
@@ -199,18 +201,25 @@ class SequencerKnowledge:
         for a, b, vv in (self.legs_ok.get((i, j), ()) if verified_only else bad):
             if pi[a] >= 0 and pj[b] >= 0:
                 marks.setdefault(vv, []).append((int(pi[a]), int(pj[b])))
-        for k, v in enumerate(usable):
-            via = enter[:, k, None] + self._inner_time(v, vias[v]) + leave[k][None, :]
-            cells = marks.get(v, ())
+        inner = np.array([self._inner_time(v, vias[v]) for v in usable])
+        column = {v: k for k, v in enumerate(usable)}
+        # Every detour's sum at once, a few at a time (rows x detours x cols), its least kept: the
+        # same sums and the same least as detour by detour (per detour, the numpy calls on a few
+        # rows cost their overhead dozens of times per matrix, and the matrices are asked N^2 times).
+        for k0 in range(0, len(usable), VIA_CHUNK):
+            k1 = min(k0 + VIA_CHUNK, len(usable))
+            via = (enter[:, k0:k1, None] + inner[None, k0:k1, None]) + leave[None, k0:k1, :]
+            cells = [(r, column[v] - k0, c) for v, rc in marks.items() if v in column and k0 <= column[v] < k1
+                     for r, c in rc]
             if verified_only:
                 verified = np.full_like(via, np.inf)
-                for r, c in cells:
-                    verified[r, c] = via[r, c]
+                for r, k, c in cells:
+                    verified[r, k, c] = via[r, k, c]
                 via = verified
             else:
-                for r, c in cells:
-                    via[r, c] = np.inf
-            out = np.minimum(out, via)
+                for r, k, c in cells:
+                    via[r, k, c] = np.inf
+            out = np.minimum(out, np.min(via, axis=1))
         return out
 
     def _detour_speed(self) -> float:
