@@ -107,3 +107,32 @@ def test_usable_detours_kept_per_pair_match_a_rebuilt_list(tmp_path: Path, write
         seq.detours.append((i, j, det))
         for a, b in pairs:
             assert kept(a, b) == rebuilt(a, b)
+
+
+def test_matrices_kept_only_where_a_verdict_cannot_change_them(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    from robomax_py.plan.graph_knowledge import MAX_BLOCKED_STRAIGHT
+
+    seq = _sequencer(tmp_path, write_small_cell)
+    i, j = 0, 1
+    n_i, n_j = len(seq.q(i)), len(seq.q(j))
+    assert n_i * n_j > MAX_BLOCKED_STRAIGHT + 2
+    pairs = [(a, b) for a in range(n_i) for b in range(n_j)]
+
+    def fresh() -> np.ndarray:
+        return seq._costs(i, j, np.arange(n_i), np.arange(n_j))
+
+    m = seq.full_cost(i, j)
+    seq._record_straight(i, pairs[0][0], j, pairs[0][1], True)      # a new free move: priced as before
+    assert seq.full_cost(i, j) is m and np.array_equal(m, fresh())
+    seq._record_straight(i, pairs[0][0], j, pairs[0][1], True)      # the same verdict again
+    assert seq.full_cost(i, j) is m
+    seq._record_straight(i, pairs[1][0], j, pairs[1][1], False)        # blocked: the matrix is made again
+    m = seq.full_cost(i, j)
+    assert np.isinf(m[pairs[1]]) and np.array_equal(m, fresh())
+    for a, b in pairs[2:2 + MAX_BLOCKED_STRAIGHT]:                     # mostly blocked: free moves alone offered
+        seq._record_straight(i, a, j, b, False)
+    m = seq.full_cost(i, j)
+    a, b = pairs[2 + MAX_BLOCKED_STRAIGHT]
+    seq._record_straight(i, a, j, b, True)                              # now a free move changes the prices
+    assert seq.full_cost(i, j) is not m and np.array_equal(seq.full_cost(i, j), fresh())
+    assert np.isfinite(seq.full_cost(i, j)[a, b])
