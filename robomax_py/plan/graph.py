@@ -16,7 +16,7 @@ from typing import Literal
 
 import numpy as np
 
-from robomax_py._typing import FloatArray
+from robomax_py._typing import FloatArray, IntArray
 from robomax_py.plan.graph_detours import (
     LIFT_HEIGHTS_M,
     WITHDRAW_DIRECTIONS,
@@ -39,7 +39,6 @@ from robomax_py.plan.sequence import (
     HOME,
     SeamBlock,
     Tour,
-    choice_for_order,
     optimise,
     order_count,
 )
@@ -141,10 +140,43 @@ class Sequencer(SequencerLookahead):
         """The candidate pair whose straight move `_probe_pairs` checks: the cheapest straight move
         between the two spots' representatives. Not cached: the probe asks for every pair once, and
         the search later needs only a few of those matrices."""
-        ri, rj = self._rows(i), self._rows(j)
-        est = ptp_time_estimate(self.q(i)[ri][:, None, :], self.q(j)[rj][None, :, :], self.limits, self.options.speed)
-        a, b = np.unravel_index(int(np.argmin(est)), est.shape)
-        return int(ri[a]), int(rj[b])
+        return self._probe_row(i, [j])[0]
+
+    def _probe_row(self, i: int, others: list[int]) -> list[tuple[int, int]]:
+        """`probe_pair(i, j)` for every j of `others`, from one estimate of i's representatives
+        against all of theirs: one call per pair cost numpy's overhead N^2 / 2 times. The estimate
+        is element-wise, so each pair's block and its first least entry are those of its own call."""
+        ri = self._rows(i)
+        cols = [self._rows(j) for j in others]
+        qs = np.concatenate([self.q(j)[c] for j, c in zip(others, cols, strict=True)])
+        est = ptp_time_estimate(self.q(i)[ri][:, None, :], qs[None, :, :], self.limits, self.options.speed)
+        out: list[tuple[int, int]] = []
+        start = 0
+        for c in cols:
+            block = est[:, start:start + len(c)]
+            start += len(c)
+            a, b = np.unravel_index(int(np.argmin(block)), block.shape)
+            out.append((int(ri[a]), int(c[b])))
+        return out
+
+    def _coarse_blocked(self, i: int, starts: FloatArray, goals: FloatArray) -> IntArray:
+        """For the coarse probes of moves leaving stop i (k starts and goals, (k, n)): the index of
+        the first blocked state of each (PROBE_STATES states in bisection order), -1 where all are
+        free. Checked state by state over all moves at once, each state only where the states
+        before it were free: the same configurations, checks and verdicts as one move at a time."""
+        fractions = bisection_order(PROBE_STATES - 1) / (PROBE_STATES - 1)
+        first = np.full(len(starts), -1, dtype=np.int64)
+        alive = np.arange(len(starts))
+        world = self.world_from(i)
+        for k, f in enumerate(fractions):
+            if not len(alive):
+                break
+            qa, qb = starts[alive], goals[alive]
+            free = world.are_free(qa + f * (qb - qa))
+            self.checks += len(alive)
+            first[alive[~free]] = k
+            alive = alive[free]
+        return first
 
     def _probe_pairs(self) -> None:
         """What is blocked, learnt before the first round: a straight move (the cheapest
@@ -166,23 +198,28 @@ class Sequencer(SequencerLookahead):
             np.fill_diagonal(gap, np.inf)
             nearest = np.argsort(gap, axis=1, kind="stable")[:, :k]
             near = {(min(i, int(j)), max(i, int(j))) for i in range(len(self.spots)) for j in nearest[i]}
-        fractions = bisection_order(PROBE_STATES - 1) / (PROBE_STATES - 1)
         for x, i in enumerate(ids):
-            for j in ids[x + 1:]:
-                a, b = self.probe_pair(i, j)
-                qa, qb = self.q(i)[a], self.q(j)[b]
+            others = ids[x + 1:]
+            if not others:
+                continue
+            pairs = self._probe_row(i, others)
+            far = [y for y, j in enumerate(others) if (i, j) not in near]
+            blocked_far: set[int] = set()
+            if far:
+                starts = np.array([self.q(i)[pairs[y][0]] for y in far])
+                goals = np.array([self.q(others[y])[pairs[y][1]] for y in far])
+                first = self._coarse_blocked(i, starts, goals)
+                blocked_far = {y for y, state in zip(far, first.tolist(), strict=True) if state >= 0}
+            # Recorded pair by pair in the order they were always learnt.
+            for y, j in enumerate(others):
+                a, b = pairs[y]
                 if (i, j) in near:
-                    res = self.world_from(i).check_segment(qa, qb)
+                    res = self.world_from(i).check_segment(self.q(i)[a], self.q(j)[b])
                     self.checks += res.checks
                     free = res.free
                     self._record_straight(i, a, j, b, free)
                 else:
-                    free = True
-                    for f in fractions:
-                        self.checks += 1
-                        if not self.world_from(i).is_free(qa + f * (qb - qa)):
-                            free = False
-                            break
+                    free = y not in blocked_far
                     if not free:
                         self._record_straight(i, a, j, b, False)
                 if not free:
@@ -204,7 +241,7 @@ class Sequencer(SequencerLookahead):
             self.progress("sequencing", self.rounds - 1, self.rounds)
             if self.options.baseline or self.options.given_order:
                 order = tuple(s for b in blocks for s in b.spots)
-                choice, cost = choice_for_order(order, self.full_cost, self.node)
+                choice, cost = self.choose(order)
                 tour = Tour(order, choice, cost)
             else:
                 budget = self.options.max_evaluations if self.rounds == 1 else max(50, self.options.max_evaluations // 4)
@@ -218,7 +255,7 @@ class Sequencer(SequencerLookahead):
                 # Every candidate for the order found; full matrices only of this order's moves.
                 moves = _moves_of(found.order)
                 self._full = {key: m for key, m in self._full.items() if key in moves}
-                choice, cost = choice_for_order(found.order, self.full_cost, self.node)
+                choice, cost = self.choose(found.order)
                 tour = Tour(found.order, choice, cost)
             if not np.isfinite(tour.cost) and self._open_dead_end(tour.order):
                 continue
@@ -279,7 +316,7 @@ class Sequencer(SequencerLookahead):
         round's order search weighs what was learnt, and that tour is taken only when no round finds
         one cheaper by more than KNOWN_TOUR_MARGIN (`run`)."""
         for _ in range(REPAIRS_PER_ROUND):
-            choice, cost = choice_for_order(order, self.full_cost, self.node)
+            choice, cost = self.choose(order)
             if not np.isfinite(cost):
                 return None
             tour = Tour(order, choice, cost)

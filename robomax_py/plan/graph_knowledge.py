@@ -11,6 +11,7 @@ import numpy as np
 
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.plan.candidates import SpotCandidates
+from robomax_py.plan.choice_memo import ChoiceMemo
 from robomax_py.plan.learned_detour import LearnedDetours
 from robomax_py.plan.loads import Loads
 from robomax_py.plan.results import Progress, ResolvedOptions, _no_progress
@@ -45,6 +46,8 @@ MAX_FAILED_DETOURS = 6
 # A detour of TCP lines starts and ends in the configurations it was found between: another
 # candidate this close (rad, any joint) is that configuration (`plan.tcp_detour.GOAL_TOL_RAD`).
 JOIN_TOL_RAD = 1e-6
+# Detours priced together in one array by `_via_costs` (bounds its rows x detours x cols memory).
+VIA_CHUNK = 16
 
 
 def _same(a: FloatArray, b: FloatArray) -> np.ndarray:
@@ -99,6 +102,10 @@ class SequencerKnowledge:
         # it was before any round: a sequencer of the given order starts from them (`given_order`).
         self._probed: tuple[dict[tuple[int, int], dict[tuple[int, int], bool]], set[tuple[int, int]], int] | None = None
         self._rng_at_start = copy.deepcopy(rng)
+        # The exact DP of one order over every candidate (`full_cost`), its layers kept between calls.
+        self.choose = ChoiceMemo(self.full_cost, self.node)
+        # `vias_for` per spot pair: (detours seen, the list), extended as detours are appended.
+        self._vias: dict[tuple[int, int], tuple[int, list[Detour]]] = {}
 
     # ------------------------------------------------------------------ knowledge and costs
 
@@ -146,9 +153,15 @@ class SequencerKnowledge:
     def vias_for(self, i: int, j: int) -> list[Detour]:
         """Known detours usable from spot i to spot j, oriented i -> j: those found between i and j,
         and those leaving i or reaching j (another leg then joins their far end to the other spot).
-        Indices are stable: new detours are only appended."""
-        out: list[Detour] = []
-        for di, dj, det in self.detours:
+        Indices are stable: new detours are only appended, so the list is kept per spot pair and
+        only extended by the detours found since (it was rebuilt over every detour for every matrix
+        and every leg checked: detours x legs grows with the square of the spots). Callers read it,
+        never change it."""
+        seen, out = self._vias.get((i, j), (0, []))
+        if seen == len(self.detours):
+            return out
+        out = list(out)
+        for di, dj, det in self.detours[seen:]:
             if self._load(di) != self._load(i):
                 out.append(_UNUSABLE)            # found for another load: not checked for this one
             elif di == i or dj == j:
@@ -157,6 +170,7 @@ class SequencerKnowledge:
                 out.append(det.reversed())
             else:
                 out.append(_UNUSABLE)
+        self._vias[(i, j)] = (len(self.detours), out)
         return out
 
     def _via_costs(self, i: int, j: int, vias: list[Detour], rows: IntArray, cols: IntArray, pi: IntArray,
@@ -187,18 +201,25 @@ class SequencerKnowledge:
         for a, b, vv in (self.legs_ok.get((i, j), ()) if verified_only else bad):
             if pi[a] >= 0 and pj[b] >= 0:
                 marks.setdefault(vv, []).append((int(pi[a]), int(pj[b])))
-        for k, v in enumerate(usable):
-            via = enter[:, k, None] + self._inner_time(v, vias[v]) + leave[k][None, :]
-            cells = marks.get(v, ())
+        inner = np.array([self._inner_time(v, vias[v]) for v in usable])
+        column = {v: k for k, v in enumerate(usable)}
+        # Every detour's sum at once, a few at a time (rows x detours x cols), its least kept: the
+        # same sums and the same least as detour by detour (per detour, the numpy calls on a few
+        # rows cost their overhead dozens of times per matrix, and the matrices are asked N^2 times).
+        for k0 in range(0, len(usable), VIA_CHUNK):
+            k1 = min(k0 + VIA_CHUNK, len(usable))
+            via = (enter[:, k0:k1, None] + inner[None, k0:k1, None]) + leave[None, k0:k1, :]
+            cells = [(r, column[v] - k0, c) for v, rc in marks.items() if v in column and k0 <= column[v] < k1
+                     for r, c in rc]
             if verified_only:
                 verified = np.full_like(via, np.inf)
-                for r, c in cells:
-                    verified[r, c] = via[r, c]
+                for r, k, c in cells:
+                    verified[r, k, c] = via[r, k, c]
                 via = verified
             else:
-                for r, c in cells:
-                    via[r, c] = np.inf
-            out = np.minimum(out, via)
+                for r, k, c in cells:
+                    via[r, k, c] = np.inf
+            out = np.minimum(out, np.min(via, axis=1))
         return out
 
     def _detour_speed(self) -> float:
@@ -334,19 +355,52 @@ class SequencerKnowledge:
         res = self.world_from(i).check_segment(self.q(i)[a], self.q(j)[b])
         self.checks += res.checks
         self._record_straight(i, a, j, b, res.free)
-        if res.free:
-            self.detour_only.discard((min(i, j), max(i, j)))
+        pair = (min(i, j), max(i, j))
+        if res.free and pair in self.detour_only:
+            self.detour_only.discard(pair)
+            self._forget(i, j)                   # the pair's costs are no longer a detour's
         return bool(res.free)
 
     def _record_straight(self, i: int, a: int, j: int, b: int, free: bool) -> None:
-        self.straight.setdefault((i, j), {})[(a, b)] = free
+        keys = [(i, j, a, b)]
         if self._load(i) == self._load(j):       # else the way back is checked in another world
-            self.straight.setdefault((j, i), {})[(b, a)] = free
-        self._forget(i, j)
+            keys.append((j, i, b, a))
+        # The cost matrices are dropped only where this verdict can change them (`_costs`): every
+        # move a tour verifies free was recorded, and the next choice of that order then built
+        # the full matrices of all those moves again, equal to the last.
+        changes = any(self._straight_changes_costs(x, y, c, d, free) for x, y, c, d in keys)
+        for x, y, c, d in keys:
+            self.straight.setdefault((x, y), {})[(c, d)] = free
+        if changes:
+            self._forget(i, j)
+
+    def _straight_changes_costs(self, i: int, j: int, a: int, b: int, free: bool) -> bool:
+        """Whether recording the straight move a of i -> b of j as `free` can change `_costs(i, j)`:
+        a blocked verdict, a changed one, or any where only moves known free are offered (before or
+        after it); not a new free move where blocked ones are priced and free ones are estimated,
+        nor any between a detour-only pair (priced by its detours)."""
+        known = self.straight.get((i, j), {})
+        before = known.get((a, b))
+        if before is not None and before == free:
+            return False
+        if not free or before is not None:
+            return True
+        if (min(i, j), max(i, j)) in self.detour_only:
+            return False
+        blocked = sum(1 for f in known.values() if not f)
+        unconnected = (min(i, j), max(i, j)) in self.unconnected
+        verified_after = blocked >= MAX_BLOCKED_STRAIGHT or (unconnected and blocked >= len(known) + 1 - blocked)
+        return self._verified_straight_only(i, j) or verified_after
 
     def _record_leg(self, i: int, a: int, j: int, b: int, v: int, ok: bool) -> None:
         table = self.legs_ok if ok else self.legs_bad
-        table.setdefault((i, j), set()).add((a, b, v))
+        keys = [(i, j, (a, b, v))]
         if self._load(i) == self._load(j):
-            table.setdefault((j, i), set()).add((b, a, v))
-        self._forget(i, j)
+            keys.append((j, i, (b, a, v)))
+        # A leg known free changes `_via_costs` only where verified legs alone are offered.
+        changes = any(not ok or len(self.legs_bad.get((x, y), ())) >= MAX_BLOCKED_LEGS for x, y, _ in keys)
+        changes = changes and any(leg not in table.get((x, y), ()) for x, y, leg in keys)
+        for x, y, leg in keys:
+            table.setdefault((x, y), set()).add(leg)
+        if changes:
+            self._forget(i, j)

@@ -33,6 +33,13 @@ NEAR_FRACTION = 0.5
 NEAR_SIGMA = 0.25
 # Lazy search gives up after this many blocked edges in one query.
 MAX_BLOCKED_PER_QUERY = 60
+# A query's shortest-path search first settles only the nodes within this multiple of the straight
+# move's estimate from its start, growing the bound SEARCH_GROWTH-fold until the way found fits in
+# it (`Roadmap._shortest`); past MAX_BOUNDED_REACH (s) it searches unbounded. Bounds change only
+# how much of the roadmap is searched, never the path found.
+SEARCH_REACH = 3.0
+SEARCH_GROWTH = 4.0
+MAX_BOUNDED_REACH = 1e3
 
 
 @dataclass(frozen=True, slots=True)
@@ -181,8 +188,11 @@ class Roadmap:
         blocked = 0
         start_w = ptp_time_estimate(q_start[None, :], self.nodes[start_links], self._limits)
         goal_w = ptp_time_estimate(self.nodes[goal_links], q_goal[None, :], self._limits)
+        # The first search's reach (`_shortest`); blocked edges only lengthen the way, so each
+        # search starts from the reach the one before needed.
+        reach = SEARCH_REACH * float(ptp_time_estimate(q_start, q_goal, self._limits))
         while blocked < MAX_BLOCKED_PER_QUERY:
-            path = self._shortest(start_links, start_w, goal_links, goal_w, extra_free)
+            path, reach = self._shortest(start_links, start_w, goal_links, goal_w, extra_free, reach)
             if path is None:
                 return None
             bad = None
@@ -210,7 +220,7 @@ class Roadmap:
         return None
 
     def _shortest(self, start_links: list[int], start_w: FloatArray, goal_links: list[int], goal_w: FloatArray,
-                  extra_free: dict[tuple[int, int], bool]) -> list[int] | None:
+                  extra_free: dict[tuple[int, int], bool], reach: float = np.inf) -> tuple[list[int] | None, float]:
         """Dijkstra (scipy, in C) on time estimates from the start S = -1 through the roadmap to the
         goal G = -2, skipping edges known to be blocked; the path as node indices, S and G included.
 
@@ -219,6 +229,14 @@ class Roadmap:
         each blocked edge it meets: the graph's arrays are made once (`_both_ways`), a blocked
         edge weighs infinity (scipy never relaxes it), the start is one row appended, and the goal
         is reached through whichever of its links ends the shortest way (no node of its own).
+
+        The search is bounded to `reach` (s; scipy's `limit`), then SEARCH_GROWTH times that until
+        the way found is no longer than the bound, then unbounded: each search settled every node
+        of a roadmap that grows with the spots (tens of thousands of candidates) for a detour
+        between two neighbouring spots, a search per detour query and blocked edge. Within the
+        bound Dijkstra's distances and predecessors are the unbounded search's, and a goal link
+        beyond it ends a longer way than one within it: the path is the same. Returns the path
+        (None: no way) and the bound that found it.
         """
         n = len(self.nodes)
         indptr, indices, weights, slots = self._both_ways()
@@ -237,15 +255,24 @@ class Roadmap:
         s_w = np.maximum(np.asarray(start_w, dtype=float)[s_ok], np.finfo(float).tiny)
         graph = csr_matrix((np.concatenate([weights, s_w]), np.concatenate([indices, s_links]),
                             np.append(indptr, indptr[-1] + len(s_links))), shape=(n + 1, n + 1))
-        dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True)
         g_ok = usable(goal_links, -2)
-        total = np.where(g_ok, dist[np.asarray(goal_links, dtype=np.int64)] + np.asarray(goal_w, dtype=float), np.inf)
-        if not len(total) or not np.isfinite(np.min(total)):
-            return None
+        goal_at = np.asarray(goal_links, dtype=np.int64)
+        if not len(goal_at):
+            return None, reach
+        reach = reach if np.isfinite(reach) and reach > 0 else np.inf
+        while True:
+            dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True, limit=reach)
+            total = np.where(g_ok, dist[goal_at] + np.asarray(goal_w, dtype=float), np.inf)
+            least = float(np.min(total))
+            if np.isfinite(least) and least <= reach:
+                break
+            if not np.isfinite(reach):
+                return None, reach
+            reach = reach * SEARCH_GROWTH if reach * SEARCH_GROWTH < MAX_BOUNDED_REACH else np.inf
         path = [goal_links[int(np.argmin(total))]]
         while path[-1] != n:
             path.append(int(pred[path[-1]]))
-        return [-1 if u == n else u for u in reversed(path)] + [-2]
+        return [-1 if u == n else u for u in reversed(path)] + [-2], reach
 
     def _both_ways(self) -> tuple[IntArray, IntArray, FloatArray, IntArray]:
         """The roadmap's edges stored both ways as CSR arrays of its n rows (the start's row is

@@ -120,14 +120,16 @@ class _BoundTable:
         arr = np.asarray(orders, dtype=np.int64)
         home = np.full((len(arr), 1), self.size)
         padded = np.concatenate([home, arr, home], axis=1)
-        a, b = padded[:, :-1], padded[:, 1:]
-        values = self.table[a, b]
+        # Flat indices into the table: one gather, not a two-index one (rows x spots per neighbourhood).
+        codes = padded[:, :-1] * (self.size + 1) + padded[:, 1:]
+        flat = self.table.reshape(-1)
+        values = flat[codes]
         missing = np.isnan(values)
         if missing.any():
-            for code in np.unique(a[missing] * (self.size + 1) + b[missing]).tolist():
+            for code in np.unique(codes[missing]).tolist():
                 x, y = divmod(code, self.size + 1)
                 self.table[x, y] = self.costs.lower_bound(self._id(x), self._id(y))
-            values = self.table[a, b]
+            values = flat[codes]
         total: FloatArray = values.sum(axis=1)
         return total
 
@@ -336,18 +338,35 @@ def _as_blocks(order: tuple[int, ...], blocks: Sequence[SeamBlock]) -> Blocks:
 
 
 def _insertion_start(blocks: Sequence[SeamBlock], costs: _Costs) -> Blocks:
-    """Cheapest insertion, spot by spot, judged by the spot-level bound (no DP: it is a start)."""
+    """Cheapest insertion, spot by spot, judged by the spot-level bound (no DP: it is a start).
+
+    Each option is judged by `_bound` of the whole order so far; the terms of the seams already
+    placed are the same for every option and are kept, not looked up again (an option's bound
+    took N look-ups, N^2 per start): the same terms summed in the same order, the same bound."""
     out: Blocks = []
+    edges: list[float] = []         # `_bound`'s edge terms along (HOME, *placed seams)
+    nodes: list[float] = []         # its node terms of the placed spots
+    last = HOME
+
+    def bound(option: tuple[int, ...]) -> float:
+        stops = (last, *option, HOME)
+        tail = [costs.lower_bound(a, b) for a, b in itertools.pairwise(stops)]
+        return sum(edges + tail) + sum(nodes + [costs.node_min[s] for s in option])
+
     for seam, block in enumerate(blocks):
         if block.ordered or len(block.spots) <= 2:
-            out.append((seam, block.spots))
-            continue
-        tour: list[int] = [block.spots[0]]
-        for spot in block.spots[1:]:
-            options = [tuple(tour[:k] + [spot] + tour[k:]) for k in range(len(tour) + 1)]
-            best = min(options, key=lambda o: _bound(_flatten([*out, (seam, o)]), costs))
-            tour = list(best)
-        out.append((seam, tuple(tour)))
+            placed = block.spots
+        else:
+            tour: list[int] = [block.spots[0]]
+            for spot in block.spots[1:]:
+                options = [tuple(tour[:k] + [spot] + tour[k:]) for k in range(len(tour) + 1)]
+                best: tuple[int, ...] = min(options, key=bound)
+                tour = list(best)
+            placed = tuple(tour)
+        out.append((seam, placed))
+        edges.extend(costs.lower_bound(a, b) for a, b in itertools.pairwise((last, *placed)))
+        nodes.extend(costs.node_min[s] for s in placed)
+        last = placed[-1] if placed else last
     return out
 
 

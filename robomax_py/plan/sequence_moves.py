@@ -63,7 +63,18 @@ class _Moves:
             suffix = np.array([s for f in flats[b + 1:] for s in f], dtype=np.int64)
             out.append(np.concatenate([np.broadcast_to(prefix, (len(rows), len(prefix))), rows,
                                        np.broadcast_to(suffix, (len(rows), len(suffix)))], axis=1))
-        out.extend(np.array([_flatten(w)], dtype=np.int64) for w in self.whole)
+        if self.whole:
+            # Seam moves rearrange whole blocks: each row joined from the blocks' arrays (made once
+            # per block order), not flattened spot by spot (seams^2 moves of N spots each).
+            arrays: dict[tuple[int, ...], np.ndarray] = {}
+
+            def array(block: tuple[int, ...]) -> np.ndarray:
+                got = arrays.get(block)
+                if got is None:
+                    got = arrays[block] = np.asarray(block, dtype=np.int64)
+                return got
+
+            out.append(np.stack([np.concatenate([array(block) for _, block in w]) for w in self.whole]))
         return np.concatenate(out) if out else np.zeros((0, 0), dtype=np.int64)
 
 

@@ -68,6 +68,10 @@ class _CountingWorld:
         self.states += 1
         return False
 
+    def are_free(self, qs: np.ndarray, t: float | None = None) -> np.ndarray:
+        self.states += len(qs)
+        return np.zeros(len(qs), dtype=bool)
+
     def __getattr__(self, name: str) -> Any:
         return getattr(self._world, name)
 
@@ -139,9 +143,14 @@ def _via_costs_one_by_one(seq: Sequencer, i: int, j: int, rows: np.ndarray, cols
 
 
 @pytest.mark.slow
-def test_detour_prices_batched_equal_one_by_one(reference: tuple[Any, Any, CollisionWorld, list[Any]]) -> None:
+@pytest.mark.parametrize("chunk", [2, 16])
+def test_detour_prices_batched_equal_one_by_one(reference: tuple[Any, Any, CollisionWorld, list[Any]], chunk: int,
+                                                monkeypatch: pytest.MonkeyPatch) -> None:
+    from robomax_py.plan import graph_knowledge
     from robomax_py.plan.graph import MAX_BLOCKED_LEGS
     from robomax_py.plan.roadmap import Detour
+
+    monkeypatch.setattr(graph_knowledge, "VIA_CHUNK", chunk)       # detours priced a few at a time, or all at once
 
     cell, robot, world, spots = reference
     seq = Sequencer(cell, robot, world, None, spots, resolved_options(cell, PlanOptions()), np.random.default_rng(0))
