@@ -2,7 +2,8 @@
 graph and detour learner (`graph`, with `sequence` and `roadmap`), the tour timed junction by
 junction (`tour_timing`, `junction`, `waiting`), checked (`pipeline`) -> a `PlanResult` (`results`)."""
 
-from robomax_py.plan.pipeline import plan_cell, verify_trajectory
+from robomax_py.plan.checked_tour import verify_trajectory
+from robomax_py.plan.pipeline import plan_cell
 from robomax_py.plan.results import (
     METHODS,
     FailureReason,

@@ -319,9 +319,9 @@ def test_optimiser_beats_baseline_on_reference_cell() -> None:
 def _failing_checks(monkeypatch: pytest.MonkeyPatch, failures: int) -> list[bool]:
     """verify_trajectory made to report a collision at the motion's second sample for its first
     `failures` calls (as if a blend grazed an object); the real verdicts of every call, in order."""
-    from robomax_py.plan import pipeline
+    from robomax_py.plan import checked_tour
 
-    real = pipeline.verify_trajectory
+    real = checked_tour.verify_trajectory
     seen: list[bool] = []
 
     def check(world: Any, robot: Any, traj: Any, *args: Any, **kwargs: Any) -> Any:
@@ -331,7 +331,7 @@ def _failing_checks(monkeypatch: pytest.MonkeyPatch, failures: int) -> list[bool
             return type(got)((_violation(traj),), got.checks)
         return got
 
-    monkeypatch.setattr(pipeline, "verify_trajectory", check)
+    monkeypatch.setattr(checked_tour, "verify_trajectory", check)
     return seen
 
 
@@ -374,7 +374,7 @@ def test_a_tour_whose_junctions_keep_failing_is_timed_without_blends(
 ) -> None:
     """When the junctions stopped at their corners still fail (here: every retiming's check made
     to fail), the whole tour is timed without blends, the straight moves the sequencer proved free."""
-    from robomax_py.plan.pipeline import EXACT_JUNCTION_ROUNDS
+    from robomax_py.plan.checked_tour import EXACT_JUNCTION_ROUNDS
 
     cell = load_cell(write_small_cell(tmp_path, "small"))
     robot = load_cell_robot(cell)
