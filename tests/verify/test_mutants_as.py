@@ -9,7 +9,7 @@ import math
 import re
 
 import pytest
-from conftest import Edit, Placed, placement_mm_zyx
+from verify_mutants import Edit, Placed, placement_mm_zyx
 
 
 def _placement_as_base(placed: Placed) -> dict[str, Edit]:

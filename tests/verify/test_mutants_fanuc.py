@@ -12,7 +12,8 @@ import re
 from collections.abc import Callable
 
 import pytest
-from conftest import (
+from controller_model.fanuc import run_fanuc
+from verify_mutants import (
     Edit,
     Placed,
     detour_into_the_part,
@@ -20,7 +21,6 @@ from conftest import (
     placement_mm_zyx,
     read_execution,
 )
-from controller_model.fanuc import run_fanuc
 
 
 def _placement_as_uframe(placed: Placed) -> dict[str, Edit]:

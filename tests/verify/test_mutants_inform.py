@@ -8,7 +8,7 @@ from __future__ import annotations
 import re
 
 import pytest
-from conftest import Edit, Placed
+from verify_mutants import Edit, Placed
 
 
 def _user_frame_left_out(placed: Placed) -> dict[str, Edit]:

@@ -17,7 +17,9 @@ import re
 from collections.abc import Callable
 
 import pytest
-from conftest import (
+from controller_model.krl import run_krl
+from scipy.spatial.transform import Rotation
+from verify_mutants import (
     Edit,
     Placed,
     detour_into_the_part,
@@ -25,8 +27,6 @@ from conftest import (
     placement_mm_zyx,
     read_execution,
 )
-from controller_model.krl import run_krl
-from scipy.spatial.transform import Rotation
 
 FRAME = re.compile(r"\{X (-?[\d.]+), Y (-?[\d.]+), Z (-?[\d.]+), A (-?[\d.]+), B (-?[\d.]+), C (-?[\d.]+)\}")
 

@@ -17,7 +17,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest import (
+from controller_model.common import Call, Motion
+from controller_model.rapid import run_rapid
+from scipy.spatial.transform import Rotation
+from verify_mutants import (
     Edit,
     Placed,
     detour_into_the_part,
@@ -25,9 +28,6 @@ from conftest import (
     placement_mm_zyx,
     read_execution,
 )
-from controller_model.common import Call, Motion
-from controller_model.rapid import run_rapid
-from scipy.spatial.transform import Rotation
 
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import plan_cell

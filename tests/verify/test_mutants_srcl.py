@@ -8,8 +8,8 @@ import re
 from collections.abc import Callable
 
 import pytest
-from conftest import Edit, Placed, placement_mm_zyx
 from scipy.spatial.transform import Rotation
+from verify_mutants import Edit, Placed, placement_mm_zyx
 
 from robomax_py.errors import ProgramError
 

@@ -10,7 +10,9 @@ import re
 from collections.abc import Callable
 
 import pytest
-from conftest import (
+from controller_model.urscript import run_urscript
+from scipy.spatial.transform import Rotation
+from verify_mutants import (
     Edit,
     Placed,
     detour_into_the_part,
@@ -18,8 +20,6 @@ from conftest import (
     placement_mm_zyx,
     read_execution,
 )
-from controller_model.urscript import run_urscript
-from scipy.spatial.transform import Rotation
 
 
 def _placement_as_feature(placed: Placed) -> dict[str, Edit]:
