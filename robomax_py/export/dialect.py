@@ -105,18 +105,25 @@ def controller_identifier(name: str, *, upper: bool, max_chars: int, reserved: S
     ident = ident[:max_chars]
     return ident + suffix if ident in reserved else ident
 
+# A long name keeps its last words when they are this short (a station robot's `_r1`, a variant's
+# `_4_r1`): what tells two programs of one station apart is at the end of their names.
+TAIL_CHARS = 6
+
+
 def fitted_identifier(name: str, *, max_chars: int, reserved: Sequence[str] = (), keep: Sequence[str] = ()) -> str:
     """A program's name as a controller that ties the file to it takes it (KRL's DEF and file,
-    RAPID's MODULE and file): letters of either case, digits and `_`, a letter first (`P` put in
-    front otherwise), at most `max_chars`. A longer name is cut and given `_` and 4 hexadecimal
-    digits of its SHA-256, so that two long names stay two programs; an ending in `keep` (a
-    baseline's `_teach_in`) stays on. A name in `reserved` (case-insensitively: the dialect's own
-    routines and keywords) gets `_prog` after it.
+    RAPID's MODULE and file, FANUC's program and file): letters, digits and `_`, a letter first
+    (`P` put in front otherwise), at most `max_chars`. A name in `reserved` (case-insensitively: the
+    dialect's own routines and keywords) gets `_prog` after it. A longer name keeps its head, then
+    `_` and 4 hexadecimal digits of its SHA-256 (two long names stay two programs), then its ending:
+    one in `keep` (a baseline's `_teach_in`), else its last words up to TAIL_CHARS characters.
 
     >>> fitted_identifier("7 door-L", max_chars=17), fitted_identifier("spot_weld", max_chars=17, reserved=["SPOT_WELD"])
     ('P7_door_L', 'spot_weld_prog')
     >>> fitted_identifier("cabin_flange_rear_left_teach_in", max_chars=17, keep=["_teach_in"])
     'cab_5E67_teach_in'
+    >>> fitted_identifier("side_frame_station_4_r1", max_chars=17)
+    'side_fr_B7E6_4_r1'
     """
     ident = re.sub(r"[^A-Za-z0-9_]", "_", name) or "P"
     if not ("A" <= ident[0] <= "Z" or "a" <= ident[0] <= "z"):
@@ -124,10 +131,23 @@ def fitted_identifier(name: str, *, max_chars: int, reserved: Sequence[str] = ()
     if ident.upper() in {r.upper() for r in reserved}:
         ident += "_prog"
     if len(ident) > max_chars:
-        kept = next((k for k in keep if ident.endswith(k)), "")
+        kept = next((k for k in keep if ident.upper().endswith(k.upper())), "")
+        kept = ident[len(ident) - len(kept):] if kept else "_" + _last_words(ident[1:], TAIL_CHARS)
         digest = hashlib.sha256(name.encode()).hexdigest()[:4].upper()
-        ident = ident[:max_chars - len(kept) - 5] + "_" + digest + kept
+        ident = ident[:max_chars - len(kept.rstrip("_")) - 5] + "_" + digest + kept.rstrip("_")
     return ident
+
+
+def _last_words(ident: str, most: int) -> str:
+    """The `_`-separated words at the end of `ident`, as many as fit in `most` characters ("" when
+    even the last does not)."""
+    tail = ""
+    for word in reversed(ident.split("_")):
+        joined = f"{word}_{tail}" if tail else word
+        if not word or len(joined) > most:
+            break
+        tail = joined
+    return tail
 
 
 def own_name(frame: FrameDef) -> str:

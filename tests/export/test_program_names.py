@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from robomax_py.app.cli import app
-from robomax_py.export import krl, rapid
+from robomax_py.export import fanuc, krl, rapid
 from robomax_py.export.plan_program import identifier
 
 KRL_NAME = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]{0,23}")
@@ -47,6 +47,17 @@ def test_long_names_cut_stay_apart() -> None:
     a, b = "side_frame_station_robot_left", "side_frame_station_robot_right"
     assert krl.program_name(a) != krl.program_name(b) and rapid.program_name(a) != rapid.program_name(b)
     assert krl.program_name(a + "_teach_in").endswith("_teach_in")
+
+
+def test_a_station_robots_programs_keep_the_robot_in_their_names() -> None:
+    """`<station>_<robot>` cut to fit: the robot's name (the name's last short words) stays on, in
+    every dialect that ties its files to the program."""
+    station = "2 Seitenrahmen Station links Zelle 4"
+    for robot in ("r1", "r2"):
+        name = identifier(f"{station}_{robot}")
+        assert krl.program_name(name).endswith(f"_4_{robot}")
+        assert rapid.program_name(name).endswith(f"_4_{robot}")
+        assert fanuc.program_name(name).endswith(f"_4_{robot.upper()}")
 
 
 def test_short_names_are_kept() -> None:

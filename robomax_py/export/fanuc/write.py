@@ -4,13 +4,13 @@ it) and the writer of `<NAME>.ls` and its frames' program (the package's docstri
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import math
 import re
 
 from robomax_py.errors import ControllerSetupError, ExportError
 from robomax_py.export.dialect import (
     PlannedProgram,
+    fitted_identifier,
     gripper_label,
     header_lines,
     numbered_frames,
@@ -92,22 +92,14 @@ def frame_name(frame: FrameDef) -> str:
 def program_name(name: str) -> str:
     """The TP program a cell's program `name` becomes (module docstring): capitals, digits and `_`,
     a letter first, at most NAME_CHARS - len("_FRAMES") characters; a longer name is cut and given 4
-    hexadecimal digits of its SHA-256 (a trailing `_BASELINE` is kept), a routine's name gets `_PROG`.
+    hexadecimal digits of its SHA-256 and its ending (a baseline's suffix, a station robot's name;
+    `dialect.fitted_identifier`), a routine's name gets `_PROG`.
 
     >>> program_name("door-L 2"), program_name("7up"), program_name("spot_weld")
     ('DOOR_L_2', 'P7UP', 'SPOT_WELD_PROG')
     """
-    ident = re.sub(r"[^A-Z0-9_]", "_", name.upper()) or "P"
-    if not "A" <= ident[0] <= "Z":
-        ident = "P" + ident
-    room = NAME_CHARS - len(FRAMES_SUFFIX)
-    if len(ident) > room:
-        kept = "_BASELINE" if ident.endswith("_BASELINE") else ""
-        digest = hashlib.sha256(name.encode()).hexdigest()[:4].upper()
-        ident = ident[:room - len(kept) - 5] + "_" + digest + kept
-    if ident in ROUTINES:
-        ident += "_PROG"
-    return ident
+    return fitted_identifier(name.upper(), max_chars=NAME_CHARS - len(FRAMES_SUFFIX), reserved=ROUTINES,
+                             keep=("_BASELINE", "_PUBLISHED", "_TEACH_IN")).upper()
 
 
 def remarks(text: str) -> list[str]:
