@@ -67,12 +67,13 @@ _DATA_TYPES = ("E6AXIS", "AXIS", "E6POS", "POS", "FRAME", "FDAT", "PDAT", "LDAT"
 
 
 # KSS names (KSS 8.x Operating and Programming Instructions for System Integrators, "Names in
-# KRL", as restated in Hungsiu/WtRobotTraining @ c92b8435 03_Syntax.md, "naming and variables"): at most 24
-# characters, letters, digits, `_` and `$`, not a digit first, not a keyword. A module's file and
-# its DEF (and DEFDAT) have one name: KSS selects `<name>.src` by running its DEF `<name>`, and
-# RoboDK's KUKA post names the file after the DEF it writes (ros-industrial-attic/
-# robodk_postprocessors @ d7e6c1c0 KUKA_KRC4.py 146-188). So the program's name is the files'
-# stem, short enough that the setup program `<name>_frames` is a name too.
+# KRL", as restated in Hungsiu/WtRobotTraining @ c92b8435 03_Syntax.md, "naming and variables"): at
+# most 24 characters, letters, digits, `_` and `$`, not a digit first, not a keyword. A DEF beyond
+# them does not compile. The module's files carry the DEF's name, as a module made on the smartPAD
+# has them and as RoboDK's KUKA post writes them (ros-industrial-attic/robodk_postprocessors @
+# d7e6c1c0 KUKA_KRC4.py 146-188: `DEF progname` into `progname.src`); a published program may
+# differ (kuka_experimental's ros_rsi.src holds DEF RSI_AxisCorr), so the reader does not require
+# it. The setup program `<name>_frames` must be a name too.
 PROGRAM_CHARS = _NAME_CHARS - len("_frames")
 # The routines the program defines after its own DEF, and the keywords of the statements robomax
 # reads and writes (a DEF so named would not compile).

@@ -38,8 +38,9 @@ from robomax_py.robot import RobotModel
 FRAMES_FILE = "_frames.mod"
 # RAPID identifiers name modules, routines and data: a letter first, then letters, digits and `_`,
 # at most 32 characters (ABB Technical reference manual, RAPID kernel, 3HAC050946-001,
-# "Identifiers"); reserved words are not identifiers. The module is saved as `<MODULE name>.mod`,
-# as RobotStudio saves a module, and `<name>_frames` must be an identifier too.
+# "Identifiers"); reserved words are not identifiers. The file carries the module's name, as
+# RobotStudio names a module it saves (the controller takes the name from the MODULE line), and
+# `<name>_frames` must be an identifier too.
 PROGRAM_CHARS = 32 - len("_frames")
 _RESERVED = ("main", "spot_weld", "grip", "release", "MODULE", "ENDMODULE", "PROC", "ENDPROC", "FUNC", "ENDFUNC",
              "TRAP", "ENDTRAP", "CONST", "PERS", "VAR", "LOCAL", "TASK", "IF", "THEN", "ELSE", "ELSEIF", "ENDIF", "FOR",
