@@ -1,5 +1,5 @@
-"""Program names where the controller ties the file to the program: KRL's DEF and DEFDAT carry
-the name of their `.src` / `.dat`, RAPID's MODULE that of its `.mod` (as RobotStudio saves it).
+"""Program names: KRL's DEF and DEFDAT carry the name of their `.src` / `.dat`, RAPID's MODULE that
+of its `.mod`, as the controllers' editors name them, and each is a name the controller compiles.
 The rules are checked as the vendors state them, not with the writer's code:
 - KRL names: at most 24 characters, letters, digits, `_` and `$`, not a digit first (KSS 8.x
   "Names in KRL"; Hungsiu/WtRobotTraining @ c92b8435 03_Syntax.md), so the setup program
