@@ -116,3 +116,19 @@ def test_verify_of_a_setup_file_names_the_program(awkward: tuple[Path, Path]) ->
         if "setup program of" in text:
             main = setup.name[:-len("_frames") - len(setup.suffix)] + setup.suffix
             assert f"verify {main}" in text
+
+
+def test_verify_reports_a_def_name_krl_does_not_compile(awkward: tuple[Path, Path], tmp_path: Path) -> None:
+    """A program's DEF renamed to 30 characters (file and DEFDAT with it): verify reports it at the
+    DEF line, as a controller that will not compile it."""
+    cell, out = awkward
+    src = next(p for p in out.glob("*.src") if not p.stem.endswith("_frames"))
+    long = "a_weld_program_named_30_chars_"
+    assert len(long) == 30
+    for p in out.iterdir():
+        if p.suffix in (".src", ".dat") and not p.stem.endswith("_frames"):
+            text = p.read_text(encoding="cp1252").replace(src.stem, long)
+            (tmp_path / f"{long}{p.suffix}").write_text(text, encoding="cp1252")
+    got = CliRunner().invoke(app, ["verify", str(cell), str(tmp_path / f"{long}.src")])
+    text = " ".join(got.output.split())
+    assert got.exit_code != 0 and f"DEF {long}: 30 characters" in text, text

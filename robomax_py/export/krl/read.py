@@ -15,7 +15,7 @@ from robomax_py.export.dialect import (
     read_header,
     read_spot_label,
 )
-from robomax_py.export.flow import Statement, follow
+from robomax_py.export.flow import Routine, Statement, follow
 from robomax_py.export.krl.flow import (
     _REST_ROUTINES,
     _classifier,
@@ -24,7 +24,13 @@ from robomax_py.export.krl.flow import (
 )
 from robomax_py.export.krl.grammar import _SPLINE_SEGMENT, _statement
 from robomax_py.export.krl.reader import _DataReader
-from robomax_py.export.krl.write import _AXES, _DATA_TYPES, _NOTE, FRAMES_FILE
+from robomax_py.export.krl.write import (
+    _AXES,
+    _DATA_TYPES,
+    _NAME_CHARS,
+    _NOTE,
+    FRAMES_FILE,
+)
 from robomax_py.program import (
     NULL_FRAME,
     Comment,
@@ -225,6 +231,18 @@ def _dat_name(file: str) -> str:
     return re.sub(r"\.src$", ".dat", file, flags=re.IGNORECASE) if file.lower().endswith(".src") else file + " (.dat)"
 
 
+def _check_names(src: str, routines: list[Routine], reader: _Reader) -> None:
+    """A DEF whose name is longer than a KRL name may be (24 characters, the note at
+    `write.PROGRAM_CHARS`) does not compile: a problem at its DEF line."""
+    lines = src.splitlines()
+    for r in routines:
+        if len(r.name) > _NAME_CHARS:
+            at = next((i for i, raw in enumerate(lines, start=1)
+                       if re.match(rf"^\s*(GLOBAL\s+)?DEF(FCT\s+\w+)?\s+{re.escape(r.name)}\s*\(", raw, re.IGNORECASE)), 0)
+            reader.problems.append((at, "format", (f"DEF {r.name}: {len(r.name)} characters, and a KRL name has "
+                                                   f"at most {_NAME_CHARS}: KSS does not compile it")))
+
+
 def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
     """A KRL program from its `.src` (and `.dat`, when given) texts."""
     reader = _Reader(file, robot)
@@ -243,6 +261,7 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
     if not routines:
         raise ProgramError(file, None, "no DEF line: not a KRL program")
     main = routines[0]
+    _check_names(texts.get(".src", ""), routines, reader)
     defined = {r.name.lower(): r for r in [*_routines(texts.get(FRAMES_FILE, ""), FRAMES_FILE), *routines]}
     followed = follow(main, defined, _classifier(set(defined)))
     folds = 0
