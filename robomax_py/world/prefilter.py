@@ -184,8 +184,8 @@ class Prefilter:
     def near_reach(self, qs: FloatArray, active: BoolArray) -> tuple[BoolArray, BoolArray, FloatArray]:
         """`near(qs, active, deep=True)` and, for each pair left, how much its distance can shrink
         between the centre of qs's box ((min + max) / 2 per joint) and any configuration of the box
-        (m; inf for the others): a pair farther apart at the centre than its margin and that is
-        clear at every configuration of the box."""
+        (m; inf for the others): a pair farther apart at the centre than its margin plus its reach
+        is farther apart than its margin at every configuration of the box."""
         blocks, pairs, reach = _near(_read_only(qs), self.floats, self.ints, active, True)
         return blocks, pairs, reach
 
