@@ -17,6 +17,18 @@ _FIRST_CHUNK = 8     # states the first pre-filter call of a scan covers (blocke
 # A near scan (`_scan`) of fewer states tests every pair: finding the pairs to leave out costs about
 # one state's test.
 _NEAR_STATES = 8
+# A near scan finds the pairs to leave out per run of this many neighbouring states (by their place
+# along the path, not the scan order): a short run moves the robot little, so its grown bounds clear
+# nearly what each state's own test clears, and with the finer tests (`Prefilter.near(deep=True)`)
+# the pieces close to a meshed obstacle too, which each state's test could clear only chunk by chunk.
+_NEAR_RUN = 16
+# A pair left by a run's pre-filter whose coal distance at the run's centre exceeds its margin by
+# more than the distance can shrink over the run (`Prefilter.near_reach`) is free at every state of
+# the run, and skips coal's test at each: the arm's neighbouring links (UR10: base and upper arm,
+# forearm and wrist) are a few cm apart at every state, so no bound on spheres or boxes clears them.
+# The margin is grown by CERTIFY_SLACK_M, far above GJK's tolerance (1e-6) and the residual coal may return
+# for touching shapes, so that no pair coal could call colliding is left out.
+CERTIFY_SLACK_M = 1e-4
 
 
 class CollisionWorldCore:
@@ -89,20 +101,29 @@ class CollisionWorldCore:
             k0 = k1
         return SegmentCheck(True, len(order), m + 1, tests, None)
 
-    def _scan(self, states: FloatArray, fractions: FloatArray, n_states: int, near: bool = False) -> SegmentCheck:
+    def _scan(self, states: FloatArray, fractions: FloatArray, n_states: int, near: bool = False,
+              place: IntArray | None = None) -> SegmentCheck:
         """Check `states` in the given order, stopping at the first collision (pre-filter on).
 
         near: the states lie close together (a short path); the pre-filter's pairs cleared at every
-        state of their joint-space box are then found once and left out of each state's test."""
+        state of a run of `_NEAR_RUN` neighbours are then found once per run and left out of each
+        state's test. place: each state's place along the path (default: the given order)."""
         assert self._pf is not None
         tests = 0
         start, chunk = 0, _FIRST_CHUNK
-        blocks, active = None, self._active
+        blocks: np.ndarray | None = None
+        active: np.ndarray = self._active
+        rows: IntArray | None = None
         if near and len(states) >= _NEAR_STATES:
-            blocks, active = self._pf.near(states, self._active)
+            run = (np.arange(len(states)) if place is None else np.asarray(place)) // _NEAR_RUN
+            found = [self._run_pairs(states[run == r]) for r in range(int(run.max()) + 1)]
+            blocks = np.array([b for b, _ in found])
+            active = np.array([a for _, a in found])
+            rows = run.astype(np.int64)
         while start < len(states):
             block = states[start:start + chunk]
-            offsets, pairs = self._pf.uncleared(block, active, blocks)
+            offsets, pairs = self._pf.uncleared(block, active, blocks,
+                                                None if rows is None else rows[start:start + chunk])
             for i in np.flatnonzero(np.diff(offsets)):
                 free, n = self._exact(block[i], pairs[offsets[i]:offsets[i + 1]])
                 tests += n
@@ -112,6 +133,24 @@ class CollisionWorldCore:
             start += len(block)
             chunk *= 4
         return SegmentCheck(True, len(states), n_states, tests, None)
+
+    def _run_pairs(self, states: FloatArray) -> tuple[np.ndarray, np.ndarray]:
+        """(blocks, pairs) a run of neighbouring states must still test: `Prefilter.near_reach`'s,
+        less the pairs coal's distance at the run's centre proves free at every state of it."""
+        assert self._pf is not None
+        blocks, live, reach = self._pf.near_reach(states, self._active)
+        left = np.flatnonzero(live)
+        if not left.size:
+            return blocks, live
+        s, gd = self._s, self._gdata
+        gm = s.geom_model
+        centre = (states.min(axis=0) + states.max(axis=0)) / 2     # as `_near` takes it
+        pin.updateGeometryPlacements(s.model, self._data, gm, gd, centre)
+        bar = s.pair_margin + CERTIFY_SLACK_M
+        for p in left.tolist():
+            if pin.computeDistance(gm, gd, p).min_distance - reach[p] > bar[p]:
+                live[p] = False
+        return blocks, live
 
     def _collides(self, q: FloatArray) -> bool:
         s = self._s

@@ -139,7 +139,7 @@ class SweptChecks(CollisionWorldCore):
         last = len(states) - 1
         order = bisection_order(last)
         if self._pf is not None:
-            return self._scan(states[order], order / last if last else np.zeros(len(order)), len(states), near)
+            return self._scan(states[order], order / last if last else np.zeros(len(order)), len(states), near, order)
         tests = 0
         for k, idx in enumerate(order):
             hit = self._collides(states[idx])

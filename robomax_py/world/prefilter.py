@@ -149,25 +149,45 @@ class Prefilter:
         )
         return Prefilter(floats=floats, ints=ints, every_block=np.ones(len(keys), dtype=bool))
 
-    def uncleared(self, qs: FloatArray, active: BoolArray, blocks: BoolArray | None = None) -> tuple[IntArray, IntArray]:
+    def uncleared(self, qs: FloatArray, active: BoolArray, blocks: BoolArray | None = None,
+                  rows: IntArray | None = None) -> tuple[IntArray, IntArray]:
         """For each configuration of qs (k, n), the active pairs it does not clear.
 
         blocks: which blocks to test (`near`: the others are cleared at every configuration of qs, and
         skipped: the same answer with fewer tests); None: every block.
+        rows: per configuration, the row of `active` (r, p) and `blocks` (r, b) it takes (each row
+        the `near` of a part of qs); None: `active` (p,) and `blocks` (b,) for all.
         Returns (offsets (k + 1,), pairs): configuration i's pairs are pairs[offsets[i]:offsets[i + 1]],
         in pair order.
         """
-        counts, pairs = _uncleared(_read_only(qs), self.floats, self.ints, active,
-                                   self.every_block if blocks is None else blocks)
+        if rows is None:
+            rows = np.zeros(len(qs), dtype=np.int64)
+            active = active[None]
+            blocks = (self.every_block if blocks is None else blocks)[None]
+        elif blocks is None:
+            blocks = np.broadcast_to(self.every_block, (len(active), len(self.every_block)))
+        counts, pairs = _uncleared(_read_only(qs), self.floats, self.ints, np.ascontiguousarray(active),
+                                   np.ascontiguousarray(blocks), np.ascontiguousarray(rows, dtype=np.int64))
         return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), pairs
 
-    def near(self, qs: FloatArray, active: BoolArray) -> tuple[BoolArray, BoolArray]:
+    def near(self, qs: FloatArray, active: BoolArray, deep: bool = False) -> tuple[BoolArray, BoolArray]:
         """(blocks (b,) bool, pairs (p,) bool): the blocks, and the pairs of `active`, that a
         configuration in the joint-space box spanned by qs (k, n) may not clear; the others are
         cleared at every configuration of the box, so `uncleared(q, pairs, blocks)` of any q in it
-        gives what `uncleared(q, active)` gives (`prefilter_kernels._near`)."""
-        blocks, pairs = _near(_read_only(qs), self.floats, self.ints, active)
+        gives what `uncleared(q, active)` gives (`prefilter_kernels._near`). deep: also the finer
+        tests (chunks, oriented boxes) at the box's centre, grown by the box's motion: fewer pairs,
+        each left out provably free at every configuration of the box, though `uncleared` of one
+        might have left it to coal (so the same verdicts, perhaps from fewer exact tests)."""
+        blocks, pairs, _ = _near(_read_only(qs), self.floats, self.ints, active, deep)
         return blocks, pairs
+
+    def near_reach(self, qs: FloatArray, active: BoolArray) -> tuple[BoolArray, BoolArray, FloatArray]:
+        """`near(qs, active, deep=True)` and, for each pair left, how much its distance can shrink
+        between the centre of qs's box ((min + max) / 2 per joint) and any configuration of the box
+        (m; inf for the others): a pair farther apart at the centre than its margin plus its reach
+        is farther apart than its margin at every configuration of the box."""
+        blocks, pairs, reach = _near(_read_only(qs), self.floats, self.ints, active, True)
+        return blocks, pairs, reach
 
     def joint_placements(self, q: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(J, 3, 3) rotations and (J, 3) translations of every joint frame at q (as Pinocchio's oMi)."""

@@ -10,6 +10,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from robomax_py.world.prefilter_reach import _growth, _pair_reach
+
 _N_HEADER, _N_FLOAT_TABLES, _N_INT_TABLES = 6, 19, 16
 
 
@@ -101,9 +103,10 @@ def _placements(q: Any, F: Any, I: Any) -> Any:
 
 
 @njit(cache=True, nogil=True)
-def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any) -> Any:
-    """For each configuration of qs, the active pairs it does not clear, in pair order; blocks
-    whose `blocks` entry is False are known cleared (`_near`) and skipped."""
+def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any, rows: Any) -> Any:
+    """For each configuration i of qs, the pairs active in row rows[i] of `active` (r, P) it does
+    not clear, in pair order; blocks whose entry in row rows[i] of `blocks` (r, NB) is False are
+    known cleared (`_near`) and skipped."""
     J, G, P, NG, NB, C = I[0], I[1], I[2], I[3], I[4], I[5]
     fo, io = _offsets(I)
     parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
@@ -151,6 +154,7 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any) -> Any:
         for c in range(q.shape[0]):          # a loop: slice assignment compiles its shape checks
             q[c] = qs[i, c]
         _forward(q, parent, kind, axis, jrot, jtrans, jq, rot, trans)
+        row = rows[i]
         for m in range(n_moving):
             _place(rot, trans, piece_joint[moving[m]], centre, moving[m], world)
         for g in range(NG):
@@ -160,7 +164,7 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any) -> Any:
         begin = 0
         for blk in range(NB):
             stop = b_end[blk]
-            if not blocks[blk]:
+            if not blocks[row, blk]:
                 begin = stop
                 continue
             ga, gb = b_a[blk], b_b[blk]
@@ -171,7 +175,7 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any) -> Any:
             if not cleared:
                 for n in range(begin, stop):
                     k = b_pairs[n]
-                    if not active[k]:
+                    if not active[row, k]:
                         continue
                     a, b = pair_a[k], pair_b[k]
                     if pair_obstacle[k]:
@@ -215,7 +219,7 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any) -> Any:
 
 
 @njit(cache=True, nogil=True)
-def _near(qs: Any, F: Any, I: Any, active: Any) -> Any:
+def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
     """(blocks (NB,) bool, pairs (P,) bool): the blocks, and the active pairs, that `_uncleared`'s
     tests may fail to clear at some configuration of the joint-space box spanned by qs (k, n);
     the others are cleared at every configuration of the box.
@@ -226,16 +230,26 @@ def _near(qs: Any, F: Any, I: Any, active: Any) -> Any:
     most the joint-origin offsets from i to j plus the point's distance from o_j (rotations keep
     lengths); along the straight line from the centre to any configuration of the box its centre
     so moves at most sum_i (half range_i) * that bound. A chain with a prismatic joint, or a
-    configuration with a NaN, gets no bound (every block and active pair kept)."""
-    J, G, NG, NB = I[0], I[1], I[3], I[4]
+    configuration with a NaN, gets no bound (every block and active pair kept).
+
+    deep: a pair whose grown spheres meet is also tried with `_uncleared`'s finer tests at the box's
+    centre (an obstacle's chunk tree, the pieces' oriented boxes), the gap grown by how far any point
+    of the piece can move (`_growth` of its farthest point: the piece lies within its sphere); a pair
+    so cleared is cleared at every configuration of the box, though `_uncleared` of one of them may
+    not clear it (it then goes to coal's exact test, which finds it free). Also returned: reach (P,),
+    for each pair left when deep, how much its distance can shrink from the box's centre
+    (`_pair_reach`; inf otherwise)."""
+    J, G, NG, NB, C = I[0], I[1], I[3], I[4], I[5]
+    fo, io = _offsets(I)
     parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
     (centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin, piece_joint, pair_a, pair_b, pair_obstacle,
      group_joint, b_kind, b_a, b_b, b_end, b_pairs) = _sphere_tables(F, I)
     keep = np.ones(NB, dtype=np.bool_)
     live = active.copy()
+    reach = np.full(I[2], np.inf)
     for j in range(1, J):
         if kind[j] != 0:
-            return keep, live
+            return keep, live, reach
     n = qs.shape[1]
     lo = np.empty(n)
     hi = np.empty(n)
@@ -244,7 +258,7 @@ def _near(qs: Any, F: Any, I: Any, active: Any) -> Any:
         for i in range(qs.shape[0]):
             x = qs[i, c]
             if not math.isfinite(x):
-                return keep, live
+                return keep, live, reach
             lo[c] = min(lo[c], x)
             hi[c] = max(hi[c], x)
     mid = (lo + hi) / 2.0
@@ -258,6 +272,19 @@ def _near(qs: Any, F: Any, I: Any, active: Any) -> Any:
         g_grow[g] = _growth(g_centre, g, group_joint[g], lo, hi, parent, jtrans, jq)
     world = np.empty((G, 3))
     grow = np.full(G, -1.0)                   # not yet computed
+    obb_c = F[fo[11]:fo[11] + 3 * G].reshape((G, 3))
+    obb_r = F[fo[12]:fo[12] + 9 * G].reshape((G, 3, 3))
+    obb_h = F[fo[13]:fo[13] + 3 * G].reshape((G, 3))
+    ch_c = F[fo[14]:fo[14] + 3 * C].reshape((C, 3))
+    ch_rad = F[fo[15]:fo[15] + C]
+    ch_bc = F[fo[16]:fo[16] + 3 * C].reshape((C, 3))
+    ch_br = F[fo[17]:fo[17] + 9 * C].reshape((C, 3, 3))
+    ch_h = F[fo[18]:fo[18] + 3 * C].reshape((C, 3))
+    ch_start, ch_end, ch_skip = I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C]
+    box_c = np.empty((G, 3))
+    box_r = np.empty((G, 3, 3))
+    spread = np.full(G, -1.0)                 # how far any point of the piece can move; not yet computed
+    scratch = np.empty((7, 3))
     begin = 0
     for blk in range(NB):
         stop = b_end[blk]
@@ -281,30 +308,41 @@ def _near(qs: Any, F: Any, I: Any, active: Any) -> Any:
                 grow[a] = _growth(centre, a, piece_joint[a], lo, hi, parent, jtrans, jq)
             if pair_obstacle[k]:
                 live[k] = not _sphere_box(world, a, radius[a] + margin[k] + grow[a], box_lo, box_hi, b)
+                if live[k] and deep and ch_start[b] >= 0:
+                    if spread[a] < 0.0:
+                        _place_box(rot, trans, piece_joint[a], obb_c, obb_r, a, box_c, box_r)
+                        spread[a] = _growth(centre, a, piece_joint[a], lo, hi, parent, jtrans, jq, radius[a])
+                    live[k] = False
+                    c = ch_start[b]
+                    while c < ch_end[b]:              # `_uncleared`'s traversal, every test grown
+                        if _sphere_point(world, a, ch_c, c, radius[a] + ch_rad[c] + margin[k] + grow[a]) or \
+                                _boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, margin[k] + spread[a],
+                                             scratch):
+                            c = ch_skip[c]
+                        elif ch_skip[c] == c + 1:
+                            live[k] = True
+                            break
+                        else:
+                            c += 1
             else:
                 if grow[b] < 0.0:
                     _place(rot, trans, piece_joint[b], centre, b, world)
                     grow[b] = _growth(centre, b, piece_joint[b], lo, hi, parent, jtrans, jq)
                 live[k] = not _sphere_point(world, a, world, b, radius[a] + radius[b] + margin[k] + grow[a] + grow[b])
+                if live[k] and deep:
+                    for g in (a, b):
+                        if spread[g] < 0.0:
+                            _place_box(rot, trans, piece_joint[g], obb_c, obb_r, g, box_c, box_r)
+                            spread[g] = _growth(centre, g, piece_joint[g], lo, hi, parent, jtrans, jq, radius[g])
+                    live[k] = not _boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b,
+                                               margin[k] + spread[a] + spread[b], scratch)
+            if live[k] and deep:
+                reach[k] = _pair_reach(centre, radius, piece_joint, a, b, pair_obstacle[k], lo, hi, parent, jtrans, jq,
+                                       spread)
             any_live = any_live or live[k]
         keep[blk] = any_live             # a block without a live pair adds nothing
         begin = stop
-    return keep, live
-
-
-@njit(cache=True, nogil=True)
-def _growth(local: Any, g: int, j: int, lo: Any, hi: Any, parent: Any, jtrans: Any, jq: Any) -> float:
-    """How far point local[g] of joint j's link can move from where it is at the centre of the box
-    [lo, hi] of a revolute chain's configurations (`_near`), m; grown by a micrometre so that the
-    round-off of the two tests it separates cannot tell them apart."""
-    arm = math.sqrt(local[g, 0] ** 2 + local[g, 1] ** 2 + local[g, 2] ** 2)
-    moved = 0.0
-    k = j
-    while k > 0:
-        moved += (hi[jq[k]] - lo[jq[k]]) / 2.0 * arm
-        arm += math.sqrt(jtrans[k, 0] ** 2 + jtrans[k, 1] ** 2 + jtrans[k, 2] ** 2)
-        k = parent[k]
-    return moved * (1.0 + 1e-9) + 1e-6
+    return keep, live, reach
 
 
 @njit(cache=True, nogil=True)
