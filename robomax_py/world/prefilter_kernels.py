@@ -269,7 +269,7 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
     g_grow = np.empty(NG)
     for g in range(NG):
         _place(rot, trans, group_joint[g], g_centre, g, g_world)
-        g_grow[g] = _growth(g_centre, g, group_joint[g], lo, hi, parent, jtrans, jq)
+        g_grow[g] = _growth(g_centre, g, group_joint[g], lo, hi, parent, jtrans, jq, 0.0, np.int64(0))
     world = np.empty((G, 3))
     grow = np.full(G, -1.0)                   # not yet computed
     obb_c = F[fo[11]:fo[11] + 3 * G].reshape((G, 3))
@@ -305,13 +305,13 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
             a, b = pair_a[k], pair_b[k]
             if grow[a] < 0.0:
                 _place(rot, trans, piece_joint[a], centre, a, world)
-                grow[a] = _growth(centre, a, piece_joint[a], lo, hi, parent, jtrans, jq)
+                grow[a] = _growth(centre, a, piece_joint[a], lo, hi, parent, jtrans, jq, 0.0, np.int64(0))
             if pair_obstacle[k]:
                 live[k] = not _sphere_box(world, a, radius[a] + margin[k] + grow[a], box_lo, box_hi, b)
                 if live[k] and deep and ch_start[b] >= 0:
                     if spread[a] < 0.0:
                         _place_box(rot, trans, piece_joint[a], obb_c, obb_r, a, box_c, box_r)
-                        spread[a] = _growth(centre, a, piece_joint[a], lo, hi, parent, jtrans, jq, radius[a])
+                        spread[a] = _growth(centre, a, piece_joint[a], lo, hi, parent, jtrans, jq, radius[a], np.int64(0))
                     live[k] = False
                     c = ch_start[b]
                     while c < ch_end[b]:              # `_uncleared`'s traversal, every test grown
@@ -327,13 +327,13 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
             else:
                 if grow[b] < 0.0:
                     _place(rot, trans, piece_joint[b], centre, b, world)
-                    grow[b] = _growth(centre, b, piece_joint[b], lo, hi, parent, jtrans, jq)
+                    grow[b] = _growth(centre, b, piece_joint[b], lo, hi, parent, jtrans, jq, 0.0, np.int64(0))
                 live[k] = not _sphere_point(world, a, world, b, radius[a] + radius[b] + margin[k] + grow[a] + grow[b])
                 if live[k] and deep:
                     for g in (a, b):
                         if spread[g] < 0.0:
                             _place_box(rot, trans, piece_joint[g], obb_c, obb_r, g, box_c, box_r)
-                            spread[g] = _growth(centre, g, piece_joint[g], lo, hi, parent, jtrans, jq, radius[g])
+                            spread[g] = _growth(centre, g, piece_joint[g], lo, hi, parent, jtrans, jq, radius[g], np.int64(0))
                     live[k] = not _boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b,
                                                margin[k] + spread[a] + spread[b], scratch)
             if live[k] and deep:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
 from numba import njit
 
 
@@ -18,7 +19,7 @@ def _pair_reach(centre: Any, radius: Any, piece_joint: Any, a: int, b: int, obst
     (the nearer one's frame carries both), else both spreads. spread: cached per piece (< 0: not yet)."""
     if obstacle:
         if spread[a] < 0.0:
-            spread[a] = _growth(centre, a, piece_joint[a], lo, hi, parent, jtrans, jq, radius[a])
+            spread[a] = _growth(centre, a, piece_joint[a], lo, hi, parent, jtrans, jq, radius[a], np.int64(0))
         return float(spread[a])
     for near, far in ((a, b), (b, a)):
         k = piece_joint[far]
@@ -28,17 +29,19 @@ def _pair_reach(centre: Any, radius: Any, piece_joint: Any, a: int, b: int, obst
             return _growth(centre, far, piece_joint[far], lo, hi, parent, jtrans, jq, radius[far], piece_joint[near])
     for g in (a, b):
         if spread[g] < 0.0:
-            spread[g] = _growth(centre, g, piece_joint[g], lo, hi, parent, jtrans, jq, radius[g])
+            spread[g] = _growth(centre, g, piece_joint[g], lo, hi, parent, jtrans, jq, radius[g], np.int64(0))
     return float(spread[a] + spread[b])
 
 
 @njit(cache=True, nogil=True)
 def _growth(local: Any, g: int, j: int, lo: Any, hi: Any, parent: Any, jtrans: Any, jq: Any,
-            reach: float = 0.0, stop: int = 0) -> float:
+            reach: float, stop: Any) -> float:
     """How far point local[g] of joint j's link, or any point within `reach` of it, can move from
     where it is at the centre of the box [lo, hi] of a revolute chain's configurations (`_near`), m;
     grown by a micrometre so that the round-off of the two tests it separates cannot tell them apart.
-    stop: an ancestor joint of j; the motion in its frame (by the joints after it only)."""
+    stop: an ancestor joint of j (0: the base); the motion in its frame (by the joints after it only).
+    Every caller passes every argument, `stop` as an int64 (not a literal 0): numba compiles one
+    specialisation per set of omitted arguments and per literal."""
     arm = math.sqrt(local[g, 0] ** 2 + local[g, 1] ** 2 + local[g, 2] ** 2) + reach
     moved = 0.0
     k = j
