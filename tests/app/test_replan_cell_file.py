@@ -18,12 +18,15 @@ import yaml
 from typer.testing import CliRunner
 
 from robomax_py.app.cli import EXIT_BAD_INPUT, EXIT_OK, EXIT_VIOLATIONS, app
+from robomax_py.export import krl
 from robomax_py.io.cell import load_cell
 
 REPO = Path(__file__).resolve().parents[2]
 PROGRAM = REPO / "tests" / "golden" / "shipped" / "cabin_flange.srcl"
 EVENT = "appear:post box=0.1,0.1,0.4 xyz=1.0,0.9,1.0"
 NAME = "cabin_flange_from_6"
+# The KRL program's files are named as its DEF, a KRL name short enough for `<name>_frames`.
+KRL_SRC = f"{krl.program_name(NAME)}.src"
 # The start is written as the programs write joints (1e-4 deg), read back as the stop configuration.
 START_TOL_DEG = 1e-4
 runner = CliRunner()
@@ -77,7 +80,7 @@ def test_the_continuation_cell_is_written_in_the_set_and_holds_the_stop(continue
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("program", [f"{NAME}.src", f"{NAME}.json"])
+@pytest.mark.parametrize("program", [KRL_SRC, f"{NAME}.json"])
 def test_its_programs_verify_clean_against_it(continued: Continued, program: str) -> None:
     code, text = _verify(continued.cell_file, continued.out / program)
     assert code == EXIT_OK, text
@@ -97,7 +100,7 @@ def test_a_spot_left_that_the_program_does_not_weld_is_a_violation(continued: Co
 
 @pytest.mark.slow
 def test_against_the_original_cell_it_fails_and_names_the_cell_it_runs_in(continued: Continued) -> None:
-    code, text = _verify(continued.cell, continued.out / f"{NAME}.src")
+    code, text = _verify(continued.cell, continued.out / KRL_SRC)
     assert code == EXIT_VIOLATIONS
     assert "does not start at robot.home" in text
     assert f"{NAME}.cell.yaml" in text and "verify it against that file" in text

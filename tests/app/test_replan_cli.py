@@ -14,6 +14,7 @@ import yaml
 from typer.testing import CliRunner
 
 from robomax_py.app.cli import EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_OK, app
+from robomax_py.export import krl
 from robomax_py.io.cell import load_cell
 
 REPO = Path(__file__).resolve().parents[2]
@@ -51,7 +52,7 @@ def test_a_door_opening_late_is_waited_for_and_the_continuation_verifies(tmp_pat
     assert report["ok"] and report["verify"]["clean"], report
     name = report["name"]
     assert name == "tending_from_36"
-    assert {Path(p).name for p in report["written"]} >= {f"{name}.json", f"{name}.srcl", f"{name}.src"}
+    assert {Path(p).name for p in report["written"]} >= {f"{name}.json", f"{name}.srcl", f"{krl.program_name(name)}.src"}
     # The door closed at T now opens `late` s later, in the program's clock.
     w0, w1 = next(w for w in _door_windows("cnc1_door") if w[0] <= T_AT <= w[1])
     opens = w1 + late
@@ -70,7 +71,7 @@ def test_a_door_opening_late_is_waited_for_and_the_continuation_verifies(tmp_pat
     assert report["verify"]["cell"] == str(cell_file)
     machine = next(m for m in yaml.safe_load(cell_file.read_text())["tending"]["machines"] if m["name"] == "cnc1")
     assert "schedule" not in machine and [w0, opens] in machine["windows"]
-    verified = runner.invoke(app, ["verify", str(cell_file), str(out / f"{name}.src")])
+    verified = runner.invoke(app, ["verify", str(cell_file), str(out / f"{krl.program_name(name)}.src")])
     assert verified.exit_code == EXIT_OK, verified.output
 
 
