@@ -93,6 +93,21 @@ def _sphere_tables(F: Any, I: Any) -> Any:
 
 
 @njit(cache=True, nogil=True)
+def _box_tables(F: Any, I: Any) -> Any:
+    """The tables the box and chunk tests read (`_uncleared`, `_near`'s deep test): per piece its
+    oriented box (centre, rotation, half extents), per chunk of an obstacle's mesh its sphere
+    (centre, radius) and box; per piece its first and end chunk, per chunk the chunk after its
+    subtree."""
+    G, C = I[1], I[5]
+    fo, io = _offsets(I)
+    return (F[fo[11]:fo[11] + 3 * G].reshape((G, 3)), F[fo[12]:fo[12] + 9 * G].reshape((G, 3, 3)),
+            F[fo[13]:fo[13] + 3 * G].reshape((G, 3)), F[fo[14]:fo[14] + 3 * C].reshape((C, 3)),
+            F[fo[15]:fo[15] + C], F[fo[16]:fo[16] + 3 * C].reshape((C, 3)),
+            F[fo[17]:fo[17] + 9 * C].reshape((C, 3, 3)), F[fo[18]:fo[18] + 3 * C].reshape((C, 3)),
+            I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C])
+
+
+@njit(cache=True, nogil=True)
 def _placements(q: Any, F: Any, I: Any) -> Any:
     J = I[0]
     parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
@@ -107,20 +122,11 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any, rows: Any) -> 
     """For each configuration i of qs, the pairs active in row rows[i] of `active` (r, P) it does
     not clear, in pair order; blocks whose entry in row rows[i] of `blocks` (r, NB) is False are
     known cleared (`_near`) and skipped."""
-    J, G, P, NG, NB, C = I[0], I[1], I[2], I[3], I[4], I[5]
-    fo, io = _offsets(I)
+    J, G, P, NG, NB = I[0], I[1], I[2], I[3], I[4]
     parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
     (centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin, piece_joint, pair_a, pair_b, pair_obstacle,
      group_joint, b_kind, b_a, b_b, b_end, b_pairs) = _sphere_tables(F, I)
-    obb_c = F[fo[11]:fo[11] + 3 * G].reshape((G, 3))
-    obb_r = F[fo[12]:fo[12] + 9 * G].reshape((G, 3, 3))
-    obb_h = F[fo[13]:fo[13] + 3 * G].reshape((G, 3))
-    ch_c = F[fo[14]:fo[14] + 3 * C].reshape((C, 3))
-    ch_rad = F[fo[15]:fo[15] + C]
-    ch_bc = F[fo[16]:fo[16] + 3 * C].reshape((C, 3))
-    ch_br = F[fo[17]:fo[17] + 9 * C].reshape((C, 3, 3))
-    ch_h = F[fo[18]:fo[18] + 3 * C].reshape((C, 3))
-    ch_start, ch_end, ch_skip = I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C]
+    obb_c, obb_r, obb_h, ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip = _box_tables(F, I)
 
     n_cfg = qs.shape[0]
     rot = np.empty((J, 3, 3))
@@ -239,8 +245,7 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
     not clear it (it then goes to coal's exact test, which finds it free). Also returned: reach (P,),
     for each pair left when deep, how much its distance can shrink from the box's centre
     (`_pair_reach`; inf otherwise)."""
-    J, G, NG, NB, C = I[0], I[1], I[3], I[4], I[5]
-    fo, io = _offsets(I)
+    J, G, NG, NB = I[0], I[1], I[3], I[4]
     parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
     (centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin, piece_joint, pair_a, pair_b, pair_obstacle,
      group_joint, b_kind, b_a, b_b, b_end, b_pairs) = _sphere_tables(F, I)
@@ -272,15 +277,7 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
         g_grow[g] = _growth(g_centre, g, group_joint[g], lo, hi, parent, jtrans, jq, 0.0, np.int64(0))
     world = np.empty((G, 3))
     grow = np.full(G, -1.0)                   # not yet computed
-    obb_c = F[fo[11]:fo[11] + 3 * G].reshape((G, 3))
-    obb_r = F[fo[12]:fo[12] + 9 * G].reshape((G, 3, 3))
-    obb_h = F[fo[13]:fo[13] + 3 * G].reshape((G, 3))
-    ch_c = F[fo[14]:fo[14] + 3 * C].reshape((C, 3))
-    ch_rad = F[fo[15]:fo[15] + C]
-    ch_bc = F[fo[16]:fo[16] + 3 * C].reshape((C, 3))
-    ch_br = F[fo[17]:fo[17] + 9 * C].reshape((C, 3, 3))
-    ch_h = F[fo[18]:fo[18] + 3 * C].reshape((C, 3))
-    ch_start, ch_end, ch_skip = I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C]
+    obb_c, obb_r, obb_h, ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip = _box_tables(F, I)
     box_c = np.empty((G, 3))
     box_r = np.empty((G, 3, 3))
     spread = np.full(G, -1.0)                 # how far any point of the piece can move; not yet computed
