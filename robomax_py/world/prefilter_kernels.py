@@ -280,6 +280,7 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
     obb_c, obb_r, obb_h, ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip = _box_tables(F, I)
     box_c = np.empty((G, 3))
     box_r = np.empty((G, 3, 3))
+    boxed = np.zeros(G, dtype=np.bool_)       # the piece's box placed at the centre
     spread = np.full(G, -1.0)                 # how far any point of the piece can move; not yet computed
     scratch = np.empty((7, 3))
     begin = 0
@@ -306,8 +307,12 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
             if pair_obstacle[k]:
                 live[k] = not _sphere_box(world, a, radius[a] + margin[k] + grow[a], box_lo, box_hi, b)
                 if live[k] and deep and ch_start[b] >= 0:
-                    if spread[a] < 0.0:
+                    # The box and the spread are kept apart: `_pair_reach` may have computed the
+                    # spread (for an obstacle without chunks) without placing the box.
+                    if not boxed[a]:
                         _place_box(rot, trans, piece_joint[a], obb_c, obb_r, a, box_c, box_r)
+                        boxed[a] = True
+                    if spread[a] < 0.0:
                         spread[a] = _growth(centre, a, piece_joint[a], lo, hi, parent, jtrans, jq, radius[a], np.int64(0))
                     live[k] = False
                     c = ch_start[b]
@@ -328,8 +333,10 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
                 live[k] = not _sphere_point(world, a, world, b, radius[a] + radius[b] + margin[k] + grow[a] + grow[b])
                 if live[k] and deep:
                     for g in (a, b):
-                        if spread[g] < 0.0:
+                        if not boxed[g]:
                             _place_box(rot, trans, piece_joint[g], obb_c, obb_r, g, box_c, box_r)
+                            boxed[g] = True
+                        if spread[g] < 0.0:
                             spread[g] = _growth(centre, g, piece_joint[g], lo, hi, parent, jtrans, jq, radius[g], np.int64(0))
                     live[k] = not _boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b,
                                                margin[k] + spread[a] + spread[b], scratch)
