@@ -19,7 +19,7 @@ _FIRST_CHUNK = 8     # states the first pre-filter call of a scan covers (blocke
 _NEAR_STATES = 8
 # A near scan finds the pairs to leave out per run of this many neighbouring states (by their place
 # along the path, not the scan order): a short run moves the robot little, so its grown bounds clear
-# nearly what each state's own test clears, and with the finer tests (`Prefilter.near(deep=True)`)
+# nearly what each state's own test clears, and with the finer tests (`Prefilter.near_reach`)
 # the pieces close to a meshed obstacle too, which each state's test could clear only chunk by chunk.
 _NEAR_RUN = 16
 # A pair left by a run's pre-filter whose coal distance at the run's centre exceeds its margin by

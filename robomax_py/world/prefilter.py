@@ -170,22 +170,22 @@ class Prefilter:
                                    np.ascontiguousarray(blocks), np.ascontiguousarray(rows, dtype=np.int64))
         return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), pairs
 
-    def near(self, qs: FloatArray, active: BoolArray, deep: bool = False) -> tuple[BoolArray, BoolArray]:
+    def near(self, qs: FloatArray, active: BoolArray) -> tuple[BoolArray, BoolArray]:
         """(blocks (b,) bool, pairs (p,) bool): the blocks, and the pairs of `active`, that a
         configuration in the joint-space box spanned by qs (k, n) may not clear; the others are
         cleared at every configuration of the box, so `uncleared(q, pairs, blocks)` of any q in it
-        gives what `uncleared(q, active)` gives (`prefilter_kernels._near`). deep: also the finer
-        tests (chunks, oriented boxes) at the box's centre, grown by the box's motion: fewer pairs,
-        each left out provably free at every configuration of the box, though `uncleared` of one
-        might have left it to coal (so the same verdicts, perhaps from fewer exact tests)."""
-        blocks, pairs, _ = _near(_read_only(qs), self.floats, self.ints, active, deep)
+        gives what `uncleared(q, active)` gives (`prefilter_kernels._near`)."""
+        blocks, pairs, _ = _near(_read_only(qs), self.floats, self.ints, active, False)
         return blocks, pairs
 
     def near_reach(self, qs: FloatArray, active: BoolArray) -> tuple[BoolArray, BoolArray, FloatArray]:
-        """`near(qs, active, deep=True)` and, for each pair left, how much its distance can shrink
-        between the centre of qs's box ((min + max) / 2 per joint) and any configuration of the box
-        (m; inf for the others): a pair farther apart at the centre than its margin plus its reach
-        is farther apart than its margin at every configuration of the box."""
+        """`near(qs, active)` with the finer tests (chunks, oriented boxes) at the box's centre too,
+        grown by the box's motion: fewer pairs, each left out provably free at every configuration of
+        the box, though `uncleared` of one might have left it to coal (so the same verdicts, perhaps
+        from fewer exact tests). Also, for each pair left, how much its distance can shrink between
+        the centre of qs's box ((min + max) / 2 per joint) and any configuration of the box (m; inf
+        for the others): a pair farther apart at the centre than its margin plus its reach is farther
+        apart than its margin at every configuration of the box."""
         blocks, pairs, reach = _near(_read_only(qs), self.floats, self.ints, active, True)
         return blocks, pairs, reach
 
