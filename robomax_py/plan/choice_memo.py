@@ -23,7 +23,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomax_py._typing import FloatArray, IntArray
-from robomax_py.plan.sequence import HOME, EdgeCosts, choice_for_order
+from robomax_py.plan.sequence import (
+    HOME,
+    EdgeCosts,
+    choice_for_order,
+    dp_choice,
+    dp_layer,
+)
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -72,10 +78,7 @@ class ChoiceMemo:
             if value is None:
                 value = matrix[0] + self._node[spot]
             else:
-                # `best_choice`'s arithmetic, step for step.
-                total = value[:, None] + matrix
-                arg = np.argmin(total, axis=0)
-                value = total[arg, np.arange(total.shape[1])] + self._node[spot]
+                value, arg = dp_layer(value, matrix, self._node[spot])     # `best_choice`'s step
             self.layers_computed += 1
             assert value is not None
             layers.append(_Layer(prev, spot, weakref.ref(matrix), value, arg))
@@ -83,11 +86,9 @@ class ChoiceMemo:
         self._layers = layers
         assert value is not None
         final = value + np.asarray(self._edge(order[-1], HOME), dtype=float)[:, 0]
-        last = int(np.argmin(final))
-        best = float(final[last])
-        choice = [last]
-        for layer in reversed(layers[1:]):
-            assert layer.arg is not None
-            choice.append(int(layer.arg[choice[-1]]))
-        return tuple(reversed(choice)), best
+        back: list[IntArray] = []
+        for layer in layers[1:]:
+            assert layer.arg is not None         # every layer after the first comes from one
+            back.append(layer.arg)
+        return dp_choice(final, back)
 

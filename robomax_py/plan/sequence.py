@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from robomax_py._typing import FloatArray
+from robomax_py._typing import FloatArray, IntArray
 from robomax_py.plan.sequence_moves import (
     OR_OPT_WINDOW,
     Blocks,
@@ -32,8 +32,8 @@ from robomax_py.plan.sequence_moves import (
 
 __all__ = [
     "EXACT_ORDERS", "HOME", "KEPT_NEIGHBOURHOODS", "MAX_STALE_KICKS", "OR_OPT_WINDOW", "Blocks", "EdgeCosts",
-    "SeamBlock", "SearchStats", "Tour", "admissible_orders", "best_choice", "choice_for_order", "exact_tour",
-    "optimise", "order_count",
+    "SeamBlock", "SearchStats", "Tour", "admissible_orders", "best_choice", "choice_for_order", "dp_choice",
+    "dp_layer", "exact_tour", "optimise", "order_count",
 ]
 
 HOME = -1  # the start/end configuration, a layer of one node
@@ -142,19 +142,31 @@ def best_choice(order: Sequence[int], costs: _Costs) -> tuple[tuple[int, ...], f
     if not order:
         return (), float(costs(HOME, HOME)[0, 0])
     value = costs(HOME, order[0])[0] + costs.node[order[0]]
-    back: list[np.ndarray] = []
+    back: list[IntArray] = []
     for prev, nxt in itertools.pairwise(order):
-        total = value[:, None] + costs(prev, nxt)           # (N_prev, N_next)
-        arg = np.argmin(total, axis=0)
-        value = total[arg, np.arange(total.shape[1])] + costs.node[nxt]
+        value, arg = dp_layer(value, costs(prev, nxt), costs.node[nxt])
         back.append(arg)
-    final = value + costs(order[-1], HOME)[:, 0]
+    return dp_choice(value + costs(order[-1], HOME)[:, 0], back)
+
+
+def dp_layer(value: FloatArray, matrix: FloatArray, node: FloatArray) -> tuple[FloatArray, IntArray]:
+    """One layer of `best_choice`'s DP: the best cost ending at each candidate of the next spot
+    (value (N_prev,) of the last layer, matrix (N_prev, N_next) of the move, node (N_next,)) and, for
+    each, the candidate of the last spot it comes from (the lowest index among equals)."""
+    total = value[:, None] + matrix
+    arg = np.argmin(total, axis=0)
+    out: FloatArray = total[arg, np.arange(total.shape[1])] + node
+    return out, arg
+
+
+def dp_choice(final: FloatArray, back: Sequence[IntArray]) -> tuple[tuple[int, ...], float]:
+    """The choice and cost of `best_choice`'s DP from the costs of the tour ending at each candidate
+    of the last spot (home included) and each layer's `dp_layer` argmins after the first."""
     last = int(np.argmin(final))
-    best = float(final[last])
     choice = [last]
     for arg in reversed(back):
         choice.append(int(arg[choice[-1]]))
-    return tuple(reversed(choice)), best
+    return tuple(reversed(choice)), float(final[last])
 
 
 class _PrefixCost:
