@@ -14,6 +14,7 @@ never ran.
 
 from __future__ import annotations
 
+import gc
 import signal
 import sys
 from collections.abc import Callable, Iterable
@@ -208,6 +209,12 @@ def main(restore_mask: Iterable[int] | None = None) -> None:
         if _Received.signum == signal.SIGTERM and exc.code == 128 + signal.SIGTERM:
             err.print("terminated")
         raise
+    finally:
+        # The process ends here: the interpreter's last collection would walk every object the
+        # command and its ~2000 imported modules made (~0.3 s of CPU after a plan) only to free
+        # memory the exit returns anyway. Frozen objects are left out of it; exit handlers, open
+        # files and the streams are closed as before.
+        gc.freeze()
 
 
 if __name__ == "__main__":
