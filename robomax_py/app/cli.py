@@ -40,6 +40,7 @@ from robomax_py.app.commands.base import (
     _command,
     _guarded,
     _print_json,
+    _Process,
     _Received,
     _warn,
     app,
@@ -190,6 +191,7 @@ def main(restore_mask: Iterable[int] | None = None) -> None:
     if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:            # not when started ignoring it (nohup, &)
         signal.signal(signal.SIGINT, _on_signal)
     sys.unraisablehook = _unraisable(sys.unraisablehook)
+    _Process.own = True
     try:
         if restore_mask is not None:
             signal.pthread_sigmask(signal.SIG_SETMASK, restore_mask)     # a held signal is delivered here

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import gc
 import signal
 from collections.abc import Callable
 from pathlib import Path
@@ -194,6 +195,22 @@ class _Received:
     Process state by nature: a signal handler has nowhere else to leave it."""
 
     signum: int | None = None
+
+
+class _Process:
+    """Whether this process is the command's own (started by `cli.main`, which ends it), rather
+    than a caller's that runs the app in-process (tests, scripts). Process state by nature."""
+
+    own: bool = False
+
+
+def _imports_done() -> None:
+    """After a command's heavy imports, in a process of its own: everything those imports made
+    lives to the exit, and every full collection of the run would walk it again (~0.15 s of CPU in
+    a plan); frozen, the collections see only what the command makes. Not in a caller's process,
+    where objects alive now may later become garbage that frozen would never be freed."""
+    if _Process.own:
+        gc.freeze()
 
 
 def _honour_signals() -> None:

@@ -15,6 +15,7 @@ from robomax_py.app.commands.base import (
     _command,
     _guarded,
     _honour_signals,
+    _imports_done,
     _method,
     _num,
     _print_json,
@@ -66,6 +67,7 @@ def plan(
                 plan_cell,
             )
             from robomax_py.publish import publish
+        _imports_done()
         _honour_signals()
 
         configure_logging(err, verbose)
