@@ -204,6 +204,13 @@ class _Process:
     own: bool = False
 
 
+# Allocations between two collections of the youngest generation in a command's own process
+# (Python's default: 700). The planner makes and drops arrays and small objects by the hundred
+# thousand, few of them in cycles; a tenth as many collections halve their cost (~0.06 s of CPU in
+# a plan) and leave at most a few thousand objects' garbage waiting a little longer.
+YOUNG_COLLECTION_THRESHOLD = 7000
+
+
 def _imports_done() -> None:
     """After a command's heavy imports, in a process of its own: everything those imports made
     lives to the exit, and every full collection of the run would walk it again (~0.15 s of CPU in
@@ -211,6 +218,7 @@ def _imports_done() -> None:
     where objects alive now may later become garbage that frozen would never be freed."""
     if _Process.own:
         gc.freeze()
+        gc.set_threshold(YOUNG_COLLECTION_THRESHOLD, *gc.get_threshold()[1:])
 
 
 def _honour_signals() -> None:
