@@ -13,6 +13,7 @@ computation raises as it did, every time. An unwritable cache only costs computi
 from __future__ import annotations
 
 import hashlib
+import stat
 import zipfile
 from collections.abc import Callable
 from functools import lru_cache
@@ -22,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from robomax_py.cache_files import cache_folder, store_arrays
+from robomax_py.safe_files import LIMITS
 
 # Raised when what is stored, or how, changes.
 FORMAT = 1
@@ -39,14 +41,29 @@ def _library_versions() -> str:
 
 
 def mesh_digest(path: Path, params: tuple[object, ...]) -> str | None:
-    """sha256 of the mesh file's bytes, `params` (by repr), the libraries' versions and `FORMAT`;
-    None when the file cannot be read (the caller's computation then reports it)."""
+    """sha256 of the mesh file's content digest, `params` (by repr), the libraries' versions and
+    `FORMAT`; None when the file is not a regular file within `LIMITS.mesh` or cannot be read (the
+    caller's computation then reports it as before)."""
     try:
-        data = Path(path).read_bytes()
+        info = Path(path).stat()
     except OSError:
         return None
-    tail = f"|{params!r}|{_library_versions()}|{FORMAT}".encode()
-    return hashlib.sha256(data + tail).hexdigest()
+    if not stat.S_ISREG(info.st_mode) or info.st_size > LIMITS.mesh:
+        return None
+    content = _content_digest(str(Path(path).resolve()), info.st_size, info.st_mtime_ns, info.st_ino)
+    if content is None:
+        return None
+    return hashlib.sha256(f"{content}|{params!r}|{_library_versions()}|{FORMAT}".encode()).hexdigest()
+
+
+@lru_cache(maxsize=64)
+def _content_digest(path: str, size: int, mtime_ns: int, inode: int) -> str | None:
+    """sha256 of a file's bytes, once per process while its size, modification time and inode
+    are the same (a run asks for several things of one mesh)."""
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError:
+        return None
 
 
 def kept_arrays(kind: str, path: Path, params: tuple[object, ...],
