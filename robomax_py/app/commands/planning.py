@@ -14,8 +14,8 @@ from robomax_py.app.commands.base import (
     JsonFlag,
     _command,
     _guarded,
+    _heavy_imports,
     _honour_signals,
-    _imports_done,
     _method,
     _num,
     _print_json,
@@ -54,7 +54,7 @@ def plan(
         # SIGINT and SIGTERM held while the heavy modules are imported (a few seconds at most): an
         # import that catches BaseException would swallow the interrupt and leave half-imported
         # modules behind. A signal that arrived meanwhile is delivered when the imports are done.
-        with signals_held():
+        with signals_held(), _heavy_imports():
             from robomax_py.app.progress import configure_logging, stage_bars
             from robomax_py.app.report import plan_report, report_tables
             from robomax_py.export import SHARED_FILES, choose_formats
@@ -67,7 +67,6 @@ def plan(
                 plan_cell,
             )
             from robomax_py.publish import publish
-        _imports_done()
         _honour_signals()
 
         configure_logging(err, verbose)
