@@ -36,6 +36,7 @@ def _check_mesh_readable(shape: Path | MeshShape, error: CellFileError | RobotMo
         raise type(error)(error.file, error.key, f"mesh {mesh} brings the cell's meshes and its tool's to "
                                                  f"{total + declared:,} triangles{more}, more than the "
                                                  f"{CELL_LIMITS.cell_triangles:,} a cell may have (cell_triangles)")
+
     def count() -> dict[str, np.ndarray]:
         loaded = mesh_shape_trimesh(shape) if isinstance(shape, MeshShape) else load_mesh(mesh)
         return {"triangles": np.array([len(loaded.faces)], dtype=np.int64)}
