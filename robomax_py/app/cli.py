@@ -14,6 +14,7 @@ never ran.
 
 from __future__ import annotations
 
+import gc
 import signal
 import sys
 from collections.abc import Callable, Iterable
@@ -39,6 +40,7 @@ from robomax_py.app.commands.base import (
     _command,
     _guarded,
     _print_json,
+    _Process,
     _Received,
     _warn,
     app,
@@ -189,6 +191,7 @@ def main(restore_mask: Iterable[int] | None = None) -> None:
     if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:            # not when started ignoring it (nohup, &)
         signal.signal(signal.SIGINT, _on_signal)
     sys.unraisablehook = _unraisable(sys.unraisablehook)
+    _Process.own = True
     try:
         if restore_mask is not None:
             signal.pthread_sigmask(signal.SIG_SETMASK, restore_mask)     # a held signal is delivered here
@@ -208,6 +211,12 @@ def main(restore_mask: Iterable[int] | None = None) -> None:
         if _Received.signum == signal.SIGTERM and exc.code == 128 + signal.SIGTERM:
             err.print("terminated")
         raise
+    finally:
+        # The process ends here: the interpreter's last collection would walk every object the
+        # command and its ~2000 imported modules made (~0.3 s of CPU after a plan) only to free
+        # memory the exit returns anyway. Frozen objects are left out of it; exit handlers, open
+        # files and the streams are closed as before.
+        gc.freeze()
 
 
 if __name__ == "__main__":

@@ -12,14 +12,17 @@ cover every contact.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import coal
 import numpy as np
-import trimesh
 
 from robomax_py._typing import FloatArray
 from robomax_py.world.bounds import support_points, triangles
 from robomax_py.world.scene import Scene
+
+if TYPE_CHECKING:       # imported where points are sampled: a plan that samples none never imports it
+    import trimesh
 
 
 def cover_radius(spacing: float) -> float:
@@ -29,6 +32,8 @@ def cover_radius(spacing: float) -> float:
 
 def surface_points(scene: Scene, spacing: float) -> FloatArray:
     """(P, 3) points on every obstacle surface (static and dynamic), robot base frame, metres."""
+    import trimesh
+
     if not spacing > 0:
         raise ValueError(f"spacing must be > 0 m, got {spacing}")
     out = []
@@ -48,6 +53,8 @@ def surface_points(scene: Scene, spacing: float) -> FloatArray:
 
 
 def _piece_mesh(geom: coal.CollisionGeometry) -> trimesh.Trimesh | None:
+    import trimesh
+
     if isinstance(geom, coal.BVHModelBase):
         return trimesh.Trimesh(support_points(geom), triangles(geom), process=False)
     pts = support_points(geom)

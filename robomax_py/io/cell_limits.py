@@ -8,10 +8,13 @@ import stat
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.io.cell_file import CellFile
 from robomax_py.io.cell_file_values import CELL_LIMITS, SAME_ORIENTATION_RAD
 from robomax_py.robot.geometry import load_mesh, mesh_shape_trimesh
+from robomax_py.robot.mesh_cache import kept_arrays
 from robomax_py.safe_files import LIMITS
 from robomax_py.spec import MeshShape
 from robomax_py.units import deg_to_rad
@@ -33,8 +36,15 @@ def _check_mesh_readable(shape: Path | MeshShape, error: CellFileError | RobotMo
         raise type(error)(error.file, error.key, f"mesh {mesh} brings the cell's meshes and its tool's to "
                                                  f"{total + declared:,} triangles{more}, more than the "
                                                  f"{CELL_LIMITS.cell_triangles:,} a cell may have (cell_triangles)")
+
+    def count() -> dict[str, np.ndarray]:
+        loaded = mesh_shape_trimesh(shape) if isinstance(shape, MeshShape) else load_mesh(mesh)
+        return {"triangles": np.array([len(loaded.faces)], dtype=np.int64)}
+
+    params = ("triangles", shape.scale, shape.tolerance) if isinstance(shape, MeshShape) else ("triangles",)
     try:
-        n = len((mesh_shape_trimesh(shape) if isinstance(shape, MeshShape) else load_mesh(mesh)).faces)
+        # The count read back from the cache when an earlier run read the same file.
+        n = int(kept_arrays("triangles", mesh, params, count)["triangles"][0])
     except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
         raise type(error)(error.file, error.key, f"{error.problem}: {exc}") from None
     if n > limit:

@@ -13,6 +13,7 @@ notices into `CellWarning`s of Python's `warnings` module.
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -198,7 +199,7 @@ def _tool_sizes(cell: CellSpec, meshes: dict[MeshShape, Any]) -> list[Notice]:
     large: list[tuple[str, str]] = []
     small: list[tuple[str, str]] = []
     for key, shape in (("body", cell.tool.body), ("tips", cell.tool.tips)):
-        size = float(np.max(_mesh(shape, meshes).extents))
+        size = float(np.max(_mesh_extents(shape, meshes)))
         if TOOL_TINY_M <= size <= TOOL_MM_M:
             continue
         if is_step(shape.path):
@@ -331,7 +332,18 @@ def _extents(obj: ObjectSpec, meshes: dict[MeshShape, Any]) -> np.ndarray:
         return np.array([2 * s.radius, 2 * s.radius, s.length])
     if isinstance(s, Capsule):
         return np.array([2 * s.radius, 2 * s.radius, s.length + 2 * s.radius])
-    return np.asarray(_mesh(s, meshes).extents, dtype=float)
+    return _mesh_extents(s, meshes)
+
+
+def _mesh_extents(shape: MeshShape, meshes: dict[MeshShape, Any]) -> np.ndarray:
+    """(3,) float, m: the mesh's bounding box size, read back from the cache when an earlier run
+    read the same file."""
+    from robomax_py.robot.mesh_cache import kept_arrays
+
+    def compute() -> dict[str, np.ndarray]:
+        return {"extents": np.asarray(_mesh(shape, meshes).extents, dtype=float)}
+
+    return kept_arrays("extents", shape.path, ("extents", shape.scale, shape.tolerance), compute)["extents"]
 
 
 def _signed_distance(obj: ObjectSpec, points: np.ndarray, meshes: dict[MeshShape, Any]) -> np.ndarray:
@@ -355,14 +367,27 @@ def _signed_distance(obj: ObjectSpec, points: np.ndarray, meshes: dict[MeshShape
         axis = np.zeros_like(local)
         axis[:, 2] = np.clip(local[:, 2], -s.length / 2, s.length / 2)
         return np.asarray(np.linalg.norm(local - axis, axis=1) - s.radius)
-    import trimesh
+    return _mesh_signed_distance(s, np.ascontiguousarray(local, dtype=float), meshes)
 
-    mesh = _mesh(s, meshes)
-    _, distance, _ = trimesh.proximity.closest_point(mesh, local)  # type: ignore[no-untyped-call]
-    distance = np.asarray(distance, dtype=float)
-    if mesh.is_watertight:
-        distance = np.where(mesh.contains(local), -distance, distance)
-    return distance
+
+def _mesh_signed_distance(shape: MeshShape, local: np.ndarray, meshes: dict[MeshShape, Any]) -> np.ndarray:
+    """`_signed_distance` of points (n, 3) in the mesh's frame, read back from the cache when an
+    earlier run computed it for the same file and points."""
+    from robomax_py.robot.mesh_cache import kept_arrays
+
+    def compute() -> dict[str, np.ndarray]:
+        import trimesh
+
+        mesh = _mesh(shape, meshes)
+        _, distance, _ = trimesh.proximity.closest_point(mesh, local)  # type: ignore[no-untyped-call]
+        distance = np.asarray(distance, dtype=float)
+        if mesh.is_watertight:
+            distance = np.where(mesh.contains(local), -distance, distance)
+        return {"distance": distance}
+
+    points = hashlib.sha256(local.tobytes() + repr(local.shape).encode()).hexdigest()
+    return kept_arrays("distance", shape.path, ("signed distance", shape.scale, shape.tolerance, points),
+                       compute)["distance"]
 
 
 def _fmt(values: Sequence[float]) -> str:

@@ -29,11 +29,14 @@ import tempfile
 import zipfile
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import trimesh
 
 from robomax_py.cache_files import cache_folder, store_arrays
+
+if TYPE_CHECKING:                       # imported where a STEP is read (see geometry)
+    import trimesh
 
 STEP_SUFFIXES = (".step", ".stp")
 
@@ -84,6 +87,8 @@ def load_step(path: Path, tolerance_mm: float | None = None) -> trimesh.Trimesh:
 
     Raises CadExtraMissing without cascadio; ValueError when the file holds no surface.
     """
+    import trimesh
+
     tol = DEFAULT_TOLERANCE_MM if tolerance_mm is None else float(tolerance_mm)
     try:
         import cascadio

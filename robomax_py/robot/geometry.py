@@ -9,14 +9,19 @@ otherwise it stays an exact BVH, so a shortcut never changes a collision answer.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import coal
 import numpy as np
-import trimesh
 
 from robomax_py.robot.cad import is_step, load_step
 from robomax_py.spec import Box, Capsule, Cylinder, MeshShape, Shape, Sphere
 from robomax_py.tolerances import DEFAULT as TOL
+
+# trimesh is imported where a mesh is read or built: a run that finds what it needs of its meshes
+# in the cache (`mesh_cache`) never imports it.
+if TYPE_CHECKING:
+    import trimesh
 
 # Relative volume difference below which a closed piece counts as convex (mesh tessellation noise).
 CONVEX_VOLUME_RTOL = TOL.convex_volume_rtol
@@ -30,6 +35,8 @@ def load_mesh(path: Path, scale: np.ndarray | None = None, tolerance: float | No
     A vertex that is not finite is an error: trimesh's processing would drop it and the faces using
     it without a word, and the collision geometry would have holes.
     """
+    import trimesh
+
     loaded = (load_step(path, None if tolerance is None else tolerance * 1000.0) if is_step(path)
               else trimesh.load(str(path), force="mesh", process=False))
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
@@ -46,19 +53,36 @@ def load_mesh(path: Path, scale: np.ndarray | None = None, tolerance: float | No
 
 def convex_hull_shape(vertices: np.ndarray) -> coal.ConvexBase:
     """coal convex polytope of the hull of a point set (m)."""
+    return hull_shape(hull_vertices(vertices))
+
+
+def hull_vertices(vertices: np.ndarray) -> np.ndarray:
+    """(k, 3) float, m: the vertices of the convex hull of a point set (trimesh's, in its order)."""
+    import trimesh
+
     hull = trimesh.convex.convex_hull(np.asarray(vertices, dtype=float))
+    return np.asarray(hull.vertices, dtype=float)
+
+
+def hull_shape(hull: np.ndarray) -> coal.ConvexBase:
+    """coal convex polytope of the hull vertices `hull_vertices` gave (m)."""
     points = coal.StdVec_Vec3s()
-    for p in np.asarray(hull.vertices, dtype=float):
+    for p in np.asarray(hull, dtype=float):
         points.append(p)
     return coal.Convex.convexHull(points, False, None)
 
 
 def bvh_shape(mesh: trimesh.Trimesh) -> coal.BVHModelOBBRSS:
     """Exact triangle-soup collision model of a mesh."""
+    return bvh_of(np.asarray(mesh.vertices), np.asarray(mesh.faces))
+
+
+def bvh_of(vertices: np.ndarray, faces: np.ndarray) -> coal.BVHModelOBBRSS:
+    """Exact triangle-soup collision model of vertices (n, 3) m and faces (k, 3) int."""
     bvh = coal.BVHModelOBBRSS()
-    bvh.beginModel(len(mesh.faces), len(mesh.vertices))
-    bvh.addVertices(np.ascontiguousarray(mesh.vertices, dtype=float))
-    bvh.addTriangles(np.ascontiguousarray(mesh.faces, dtype=np.int64))
+    bvh.beginModel(len(faces), len(vertices))
+    bvh.addVertices(np.ascontiguousarray(vertices, dtype=float))
+    bvh.addTriangles(np.ascontiguousarray(faces, dtype=np.int64))
     bvh.endModel()
     return bvh
 
@@ -72,10 +96,24 @@ def is_convex_piece(piece: trimesh.Trimesh) -> bool:
 
 def mesh_collision_shapes(mesh: trimesh.Trimesh) -> list[coal.CollisionGeometry]:
     """Convex pieces when the mesh is a set of closed convex shells, else one exact BVH."""
+    return collision_shapes_of(collision_piece_arrays(mesh))
+
+
+def collision_piece_arrays(mesh: trimesh.Trimesh) -> dict[str, np.ndarray]:
+    """`mesh_collision_shapes`' choice as arrays, to keep: the hull vertices of each convex piece
+    (hull_0, hull_1, ...) when the mesh is a set of closed convex shells, else the mesh's vertices
+    and faces for one exact BVH."""
     pieces = mesh.split(only_watertight=False)
     if len(pieces) > 0 and all(is_convex_piece(p) for p in pieces):
-        return [convex_hull_shape(p.vertices) for p in pieces]
-    return [bvh_shape(mesh)]
+        return {f"hull_{i}": hull_vertices(p.vertices) for i, p in enumerate(pieces)}
+    return {"vertices": np.asarray(mesh.vertices, dtype=float), "faces": np.asarray(mesh.faces, dtype=np.int64)}
+
+
+def collision_shapes_of(arrays: dict[str, np.ndarray]) -> list[coal.CollisionGeometry]:
+    """The coal shapes of `collision_piece_arrays`' arrays."""
+    if "faces" in arrays:
+        return [bvh_of(arrays["vertices"], arrays["faces"])]
+    return [hull_shape(arrays[f"hull_{i}"]) for i in range(len(arrays))]
 
 
 def primitive_shape(shape: Shape) -> coal.CollisionGeometry:
@@ -99,6 +137,8 @@ def mesh_shape_trimesh(shape: MeshShape) -> trimesh.Trimesh:
 
 def shape_trimesh(shape: Shape) -> trimesh.Trimesh:
     """A triangle mesh of any shape in its local frame (for previews and exact-answer tests)."""
+    import trimesh
+
     if isinstance(shape, Box):
         made: trimesh.Trimesh = trimesh.creation.box(extents=shape.extents)
         return made

@@ -10,8 +10,9 @@ import numpy as np
 import pinocchio as pin
 
 from robomax_py.errors import RobotModelError
-from robomax_py.robot.geometry import convex_hull_shape, load_mesh
+from robomax_py.robot.geometry import hull_shape, hull_vertices, load_mesh
 from robomax_py.robot.kinematics import _urdf_text, pinocchio_urdf_text
+from robomax_py.robot.mesh_cache import kept_arrays
 from robomax_py.spec import RobotSpec
 
 # Link geometry already built in this process, by (URDF, package folders, kind): with the state
@@ -64,8 +65,14 @@ def _make_meshes_convex(geom_model: pin.GeometryModel, spec: RobotSpec) -> None:
     for obj in geom_model.geometryObjects:
         if not obj.meshPath or obj.meshPath in ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE"):
             continue
+        path, scale = Path(obj.meshPath), np.asarray(obj.meshScale, dtype=float)
+
+        def hull(path: Path = path, scale: np.ndarray = scale) -> dict[str, np.ndarray]:
+            return {"vertices": hull_vertices(load_mesh(path, scale).vertices)}
+
         try:
-            mesh = load_mesh(Path(obj.meshPath), np.asarray(obj.meshScale))
+            # The hull read back from the cache when an earlier run built it from the same file.
+            vertices = kept_arrays("hull", path, ("link hull", tuple(scale.tolist())), hull)["vertices"]
         except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
             raise RobotModelError(spec.urdf, f"link {obj.name}", f"cannot read mesh {obj.meshPath}: {exc}") from None
-        obj.geometry = convex_hull_shape(mesh.vertices)
+        obj.geometry = hull_shape(vertices)

@@ -7,7 +7,7 @@ Built once per cell; read-only afterwards (the coal geometries are shared, never
 How each shape becomes collision geometry
 -----------------------------------------
 - Box, cylinder, sphere, capsule: the exact coal primitive (docs/cell-files.md, "A cell file": centred, axis z).
-- Mesh (obstacle, workpiece or tool): `geometry.mesh_collision_shapes`: when *every* connected piece
+- Mesh (obstacle, workpiece or tool): `geometry.collision_piece_arrays`: when *every* connected piece
   of the mesh is a closed convex shell, one coal convex polytope per piece (exact, and fast GJK);
   otherwise the whole mesh stays one exact triangle BVH (OBBRSS). Sheet-metal parts such as the
   reference `cabin_panel.stl` are open, bent surfaces, so they stay BVH: a convex hull would fill the
@@ -27,17 +27,18 @@ from pathlib import Path
 
 import coal
 import numpy as np
-import trimesh
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.robot import RobotModel
 from robomax_py.robot.geometry import (
-    bvh_shape,
-    mesh_collision_shapes,
+    CONVEX_VOLUME_RTOL,
+    collision_piece_arrays,
+    collision_shapes_of,
     mesh_shape_trimesh,
     primitive_shape,
 )
+from robomax_py.robot.mesh_cache import kept_arrays
 from robomax_py.spec import (
     Box,
     Capsule,
@@ -312,33 +313,42 @@ _MESH_ENTRIES = 32
 def _build_mesh_pieces(
     shape: MeshShape, error: type[CellFileError | RobotModelError], file: Path | None, key: str | None
 ) -> tuple[tuple[coal.CollisionGeometry, ...], str]:
-    path = shape.path
-    try:
-        mesh = mesh_shape_trimesh(shape)
-    except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
-        raise error(file, key, f"cannot read mesh {path}: {exc}") from None
-    pieces = mesh_collision_shapes(mesh)
-    convex = not any(isinstance(p, coal.BVHModelBase) for p in pieces)
-    if not convex and np.any(np.ptp(np.asarray(mesh.vertices, dtype=float), axis=0) <= 0.0):
-        pieces = [_flat_bvh(mesh)]
+    # The pieces' arrays read back from the cache when an earlier run split the same file.
+    params = ("collision pieces", shape.scale, shape.tolerance, CONVEX_VOLUME_RTOL, FLAT_MESH_PAD_M)
+    arrays = kept_arrays("pieces", shape.path, params, lambda: _piece_arrays(shape, error, file, key))
+    convex = "faces" not in arrays
+    pieces = collision_shapes_of(arrays)
     for p in pieces:
         p.computeLocalAABB()
     return tuple(pieces), (REPRESENTATION_CONVEX if convex else REPRESENTATION_BVH)
 
 
-def _flat_bvh(mesh: trimesh.Trimesh) -> coal.BVHModelOBBRSS:
-    """Exact BVH of a perfectly flat mesh plus a stand-off triangle, so its bounding box has volume."""
-    extents = np.ptp(np.asarray(mesh.vertices, dtype=float), axis=0)
+def _piece_arrays(
+    shape: MeshShape, error: type[CellFileError | RobotModelError], file: Path | None, key: str | None
+) -> dict[str, np.ndarray]:
+    """`geometry.collision_piece_arrays` of the mesh, a flat one's BVH with its stand-off triangle."""
+    path = shape.path
+    try:
+        mesh = mesh_shape_trimesh(shape)
+    except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
+        raise error(file, key, f"cannot read mesh {path}: {exc}") from None
+    arrays = collision_piece_arrays(mesh)
+    if "faces" in arrays and np.any(np.ptp(arrays["vertices"], axis=0) <= 0.0):
+        arrays["vertices"], arrays["faces"] = _flat_padded(arrays["vertices"], arrays["faces"])
+    return arrays
+
+
+def _flat_padded(vertices: FloatArray, faces: np.ndarray) -> tuple[FloatArray, np.ndarray]:
+    """A perfectly flat mesh plus a stand-off triangle, so its bounding box has volume."""
+    extents = np.ptp(vertices, axis=0)
     flat = np.flatnonzero(extents <= 0.0)
-    v0 = np.asarray(mesh.vertices[0], dtype=float)
+    v0 = np.asarray(vertices[0], dtype=float)
     pad = np.zeros(3)
     pad[flat] = FLAT_MESH_PAD_M
     other = np.zeros(3)
     other[int(np.argmax(extents))] = FLAT_MESH_PAD_M
-    vertices = np.vstack([mesh.vertices, v0 + pad, v0 + other])
-    n = len(mesh.vertices)
-    faces = np.vstack([mesh.faces, [[0, n, n + 1]]])
-    return bvh_shape(trimesh.Trimesh(vertices=vertices, faces=faces, process=False))
+    n = len(vertices)
+    return np.vstack([vertices, v0 + pad, v0 + other]), np.vstack([faces, [[0, n, n + 1]]])
 
 
 __all__ = [

@@ -25,6 +25,8 @@ def failing_app(monkeypatch: pytest.MonkeyPatch) -> Any:
         monkeypatch.setattr(cli._Received, "signum", None)
         monkeypatch.setattr(signal, "signal", lambda *a: None)            # the test process keeps its handlers
         monkeypatch.setattr(sys, "unraisablehook", sys.unraisablehook)    # main() wraps it; put back after
+        monkeypatch.setattr(cli._Process, "own", False)                  # main() marks the process its own ...
+        monkeypatch.setattr(cli.gc, "freeze", lambda: None)                # ... and freezes it at the end
     return install
 
 

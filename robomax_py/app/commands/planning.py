@@ -14,6 +14,7 @@ from robomax_py.app.commands.base import (
     JsonFlag,
     _command,
     _guarded,
+    _heavy_imports,
     _honour_signals,
     _method,
     _num,
@@ -53,7 +54,7 @@ def plan(
         # SIGINT and SIGTERM held while the heavy modules are imported (a few seconds at most): an
         # import that catches BaseException would swallow the interrupt and leave half-imported
         # modules behind. A signal that arrived meanwhile is delivered when the imports are done.
-        with signals_held():
+        with signals_held(), _heavy_imports():
             from robomax_py.app.progress import configure_logging, stage_bars
             from robomax_py.app.report import plan_report, report_tables
             from robomax_py.export import SHARED_FILES, choose_formats

@@ -8,6 +8,7 @@ from functools import lru_cache
 from lark import Lark
 
 from robomax_py.export.krl.write import _DATA_TYPES
+from robomax_py.export.parsers import lalr_parser
 
 # ================================================================================== reading
 
@@ -73,7 +74,7 @@ _MOTION_FOLD = re.compile(r"^;FOLD\s+(PTP|LIN)\b.*;%\{PE\}.*%P\s+(.*)$", re.IGNO
 
 @lru_cache(maxsize=1)
 def _parser() -> Lark:
-    return Lark(_GRAMMAR, parser="lalr", lexer="contextual")
+    return lalr_parser("krl", _GRAMMAR, lexer="contextual")
 
 
 def _statement(text: str) -> tuple[str, str]:

@@ -8,6 +8,8 @@ from functools import lru_cache
 
 from lark import Lark
 
+from robomax_py.export.parsers import lalr_parser
+
 # ================================================================================== reading
 
 _GRAMMAR = r"""
@@ -64,7 +66,7 @@ _GUN_DATA = re.compile(r"^gun([0-9]+)$", re.IGNORECASE)
 
 @lru_cache(maxsize=1)
 def _parser() -> Lark:
-    return Lark(_GRAMMAR, parser="lalr", lexer="contextual")
+    return lalr_parser("rapid", _GRAMMAR, lexer="contextual")
 
 
 def _statements(text: str) -> list[tuple[int, str, str]]:

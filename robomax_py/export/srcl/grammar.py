@@ -7,6 +7,8 @@ from functools import lru_cache
 
 from lark import Lark
 
+from robomax_py.export.parsers import lalr_parser
+
 # ================================================================================== reading
 
 GRAMMAR = r"""
@@ -66,4 +68,4 @@ _NAMED = {
 
 @lru_cache(maxsize=1)
 def _parser() -> Lark:
-    return Lark(GRAMMAR, parser="lalr", lexer="basic", propagate_positions=True, maybe_placeholders=False)
+    return lalr_parser("srcl", GRAMMAR, lexer="basic", propagate_positions=True, maybe_placeholders=False)

@@ -8,6 +8,7 @@ from functools import lru_cache
 from lark import Lark
 
 from robomax_py.export.dialect import tree_numbers
+from robomax_py.export.parsers import lalr_parser
 
 # ================================================================================== reading
 
@@ -31,7 +32,7 @@ _UNSIMULATED = ("movep", "movec", "servoj", "servoc", "speedj", "speedl", "move_
 
 @lru_cache(maxsize=1)
 def _parser() -> Lark:
-    return Lark(_GRAMMAR, parser="lalr", lexer="contextual")
+    return lalr_parser("urscript", _GRAMMAR, lexer="contextual")
 
 
 def _split(raw: str) -> tuple[str, str]:
