@@ -193,7 +193,7 @@ class Prefilter:
 
     def joint_placements(self, q: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(J, 3, 3) rotations and (J, 3) translations of every joint frame at q (as Pinocchio's oMi)."""
-        return _placements(np.ascontiguousarray(q, dtype=np.float64), self.rows, self.mats, self.ints)  # type: ignore[no-any-return]
+        return _placements(np.ascontiguousarray(q, dtype=np.float64), self.floats, self.rows, self.mats, self.ints)  # type: ignore[no-any-return]
 
 
 def _read_only(qs: FloatArray) -> FloatArray:

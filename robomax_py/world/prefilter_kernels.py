@@ -60,54 +60,36 @@ def _forward(q: Any, parent: Any, kind: Any, axis: Any, jrot: Any, jtrans: Any, 
 
 
 @helper
-def _offsets(I: Any) -> Any:
-    """Where each float and each int table starts in the packed buffers (see `_pack`)."""
+def _tables(F: Any, R: Any, M: Any, I: Any) -> Any:
+    """Every table, as slices of the packed buffers (`prefilter._pack`): F the scalars, R (n, 3) the
+    3-vectors, M (n, 3, 3) the matrices, I the ints. In order: the chain's (`_forward`'s argument
+    order: parent, kind, axis, rotation, translation, q index); the sphere tests' (per piece centre,
+    radius and obstacle box corners, per pair margin, per group centre and radius, per block
+    margin; per piece its joint, per pair its pieces and whether b is an obstacle, per group its
+    joint, per block its kind, groups and end, the pairs in block order); the box and chunk tests'
+    (per piece its oriented box: centre, rotation, half extents; per chunk of an obstacle's mesh its
+    sphere, centre and radius, and box; per piece its first and end chunk, per chunk the chunk after
+    its subtree). One helper, not one per group of tables: each jitted function has a fixed compile
+    cost (about 0.1 s of a first plan for the three it replaces)."""
+    J, G, P, NG, NB, C = I[0], I[1], I[2], I[3], I[4], I[5]
     fo = I[_N_HEADER:_N_HEADER + _N_FLOAT_TABLES]
     io = I[_N_HEADER + _N_FLOAT_TABLES:_N_HEADER + _N_FLOAT_TABLES + _N_INT_TABLES]
-    return fo, io
-
-
-@helper
-def _chain_tables(R: Any, M: Any, I: Any) -> Any:
-    """The chain's tables in `_forward`'s argument order: parent, kind, axis, rotation, translation, q index."""
-    J = I[0]
-    fo, io = _offsets(I)
-    return I[io[0]:io[0] + J], I[io[1]:io[1] + J], R[fo[0]:fo[0] + J], M[fo[1]:fo[1] + J], R[fo[2]:fo[2] + J], \
-        I[io[2]:io[2] + J]
-
-
-@helper
-def _sphere_tables(F: Any, R: Any, I: Any) -> Any:
-    """The tables the sphere tests read (`_uncleared`, `_near`): per piece centre, radius and
-    obstacle box corners, per pair margin, per group centre and radius, per block margin; then per
-    piece its joint, per pair its pieces and whether b is an obstacle, per group its joint, per
-    block its kind, groups and end, and the pairs in block order."""
-    G, P, NG, NB = I[1], I[2], I[3], I[4]
-    fo, io = _offsets(I)
-    return (R[fo[3]:fo[3] + G], F[fo[4]:fo[4] + G], R[fo[5]:fo[5] + G], R[fo[6]:fo[6] + G], F[fo[7]:fo[7] + P],
+    return (I[io[0]:io[0] + J], I[io[1]:io[1] + J], R[fo[0]:fo[0] + J], M[fo[1]:fo[1] + J], R[fo[2]:fo[2] + J],
+            I[io[2]:io[2] + J],
+            R[fo[3]:fo[3] + G], F[fo[4]:fo[4] + G], R[fo[5]:fo[5] + G], R[fo[6]:fo[6] + G], F[fo[7]:fo[7] + P],
             R[fo[8]:fo[8] + NG], F[fo[9]:fo[9] + NG], F[fo[10]:fo[10] + NB],
             I[io[3]:io[3] + G], I[io[4]:io[4] + P], I[io[5]:io[5] + P], I[io[6]:io[6] + P], I[io[7]:io[7] + NG],
             I[io[8]:io[8] + NB], I[io[9]:io[9] + NB], I[io[10]:io[10] + NB], I[io[11]:io[11] + NB],
-            I[io[12]:io[12] + P])
-
-
-@helper
-def _box_tables(F: Any, R: Any, M: Any, I: Any) -> Any:
-    """The tables the box and chunk tests read (`_uncleared`, `_near`'s deep test): per piece its
-    oriented box (centre, rotation, half extents), per chunk of an obstacle's mesh its sphere
-    (centre, radius) and box; per piece its first and end chunk, per chunk the chunk after its
-    subtree."""
-    G, C = I[1], I[5]
-    fo, io = _offsets(I)
-    return (R[fo[11]:fo[11] + G], M[fo[12]:fo[12] + G], R[fo[13]:fo[13] + G], R[fo[14]:fo[14] + C],
+            I[io[12]:io[12] + P],
+            R[fo[11]:fo[11] + G], M[fo[12]:fo[12] + G], R[fo[13]:fo[13] + G], R[fo[14]:fo[14] + C],
             F[fo[15]:fo[15] + C], R[fo[16]:fo[16] + C], M[fo[17]:fo[17] + C], R[fo[18]:fo[18] + C],
             I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C])
 
 
 @njit(cache=True, nogil=True)
-def _placements(q: Any, R: Any, M: Any, I: Any) -> Any:
+def _placements(q: Any, F: Any, R: Any, M: Any, I: Any) -> Any:
     J = I[0]
-    parent, kind, axis, jrot, jtrans, jq = _chain_tables(R, M, I)
+    parent, kind, axis, jrot, jtrans, jq = _tables(F, R, M, I)[:6]
     rot = np.empty((J, 3, 3))
     trans = np.empty((J, 3))
     _forward(q, parent, kind, axis, jrot, jtrans, jq, rot, trans)
@@ -120,10 +102,9 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     not clear, in pair order; blocks whose entry in row rows[i] of `blocks` (r, NB) is False are
     known cleared (`_near`) and skipped."""
     J, G, P, NG, NB = I[0], I[1], I[2], I[3], I[4]
-    parent, kind, axis, jrot, jtrans, jq = _chain_tables(R, M, I)
-    (centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin, piece_joint, pair_a, pair_b, pair_obstacle,
-     group_joint, b_kind, b_a, b_b, b_end, b_pairs) = _sphere_tables(F, R, I)
-    obb_c, obb_r, obb_h, ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip = _box_tables(F, R, M, I)
+    (parent, kind, axis, jrot, jtrans, jq, centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin,
+     piece_joint, pair_a, pair_b, pair_obstacle, group_joint, b_kind, b_a, b_b, b_end, b_pairs, obb_c, obb_r, obb_h,
+     ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip) = _tables(F, R, M, I)
 
     n_cfg = qs.shape[0]
     rot = np.empty((J, 3, 3))
@@ -244,9 +225,9 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
     for each pair left when deep, how much its distance can shrink from the box's centre
     (`_pair_reach`; inf otherwise)."""
     J, G, NG, NB = I[0], I[1], I[3], I[4]
-    parent, kind, axis, jrot, jtrans, jq = _chain_tables(R, M, I)
-    (centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin, piece_joint, pair_a, pair_b, pair_obstacle,
-     group_joint, b_kind, b_a, b_b, b_end, b_pairs) = _sphere_tables(F, R, I)
+    (parent, kind, axis, jrot, jtrans, jq, centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin,
+     piece_joint, pair_a, pair_b, pair_obstacle, group_joint, b_kind, b_a, b_b, b_end, b_pairs, obb_c, obb_r, obb_h,
+     ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip) = _tables(F, R, M, I)
     keep = np.ones(NB, dtype=np.bool_)
     live = active.copy()
     reach = np.full(I[2], np.inf)
@@ -275,7 +256,6 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
         g_grow[g] = _growth(g_centre, g, group_joint[g], lo, hi, parent, jtrans, jq, 0.0, np.int64(0))
     world = np.empty((G, 3))
     grow = np.full(G, -1.0)                   # not yet computed
-    obb_c, obb_r, obb_h, ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip = _box_tables(F, R, M, I)
     box_c = np.empty((G, 3))
     box_r = np.empty((G, 3, 3))
     boxed = np.zeros(G, dtype=np.bool_)       # the piece's box placed at the centre
