@@ -237,6 +237,7 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
     n = qs.shape[1]
     lo = np.empty(n)
     hi = np.empty(n)
+    mid = np.empty(n)
     for c in range(n):
         lo[c] = hi[c] = qs[0, c]
         for i in range(qs.shape[0]):
@@ -245,7 +246,8 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
                 return keep, live, reach
             lo[c] = min(lo[c], x)
             hi[c] = max(hi[c], x)
-    mid = (lo + hi) / 2.0
+    for c in range(n):                       # a loop: an array expression compiles a kernel of its own
+        mid[c] = (lo[c] + hi[c]) / 2.0
     rot = np.empty((J, 3, 3))
     trans = np.empty((J, 3))
     _forward(mid, parent, kind, axis, jrot, jtrans, jq, rot, trans)

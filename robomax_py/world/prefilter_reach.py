@@ -55,11 +55,12 @@ def _growth(local: Any, g: int, j: int, lo: Any, hi: Any, parent: Any, jtrans: A
     stop: an ancestor joint of j (0: the base); the motion in its frame (by the joints after it only).
     Every caller passes every argument, `stop` as an int64 (not a literal 0): numba compiles one
     specialisation per set of omitted arguments and per literal."""
-    arm = math.sqrt(local[g, 0] ** 2 + local[g, 1] ** 2 + local[g, 2] ** 2) + reach
+    # x * x, not x ** 2: the same number (numba's power by 2 is 1.0 * (x * x)) without compiling numba's power
+    arm = math.sqrt(local[g, 0] * local[g, 0] + local[g, 1] * local[g, 1] + local[g, 2] * local[g, 2]) + reach
     moved = 0.0
     k = j
     while k != stop and k > 0:
         moved += (hi[jq[k]] - lo[jq[k]]) / 2.0 * arm
-        arm += math.sqrt(jtrans[k, 0] ** 2 + jtrans[k, 1] ** 2 + jtrans[k, 2] ** 2)
+        arm += math.sqrt(jtrans[k, 0] * jtrans[k, 0] + jtrans[k, 1] * jtrans[k, 1] + jtrans[k, 2] * jtrans[k, 2])
         k = parent[k]
     return moved * (1.0 + 1e-9) + 1e-6
