@@ -119,7 +119,7 @@ def test_a_pieces_volumes_are_reused_only_for_the_same_geometry_at_the_same_plac
     fresh = Prefilter.of(*args)
     reused = Prefilter.of(*args)
     assert fresh is not None and reused is not None
-    np.testing.assert_array_equal(fresh.floats, reused.floats)      # rows and mats are views of floats
+    np.testing.assert_array_equal(fresh.floats, reused.floats)      # vectors and matrices are views of floats
     np.testing.assert_array_equal(fresh.ints, reused.ints)
 
     gm = s.geom_model.copy()
