@@ -56,6 +56,8 @@ class Prefilter:
     """
 
     floats: FloatArray           # every float table, packed (see `_pack`)
+    vectors: FloatArray          # (n, 3) view of floats: the tables of 3-vectors
+    matrices: FloatArray         # (n, 3, 3) view of floats: the tables of 3x3 matrices
     ints: IntArray               # every integer table and the offsets of both, packed
     every_block: BoolArray       # (blocks,) all True: `uncleared` without `blocks`
 
@@ -140,14 +142,15 @@ class Prefilter:
         ch_box_r = np.array([b[1] for b in boxes]).reshape(-1, 3, 3)
         ch_half = np.array([b[2] for b in boxes]).reshape(-1, 3)
 
-        floats, ints = _pack(
+        floats, vectors, matrices, ints = _pack(
             [axis, rot, trans, centre, radius, box_lo, box_hi, margin, g_centre, g_radius, block_margin,
              obb_centre, obb_axes, obb_half, ch_centre, ch_radius, ch_box_c, ch_box_r, ch_half],
             [parent, kind, qi, piece_joint, robot_side, other, is_obs[other].astype(np.int64), group_joint,
              block_kind, block_a, block_b, block_end, block_pairs, ch_start, ch_end, ch_skip],
             len(flat),
         )
-        return Prefilter(floats=floats, ints=ints, every_block=np.ones(len(keys), dtype=bool))
+        return Prefilter(floats=floats, vectors=vectors, matrices=matrices, ints=ints,
+                         every_block=np.ones(len(keys), dtype=bool))
 
     def uncleared(self, qs: FloatArray, active: BoolArray, blocks: BoolArray | None = None,
                   rows: IntArray | None = None) -> tuple[IntArray, IntArray]:
@@ -166,8 +169,9 @@ class Prefilter:
             blocks = (self.every_block if blocks is None else blocks)[None]
         elif blocks is None:
             blocks = np.broadcast_to(self.every_block, (len(active), len(self.every_block)))
-        counts, pairs = _uncleared(_read_only(qs), self.floats, self.ints, np.ascontiguousarray(active),
-                                   np.ascontiguousarray(blocks), np.ascontiguousarray(rows, dtype=np.int64))
+        counts, pairs = _uncleared(_read_only(qs), self.floats, self.vectors, self.matrices, self.ints,
+                                   np.ascontiguousarray(active), np.ascontiguousarray(blocks),
+                                   np.ascontiguousarray(rows, dtype=np.int64))
         return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), pairs
 
     def near(self, qs: FloatArray, active: BoolArray) -> tuple[BoolArray, BoolArray]:
@@ -175,7 +179,7 @@ class Prefilter:
         configuration in the joint-space box spanned by qs (k, n) may not clear; the others are
         cleared at every configuration of the box, so `uncleared(q, pairs, blocks)` of any q in it
         gives what `uncleared(q, active)` gives (`prefilter_kernels._near`)."""
-        blocks, pairs, _ = _near(_read_only(qs), self.floats, self.ints, active, False)
+        blocks, pairs, _ = _near(_read_only(qs), self.floats, self.vectors, self.matrices, self.ints, active, False)
         return blocks, pairs
 
     def near_reach(self, qs: FloatArray, active: BoolArray) -> tuple[BoolArray, BoolArray, FloatArray]:
@@ -186,12 +190,13 @@ class Prefilter:
         the centre of qs's box ((min + max) / 2 per joint) and any configuration of the box (m; inf
         for the others): a pair farther apart at the centre than its margin plus its reach is farther
         apart than its margin at every configuration of the box."""
-        blocks, pairs, reach = _near(_read_only(qs), self.floats, self.ints, active, True)
+        blocks, pairs, reach = _near(_read_only(qs), self.floats, self.vectors, self.matrices, self.ints, active, True)
         return blocks, pairs, reach
 
     def joint_placements(self, q: FloatArray) -> tuple[FloatArray, FloatArray]:
         """(J, 3, 3) rotations and (J, 3) translations of every joint frame at q (as Pinocchio's oMi)."""
-        return _placements(np.ascontiguousarray(q, dtype=np.float64), self.floats, self.ints)  # type: ignore[no-any-return]
+        q = np.ascontiguousarray(q, dtype=np.float64)
+        return _placements(q, self.floats, self.vectors, self.matrices, self.ints)  # type: ignore[no-any-return]
 
 
 def _read_only(qs: FloatArray) -> FloatArray:
@@ -303,21 +308,39 @@ def _mesh_chunks(geom: Any, placed: FloatArray) -> tuple[list[FloatArray], list[
     return nodes, skip
 
 
-def _pack(floats: list[FloatArray], ints: list[IntArray], n_chunks: int) -> tuple[FloatArray, IntArray]:
-    """Every table in one float and one int buffer, so a call unboxes four arrays, not forty.
+def _pack(floats: list[FloatArray], ints: list[IntArray],
+          n_chunks: int) -> tuple[FloatArray, FloatArray, FloatArray, IntArray]:
+    """Every table in one float and one int buffer, so a call unboxes a few arrays, not forty.
+
+    The float buffer holds the scalar tables, then the tables of 3-vectors, then those of 3x3
+    matrices; the kernels take it whole and as (n, 3) and (n, 3, 3) views of its two later parts,
+    so that every table is a plain slice of one of them. Each table reshaped in the kernels instead
+    (`F[a:b].reshape((G, 3))`) cost numba about 0.05 s of compile apiece, 14 of them about 0.75 s
+    of a first plan.
 
     ints starts with J (joints), G (pieces), P (pairs), NG (groups), NB (blocks), C (obstacle
-    chunks), then the start of each float table in `floats`, then the start of each int table.
+    chunks), then the start of each float table (an index into the scalars, the vectors or
+    the matrices, by its shape), then the start of each int table.
+    Returns (floats, vectors, matrices, ints).
     """
     parent, piece_joint, pair_a, group_joint, block_kind = ints[0], ints[3], ints[4], ints[7], ints[8]
     header = [len(parent), len(piece_joint), len(pair_a), len(group_joint), len(block_kind), n_chunks]
-    f_starts = np.cumsum([0] + [a.size for a in floats])[:-1]
+    tables = [np.ascontiguousarray(a, dtype=float) for a in floats]
+    parts: list[list[FloatArray]] = [[], [], []]      # scalars, 3-vectors, 3x3 matrices
+    f_starts = []
+    for a in tables:
+        part = parts[a.ndim - 1]
+        f_starts.append(sum(len(b) for b in part))
+        part.append(a)
     n_head = len(header) + len(floats) + len(ints)
     i_starts = n_head + np.cumsum([0] + [a.size for a in ints])[:-1]
-    flat_f = np.concatenate([np.ascontiguousarray(a, dtype=float).ravel() for a in floats])
-    flat_i = np.concatenate([np.array(header + list(f_starts) + list(i_starts), dtype=np.int64)]
+    flat_f = np.concatenate([a.ravel() for part in parts for a in part])
+    n1, n3 = sum(len(a) for a in parts[0]), sum(len(a) for a in parts[1])
+    vectors = flat_f[n1:n1 + 3 * n3].reshape(-1, 3)
+    matrices = flat_f[n1 + 3 * n3:].reshape(-1, 3, 3)
+    flat_i = np.concatenate([np.array(header + f_starts + list(i_starts), dtype=np.int64)]
                             + [np.ascontiguousarray(a, dtype=np.int64).ravel() for a in ints])
-    return flat_f, flat_i
+    return flat_f, vectors, matrices, flat_i
 
 
 def _chain(model: pin.Model) -> tuple[IntArray, IntArray, FloatArray, FloatArray, FloatArray, IntArray] | None:

@@ -10,12 +10,12 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from robomax_py.world.prefilter_reach import _growth, _pair_reach
+from robomax_py.world.prefilter_reach import _growth, _pair_reach, helper
 
 _N_HEADER, _N_FLOAT_TABLES, _N_INT_TABLES = 6, 19, 16
 
 
-@njit(cache=True, nogil=True)
+@helper
 def _forward(q: Any, parent: Any, kind: Any, axis: Any, jrot: Any, jtrans: Any, jq: Any, rot: Any, trans: Any) -> None:
     """Joint frames in the base frame: oMi[j] = oMi[parent] * placement[j] * motion_j(q)."""
     rot[0, :, :] = 0.0
@@ -59,58 +59,37 @@ def _forward(q: Any, parent: Any, kind: Any, axis: Any, jrot: Any, jtrans: Any, 
                 rot[j, r, 0], rot[j, r, 1], rot[j, r, 2] = m[r, 0], m[r, 1], m[r, 2]
 
 
-@njit(cache=True, nogil=True)
-def _offsets(I: Any) -> Any:
-    """Where each float and each int table starts in the packed buffers (see `_pack`)."""
+@helper
+def _tables(F: Any, R: Any, M: Any, I: Any) -> Any:
+    """Every table, as slices of the packed buffers (`prefilter._pack`): F the scalars, R (n, 3) the
+    3-vectors, M (n, 3, 3) the matrices, I the ints. In order: the chain's (`_forward`'s argument
+    order: parent, kind, axis, rotation, translation, q index); the sphere tests' (per piece centre,
+    radius and obstacle box corners, per pair margin, per group centre and radius, per block
+    margin; per piece its joint, per pair its pieces and whether b is an obstacle, per group its
+    joint, per block its kind, groups and end, the pairs in block order); the box and chunk tests'
+    (per piece its oriented box: centre, rotation, half extents; per chunk of an obstacle's mesh its
+    sphere, centre and radius, and box; per piece its first and end chunk, per chunk the chunk after
+    its subtree). One helper, not one per group of tables: each jitted function has a fixed compile
+    cost (about 0.1 s of a first plan for the three it replaces)."""
+    J, G, P, NG, NB, C = I[0], I[1], I[2], I[3], I[4], I[5]
     fo = I[_N_HEADER:_N_HEADER + _N_FLOAT_TABLES]
     io = I[_N_HEADER + _N_FLOAT_TABLES:_N_HEADER + _N_FLOAT_TABLES + _N_INT_TABLES]
-    return fo, io
-
-
-@njit(cache=True, nogil=True)
-def _chain_tables(F: Any, I: Any) -> Any:
-    """The chain's tables in `_forward`'s argument order: parent, kind, axis, rotation, translation, q index."""
-    J = I[0]
-    fo, io = _offsets(I)
-    return (I[io[0]:io[0] + J], I[io[1]:io[1] + J], F[fo[0]:fo[0] + 3 * J].reshape((J, 3)),
-            F[fo[1]:fo[1] + 9 * J].reshape((J, 3, 3)), F[fo[2]:fo[2] + 3 * J].reshape((J, 3)), I[io[2]:io[2] + J])
-
-
-@njit(cache=True, nogil=True)
-def _sphere_tables(F: Any, I: Any) -> Any:
-    """The tables the sphere tests read (`_uncleared`, `_near`): per piece centre, radius and
-    obstacle box corners, per pair margin, per group centre and radius, per block margin; then per
-    piece its joint, per pair its pieces and whether b is an obstacle, per group its joint, per
-    block its kind, groups and end, and the pairs in block order."""
-    G, P, NG, NB = I[1], I[2], I[3], I[4]
-    fo, io = _offsets(I)
-    return (F[fo[3]:fo[3] + 3 * G].reshape((G, 3)), F[fo[4]:fo[4] + G], F[fo[5]:fo[5] + 3 * G].reshape((G, 3)),
-            F[fo[6]:fo[6] + 3 * G].reshape((G, 3)), F[fo[7]:fo[7] + P], F[fo[8]:fo[8] + 3 * NG].reshape((NG, 3)),
-            F[fo[9]:fo[9] + NG], F[fo[10]:fo[10] + NB],
+    return (I[io[0]:io[0] + J], I[io[1]:io[1] + J], R[fo[0]:fo[0] + J], M[fo[1]:fo[1] + J], R[fo[2]:fo[2] + J],
+            I[io[2]:io[2] + J],
+            R[fo[3]:fo[3] + G], F[fo[4]:fo[4] + G], R[fo[5]:fo[5] + G], R[fo[6]:fo[6] + G], F[fo[7]:fo[7] + P],
+            R[fo[8]:fo[8] + NG], F[fo[9]:fo[9] + NG], F[fo[10]:fo[10] + NB],
             I[io[3]:io[3] + G], I[io[4]:io[4] + P], I[io[5]:io[5] + P], I[io[6]:io[6] + P], I[io[7]:io[7] + NG],
             I[io[8]:io[8] + NB], I[io[9]:io[9] + NB], I[io[10]:io[10] + NB], I[io[11]:io[11] + NB],
-            I[io[12]:io[12] + P])
-
-
-@njit(cache=True, nogil=True)
-def _box_tables(F: Any, I: Any) -> Any:
-    """The tables the box and chunk tests read (`_uncleared`, `_near`'s deep test): per piece its
-    oriented box (centre, rotation, half extents), per chunk of an obstacle's mesh its sphere
-    (centre, radius) and box; per piece its first and end chunk, per chunk the chunk after its
-    subtree."""
-    G, C = I[1], I[5]
-    fo, io = _offsets(I)
-    return (F[fo[11]:fo[11] + 3 * G].reshape((G, 3)), F[fo[12]:fo[12] + 9 * G].reshape((G, 3, 3)),
-            F[fo[13]:fo[13] + 3 * G].reshape((G, 3)), F[fo[14]:fo[14] + 3 * C].reshape((C, 3)),
-            F[fo[15]:fo[15] + C], F[fo[16]:fo[16] + 3 * C].reshape((C, 3)),
-            F[fo[17]:fo[17] + 9 * C].reshape((C, 3, 3)), F[fo[18]:fo[18] + 3 * C].reshape((C, 3)),
+            I[io[12]:io[12] + P],
+            R[fo[11]:fo[11] + G], M[fo[12]:fo[12] + G], R[fo[13]:fo[13] + G], R[fo[14]:fo[14] + C],
+            F[fo[15]:fo[15] + C], R[fo[16]:fo[16] + C], M[fo[17]:fo[17] + C], R[fo[18]:fo[18] + C],
             I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C])
 
 
 @njit(cache=True, nogil=True)
-def _placements(q: Any, F: Any, I: Any) -> Any:
+def _placements(q: Any, F: Any, R: Any, M: Any, I: Any) -> Any:
     J = I[0]
-    parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
+    parent, kind, axis, jrot, jtrans, jq = _tables(F, R, M, I)[:6]
     rot = np.empty((J, 3, 3))
     trans = np.empty((J, 3))
     _forward(q, parent, kind, axis, jrot, jtrans, jq, rot, trans)
@@ -118,15 +97,14 @@ def _placements(q: Any, F: Any, I: Any) -> Any:
 
 
 @njit(cache=True, nogil=True)
-def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any, rows: Any) -> Any:
+def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any, rows: Any) -> Any:
     """For each configuration i of qs, the pairs active in row rows[i] of `active` (r, P) it does
     not clear, in pair order; blocks whose entry in row rows[i] of `blocks` (r, NB) is False are
     known cleared (`_near`) and skipped."""
     J, G, P, NG, NB = I[0], I[1], I[2], I[3], I[4]
-    parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
-    (centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin, piece_joint, pair_a, pair_b, pair_obstacle,
-     group_joint, b_kind, b_a, b_b, b_end, b_pairs) = _sphere_tables(F, I)
-    obb_c, obb_r, obb_h, ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip = _box_tables(F, I)
+    (parent, kind, axis, jrot, jtrans, jq, centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin,
+     piece_joint, pair_a, pair_b, pair_obstacle, group_joint, b_kind, b_a, b_b, b_end, b_pairs, obb_c, obb_r, obb_h,
+     ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip) = _tables(F, R, M, I)
 
     n_cfg = qs.shape[0]
     rot = np.empty((J, 3, 3))
@@ -148,7 +126,8 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any, rows: Any) -> 
     n_moving = 0
     for g in range(G):
         if piece_joint[g] == 0:
-            _place(rot, trans, 0, centre, g, world)
+            # j an int64, not a literal 0: numba would compile `_place` again for Literal[int](0)
+            _place(rot, trans, np.int64(0), centre, g, world)
         else:
             moving[n_moving] = g
             n_moving += 1
@@ -225,7 +204,7 @@ def _uncleared(qs: Any, F: Any, I: Any, active: Any, blocks: Any, rows: Any) -> 
 
 
 @njit(cache=True, nogil=True)
-def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
+def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> Any:
     """(blocks (NB,) bool, pairs (P,) bool): the blocks, and the active pairs, that `_uncleared`'s
     tests may fail to clear at some configuration of the joint-space box spanned by qs (k, n);
     the others are cleared at every configuration of the box.
@@ -246,9 +225,9 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
     for each pair left when deep, how much its distance can shrink from the box's centre
     (`_pair_reach`; inf otherwise)."""
     J, G, NG, NB = I[0], I[1], I[3], I[4]
-    parent, kind, axis, jrot, jtrans, jq = _chain_tables(F, I)
-    (centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin, piece_joint, pair_a, pair_b, pair_obstacle,
-     group_joint, b_kind, b_a, b_b, b_end, b_pairs) = _sphere_tables(F, I)
+    (parent, kind, axis, jrot, jtrans, jq, centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin,
+     piece_joint, pair_a, pair_b, pair_obstacle, group_joint, b_kind, b_a, b_b, b_end, b_pairs, obb_c, obb_r, obb_h,
+     ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip) = _tables(F, R, M, I)
     keep = np.ones(NB, dtype=np.bool_)
     live = active.copy()
     reach = np.full(I[2], np.inf)
@@ -258,6 +237,7 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
     n = qs.shape[1]
     lo = np.empty(n)
     hi = np.empty(n)
+    mid = np.empty(n)
     for c in range(n):
         lo[c] = hi[c] = qs[0, c]
         for i in range(qs.shape[0]):
@@ -266,7 +246,8 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
                 return keep, live, reach
             lo[c] = min(lo[c], x)
             hi[c] = max(hi[c], x)
-    mid = (lo + hi) / 2.0
+    for c in range(n):                       # a loop: an array expression compiles a kernel of its own
+        mid[c] = (lo[c] + hi[c]) / 2.0
     rot = np.empty((J, 3, 3))
     trans = np.empty((J, 3))
     _forward(mid, parent, kind, axis, jrot, jtrans, jq, rot, trans)
@@ -277,7 +258,6 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
         g_grow[g] = _growth(g_centre, g, group_joint[g], lo, hi, parent, jtrans, jq, 0.0, np.int64(0))
     world = np.empty((G, 3))
     grow = np.full(G, -1.0)                   # not yet computed
-    obb_c, obb_r, obb_h, ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip = _box_tables(F, I)
     box_c = np.empty((G, 3))
     box_r = np.empty((G, 3, 3))
     boxed = np.zeros(G, dtype=np.bool_)       # the piece's box placed at the centre
@@ -349,13 +329,13 @@ def _near(qs: Any, F: Any, I: Any, active: Any, deep: bool) -> Any:
     return keep, live, reach
 
 
-@njit(cache=True, nogil=True)
-def _place(rot: Any, trans: Any, j: int, local: Any, g: int, world: Any) -> None:
+@helper
+def _place(rot: Any, trans: Any, j: Any, local: Any, g: int, world: Any) -> None:
     for r in range(3):
         world[g, r] = trans[j, r] + rot[j, r, 0] * local[g, 0] + rot[j, r, 1] * local[g, 1] + rot[j, r, 2] * local[g, 2]
 
 
-@njit(cache=True, nogil=True)
+@helper
 def _sphere_box(world: Any, a: int, reach: float, lo: Any, hi: Any, b: int) -> bool:
     """Whether sphere centre a is farther than `reach` from box b (an inf reach is never cleared)."""
     d2 = 0.0
@@ -368,7 +348,7 @@ def _sphere_box(world: Any, a: int, reach: float, lo: Any, hi: Any, b: int) -> b
     return d2 > reach * reach
 
 
-@njit(cache=True, nogil=True)
+@helper
 def _sphere_point(world: Any, a: int, points: Any, c: int, reach: float) -> bool:
     """Whether point world[a] is farther than `reach` from point points[c]."""
     d2 = 0.0
@@ -378,7 +358,7 @@ def _sphere_point(world: Any, a: int, points: Any, c: int, reach: float) -> bool
     return d2 > reach * reach
 
 
-@njit(cache=True, nogil=True)
+@helper
 def _place_box(rot: Any, trans: Any, j: int, local_c: Any, local_r: Any, g: int, box_c: Any, box_r: Any) -> None:
     for r in range(3):
         box_c[g, r] = trans[j, r] + rot[j, r, 0] * local_c[g, 0] + rot[j, r, 1] * local_c[g, 1] \
@@ -388,13 +368,13 @@ def _place_box(rot: Any, trans: Any, j: int, local_c: Any, local_r: Any, g: int,
                 + rot[j, r, 2] * local_r[g, 2, c]
 
 
-@njit(cache=True, nogil=True)
+@helper
 def _boxes_apart(ca: Any, ra: Any, ha: Any, a: int, cb: Any, rb: Any, hb: Any, b: int, gap: float, scratch: Any) -> bool:
     """Whether oriented box a (centre ca[a], axes the columns of ra[a], half extents ha[a]) and box b
     are more than `gap` apart along one of the 15 separating axes (`separated`). False proves nothing.
     scratch: (7, 3) float the tests work in (allocated by the caller: this runs in inner loops)."""
     ea, eb = ha[a], hb[b]
-    if not (np.isfinite(ea[0]) and np.isfinite(eb[0])):
+    if not (math.isfinite(ea[0]) and math.isfinite(eb[0])):    # math's, not numpy's ufunc: cheaper to compile
         return False
     R = scratch[0:3]
     t = scratch[3]
@@ -419,7 +399,7 @@ def separated(R: Any, t: Any, ea: Any, eb: Any, gap: float) -> bool:
     return _separated(R, t, ea, eb, gap, np.empty((3, 3)))
 
 
-@njit(cache=True, nogil=True)
+@helper
 def _separated(R: Any, t: Any, ea: Any, eb: Any, gap: float, AbsR: Any) -> bool:
     """`separated`, working in AbsR (3, 3)."""
     for i in range(3):

@@ -4,13 +4,26 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 import numpy as np
 from numba import njit
+from numba.core.dispatcher import Dispatcher
+
+_F = TypeVar("_F", bound=Callable[..., object])
 
 
-@njit(cache=True, nogil=True)
+def helper(fn: _F) -> Dispatcher[_F]:
+    """`njit(cache=True, nogil=True)` for a kernel called only from other kernels: without a Python
+    entry point (numba's CPython and C wrappers, lowered and optimised for every function, were about
+    0.7 s of a first plan's compile over the pre-filter's helpers, which Python never calls)."""
+    options: Any = {"cache": True, "nogil": True, "no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+    jit: Callable[[_F], Dispatcher[_F]] = njit(**options)      # Any: numba's stubs do not list these options
+    return jit(fn)
+
+
+@helper
 def _pair_reach(centre: Any, radius: Any, piece_joint: Any, a: int, b: int, obstacle: bool, lo: Any, hi: Any,
                 parent: Any, jtrans: Any, jq: Any, spread: Any) -> float:
     """How much the distance between robot piece a and piece b can shrink from the centre of the box
@@ -33,7 +46,7 @@ def _pair_reach(centre: Any, radius: Any, piece_joint: Any, a: int, b: int, obst
     return float(spread[a] + spread[b])
 
 
-@njit(cache=True, nogil=True)
+@helper
 def _growth(local: Any, g: int, j: int, lo: Any, hi: Any, parent: Any, jtrans: Any, jq: Any,
             reach: float, stop: Any) -> float:
     """How far point local[g] of joint j's link, or any point within `reach` of it, can move from
@@ -42,11 +55,12 @@ def _growth(local: Any, g: int, j: int, lo: Any, hi: Any, parent: Any, jtrans: A
     stop: an ancestor joint of j (0: the base); the motion in its frame (by the joints after it only).
     Every caller passes every argument, `stop` as an int64 (not a literal 0): numba compiles one
     specialisation per set of omitted arguments and per literal."""
-    arm = math.sqrt(local[g, 0] ** 2 + local[g, 1] ** 2 + local[g, 2] ** 2) + reach
+    # x * x, not x ** 2: the same number (numba's power by 2 is 1.0 * (x * x)) without compiling numba's power
+    arm = math.sqrt(local[g, 0] * local[g, 0] + local[g, 1] * local[g, 1] + local[g, 2] * local[g, 2]) + reach
     moved = 0.0
     k = j
     while k != stop and k > 0:
         moved += (hi[jq[k]] - lo[jq[k]]) / 2.0 * arm
-        arm += math.sqrt(jtrans[k, 0] ** 2 + jtrans[k, 1] ** 2 + jtrans[k, 2] ** 2)
+        arm += math.sqrt(jtrans[k, 0] * jtrans[k, 0] + jtrans[k, 1] * jtrans[k, 1] + jtrans[k, 2] * jtrans[k, 2])
         k = parent[k]
     return moved * (1.0 + 1e-9) + 1e-6

@@ -119,7 +119,7 @@ def test_a_pieces_volumes_are_reused_only_for_the_same_geometry_at_the_same_plac
     fresh = Prefilter.of(*args)
     reused = Prefilter.of(*args)
     assert fresh is not None and reused is not None
-    np.testing.assert_array_equal(fresh.floats, reused.floats)
+    np.testing.assert_array_equal(fresh.floats, reused.floats)      # vectors and matrices are views of floats
     np.testing.assert_array_equal(fresh.ints, reused.ints)
 
     gm = s.geom_model.copy()
@@ -195,3 +195,32 @@ def test_pairs_cleared_near_a_short_path_are_cleared_at_each_of_its_states(
     assert left_out > 0.5 * len(starts) * len(filt.every_block)
     nan_path = np.vstack([starts[0], np.full(robot.dof, np.nan)])
     assert filt.near(nan_path, active)[0].all()                    # no box, no bound: every block kept
+
+
+def test_each_kernel_compiles_one_specialisation(reference: tuple[CellSpec, RobotModel, CollisionWorld],
+                                                 rng: np.random.Generator) -> None:
+    """Every way the filter is called (one configuration, a batch, a batch by rows of `near`, the
+    near tests, the joint placements) reaches each compiled function with the same argument types:
+    numba compiles a function again for each new type (a literal int, a read-only or a differently
+    laid out array, an omitted argument), a first plan's compile paid twice."""
+    from numba.core.dispatcher import Dispatcher
+
+    from robomax_py.world import prefilter_kernels, prefilter_reach
+
+    _, robot, world = reference
+    filt = world._s.prefilter
+    assert filt is not None
+    active = np.ones(world.n_pairs, dtype=bool)
+    qs = rng.uniform(robot.limits.lower, robot.limits.upper, size=(8, robot.dof))
+    blocks, live = filt.near(qs, active)
+    filt.near_reach(qs, active)
+    filt.uncleared(qs[:1], active)
+    filt.uncleared(qs, active)
+    filt.uncleared(qs[::2], live, blocks)
+    filt.uncleared(qs, np.array([live, active]), np.array([blocks, filt.every_block]), np.arange(8) % 2)
+    filt.joint_placements(qs[0])
+    kernels = [f for m in (prefilter_kernels, prefilter_reach) for f in vars(m).values()
+               if isinstance(f, Dispatcher) and f.py_func.__module__ == m.__name__]
+    assert len(kernels) >= 10
+    for kernel in kernels:   # none when its callers were loaded from numba's cache
+        assert len(kernel.signatures) <= 1, (kernel.py_func.__name__, kernel.signatures)
