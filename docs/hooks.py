@@ -44,7 +44,8 @@ def _usage(arg: Any) -> str:
 
 
 def _cell(text: str) -> str:
-    text = " ".join(text.split()).replace("|", "\\|")
+    # Brackets escaped: help text such as "[rpy=R,P,Y] [from=T1]" would read as a reference link.
+    text = " ".join(text.split()).replace("|", "\\|").replace("[", "\\[").replace("]", "\\]")
     return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
 
 
