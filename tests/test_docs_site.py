@@ -57,7 +57,8 @@ def test_site_builds_strict(tmp_path: Path) -> None:
     pytest.importorskip("mkdocstrings_handlers.python")
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]),
                NO_MKDOCS_2_WARNING="1")
-    run = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "-q", "-d", str(tmp_path / "site")],
+    # Not -q: mkdocs then logs errors only, and --strict counts the warnings it logs (none).
+    run = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "-d", str(tmp_path / "site")],
                          check=False, cwd=REPO, env=env, capture_output=True, text=True)
     assert run.returncode == 0, run.stdout + run.stderr
     cli = (tmp_path / "site" / "cli" / "index.html").read_text(encoding="utf-8")
