@@ -40,6 +40,7 @@ from robomax_py.world.prefilter_kernels import (
     _placements,
     _uncleared,
 )
+from robomax_py.world.prefilter_tree import TREE_MIN_BLOCKS, block_walk
 
 SLACK_M = 1e-6                 # m: a cleared pair's bound exceeds its margin by this (GJK decides to ~1e-9 m)
 _REVOLUTE, _PRISMATIC = 0, 1
@@ -63,8 +64,10 @@ class Prefilter:
 
     @staticmethod
     def of(model: pin.Model, gm: pin.GeometryModel, obstacle: list[bool], pair_a: IntArray, pair_b: IntArray,
-           pair_margin: FloatArray) -> Prefilter | None:
-        """The filter of a world's geometry, or None when the chain has a joint it does not model."""
+           pair_margin: FloatArray, tree_min_blocks: int = TREE_MIN_BLOCKS) -> Prefilter | None:
+        """The filter of a world's geometry, or None when the chain has a joint it does not model.
+        tree_min_blocks: a joint group with this many obstacle blocks walks them by a box tree
+        (`prefilter_tree`); the answers are the same either way."""
         chain = _chain(model)
         if chain is None:
             return None
@@ -142,12 +145,18 @@ class Prefilter:
         ch_box_r = np.array([b[1] for b in boxes]).reshape(-1, 3, 3)
         ch_half = np.array([b[2] for b in boxes]).reshape(-1, 3)
 
+        walk = block_walk(block_kind, block_a, block_b, block_margin, box_lo, box_hi, tree_min_blocks)
+
+        # The walk's boxes and margins ride in the pieces' and blocks' tables, its ints in one table:
+        # each table more is a slice more for numba to compile in every kernel.
         floats, vectors, matrices, ints = _pack(
-            [axis, rot, trans, centre, radius, box_lo, box_hi, margin, g_centre, g_radius, block_margin,
+            [axis, rot, trans, centre, radius, np.concatenate([box_lo, walk.lo]), np.concatenate([box_hi, walk.hi]),
+             margin, g_centre, g_radius, np.concatenate([block_margin, walk.margin]),
              obb_centre, obb_axes, obb_half, ch_centre, ch_radius, ch_box_c, ch_box_r, ch_half],
             [parent, kind, qi, piece_joint, robot_side, other, is_obs[other].astype(np.int64), group_joint,
-             block_kind, block_a, block_b, block_end, block_pairs, ch_start, ch_end, ch_skip],
-            len(flat),
+             block_kind, block_a, block_b, block_end, block_pairs, ch_start, ch_end, ch_skip,
+             np.stack([walk.block, walk.group, walk.skip], axis=1).ravel()],
+            len(flat), len(walk.block),
         )
         return Prefilter(floats=floats, vectors=vectors, matrices=matrices, ints=ints,
                          every_block=np.ones(len(keys), dtype=bool))
@@ -308,8 +317,8 @@ def _mesh_chunks(geom: Any, placed: FloatArray) -> tuple[list[FloatArray], list[
     return nodes, skip
 
 
-def _pack(floats: list[FloatArray], ints: list[IntArray],
-          n_chunks: int) -> tuple[FloatArray, FloatArray, FloatArray, IntArray]:
+def _pack(floats: list[FloatArray], ints: list[IntArray], n_chunks: int,
+          n_nodes: int) -> tuple[FloatArray, FloatArray, FloatArray, IntArray]:
     """Every table in one float and one int buffer, so a call unboxes a few arrays, not forty.
 
     The float buffer holds the scalar tables, then the tables of 3-vectors, then those of 3x3
@@ -319,12 +328,13 @@ def _pack(floats: list[FloatArray], ints: list[IntArray],
     of a first plan.
 
     ints starts with J (joints), G (pieces), P (pairs), NG (groups), NB (blocks), C (obstacle
-    chunks), then the start of each float table (an index into the scalars, the vectors or
-    the matrices, by its shape), then the start of each int table.
+    chunks), N (nodes of the block walk, `prefilter_tree`), then the start of each float table (an
+    index into the scalars, the vectors or the matrices, by its shape), then the start of each int
+    table.
     Returns (floats, vectors, matrices, ints).
     """
     parent, piece_joint, pair_a, group_joint, block_kind = ints[0], ints[3], ints[4], ints[7], ints[8]
-    header = [len(parent), len(piece_joint), len(pair_a), len(group_joint), len(block_kind), n_chunks]
+    header = [len(parent), len(piece_joint), len(pair_a), len(group_joint), len(block_kind), n_chunks, n_nodes]
     tables = [np.ascontiguousarray(a, dtype=float) for a in floats]
     parts: list[list[FloatArray]] = [[], [], []]      # scalars, 3-vectors, 3x3 matrices
     f_starts = []

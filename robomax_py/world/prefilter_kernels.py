@@ -12,7 +12,7 @@ from numba import njit
 
 from robomax_py.world.prefilter_reach import _growth, _pair_reach, helper
 
-_N_HEADER, _N_FLOAT_TABLES, _N_INT_TABLES = 6, 19, 16
+_N_HEADER, _N_FLOAT_TABLES, _N_INT_TABLES = 7, 19, 17
 
 
 @helper
@@ -69,21 +69,23 @@ def _tables(F: Any, R: Any, M: Any, I: Any) -> Any:
     joint, per block its kind, groups and end, the pairs in block order); the box and chunk tests'
     (per piece its oriented box: centre, rotation, half extents; per chunk of an obstacle's mesh its
     sphere, centre and radius, and box; per piece its first and end chunk, per chunk the chunk after
-    its subtree). One helper, not one per group of tables: each jitted function has a fixed compile
+    its subtree); the block walk's (`prefilter_tree`: per node its block, group and the node after
+    its subtree, interleaved; an inner node's box and largest margin follow the pieces' boxes and
+    the blocks' margins: rows G + node and NB + node). One helper, not one per group of tables: each jitted function has a fixed compile
     cost (about 0.1 s of a first plan for the three it replaces)."""
-    J, G, P, NG, NB, C = I[0], I[1], I[2], I[3], I[4], I[5]
+    J, G, P, NG, NB, C, N = I[0], I[1], I[2], I[3], I[4], I[5], I[6]
     fo = I[_N_HEADER:_N_HEADER + _N_FLOAT_TABLES]
     io = I[_N_HEADER + _N_FLOAT_TABLES:_N_HEADER + _N_FLOAT_TABLES + _N_INT_TABLES]
     return (I[io[0]:io[0] + J], I[io[1]:io[1] + J], R[fo[0]:fo[0] + J], M[fo[1]:fo[1] + J], R[fo[2]:fo[2] + J],
             I[io[2]:io[2] + J],
-            R[fo[3]:fo[3] + G], F[fo[4]:fo[4] + G], R[fo[5]:fo[5] + G], R[fo[6]:fo[6] + G], F[fo[7]:fo[7] + P],
-            R[fo[8]:fo[8] + NG], F[fo[9]:fo[9] + NG], F[fo[10]:fo[10] + NB],
+            R[fo[3]:fo[3] + G], F[fo[4]:fo[4] + G], R[fo[5]:fo[5] + G + N], R[fo[6]:fo[6] + G + N], F[fo[7]:fo[7] + P],
+            R[fo[8]:fo[8] + NG], F[fo[9]:fo[9] + NG], F[fo[10]:fo[10] + NB + N],
             I[io[3]:io[3] + G], I[io[4]:io[4] + P], I[io[5]:io[5] + P], I[io[6]:io[6] + P], I[io[7]:io[7] + NG],
             I[io[8]:io[8] + NB], I[io[9]:io[9] + NB], I[io[10]:io[10] + NB], I[io[11]:io[11] + NB],
             I[io[12]:io[12] + P],
             R[fo[11]:fo[11] + G], M[fo[12]:fo[12] + G], R[fo[13]:fo[13] + G], R[fo[14]:fo[14] + C],
             F[fo[15]:fo[15] + C], R[fo[16]:fo[16] + C], M[fo[17]:fo[17] + C], R[fo[18]:fo[18] + C],
-            I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C])
+            I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C], I[io[16]:io[16] + 3 * N])
 
 
 @njit(cache=True, nogil=True)
@@ -101,10 +103,10 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     """For each configuration i of qs, the pairs active in row rows[i] of `active` (r, P) it does
     not clear, in pair order; blocks whose entry in row rows[i] of `blocks` (r, NB) is False are
     known cleared (`_near`) and skipped."""
-    J, G, P, NG, NB = I[0], I[1], I[2], I[3], I[4]
+    J, G, P, NG, NB, N = I[0], I[1], I[2], I[3], I[4], I[6]
     (parent, kind, axis, jrot, jtrans, jq, centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin,
      piece_joint, pair_a, pair_b, pair_obstacle, group_joint, b_kind, b_a, b_b, b_end, b_pairs, obb_c, obb_r, obb_h,
-     ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip) = _tables(F, R, M, I)
+     ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip, walk) = _tables(F, R, M, I)
 
     n_cfg = qs.shape[0]
     rot = np.empty((J, 3, 3))
@@ -134,6 +136,17 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     # Each configuration is copied to a writable row first: `_forward` then has the one
     # specialisation `_near` and `_placements` also use (a read-only row would compile it again,
     # about 0.4 s of a first plan).
+    # A row of `blocks` with few blocks (`near`'s, typically a block or two of hundreds) is walked by
+    # its list of blocks: the tree would test boxes over blocks the row leaves out anyway.
+    listed = np.empty(blocks.shape, dtype=np.int64)
+    n_listed = np.empty(blocks.shape[0], dtype=np.int64)      # -1: the row walks the tree
+    for r in range(blocks.shape[0]):
+        n_on = 0
+        for blk in range(NB):
+            if blocks[r, blk]:
+                listed[r, n_on] = blk
+                n_on += 1
+        n_listed[r] = n_on if 4 * n_on < NB else -1
     q = np.empty(qs.shape[1])
     for i in range(n_cfg):
         for c in range(q.shape[0]):          # a loop: slice assignment compiles its shape checks
@@ -146,12 +159,25 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
             _place(rot, trans, group_joint[g], g_centre, g, g_world)
         placed[:] = False
         first = filled
-        begin = 0
-        for blk in range(NB):
+        few = n_listed[row] >= 0
+        end = n_listed[row] if few else N
+        nd = 0
+        while nd < end:                         # the row's list, or the block walk (`prefilter_tree`)
+            if few:
+                blk = listed[row, nd]
+                nd += 1
+            else:
+                blk = walk[3 * nd]
+                if blk < 0:                     # a box over obstacles: cleared, all their blocks are
+                    ga = walk[3 * nd + 1]
+                    cleared = _sphere_box(g_world, ga, g_radius[ga] + b_margin[NB + nd], box_lo, box_hi, G + nd)
+                    nd = walk[3 * nd + 2] if cleared else nd + 1
+                    continue
+                nd += 1
+                if not blocks[row, blk]:
+                    continue
+            begin = b_end[blk - 1] if blk > 0 else 0
             stop = b_end[blk]
-            if not blocks[row, blk]:
-                begin = stop
-                continue
             ga, gb = b_a[blk], b_b[blk]
             if b_kind[blk] == 0:
                 cleared = _sphere_box(g_world, ga, g_radius[ga] + b_margin[blk], box_lo, box_hi, gb)
@@ -191,7 +217,6 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
                     if not ok:
                         out[filled] = k
                         filled += 1
-            begin = stop
         for n in range(first + 1, filled):      # into pair order: a few entries, insertion sort
             k = out[n]
             m = n - 1
@@ -224,13 +249,13 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
     not clear it (it then goes to coal's exact test, which finds it free). Also returned: reach (P,),
     for each pair left when deep, how much its distance can shrink from the box's centre
     (`_pair_reach`; inf otherwise)."""
-    J, G, NG, NB = I[0], I[1], I[3], I[4]
+    J, G, P, NG, NB, N = I[0], I[1], I[2], I[3], I[4], I[6]
     (parent, kind, axis, jrot, jtrans, jq, centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin,
      piece_joint, pair_a, pair_b, pair_obstacle, group_joint, b_kind, b_a, b_b, b_end, b_pairs, obb_c, obb_r, obb_h,
-     ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip) = _tables(F, R, M, I)
+     ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip, walk) = _tables(F, R, M, I)
     keep = np.ones(NB, dtype=np.bool_)
     live = active.copy()
-    reach = np.full(I[2], np.inf)
+    reach = np.full(P, np.inf)
     for j in range(1, J):
         if kind[j] != 0:
             return keep, live, reach
@@ -263,8 +288,20 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
     boxed = np.zeros(G, dtype=np.bool_)       # the piece's box placed at the centre
     spread = np.full(G, -1.0)                 # how far any point of the piece can move; not yet computed
     scratch = np.empty((7, 3))
-    begin = 0
-    for blk in range(NB):
+    for m in range(NB):                       # a block or pair the walk leaves out is cleared
+        keep[m] = False
+    for m in range(P):
+        live[m] = False
+    nd = 0
+    while nd < N:                             # `_uncleared`'s block walk, every test grown
+        blk = walk[3 * nd]
+        if blk < 0:
+            ga = walk[3 * nd + 1]
+            cleared = _sphere_box(g_world, ga, g_radius[ga] + b_margin[NB + nd] + g_grow[ga], box_lo, box_hi, G + nd)
+            nd = walk[3 * nd + 2] if cleared else nd + 1
+            continue
+        nd += 1
+        begin = b_end[blk - 1] if blk > 0 else 0
         stop = b_end[blk]
         ga, gb = b_a[blk], b_b[blk]
         if b_kind[blk] == 0:
@@ -272,13 +309,12 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
         else:
             cleared = _sphere_point(g_world, ga, g_world, gb, g_radius[ga] + g_radius[gb] + b_margin[blk]
                                     + g_grow[ga] + g_grow[gb])
+        if cleared:
+            continue
         any_live = False
         for m in range(begin, stop):
             k = b_pairs[m]
-            if not live[k]:
-                continue
-            if cleared:
-                live[k] = False
+            if not active[k]:
                 continue
             a, b = pair_a[k], pair_b[k]
             if grow[a] < 0.0:
@@ -325,7 +361,6 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
                                        spread)
             any_live = any_live or live[k]
         keep[blk] = any_live             # a block without a live pair adds nothing
-        begin = stop
     return keep, live, reach
 
 

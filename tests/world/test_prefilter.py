@@ -224,3 +224,56 @@ def test_each_kernel_compiles_one_specialisation(reference: tuple[CellSpec, Robo
     assert len(kernels) >= 10
     for kernel in kernels:   # none when its callers were loaded from numba's cache
         assert len(kernel.signatures) <= 1, (kernel.py_func.__name__, kernel.signatures)
+
+
+def test_the_block_tree_leaves_out_only_blocks_their_own_test_clears(
+        reference: tuple[CellSpec, RobotModel, CollisionWorld], rng: np.random.Generator) -> None:
+    """A world of many scattered obstacles (60 boxes around the arm, each pair with its own margin):
+    walked by its box tree (every group's blocks), the filter gives the same uncleared pairs, and
+    the same `near` and `near_reach`, as walked block by block; and a row of `near`'s few blocks,
+    walked by its list, what the whole walk gives."""
+    import coal
+
+    _, robot, world = reference
+    s = world._s
+    gm = s.geom_model.copy()
+    robot_pieces = [g for g, o in enumerate(gm.geometryObjects) if int(o.parentJoint) > 0]
+    n_old = gm.ngeoms
+    for n in range(60):
+        centre = rng.uniform([-1.6, -1.6, -0.2], [1.6, 1.6, 1.8])
+        box = coal.Box(*rng.uniform(0.03, 0.4, size=3))
+        gm.addGeometryObject(pin.GeometryObject(f"clutter{n}", 0, pin.SE3(pin.rpy.rpyToMatrix(*rng.uniform(-3, 3, 3)),
+                                                                         centre), box))
+    new_a = np.array([a for a in robot_pieces for _ in range(60)], dtype=np.int64)
+    new_b = np.array([n_old + n for _ in robot_pieces for n in range(60)], dtype=np.int64)
+    pair_a = np.concatenate([s.pair_a, new_a])
+    pair_b = np.concatenate([s.pair_b, new_b])
+    margin = np.concatenate([s.pair_margin, rng.choice([0.0, 0.01, 0.05, 0.2], size=len(new_a))])
+    from robomax_py.world.acm import OBSTACLE_KINDS
+
+    obstacle = [p.kind in OBSTACLE_KINDS for p in s.pieces] + [True] * 60
+    plain = Prefilter.of(s.model, gm, obstacle, pair_a, pair_b, margin, tree_min_blocks=10**9)
+    tree = Prefilter.of(s.model, gm, obstacle, pair_a, pair_b, margin, tree_min_blocks=1)
+    assert plain is not None and tree is not None
+    assert len(tree.ints) > len(plain.ints)                 # the tree has inner nodes, the plain walk none
+    lo, hi = robot.limits.lower, robot.limits.upper
+    qs = rng.uniform(lo, hi, size=(20000, robot.dof))
+    listed = 0
+    for active in (np.ones(len(pair_a), dtype=bool), rng.random(len(pair_a)) < 0.7):
+        expected, got = plain.uncleared(qs, active), tree.uncleared(qs, active)
+        np.testing.assert_array_equal(expected[0], got[0])
+        np.testing.assert_array_equal(expected[1], got[1])
+        assert np.isin(expected[1], np.arange(len(s.pair_a), len(pair_a))).sum() > len(qs)   # clutter is met
+        for start in qs[:60]:
+            path = np.clip(start + np.cumsum(rng.normal(0.0, 0.02, size=(5, robot.dof)), axis=0), lo, hi)
+            tree_all = tree.uncleared(path, active)
+            for mine, theirs in ((tree.near(path, active), plain.near(path, active)),
+                                 (tree.near_reach(path, active), plain.near_reach(path, active))):
+                for x, y in zip(mine, theirs):
+                    np.testing.assert_array_equal(x, y)
+            blocks, live = tree.near(path, active)
+            listed += 4 * int(blocks.sum()) < len(blocks)        # a row of few blocks: walked by its list
+            for got in (plain.uncleared(path, live, blocks), tree.uncleared(path, live, blocks)):
+                np.testing.assert_array_equal(got[0], tree_all[0])
+                np.testing.assert_array_equal(got[1], tree_all[1])
+    assert listed > 10
