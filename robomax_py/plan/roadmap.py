@@ -15,6 +15,7 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
@@ -24,6 +25,9 @@ from robomax_py.plan.shortcut import swept_shortcut
 from robomax_py.robot import JointLimits
 from robomax_py.timing import polyline_time_estimate, ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
+
+# scipy.sparse.csgraph's index arrays.
+Int32Array = npt.NDArray[np.int32]
 
 # Sampling box margin around the work's joint-space spread, rad (or m), per joint.
 BOX_MARGIN = 0.6
@@ -121,6 +125,7 @@ class Roadmap:
         self._checked: dict[tuple[int, int], bool] = {}
         self.edge_checks = 0
         self._csr: tuple[IntArray, IntArray, FloatArray, IntArray] | None = None   # `_both_ways`
+        self._search: tuple[FloatArray, Int32Array, Int32Array] | None = None         # `_search_arrays`
 
     def fresh(self) -> Roadmap:
         """This roadmap as it was built, before any edge was known: its queries find what a new
@@ -129,6 +134,7 @@ class Roadmap:
         other = copy.copy(self)
         other._edge_blocked = np.zeros(len(self._pairs), dtype=bool)
         other._edge_free = {}
+        other._search = None
         other.edge_checks = 0
         return other
 
@@ -239,12 +245,12 @@ class Roadmap:
         (None: no way) and the bound that found it.
         """
         n = len(self.nodes)
-        indptr, indices, weights, slots = self._both_ways()
+        slots = self._both_ways()[3]
+        data, indices, indptr = self._search_arrays(len(start_links))
+        # Blocked edges weigh infinity (idempotent: an edge once blocked stays blocked).
         blocked = np.flatnonzero(self._edge_blocked)
-        if len(blocked):
-            weights = weights.copy()
-            weights[slots[blocked]] = np.inf
-            weights[slots[blocked + len(self._pairs)]] = np.inf
+        data[slots[blocked]] = np.inf
+        data[slots[blocked + len(self._pairs)]] = np.inf
 
         def usable(links: list[int], label: int) -> FloatArray:
             return np.array([extra_free.get((min(label, v), max(label, v))) is not False for v in links], dtype=bool)
@@ -253,8 +259,14 @@ class Roadmap:
         s_links = np.asarray(start_links, dtype=np.int64)[s_ok]
         # csgraph reads a stored zero as no edge: coinciding configurations get the least positive weight.
         s_w = np.maximum(np.asarray(start_w, dtype=float)[s_ok], np.finfo(float).tiny)
-        graph = csr_matrix((np.concatenate([weights, s_w]), np.concatenate([indices, s_links]),
-                            np.append(indptr, indptr[-1] + len(s_links))), shape=(n + 1, n + 1))
+        # The start's row overwrites the end of the buffers; the matrix views them (no copy: the
+        # indices are already csgraph's int32, which scipy would otherwise convert every search).
+        edges = int(indptr[n])
+        end = edges + len(s_links)
+        data[edges:end] = s_w
+        indices[edges:end] = s_links
+        indptr[n + 1] = end
+        graph = csr_matrix((data[:end], indices[:end], indptr), shape=(n + 1, n + 1))
         g_ok = usable(goal_links, -2)
         goal_at = np.asarray(goal_links, dtype=np.int64)
         if not len(goal_at):
@@ -289,6 +301,24 @@ class Roadmap:
             weight = np.maximum(np.concatenate([self._pair_weight, self._pair_weight]), np.finfo(float).tiny)
             self._csr = (indptr, cols[order].astype(np.int64), weight[order], slots)
         return self._csr
+
+    def _search_arrays(self, room: int) -> tuple[FloatArray, Int32Array, Int32Array]:
+        """This roadmap's graph for `_shortest` in buffers kept between its searches: data (its
+        blocked edges at infinity) and indices with room for a start row of `room` links after the
+        edges, indptr (n + 2,). Indices in scipy's csgraph index type (int32: its searches take no
+        other). Made once per roadmap and per `fresh` copy (whose blocked edges differ)."""
+        edges = len(self._both_ways()[2])
+        if self._search is None or len(self._search[0]) < edges + room:
+            indptr, indices, weights, _ = self._both_ways()
+            n, room = len(self.nodes), max(room, self._k)
+            data = np.empty(edges + room)
+            data[:edges] = weights
+            idx = np.empty(edges + room, dtype=np.int32)
+            idx[:edges] = indices
+            ptr = np.empty(n + 2, dtype=np.int32)
+            ptr[:n + 1] = indptr
+            self._search = (data, idx, ptr)
+        return self._search
 
     def _shortcut(self, waypoints: FloatArray) -> tuple[FloatArray, int]:
         """Greedy (`swept_shortcut`): each kept waypoint joined to the farthest later one reachable

@@ -126,3 +126,34 @@ def test_a_fresh_copy_finds_what_a_new_roadmap_finds_without_checking_edges_agai
         assert got is not None and want is not None
         assert np.array_equal(got.waypoints, want.waypoints)
     assert fresh_world.segments < new_world.segments
+
+
+def test_searches_reusing_the_graph_buffers_find_what_a_rebuilt_graph_finds() -> None:
+    """`Roadmap._shortest` keeps its CSR buffers between searches, marking blocked edges and
+    writing the start's row in place: after each newly blocked edge and with start rows of other
+    lengths, the path is that of buffers built anew, and a `fresh` copy sees none of the blocks."""
+    import copy
+
+    rng = np.random.default_rng(7)
+    start, goal = np.full(6, -1.5), np.full(6, 1.5)
+    roadmap = Roadmap(BallWorld(), LIMITS, np.array([start, goal]), rng, n_nodes=300, k=8)  # type: ignore[arg-type]
+    links, goal_links = roadmap.nearest(start, 8), roadmap.nearest(goal, 8)
+    goal_w = ptp_time_estimate(roadmap.nodes[goal_links], goal[None], LIMITS)
+
+    def search(rm: Roadmap, n_links: int) -> list[int] | None:
+        start_w = ptp_time_estimate(start[None], rm.nodes[links[:n_links]], LIMITS)
+        return rm._shortest(links[:n_links], start_w, goal_links, goal_w, {})[0]
+
+    first = search(roadmap, 8)
+    paths = []
+    for n_links in (8, 3, 8, 5, 1, 8):
+        path = search(roadmap, n_links)
+        rebuilt = copy.copy(roadmap)
+        rebuilt._search = None
+        assert path is not None and path == search(rebuilt, n_links)
+        paths.append(path)
+        inner = [(u, v) for u, v in itertools.pairwise(path) if u >= 0 and v >= 0]
+        if inner:                                   # block the path's first roadmap edge
+            roadmap._edge_blocked[roadmap._edge_index[(min(inner[0]), max(inner[0]))]] = True
+    assert len({tuple(p) for p in paths}) > 2       # the blocks changed the way found
+    assert search(roadmap.fresh(), 8) == first
