@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from robomax_py.world.prefilter_kernels import separated
+from robomax_py.world.box_separation import separated
 
 
 @njit(cache=True, nogil=True)
@@ -29,7 +29,7 @@ def _grow(buf: Any, n: int) -> Any:
 @njit(cache=True, nogil=True)
 def _boxes_apart(Ta: Any, ca: Any, ha: Any, Tb: Any, cb: Any, hb: Any, margin: float) -> bool:
     """Whether two boxes are farther apart than `margin` along a separating axis
-    (`world.prefilter_kernels.separated`). Ta, Tb: (4, 4) poses whose rotation columns are the boxes'
+    (`world.box_separation.separated`). Ta, Tb: (4, 4) poses whose rotation columns are the boxes'
     axes; ca, cb: (3,) box centres in the world; ha, hb: (3,) half extents, m."""
     R = np.empty((3, 3))
     t = np.empty(3)

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from robomax_py.world.box_separation import boxes_apart
 from robomax_py.world.prefilter_reach import _growth, _pair_reach, helper
 
 _N_HEADER, _N_FLOAT_TABLES, _N_INT_TABLES = 7, 19, 17
@@ -116,7 +117,7 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     box_c = np.empty((G, 3))
     box_r = np.empty((G, 3, 3))
     placed = np.zeros(G, dtype=np.bool_)     # world box of the piece computed for this configuration
-    scratch = np.empty((7, 3))               # `_boxes_apart`'s, allocated once
+    scratch = np.empty((7, 3))               # `boxes_apart`'s, allocated once
     counts = np.zeros(n_cfg, dtype=np.int64)
     out = np.empty(n_cfg * P, dtype=np.int64)
     filled = 0
@@ -199,7 +200,7 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
                             c = ch_start[b]
                             while c < ch_end[b]:          # the chunk tree, pre-order, without a stack
                                 if _sphere_point(world, a, ch_c, c, radius[a] + ch_rad[c] + margin[k]) or \
-                                        _boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, margin[k], scratch):
+                                        boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, margin[k], scratch):
                                     c = ch_skip[c]        # cleared: past its subtree
                                 elif ch_skip[c] == c + 1:
                                     ok = False            # a leaf it cannot clear
@@ -213,7 +214,7 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
                                 if not placed[g]:
                                     _place_box(rot, trans, piece_joint[g], obb_c, obb_r, g, box_c, box_r)
                                     placed[g] = True
-                            ok = _boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b, margin[k], scratch)
+                            ok = boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b, margin[k], scratch)
                     if not ok:
                         out[filled] = k
                         filled += 1
@@ -334,7 +335,7 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
                     c = ch_start[b]
                     while c < ch_end[b]:              # `_uncleared`'s traversal, every test grown
                         if _sphere_point(world, a, ch_c, c, radius[a] + ch_rad[c] + margin[k] + grow[a]) or \
-                                _boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, margin[k] + spread[a],
+                                boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, margin[k] + spread[a],
                                              scratch):
                             c = ch_skip[c]
                         elif ch_skip[c] == c + 1:
@@ -354,7 +355,7 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
                             boxed[g] = True
                         if spread[g] < 0.0:
                             spread[g] = _growth(centre, g, piece_joint[g], lo, hi, parent, jtrans, jq, radius[g], np.int64(0))
-                    live[k] = not _boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b,
+                    live[k] = not boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b,
                                                margin[k] + spread[a] + spread[b], scratch)
             if live[k] and deep:
                 reach[k] = _pair_reach(centre, radius, piece_joint, a, b, pair_obstacle[k], lo, hi, parent, jtrans, jq,
@@ -401,61 +402,3 @@ def _place_box(rot: Any, trans: Any, j: int, local_c: Any, local_r: Any, g: int,
         for c in range(3):
             box_r[g, r, c] = rot[j, r, 0] * local_r[g, 0, c] + rot[j, r, 1] * local_r[g, 1, c] \
                 + rot[j, r, 2] * local_r[g, 2, c]
-
-
-@helper
-def _boxes_apart(ca: Any, ra: Any, ha: Any, a: int, cb: Any, rb: Any, hb: Any, b: int, gap: float, scratch: Any) -> bool:
-    """Whether oriented box a (centre ca[a], axes the columns of ra[a], half extents ha[a]) and box b
-    are more than `gap` apart along one of the 15 separating axes (`separated`). False proves nothing.
-    scratch: (7, 3) float the tests work in (allocated by the caller: this runs in inner loops)."""
-    ea, eb = ha[a], hb[b]
-    if not (math.isfinite(ea[0]) and math.isfinite(eb[0])):    # math's, not numpy's ufunc: cheaper to compile
-        return False
-    R = scratch[0:3]
-    t = scratch[3]
-    for i in range(3):
-        t[i] = 0.0
-        for k in range(3):
-            t[i] += ra[a, k, i] * (cb[b, k] - ca[a, k])
-        for j in range(3):
-            v = 0.0
-            for k in range(3):
-                v += ra[a, k, i] * rb[b, k, j]
-            R[i, j] = v
-    return _separated(R, t, ea, eb, gap, scratch[4:7])
-
-
-@njit(cache=True, nogil=True)
-def separated(R: Any, t: Any, ea: Any, eb: Any, gap: float) -> bool:
-    """Whether two oriented boxes are more than `gap` apart along one of the 15 separating axes
-    (Gottschalk et al., SIGGRAPH 1996; Ericson, Real-Time Collision Detection 4.4.1; a cross-product
-    axis's gap scaled by its length). R (3, 3): box b's axes in box a's frame; t (3,): b's centre
-    less a's in a's frame; ea, eb (3,): half extents, m. False proves nothing."""
-    return _separated(R, t, ea, eb, gap, np.empty((3, 3)))
-
-
-@helper
-def _separated(R: Any, t: Any, ea: Any, eb: Any, gap: float, AbsR: Any) -> bool:
-    """`separated`, working in AbsR (3, 3)."""
-    for i in range(3):
-        for j in range(3):
-            AbsR[i, j] = abs(R[i, j]) + 1e-9    # near-parallel edges: no false separation
-    for i in range(3):
-        if abs(t[i]) > ea[i] + eb[0] * AbsR[i, 0] + eb[1] * AbsR[i, 1] + eb[2] * AbsR[i, 2] + gap:
-            return True
-    for j in range(3):
-        if abs(t[0] * R[0, j] + t[1] * R[1, j] + t[2] * R[2, j]) > \
-                ea[0] * AbsR[0, j] + ea[1] * AbsR[1, j] + ea[2] * AbsR[2, j] + eb[j] + gap:
-            return True
-    for i in range(3):
-        i1, i2 = (i + 1) % 3, (i + 2) % 3
-        for j in range(3):
-            j1, j2 = (j + 1) % 3, (j + 2) % 3
-            length = math.sqrt(max(0.0, 1.0 - R[i, j] * R[i, j]))
-            if length < 1e-6:
-                continue
-            ra = ea[i1] * AbsR[i2, j] + ea[i2] * AbsR[i1, j]
-            rb = eb[j1] * AbsR[i, j2] + eb[j2] * AbsR[i, j1]
-            if abs(t[i2] * R[i1, j] - t[i1] * R[i2, j]) > ra + rb + gap * length:
-                return True
-    return False
