@@ -215,8 +215,14 @@ def main(restore_mask: Iterable[int] | None = None) -> None:
         # The process ends here: the interpreter's last collection would walk every object the
         # command and its ~2000 imported modules made (~0.3 s of CPU after a plan) only to free
         # memory the exit returns anyway. Frozen objects are left out of it; exit handlers, open
-        # files and the streams are closed as before.
-        gc.freeze()
+        # files and the streams are closed as before. Not once OMPL was used (a detour's last
+        # resort, a replan): its bindings (nanobind) print every object of theirs still alive at
+        # shutdown as a leak, types and functions by the thousand, so that run's last collection
+        # walks everything, the objects the heavy imports froze included.
+        if "ompl" in sys.modules:
+            gc.unfreeze()
+        else:
+            gc.freeze()
 
 
 if __name__ == "__main__":

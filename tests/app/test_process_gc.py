@@ -4,6 +4,9 @@ is the command's own (`cli.main`), untouched in a caller's process (tests, scrip
 from __future__ import annotations
 
 import gc
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
 
@@ -36,3 +39,30 @@ def test_the_command_s_own_process_collects_nothing_during_imports_then_freezes_
         gc.set_threshold(*threshold)
         if not enabled:
             gc.disable()
+
+
+# A command run after OMPL made objects that only a collection frees (a cycle), as a plan's last-resort
+# detour or a replan leaves them: the exit must not freeze them, or OMPL's bindings (nanobind) print
+# each of its types and functions as leaked.
+_OMPL_THEN_COMMAND = """
+import sys
+from ompl import base as ob
+space = ob.RealVectorStateSpace(2)
+si = ob.SpaceInformation(space)
+cycle = [si]
+cycle.append(cycle)
+del cycle, si, space
+sys.argv = ["robomax", "--version"]
+from robomax_py.app.cli import main
+main()
+"""
+
+
+def test_a_command_after_ompl_ends_without_leak_reports() -> None:
+    pytest.importorskip("ompl")
+    repo = Path(__file__).resolve().parents[2]
+    run = subprocess.run([sys.executable, "-c", _OMPL_THEN_COMMAND], cwd=repo, capture_output=True, text=True,
+                         check=False, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert "robomax_py" in run.stdout
+    assert "leaked" not in run.stderr, run.stderr[:500]
