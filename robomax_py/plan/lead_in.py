@@ -5,8 +5,9 @@ ends). A continuation (`CellSpec.start`, `robomax replan`) starts elsewhere: its
 as usual and its first transition, home to the first approach point, is then made again from the
 start: the straight joint move where it is free of the static obstacles, else a path through the
 plan's roadmap (whose anchors include the start), else the start joined straight to the tour's own
-first move where it sees one of its waypoints, else the random trees of `plan.rrt_detour`. The order and the candidates were chosen for a
-start at home; on the ordered jobs that replanning serves (a tending cycle's station visits) only
+first move where it sees one of its waypoints, else the random trees of `plan.rrt_detour`, else back
+to home (by the same ways) and the tour's first move from there. The order and the candidates were
+chosen for a start at home; on the ordered jobs that replanning serves (a tending cycle's station visits) only
 the candidate of the first stop could differ, and it is still a valid one.
 """
 
@@ -60,14 +61,40 @@ def lead_in(world: CollisionWorld, roadmap: Roadmap | None, start: np.ndarray,
     detour = roadmap.query(q0, goal) if roadmap is not None else None
     if detour is not None:
         return led("detour", as_written_joints(detour.waypoints), detour.checks)
-    joined = _joined(world, q0, np.asarray(first.waypoints, dtype=float))
+    waypoints = np.asarray(first.waypoints, dtype=float)
+    joined = _joined(world, q0, waypoints)
     if joined is None:
         searched, _ = rrt_detour(world, limits, q0, goal, rng)
-        if searched is None:
-            raise LeadInError(f"no collision-free move from the stop configuration to the first stop of the rest "
-                              f"({first.label})")
-        joined = searched.waypoints
+        joined = None if searched is None else searched.waypoints
+    if joined is None:
+        joined = _via_home(world, roadmap, q0, waypoints, limits, rng)
+    if joined is None:
+        raise LeadInError(f"no collision-free move from the stop configuration to the first stop of the rest "
+                          f"({first.label}), nor back to home")
     return led("detour", as_written_joints(joined), 0)
+
+
+def _via_home(world: CollisionWorld, roadmap: Roadmap | None, q0: np.ndarray, waypoints: np.ndarray,
+              limits: JointLimits, rng: np.random.Generator) -> np.ndarray | None:
+    """The start taken back to home (straight, through the roadmap, else by the random trees) and
+    the tour's own first move followed from there, as an operator restarts a cell: the first stop
+    was chosen for a start at home, and the move from home to it was checked free when the tour was
+    sequenced (its first waypoint is home). Where the stop sees no way to the first stop (a robot
+    stopped beyond clamps from it, an object appeared between them), the way home, which the robot
+    often came along, may still be open. None when no way home is found either."""
+    home = waypoints[0]
+    if world.check_segment(q0, home).free:
+        back = np.vstack([q0, home])
+    else:
+        detour = roadmap.query(q0, home) if roadmap is not None else None
+        if detour is None:
+            searched, _ = rrt_detour(world, limits, q0, home, rng)
+            if searched is None:
+                return None
+            back = np.asarray(searched.waypoints, dtype=float)
+        else:
+            back = np.asarray(detour.waypoints, dtype=float)
+    return np.vstack([back, waypoints[1:]])
 
 
 def _joined(world: CollisionWorld, q0: np.ndarray, waypoints: np.ndarray) -> np.ndarray | None:

@@ -7,6 +7,7 @@ is free by the swept check (checked here again); the same generator state gives 
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import numpy as np
@@ -75,3 +76,34 @@ def test_a_blocked_swing_is_joined_by_free_segments_and_the_same_seed_gives_the_
     again, checks_again = rrt_detour(world, robot.limits, qa, qb, np.random.default_rng(0))
     assert again is not None and checks_again == checks
     np.testing.assert_array_equal(again.waypoints, det.waypoints)
+
+
+def test_a_stop_that_sees_no_way_to_its_first_stop_goes_home_and_follows_the_tour_s_first_move(
+        pillar_world: tuple[RobotModel, CollisionWorld], monkeypatch: pytest.MonkeyPatch) -> None:
+    """`plan.lead_in`: a continuation stopped left of the pillar whose first stop is right of it,
+    with no roadmap and the random trees out of budget (as on a stop beyond clamps and an object
+    that appeared): the lead-in goes back to home, free from the stop, and follows the tour's own
+    first move from home, every segment free; where home cannot be reached either, it refuses."""
+    from robomax_py.plan import lead_in as lead
+    from robomax_py.plan.results import Transition
+
+    robot, world = pillar_world
+    stop, first_stop = UR10_Q0 + [-0.6, 0, 0, 0, 0, 0], UR10_Q0 + [0.6, 0, 0, 0, 0, 0]
+    home = UR10_Q0 + [0.0, -0.6, -0.5, 0, 0, 0]          # above the pillar: seen from both
+    assert not world.check_segment(stop, first_stop).free
+    monkeypatch.setattr(lead, "rrt_detour", lambda *args: (None, 0))      # the trees' budget spent
+    tour = [Transition("move", np.vstack([home, first_stop]), "home -> s1")]
+
+    moved = lead.lead_in(world, None, stop, tour, robot.limits, np.random.default_rng(0))
+    path = moved[0].waypoints
+    assert moved[0].kind == "detour" and moved[0].label == "stop -> s1"
+    np.testing.assert_allclose(path[0], stop, atol=1e-6)                    # as written: 1e-4 deg rounding
+    np.testing.assert_allclose(path[-1], first_stop, atol=1e-6)
+    assert any(np.allclose(w, home, atol=1e-6) for w in path)
+    assert all(world.check_segment(a, b).free for a, b in itertools.pairwise(path))
+
+    unseen = UR10_Q0 + [0.0, -0.8, 0, 0, 0, 0]           # free, but the stop's straight move to it is not
+    assert world.is_free(unseen) and not world.check_segment(stop, unseen).free
+    with pytest.raises(lead.LeadInError, match="nor back to home"):
+        lead.lead_in(world, None, stop, [Transition("move", np.vstack([unseen, first_stop]), "home -> s1")],
+                     robot.limits, np.random.default_rng(0))
