@@ -51,11 +51,6 @@ def load_mesh(path: Path, scale: np.ndarray | None = None, tolerance: float | No
     return loaded
 
 
-def convex_hull_shape(vertices: np.ndarray) -> coal.ConvexBase:
-    """coal convex polytope of the hull of a point set (m)."""
-    return hull_shape(hull_vertices(vertices))
-
-
 def hull_vertices(vertices: np.ndarray) -> np.ndarray:
     """(k, 3) float, m: the vertices of the convex hull of a point set (trimesh's, in its order)."""
     import trimesh
@@ -70,11 +65,6 @@ def hull_shape(hull: np.ndarray) -> coal.ConvexBase:
     for p in np.asarray(hull, dtype=float):
         points.append(p)
     return coal.Convex.convexHull(points, False, None)
-
-
-def bvh_shape(mesh: trimesh.Trimesh) -> coal.BVHModelOBBRSS:
-    """Exact triangle-soup collision model of a mesh."""
-    return bvh_of(np.asarray(mesh.vertices), np.asarray(mesh.faces))
 
 
 def bvh_of(vertices: np.ndarray, faces: np.ndarray) -> coal.BVHModelOBBRSS:
