@@ -7,10 +7,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from numba import njit
+from robomax_py.jit import kernel
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def least_leg(spot_a: Any, app_a: Any, spot_b: Any, app_b: Any, v: Any, a: Any, lines: float, best: float) -> float:
     """min(best, the least over rows p of a and q of b of max(rest-to-rest trapezoid between
     spot_a[p] and spot_b[q], lines + slowest joint at its velocity limit between app_a[p] and

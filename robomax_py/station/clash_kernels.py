@@ -13,12 +13,12 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from robomax_py.jit import kernel
 from robomax_py.world.box_separation import separated
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _grow(buf: Any, n: int) -> Any:
     """`buf` with room for twice its rows, its first n rows kept."""
     out = np.empty((2 * buf.shape[0], buf.shape[1]), dtype=buf.dtype)
@@ -26,7 +26,7 @@ def _grow(buf: Any, n: int) -> Any:
     return out
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _boxes_apart(Ta: Any, ca: Any, ha: Any, Tb: Any, cb: Any, hb: Any, margin: float) -> bool:
     """Whether two boxes are farther apart than `margin` along a separating axis
     (`world.box_separation.separated`). Ta, Tb: (4, 4) poses whose rotation columns are the boxes'
@@ -40,7 +40,7 @@ def _boxes_apart(Ta: Any, ca: Any, ha: Any, Tb: Any, cb: Any, hb: Any, margin: f
     return separated(R, t, ha, hb, margin)
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def near_pieces(block: int, block_a: Any, block_ra: Any, block_b: Any, block_rb: Any,
                 link_a: Any, link_ra: Any, link_b: Any, link_rb: Any,
                 ca: Any, ra: Any, start_a: Any, pieces_a: Any, poses_a: Any, half_a: Any,

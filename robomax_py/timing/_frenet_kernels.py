@@ -23,8 +23,6 @@ the profile is that braking until it meets the bound with the bound's accelerati
 late crosses the bound, too early stalls or over-decelerates: the search gallops back from the
 failure, bisects between the two, then bisects theta. Any other failure (the ellipses closed
 whatever the slope) ends the sweep; the caller lowers the speed there.
-
-One module, since numba's cache does not see a change in a compiled function another module calls.
 """
 
 from __future__ import annotations
@@ -32,7 +30,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from numba import njit
+from robomax_py.jit import kernel
 
 OK, FAIL_W, FAIL_A, FAIL_J, FAIL_STALL, LANDED = 0, 1, 2, 3, 4, 5
 TOO_LATE, TOO_EARLY = 6, 7
@@ -42,7 +40,7 @@ _ENVELOPE_MARGIN = 1e-3    # step 1 keeps this far inside the limits (relative)
 _MARGIN = 1e-7         # the slope's fixed point is sought this far inside its interval (relative)
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def accel_cap(kappa: float, b: float, a_t: float, a_r: float) -> float:
     """The largest |a_T| the acceleration ellipse leaves at curvature kappa and b = v^2; -1 when the
     radial acceleration alone is past its limit."""
@@ -53,7 +51,7 @@ def accel_cap(kappa: float, b: float, a_t: float, a_r: float) -> float:
     return a_t * math.sqrt(q)
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def jerk_interval(b: float, a: float, kappa: float, dk: float, j_t: float, j_r: float) -> tuple[float, float]:
     """The sigma = da/ds the jerk ellipse allows at state (b, a); (1, -1) when j_R alone is past it."""
     v = math.sqrt(max(b, 0.0))
@@ -68,7 +66,7 @@ def jerk_interval(b: float, a: float, kappa: float, dk: float, j_t: float, j_r: 
     return c - big_j / v, c + big_j / v
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _state_ok(b: float, a: float, sig: float, kappa: float, dk: float, limits: Any) -> int:
     """Whether state (b, a) with slope sig keeps v_max and both ellipses; else which it breaks."""
     if b > limits[0] * limits[0] * (1.0 + _TOL):
@@ -83,7 +81,7 @@ def _state_ok(b: float, a: float, sig: float, kappa: float, dk: float, limits: A
     return OK
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def step_code(b: float, a: float, sig: float, h: float, i: int, geo: Any, w1: float, limits: Any) -> int:
     """Whether the step from node i with slope sig from state (b, a) keeps every constraint at its
     start, middle and end and ends under the bound w1; else which one it breaks first."""
@@ -100,7 +98,7 @@ def step_code(b: float, a: float, sig: float, h: float, i: int, geo: Any, w1: fl
     return FAIL_J if code == FAIL_A and b == 0.0 else code
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _bounds_guess(b: float, a: float, sig: float, h: float, i: int, geo: Any, limits: Any) -> tuple[float, float]:
     """The sigma interval of the step's constraints evaluated at the states sig leads to, each end
     pulled in by _MARGIN of the interval so that the fixed point needs no exact convergence."""
@@ -117,7 +115,7 @@ def _bounds_guess(b: float, a: float, sig: float, h: float, i: int, geo: Any, li
     return lo + pull, hi - pull
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _iterate(b: float, a: float, h: float, i: int, geo: Any, lo: float, hi: float, limits: Any,
              low_end: bool) -> float:
     sig = lo if low_end else hi
@@ -127,7 +125,7 @@ def _iterate(b: float, a: float, h: float, i: int, geo: Any, lo: float, hi: floa
     return sig
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def choose(b: float, a: float, h: float, i: int, geo: Any, w1: float, cap_hi: float, limits: Any,
            brake: bool) -> tuple[int, float]:
     """The largest (brake False) or smallest (brake True) feasible slope of the step from node i,
@@ -159,7 +157,7 @@ def choose(b: float, a: float, h: float, i: int, geo: Any, w1: float, cap_hi: fl
     return OK, good
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def start_piece(a_t: float, j_t: float, h: float) -> tuple[float, float, float]:
     """From rest over the first step h: jerk j_t until a reaches a_t, then a_t; (b, a, time) at h."""
     t_a = a_t / j_t
@@ -175,7 +173,7 @@ def start_piece(a_t: float, j_t: float, h: float) -> tuple[float, float, float]:
     return v1 * v1, a_t, t_a + tau
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def accel_band(kappa: float, dk: float, b: float, limits: Any) -> tuple[float, float]:
     """The tangential accelerations the acceleration ellipse and the radial jerk alone allow at
     speed^2 b: |a| <= the ellipse's cap and |3 kappa v a + kappa' v^3| <= j_Rmax."""
@@ -192,7 +190,7 @@ def accel_band(kappa: float, dk: float, b: float, limits: Any) -> tuple[float, f
     return lo, hi
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def envelope(h: Any, geo: Any, limits: Any, out: Any) -> None:
     """Step 1: the largest b = v^2 under v_max and the acceleration ellipse, by forward and backward
     passes from rest at both ends under the limit curve, written to out (n+1,). Both the limit
@@ -223,7 +221,7 @@ def envelope(h: Any, geo: Any, limits: Any, out: Any) -> None:
                                         inner, -1.0))
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _trapezoid(b0: float, h: float, k0: float, dk0: float, k1: float, dk1: float, limits: Any, sign: float) -> float:
     """One step of a step-1 pass, implicit: the b1 = b0 + h (A0 + A1) with A the largest
     acceleration (sign 1, forward) or deceleration (sign -1, backward; dk is then the derivative
@@ -258,7 +256,7 @@ _HANDOVER_GAP = 1e-6
 _HANDOVER_A = 1e-4
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _slope(i: int, b: float, a: float, h: Any, geo: Any, w: Any, aw: Any, limits: Any, delta: float) -> tuple[int, float]:
     """The sweep's slope at node i: the largest feasible one; on or just under the bound, the
     bound's own acceleration (plus what closes the gap smoothly) where feasible."""
@@ -272,7 +270,7 @@ def _slope(i: int, b: float, a: float, h: Any, geo: Any, w: Any, aw: Any, limits
     return choose(b, a, h[i], i, geo, w[i + 1], 1e300, limits, False)
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _greedy(i: int, b: float, a: float, h: Any, geo: Any, w: Any, aw: Any, limits: Any, delta: float) -> tuple[int, float]:
     """`_slope`, except that meeting the bound much faster than it rises is a crossing (FAIL_W),
     repaired by a braking that lands on it with its acceleration rather than a kink the next steps
@@ -289,7 +287,7 @@ def _greedy(i: int, b: float, a: float, h: Any, geo: Any, w: Any, aw: Any, limit
     return code, sig
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _braking_outcome(b: float, a: float, h: float, i: int, geo: Any, limits: Any) -> int:
     """Why no braking step is feasible from (b, a): TOO_EARLY when the hardest braking the jerk
     allows stops the robot or decelerates past the acceleration ellipse (braking began too soon);
@@ -304,7 +302,7 @@ def _braking_outcome(b: float, a: float, h: float, i: int, geo: Any, limits: Any
     return TOO_LATE
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _maneuver(k: int, theta: float, f: int, typ: int, h: Any, geo: Any, w: Any, aw: Any, limits: Any,
               delta: float, b: Any, a: Any, i_end: int, tb: Any, ta: Any, ts: Any) -> tuple[int, int]:
     """Braking from node k (its step blended theta of the way from the sweep's slope to the
@@ -336,7 +334,7 @@ def _maneuver(k: int, theta: float, f: int, typ: int, h: Any, geo: Any, w: Any, 
             return _braking_outcome(tb[m], ta[m], h[m], m, geo, limits), m
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _repair_node(f: int, typ: int, i0: int, h: Any, geo: Any, w: Any, aw: Any, limits: Any, delta: float, b: Any,
                  a: Any, i_end: int, tb: Any, ta: Any, ts: Any) -> int:
     """The latest node from which braking gets past the failure at f, or -1. Braking too late
@@ -381,7 +379,7 @@ def _repair_node(f: int, typ: int, i0: int, h: Any, geo: Any, w: Any, aw: Any, l
     return ok
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def sweep(h: Any, geo: Any, w: Any, aw: Any, limits: Any, b: Any, a: Any, sig: Any,
           i0: int, i_end: int, stop_on_landing: bool, delta: float, tb: Any, ta: Any, ts: Any) -> tuple[int, int]:
     """Fill b, a (nodes) and sig (steps) from node i0 (its state given) to node i_end. Returns

@@ -8,9 +8,8 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import njit
 
-from robomax_py.world.prefilter_reach import helper
+from robomax_py.jit import helper, kernel
 
 
 @helper
@@ -35,7 +34,7 @@ def boxes_apart(ca: Any, ra: Any, ha: Any, a: int, cb: Any, rb: Any, hb: Any, b:
     return _separated(R, t, ea, eb, gap, scratch[4:7])
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def separated(R: Any, t: Any, ea: Any, eb: Any, gap: float) -> bool:
     """Whether two oriented boxes are more than `gap` apart along one of the 15 separating axes
     (Gottschalk et al., SIGGRAPH 1996; Ericson, Real-Time Collision Detection 4.4.1; a cross-product

@@ -8,10 +8,10 @@ import math
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from robomax_py.jit import helper, kernel
 from robomax_py.world.box_separation import boxes_apart
-from robomax_py.world.prefilter_reach import _growth, _pair_reach, helper
+from robomax_py.world.prefilter_reach import _growth, _pair_reach
 
 _N_HEADER, _N_FLOAT_TABLES, _N_INT_TABLES = 7, 19, 17
 
@@ -89,7 +89,7 @@ def _tables(F: Any, R: Any, M: Any, I: Any) -> Any:
             I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C], I[io[16]:io[16] + 3 * N])
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _placements(q: Any, F: Any, R: Any, M: Any, I: Any) -> Any:
     J = I[0]
     parent, kind, axis, jrot, jtrans, jq = _tables(F, R, M, I)[:6]
@@ -99,7 +99,7 @@ def _placements(q: Any, F: Any, R: Any, M: Any, I: Any) -> Any:
     return rot, trans
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any, rows: Any) -> Any:
     """For each configuration i of qs, the pairs active in row rows[i] of `active` (r, P) it does
     not clear, in pair order; blocks whose entry in row rows[i] of `blocks` (r, NB) is False are
@@ -229,7 +229,7 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     return counts, out[:filled]
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> Any:
     """(blocks (NB,) bool, pairs (P,) bool): the blocks, and the active pairs, that `_uncleared`'s
     tests may fail to clear at some configuration of the joint-space box spanned by qs (k, n);

@@ -4,23 +4,11 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
-from numba import njit
-from numba.core.dispatcher import Dispatcher
 
-_F = TypeVar("_F", bound=Callable[..., object])
-
-
-def helper(fn: _F) -> Dispatcher[_F]:
-    """`njit(cache=True, nogil=True)` for a kernel called only from other kernels: without a Python
-    entry point (numba's CPython and C wrappers, lowered and optimised for every function, were about
-    0.7 s of a first plan's compile over the pre-filter's helpers, which Python never calls)."""
-    options: Any = {"cache": True, "nogil": True, "no_cpython_wrapper": True, "no_cfunc_wrapper": True}
-    jit: Callable[[_F], Dispatcher[_F]] = njit(**options)      # Any: numba's stubs do not list these options
-    return jit(fn)
+from robomax_py.jit import helper
 
 
 @helper

@@ -14,9 +14,9 @@ inside a convex solid meets none of its triangles; `voxels` finds those with the
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from robomax_py._typing import BoolArray, FloatArray
+from robomax_py.jit import kernel
 
 # Cells per axis of the triangle grid at most, and the cell edge in precision limits at least.
 MAX_GRID_CELLS = 160
@@ -73,7 +73,7 @@ def _bucket(i0: np.ndarray, i1: np.ndarray, dims: np.ndarray) -> tuple[np.ndarra
     return np.cumsum(start), tri[order].astype(np.int64)
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _touching(centres: np.ndarray, half: np.ndarray, lo: np.ndarray, cell: float, dims: np.ndarray,
               start: np.ndarray, items: np.ndarray, tris: np.ndarray, out: np.ndarray) -> int:
     tests = 0
@@ -112,7 +112,7 @@ def _touching(centres: np.ndarray, half: np.ndarray, lo: np.ndarray, cell: float
     return tests
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _tri_box(c: np.ndarray, h: float, tri: np.ndarray) -> bool:
     """Whether the cube (centre c, half edge h) and the triangle overlap (separating axes)."""
     v0 = tri[0] - c

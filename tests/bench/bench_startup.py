@@ -4,8 +4,8 @@ process and any it waits for), on the cell of the README's quick start unless gi
     python tests/bench/bench_startup.py [CELL] [--runs 3]
 
 Cold is the first plan after an install: empty caches (a fresh ROBOMAX_CACHE and NUMBA_CACHE_DIR,
-so numba compiles every kernel the plan calls; a set NUMBA_CACHE_DIR is searched before the
-numba files next to the sources). Warm is the next plan with the caches the cold one left.
+so numba compiles every kernel the plan calls: robomax keeps its kernels under a set
+NUMBA_CACHE_DIR, else in the cache folder). Warm is the next plan with the caches the cold one left.
 Python reads and writes its bytecode (`__pycache__`, ignored by git) whatever the calling
 environment says, as an installed package has it: with PYTHONDONTWRITEBYTECODE set, every run
 compiled robomax's ~190 modules again, ~0.2 s of CPU that a user's run never pays.

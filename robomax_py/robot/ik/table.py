@@ -23,12 +23,12 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
-from numba import njit
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
 from robomax_py._typing import BoolArray, FloatArray, IntArray
+from robomax_py.jit import kernel
 
 Forward = Callable[[FloatArray], FloatArray]          # (m, n) joint rows -> (m, d) points
 FreeTest = Callable[[FloatArray], BoolArray]          # (m, n) joint rows -> (m,) collision-free
@@ -44,7 +44,7 @@ MAX_JOINT_STEP = 0.2
 SCAN_MAX_VALUES = 50_000
 
 
-@njit(cache=True, nogil=True)
+@kernel
 def _scan_nearest(points: FloatArray, target: FloatArray) -> tuple[int, float]:
     best, best_i = np.inf, 0
     for i in range(points.shape[0]):
