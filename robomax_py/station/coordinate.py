@@ -148,7 +148,9 @@ def _first_clash(pairs: Sequence[PairMap], schedule: Schedule) -> tuple[PairMap,
     time, shared time)."""
     best: tuple[PairMap, float, float, float] | None = None
     for p in pairs:
-        stop = min(schedule.ends[p.a], schedule.ends[p.b])
+        # To the later end: a robot that has ended stands at home, where the other may still reach it
+        # (an imported FANUC M-710iC parked on its riser, swept by a KR 125-class arm going home).
+        stop = max(schedule.ends[p.a], schedule.ends[p.b])
         shared = np.arange(0.0, stop + p.dt, p.dt / 2)
         ta, tb = own_time(schedule, p.a, shared), own_time(schedule, p.b, shared)
         i = np.clip(np.rint(ta / p.dt).astype(int), 0, p.clash.shape[0] - 1)

@@ -125,3 +125,17 @@ def test_a_robot_passes_while_the_other_rests_at_its_one_clear_point() -> None:
     assert _clashes_to_the_end(pair, done.schedule) == 0
     # a waits at 4 s for b to reach its 7 s rest; b waits there until a is through (5 s).
     assert {(x.waiter, x.wait_at, x.signal_at) for x in done.interlocks} == {("a", 4.0, 7.0), ("b", 7.0, 5.0)}
+
+
+def test_a_robot_that_has_ended_stands_at_home_in_the_others_way() -> None:
+    """b is home again at 5 s; a's move from 6 to 7 s sweeps through b's home posture: b must wait
+    at its last weld until a is through, though b would end long before a moves there."""
+    lines = [_timeline("a", 10.0, [2.0, 4.0, 6.0, 7.0, 8.0]), _timeline("b", 5.0, [1.0, 2.0, 3.0, 4.0])]
+    t = np.arange(0.0, 10.0 + DT, DT)
+    in_a = (t > 6.15) & (t < 6.85)
+    at_home_b = (t < 0.45) | (t > 4.55)
+    pair = PairMap("a", "b", DT, in_a[:, None] & at_home_b[None, :])
+    done = coordinate(lines, [pair])
+    assert not done.unresolved
+    assert _clashes_to_the_end(pair, done.schedule) == 0
+    assert [(x.waiter, x.wait_at, x.signal_at) for x in done.interlocks] == [("b", 4.0, 7.0)]
