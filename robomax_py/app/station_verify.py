@@ -49,6 +49,13 @@ def station_programs(station: StationSpec, given: list[Path]) -> list[dict[str, 
     for path in given:
         if not path.exists():
             raise ProgramError(path, None, "no such file or folder")
+        if path.suffix.lower() == ".json":
+            # A robot's trajectory file holds its own motion; its interlocks are statements of its
+            # program only, so the station is replayed from the programs (the read would otherwise
+            # fail with "expected a trajectory file (.json) or a program", naming what was given).
+            raise ProgramError(path, None, f"a trajectory file: station {station.name} is replayed from its robots' "
+                                           "programs (their interlocks are statements there); give one program per "
+                                           "robot or the output folder")
         robot = next((r for r in robots if path.stem.lower() == f"{station.name}_{r}".lower()), None)
         if robot is None:
             raise ProgramError(path, None, f"not a program of station {station.name}'s robots "

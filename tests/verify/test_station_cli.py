@@ -82,7 +82,7 @@ def test_without_interlocks_the_contact_is_reported(tmp_path: Path, station: Pat
     assert "collision" in result.output and "r1 and r2 touch" in result.output
 
 
-@pytest.mark.parametrize("case", ["stranger", "one_missing", "empty_folder", "no_such_folder"])
+@pytest.mark.parametrize("case", ["stranger", "one_missing", "empty_folder", "no_such_folder", "trajectories"])
 def test_bad_input_exits_two(tmp_path: Path, station: Path, case: str) -> None:
     paths = _write(tmp_path, station, {"r1": ((), (), "srcl"), "r2": ((), (), "srcl")})
     if case == "stranger":
@@ -91,6 +91,11 @@ def test_bad_input_exits_two(tmp_path: Path, station: Path, case: str) -> None:
         args = [str(paths[0]), str(stranger)]
     elif case == "one_missing":
         args = [str(paths[0])]
+    elif case == "trajectories":
+        # The robots' trajectory files, as a single cell's verify takes one.
+        args = [str(tmp_path / f"duo_{r}.json") for r in ("r1", "r2")]
+        for a in args:
+            Path(a).write_text("{}")
     elif case == "empty_folder":
         (tmp_path / "empty").mkdir()
         args = [str(tmp_path / "empty")]
@@ -101,6 +106,8 @@ def test_bad_input_exits_two(tmp_path: Path, station: Path, case: str) -> None:
     assert "Traceback" not in result.output
     if case == "no_such_folder":
         assert "no such file or folder" in result.output
+    if case == "trajectories":
+        assert "duo_r1.json: a trajectory file: station duo is replayed from its robots' programs" in result.output
 
 
 def test_station_preview_needs_its_folder(tmp_path: Path, station: Path) -> None:
