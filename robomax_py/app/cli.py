@@ -15,10 +15,13 @@ never ran.
 from __future__ import annotations
 
 import gc
+import importlib._bootstrap
+import importlib._bootstrap_external
 import signal
 import sys
 from collections.abc import Callable, Iterable
 from pathlib import Path
+from types import FrameType
 from typing import Annotated, Any
 
 import typer
@@ -159,15 +162,50 @@ def _library_flags_first(argv: list[str]) -> list[str]:
     return front + rest
 
 
-def _on_signal(signum: int, frame: object) -> None:
+# The globals of Python's import machinery: a frame running in them means a module is being imported.
+_IMPORT_MACHINERY = (vars(importlib._bootstrap), vars(importlib._bootstrap_external))
+# Seconds between looks, after a signal that came during an import, at whether the import is done.
+IMPORT_RETRY_S = 0.01
+
+
+def _importing(frame: FrameType | None) -> bool:
+    """Whether `frame` runs inside an import: the module's own code, an import it makes, or
+    Python code an extension module's initialisation calls (nanobind builds enums with Python's
+    `enum`), all below importlib's frames."""
+    while frame is not None:
+        if any(frame.f_globals is machinery for machinery in _IMPORT_MACHINERY):
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _on_signal(signum: int, frame: FrameType | None) -> None:
     # SIGTERM unwinds like Ctrl-C (KeyboardInterrupt, which the preview ends on), so a write in
     # progress removes its temporary files; the signal is also kept for `_honour_signals`, since a
     # dependency that catches BaseException (trimesh, on import and in some mesh functions) can
     # swallow the exception.
     _Received.signum = signum
+    if _importing(frame):
+        # Not raised inside an import: an extension module whose initialisation meets the
+        # exception ends the process (cascadio's nanobind init, which trimesh imports when it first
+        # reads a mesh: SIGSEGV or an uncaught C++ exception), and a pure-Python one is left half
+        # imported. The signal is delivered again once the import is done (or honoured at the
+        # run's next stage, whichever comes first).
+        _Received.deferred = True
+        signal.signal(signal.SIGALRM, _deliver_deferred)
+        signal.setitimer(signal.ITIMER_REAL, IMPORT_RETRY_S)
+        return
+    _Received.deferred = False
     if signum == signal.SIGINT:
         raise KeyboardInterrupt
     raise SystemExit(128 + signum)
+
+
+def _deliver_deferred(signum: int, frame: FrameType | None) -> None:
+    """SIGALRM after a signal was deferred: the signal raised again, so that `_on_signal` sees
+    where the run is now (and a block that holds SIGINT and SIGTERM still holds it)."""
+    if _Received.deferred and _Received.signum is not None:
+        signal.raise_signal(_Received.signum)
 
 
 def _unraisable(default: Callable[[Any], object]) -> Callable[[Any], None]:
@@ -208,10 +246,20 @@ def main(restore_mask: Iterable[int] | None = None) -> None:
         err.print("interrupted" if _Received.signum == signal.SIGINT else "terminated")
         sys.exit(128 + _Received.signum)
     except SystemExit as exc:
+        if _Received.deferred and _Received.signum is not None:
+            # The command ended before a signal that came during an import was delivered again.
+            _Received.deferred = False
+            err.print("interrupted" if _Received.signum == signal.SIGINT else "terminated")
+            sys.exit(128 + _Received.signum)
         if _Received.signum == signal.SIGTERM and exc.code == 128 + signal.SIGTERM:
             err.print("terminated")
         raise
     finally:
+        if signal.getsignal(signal.SIGALRM) is _deliver_deferred:
+            # No delivery again while the interpreter shuts down, which puts SIGALRM's default
+            # action (ending the process) back.
+            _Received.deferred = False
+            signal.setitimer(signal.ITIMER_REAL, 0)
         # The process ends here: the interpreter's last collection would walk every object the
         # command and its ~2000 imported modules made (~0.3 s of CPU after a plan) only to free
         # memory the exit returns anyway. Frozen objects are left out of it; exit handlers, open

@@ -196,6 +196,9 @@ class _Received:
     Process state by nature: a signal handler has nowhere else to leave it."""
 
     signum: int | None = None
+    # The signal came while a module was being imported and is to be delivered again once that
+    # import is done (cli._on_signal); cleared when the run ends on it another way.
+    deferred: bool = False
 
 
 class _Process:
@@ -234,6 +237,8 @@ def _heavy_imports() -> Iterator[None]:
 def _honour_signals() -> None:
     """End the run as an earlier SIGINT or SIGTERM asked, if its exception was swallowed: called
     between stages and before anything is written."""
+    if _Received.signum is not None:
+        _Received.deferred = False              # the run ends here: no second delivery during its cleanup
     if _Received.signum == signal.SIGINT:
         raise KeyboardInterrupt
     if _Received.signum is not None:
