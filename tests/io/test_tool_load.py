@@ -120,9 +120,17 @@ def test_a_gun_above_the_rated_payload_is_refused_at_check(tmp_path: Path, write
     done = runner.invoke(app, ["check", str(cell)])
     assert done.exit_code == EXIT_BAD_INPUT
     assert "Traceback" not in done.output and f"{cell}: tool:" in " ".join(done.output.split())
+    out = tmp_path / "programs"
+    done = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
+    assert done.exit_code == EXIT_BAD_INPUT and "rated payload 125 kg" in " ".join(done.output.split())
+    assert not out.exists() or not any(out.iterdir())                 # nothing written
     light = _tool(tmp_path / "light", "spot_gun_c", {"mass": 100, "cog": [0.12, 0, 0.18]})
-    loaded = load_cell(_cell_with_tool(tmp_path / "c2", write_small_cell, light))
+    light_cell = _cell_with_tool(tmp_path / "c2", write_small_cell, light)
+    loaded = load_cell(light_cell)
     assert loaded.tool.load is not None and loaded.tool.load.mass == 100.0
+    done = runner.invoke(app, ["check", str(light_cell)], env={"COLUMNS": "200"})
+    assert done.exit_code == 0, done.output
+    assert "100 kg at [0.120, 0.000, 0.180] m" in done.output      # the summary shows the load
     # At the rating exactly: within it.
     at = _tool(tmp_path / "at", "spot_gun_c", {"mass": 125, "cog": [0, 0, 0.2]})
     assert load_cell(_cell_with_tool(tmp_path / "c3", write_small_cell, at)).tool.load is not None
