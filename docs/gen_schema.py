@@ -243,6 +243,10 @@ DESCRIPTIONS: dict[str, str] = {
     "ToolFile.scale": "Further factor on both meshes after their units: one number or one per axis (default 1).",
     "ToolFile.tolerance": "STEP only: largest distance between a mesh and the exact surface, in units "
                           "(default 0.1 mm, at least 0.01 mm).",
+    "ToolFile.load": "The tool's load: {mass, cog}. Checked against the robot's rated payload; programs "
+                     "declare it (RAPID tooldata, URScript set_payload). Absent: not stated.",
+    "ToolLoadFile.mass": "The tool's mass, kg (> 0), with its bracket and anything else on the flange.",
+    "ToolLoadFile.cog": "The tool's centre of gravity in the flange frame, m.",
     "ToolMeshFile.mesh": "The mesh file, relative to the tool.yaml: any format trimesh reads, or a STEP.",
     "ToolMeshFile.units": "Unit of this mesh's numbers (overrides the tool's units): m or mm.",
     "ToolMeshFile.scale": "Further factor on this mesh after its units (overrides the tool's scale).",

@@ -302,6 +302,15 @@ Instruction: TypeAlias = PtpMove | LinMove | Spot | Gripper | Wait | WaitFor | S
 
 
 @dataclass(frozen=True, slots=True)
+class ToolLoad:
+    """The mounted tool's load (tool.yaml `load`): its mass, kg, and its centre of gravity in the
+    flange frame, m; a point mass (no inertia is stated)."""
+
+    mass: float
+    cog: tuple[float, float, float]
+
+
+@dataclass(frozen=True, slots=True)
 class ProgramSetup:
     """What the controller's integrator hands a program (the cell's `robot.controller`), for the
     writers: the position and numeric registers it may use (FANUC), whether a weld calls the
@@ -309,13 +318,16 @@ class ProgramSetup:
     frames a setup file lists for the integrator to enter by hand (`listed`: FANUC without position
     registers to set them from), and the controller's own names of the numbered frames the program
     selects, by the name the program refers to them with (`frame_names`: KUKA TOOL_NAME / BASE_NAME,
-    which inline forms show). Nothing of it is read back: the statements say what they use."""
+    which inline forms show), and the tool's load where the tool file states one (`tool_load`, for
+    the dialects that declare it: RAPID tooldata, URScript set_payload). Nothing of it is read
+    back: the statements say what they use."""
 
     position_registers: tuple[int, ...] = ()
     numeric_registers: tuple[int, ...] = ()
     weld: Literal["call", "package"] = "call"
     listed: tuple[FrameDef, ...] = ()
     frame_names: tuple[tuple[str, str], ...] = ()
+    tool_load: ToolLoad | None = None
 
 
 @dataclass(frozen=True, slots=True)

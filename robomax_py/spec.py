@@ -13,6 +13,9 @@ from typing import Any, Literal
 import numpy as np
 
 from robomax_py._typing import FloatArray
+from robomax_py.program_instructions import (
+    ToolLoad,  # a tool spec's load, which programs carry too
+)
 
 
 def frozen_array(values: Any) -> FloatArray:
@@ -169,13 +172,14 @@ class JointLoadLimits:
 @dataclass(frozen=True, slots=True, eq=False)
 class ToolSpec:
     """A tool.yaml, checked: meshes in the flange frame (with the units, scale and STEP tolerance
-    the file gives them), TCP pose in the flange frame."""
+    the file gives them), TCP pose in the flange frame, and its load when the file states one."""
 
     name: str
     source: Path
     body: MeshShape
     tips: MeshShape
     T_flange_tcp: FloatArray          # (4, 4)
+    load: ToolLoad | None = None      # mass, kg; centre of gravity in the flange frame, m
 
 
 @dataclass(frozen=True, slots=True)

@@ -68,7 +68,9 @@ def cell_summary(cell: CellSpec, robot: Any) -> Group:
     home_deg = ", ".join(f"{v:.1f}" for v in np.degrees(cell.home))
     head.add_row("robot", f"{robot.name}: {robot.dof} axes, IK {robot.ik_solver}, home [{home_deg}] deg")
     tcp = cell.tool.T_flange_tcp[:3, 3]
-    head.add_row("tool", f"{cell.tool.name}: TCP at [{', '.join(f'{v:.3f}' for v in tcp)}] m from the flange")
+    load = cell.tool.load
+    weight = "" if load is None else f", {load.mass:g} kg at [{', '.join(f'{v:.3f}' for v in load.cog)}] m"
+    head.add_row("tool", f"{cell.tool.name}: TCP at [{', '.join(f'{v:.3f}' for v in tcp)}] m from the flange{weight}")
     p = cell.process
     head.add_row("process", f"weld {p.weld_time:.2f} s, approach {p.approach * 1000:.1f} mm, "
                             f"clearance {p.clearance * 1000:.1f} mm")

@@ -177,7 +177,7 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
                         flyby=math.degrees(retract_radius), comment="retract", accel=1.0 if after is None else after.accel))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
                     tuple(identifier(j) for j in result.joint_names), f"robomax_py {__version__}", cell_sha256, stamp)
-    handed = ProgramSetup(setup.position_registers, setup.numeric_registers, setup.weld)
+    handed = ProgramSetup(setup.position_registers, setup.numeric_registers, setup.weld, tool_load=result.tool_load)
     return PlannedProgram(Program(identifier(result.cell), header, frames, tuple(out), handed), tuple(joints), setup)
 
 

@@ -31,7 +31,13 @@ from robomax_py.io.cell_file_values import (
     MAX_CELL_NAME_CHARS,
     SUPPORTED_VERSIONS,
 )
-from robomax_py.io.cell_jobs import _job_seams, _machines, _parts, _tcp_limits
+from robomax_py.io.cell_jobs import (
+    _job_seams,
+    _machines,
+    _parts,
+    _tcp_limits,
+    check_tool_load,
+)
 from robomax_py.io.cell_limits import (
     _check_counts,
     _check_declared_triangles,
@@ -195,6 +201,7 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
     start = problems.attempt(_start, parsed, robot_spec, path)
     problems.raise_found()
     assert parts is not None and home is not None
+    check_tool_load(robot_spec, tool_spec, parts, path)
     if sum(triangles) > CELL_LIMITS.cell_triangles:
         raise CellFileError(path, "objects", f"its meshes and its tool's have {sum(triangles):,} triangles together, "
                             f"more than the {CELL_LIMITS.cell_triangles:,} a cell may have (cell_triangles)")

@@ -27,6 +27,7 @@ from robomax_py.spec import (
     SeamSpec,
     SpotSpec,
     TcpLimits,
+    ToolSpec,
     frozen_array,
 )
 from robomax_py.transforms import invert, pose_matrix
@@ -63,6 +64,23 @@ def _parts(parsed: CellFile, path: Path, robot: RobotSpec, triangles: list[int])
                             T_tcp_part=frozen_array(invert(_pose(part.grasp))),
                             limits=_tcp_limits(part.limits), supports=tuple(supports)))
     return tuple(out)
+
+
+def check_tool_load(robot: RobotSpec, tool: ToolSpec, parts: tuple[PartSpec, ...], path: Path) -> None:
+    """The tool's stated mass, with the heaviest part the job carries, within the robot's rated
+    payload (both stated: a tool or robot file without them is not checked). The rating holds for
+    everything on the flange, tool and part together."""
+    if robot.payload_kg is None or tool.load is None:
+        return
+    heaviest = max(parts, key=lambda p: p.mass, default=None)
+    total = tool.load.mass + (0.0 if heaviest is None else heaviest.mass)
+    if total <= robot.payload_kg:
+        return
+    weight = f"the tool '{tool.name}' weighs {tool.load.mass:g} kg ({tool.source})"
+    if heaviest is not None:
+        weight += f" and carries the part '{heaviest.name}' of {heaviest.mass:g} kg: {total:g} kg"
+    raise CellFileError(path, "tool", f"{weight}, "
+                        f"above the robot's rated payload {robot.payload_kg:g} kg ({robot.source})")
 
 
 def _index_by_name(names: list[str], what: str, key: str, path: Path) -> dict[str, int]:

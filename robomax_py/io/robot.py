@@ -42,6 +42,7 @@ from robomax_py.io.urdf import (
     urdf_base_link,
 )
 from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
+from robomax_py.program import ToolLoad
 from robomax_py.safe_files import LIMITS, checked_file, named_by, read_text
 from robomax_py.spec import (
     ControllerSpec,
@@ -58,7 +59,7 @@ __all__ = [
     "JOINT_POSITION_BOUND", "JOINT_VELOCITY_RANGE", "PACKAGE_SEARCH_DEPTH", "PACKAGE_SEARCH_PARENTS",
     "ROBOTS_ENV", "ROS_INDUSTRIAL_BASE_LINK", "ROS_PACKAGE_PATH_ENV", "CollisionFile", "ControllerFile",
     "Finite", "IkFile", "LimitsFile", "LinkName", "LoadedLimitsFile", "PoseFile", "RobotFile", "ToolFile",
-    "ToolMeshFile",
+    "ToolLoadFile", "ToolMeshFile",
     "Vec3", "check_urdf", "load_robot_spec", "load_tool_spec", "mesh_candidates", "package_dirs_for",
     "package_share_dirs", "parse_urdf", "resolve_package_uri", "resolve_robot_file", "resolve_tool_file",
     "robot_library", "shipped_robots_dir", "srdf_disabled_pairs", "urdf_base_link", "urdf_package_dirs",
@@ -186,6 +187,15 @@ class ToolMeshFile(_Strict):
     tolerance: MeshTolerance | None = None
 
 
+class ToolLoadFile(_Strict):
+    """The tool's load (docs/cell-files.md, "The tool folder"): mass, kg; centre of gravity in the
+    flange frame, m. Programs declare it where the controller takes it (RAPID tooldata, URScript
+    set_payload), and a cell checks it against the robot's rated `payload`."""
+
+    mass: Annotated[float, Field(gt=0, allow_inf_nan=False)]
+    cog: Vec3
+
+
 class ToolFile(_Strict):
     name: str
     body: str | ToolMeshFile                  # a path, or {mesh, units, scale, tolerance}
@@ -196,6 +206,7 @@ class ToolFile(_Strict):
     units: MeshUnits | None = None
     scale: MeshScale | None = None
     tolerance: MeshTolerance | None = None
+    load: ToolLoadFile | None = None          # extension: mass and centre of gravity; None: not stated
 
 
 # ------------------------------------------------------------------------------ loading
@@ -305,4 +316,6 @@ def load_tool_spec(path: Path) -> ToolSpec:
         body=meshes["body"],
         tips=meshes["tips"],
         T_flange_tcp=frozen_array(pose_matrix(parsed.tcp.xyz, rpy)),
+        load=None if parsed.load is None else ToolLoad(parsed.load.mass, (parsed.load.cog[0], parsed.load.cog[1],
+                                                                         parsed.load.cog[2])),
     )

@@ -9,6 +9,7 @@ from typing import Any, Literal
 from robomax_py._typing import FloatArray
 from robomax_py.plan.spline_moves import CartesianChoice, SplineMoves
 from robomax_py.plan.waiting import WaitPlan
+from robomax_py.program import ToolLoad
 from robomax_py.spec import CellSpec, ControllerSetup
 from robomax_py.timing import (
     Trajectory,
@@ -320,6 +321,7 @@ class PlanResult:
     joint_names: tuple[str, ...] = ()
     tool: str = ""
     T_flange_tcp: FloatArray | None = None   # (4, 4)
+    tool_load: ToolLoad | None = None        # the tool's stated load, which some dialects declare
     T_world_base: FloatArray | None = None   # (4, 4)
     T_root_controller: FloatArray | None = None   # (4, 4) the controller's base in the URDF root frame
     controller: ControllerSetup = field(default_factory=ControllerSetup)   # the cell's `robot.controller`: frames, inputs, weld style

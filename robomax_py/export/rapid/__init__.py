@@ -79,10 +79,15 @@ data used must be declared" ([R3] p. 96; [DRV]). Hence the integrator's procedur
    module is loaded at start-up from the system parameters and outlives programs; frames the
    integrator wants kept belong in the controller's own calibration module, named in the cell).
 
-The tool's load is not known to robomax: tooldata carries a point load of 1 kg at the TCP ("If all
-components are defined as being 0 kgm2, the tool is handled as if it were a spot load", [R3]
-p. 226; the centre of gravity of a tool in the wrist coordinate system, p. 183), with a comment:
-replace it with the gun's (LoadIdentify); a wrong load impairs path accuracy (p. 183).
+The tool's load is the tooldata's tload, loaddata [mass kg, cog [x, y, z] mm, aom, ix, iy, iz]
+with the centre of gravity "of a tool load expressed in the wrist coordinate system" ([R3] p. 183;
+robomax's flange frame, in which the tool file states it). A tool file that states `load` gets
+its mass and centre of gravity, as a point mass ("If all components are defined as being 0 kgm2,
+the tool is handled as if it were a spot load", [R3] p. 226; aom [1, 0, 0, 0]); one that states
+none gets a point load of 1 kg at the TCP with a comment: replace it with the gun's
+(LoadIdentify). Either way a comment says what it is; a wrong load impairs path accuracy
+(p. 183). A tool the cell names on the controller is not declared, so its load is the
+controller's.
 
 The reader takes the motion subset of any module as the controller executes it: MoveAbsJ (tool,
 `\WObj` and `\TLoad` do not change a joint target), MoveL and SpotL with declared or in-place targets

@@ -22,6 +22,7 @@ from robomax_py.export.quaternions import quaternion_from_zyx
 from robomax_py.program import (
     UNSET_FRAME,
     Comment,
+    FrameDef,
     Gripper,
     Instruction,
     LinMove,
@@ -29,6 +30,7 @@ from robomax_py.program import (
     PtpMove,
     SetSignal,
     Spot,
+    ToolLoad,
     Wait,
     WaitFor,
 )
@@ -164,6 +166,19 @@ def _tail(tool: str, base: str) -> str:
     return f", {tool or 'tool0'}" + (f" \\WObj:={base}" if base else "") + ";"
 
 
+def _tool_load(frame: FrameDef, load: ToolLoad | None) -> str:
+    """A tooldata's tload and the statement's end: loaddata [mass kg, cog [x, y, z] mm in the wrist
+    (flange) frame, aom, ix, iy, iz kgm2] ([R3] p. 183); with every inertia 0 "the tool is handled
+    as if it were a spot load" ([R3] p. 226), the axes of moment then the identity [1, 0, 0, 0]."""
+    if load is None:
+        # A 1 kg point load at the TCP: the tool file states none.
+        return (f"[1, {_xyz(frame.xyz_mm)}, [1, 0, 0, 0], 0, 0, 0]];  "
+                "! load: 1 kg at the TCP, a placeholder: replace with the gun's (LoadIdentify)")
+    cog_mm = tuple(1000.0 * v for v in load.cog)
+    return (f"[{load.mass:.3f}, {_xyz(cog_mm)}, [1, 0, 0, 0], 0, 0, 0]];  "
+            "! load: the tool file's mass and centre of gravity, a point mass: LoadIdentify adds its inertia")
+
+
 def _frames_module(program: Program) -> str:
     """The data module declaring the frames the program uses and does not find on the controller."""
     lines = ["%%%", "  VERSION:1", "  LANGUAGE:ENGLISH", "%%%", "", f"MODULE {program.name}_frames"]
@@ -172,10 +187,8 @@ def _frames_module(program: Program) -> str:
                  "(mm, quaternions [w, x, y, z]; work objects in the robot base frame, which is the world)")
     for f in program.frames:
         if f.kind == "tool":
-            # tload: a 1 kg point load at the TCP (centre of gravity in the wrist frame, no inertia).
             lines.append(f"  PERS tooldata {f.name} := [TRUE, [{_xyz(f.xyz_mm)}, {_q(f.zyx_deg)}], "
-                         f"[1, {_xyz(f.xyz_mm)}, [1, 0, 0, 0], 0, 0, 0]];  "
-                         "! load: 1 kg at the TCP, a placeholder: replace with the gun's (LoadIdentify)")
+                         f"{_tool_load(f, program.setup.tool_load)}")
         else:
             lines.append(f"  PERS wobjdata {f.name} := [FALSE, TRUE, \"\", [{_xyz(f.xyz_mm)}, {_q(f.zyx_deg)}], "
                          "[[0, 0, 0], [1, 0, 0, 0]]];")

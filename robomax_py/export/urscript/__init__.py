@@ -13,6 +13,9 @@ Language", movej / movel / set_tcp / sleep / get_standard_digital_in):
   the robot base as the UR controller defines it (ROS-Industrial's `base` link: robot.yaml
   `controller.base`), the robot's placement in the cell never written; in a user frame (a feature)
   `movel(pose_trans(<frame>, p[...]), ...)` with `global <frame> = p[...]` its pose in the base;
+- the tool's load, when its tool file states one, as `set_payload(m, [cx, cy, cz])` (kg; the
+  centre of gravity in m from the tool flange: Universal Robots, "How to change payload and center
+  of gravity settings using URScript") before the first motion; none stated, the installation's;
 - blends as `r`, the TCP distance (m) of the planned radius; 0 at every stop and weld;
 - no configuration data: the controller keeps the branch the arm is in, as robomax's LIN moves do;
 - a weld as `movel(..., r=0)` followed by `spot_weld(n, weld_time)  # seam/name`, `spot_weld`

@@ -83,6 +83,13 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     out.append(f"  # {_NOTE}: m, rad, rotation vectors; movej v rad/s, a rad/s^2; movel v m/s; blend r m")
     what = {"tool": "TCP in the flange frame", "base": "user frame in the robot base frame"}
     out += [f"  global {f.name} = {_pose(f.xyz_mm, f.zyx_deg)}  # {what[f.kind]}" for f in program.frames]
+    load = program.setup.tool_load
+    if load is not None:
+        # set_payload(m, cog): mass in kg, cog [CoGx, CoGy, CoGz] in m from the tool flange
+        # (Universal Robots, "How to change payload and center of gravity settings using URScript";
+        # "The URScript Programming Language", set_payload); the tool file states the flange frame's.
+        cog = ", ".join(f"{v:.6f}" for v in load.cog)
+        out.append(f"  set_payload({load.mass:.3f}, [{cog}])  # the tool's load: kg, centre of gravity m in the flange frame")
     first = next((i for i in program.instructions if isinstance(i, LinMove)), None)
     tool = UNSET_FRAME
     if first is not None:
