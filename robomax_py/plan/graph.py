@@ -259,6 +259,12 @@ class Sequencer(SequencerLookahead):
                 tour = Tour(found.order, choice, cost)
             if not np.isfinite(tour.cost) and self._open_dead_end(tour.order):
                 continue
+            # Else the file's order's own dead end, which every order may then use: a spot under a
+            # clamp (generated bracket cell 117), every straight move from it blocked, was joined by
+            # RRT-Connect to home, its next stop in the file, not to the best order's next spot.
+            given = tuple(s for b in blocks for s in b.spots)
+            if not np.isfinite(tour.cost) and tour.order != given and self._open_dead_end(given):
+                continue
             if not np.isfinite(tour.cost):
                 given_up = ", ".join(f"{self._name(i)} - {self._name(j)}" for i, j in sorted(self.unconnected)[:6])
                 return SequencingOutcome("disconnected", message="no collision-free connection found between some "
