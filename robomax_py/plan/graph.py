@@ -260,7 +260,7 @@ class Sequencer(SequencerLookahead):
             if not np.isfinite(tour.cost) and self._open_dead_end(tour.order):
                 continue
             # Else the file's order's own dead end, which every order may then use: a spot under a
-            # clamp (generated bracket cell 117), every straight move from it blocked, was joined by
+            # clamp (tests/data/pocket_spot), every straight move from it blocked, was joined by
             # RRT-Connect to home, its next stop in the file, not to the best order's next spot.
             given = tuple(s for b in blocks for s in b.spots)
             if not np.isfinite(tour.cost) and tour.order != given and self._open_dead_end(given):
