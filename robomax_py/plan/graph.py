@@ -229,6 +229,7 @@ class Sequencer(SequencerLookahead):
     def run(self) -> SequencingOutcome:
         """The best tour whose every leg is known free, or why there is none (a status, not None)."""
         blocks = self._blocks()
+        given = tuple(s for b in blocks for s in b.spots)          # the cell file's order
         if self._probed is None:
             self._probe_pairs()
             self._probed = ({k: dict(v) for k, v in self.straight.items()}, set(self.detour_only), self.checks)
@@ -240,9 +241,8 @@ class Sequencer(SequencerLookahead):
             # Rounds end when a tour's legs are all known free; the bar shows rounds so far.
             self.progress("sequencing", self.rounds - 1, self.rounds)
             if self.options.baseline or self.options.given_order:
-                order = tuple(s for b in blocks for s in b.spots)
-                choice, cost = self.choose(order)
-                tour = Tour(order, choice, cost)
+                choice, cost = self.choose(given)
+                tour = Tour(given, choice, cost)
             else:
                 budget = self.options.max_evaluations if self.rounds == 1 else max(50, self.options.max_evaluations // 4)
                 # Few orders are enumerated exactly over every candidate; else the search sees representatives.
@@ -262,7 +262,6 @@ class Sequencer(SequencerLookahead):
             # Else the file's order's own dead end, which every order may then use: a spot under a
             # clamp (tests/data/pocket_spot), every straight move from it blocked, was joined by
             # RRT-Connect to home, its next stop in the file, not to the best order's next spot.
-            given = tuple(s for b in blocks for s in b.spots)
             if not np.isfinite(tour.cost) and tour.order != given and self._open_dead_end(given):
                 continue
             if not np.isfinite(tour.cost):
