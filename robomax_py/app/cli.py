@@ -22,7 +22,7 @@ import sys
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from types import FrameType
-from typing import Annotated, Any
+from typing import Annotated, Any, NoReturn
 
 import typer
 
@@ -222,6 +222,12 @@ def _unraisable(default: Callable[[Any], object]) -> Callable[[Any], None]:
     return hook
 
 
+def _end_on_signal(signum: int) -> NoReturn:
+    """Exit as the received signal asked: 128 + its number, saying so."""
+    err.print("interrupted" if signum == signal.SIGINT else "terminated")
+    sys.exit(128 + signum)
+
+
 def main(restore_mask: Iterable[int] | None = None) -> None:
     """Console entry point. `restore_mask`: the signal mask to set once the handlers are installed
     (`python -m robomax_py` holds SIGINT and SIGTERM while it imports the command)."""
@@ -235,22 +241,19 @@ def main(restore_mask: Iterable[int] | None = None) -> None:
             signal.pthread_sigmask(signal.SIG_SETMASK, restore_mask)     # a held signal is delivered here
         app(args=_bare_ray_flag(_library_flags_first(sys.argv[1:])))
     except KeyboardInterrupt:
-        err.print("interrupted")
-        sys.exit(130)
+        _end_on_signal(signal.SIGINT)
     except Exception:
         if _Received.signum is None:
             raise
         # The signal's exception raised inside compiled code comes out as another error: numba's
         # dispatcher reports a KeyboardInterrupt raised while its kernel ran as "SystemError: ...
         # returned a result with an exception set". The run ends as the signal asked all the same.
-        err.print("interrupted" if _Received.signum == signal.SIGINT else "terminated")
-        sys.exit(128 + _Received.signum)
+        _end_on_signal(_Received.signum)
     except SystemExit as exc:
         if _Received.deferred and _Received.signum is not None:
             # The command ended before a signal that came during an import was delivered again.
             _Received.deferred = False
-            err.print("interrupted" if _Received.signum == signal.SIGINT else "terminated")
-            sys.exit(128 + _Received.signum)
+            _end_on_signal(_Received.signum)
         if _Received.signum == signal.SIGTERM and exc.code == 128 + signal.SIGTERM:
             err.print("terminated")
         raise
