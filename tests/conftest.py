@@ -129,6 +129,44 @@ def write_small_cell() -> SmallCell:
     return _write_small_cell
 
 
+def _write_tool(folder: Path, shipped: str, load: Any) -> Path:
+    """A copy of shipped tool `shipped` in `folder` (its meshes beside it), named after the folder,
+    with tool.yaml `load` set to `load`; its tool.yaml."""
+    from robomax_py.io.robot import shipped_robots_dir
+
+    source = shipped_robots_dir() / "tools" / shipped
+    folder.mkdir(parents=True, exist_ok=True)
+    data = yaml.safe_load((source / "tool.yaml").read_text())
+    for mesh in ("body", "tips"):
+        shutil.copy(source / data[mesh], folder / data[mesh])
+    data["name"] = folder.name
+    data["load"] = load
+    path = folder / "tool.yaml"
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+def _write_small_cell_with_tool(folder: Path, tool: Path) -> Path:
+    """The small test cell in `folder` with its tool the tool.yaml at `tool`."""
+    path = _write_small_cell(folder)
+    data = yaml.safe_load(path.read_text())
+    data["tool"] = str(tool)
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    return path
+
+
+@pytest.fixture(scope="session")
+def write_tool() -> Callable[[Path, str, Any], Path]:
+    """Writes a copy of a shipped tool with a load: write_tool(folder, shipped, load) -> its tool.yaml."""
+    return _write_tool
+
+
+@pytest.fixture(scope="session")
+def write_small_cell_with_tool() -> Callable[[Path, Path], Path]:
+    """Writes the small test cell using another tool: write_small_cell_with_tool(folder, tool_yaml)."""
+    return _write_small_cell_with_tool
+
+
 def _plan_set_state(folder: Path, name: str) -> str | None:
     """The plan id of the one consistent set of programs `name` in `folder` (None: no set, and no
     program file of the set's names readable): every file its manifest names has the manifest's

@@ -14,18 +14,14 @@ import ast
 import dataclasses
 import json
 import re
-import shutil
 from typing import Any
 
 import pytest
-import yaml
 
 from robomax_py.io.cell import load_cell, load_cell_robot
-from robomax_py.io.robot import shipped_robots_dir
 from robomax_py.plan import plan_cell
 from robomax_py.publish import publish
 
-GUN = shipped_robots_dir() / "tools" / "spot_gun_c"
 MASS_KG = 110.0
 COG_M = (0.12, -0.015, 0.18)
 # The files write mass and centre of gravity in mm to 3 decimals, m to 6: read back within these.
@@ -35,21 +31,12 @@ DIALECTS = ("rapid", "urscript")
 
 
 @pytest.fixture(scope="module")
-def written(tmp_path_factory: pytest.TempPathFactory, write_small_cell: Any) -> dict[str, Any]:
+def written(tmp_path_factory: pytest.TempPathFactory, write_tool: Any, write_small_cell_with_tool: Any) -> dict[str, Any]:
     """The small cell planned with spot_gun_c stating a 110 kg load; its RAPID and URScript files,
     and those of the same plan without the load."""
     root = tmp_path_factory.mktemp("loaded")
-    gun = root / "gun"
-    gun.mkdir()
-    data = yaml.safe_load((GUN / "tool.yaml").read_text())
-    for mesh in ("body", "tips"):
-        shutil.copy(GUN / data[mesh], gun / data[mesh])
-    data.update(name="gun", load={"mass": MASS_KG, "cog": list(COG_M)})
-    (gun / "tool.yaml").write_text(yaml.safe_dump(data, sort_keys=False))
-    path = write_small_cell(root)
-    cell_data = yaml.safe_load(path.read_text())
-    cell_data["tool"] = "gun/tool.yaml"
-    path.write_text(yaml.safe_dump(cell_data, sort_keys=False))
+    gun = write_tool(root / "gun", "spot_gun_c", {"mass": MASS_KG, "cog": list(COG_M)})
+    path = write_small_cell_with_tool(root, gun)
     cell = load_cell(path)
     robot = load_cell_robot(cell)
     result = plan_cell(cell, robot)

@@ -30,22 +30,10 @@ REPO = Path(__file__).resolve().parents[2]
 PICK_PLACE = REPO / "cells" / "pick_place.yaml"     # kr16 (rated 16 kg), parts of 4 and 1.5 kg
 
 
-def _tool(folder: Path, shipped: str, load: Any) -> Path:
-    """A copy of a shipped tool in `folder` with `load` added (its meshes copied beside it)."""
-    folder.mkdir(parents=True, exist_ok=True)
-    data = yaml.safe_load((TOOLS / shipped / "tool.yaml").read_text())
-    for mesh in ("body", "tips"):
-        shutil.copy(TOOLS / shipped / data[mesh], folder / data[mesh])
-    data["name"] = folder.name
-    data["load"] = load
-    path = folder / "tool.yaml"
-    path.write_text(yaml.safe_dump(data, sort_keys=False))
-    return path
-
-
 @pytest.fixture(scope="module")
-def gun_folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return _tool(tmp_path_factory.mktemp("tools") / "gun", "spot_gun_c", None).parent
+def gun_folder(tmp_path_factory: pytest.TempPathFactory, write_tool: Any) -> Path:
+    folder: Path = write_tool(tmp_path_factory.mktemp("tools") / "gun", "spot_gun_c", None).parent
+    return folder
 
 
 def _with_load(folder: Path, load: Any) -> Path:
@@ -101,19 +89,12 @@ def test_no_load_stated_is_none() -> None:
     assert load_tool_spec(TOOLS / "spot_gun_c" / "tool.yaml").load is None
 
 
-def _cell_with_tool(folder: Path, write_small_cell: Any, tool: Path) -> Path:
-    path: Path = write_small_cell(folder)
-    data = yaml.safe_load(path.read_text())
-    data["tool"] = str(tool)
-    path.write_text(yaml.safe_dump(data, sort_keys=False))
-    return path
-
-
-def test_a_gun_above_the_rated_payload_is_refused_at_check(tmp_path: Path, write_small_cell: Any) -> None:
+def test_a_gun_above_the_rated_payload_is_refused_at_check(tmp_path: Path, write_tool: Any,
+                                                           write_small_cell_with_tool: Any) -> None:
     """The small cell's kr125 is rated 125 kg: a 150 kg gun is refused by `check` (exit 2) naming the
     cell, the key `tool`, both figures and the robot.yaml; a 100 kg gun is a valid cell."""
-    heavy = _tool(tmp_path / "heavy", "spot_gun_c", {"mass": 150, "cog": [0.12, 0, 0.18]})
-    cell = _cell_with_tool(tmp_path / "c1", write_small_cell, heavy)
+    heavy = write_tool(tmp_path / "heavy", "spot_gun_c", {"mass": 150, "cog": [0.12, 0, 0.18]})
+    cell = write_small_cell_with_tool(tmp_path / "c1", heavy)
     with pytest.raises(CellFileError) as err:
         load_cell(cell)
     assert (err.value.file, err.value.key) == (str(cell), "tool")
@@ -127,8 +108,8 @@ def test_a_gun_above_the_rated_payload_is_refused_at_check(tmp_path: Path, write
     done = runner.invoke(app, ["plan", str(cell), "-o", str(out)])
     assert done.exit_code == EXIT_BAD_INPUT and "rated payload 125 kg" in " ".join(done.output.split())
     assert not out.exists() or not any(out.iterdir())                 # nothing written
-    light = _tool(tmp_path / "light", "spot_gun_c", {"mass": 100, "cog": [0.12, 0, 0.18]})
-    light_cell = _cell_with_tool(tmp_path / "c2", write_small_cell, light)
+    light = write_tool(tmp_path / "light", "spot_gun_c", {"mass": 100, "cog": [0.12, 0, 0.18]})
+    light_cell = write_small_cell_with_tool(tmp_path / "c2", light)
     loaded = load_cell(light_cell)
     assert loaded.tool.load is not None and loaded.tool.load.mass == 100.0
     done = runner.invoke(app, ["check", str(light_cell)])
@@ -139,12 +120,12 @@ def test_a_gun_above_the_rated_payload_is_refused_at_check(tmp_path: Path, write
     wide.print(cell_summary(loaded, load_cell_robot(loaded)))
     assert "100 kg at [0.120, 0.000, 0.180] m" in wide.file.getvalue()  # type: ignore[attr-defined]
     # At the rating exactly: within it.
-    at = _tool(tmp_path / "at", "spot_gun_c", {"mass": 125, "cog": [0, 0, 0.2]})
-    assert load_cell(_cell_with_tool(tmp_path / "c3", write_small_cell, at)).tool.load is not None
+    at = write_tool(tmp_path / "at", "spot_gun_c", {"mass": 125, "cog": [0, 0, 0.2]})
+    assert load_cell(write_small_cell_with_tool(tmp_path / "c3", at)).tool.load is not None
 
 
-def _pick_place_with(tmp_path: Path, mass: float) -> Path:
-    gripper = _tool(tmp_path / "gripper", "gripper_2f", {"mass": mass, "cog": [0, 0, 0.06]})
+def _pick_place_with(tmp_path: Path, write_tool: Any, mass: float) -> Path:
+    gripper = write_tool(tmp_path / "gripper", "gripper_2f", {"mass": mass, "cog": [0, 0, 0.06]})
     data = yaml.safe_load(PICK_PLACE.read_text())
     data["tool"] = str(gripper)
     shutil.copytree(PICK_PLACE.parent / "parts", tmp_path / "parts", dirs_exist_ok=True)
@@ -153,11 +134,11 @@ def _pick_place_with(tmp_path: Path, mass: float) -> Path:
     return path
 
 
-def test_the_gripper_and_its_heaviest_part_together_within_the_payload(tmp_path: Path) -> None:
+def test_the_gripper_and_its_heaviest_part_together_within_the_payload(tmp_path: Path, write_tool: Any) -> None:
     """kr16 (16 kg): a 12 kg gripper with the 4 kg housing is at the rating; 13 kg with it is 17 kg
     together, refused naming the part, though the gripper alone and each part alone are within it."""
-    assert load_cell(_pick_place_with(tmp_path / "ok", 12.0)).tool.load is not None
-    path = _pick_place_with(tmp_path / "over", 13.0)
+    assert load_cell(_pick_place_with(tmp_path / "ok", write_tool, 12.0)).tool.load is not None
+    path = _pick_place_with(tmp_path / "over", write_tool, 13.0)
     with pytest.raises(CellFileError) as err:
         load_cell(path)
     assert (err.value.file, err.value.key) == (str(path), "tool")
