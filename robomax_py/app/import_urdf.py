@@ -45,6 +45,7 @@ from robomax_py.app.import_urdf_fit import (
     CONVENTION_UNKNOWN,
     FLANGE_Z_WARNING,
     NUMERIC_COST,
+    AlwaysTouching,
     Convention,
     _convention,
     _fit,
@@ -111,6 +112,8 @@ class ImportResult:
     seconds: float
     unchanged: bool               # the folder existed with exactly this content: nothing written
     warnings: tuple[str, ...]
+    # Link pairs touching in every sampled posture, written to robot.yaml's `collision.disable`.
+    always_touching: AlwaysTouching
 
 
 def guess_brand(*names: str) -> str:
@@ -327,7 +330,7 @@ def import_urdf(
             if srdf_text is not None:
                 _confined(stage, f"{name}.srdf").write_text(srdf_text, encoding="utf-8")
             try:
-                solver_name, fk_error, spec, robot_warnings = _build(
+                solver_name, fk_error, spec, robot_warnings, touching = _build(
                     stage, name, urdf_name, flange, solver, brand, source, root, T_root_base,
                     None if srdf_text is None else f"{name}.srdf", roots)
             except RobotModelError as exc:
@@ -344,7 +347,7 @@ def import_urdf(
     except OSError as exc:
         raise RobotModelError(out, None, f"cannot write the robot folder: {exc.strerror or exc}") from None
     return ImportResult(out, name, solver_name, spec.controller.brand, len(meshes), len(spec.srdf_disabled_links),
-                        fk_error, time.perf_counter() - t0, unchanged, tuple(warnings))
+                        fk_error, time.perf_counter() - t0, unchanged, tuple(warnings), touching)
 
 
 def _collect_meshes(root: ET.Element, source: Path, roots: Sequence[Path],
@@ -395,13 +398,25 @@ def _collect_meshes(root: ET.Element, source: Path, roots: Sequence[Path],
 
 def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | None, brand: str | None, source: Path,
            root: ET.Element, T_root_base: FloatArray | None,
-           srdf_name: str | None, roots: Sequence[Path] = ()) -> tuple[str, float, RobotSpec, tuple[str, ...]]:
-    """Fit the IK, write robot.yaml, and load the staged folder back as any robot folder is."""
+           srdf_name: str | None, roots: Sequence[Path] = (),
+           ) -> tuple[str, float, RobotSpec, tuple[str, ...], AlwaysTouching]:
+    """Fit the IK, write robot.yaml, and load the staged folder back as any robot folder is.
+
+    Link pairs the collision world would keep checked though they touch in every one of its seeded
+    samples (`world.acm.always_touching_links`: the arm alone, pairs its SRDF disables left out)
+    would make every posture a collision. Like MoveIt's Setup Assistant, which disables the pairs
+    in collision in (nearly) all of its random samples ("Always"; moveit_setup_srdf_plugins
+    `computeDefaultCollisions(..., trials, min_collision_fraction, ...)`,
+    https://docs.ros.org/en/iron/p/moveit_setup_srdf_plugins/generated/function_compute__default__collisions_8hpp_1a2812f73b447d838cd7dba1b0ee1a0c95.html),
+    the import writes them into `collision.disable`, with the reason, and names them in its summary
+    for the user to review. Only pairs touching in *every* sample are taken: one that separates
+    anywhere may be a real collision."""
     import pinocchio as pin
 
     from robomax_py.io.robot import load_robot_spec
     from robomax_py.robot import load_robot, urdf_model
     from robomax_py.robot.ik.fit import FitError
+    from robomax_py.world.acm import CollisionOptions, always_touching_links
 
     try:
         model = urdf_model((stage / urdf_name).read_text(encoding="utf-8"))
@@ -417,14 +432,23 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
     # The file's folders too: ROS-Industrial packages name the maker (motoman_gp180_support/urdf/...).
     brand = brand or guess_brand(name, *source.parts[-4:], str(root.get("name", "")))
     convention = _convention(model, int(model.getFrameId(flange)), brand, T_root_base, source, roots)
-    _confined(stage, "robot.yaml").write_text(
-        _robot_yaml(name, urdf_name, flange, solver_name, params, brand, srdf_name, source, T_root_base, convention),
-        encoding="utf-8")
-    spec = load_robot_spec(stage / "robot.yaml")
+
+    def written(touching: AlwaysTouching | None) -> RobotSpec:
+        _confined(stage, "robot.yaml").write_text(
+            _robot_yaml(name, urdf_name, flange, solver_name, params, brand, srdf_name, source, T_root_base,
+                        convention, touching), encoding="utf-8")
+        return load_robot_spec(stage / "robot.yaml")
+
+    spec = written(None)
     robot = load_robot(spec)       # the whole folder loads: meshes, pairs, IK checked against the URDF
+    options = CollisionOptions()   # the plan's own: the same seeded samples
+    touching = AlwaysTouching(always_touching_links(robot, options), options.acm_samples)
+    if touching.pairs:
+        spec = written(touching)
+        robot = load_robot(spec)   # and loads again with the pairs written
     flange_z = _flange_z_warning(model, int(model.getFrameId(flange)), flange)
     notes = tuple(n for n in (fallback, flange_z, convention.note) if n is not None)
-    return solver_name, fk_error, spec, (*notes, *robot.warnings)
+    return solver_name, fk_error, spec, (*notes, *robot.warnings), touching
 
 
 def _unstaged(exc: RobotModelError, stage: Path, source: Path, urdf_name: str) -> RobotModelError:

@@ -33,10 +33,13 @@ def _base_yaml(T_root_base: FloatArray) -> str:
 
 
 def _robot_yaml(name: str, urdf: str, flange: str, solver: str, params: object, brand: str, srdf: str | None,
-                source: Path, T_root_base: FloatArray | None, convention: Convention | None = None) -> str:
+                source: Path, T_root_base: FloatArray | None, convention: Convention | None = None,
+                touching: AlwaysTouching | None = None) -> str:
     """The robot.yaml text. `T_root_base` (4, 4), metres: the URDF's ROS-Industrial `base` link in
     its root frame (`io.robot.urdf_base_link`), written as `controller.base`; None when the URDF has
-    none (a UR arm then gets the UR controller's base, `base_link` turned 180 deg about z)."""
+    none (a UR arm then gets the UR controller's base, `base_link` turned 180 deg about z).
+    `touching`: link pairs touching in every sampled posture, written as `collision.disable` with
+    the reason beside them, for the user to review."""
     from robomax_py.robot.ik.opw import OpwParams
     from robomax_py.robot.ik.ur import UrParams
 
@@ -82,9 +85,27 @@ def _robot_yaml(name: str, urdf: str, flange: str, solver: str, params: object, 
     if convention is not None and convention.signs:
         lines.append(f"  joint_signs: [{', '.join(str(v) for v in convention.signs)}]  # derived from the URDF's axes")
         lines.append(f"  joint_zeros_deg: [{', '.join(_number(v) for v in convention.zeros_deg)}]")
+    if touching is not None and touching.pairs:
+        lines.extend([
+            "collision:",
+            f"  # Touching in every one of the collision world's {touching.samples} seeded postures (random within the",
+            "  # joint limits), so never checked, as MoveIt's Setup Assistant disables its \"Always\" pairs: parts",
+            "  # that touch by design, or coarse meshes. Review them; remove a pair that must stay checked.",
+            "  disable:",
+            *(f"    - [{_yaml_text(a)}, {_yaml_text(b)}]  # in contact in {touching.samples} of {touching.samples} samples"
+              for a, b in touching.pairs),
+        ])
     if srdf is not None:
         lines.append(f"srdf: {srdf}")
     return "\n".join(lines) + "\n"
+
+
+@dataclass(frozen=True, slots=True)
+class AlwaysTouching:
+    """Link pairs in contact in every one of `samples` seeded postures (`world.acm.always_touching_links`)."""
+
+    pairs: tuple[tuple[str, str], ...]
+    samples: int
 
 
 def _yaml_text(text: str) -> str:

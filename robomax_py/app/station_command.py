@@ -47,7 +47,9 @@ def plan_station_files(path: Path, out_dir: Path, formats: str, speed: float | N
     if plan.status != "planned" or plan.coordination is None:
         if as_json:
             _print_json("plan", False, {"station": station.name, "status": plan.status, "message": plan.message})
-        err.print(f"[bold red]infeasible:[/] {plan.message}", soft_wrap=True)
+        from rich.markup import escape
+
+        err.print(f"[bold red]infeasible:[/] {escape(plan.message)}", soft_wrap=True)
         return EXIT_INFEASIBLE
     interlocks = allocate(station, plan.coordination.interlocks)
     signals = frozenset(x.signal for x in interlocks)

@@ -23,6 +23,7 @@ from robomax_py.plan.checked_tour import Timed, time_and_check
 from robomax_py.plan.graph import Sequencer
 from robomax_py.plan.learned_detour import LearnedDetours
 from robomax_py.plan.loads import Loads
+from robomax_py.plan.reach import always_touching_text
 from robomax_py.plan.results import (
     FailureReason,
     OrderChoice,
@@ -40,6 +41,7 @@ from robomax_py.plan.sequence import Tour, choice_for_order
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.collision_results import Contact
 from robomax_py.world.motion import min_clearance
 from robomax_py.world.scene import build_scene
 
@@ -59,6 +61,16 @@ def plan_cell(
     return _plan(cell, robot, resolved_options(cell, options), progress, known or {})
 
 
+def _in_collision(what: str, contact: Contact, world: CollisionWorld, robot: RobotModel) -> str:
+    """'<what> is in collision: a vs b', saying so when the pair touches in every one of the world's
+    samples (no posture is free of it: robot.yaml must exempt it, `plan.reach.always_touching_text`)."""
+    text = f"{what} is in collision: {contact.describe()}"
+    pieces = {(contact.piece_a, contact.piece_b), (contact.piece_b, contact.piece_a)}
+    if pieces & set(world.acm.always_in_contact):
+        text += f"; {always_touching_text(robot, contact.body_a, contact.body_b, world.acm.samples)}"
+    return text
+
+
 def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress: Progress,
           known: Mapping[tuple[str, str], SpotCandidates]) -> PlanResult:
     check_ik_work(cell, robot)              # before anything large is built
@@ -75,12 +87,12 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
 
     home_contact = world.first_contact(cell.home)
     if home_contact is not None:
-        return PlanResult(cell.name, robot.name, "infeasible", f"home is in collision: {home_contact.describe()}")
+        return PlanResult(cell.name, robot.name, "infeasible", _in_collision("home", home_contact, world, robot))
     if cell.start is not None:
         start_contact = full_world.first_contact(cell.start, 0.0)
         if start_contact is not None:
             return PlanResult(cell.name, robot.name, "infeasible",
-                              f"the stop configuration is in collision: {start_contact.describe()}")
+                              _in_collision("the stop configuration", start_contact, full_world, robot))
 
     t0 = time.perf_counter()
     spots: list[SpotCandidates] = []

@@ -6,8 +6,8 @@
   whose grid orientations put that point farther from the circle is unreachable, and by how much
   is a figure the user can act on. Arms without a spherical wrist use the whole chain's length to
   the TCP instead (a weaker bound, still never wrong).
-- Self contact: link pairs (neither adjacent nor disabled) that touch at home, or in every one of a
-  few hundred random configurations: candidates for robot.yaml `collision.disable`.
+- Self contact: link pairs (neither adjacent nor disabled) that touch at home, or in every one of the
+  collision world's seeded samples: candidates for robot.yaml `collision.disable`.
 """
 
 from __future__ import annotations
@@ -24,9 +24,9 @@ from robomax_py.robot.ik._chain import joint_axes_at_zero
 from robomax_py.spec import CellSpec
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.transforms import closest_on_line, invert
+from robomax_py.world.acm import CollisionOptions, always_touching_links
 
 WRIST_MEET_TOL_M = TOL.wrist_meet_tol_m
-CONTACT_SAMPLES = 200
 
 
 @dataclass(frozen=True, slots=True)
@@ -109,10 +109,10 @@ def _distance_to_circle(points: FloatArray, rm: _ReachModel) -> FloatArray:
     return dist
 
 
-def self_contacts(robot: RobotModel, home: FloatArray, samples: int = CONTACT_SAMPLES,
-                  seed: int = 0) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
-    """(link pairs touching at home, link pairs touching in every random sample); neither adjacent
-    nor disabled in robot.yaml. Link geometry only (the tool is checked by the planner)."""
+def self_contacts(robot: RobotModel, home: FloatArray) -> tuple[list[tuple[str, str]], list[tuple[str, str]]]:
+    """(link pairs touching at home, link pairs touching in every one of the collision world's seeded
+    samples, `world.acm.always_touching_links`); neither adjacent nor disabled in robot.yaml. Link
+    geometry only (the tool is checked by the planner)."""
     model = robot.model
     gm = robot.collision_model.copy()
     objs = list(gm.geometryObjects)
@@ -132,27 +132,20 @@ def self_contacts(robot: RobotModel, home: FloatArray, samples: int = CONTACT_SA
     gdata = gm.createData()
     for req in gdata.collisionRequests:
         req.enable_contact = True      # coal reports overlapping convex hulls only with contacts on
-    data = model.createData()
+    pin.computeCollisions(model, model.createData(), gm, gdata, np.asarray(home, dtype=float), False)
+    at_home: list[tuple[str, str]] = []
+    for k, result in enumerate(gdata.collisionResults):
+        a, b = pairs[k]
+        pair = (model.frames[objs[a].parentFrame].name, model.frames[objs[b].parentFrame].name)
+        if result.isCollision() and pair not in at_home:
+            at_home.append(pair)
+    return at_home, list(always_touching_links(robot))
 
-    def touching(q: FloatArray) -> set[int]:
-        pin.computeCollisions(model, data, gm, gdata, np.asarray(q, dtype=float), False)
-        return {k for k, r in enumerate(gdata.collisionResults) if r.isCollision()}
 
-    at_home = touching(home)
-    rng = np.random.default_rng(seed)
-    always = set(range(len(pairs)))
-    for q in rng.uniform(robot.limits.lower, robot.limits.upper, size=(samples, robot.dof)):
-        always &= touching(q)
-        if not always:
-            break
-
-    def names(ks: set[int]) -> list[tuple[str, str]]:
-        out = []
-        for k in sorted(ks):
-            a, b = pairs[k]
-            pair = (model.frames[objs[a].parentFrame].name, model.frames[objs[b].parentFrame].name)
-            if pair not in out:
-                out.append(pair)
-        return out
-
-    return names(at_home), names(always)
+def always_touching_text(robot: RobotModel, link_a: str, link_b: str,
+                         samples: int = CollisionOptions().acm_samples) -> str:
+    """What a link pair touching in every one of the collision world's `samples` samples means, and
+    how to exempt it: every posture of the arm is a collision until it is."""
+    return (f"links {link_a} and {link_b} touch in every one of the {samples} sampled "
+            f"postures (parts that touch by design, or coarse collision meshes), so every posture collides; if "
+            f"they touch by design, add [{link_a}, {link_b}] to collision.disable in {robot.source}")

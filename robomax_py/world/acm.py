@@ -71,14 +71,14 @@ from robomax_py.world.acm_types import (
 )
 from robomax_py.world.bounds import KinematicBounds, joint_path
 from robomax_py.world.prefilter import Prefilter
-from robomax_py.world.scene import Scene
+from robomax_py.world.scene import Scene, ToolGeometry
 
 # What this module offered before its parts moved out stays importable from here.
 __all__ = [
     "HELD_SUPPORT_PENETRATION_M", "KIND_DYNAMIC", "KIND_HELD", "KIND_LINK", "KIND_OBJECT", "KIND_TOOL_BODY",
     "KIND_TOOL_TIPS", "OBSTACLE_KINDS", "OUT_OF_REACH_SLACK_M", "ROBOT_KINDS", "AllowedCollisions",
-    "CollisionOptions", "DisabledPair", "Piece", "SharedGeometry", "acm_samples", "build_shared",
-    "configure_requests", "reach_spheres",
+    "CollisionOptions", "DisabledPair", "Piece", "SharedGeometry", "acm_samples", "always_touching_links",
+    "build_shared", "configure_requests", "reach_spheres",
 ]
 
 
@@ -197,8 +197,7 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
         a, b = pair
         if pair in sampled.flange_touch:
             disabled.append(DisabledPair(pieces[a].name, pieces[b].name, "tool touches flange link"))
-        elif pair in sampled.always_touch and (_is_passive_piece(model, pieces[a].joint)
-                                               or _is_passive_piece(model, pieces[b].joint)):
+        elif pair in sampled.always_touch and _passive_pair(model, pieces, pair):
             # A passive link (a balancer's cylinder or piston, a parallelogram bar) closes a
             # linkage: it meets the links it is pinned to by design, in every posture. MoveIt's
             # Setup Assistant disables such pairs too ("Always" / "Default"); a pair that separates
@@ -269,6 +268,30 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
         layout_contacts=_layout_contacts(gm, pieces, base_obstacle),
         prefilter=Prefilter.of(model, gm, [p.kind in OBSTACLE_KINDS for p in pieces], pair_a, pair_b, pair_margin),
     )
+
+
+def _passive_pair(model: pin.Model, pieces: list[Piece], pair: tuple[int, int]) -> bool:
+    return _is_passive_piece(model, pieces[pair[0]].joint) or _is_passive_piece(model, pieces[pair[1]].joint)
+
+
+def always_touching_links(robot: RobotModel, options: CollisionOptions = CollisionOptions()) -> tuple[tuple[str, str], ...]:
+    """The arm's link pairs that `build_shared` would keep checked though they touch in every one of
+    its `options.acm_samples` seeded samples: its `AllowedCollisions.always_in_contact` for the arm
+    alone (no tool, no objects), by link name, in geometry order.
+
+    The same pair rules and the same samples (`_classify_pairs`, `_sample_self_pairs`), without the
+    never-close proof: a pair touching in every sample cannot be proved apart. Pairs of a passive
+    link are left out (the world disables those itself), as are adjacent pairs and those robot.yaml
+    or its SRDF disable."""
+    eye = np.eye(4)
+    bare = Scene("", (), (), ToolGeometry("", (), (), "", "", eye), eye, int(robot.flange_frame_id))
+    gm, pieces, obstacles = _pieces(robot, bare)
+    rules = _classify_pairs(robot, bare, pieces, obstacles, set())
+    sampled = _sample_self_pairs(robot, gm, rules.self_candidates, set(), set(), options)
+    links = (
+        (pieces[a].body, pieces[b].body) for a, b in rules.self_candidates
+        if (a, b) in sampled.always_touch and not _passive_pair(robot.model, pieces, (a, b)))
+    return tuple(dict.fromkeys(links))
 
 
 def _layout_contacts(gm: pin.GeometryModel, pieces: list[Piece], pairs: list[tuple[int, int]]) -> tuple[tuple[str, str], ...]:

@@ -70,7 +70,11 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
         from robomax_py.io.cell import load_cell, load_cell_robot, read_cell_frames
         from robomax_py.io.frames import format_tree
         from robomax_py.io.station import is_station_file
-        from robomax_py.plan.reach import reach_report, self_contacts
+        from robomax_py.plan.reach import (
+            always_touching_text,
+            reach_report,
+            self_contacts,
+        )
 
         if is_station_file(cell):
             _check_station(cell, as_json)
@@ -103,8 +107,7 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
         at_home, always = self_contacts(robot, spec.home)
         _warn([f"{robot.name}: links {a} and {b} touch at home; if they touch by design, add "
                f"[{a}, {b}] to collision.disable in {robot.source}" for a, b in at_home])
-        _warn([f"{robot.name}: links {a} and {b} touch in every sampled configuration; add [{a}, {b}] "
-               f"to collision.disable in {robot.source} (or give its SRDF as srdf:)" for a, b in always])
+        _warn([f"{robot.name}: {always_touching_text(robot, a, b)} (or give its SRDF as srdf:)" for a, b in always])
         if as_json:
             _print_json("check", True, {
                 "cell": str(cell), "name": spec.name, "robot": robot.name, "tool": spec.tool.name,

@@ -73,11 +73,19 @@ def import_urdf_command(
             _print_json("import-urdf", True, {
                 "folder": str(r.folder), "name": r.name, "solver": r.solver, "fk_error_m": float(r.fk_error_m),
                 "brand": r.brand, "meshes": r.meshes, "disabled_pairs": r.disabled_pairs,
-                "seconds": round(r.seconds, 3), "unchanged": r.unchanged, "warnings": list(r.warnings)})
+                "seconds": round(r.seconds, 3), "unchanged": r.unchanged, "warnings": list(r.warnings),
+                "always_touching": {"pairs": [list(p) for p in r.always_touching.pairs],
+                                    "samples": r.always_touching.samples}})
             return
         what = "unchanged" if r.unchanged else "wrote"
         out.print(f"{what} {r.folder}: robot {r.name}, IK {r.solver} (FK agrees with the URDF within "
                   f"{r.fk_error_m:.1e} m), controller {r.brand}, {r.meshes} meshes, {r.disabled_pairs} disabled "
-                  f"pairs from the SRDF ({r.seconds:.1f} s)")
+                  f"pairs from the SRDF ({r.seconds:.1f} s)", markup=False, highlight=False, soft_wrap=True)
+        if r.always_touching.pairs:
+            pairs = ", ".join(f"[{a}, {b}]" for a, b in r.always_touching.pairs)
+            out.print(f"collision.disable: {pairs} touch in every one of {r.always_touching.samples} sampled "
+                      f"postures, so they are not checked (as MoveIt's Setup Assistant disables \"Always\" pairs); "
+                      f"review them in {r.folder / 'robot.yaml'} and remove a pair that must stay checked",
+                      markup=False, highlight=False, soft_wrap=True)
 
     _guarded(run, "import-urdf" if as_json else None)

@@ -130,7 +130,9 @@ def plan(
             for renderable in report_tables(report):
                 out.print(renderable)
         if result.status != "planned":
-            err.print(f"[bold red]infeasible:[/] {result.message}", soft_wrap=True)
+            from rich.markup import escape
+
+            err.print(f"[bold red]infeasible:[/] {escape(result.message)}", soft_wrap=True)
             from robomax_py.plan.reach import reach_report
 
             reach = {(r.seam, r.name): r for r in reach_report(spec, robot)} if result.failures else {}
