@@ -44,9 +44,13 @@ def world(reference_cell_path: Path) -> tuple[CollisionWorld, np.ndarray]:
     return CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance), np.asarray(cell.home)
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2])
-def test_skipping_finds_the_brute_force_minimum(world: tuple[CollisionWorld, np.ndarray], seed: int) -> None:
+@pytest.mark.parametrize(("seed", "prefilter"), [(0, True), (1, True), (2, True), (0, False)])
+def test_skipping_finds_the_brute_force_minimum(world: tuple[CollisionWorld, np.ndarray], seed: int,
+                                                prefilter: bool) -> None:
+    """With the pre-filter the screen leaves pairs out as well; without it, only the motion bound."""
     w, home = world
+    w = w if prefilter else w.copy(prefilter=False)
+    assert (w.distance_screen(0.0) is not None) == prefilter
     rng = np.random.default_rng(seed)
     # A walk that comes near the part and the clamps: small steps from home towards the flange.
     goal = np.array([0.0, -0.35, 0.55, 0.0, 0.6, 0.0]) + rng.uniform(-0.3, 0.3, 6)
