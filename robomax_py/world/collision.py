@@ -310,8 +310,8 @@ class CollisionWorld(SweptChecks):
         return np.array([pin.computeDistance(gm, gd, int(p)).min_distance for p in pairs], dtype=float)
 
     def distance_screen(self, distance: float) -> Prefilter | None:
-        """The pre-filter with `distance` (m) as every pair's margin, for `pairs_within`; None for a
-        world without one."""
+        """The pre-filter with `distance` (m, >= 0) as every pair's margin, for `pairs_within`; None
+        for a world without one."""
         return None if self._pf is None else self._pf.with_margin(distance)
 
     def pairs_within(self, q: FloatArray, pairs: BoolArray, screen: Prefilter) -> IntArray:

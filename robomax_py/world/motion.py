@@ -251,11 +251,12 @@ def _closest_sample(world: CollisionWorld, q: FloatArray, t: FloatArray | None =
         if t is not None:
             wanted &= world.active_pairs(float(t[i]))
         due = np.flatnonzero(wanted)
-        if len(due) >= SCREEN_MIN_PAIRS and math.isfinite(best):
+        if len(due) >= SCREEN_MIN_PAIRS and 0.0 < best < math.inf:
             # Of those, the pairs whose bounding volumes are farther apart than the best so far
             # are farther apart too and cannot lower it: not computed (their `last` stays where it
             # was, still a true distance). The screen is made again whenever the best falls (one
-            # made for a larger distance would screen fewer pairs, never a wrong one).
+            # made for a larger distance would screen fewer pairs, never a wrong one); none once
+            # two pieces touch or overlap (the bounds say nothing of how deep).
             if screened > best:
                 screen, screened = world.distance_screen(best), best
             if screen is not None:

@@ -191,7 +191,10 @@ class Prefilter:
         """This filter with `distance` (m) as every pair's margin (SLACK_M added, as to every margin):
         a pair its `uncleared` leaves out at a configuration is there provably farther apart than
         `distance`, so a search for the least distance need not compute it. Every block's and every
-        node's margin (the largest of the pairs' under it) is `distance` too."""
+        node's margin (the largest of the pairs' under it) is `distance` too. distance >= 0: the
+        bounds say nothing of how deep two pieces that overlap are."""
+        if not distance >= 0.0:
+            raise ValueError(f"a screen's distance must be >= 0 m, got {distance}")
         ints = self.ints
         n_pairs, n_blocks, n_nodes = int(ints[2]), int(ints[4]), int(ints[6])
         pairs_at, blocks_at = int(ints[_N_HEADER + _PAIR_MARGINS]), int(ints[_N_HEADER + _BLOCK_MARGINS])

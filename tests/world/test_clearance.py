@@ -110,7 +110,7 @@ def test_a_screen_leaves_out_only_pairs_farther_than_its_distance(
     q = home + fraction * (goal - home)
     every = np.arange(w.n_pairs)
     exact = w.pair_distances(q, every)
-    distance = float(np.sort(exact)[rank]) - below
+    distance = max(float(np.sort(exact)[rank]) - below, 0.0)      # a screen is for distances >= 0
     wanted = np.ones(w.n_pairs, dtype=bool)
     wanted[::3] = False                               # only the pairs asked about come back
     screen = w.distance_screen(distance)
@@ -120,3 +120,9 @@ def test_a_screen_leaves_out_only_pairs_farther_than_its_distance(
     left_out = np.setdiff1d(every[wanted], kept)
     assert np.all(exact[left_out] > distance)
     assert np.all(np.isin(np.flatnonzero(wanted & (exact <= distance)), kept))
+
+
+def test_a_screen_is_for_distances_of_at_least_zero(world: tuple[CollisionWorld, np.ndarray]) -> None:
+    w, _ = world
+    with pytest.raises(ValueError, match="distance"):
+        w.distance_screen(-1e-3)
