@@ -107,10 +107,10 @@ class Roadmap:
         if self._tree is not None and len(self.nodes) > 1:
             kk = min(k + 1, len(self.nodes))
             _, idx = self._tree.query(self.nodes * self._scale, k=kk)
-            for u, row in enumerate(idx):
+            for u, row in enumerate(idx.tolist()):          # Python ints: numpy's cost a call each
                 for v in row[1:]:
-                    self._adjacent[u].add(int(v))
-                    self._adjacent[int(v)].add(u)
+                    self._adjacent[u].add(v)
+                    self._adjacent[v].add(u)
         # Edge weights (s, estimated) computed once, vectorised.
         pairs = np.array([(u, v) for u, adj in enumerate(self._adjacent) for v in adj if u < v], dtype=np.int64)
         self._pairs = pairs.reshape(-1, 2)
@@ -118,7 +118,7 @@ class Roadmap:
         if len(pairs):
             self._pair_weight = np.asarray(ptp_time_estimate(self.nodes[pairs[:, 0]], self.nodes[pairs[:, 1]], limits),
                                            dtype=float)
-        self._edge_index = {(int(u), int(v)): e for e, (u, v) in enumerate(self._pairs)}
+        self._edge_index = {(u, v): e for e, (u, v) in enumerate(self._pairs.tolist())}
         self._edge_blocked = np.zeros(len(self._pairs), dtype=bool)
         self._edge_free: dict[tuple[int, int], bool] = {}
         # Every edge's check result, shared with `fresh` copies (which do not know them yet).

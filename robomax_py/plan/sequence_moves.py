@@ -49,7 +49,7 @@ class _Moves:
         if isinstance(where, list):
             return where
         b, row = where
-        return self.origin[:b] + [(self.origin[b][0], tuple(int(s) for s in row))] + self.origin[b + 1:]
+        return self.origin[:b] + [(self.origin[b][0], tuple(row.tolist()))] + self.origin[b + 1:]
 
     def flat(self, k: int) -> tuple[int, ...]:
         return _flatten(self.blocks(k))

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from robomax_py._typing import FloatArray
+from robomax_py._typing import BoolArray, FloatArray
 from robomax_py.robot import JointLimits
 from robomax_py.timing._common import (
     DEFAULT_DT_S,
@@ -108,15 +108,30 @@ def gridpoints(path: GeometricPath) -> FloatArray:
     s = path.grid(max(polygon * GRID_STEP_FRACTION, 1e-12))
     while len(s) < MIN_GRID_POINTS:
         s = np.sort(np.concatenate([s, 0.5 * (s[:-1] + s[1:])]))
+    turn = _turn(path, s, np.ones(len(s) - 1, dtype=bool), np.empty(len(s) - 1))
     for _ in range(20):
-        ds = np.diff(s)
-        mid = 0.5 * (s[:-1] + s[1:])
-        turn = np.linalg.norm(path(mid, 2), axis=1) * ds / np.maximum(np.linalg.norm(path(mid, 1), axis=1), 1e-12)
         split = turn > GRID_TURN_PER_STEP
         if not np.any(split) or len(s) + int(np.sum(split)) > MAX_GRID_POINTS:
             break
-        s = np.sort(np.concatenate([s, mid[split]]))
+        # Each step split at its midpoint (which lies between its ends, so the grid stays sorted);
+        # only the halves are evaluated anew, the other steps keep their turn (the same ends give
+        # the same midpoint and the same value: the path is evaluated point by point).
+        at = np.flatnonzero(split)
+        s = np.insert(s, at + 1, 0.5 * (s[at] + s[at + 1]))
+        fresh = np.repeat(split, np.where(split, 2, 1))
+        kept = np.empty(len(s) - 1)
+        kept[~fresh] = turn[~split]
+        turn = _turn(path, s, fresh, kept)
     return s
+
+
+def _turn(path: GeometricPath, s: FloatArray, fresh: BoolArray, turn: FloatArray) -> FloatArray:
+    """`turn` with its entries where `fresh` set to how far the tangent turns over each step of
+    grid s (rad, ~ |q''| ds / |q'| at the step's midpoint)."""
+    ds = np.diff(s)[fresh]
+    mid = 0.5 * (s[:-1] + s[1:])[fresh]
+    turn[fresh] = np.linalg.norm(path(mid, 2), axis=1) * ds / np.maximum(np.linalg.norm(path(mid, 1), axis=1), 1e-12)
+    return turn
 
 
 def _time_piece(

@@ -95,6 +95,7 @@ from robomax_py.world.collision_results import (
     bisection_order,
 )
 from robomax_py.world.collision_sweeps import SweptChecks
+from robomax_py.world.prefilter import Prefilter
 from robomax_py.world.scene import Scene
 
 
@@ -307,6 +308,18 @@ class CollisionWorld(SweptChecks):
         pin.updateGeometryPlacements(s.model, self._data, s.geom_model, self._gdata, np.asarray(q, dtype=np.float64))
         gm, gd = s.geom_model, self._gdata
         return np.array([pin.computeDistance(gm, gd, int(p)).min_distance for p in pairs], dtype=float)
+
+    def distance_screen(self, distance: float) -> Prefilter | None:
+        """The pre-filter with `distance` (m, >= 0) as every pair's margin, for `pairs_within`; None
+        for a world without one."""
+        return None if self._pf is None else self._pf.with_margin(distance)
+
+    def pairs_within(self, q: FloatArray, pairs: BoolArray, screen: Prefilter) -> IntArray:
+        """Of the pairs `pairs` ((p,) bool), those whose distance at q may be at most the distance
+        `screen` was made for (`distance_screen`), in pair order: each other one is provably farther
+        apart (its bounding volumes are), every dynamic obstacle present."""
+        q = np.asarray(q, dtype=np.float64)
+        return screen.uncleared(q[None], np.asarray(pairs, dtype=bool))[1]
 
     def pair_approach_factors(self) -> FloatArray:
         """(p,) how fast each enabled pair's distance can shrink, in units of `sweep_length`: 1 for

@@ -183,6 +183,10 @@ class Clearance:
 # moves no point farther than the lever arms (a few m) times this.
 REST_Q_TOL_RAD = 1e-12
 
+# `_closest_sample` screens the pairs due at a sample with the pre-filter's bounds when there are at
+# least this many (one exact distance costs about as much as the screen).
+SCREEN_MIN_PAIRS = 2
+
 
 def min_clearance(world: CollisionWorld, t: FloatArray, q: FloatArray) -> Clearance | None:
     """The smallest distance over the samples of a motion, refined on the steps either side of
@@ -221,7 +225,10 @@ def _closest_sample(world: CollisionWorld, q: FloatArray, t: FloatArray | None =
     it below the best so far: no point moves farther than `sweep_length`, so a pair's distance
     shrinks by at most its approach factor times the sweep (1 against a static obstacle, 2 between
     two moving bodies). The answer is the minimum over every pair and sample, exactly as computing
-    them all; the closest few pairs are computed at most samples, the rest rarely.
+    them all; the closest few pairs are computed at most samples, the rest rarely. Of the pairs
+    due, those the pre-filter's bounding volumes put farther apart than the best so far are not
+    computed either (`CollisionWorld.pairs_within`): about a tenth of the distances on the
+    reference cell's plan.
 
     With `t` (a scene whose obstacles come and go), only the pairs counting at each sample's time
     are candidates there: a dynamic obstacle stands still while present, so the bound holds for
@@ -237,12 +244,23 @@ def _closest_sample(world: CollisionWorld, q: FloatArray, t: FloatArray | None =
     where = np.repeat(np.asarray(q[:1], dtype=float), n_pairs, axis=0)
     counts = world.active_pairs(float(t[0])) if t is not None else np.ones(n_pairs, dtype=bool)
     best_i, best = 0, float(np.min(last[counts])) if counts.any() else math.inf
+    screen, screened = None, math.inf           # the pre-filter with margin `screened` (>= best)
     for i in range(1, len(q)):
         bound = last - factor * (np.abs(q[i] - where) @ lever)
         wanted = bound < best
         if t is not None:
             wanted &= world.active_pairs(float(t[i]))
         due = np.flatnonzero(wanted)
+        if len(due) >= SCREEN_MIN_PAIRS and 0.0 < best < math.inf:
+            # Of those, the pairs whose bounding volumes are farther apart than the best so far
+            # are farther apart too and cannot lower it: not computed (their `last` stays where it
+            # was, still a true distance). The screen is made again whenever the best falls (one
+            # made for a larger distance would screen fewer pairs, never a wrong one); none once
+            # two pieces touch or overlap (the bounds say nothing of how deep).
+            if screened > best:
+                screen, screened = world.distance_screen(best), best
+            if screen is not None:
+                due = world.pairs_within(q[i], wanted, screen)
         if not len(due):
             continue
         d = world.pair_distances(q[i], due)

@@ -26,7 +26,7 @@ world keeps coal's broad phase for every query.
 from __future__ import annotations
 
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import coal
@@ -36,6 +36,7 @@ import pinocchio as pin
 from robomax_py._typing import BoolArray, FloatArray, IntArray
 from robomax_py.world.bounds import support_points, triangles
 from robomax_py.world.prefilter_kernels import (
+    _N_HEADER,
     _near,
     _placements,
     _uncleared,
@@ -44,6 +45,9 @@ from robomax_py.world.prefilter_tree import TREE_MIN_BLOCKS, block_walk
 
 SLACK_M = 1e-6                 # m: a cleared pair's bound exceeds its margin by this (GJK decides to ~1e-9 m)
 _REVOLUTE, _PRISMATIC = 0, 1
+# Where the margins are among the float tables `_pack` is given (`Prefilter.of`): per pair, and per
+# block followed by per node of the block walk.
+_PAIR_MARGINS, _BLOCK_MARGINS = 7, 10
 _AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
 
 
@@ -182,6 +186,22 @@ class Prefilter:
                                    np.ascontiguousarray(active), np.ascontiguousarray(blocks),
                                    np.ascontiguousarray(rows, dtype=np.int64))
         return np.concatenate([[0], np.cumsum(counts)]).astype(np.int64), pairs
+
+    def with_margin(self, distance: float) -> Prefilter:
+        """This filter with `distance` (m) as every pair's margin (SLACK_M added, as to every margin):
+        a pair its `uncleared` leaves out at a configuration is there provably farther apart than
+        `distance`, so a search for the least distance need not compute it. Every block's and every
+        node's margin (the largest of the pairs' under it) is `distance` too. distance >= 0: the
+        bounds say nothing of how deep two pieces that overlap are."""
+        if not distance >= 0.0:
+            raise ValueError(f"a screen's distance must be >= 0 m, got {distance}")
+        ints = self.ints
+        n_pairs, n_blocks, n_nodes = int(ints[2]), int(ints[4]), int(ints[6])
+        pairs_at, blocks_at = int(ints[_N_HEADER + _PAIR_MARGINS]), int(ints[_N_HEADER + _BLOCK_MARGINS])
+        floats = self.floats.copy()        # only the scalar tables are read from it; the views stay
+        floats[pairs_at:pairs_at + n_pairs] = distance + SLACK_M
+        floats[blocks_at:blocks_at + n_blocks + n_nodes] = distance + SLACK_M
+        return replace(self, floats=floats)
 
     def near(self, qs: FloatArray, active: BoolArray) -> tuple[BoolArray, BoolArray]:
         """(blocks (b,) bool, pairs (p,) bool): the blocks, and the pairs of `active`, that a

@@ -1,7 +1,8 @@
 """Paths evaluated many times give the values of their first evaluation, a blend's cut found
 with fewer bisection steps (and fewer calls of the path) is the cut of the full bisection, and a
-path's grid and a stack's degree elevation computed at once are those computed piece by piece, bit
-for bit."""
+path's grid and a stack's degree elevation computed at once are those computed piece by piece, and
+toppra's grid refined by evaluating only the new steps is the grid of evaluating them all every
+round, bit for bit."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robomax_py.timing import GeometricPath
+from robomax_py.timing import GeometricPath, topp
 from robomax_py.timing.blend import _cut_at_distance
 from robomax_py.timing.paths import (
     concatenate_paths,
@@ -97,3 +98,34 @@ def test_elevating_a_stack_elevates_each_curve_as_on_its_own(seed: int, samples:
     joined = concatenate_paths([path, line])           # the line's pieces raised to the spline's degree 3
     assert np.array_equal(joined.control_points[len(path.breaks) - 1:], np.stack([elevate(c, 3) for c in
                                                                                   line.control_points]))
+
+
+def _grid_evaluating_every_step(path: GeometricPath) -> np.ndarray:
+    """`topp.gridpoints` with the turn of every step evaluated again in every round."""
+    c = path.control_points
+    polygon = float(np.sum(np.linalg.norm(np.diff(c, axis=1), axis=2)))
+    s = path.grid(max(polygon * topp.GRID_STEP_FRACTION, 1e-12))
+    while len(s) < topp.MIN_GRID_POINTS:
+        s = np.sort(np.concatenate([s, 0.5 * (s[:-1] + s[1:])]))
+    for _ in range(20):
+        ds = np.diff(s)
+        mid = 0.5 * (s[:-1] + s[1:])
+        turn = np.linalg.norm(path(mid, 2), axis=1) * ds / np.maximum(np.linalg.norm(path(mid, 1), axis=1), 1e-12)
+        split = turn > topp.GRID_TURN_PER_STEP
+        if not np.any(split) or len(s) + int(np.sum(split)) > topp.MAX_GRID_POINTS:
+            break
+        s = np.sort(np.concatenate([s, mid[split]]))
+    return s
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(seed=st.integers(0, 2**32 - 1), pieces=st.integers(1, 6), scale=st.sampled_from([1e-3, 0.05, 1.0, 3.0]))
+def test_the_refined_grid_is_the_grid_of_evaluating_every_step(seed: int, pieces: int, scale: float) -> None:
+    rng = np.random.default_rng(seed)
+    curved = _curved(rng, pieces, scale)
+    s = np.concatenate([[0.0], np.cumsum(rng.uniform(0.05, 1.0, pieces + 2))])
+    spline = spline_path(s, rng.normal(size=(pieces + 3, N)) * scale)
+    for path in (curved, spline):
+        expected = _grid_evaluating_every_step(GeometricPath(path.breaks, path.control_points))
+        got = topp.gridpoints(GeometricPath(path.breaks, path.control_points))
+        assert got.tobytes() == expected.tobytes()

@@ -4,7 +4,8 @@ On the reference cell (kr125 with the C-gun, clamps, the cabin panel as a mesh) 
 joint walk is sampled; the smallest distance over every sample computed pair by pair with
 `CollisionWorld.closest` must equal what `min_clearance` reports before its refinement step, to the
 bit; the refined value is the brute-force minimum over the sub-steps either side of that sample
-(every pair computed with `closest`), also to the bit.
+(every pair computed with `closest`), also to the bit. The pre-filter's screen it skips pairs by
+leaves out only pairs farther apart than the distance it was made for, by coal's own distance.
 """
 
 from __future__ import annotations
@@ -13,6 +14,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.world.collision import CollisionWorld
@@ -41,9 +44,13 @@ def world(reference_cell_path: Path) -> tuple[CollisionWorld, np.ndarray]:
     return CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance), np.asarray(cell.home)
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2])
-def test_skipping_finds_the_brute_force_minimum(world: tuple[CollisionWorld, np.ndarray], seed: int) -> None:
+@pytest.mark.parametrize(("seed", "prefilter"), [(0, True), (1, True), (2, True), (0, False)])
+def test_skipping_finds_the_brute_force_minimum(world: tuple[CollisionWorld, np.ndarray], seed: int,
+                                                prefilter: bool) -> None:
+    """With the pre-filter the screen leaves pairs out as well; without it, only the motion bound."""
     w, home = world
+    w = w if prefilter else w.copy(prefilter=False)
+    assert (w.distance_screen(0.0) is not None) == prefilter
     rng = np.random.default_rng(seed)
     # A walk that comes near the part and the clamps: small steps from home towards the flange.
     goal = np.array([0.0, -0.35, 0.55, 0.0, 0.6, 0.0]) + rng.uniform(-0.3, 0.3, 6)
@@ -88,3 +95,34 @@ def test_with_obstacles_that_come_and_go_the_minimum_is_the_brute_force_one(refe
     assert i == int(np.argmin(brute))
     report = min_clearance(w, t, q)
     assert report is not None and report.distance_m == _brute_refined(w, t, q, i, d)
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(fraction=st.floats(0.0, 1.0), offset=st.lists(st.floats(-0.3, 0.3), min_size=6, max_size=6),
+       rank=st.integers(0, 40), below=st.sampled_from([0.0, 1e-7, 1e-3]))
+def test_a_screen_leaves_out_only_pairs_farther_than_its_distance(
+        world: tuple[CollisionWorld, np.ndarray], fraction: float, offset: list[float], rank: int, below: float) -> None:
+    """At configurations between home and the part, a screen made for (just below) one of the
+    configuration's smallest pair distances leaves out no pair at or below that distance; the pair
+    at exactly that distance is kept."""
+    w, home = world
+    goal = np.array([0.0, -0.35, 0.55, 0.0, 0.6, 0.0]) + np.asarray(offset)
+    q = home + fraction * (goal - home)
+    every = np.arange(w.n_pairs)
+    exact = w.pair_distances(q, every)
+    distance = max(float(np.sort(exact)[rank]) - below, 0.0)      # a screen is for distances >= 0
+    wanted = np.ones(w.n_pairs, dtype=bool)
+    wanted[::3] = False                               # only the pairs asked about come back
+    screen = w.distance_screen(distance)
+    assert screen is not None
+    kept = w.pairs_within(q, wanted, screen)
+    assert np.all(wanted[kept]) and np.all(np.diff(kept) > 0)
+    left_out = np.setdiff1d(every[wanted], kept)
+    assert np.all(exact[left_out] > distance)
+    assert np.all(np.isin(np.flatnonzero(wanted & (exact <= distance)), kept))
+
+
+def test_a_screen_is_for_distances_of_at_least_zero(world: tuple[CollisionWorld, np.ndarray]) -> None:
+    w, _ = world
+    with pytest.raises(ValueError, match="distance"):
+        w.distance_screen(-1e-3)
