@@ -99,6 +99,11 @@ class FrameDef:
         Orientation as ZYX angles (A, B, C), deg (4 decimals).
     number : int
         The controller's slot for it (KUKA TOOL_DATA / BASE_DATA, FANUC UTOOL / UFRAME); 0: none.
+    in_world : bool
+        A user frame stated relative to the controller's world frame (KUKA `$WORLD`), which the
+        integrator places away from the robot base on a tilted mount (`$ROBROOT`,
+        `export.mount`); False: in the robot base frame itself. Set by the readers and adapters of
+        the dialects whose frames are so stated (KRL).
     """
 
     name: str
@@ -106,6 +111,7 @@ class FrameDef:
     xyz_mm: tuple[float, ...]
     zyx_deg: tuple[float, ...]
     number: int = 0
+    in_world: bool = False
 
     def __post_init__(self) -> None:
         _set(self, "xyz_mm", _fixed_all(self.xyz_mm, MM_DECIMALS))
@@ -319,8 +325,9 @@ class ProgramSetup:
     registers to set them from), and the controller's own names of the numbered frames the program
     selects, by the name the program refers to them with (`frame_names`: KUKA TOOL_NAME / BASE_NAME,
     which inline forms show), and the tool's load where the tool file states one (`tool_load`, for
-    the dialects that declare it: RAPID tooldata, URScript set_payload). Nothing of it is read
-    back: the statements say what they use."""
+    the dialects that declare it: RAPID tooldata, URScript set_payload), and whether the robot is
+    mounted tilted (`tilted_mount`: ceiling, wall; `export.mount`), which KRL states its base frames
+    for. Nothing of it is read back: the statements say what they use."""
 
     position_registers: tuple[int, ...] = ()
     numeric_registers: tuple[int, ...] = ()
@@ -328,6 +335,7 @@ class ProgramSetup:
     listed: tuple[FrameDef, ...] = ()
     frame_names: tuple[tuple[str, str], ...] = ()
     tool_load: ToolLoad | None = None
+    tilted_mount: bool = False
 
 
 @dataclass(frozen=True, slots=True)

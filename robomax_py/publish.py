@@ -31,6 +31,7 @@ from robomax_py.errors import (
 from robomax_py.export import (
     DIALECTS,
     controller_frames,
+    controller_world,
     render_trajectory,
     require_calibration,
 )
@@ -168,7 +169,7 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
     _same_program(fmt, main, adapted, parsed)
     read = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
     rebuilt = rebuild(read, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
-                      controller=bool(dialect.brand), station=station)
+                      controller=bool(dialect.brand), station=station, T_base_world=controller_world(dialect, cell))
     if rebuilt.problems or rebuilt.trajectory is None:
         p = rebuilt.problems[0] if rebuilt.problems else None
         where = f"line {p.line}: " if p and p.line else ""

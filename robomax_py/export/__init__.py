@@ -13,18 +13,23 @@ from __future__ import annotations
 import dataclasses
 from importlib import metadata
 
+import numpy as np
+
+from robomax_py._typing import FloatArray
 from robomax_py.errors import ExportError
 from robomax_py.export import trajectory_json
 from robomax_py.export.dialect import Dialect
+from robomax_py.export.mount import mount_rotation, robroot
 from robomax_py.export.plan_program import frame_defs, identifier
 from robomax_py.plan import PlanResult
 from robomax_py.plan.program_frames import cell_program_frames
 from robomax_py.program import FrameDef
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
+from robomax_py.transforms import invert
 
 __all__ = ["DIALECTS", "ENTRY_POINT_GROUP", "SHARED_FILES", "Dialect", "FormatChoice", "SkippedFormat",
-           "choose_formats", "controller_frames", "dialect_for_file", "format_names", "load_dialects", "native_dialect",
+           "choose_formats", "controller_frames", "controller_world", "dialect_for_file", "format_names", "load_dialects", "native_dialect",
            "render_trajectory", "require_calibration"]
 
 # The entry point group program dialects register under (pyproject.toml): each entry point names a
@@ -77,6 +82,17 @@ def controller_frames(dialect: Dialect, cell: CellSpec) -> tuple[FrameDef, ...]:
             named.add(("base", identifier(setup.frame.frame.name)))
         frames = tuple(f for f in frames if (f.kind, f.name) in named)
     return tuple(dataclasses.replace(f, name=dialect.frame_name(f)) for f in frames)
+
+
+def controller_world(dialect: Dialect, cell: CellSpec) -> FloatArray:
+    """(4, 4) the controller's world frame in its robot base frame, as the integrator sets the
+    controller up for the cell's mounting (`export.mount`): KUKA's $WORLD is inv($ROBROOT), and
+    $ROBROOT holds a tilted mount's rotation; every other dialect's frames are the robot base's."""
+    if dialect.brand != "kuka":
+        return np.eye(4)
+    return invert(robroot(mount_rotation(cell.T_world_base, cell.robot.controller.T_root_base)))
+
+
 def native_dialect(brand: str, dialects: dict[str, Dialect] | None = None) -> str | None:
     """The `--format` name of a controller brand's own dialect (the first registered for it), or
     None for a brand robomax has no dialect for."""

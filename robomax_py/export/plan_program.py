@@ -23,6 +23,7 @@ from robomax_py._typing import FloatArray
 from robomax_py._version import __version__
 from robomax_py.errors import ExportError
 from robomax_py.export.dialect import PlannedProgram
+from robomax_py.export.mount import is_tilted, mount_rotation
 from robomax_py.plan import PlanResult
 from robomax_py.plan.lead_in import START_LABEL
 from robomax_py.plan.program_frames import ProgramFrames, program_frames
@@ -177,7 +178,8 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
                         flyby=math.degrees(retract_radius), comment="retract", accel=1.0 if after is None else after.accel))
     header = Header(identifier(result.cell), identifier(result.robot), identifier(result.tool), traj.duration,
                     tuple(identifier(j) for j in result.joint_names), f"robomax_py {__version__}", cell_sha256, stamp)
-    handed = ProgramSetup(setup.position_registers, setup.numeric_registers, setup.weld, tool_load=result.tool_load)
+    handed = ProgramSetup(setup.position_registers, setup.numeric_registers, setup.weld, tool_load=result.tool_load,
+                          tilted_mount=is_tilted(mount_rotation(result.T_world_base, C)))
     return PlannedProgram(Program(identifier(result.cell), header, frames, tuple(out), handed), tuple(joints), setup)
 
 

@@ -27,6 +27,10 @@ What a program states, in KRL's own terms:
   frames' values go into a setup program `<name>_frames.src` (``TOOL_DATA[t] = {...}``, ``BASE_DATA[b]
   = {...}``) that the integrator runs once or compares with the calibrated values; KSS declares
   TOOL_DATA[16] and BASE_DATA[32] in $config.dat. The robot's placement in the cell is never written.
+- A robot mounted tilted (ceiling, wall; `export.mount`) has its mounting in $ROBROOT, and $BASE is
+  relative to $WORLD: its base frames are ``BASE_DATA[b] = $ROBROOT : {...}`` (KRL's geometric
+  operator, the right frame stated in the left one), the robot base frame ``BASE_DATA[1] =
+  $ROBROOT`` in place of BASE_NO 0 (which would be $WORLD), and the program's note line says so.
 - Speeds: PTP ``Vel`` in whole percent; LIN ``Vel`` in m/s, stated exactly in BAS's argument (what
   the controller moves at) and the LDAT's VEL, and in the fold text (``Vel=``, ``5:``) to 3 decimals
   (1 mm/s; the inline form's own display precision is UNCONFIRMED, and a person who opens and saves
@@ -80,7 +84,8 @@ aggregates, missing components keeping their last value), BAS calls and the PDAT
 use (as above), ``$VEL``, ``$ACC_AXIS``, ``$APO`` assignments, ``C_DIS``/``C_PTP``, ``WAIT SEC``,
 ``WAIT FOR``, calls of ``spot_weld`` and ``USERSPOT(#SPOT,...)``, the frames in force at each motion
 (``$TOOL`` / ``$BASE`` set to literals, to ``TOOL_DATA[n]`` / ``BASE_DATA[n]`` or to ``$NULLFRAME``,
-or by an FDAT; the values of TOOL_DATA / BASE_DATA from a setup program when given). A fold's text
+or by an FDAT; ``$BASE = $ROBROOT`` or ``$ROBROOT : {...}``; the values of TOOL_DATA / BASE_DATA from
+a setup program when given, literals relative to $WORLD and those on $ROBROOT to the robot base). A fold's text
 that disagrees with its statements is noted among the ignored statements: the statements run. Other
 motions (CIRC, SPTP, *_REL, a PTP to a Cartesian point, a point declared outside the program, an
 external TCP ...) are reported as not simulated, everything else as ignored. Files may have CRLF

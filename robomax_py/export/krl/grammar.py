@@ -20,9 +20,10 @@ target: NAME | aggregate
 aggregate: "{" (NAME ":")? [field ("," field)*] "}"
 field: NAME ("[" "]")? value
 ?value: NUMBER | BITS | NAME | ENUM | STRING
-assign: SYSVAR ("." NAME)? ("[" NUMBER "]")? "=" (NUMBER | aggregate | SYSVAR | indexed | NAME)
+assign: SYSVAR ("." NAME)? ("[" NUMBER "]")? "=" (NUMBER | aggregate | linked | indexed | NAME)
 indexed: NAME "[" NUMBER "]"
-frame_data: NAME "[" NUMBER "]" "=" aggregate
+linked: SYSVAR [":" aggregate]
+frame_data: NAME "[" NUMBER "]" "=" (aggregate | linked)
 weld: "spot_weld"i "(" NUMBER "," NUMBER ")"
 gripper: GRIPPER "(" NUMBER "," NUMBER ")"
 wait_sec: "WAIT"i "SEC"i NUMBER

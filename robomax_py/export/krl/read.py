@@ -46,6 +46,16 @@ from robomax_py.robot import RobotModel
 from robomax_py.robot.ik.config import ConfigIndicator
 
 
+def _linked(value: Tree[Token] | Token) -> str | None:
+    """The system variable a frame value is stated on (`$ROBROOT` of `$ROBROOT : {...}` or of a
+    plain `$ROBROOT`, upper case), None for an aggregate or anything else."""
+    if isinstance(value, Tree) and value.data == "linked":
+        return str(value.children[0]).upper()
+    if isinstance(value, Token) and value.type == "SYSVAR":
+        return str(value).upper()
+    return None
+
+
 class _Reader(_DataReader):
     """The reader with its statements' handlers (`_DataReader.statement` calls `on_<rule>`)."""
 
@@ -58,30 +68,38 @@ class _Reader(_DataReader):
         elif str(var).upper() == "$OUT":
             self.outputs[int(float(str(number)))] = str(name)
 
-    def declare_frame(self, name: str, kind: str, node: Tree[Token], line: int, number: int = 0) -> None:
-        """A frame's value as the program states it (missing components are 0, as in $NULLFRAME)."""
-        agg = self.aggregate(node, line)
+    def declare_frame(self, name: str, kind: str, node: Tree[Token] | None, line: int, number: int = 0,
+                      in_world: bool = False) -> None:
+        """A frame's value as the program states it (missing components are 0, as in $NULLFRAME;
+        no aggregate: $NULLFRAME). A base frame is relative to $WORLD unless stated on $ROBROOT."""
+        agg = {} if node is None else self.aggregate(node, line)
         xyz = tuple(float(agg.get(k, 0.0)) for k in "XYZ")       # type: ignore[arg-type]
         zyx = tuple(float(agg.get(k, 0.0)) for k in "ABC")       # type: ignore[arg-type]
         self.frames = [f for f in self.frames if (f.kind, f.name) != (kind, name)]
-        self.frames.append(FrameDef(name, kind, xyz, zyx, number))      # type: ignore[arg-type]
+        self.frames.append(FrameDef(name, kind, xyz, zyx, number, in_world and kind == "base"))  # type: ignore[arg-type]
 
     def on_frame_data(self, tree: Tree[Token], comment: str, line: int) -> None:
-        """`TOOL_DATA[n] = {...}` / `BASE_DATA[n] = {...}`: the controller's stored frame n."""
+        """`TOOL_DATA[n] = {...}` / `BASE_DATA[n] = {...}`: the controller's stored frame n;
+        `BASE_DATA[n] = $ROBROOT : {...}` (or `$ROBROOT`): a base frame in the robot base frame."""
         array, index, value = tree.children
         kind = {"TOOL_DATA": "tool", "BASE_DATA": "base"}.get(str(array).upper())
-        if kind is None:
+        on = _linked(value)
+        if kind is None or on not in (None, "$ROBROOT", "$NULLFRAME", "$WORLD") or (kind == "tool" and on == "$ROBROOT"):
             self.ignored.append((line, f"{array}[{index}] = ..."))
             return
         n = int(float(str(index)))
-        self.declare_frame(f"{str(array).upper()}[{n}]", kind, value, line, n)      # type: ignore[arg-type]
+        node = value if on is None else value.children[1]          # type: ignore[union-attr]
+        self.declare_frame(f"{str(array).upper()}[{n}]", kind, node, line, n, in_world=on != "$ROBROOT")  # type: ignore[arg-type]
 
     def on_assign(self, tree: Tree[Token], comment: str, line: int) -> None:
-        toks = [c for c in tree.children if isinstance(c, Token)]
+        rhs = tree.children[-1]
+        on = _linked(rhs)
+        if isinstance(rhs, Tree) and rhs.data == "linked" and rhs.children[1] is None:
+            rhs = rhs.children[0]                        # a plain system variable
+        toks = [c for c in (*tree.children[:-1], rhs) if isinstance(c, Token)]
         var = str(toks[0]).upper()
         member = str(toks[1]).upper() if len(toks) > 2 and toks[1].type == "NAME" else ""
         index = next((int(float(t)) for t in toks[1:-1] if t.type == "NUMBER"), None)
-        rhs = tree.children[-1]
         number = float(rhs) if isinstance(rhs, Token) and rhs.type == "NUMBER" else None
         if var == "$OUT" and index is not None and isinstance(rhs, Token) and str(rhs).upper() in ("TRUE", "FALSE"):
             self.add(SetSignal(self.outputs.get(index, f"OUT_{index}"), index, str(rhs).upper() == "TRUE"), line)
@@ -90,7 +108,12 @@ class _Reader(_DataReader):
             kind = "tool" if var == "$TOOL" else "base"
             if isinstance(rhs, Tree) and rhs.data == "aggregate":
                 name = f"{var} of line {line}"
-                self.declare_frame(name, kind, rhs, line)
+                self.declare_frame(name, kind, rhs, line, in_world=True)
+            elif kind == "base" and on == "$ROBROOT":     # $BASE = $ROBROOT (: {...}): in the robot base frame
+                name = "$ROBROOT" if isinstance(rhs, Token) else f"{var} of line {line}"
+                self.declare_frame(name, kind, None if isinstance(rhs, Token) else rhs.children[1], line)  # type: ignore[arg-type]
+            elif isinstance(rhs, Tree) and rhs.data == "linked":
+                name = f"{str(rhs.children[0]).upper()} : {{...}}"   # another frame's linkage: not known here
             elif isinstance(rhs, Tree):                  # TOOL_DATA[n] / BASE_DATA[n]
                 array, n = rhs.children
                 name = f"{str(array).upper()}[{int(float(str(n)))}]"

@@ -61,6 +61,8 @@ _NAME_CHARS = 24
 _APO_DEFAULT_MM = 100.0
 
 _NOTE = "KRL of KSS 8.x"
+# The name the robot base frame gets on a tilted mount (`_robot_base_slot`), shown in the folds.
+ROBOT_BASE_FRAME = "robot_base"
 _AXES = ("A1", "A2", "A3", "A4", "A5", "A6")
 _EXTERNAL = ",".join(f"E{i} 0.0" for i in range(1, 7))
 _DATA_TYPES = ("E6AXIS", "AXIS", "E6POS", "POS", "FRAME", "FDAT", "PDAT", "LDAT", "SPOT_TYPE")
@@ -104,13 +106,21 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     """The program as KRL states it: frames by number (with the cell's names for the folds), KUKA
     configuration data, TCP-distance blends, whole-percent PTP speeds and accelerations, waits on
     input numbers, the package's welds with `weld: package`, and each move's note as a comment
-    line before its fold (the smartPAD shows the fold line, not the statements inside)."""
+    line before its fold (the smartPAD shows the fold line, not the statements inside). On a
+    tilted mount the base frames are relative to $ROBROOT, the robot base frame itself in a slot
+    of its own (`_robot_base_slot`)."""
     require_six_axes(robot, "KRL")
     numbered_frames(planned.program, "KRL", TOOL_SLOTS, BASE_SLOTS)
     numbered_inputs(planned.program, "KRL", 1, INPUTS)
     numbered_outputs(planned.program, "KRL", 1, OUTPUTS)
-    names = tuple((frame_name(f), f.name) for f in planned.program.frames)
-    program = with_frame_names(planned.program, frame_name)
+    tilted = planned.program.setup.tilted_mount
+    program = _robot_base_slot(planned.program) if tilted else planned.program
+    # $BASE is relative to $WORLD (mount.py); on a tilted mount the frames are stated relative to
+    # $ROBROOT, which is the robot base frame.
+    program = dataclasses.replace(program, frames=tuple(dataclasses.replace(f, in_world=f.kind == "base" and not tilted)
+                                                        for f in program.frames))
+    names = tuple((frame_name(f), f.name) for f in program.frames)
+    program = with_frame_names(program, frame_name)
     program = with_brand_configs(program, planned.joints, robot, "kuka")
     program = with_tcp_blends(dataclasses.replace(planned, program=program), robot)
     program = with_package_welds(program, "KRL")
@@ -129,6 +139,19 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
         out.append(ins)
     setup = dataclasses.replace(program.setup, frame_names=names)
     return dataclasses.replace(program, name=program_name(program.name), instructions=tuple(out), setup=setup)
+
+
+def _robot_base_slot(program: Program) -> Program:
+    """The program with the robot base frame as a base frame of its own when it names no user
+    frame: on a tilted mount BASE_NO 0 would select $WORLD (BAS.SRC BASE(0)), which the
+    integrator's $ROBROOT turns away from the robot base; BASE_DATA[n] = $ROBROOT is the robot
+    base frame whatever the mounting. It takes the lowest base slot (the program uses none)."""
+    if any(f.kind == "base" for f in program.frames):
+        return program
+    frame = FrameDef(ROBOT_BASE_FRAME, "base", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), 1)
+    moves = tuple(dataclasses.replace(i, base=ROBOT_BASE_FRAME) if isinstance(i, LinMove) and i.base == NULL_FRAME
+                  else i for i in program.instructions)
+    return dataclasses.replace(program, frames=(*program.frames, frame), instructions=moves)
 
 
 # ================================================================================== writing
@@ -261,6 +284,8 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
              f"DEF {name}( )", *(f"; {text}" for text in header_lines(program.header)),
              (f"; {_NOTE}: inline forms; mm, deg; PTP Vel %, LIN Vel m/s; blends C_DIS with the APO_DIST (mm) of "
               "each point's PDAT / LDAT")]
+    if program.setup.tilted_mount:
+        w.src.append(f"; {_NOTE}, {_TILTED}")      # read as the note (read.py), not as a statement
     w.src += [f"SIGNAL {sig} $IN[{k}]" for sig, k in _signals(program).items()]
     w.src += [f"SIGNAL {sig} $OUT[{k}]" for sig, k in _outputs(program).items()]
     w.src += [";FOLD INI;%{PE}", "  ;FOLD BASISTECH INI", "    GLOBAL INTERRUPT DECL 3 WHEN $STOPMESS==TRUE DO IR_STOPM ( )",
@@ -332,15 +357,27 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
 
 
 def _frames_program(program: Program) -> str:
-    """The setup program: the frames' values in the controller's TOOL_DATA / BASE_DATA."""
+    """The setup program: the frames' values in the controller's TOOL_DATA / BASE_DATA. On a
+    tilted mount each base frame is `$ROBROOT : {...}` (KRL's geometric operator: the frame on
+    the right stated in the one on the left), or `$ROBROOT` itself for the robot base frame."""
+    tilted = program.setup.tilted_mount
     lines = ["&ACCESS RVP", "&REL 1", f"DEF {program.name}_frames( )", *(f"; {t}" for t in header_lines(program.header)),
              f"; the frames {program.name}.src selects: run once to store them, or compare them with the calibrated ones",
-             "; (mm, deg; BASE_DATA in the robot base frame, $ROBROOT = $WORLD)"]
+             f"; {_TILTED}" if tilted else "; (mm, deg; BASE_DATA in the robot base frame, $ROBROOT = $WORLD)"]
     for f in program.frames:
         what = "tool (TCP in the flange frame)" if f.kind == "tool" else "user frame in the robot base frame"
-        lines.append(f"{f.name} = {_frame(f.xyz_mm, f.zyx_deg)} ; {what}")
+        value = _frame(f.xyz_mm, f.zyx_deg)
+        if tilted and f.kind == "base":
+            value = "$ROBROOT" if not any(f.xyz_mm) and not any(f.zyx_deg) else f"$ROBROOT : {value}"
+        lines.append(f"{f.name} = {value} ; {what}")
     lines.append("END")
     return "\n".join(lines) + "\n"
+
+
+# Why a tilted robot's program states its base frames relative to $ROBROOT (mount.py gives the sources).
+_TILTED = ("mounted tilted (ceiling, wall): $BASE is relative to $WORLD, and $ROBROOT holds the mounting, so "
+           "the base frames are BASE_DATA[n] = $ROBROOT : {...} in the robot base frame (mm, deg), the robot base "
+           "itself $ROBROOT")
 
 
 def _signals(program: Program) -> dict[str, int]:

@@ -12,6 +12,8 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import ProgramError
+from robomax_py.export.mount import stated_as_if_upright
+from robomax_py.export.plan_program import frame_defs
 from robomax_py.export.rebuild.result import (
     CONFIG_TOL_RAD,
     FRAME_TOL_DEG,
@@ -33,6 +35,7 @@ from robomax_py.export.rebuild.welds import (
     schedule_time,
     weld_time_problem,
 )
+from robomax_py.plan.program_frames import cell_program_frames
 from robomax_py.plan.waiting import clear_wait, signal_of
 from robomax_py.program import (
     NULL_FRAME,
@@ -71,7 +74,7 @@ from robomax_py.world.scene import clamps_near
 def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | str,
             lines: tuple[int, ...] | None = None, brand: str | None = None,
             stored: tuple[FrameDef, ...] = (), controller: bool = False,
-            station: frozenset[str] | None = None) -> Rebuilt:
+            station: frozenset[str] | None = None, T_base_world: FloatArray | None = None) -> Rebuilt:
     """Rebuild the motion; ProgramError when the program is not for this cell's robot.
 
     lines : the program line of each instruction (as the parser read them), for messages.
@@ -90,6 +93,9 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
     station : the signals the robots of a station set (a station replay); a wait for one of them,
         or for a signal the cell does not know, is then a `SignalEvent` that takes no time here.
         None: a lone program, whose waits for unknown signals are problems.
+    T_base_world : (4, 4) the controller's world frame in its robot base (KUKA inv($ROBROOT),
+        `export.controller_world`): what a user frame stated in the world frame (`FrameDef.in_world`)
+        and the dialect's base 0 (KUKA $WORLD) are composed on. None: the robot base itself.
     A program that does not name its robot (a header with robot "" and no joints, as
     programs written by others) is taken to be for the cell's robot, joints in URDF order.
     """
@@ -100,6 +106,7 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
         raise ProgramError(file, "AXES", f"expected {list(robot.joint_names)}, got {list(header.joints)}")
     builder = _Builder(cell, robot, brand or robot.controller.brand, {**_by_name(stored), **_by_name(program.frames)},
                        controller, station)
+    builder.T_base_world = np.eye(4) if T_base_world is None else np.asarray(T_base_world, dtype=float)
     numbered = [(ins, None if lines is None else lines[i]) for i, ins in enumerate(program.instructions)]
     moves = [(ins, line) for ins, line in numbered if not isinstance(ins, Comment)]
     if not moves or not isinstance(moves[0][0], PtpMove):
@@ -144,6 +151,7 @@ class _Builder:
         self.cell, self.robot, self.brand = cell, robot, brand
         self.controller = controller                       # configuration data in the controller's joint values
         self.frames = frames
+        self.T_base_world = np.eye(4)                      # the controller's world in its robot base
         self.reported: set[tuple[str, str]] = set()        # frames whose difference is reported
         self.tools: list[FloatArray | None] = []           # of the pending steps: the tool of each LIN
         self.segments: list[Segment] = []
@@ -284,7 +292,9 @@ class _Builder:
         for kind, name in (("tool", ins.tool), ("base", ins.base)):
             what = "tool" if kind == "tool" else "user frame (base)"
             if name == NULL_FRAME:
-                out.append(np.eye(4))
+                # No tool: the flange; no user frame: the dialect's base 0 (KUKA $WORLD, which
+                # the integrator's $ROBROOT places away from the robot base on a tilted mount).
+                out.append(np.eye(4) if kind == "tool" else self._on_world(name, np.eye(4)))
                 continue
             if name == UNSET_FRAME:
                 self.problems.append(Problem(self.t, "frame", f"the program selects no {what} before this move: the "
@@ -296,10 +306,23 @@ class _Builder:
                 self.problems.append(Problem(self.t, "frame", f"the move uses {what} {name}, whose value neither the "
                                                               f"program nor the cell gives (known: {known})", self.line))
                 return None
-            out.append(frame.pose)
+            out.append(self._on_world(name, frame.pose) if frame.in_world else frame.pose)
         tool, base = out
         self._check_tool(ins.tool, tool)
         return tool, base
+
+    def _on_world(self, name: str, T_world_frame: FloatArray) -> FloatArray:
+        """A user frame stated in the controller's world frame, in the robot base; one stated as if
+        a tilted robot's $ROBROOT were $WORLD is reported once (`mount.stated_as_if_upright`)."""
+        if ("base", name) not in self.reported:
+            self.reported.add(("base", name))
+            base = frame_defs(cell_program_frames(self.cell))[1:]
+            found = stated_as_if_upright(name, self.T_base_world, T_world_frame, base[0].pose if base else np.eye(4),
+                                         FRAME_TOL_MM, FRAME_TOL_DEG)
+            if found:
+                self.problems.append(Problem(self.t, "frame", found, self.line))
+        out: FloatArray = self.T_base_world @ T_world_frame
+        return out
 
     def _check_tool(self, name: str, T_flange_tcp: FloatArray) -> None:
         """A tool unlike the cell's gun is reported once: the arm follows the program's tool, and
