@@ -189,6 +189,17 @@ class SequencerDetours(SequencerKnowledge):
         ranked = np.argsort(est, axis=None, kind="stable")[:WITHDRAW_PAIRS]
         return sa, sb, [(int(x), int(y)) for x, y in (np.unravel_index(int(flat), est.shape) for flat in ranked)]
 
+    def _raised(self, idx: int, col: int, e: int, h: float) -> FloatArray:
+        """Exit e of spot idx's candidate col (`_exits`) with the TCP raised by h (world up), as
+        `_moved` gives it (NaN where the column has none). Cached: the withdrawn detours of every pair
+        a candidate ends asked the same inverse kinematics again (a third of a clamped bracket's
+        failed detour searches)."""
+        key = (idx, col, e, h)
+        got = self._raised_cache.get(key)
+        if got is None:
+            got = self._raised_cache[key] = self._moved(idx, col, self._exits(idx, col)[e], (h * self._up())[None])[0]
+        return got
+
     def _withdrawn_detour(self, i: int, a: int, j: int, b: int) -> Detour | None:
         """Off the flange, (up,) across, (down,) onto the flange: each end leaves its approach point
         perpendicular to the electrode axis (`_exits`), then the straight move between the two exits,
@@ -200,7 +211,6 @@ class SequencerDetours(SequencerKnowledge):
         if exits is None:
             return None
         sa, sb, pairs = exits
-        up = self._up()
         checks = 0
         for heights in ((0.0,), LIFT_HEIGHTS_M):
             for x, y in pairs:
@@ -209,8 +219,8 @@ class SequencerDetours(SequencerKnowledge):
                     if h == 0.0:
                         path = np.array([qa, ea, eb, qb])
                     else:
-                        ra = ea if i == HOME else self._moved(i, a, ea, (h * up)[None])[0]
-                        rb = eb if j == HOME else self._moved(j, b, eb, (h * up)[None])[0]
+                        ra = ea if i == HOME else self._raised(i, a, x, h)
+                        rb = eb if j == HOME else self._raised(j, b, y, h)
                         if np.isnan(ra).any() or np.isnan(rb).any():
                             continue
                         path = np.array([qa, ea, ra, rb, eb, qb])

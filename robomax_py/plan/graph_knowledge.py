@@ -95,6 +95,7 @@ class SequencerKnowledge:
         self.failed_detours: Counter[tuple[int, int]] = Counter()                 # unordered spot pair -> searches
         self.unconnected: set[tuple[int, int]] = set()                            # unordered spot pairs given up
         self._exit_cache: dict[tuple[int, int], list[FloatArray]] = {}            # (spot, candidate) -> exits
+        self._raised_cache: dict[tuple[int, int, int, float], FloatArray] = {}   # (spot, candidate, exit, h) -> q
         self._inner: dict[tuple[int, bool], float] = {}                           # (detour, reversed) -> time
         self.tcp_detour_searches = 0          # `planner.detour_moves: lin`: searches for TCP lines
         self.tcp_detours_found = 0            # ... and those that found them
