@@ -12,6 +12,7 @@ from pathlib import Path
 
 import yaml
 from typer.testing import CliRunner
+from urdf_case import six_joint_urdf
 
 from robomax_py.app.cli import app
 from robomax_py.world.acm import CollisionOptions
@@ -24,16 +25,8 @@ def _touchy_urdf(path: Path) -> Path:
     axes = ["0 0 1", "0 1 0", "0 1 0", "1 0 0", "0 1 0", "1 0 0"]
     origins = ["0 0 0.4", "0.1 0 0.3", "0 0 0", "0.5 0 0", "0.2 0 0", "0.1 0 0"]
     box = '<collision><origin xyz="{}"/><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'
-    geometry = {1: box.format("0.1 0 0.3"), 3: box.format("0 0 0")}     # both around joint 2's point
-    links = "".join(f'<link name="l{i}">{geometry.get(i, "")}</link>' for i in range(7))
-    joints = "".join(
-        f'<joint name="j{i + 1}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
-        f'<origin xyz="{o}"/><axis xyz="{a}"/><limit lower="-3" upper="3" effort="1" velocity="2"/></joint>'
-        for i, (a, o) in enumerate(zip(axes, origins)))
-    path.write_text(f'<robot name="touchy">{links}{joints}<link name="tool0"/><joint name="j_t" type="fixed">'
-                    f'<parent link="l6"/><child link="tool0"/><origin xyz="0.05 0 0" rpy="0 1.5707963267948966 0"/>'
-                    f'</joint></robot>')
-    return path
+    # Both boxes around joint 2's point: l1 and l3 overlap in every posture.
+    return six_joint_urdf(path, "touchy", axes, origins, {1: box.format("0.1 0 0.3"), 3: box.format("0 0 0")})
 
 
 def test_import_writes_pairs_touching_in_every_sample_into_collision_disable(tmp_path: Path) -> None:

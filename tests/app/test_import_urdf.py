@@ -18,6 +18,7 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
+from urdf_case import six_joint_urdf
 
 from robomax_py.app.cli import app
 from robomax_py.app.import_urdf import guess_brand, import_urdf
@@ -180,15 +181,7 @@ def _non_opw_urdf(path: Path) -> Path:
     """Six revolute joints whose axes 2 and 3 are perpendicular (neither OPW nor UR), no meshes."""
     axes = ["0 0 1", "0 1 0", "1 0 0", "1 0 0", "0 1 0", "1 0 0"]
     origins = ["0 0 0.4", "0.1 0 0.3", "0 0 0.6", "0.5 0 0", "0.2 0 0", "0.1 0 0"]
-    links = "".join(f'<link name="l{i}"/>' for i in range(7))
-    joints = "".join(
-        f'<joint name="j{i + 1}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
-        f'<origin xyz="{o}"/><axis xyz="{a}"/><limit lower="-3" upper="3" effort="1" velocity="2"/></joint>'
-        for i, (a, o) in enumerate(zip(axes, origins)))
-    path.write_text(f'<robot name="odd6">{links}{joints}<link name="tool0"/><joint name="j_t" type="fixed">'
-                    f'<parent link="l6"/><child link="tool0"/><origin xyz="0.05 0 0" rpy="0 1.5707963267948966 0"/>'
-                    f'</joint></robot>')
-    return path
+    return six_joint_urdf(path, "odd6", axes, origins)
 
 
 def test_fall_back_to_numeric_ik_says_why_and_what_it_costs(tmp_path: Path) -> None:
