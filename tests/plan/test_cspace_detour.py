@@ -13,12 +13,19 @@ import numpy as np
 import pytest
 import yaml
 
+from robomax_py.cspace.grid import nearest_cell
 from robomax_py.errors import CellFileError
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions
-from robomax_py.plan.cspace_detour import grid_detour
+from robomax_py.plan.cspace_detour import (
+    MARGIN_RAD,
+    RESOLUTION,
+    grid_detour,
+    local_grid,
+)
 from robomax_py.plan.results import resolved_options
 from robomax_py.world.collision import CollisionWorld
+from robomax_py.world.collision_results import SegmentCheck
 from robomax_py.world.scene import build_scene
 
 REPO = Path(__file__).resolve().parents[2]
@@ -96,3 +103,54 @@ def test_a_map_whose_start_cell_is_blocked_is_not_checked_further(reference) -> 
     det, checks = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
     assert det is None
     assert checks == world.asked == 2
+
+
+class _PlateInACorridor:
+    """A stand-in world on the local map's grid (`axes`): free cells are a corridor along A1 at the
+    A2-A3 cell (c2, c3), and a loop round beside it (A3 index c3 + 1 and c3 + 2 at A1 indices k - 1
+    and k); between the A1 samples k - 1 and k stands a plate of no thickness, 1.6 cells either
+    side of the corridor's cell on A2 and A3. A straight move is blocked when its A1-A3 line passes
+    through the plate. The corridor's way is the shortest and is blocked between two free cells in
+    the middle of the path; the loop's outer column (c3 + 2) is the one way past, longer by two
+    moves along A3 alone. Counts the blocked moves it was asked about."""
+
+    def __init__(self, axes: list[np.ndarray], k: int, c2: int, c3: int) -> None:
+        self.axes, self.k, self.c2, self.c3 = axes, k, c2, c3
+        self.a1 = 0.5 * (axes[0][k - 1] + axes[0][k])
+        self.half2, self.half3 = 1.6 * (axes[1][1] - axes[1][0]), 1.6 * (axes[2][1] - axes[2][0])
+        self.blocked_moves = 0
+
+    def are_free(self, configs: np.ndarray) -> np.ndarray:
+        i, j, l = (np.abs(configs[:, n, None] - self.axes[n][None, :]).argmin(axis=1) for n in range(3))
+        loop = np.isin(i, (self.k - 1, self.k)) & np.isin(l, (self.c3 + 1, self.c3 + 2))
+        return np.asarray((j == self.c2) & ((l == self.c3) | loop))
+
+    def check_segment(self, q0: np.ndarray, q1: np.ndarray) -> SegmentCheck:
+        d0, d1 = q0[0] - self.a1, q1[0] - self.a1
+        free = True
+        if d0 * d1 < 0:                                  # the move crosses the plate's plane
+            at = q0[1:3] + d0 / (d0 - d1) * (q1[1:3] - q0[1:3])
+            free = not (abs(at[0] - self.axes[1][self.c2]) < self.half2
+                        and abs(at[1] - self.axes[2][self.c3]) < self.half3)
+        self.blocked_moves += not free
+        return SegmentCheck(free=free, checks=1, states=2, narrow_phase_tests=0, s_contact=None)
+
+
+def test_a_blocked_move_between_free_cells_is_searched_round(reference) -> None:  # type: ignore[no-untyped-def]
+    """Every cell of the corridor free, but its move between two middle cells blocked by the plate:
+    that move is taken out of the map's graph and the map searched again until the way round the
+    plate is found, whose every move is free."""
+    _, robot, _ = reference
+    qa = np.radians([0.0, -90.0, 90.0, 0.0, 0.0, 0.0])
+    qb = qa + np.array([0.6, 0.0, 0.0, 0.2, 0.0, 0.0])
+    axes, _ = local_grid(qa, qb, robot.limits.lower, robot.limits.upper, RESOLUTION, MARGIN_RAD)
+    _, c2, c3 = nearest_cell(axes, qa)
+    world = _PlateInACorridor(axes, int(np.searchsorted(axes[0], 0.5 * (qa[0] + qb[0]))), c2, c3)
+    det, checks = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
+    assert world.blocked_moves > 0                             # the map's first path met the plate
+    assert det is not None
+    np.testing.assert_array_equal(det.waypoints[0], qa)
+    np.testing.assert_array_equal(det.waypoints[-1], qb)
+    assert all(world.check_segment(a, b).free for a, b in zip(det.waypoints[:-1], det.waypoints[1:]))
+    assert np.isclose(det.waypoints[:, 2], axes[2][c3 + 2]).any()   # past the plate at its outer column
+    assert det.checks == checks
