@@ -34,11 +34,13 @@ from robomax_py.world.collision import CollisionWorld
 
 RESOLUTION = 24             # samples per axis of the local grid
 MARGIN_RAD = 0.5            # the grid box beyond qa and qb on A1-A3
-# Repairing the map's path (`_repaired_path`): at most this many searches of the map, and swept
-# checks of its paths' segments worth at most REPAIR_BUDGET times the map's own point checks. On the
-# generated UR10 and KR16 cells the detours found needed up to 23 searches and 1.5x the map's checks;
+# Repairing the map's path (`_repaired_path`): at most MAX_REPAIR_ROUNDS searches of the map, and
+# swept checks of its paths' segments worth at most REPAIR_BUDGET times the map's own point checks
+# (the checks are the cost: a search of the 24³ map takes ~1-2 ms CPU, 64 of them ~0.1 s). Measured:
+# the detours found on generated UR10 and KR16 cells needed up to 23 searches and 1.5x the map's
+# checks, the one between s5 and s6 of the reference cell (tests/bench/bench_plan.py) 46 searches;
 # past the bounds a narrow passage the map's samples straddle is more likely than a way through.
-MAX_REPAIR_ROUNDS = 32
+MAX_REPAIR_ROUNDS = 64
 REPAIR_BUDGET = 2.0
 _STEPS = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if d != (0, 0, 0)], dtype=np.int64)
 
@@ -101,7 +103,8 @@ def _repaired_path(world: CollisionWorld, graph: csr_matrix, configs: FloatArray
     the blocked ones from the graph (both directions) and search again. A segment's answer is kept
     across rounds, so a later path pays only for its new segments.
     """
-    known: dict[tuple[int, int], bool] = {}       # (cell, cell) low first -> free by the swept check
+    # (cell, cell), low first -> free by the swept check (a straight move is blocked both ways)
+    known: dict[tuple[int, int], bool] = {}
     checks = 0
     for _ in range(MAX_REPAIR_ROUNDS):
         dist, pred = dijkstra(graph, directed=True, indices=start, return_predecessors=True)
