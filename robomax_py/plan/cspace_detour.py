@@ -42,6 +42,11 @@ MARGIN_RAD = 0.5            # the grid box beyond qa and qb on A1-A3
 # past the bounds a narrow passage the map's samples straddle is more likely than a way through.
 MAX_REPAIR_ROUNDS = 64
 REPAIR_BUDGET = 2.0
+# The grid box keeps this far inside the joint limits: the timed motion through the map's cells is
+# a smooth path that overshoots a cell lying on a limit (by 1e-6 rad on a generated IRB 2400-class
+# cell, whose repaired detour ran along A3's upper limit and could not be timed), and the timing
+# refuses any sample past a limit. 1e-3 rad is a thousand times that and 2 % of a 24-cell step.
+LIMIT_INSET_RAD = 1e-3
 _STEPS = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if d != (0, 0, 0)], dtype=np.int64)
 
 
@@ -152,8 +157,8 @@ def local_grid(qa: FloatArray, qb: FloatArray, lower: FloatArray, upper: FloatAr
     """The A1-A3 sample values over the box qa and qb span, widened by `margin` within the limits,
     and every cell's configuration (C order) with the wrist at the cell's projection onto the
     straight A1-A3 line from qa to qb."""
-    lo = np.maximum(np.minimum(qa[:3], qb[:3]) - margin, np.asarray(lower)[:3])
-    hi = np.minimum(np.maximum(qa[:3], qb[:3]) + margin, np.asarray(upper)[:3])
+    lo = np.maximum(np.minimum(qa[:3], qb[:3]) - margin, np.asarray(lower)[:3] + LIMIT_INSET_RAD)
+    hi = np.minimum(np.maximum(qa[:3], qb[:3]) + margin, np.asarray(upper)[:3] - LIMIT_INSET_RAD)
     axes = [np.linspace(lo[k], hi[k], resolution) for k in range(3)]
     cells = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
     span = qb[:3] - qa[:3]

@@ -18,6 +18,7 @@ from robomax_py.errors import CellFileError
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions
 from robomax_py.plan.cspace_detour import (
+    LIMIT_INSET_RAD,
     MARGIN_RAD,
     RESOLUTION,
     grid_detour,
@@ -154,3 +155,18 @@ def test_a_blocked_move_between_free_cells_is_searched_round(reference) -> None:
     assert all(world.check_segment(a, b).free for a, b in zip(det.waypoints[:-1], det.waypoints[1:]))
     assert np.isclose(det.waypoints[:, 2], axes[2][c3 + 2]).any()   # past the plate at its outer column
     assert det.checks == checks
+
+
+@pytest.mark.parametrize("at", ["upper", "lower"])
+def test_the_grid_keeps_inside_the_joint_limits(at: str) -> None:
+    # A detour between configurations on a limit: the timed path through cells lying on it
+    # overshoots the limit (by ~1e-6 rad, refused by the timing), so no cell may lie on it.
+    lower, upper = np.array([-3.0, -1.7, -1.0, -3.5, -2.0, -6.9]), np.array([3.0, 1.9, 1.1345, 3.5, 2.0, 6.9])
+    edge = upper if at == "upper" else lower
+    qa = np.where(np.arange(6) == 2, edge, 0.2)
+    qb = qa.copy()
+    qb[0] += 0.3
+    axes, configs = local_grid(qa, qb, lower, upper, 24, 0.5)
+    assert np.all(configs[:, :3] >= lower[:3] + LIMIT_INSET_RAD - 1e-12)
+    assert np.all(configs[:, :3] <= upper[:3] - LIMIT_INSET_RAD + 1e-12)
+    assert abs(axes[2][-1 if at == "upper" else 0] - (edge[2] - (1 if at == "upper" else -1) * LIMIT_INSET_RAD)) < 1e-12
