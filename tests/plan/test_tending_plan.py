@@ -28,7 +28,9 @@ def test_a_generated_tending_cell_plans_both_ways(tmp_path: Path) -> None:
     assert spec is not None and spec.loader is not None
     generator = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(generator)
-    rng = np.random.default_rng(5)
+    # Seed 5 stopped waiting once the local map repaired its detours; seed 0's second cell still
+    # enters a machine in a later opening when planned at rest.
+    rng = np.random.default_rng(0)
     data = [generator.cell(rng, i) for i in range(2)][1]
     path = tmp_path / "generated.yaml"
     path.write_text(yaml.safe_dump(data, sort_keys=False))
