@@ -30,19 +30,16 @@ from robomax_py.errors import (
 )
 from robomax_py.export import (
     DIALECTS,
-    controller_frames,
-    controller_world,
+    controller_rebuild,
     render_trajectory,
     require_calibration,
 )
 from robomax_py.export.dialect import (
     Parsed,
     PlannedProgram,
-    in_controller_joints,
     in_controller_terms,
 )
 from robomax_py.export.plan_program import planned_program
-from robomax_py.export.rebuild import rebuild
 from robomax_py.export.spline_lines import as_lines as lines_for_splines
 from robomax_py.export.spline_lines import has_splines
 from robomax_py.plan import PlanResult, method_suffix
@@ -167,9 +164,7 @@ def _checked(fmt: str, planned: PlannedProgram, result: PlanResult, cell: CellSp
         at, kind, detail = parsed.problems[0]
         raise ExportError(f"{fmt}: the written program is not clean: {kind}: {detail} (line {at} of {main})")
     _same_program(fmt, main, adapted, parsed)
-    read = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
-    rebuilt = rebuild(read, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
-                      controller=bool(dialect.brand), station=station, T_base_world=controller_world(dialect, cell))
+    rebuilt = controller_rebuild(dialect, cell, robot, main, parsed, station)
     if rebuilt.problems or rebuilt.trajectory is None:
         p = rebuilt.problems[0] if rebuilt.problems else None
         where = f"line {p.line}: " if p and p.line else ""

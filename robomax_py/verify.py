@@ -104,16 +104,11 @@ def rebuild_read(cell: CellSpec, robot: RobotModel, read: tuple[Any, Path, Any, 
                  station: frozenset[str] | None = None) -> Rebuilt:
     """The motion of a program read by `read_program_files`, as its controller runs it
     (`export.rebuild.Rebuilt`): its joint targets counted the controller's way, its frames those
-    the controller composes (`export.controller_frames`)."""
-    from robomax_py.export import controller_frames, controller_world
-    from robomax_py.export.dialect import in_controller_joints
-    from robomax_py.export.rebuild import rebuild
+    the controller composes (`export.controller_rebuild`)."""
+    from robomax_py.export import controller_rebuild
 
     dialect, main, parsed, _ = read
-    # A controller's joint targets count its joints its way (robot.yaml controller.joint_signs/zeros).
-    joint_program = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
-    return rebuild(joint_program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
-                   controller=bool(dialect.brand), station=station, T_base_world=controller_world(dialect, cell))
+    return controller_rebuild(dialect, cell, robot, main, parsed, station)
 
 
 def read_program(robot: RobotModel, path: Path) -> tuple[Any, Path, Any]:

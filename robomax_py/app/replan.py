@@ -90,15 +90,11 @@ def planned_motion(cell: CellSpec, robot: RobotModel, path: Path) -> PlannedMoti
             raise ProgramError(path, "cell", f"a program of cell {data.get('cell')!r}, not of {cell.name!r}")
         t, q, spots = np.asarray(data["t"]), np.asarray(data["q"]), data["spots"]
     else:
-        from robomax_py.export import controller_frames, controller_world
-        from robomax_py.export.dialect import in_controller_joints
-        from robomax_py.export.rebuild import rebuild
+        from robomax_py.export import controller_rebuild
         from robomax_py.verify import read_program
 
         dialect, main, parsed = read_program(robot, path)
-        program = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
-        rebuilt = rebuild(program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
-                          controller=bool(dialect.brand), T_base_world=controller_world(dialect, cell))
+        rebuilt = controller_rebuild(dialect, cell, robot, main, parsed)
         if rebuilt.trajectory is None:
             p = rebuilt.problems[0] if rebuilt.problems else None
             raise ProgramError(path, None if p is None or p.line is None else f"line {p.line}",

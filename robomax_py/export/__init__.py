@@ -12,13 +12,15 @@ from __future__ import annotations
 
 import dataclasses
 from importlib import metadata
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.errors import ExportError
 from robomax_py.export import trajectory_json
-from robomax_py.export.dialect import Dialect
+from robomax_py.export.dialect import Dialect, Parsed, in_controller_joints
 from robomax_py.export.mount import mount_rotation, robroot
 from robomax_py.export.plan_program import frame_defs, identifier
 from robomax_py.plan import PlanResult
@@ -28,8 +30,12 @@ from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.transforms import invert
 
+if TYPE_CHECKING:
+    from robomax_py.export.rebuild.result import Rebuilt
+
 __all__ = ["DIALECTS", "ENTRY_POINT_GROUP", "SHARED_FILES", "Dialect", "FormatChoice", "SkippedFormat",
-           "choose_formats", "controller_frames", "controller_world", "dialect_for_file", "format_names", "load_dialects", "native_dialect",
+           "choose_formats", "controller_frames", "controller_rebuild", "controller_world", "dialect_for_file", "format_names",
+           "load_dialects", "native_dialect",
            "render_trajectory", "require_calibration"]
 
 # The entry point group program dialects register under (pyproject.toml): each entry point names a
@@ -91,6 +97,19 @@ def controller_world(dialect: Dialect, cell: CellSpec) -> FloatArray:
     if dialect.brand != "kuka":
         return np.eye(4)
     return invert(robroot(mount_rotation(cell.T_world_base, cell.robot.controller.T_root_base)))
+
+
+def controller_rebuild(dialect: Dialect, cell: CellSpec, robot: RobotModel, main: Path | str, parsed: Parsed,
+                       station: frozenset[str] | None = None) -> Rebuilt:
+    """The motion of a parsed program as its controller runs it (`export.rebuild.rebuild`): its
+    joint targets counted the controller's way (robot.yaml controller.joint_signs/zeros), its
+    frames those the controller composes (`controller_frames`) on its world frame
+    (`controller_world`). One place for plan's proof, verify and replan alike."""
+    from robomax_py.export.rebuild import rebuild
+
+    program = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
+    return rebuild(program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
+                   controller=bool(dialect.brand), station=station, T_base_world=controller_world(dialect, cell))
 
 
 def native_dialect(brand: str, dialects: dict[str, Dialect] | None = None) -> str | None:
