@@ -91,8 +91,7 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
     # Every consecutive pair is free by the swept check now: the shortcut takes them as they are.
     short, spent = swept_shortcut(world, path)
     checks += spent
-    if short is None:                                   # not reached: neighbours are taken as free
-        return None, checks
+    assert short is not None                            # without check_neighbours it keeps a path
     return Detour(short, polyline_time_estimate(short, limits), checks), checks
 
 
