@@ -96,8 +96,20 @@ _BRAND_PATTERNS = (
     # arms are Motoman).
     ("yaskawa", re.compile(r"motoman|yaskawa", re.IGNORECASE)),
     ("staubli", re.compile(r"st(a|ä)ubli", re.IGNORECASE)),
-    ("kawasaki", re.compile(r"kawasaki", re.IGNORECASE)),
+    # Kawasaki's own ROS packages say `khi` (Kawasaki-Robotics/khi_robot@57200db5:
+    # khi_rs_description/urdf/rs080n.urdf.xacro, `<robot name="khi_rs080n">`); its RS arms are
+    # RS<payload><N|L|X>, its dual arm duAro.
+    ("kawasaki", re.compile(r"kawasaki|(^|[^a-z])khi([^a-z]|$)|(^|[^a-z])rs\d{3}[nlx]([^a-z]|$)|duaro",
+                            re.IGNORECASE)),
+    ("comau", re.compile(r"comau", re.IGNORECASE)),
+    ("nachi", re.compile(r"nachi", re.IGNORECASE)),
 )
+# What robot.yaml says when no name tells the maker (the brand decides how the programs count the
+# joints and state the frames, so the import says it guessed).
+DEFAULT_BRAND = "kuka"
+BRAND_UNKNOWN = ("the controller brand is not told by the robot's name or its files' names ({names}): robot.yaml "
+                 f"says {DEFAULT_BRAND}; pass --brand (kuka, abb, fanuc, ur, yaskawa, kawasaki, staubli, comau, "
+                 "nachi) or edit controller.brand before writing programs for another controller")
 
 
 @dataclass(frozen=True, slots=True)
@@ -116,13 +128,13 @@ class ImportResult:
     always_touching: AlwaysTouching
 
 
-def guess_brand(*names: str) -> str:
-    """A controller brand (kuka, abb, fanuc, ur, yaskawa, staubli, kawasaki) from a robot's name or
-    file names; kuka when nothing matches."""
+def guess_brand(*names: str) -> str | None:
+    """A controller brand (kuka, abb, fanuc, ur, yaskawa, staubli, kawasaki, comau, nachi) from a
+    robot's name or file names; None when no name tells."""
     for brand, pattern in _BRAND_PATTERNS:
         if any(pattern.search(n) for n in names):
             return brand
-    return "kuka"
+    return None
 
 
 # ------------------------------------------------------------------------------ what may be read
@@ -336,7 +348,7 @@ def import_urdf(
             except RobotModelError as exc:
                 raise _unstaged(exc, stage, source, urdf_name) from None
             warnings.extend(w for w in robot_warnings if w.startswith(
-                ("IK falls back", "the flange frame", "joint directions", "the URDF's joint axes", "abb_driver")))
+                ("the controller brand", "IK falls back", "the flange frame", "joint directions", "the URDF's joint axes", "abb_driver")))
             warnings.extend(w.replace(str(stage), str(out)) for w in robot_warnings if "limits." in w)
             warnings.extend(_named_srdf(w, stage, source, urdf_name, srdf) for w in robot_warnings if ": srdf: " in w)
             unchanged = out.is_dir() and not out.is_symlink() and _digest(out) == _digest(stage)
@@ -430,7 +442,14 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
     except FitError as exc:
         raise RobotModelError(source, "ik.solver", f"not a {solver}-class arm: {exc.problem}") from None
     # The file's folders too: ROS-Industrial packages name the maker (motoman_gp180_support/urdf/...).
-    brand = brand or guess_brand(name, *source.parts[-4:], str(root.get("name", "")))
+    names = (name, *source.parts[-4:], str(root.get("name", "")))
+    brand_note = None
+    if brand is None:
+        brand = guess_brand(*names)
+        if brand is None:
+            brand = DEFAULT_BRAND
+            shown = (name, source.name, str(root.get("name", "")), source.parent.parent.name)
+            brand_note = BRAND_UNKNOWN.format(names=", ".join(dict.fromkeys(n for n in shown if n)))
     convention = _convention(model, int(model.getFrameId(flange)), brand, T_root_base, source, roots)
 
     def written(touching: AlwaysTouching | None) -> RobotSpec:
@@ -447,7 +466,7 @@ def _build(stage: Path, name: str, urdf_name: str, flange: str, solver: str | No
         spec = written(touching)
         robot = load_robot(spec)   # and loads again with the pairs written
     flange_z = _flange_z_warning(model, int(model.getFrameId(flange)), flange)
-    notes = tuple(n for n in (fallback, flange_z, convention.note) if n is not None)
+    notes = tuple(n for n in (brand_note, fallback, flange_z, convention.note) if n is not None)
     return solver_name, fk_error, spec, (*notes, *robot.warnings), touching
 
 

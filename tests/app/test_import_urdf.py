@@ -190,9 +190,14 @@ def test_fall_back_to_numeric_ik_says_why_and_what_it_costs(tmp_path: Path) -> N
     [warning] = [w for w in result.warnings if w.startswith("IK falls back to the numeric solver")]
     assert "opw: axes 2 and 3 must be parallel" in warning and "ur: axes 2 and 3 must be parallel" in warning
     assert "slower" in warning and "sampling" in warning
+    # No name tells the maker: robot.yaml says kuka, and the import says it guessed.
+    assert result.brand == "kuka"
+    [brand_note] = [w for w in result.warnings if w.startswith("the controller brand is not told")]
+    assert "odd6" in brand_note and "--brand" in brand_note
     # Asked for, numeric IK is no fall-back: no warning.
-    asked = import_urdf(tmp_path / "odd6.urdf", tmp_path / "odd6n", solver="numeric")
+    asked = import_urdf(tmp_path / "odd6.urdf", tmp_path / "odd6n", solver="numeric", brand="abb")
     assert asked.solver == "numeric" and not [w for w in asked.warnings if w.startswith("IK falls back")]
+    assert asked.brand == "abb" and not [w for w in asked.warnings if w.startswith("the controller brand")]
 
 
 def test_import_warns_where_the_controllers_joint_convention_is_not_known(tmp_path: Path) -> None:
@@ -497,6 +502,13 @@ def test_brand_guess() -> None:
     assert guess_brand("fanuc_m20ia") == "fanuc"
     assert guess_brand("m20ia") == "fanuc"
     assert guess_brand("ur10e") == "ur"
+    # Kawasaki's own packages (khi_robot) name the arm khi_rs080n in khi_rs_description.
+    assert guess_brand("rs080n", "khi_rs_description", "urdf", "rs080n.urdf.xacro", "khi_rs080n") == "kawasaki"
+    assert guess_brand("rs007l") == "kawasaki" and guess_brand("duaro") == "kawasaki"
+    assert guess_brand("comau_nj220") == "comau" and guess_brand("nachi_mz07") == "nachi"
+    # No name tells: no guess (the import then says so; words that merely contain the letters don't count).
+    assert guess_brand("odd6", "tmp", "odd6.urdf") is None
+    assert guess_brand("sensors100n", "thinking") is None
 
 
 def test_library_path_and_robots_flag(arms: dict[str, Path], tmp_path: Path) -> None:
