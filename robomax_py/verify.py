@@ -69,6 +69,13 @@ class VerifyReport:
 def verify_program(cell: CellSpec, robot: RobotModel, path: Path) -> VerifyReport:
     """Verify a trajectory file (.json) or a program of any dialect robomax writes (its motion
     rebuilt from its statements alone)."""
+    from robomax_py.io.plan_set import MANIFEST_SUFFIX
+
+    if path.name.lower().endswith(MANIFEST_SUFFIX):
+        # Ends in .json like a trajectory file: say what it is rather than that its format is wrong.
+        stem = path.name[:-len(MANIFEST_SUFFIX)]
+        raise ProgramError(path, None, f"is the manifest of the set of programs planned together: verify one of the "
+                           f"programs it lists ({stem}.json, {stem}.src, ...)")
     if path.suffix.lower() == ".json":
         return _with_set(cell, path, (path,), verify_trajectory_file(cell, robot, path))
     return verify_read(cell, robot, path, read_program_files(robot, path))[0]

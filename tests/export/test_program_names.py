@@ -116,6 +116,11 @@ def test_verify_of_a_setup_file_names_the_program(awkward: tuple[Path, Path]) ->
         if "setup program of" in text:
             main = setup.name[:-len("_frames") - len(setup.suffix)] + setup.suffix
             assert f"verify {main}" in text
+    # The plan's manifest ends in .json as a trajectory file does: named for what it is, not a format error.
+    [manifest] = out.glob("*.manifest.json")
+    got = CliRunner().invoke(app, ["verify", str(cell), str(manifest)])
+    text = " ".join(got.output.split())
+    assert got.exit_code == 2 and "is the manifest of the set of programs" in text and "Traceback" not in text, text
 
 
 def test_verify_reports_a_def_name_krl_does_not_compile(awkward: tuple[Path, Path], tmp_path: Path) -> None:
