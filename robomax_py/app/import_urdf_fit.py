@@ -259,14 +259,19 @@ def _convention(model: object, frame_id: int, brand: str, T_root_base: FloatArra
     (UniversalRobots/Universal_Robots_ROS_Driver@66510fde40df294631bd22899677375d0b190d4e
     ur_robot_driver/src/hardware_interface.cpp:526, `readData(data_pkg, "actual_q",
     joint_positions_)`, and :714, `writeJointCommand(joint_position_command_, ...MODE_SERVOJ`) for
-    ur_description's URDFs. KUKA: KUKA's axis directions and zero (`_KUKA_AXES`) against the
+    ur_description's URDFs. Kawasaki: Kawasaki's own driver compares and commands the controller's
+    joint angles (rad) as the URDF's joint values, converting only a prismatic axis to mm
+    (Kawasaki-Robotics/khi_robot@57200db576c6feb7cea442ff06f27334a520eb7a
+    khi_robot_control/src/khi_robot_krnx_driver.cpp:366-371, `diff = home[jt]*conv -
+    motion_data.ang[jt]`, and :680-689, `comp = cmd - home`, times 1000 only for PRISMATIC), for
+    khi_robot's URDFs. KUKA: KUKA's axis directions and zero (`_KUKA_AXES`) against the
     URDF's; where they differ by axis flips and quarter turns the keys are derived
     (`_kuka_counting`). Other brands: not known here."""
     import numpy as np
 
     from robomax_py.robot.ik._chain import joint_axes_at_zero
 
-    if brand in ("fanuc", "ur"):
+    if brand in ("fanuc", "ur", "kawasaki"):
         return Convention()
     if brand == "abb":
         coupled = _abb_coupling(source, roots) if source is not None else None

@@ -225,6 +225,25 @@ def test_import_warns_where_the_controllers_joint_convention_is_not_known(tmp_pa
     assert "joint_signs" not in (tmp_path / "kr120r2500pro" / "robot.yaml").read_text()
 
 
+def test_a_kawasaki_urdf_counts_its_joints_as_the_controller(tmp_path: Path) -> None:
+    """Kawasaki's own driver (khi_robot) exchanges joint angles with the controller unchanged: an
+    arm its package names (khi_*) imports with the brand told and no keys or warning; the same arm
+    named by nothing imports as kuka with the two warnings (the brand guessed, the counting not
+    known)."""
+    axes = ["0 0 -1", "0 1 0", "0 1 0", "-1 0 0", "0 1 0", "-1 0 0"]
+    origins = ["0 0 0.4", "0.15 0 0.28", "0 0 0.87", "0.8 0 0.27", "0.0 0 0", "0.1 0 0"]
+    khi = import_urdf(six_joint_urdf(tmp_path / "rs.urdf", "khi_rs080n", axes, origins), tmp_path / "rs")
+    assert khi.brand == "kawasaki"
+    assert not [w for w in khi.warnings if "controller.joint_signs" in w or w.startswith("the controller brand")]
+    assert "joint_signs" not in (tmp_path / "rs" / "robot.yaml").read_text()
+    # (Folders deep enough that the test's own folder name, which says kawasaki, is not read.)
+    (tmp_path / "ws" / "arm_support" / "urdf").mkdir(parents=True)
+    other = import_urdf(six_joint_urdf(tmp_path / "ws" / "arm_support" / "urdf" / "arm.urdf", "arm", axes, origins),
+                        tmp_path / "arm")
+    assert other.brand == "kuka"
+    assert [w for w in other.warnings if w.startswith("the controller brand is not told")]
+
+
 def _axis_origins(robot, q):  # type: ignore[no-untyped-def]
     import pinocchio as pin
 
