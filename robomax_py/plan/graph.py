@@ -255,6 +255,7 @@ class Sequencer(SequencerLookahead):
                 # Every candidate for the order found; full matrices only of this order's moves.
                 moves = _moves_of(found.order)
                 self._full = {key: m for key, m in self._full.items() if key in moves}
+                self._full_straight = {key: e for key, e in self._full_straight.items() if key in moves}
                 choice, cost = self.choose(found.order)
                 tour = Tour(found.order, choice, cost)
             if not np.isfinite(tour.cost) and self._open_dead_end(tour.order):

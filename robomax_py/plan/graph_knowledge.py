@@ -91,6 +91,11 @@ class SequencerKnowledge:
         self.node_reps = [n[r] for n, r in zip(self.node, self.reps)]
         self._matrices: dict[tuple[int, int], FloatArray] = {}   # representatives x representatives
         self._full: dict[tuple[int, int], FloatArray] = {}       # every candidate, pairs of the last order only
+        # The straight-move estimates under the matrices above, (rows, cols, estimate) per spot pair:
+        # a matrix is recomputed whenever what is known about its moves changes, its estimate
+        # (of the configurations alone) is not. Kept for the same pairs as the matrices.
+        self._matrices_straight: dict[tuple[int, int], tuple[IntArray, IntArray, FloatArray]] = {}
+        self._full_straight: dict[tuple[int, int], tuple[IntArray, IntArray, FloatArray]] = {}
         self.unresolved: Counter[str] = Counter()                                 # move label -> rounds left open
         self.failed_detours: Counter[tuple[int, int]] = Counter()                 # unordered spot pair -> searches
         self.unconnected: set[tuple[int, int]] = set()                            # unordered spot pairs given up
@@ -268,12 +273,25 @@ class SequencerKnowledge:
         out[usable] = np.where(keep, via, np.inf)
         return out
 
-    def _costs(self, i: int, j: int, rows: IntArray, cols: IntArray) -> FloatArray:
-        """Estimated move time between candidates `rows` of i and `cols` of j, using what is known
-        about blockages."""
-        key = (i, j)
+    def _straight_estimate(self, i: int, j: int, rows: IntArray, cols: IntArray,
+                           kept: dict[tuple[int, int], tuple[IntArray, IntArray, FloatArray]] | None) -> FloatArray:
+        """Estimated straight-move time between candidates `rows` of i and `cols` of j (a fresh
+        array), taken from `kept` where it holds these rows and columns, else computed and kept."""
+        got = None if kept is None else kept.get((i, j))
+        if got is not None and np.array_equal(got[0], rows) and np.array_equal(got[1], cols):
+            return got[2].copy()
         est = ptp_time_estimate(self.q(i)[rows][:, None, :], self.q(j)[cols][None, :, :], self.limits,
                                 self.options.speed)
+        if kept is not None:
+            kept[(i, j)] = (rows.copy(), cols.copy(), est.copy())
+        return est
+
+    def _costs(self, i: int, j: int, rows: IntArray, cols: IntArray,
+               kept: dict[tuple[int, int], tuple[IntArray, IntArray, FloatArray]] | None = None) -> FloatArray:
+        """Estimated move time between candidates `rows` of i and `cols` of j, using what is known
+        about blockages; `kept`: where the straight-move estimate is kept between calls."""
+        key = (i, j)
+        est = self._straight_estimate(i, j, rows, cols, kept)
         pi, pj = self._positions(i, rows), self._positions(j, cols)
         vias = self.vias_for(i, j)
         if (min(i, j), max(i, j)) in self.detour_only:
@@ -339,7 +357,7 @@ class SequencerKnowledge:
         key = (i, j)
         got = self._matrices.get(key)
         if got is None:
-            got = self._matrices[key] = self._costs(i, j, self._rows(i), self._rows(j))
+            got = self._matrices[key] = self._costs(i, j, self._rows(i), self._rows(j), self._matrices_straight)
         return got
 
     def full_cost(self, i: int, j: int) -> FloatArray:
@@ -347,7 +365,8 @@ class SequencerKnowledge:
         key = (i, j)
         got = self._full.get(key)
         if got is None:
-            got = self._full[key] = self._costs(i, j, np.arange(len(self.q(i))), np.arange(len(self.q(j))))
+            got = self._full[key] = self._costs(i, j, np.arange(len(self.q(i))), np.arange(len(self.q(j))),
+                                                 self._full_straight)
         return got
 
     def _try_straight(self, i: int, a: int, j: int, b: int) -> bool:
