@@ -136,3 +136,32 @@ def test_matrices_kept_only_where_a_verdict_cannot_change_them(tmp_path: Path, w
     seq._record_straight(i, a, j, b, True)                              # now a free move changes the prices
     assert seq.full_cost(i, j) is not m and np.array_equal(seq.full_cost(i, j), fresh())
     assert np.isfinite(seq.full_cost(i, j)[a, b])
+
+
+def test_a_remade_matrix_reuses_its_straight_estimate(tmp_path: Path, write_small_cell: SmallCell,
+                                                     monkeypatch: Any) -> None:
+    """A matrix made again after a blocked move keeps its straight-move estimate (a function of the
+    configurations alone): the same prices as estimated afresh, without estimating them again; the
+    estimate is asked anew when the rows change."""
+    import robomax_py.plan.graph_knowledge as knowledge
+
+    seq = _sequencer(tmp_path, write_small_cell)
+    i, j = 0, 1
+    n_i, n_j = len(seq.q(i)), len(seq.q(j))
+    asked: list[tuple[int, ...]] = []
+
+    def counted(q0: np.ndarray, q1: np.ndarray, *args: Any, **kwargs: Any) -> np.ndarray:
+        out = ptp_time_estimate(q0, q1, *args, **kwargs)
+        asked.append(out.shape)
+        return out
+
+    monkeypatch.setattr(knowledge, "ptp_time_estimate", counted)
+    seq.full_cost(i, j)
+    assert asked == [(n_i, n_j)]
+    seq._record_straight(i, 0, j, 0, False)                         # blocked: the matrix is made again
+    m = seq.full_cost(i, j)
+    assert asked == [(n_i, n_j)]                                    # ... on the estimate kept
+    assert np.isinf(m[0, 0]) and np.array_equal(m, seq._costs(i, j, np.arange(n_i), np.arange(n_j)))
+    seq._full_straight[(i, j)] = (np.arange(n_i - 1), np.arange(n_j), np.zeros((n_i - 1, n_j)))
+    seq._forget(i, j)
+    assert np.array_equal(seq.full_cost(i, j), m)                   # other rows kept: estimated afresh

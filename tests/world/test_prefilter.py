@@ -9,6 +9,7 @@ without it (verdicts, the state a segment stops at, the contact named).
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -277,3 +278,26 @@ def test_the_block_tree_leaves_out_only_blocks_their_own_test_clears(
                 np.testing.assert_array_equal(got[0], tree_all[0])
                 np.testing.assert_array_equal(got[1], tree_all[1])
     assert listed > 10
+
+
+def test_piece_bounds_find_each_point_sets_box_once(monkeypatch: Any) -> None:
+    """A piece's (and each chunk's) sphere is centred on the box found for it: one principal-axes
+    box per point set, and the volumes those of `_enclosing_sphere` on its own."""
+    import coal
+
+    from robomax_py.world import prefilter
+
+    boxes: list[int] = []
+    real_box = prefilter._enclosing_box
+
+    def counted(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        boxes.append(len(points))
+        return real_box(points)
+
+    monkeypatch.setattr(prefilter, "_enclosing_box", counted)
+    geom = coal.Box(0.3, 0.2, 0.1)
+    got = prefilter._piece_bounds(geom, np.eye(4), True)       # an obstacle: with its chunk
+    assert got is not None and len(got.chunks) == 1 and len(boxes) == 2
+    monkeypatch.setattr(prefilter, "_enclosing_box", real_box)
+    c, r = prefilter._enclosing_sphere(got.placed)
+    assert np.array_equal(got.sphere[0], c) and got.sphere[1] == r
