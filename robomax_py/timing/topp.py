@@ -308,8 +308,18 @@ def _toppra_path(path: GeometricPath) -> Any:
     from toppra.interpolator import AbstractGeometricPath
 
     class ToppraPath(AbstractGeometricPath):  # type: ignore[misc]
+        # toppra's velocity and acceleration constraints each ask for the first derivative at the
+        # same grid points: the last answer is kept and handed out again (as a copy: a caller may
+        # write into its array).
+        last: tuple[int, FloatArray, FloatArray] | None = None
+
         def __call__(self, path_positions: Any, order: int = 0) -> FloatArray:
-            return path(path_positions, order)
+            s = np.array(path_positions, dtype=float)
+            if self.last is not None and self.last[0] == order and np.array_equal(self.last[1], s):
+                return self.last[2].copy()
+            out = path(s, order)
+            self.last = (order, s, out)
+            return out.copy()
 
         @property
         def dof(self) -> int:

@@ -6,7 +6,10 @@ round, bit for bit."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -129,3 +132,27 @@ def test_the_refined_grid_is_the_grid_of_evaluating_every_step(seed: int, pieces
         expected = _grid_evaluating_every_step(GeometricPath(path.breaks, path.control_points))
         got = topp.gridpoints(GeometricPath(path.breaks, path.control_points))
         assert got.tobytes() == expected.tobytes()
+
+
+def test_toppra_sees_the_path_once_per_grid_and_order(monkeypatch: pytest.MonkeyPatch) -> None:
+    """toppra's velocity and acceleration constraints both ask for q'(s) at the grid points: the
+    path is evaluated once for it (and once for q''), and every answer is the path's own, in an
+    array the caller may write into."""
+
+    path = polyline_path(np.array([[0.0, 0, 0, 0, 0, 0], [1, 2, 0, 0, 0, 1], [2, 1, 1, 0, 0, 0]]))
+    asked: list[int] = []
+    real = GeometricPath.__call__
+
+    def counted(self: GeometricPath, s: Any, order: int = 0) -> Any:
+        asked.append(order)
+        return real(self, s, order)
+
+    monkeypatch.setattr(GeometricPath, "__call__", counted)
+    seen = topp._toppra_path(path)
+    grid = np.linspace(0.0, path.length, 9)
+    first = seen(grid, 1)
+    first[:] = 0.0                                          # the caller's copy, not the kept one
+    assert np.array_equal(seen(grid, 1), real(path, grid, 1))
+    assert np.array_equal(seen(grid, 2), real(path, grid, 2))
+    assert np.array_equal(seen(grid[:-1], 2), real(path, grid[:-1], 2))
+    assert asked == [1, 2, 2]
