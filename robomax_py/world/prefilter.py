@@ -35,19 +35,18 @@ import pinocchio as pin
 
 from robomax_py._typing import BoolArray, FloatArray, IntArray
 from robomax_py.world.bounds import support_points, triangles
-from robomax_py.world.prefilter_kernels import (
-    _N_HEADER,
-    _near,
-    _placements,
-    _uncleared,
+from robomax_py.world.prefilter_kernels import _near, _placements, _uncleared
+from robomax_py.world.prefilter_layout import (
+    B_MARGIN,
+    MARGIN,
+    N_FLOAT_TABLES,
+    N_HEADER,
+    N_INT_TABLES,
 )
 from robomax_py.world.prefilter_tree import TREE_MIN_BLOCKS, block_walk
 
 SLACK_M = 1e-6                 # m: a cleared pair's bound exceeds its margin by this (GJK decides to ~1e-9 m)
 _REVOLUTE, _PRISMATIC = 0, 1
-# Where the margins are among the float tables `_pack` is given (`Prefilter.of`): per pair, and per
-# block followed by per node of the block walk.
-_PAIR_MARGINS, _BLOCK_MARGINS = 7, 10
 _AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
 
 
@@ -197,7 +196,7 @@ class Prefilter:
             raise ValueError(f"a screen's distance must be >= 0 m, got {distance}")
         ints = self.ints
         n_pairs, n_blocks, n_nodes = int(ints[2]), int(ints[4]), int(ints[6])
-        pairs_at, blocks_at = int(ints[_N_HEADER + _PAIR_MARGINS]), int(ints[_N_HEADER + _BLOCK_MARGINS])
+        pairs_at, blocks_at = int(ints[MARGIN]), int(ints[B_MARGIN])
         floats = self.floats.copy()        # only the scalar tables are read from it; the views stay
         floats[pairs_at:pairs_at + n_pairs] = distance + SLACK_M
         floats[blocks_at:blocks_at + n_blocks + n_nodes] = distance + SLACK_M
@@ -348,14 +347,12 @@ def _pack(floats: list[FloatArray], ints: list[IntArray], n_chunks: int,
 
     The float buffer holds the scalar tables, then the tables of 3-vectors, then those of 3x3
     matrices; the kernels take it whole and as (n, 3) and (n, 3, 3) views of its two later parts,
-    so that every table is a plain slice of one of them. Each table reshaped in the kernels instead
-    (`F[a:b].reshape((G, 3))`) cost numba about 0.05 s of compile apiece, 14 of them about 0.75 s
-    of a first plan.
+    and read a table's row at the table's start plus the row in one of them. Each table reshaped in
+    the kernels instead (`F[a:b].reshape((G, 3))`) cost numba about 0.05 s of compile apiece, 14 of
+    them about 0.75 s of a first plan; each a slice, about a third of the kernels' compile.
 
-    ints starts with J (joints), G (pieces), P (pairs), NG (groups), NB (blocks), C (obstacle
-    chunks), N (nodes of the block walk, `prefilter_tree`), then the start of each float table (an
-    index into the scalars, the vectors or the matrices, by its shape), then the start of each int
-    table.
+    ints starts with the header, then the start of each float table, then of each int table
+    (`prefilter_layout`).
     Returns (floats, vectors, matrices, ints).
     """
     parent, piece_joint, pair_a, group_joint, block_kind = ints[0], ints[3], ints[4], ints[7], ints[8]
@@ -367,6 +364,7 @@ def _pack(floats: list[FloatArray], ints: list[IntArray], n_chunks: int,
         part = parts[a.ndim - 1]
         f_starts.append(sum(len(b) for b in part))
         part.append(a)
+    assert (len(header), len(floats), len(ints)) == (N_HEADER, N_FLOAT_TABLES, N_INT_TABLES), "see prefilter_layout"
     n_head = len(header) + len(floats) + len(ints)
     i_starts = n_head + np.cumsum([0] + [a.size for a in ints])[:-1]
     flat_f = np.concatenate([a.ravel() for part in parts for a in part])

@@ -1,6 +1,8 @@
 """The compiled loops of the bounding-volume pre-filter (`world.prefilter`, numba): forward
 kinematics of the serial chain, the pieces' spheres and boxes placed, and the pair bounds of a batch
-of configurations, read from the packed float and int tables `Prefilter` holds."""
+of configurations, read from the packed float and int tables `Prefilter` holds (F the scalars, R
+(n, 3) the 3-vectors, M (n, 3, 3) the matrices, I the ints; where each table starts:
+`prefilter_layout`)."""
 
 from __future__ import annotations
 
@@ -11,33 +13,70 @@ import numpy as np
 
 from robomax_py.jit import helper, kernel
 from robomax_py.world.box_separation import boxes_apart
+from robomax_py.world.prefilter_layout import (
+    AXIS,
+    B_A,
+    B_B,
+    B_END,
+    B_KIND,
+    B_MARGIN,
+    B_PAIRS,
+    BOX_HI,
+    BOX_LO,
+    CENTRE,
+    CH_BC,
+    CH_BR,
+    CH_C,
+    CH_END,
+    CH_H,
+    CH_RAD,
+    CH_SKIP,
+    CH_START,
+    G_CENTRE,
+    G_RADIUS,
+    GROUP_JOINT,
+    JQ,
+    JROT,
+    JTRANS,
+    KIND,
+    MARGIN,
+    OBB_C,
+    OBB_H,
+    OBB_R,
+    PAIR_A,
+    PAIR_B,
+    PAIR_OBSTACLE,
+    PARENT,
+    PIECE_JOINT,
+    RADIUS,
+    WALK,
+)
 from robomax_py.world.prefilter_reach import _growth, _pair_reach
-
-_N_HEADER, _N_FLOAT_TABLES, _N_INT_TABLES = 7, 19, 17
 
 
 @helper
-def _forward(q: Any, parent: Any, kind: Any, axis: Any, jrot: Any, jtrans: Any, jq: Any, rot: Any, trans: Any) -> None:
+def _forward(q: Any, R: Any, M: Any, I: Any, rot: Any, trans: Any) -> None:
     """Joint frames in the base frame: oMi[j] = oMi[parent] * placement[j] * motion_j(q)."""
+    parent, kind, axis, jrot, jtrans, jq = I[PARENT], I[KIND], I[AXIS], I[JROT], I[JTRANS], I[JQ]
     rot[0, :, :] = 0.0
     rot[0, 0, 0] = rot[0, 1, 1] = rot[0, 2, 2] = 1.0
     trans[0, :] = 0.0
     m = np.empty((3, 3))
-    for j in range(1, parent.shape[0]):
-        p = parent[j]
+    for j in range(1, I[0]):
+        p = I[parent + j]
         # placement in the base frame: R = Rp @ Rj, t = tp + Rp @ tj
         for r in range(3):
             acc = trans[p, r]
             for c in range(3):
-                acc += rot[p, r, c] * jtrans[j, c]
+                acc += rot[p, r, c] * R[jtrans + j, c]
                 s = 0.0
                 for k in range(3):
-                    s += rot[p, r, k] * jrot[j, k, c]
+                    s += rot[p, r, k] * M[jrot + j, k, c]
                 m[r, c] = s
             trans[j, r] = acc
-        x = q[jq[j]]
-        ax, ay, az = axis[j, 0], axis[j, 1], axis[j, 2]
-        if kind[j] == 0:
+        x = q[I[jq + j]]
+        ax, ay, az = R[axis + j, 0], R[axis + j, 1], R[axis + j, 2]
+        if I[kind + j] == 0:
             # Rodrigues: R = I + sin x K + (1 - cos x) K^2, K the cross-product matrix of the axis
             s, c1 = math.sin(x), 1.0 - math.cos(x)
             m00 = 1.0 - c1 * (ay * ay + az * az)
@@ -60,42 +99,12 @@ def _forward(q: Any, parent: Any, kind: Any, axis: Any, jrot: Any, jtrans: Any, 
                 rot[j, r, 0], rot[j, r, 1], rot[j, r, 2] = m[r, 0], m[r, 1], m[r, 2]
 
 
-@helper
-def _tables(F: Any, R: Any, M: Any, I: Any) -> Any:
-    """Every table, as slices of the packed buffers (`prefilter._pack`): F the scalars, R (n, 3) the
-    3-vectors, M (n, 3, 3) the matrices, I the ints. In order: the chain's (`_forward`'s argument
-    order: parent, kind, axis, rotation, translation, q index); the sphere tests' (per piece centre,
-    radius and obstacle box corners, per pair margin, per group centre and radius, per block
-    margin; per piece its joint, per pair its pieces and whether b is an obstacle, per group its
-    joint, per block its kind, groups and end, the pairs in block order); the box and chunk tests'
-    (per piece its oriented box: centre, rotation, half extents; per chunk of an obstacle's mesh its
-    sphere, centre and radius, and box; per piece its first and end chunk, per chunk the chunk after
-    its subtree); the block walk's (`prefilter_tree`: per node its block, group and the node after
-    its subtree, interleaved; an inner node's box and largest margin follow the pieces' boxes and
-    the blocks' margins: rows G + node and NB + node). One helper, not one per group of tables: each jitted function has a fixed compile
-    cost (about 0.1 s of a first plan for the three it replaces)."""
-    J, G, P, NG, NB, C, N = I[0], I[1], I[2], I[3], I[4], I[5], I[6]
-    fo = I[_N_HEADER:_N_HEADER + _N_FLOAT_TABLES]
-    io = I[_N_HEADER + _N_FLOAT_TABLES:_N_HEADER + _N_FLOAT_TABLES + _N_INT_TABLES]
-    return (I[io[0]:io[0] + J], I[io[1]:io[1] + J], R[fo[0]:fo[0] + J], M[fo[1]:fo[1] + J], R[fo[2]:fo[2] + J],
-            I[io[2]:io[2] + J],
-            R[fo[3]:fo[3] + G], F[fo[4]:fo[4] + G], R[fo[5]:fo[5] + G + N], R[fo[6]:fo[6] + G + N], F[fo[7]:fo[7] + P],
-            R[fo[8]:fo[8] + NG], F[fo[9]:fo[9] + NG], F[fo[10]:fo[10] + NB + N],
-            I[io[3]:io[3] + G], I[io[4]:io[4] + P], I[io[5]:io[5] + P], I[io[6]:io[6] + P], I[io[7]:io[7] + NG],
-            I[io[8]:io[8] + NB], I[io[9]:io[9] + NB], I[io[10]:io[10] + NB], I[io[11]:io[11] + NB],
-            I[io[12]:io[12] + P],
-            R[fo[11]:fo[11] + G], M[fo[12]:fo[12] + G], R[fo[13]:fo[13] + G], R[fo[14]:fo[14] + C],
-            F[fo[15]:fo[15] + C], R[fo[16]:fo[16] + C], M[fo[17]:fo[17] + C], R[fo[18]:fo[18] + C],
-            I[io[13]:io[13] + G], I[io[14]:io[14] + G], I[io[15]:io[15] + C], I[io[16]:io[16] + 3 * N])
-
-
 @kernel
 def _placements(q: Any, F: Any, R: Any, M: Any, I: Any) -> Any:
     J = I[0]
-    parent, kind, axis, jrot, jtrans, jq = _tables(F, R, M, I)[:6]
     rot = np.empty((J, 3, 3))
     trans = np.empty((J, 3))
-    _forward(q, parent, kind, axis, jrot, jtrans, jq, rot, trans)
+    _forward(q, R, M, I, rot, trans)
     return rot, trans
 
 
@@ -105,9 +114,14 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     not clear, in pair order; blocks whose entry in row rows[i] of `blocks` (r, NB) is False are
     known cleared (`_near`) and skipped."""
     J, G, P, NG, NB, N = I[0], I[1], I[2], I[3], I[4], I[6]
-    (parent, kind, axis, jrot, jtrans, jq, centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin,
-     piece_joint, pair_a, pair_b, pair_obstacle, group_joint, b_kind, b_a, b_b, b_end, b_pairs, obb_c, obb_r, obb_h,
-     ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip, walk) = _tables(F, R, M, I)
+    centre, radius, box_lo, box_hi, margin = I[CENTRE], I[RADIUS], I[BOX_LO], I[BOX_HI], I[MARGIN]
+    g_centre, g_radius, b_margin, ch_c, ch_rad = I[G_CENTRE], I[G_RADIUS], I[B_MARGIN], I[CH_C], I[CH_RAD]
+    piece_joint, pair_a, pair_b, pair_obstacle = I[PIECE_JOINT], I[PAIR_A], I[PAIR_B], I[PAIR_OBSTACLE]
+    group_joint, b_kind, b_a, b_b, b_end, b_pairs = I[GROUP_JOINT], I[B_KIND], I[B_A], I[B_B], I[B_END], I[B_PAIRS]
+    ch_start, ch_end, ch_skip, walk = I[CH_START], I[CH_END], I[CH_SKIP], I[WALK]
+    # `boxes_apart` (shared with the clash descent) takes its boxes' tables as arrays.
+    obb_h = R[I[OBB_H]:I[OBB_H] + G]
+    ch_bc, ch_br, ch_h = R[I[CH_BC]:], M[I[CH_BR]:], R[I[CH_H]:]
 
     n_cfg = qs.shape[0]
     rot = np.empty((J, 3, 3))
@@ -128,9 +142,8 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     moving = np.empty(G, dtype=np.int64)
     n_moving = 0
     for g in range(G):
-        if piece_joint[g] == 0:
-            # j an int64, not a literal 0: numba would compile `_place` again for Literal[int](0)
-            _place(rot, trans, np.int64(0), centre, g, world)
+        if I[piece_joint + g] == 0:
+            _place(rot, trans, I[piece_joint + g], R, centre + g, world, g)
         else:
             moving[n_moving] = g
             n_moving += 1
@@ -152,12 +165,13 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     for i in range(n_cfg):
         for c in range(q.shape[0]):          # a loop: slice assignment compiles its shape checks
             q[c] = qs[i, c]
-        _forward(q, parent, kind, axis, jrot, jtrans, jq, rot, trans)
+        _forward(q, R, M, I, rot, trans)
         row = rows[i]
         for m in range(n_moving):
-            _place(rot, trans, piece_joint[moving[m]], centre, moving[m], world)
+            g = moving[m]
+            _place(rot, trans, I[piece_joint + g], R, centre + g, world, g)
         for g in range(NG):
-            _place(rot, trans, group_joint[g], g_centre, g, g_world)
+            _place(rot, trans, I[group_joint + g], R, g_centre + g, g_world, g)
         placed[:] = False
         first = filled
         few = n_listed[row] >= 0
@@ -168,53 +182,54 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
                 blk = listed[row, nd]
                 nd += 1
             else:
-                blk = walk[3 * nd]
+                blk = I[walk + 3 * nd]
                 if blk < 0:                     # a box over obstacles: cleared, all their blocks are
-                    ga = walk[3 * nd + 1]
-                    cleared = _sphere_box(g_world, ga, g_radius[ga] + b_margin[NB + nd], box_lo, box_hi, G + nd)
-                    nd = walk[3 * nd + 2] if cleared else nd + 1
+                    ga = I[walk + 3 * nd + 1]
+                    cleared = _sphere_box(g_world, ga, F[g_radius + ga] + F[b_margin + NB + nd], R, box_lo + G + nd,
+                                          box_hi + G + nd)
+                    nd = I[walk + 3 * nd + 2] if cleared else nd + 1
                     continue
                 nd += 1
                 if not blocks[row, blk]:
                     continue
-            begin = b_end[blk - 1] if blk > 0 else 0
-            stop = b_end[blk]
-            ga, gb = b_a[blk], b_b[blk]
-            if b_kind[blk] == 0:
-                cleared = _sphere_box(g_world, ga, g_radius[ga] + b_margin[blk], box_lo, box_hi, gb)
+            begin = I[b_end + blk - 1] if blk > 0 else 0
+            stop = I[b_end + blk]
+            ga, gb = I[b_a + blk], I[b_b + blk]
+            if I[b_kind + blk] == 0:
+                cleared = _sphere_box(g_world, ga, F[g_radius + ga] + F[b_margin + blk], R, box_lo + gb, box_hi + gb)
             else:
-                cleared = _sphere_point(g_world, ga, g_world, gb, g_radius[ga] + g_radius[gb] + b_margin[blk])
+                cleared = _sphere_point(g_world, ga, g_world, gb, F[g_radius + ga] + F[g_radius + gb] + F[b_margin + blk])
             if not cleared:
                 for n in range(begin, stop):
-                    k = b_pairs[n]
+                    k = I[b_pairs + n]
                     if not active[row, k]:
                         continue
-                    a, b = pair_a[k], pair_b[k]
-                    if pair_obstacle[k]:
-                        ok = _sphere_box(world, a, radius[a] + margin[k], box_lo, box_hi, b)
-                        if not ok and ch_start[b] >= 0:   # near the obstacle's box: chunk by chunk
+                    a, b = I[pair_a + k], I[pair_b + k]
+                    if I[pair_obstacle + k]:
+                        ok = _sphere_box(world, a, F[radius + a] + F[margin + k], R, box_lo + b, box_hi + b)
+                        if not ok and I[ch_start + b] >= 0:   # near the obstacle's box: chunk by chunk
                             if not placed[a]:
-                                _place_box(rot, trans, piece_joint[a], obb_c, obb_r, a, box_c, box_r)
+                                _place_box(rot, trans, I[piece_joint + a], R, M, I, a, box_c, box_r)
                                 placed[a] = True
                             ok = True
-                            c = ch_start[b]
-                            while c < ch_end[b]:          # the chunk tree, pre-order, without a stack
-                                if _sphere_point(world, a, ch_c, c, radius[a] + ch_rad[c] + margin[k]) or \
-                                        boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, margin[k], scratch):
-                                    c = ch_skip[c]        # cleared: past its subtree
-                                elif ch_skip[c] == c + 1:
+                            c = I[ch_start + b]
+                            while c < I[ch_end + b]:          # the chunk tree, pre-order, without a stack
+                                if _sphere_point(world, a, R, ch_c + c, F[radius + a] + F[ch_rad + c] + F[margin + k]) or \
+                                        boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, F[margin + k], scratch):
+                                    c = I[ch_skip + c]    # cleared: past its subtree
+                                elif I[ch_skip + c] == c + 1:
                                     ok = False            # a leaf it cannot clear
                                     break
                                 else:
                                     c += 1                # into its first child
                     else:
-                        ok = _sphere_point(world, a, world, b, radius[a] + radius[b] + margin[k])
+                        ok = _sphere_point(world, a, world, b, F[radius + a] + F[radius + b] + F[margin + k])
                         if not ok:                # the spheres overlap: try the pieces' boxes
                             for g in (a, b):
                                 if not placed[g]:
-                                    _place_box(rot, trans, piece_joint[g], obb_c, obb_r, g, box_c, box_r)
+                                    _place_box(rot, trans, I[piece_joint + g], R, M, I, g, box_c, box_r)
                                     placed[g] = True
-                            ok = boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b, margin[k], scratch)
+                            ok = boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b, F[margin + k], scratch)
                     if not ok:
                         out[filled] = k
                         filled += 1
@@ -251,14 +266,19 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
     for each pair left when deep, how much its distance can shrink from the box's centre
     (`_pair_reach`; inf otherwise)."""
     J, G, P, NG, NB, N = I[0], I[1], I[2], I[3], I[4], I[6]
-    (parent, kind, axis, jrot, jtrans, jq, centre, radius, box_lo, box_hi, margin, g_centre, g_radius, b_margin,
-     piece_joint, pair_a, pair_b, pair_obstacle, group_joint, b_kind, b_a, b_b, b_end, b_pairs, obb_c, obb_r, obb_h,
-     ch_c, ch_rad, ch_bc, ch_br, ch_h, ch_start, ch_end, ch_skip, walk) = _tables(F, R, M, I)
+    centre, radius, box_lo, box_hi, margin = I[CENTRE], I[RADIUS], I[BOX_LO], I[BOX_HI], I[MARGIN]
+    g_centre, g_radius, b_margin, ch_c, ch_rad = I[G_CENTRE], I[G_RADIUS], I[B_MARGIN], I[CH_C], I[CH_RAD]
+    piece_joint, pair_a, pair_b, pair_obstacle = I[PIECE_JOINT], I[PAIR_A], I[PAIR_B], I[PAIR_OBSTACLE]
+    group_joint, b_kind, b_a, b_b, b_end, b_pairs = I[GROUP_JOINT], I[B_KIND], I[B_A], I[B_B], I[B_END], I[B_PAIRS]
+    ch_start, ch_end, ch_skip, walk, kind = I[CH_START], I[CH_END], I[CH_SKIP], I[WALK], I[KIND]
+    # `boxes_apart` (shared with the clash descent) takes its boxes' tables as arrays.
+    obb_h = R[I[OBB_H]:I[OBB_H] + G]
+    ch_bc, ch_br, ch_h = R[I[CH_BC]:], M[I[CH_BR]:], R[I[CH_H]:]
     keep = np.ones(NB, dtype=np.bool_)
     live = active.copy()
     reach = np.full(P, np.inf)
     for j in range(1, J):
-        if kind[j] != 0:
+        if I[kind + j] != 0:
             return keep, live, reach
     n = qs.shape[1]
     lo = np.empty(n)
@@ -276,12 +296,12 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
         mid[c] = (lo[c] + hi[c]) / 2.0
     rot = np.empty((J, 3, 3))
     trans = np.empty((J, 3))
-    _forward(mid, parent, kind, axis, jrot, jtrans, jq, rot, trans)
+    _forward(mid, R, M, I, rot, trans)
     g_world = np.empty((NG, 3))
     g_grow = np.empty(NG)
     for g in range(NG):
-        _place(rot, trans, group_joint[g], g_centre, g, g_world)
-        g_grow[g] = _growth(g_centre, g, group_joint[g], lo, hi, parent, jtrans, jq, 0.0, np.int64(0))
+        _place(rot, trans, I[group_joint + g], R, g_centre + g, g_world, g)
+        g_grow[g] = _growth(R, I, g_centre + g, I[group_joint + g], lo, hi, 0.0, np.int64(0))
     world = np.empty((G, 3))
     grow = np.full(G, -1.0)                   # not yet computed
     box_c = np.empty((G, 3))
@@ -295,90 +315,94 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
         live[m] = False
     nd = 0
     while nd < N:                             # `_uncleared`'s block walk, every test grown
-        blk = walk[3 * nd]
+        blk = I[walk + 3 * nd]
         if blk < 0:
-            ga = walk[3 * nd + 1]
-            cleared = _sphere_box(g_world, ga, g_radius[ga] + b_margin[NB + nd] + g_grow[ga], box_lo, box_hi, G + nd)
-            nd = walk[3 * nd + 2] if cleared else nd + 1
+            ga = I[walk + 3 * nd + 1]
+            cleared = _sphere_box(g_world, ga, F[g_radius + ga] + F[b_margin + NB + nd] + g_grow[ga], R,
+                                  box_lo + G + nd, box_hi + G + nd)
+            nd = I[walk + 3 * nd + 2] if cleared else nd + 1
             continue
         nd += 1
-        begin = b_end[blk - 1] if blk > 0 else 0
-        stop = b_end[blk]
-        ga, gb = b_a[blk], b_b[blk]
-        if b_kind[blk] == 0:
-            cleared = _sphere_box(g_world, ga, g_radius[ga] + b_margin[blk] + g_grow[ga], box_lo, box_hi, gb)
+        begin = I[b_end + blk - 1] if blk > 0 else 0
+        stop = I[b_end + blk]
+        ga, gb = I[b_a + blk], I[b_b + blk]
+        if I[b_kind + blk] == 0:
+            cleared = _sphere_box(g_world, ga, F[g_radius + ga] + F[b_margin + blk] + g_grow[ga], R, box_lo + gb,
+                                  box_hi + gb)
         else:
-            cleared = _sphere_point(g_world, ga, g_world, gb, g_radius[ga] + g_radius[gb] + b_margin[blk]
+            cleared = _sphere_point(g_world, ga, g_world, gb, F[g_radius + ga] + F[g_radius + gb] + F[b_margin + blk]
                                     + g_grow[ga] + g_grow[gb])
         if cleared:
             continue
         any_live = False
         for m in range(begin, stop):
-            k = b_pairs[m]
+            k = I[b_pairs + m]
             if not active[k]:
                 continue
-            a, b = pair_a[k], pair_b[k]
+            a, b = I[pair_a + k], I[pair_b + k]
             if grow[a] < 0.0:
-                _place(rot, trans, piece_joint[a], centre, a, world)
-                grow[a] = _growth(centre, a, piece_joint[a], lo, hi, parent, jtrans, jq, 0.0, np.int64(0))
-            if pair_obstacle[k]:
-                live[k] = not _sphere_box(world, a, radius[a] + margin[k] + grow[a], box_lo, box_hi, b)
-                if live[k] and deep and ch_start[b] >= 0:
+                _place(rot, trans, I[piece_joint + a], R, centre + a, world, a)
+                grow[a] = _growth(R, I, centre + a, I[piece_joint + a], lo, hi, 0.0, np.int64(0))
+            if I[pair_obstacle + k]:
+                live[k] = not _sphere_box(world, a, F[radius + a] + F[margin + k] + grow[a], R, box_lo + b, box_hi + b)
+                if live[k] and deep and I[ch_start + b] >= 0:
                     # The box and the spread are kept apart: `_pair_reach` may have computed the
                     # spread (for an obstacle without chunks) without placing the box.
                     if not boxed[a]:
-                        _place_box(rot, trans, piece_joint[a], obb_c, obb_r, a, box_c, box_r)
+                        _place_box(rot, trans, I[piece_joint + a], R, M, I, a, box_c, box_r)
                         boxed[a] = True
                     if spread[a] < 0.0:
-                        spread[a] = _growth(centre, a, piece_joint[a], lo, hi, parent, jtrans, jq, radius[a], np.int64(0))
+                        spread[a] = _growth(R, I, centre + a, I[piece_joint + a], lo, hi, F[radius + a], np.int64(0))
                     live[k] = False
-                    c = ch_start[b]
-                    while c < ch_end[b]:              # `_uncleared`'s traversal, every test grown
-                        if _sphere_point(world, a, ch_c, c, radius[a] + ch_rad[c] + margin[k] + grow[a]) or \
-                                boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, margin[k] + spread[a],
-                                             scratch):
-                            c = ch_skip[c]
-                        elif ch_skip[c] == c + 1:
+                    c = I[ch_start + b]
+                    while c < I[ch_end + b]:          # `_uncleared`'s traversal, every test grown
+                        if _sphere_point(world, a, R, ch_c + c, F[radius + a] + F[ch_rad + c] + F[margin + k] + grow[a]) or \
+                                boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, F[margin + k] + spread[a],
+                                            scratch):
+                            c = I[ch_skip + c]
+                        elif I[ch_skip + c] == c + 1:
                             live[k] = True
                             break
                         else:
                             c += 1
             else:
                 if grow[b] < 0.0:
-                    _place(rot, trans, piece_joint[b], centre, b, world)
-                    grow[b] = _growth(centre, b, piece_joint[b], lo, hi, parent, jtrans, jq, 0.0, np.int64(0))
-                live[k] = not _sphere_point(world, a, world, b, radius[a] + radius[b] + margin[k] + grow[a] + grow[b])
+                    _place(rot, trans, I[piece_joint + b], R, centre + b, world, b)
+                    grow[b] = _growth(R, I, centre + b, I[piece_joint + b], lo, hi, 0.0, np.int64(0))
+                live[k] = not _sphere_point(world, a, world, b, F[radius + a] + F[radius + b] + F[margin + k] + grow[a]
+                                            + grow[b])
                 if live[k] and deep:
                     for g in (a, b):
                         if not boxed[g]:
-                            _place_box(rot, trans, piece_joint[g], obb_c, obb_r, g, box_c, box_r)
+                            _place_box(rot, trans, I[piece_joint + g], R, M, I, g, box_c, box_r)
                             boxed[g] = True
                         if spread[g] < 0.0:
-                            spread[g] = _growth(centre, g, piece_joint[g], lo, hi, parent, jtrans, jq, radius[g], np.int64(0))
+                            spread[g] = _growth(R, I, centre + g, I[piece_joint + g], lo, hi, F[radius + g], np.int64(0))
                     live[k] = not boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b,
-                                               margin[k] + spread[a] + spread[b], scratch)
+                                              F[margin + k] + spread[a] + spread[b], scratch)
             if live[k] and deep:
-                reach[k] = _pair_reach(centre, radius, piece_joint, a, b, pair_obstacle[k], lo, hi, parent, jtrans, jq,
-                                       spread)
+                reach[k] = _pair_reach(F, R, I, a, b, I[pair_obstacle + k], lo, hi, spread)
             any_live = any_live or live[k]
         keep[blk] = any_live             # a block without a live pair adds nothing
     return keep, live, reach
 
 
 @helper
-def _place(rot: Any, trans: Any, j: Any, local: Any, g: int, world: Any) -> None:
+def _place(rot: Any, trans: Any, j: Any, local: Any, p: Any, world: Any, g: Any) -> None:
+    """world[g] = joint j's frame applied to point local[p]."""
     for r in range(3):
-        world[g, r] = trans[j, r] + rot[j, r, 0] * local[g, 0] + rot[j, r, 1] * local[g, 1] + rot[j, r, 2] * local[g, 2]
+        world[g, r] = trans[j, r] + rot[j, r, 0] * local[p, 0] + rot[j, r, 1] * local[p, 1] + rot[j, r, 2] * local[p, 2]
 
 
 @helper
-def _sphere_box(world: Any, a: int, reach: float, lo: Any, hi: Any, b: int) -> bool:
-    """Whether sphere centre a is farther than `reach` from box b (an inf reach is never cleared)."""
+def _sphere_box(world: Any, a: int, reach: float, corners: Any, lo: Any, hi: Any) -> bool:
+    """Whether sphere centre a is farther than `reach` from the box of corners[lo] and corners[hi]
+    (an inf reach is never cleared)."""
     d2 = 0.0
     for r in range(3):
         c = world[a, r]
-        e = lo[b, r] - c
-        e = max(e, c - hi[b, r])
+        e = corners[lo, r] - c
+        e = max(e, c - corners[hi, r])
         if e > 0.0:
             d2 += e * e
     return d2 > reach * reach
@@ -395,10 +419,10 @@ def _sphere_point(world: Any, a: int, points: Any, c: int, reach: float) -> bool
 
 
 @helper
-def _place_box(rot: Any, trans: Any, j: int, local_c: Any, local_r: Any, g: int, box_c: Any, box_r: Any) -> None:
+def _place_box(rot: Any, trans: Any, j: Any, R: Any, M: Any, I: Any, g: Any, box_c: Any, box_r: Any) -> None:
+    """Piece g's oriented box (`prefilter_layout` OBB_C, OBB_R) in joint j's frame."""
+    lc, lr = I[OBB_C] + g, I[OBB_R] + g
     for r in range(3):
-        box_c[g, r] = trans[j, r] + rot[j, r, 0] * local_c[g, 0] + rot[j, r, 1] * local_c[g, 1] \
-            + rot[j, r, 2] * local_c[g, 2]
+        box_c[g, r] = trans[j, r] + rot[j, r, 0] * R[lc, 0] + rot[j, r, 1] * R[lc, 1] + rot[j, r, 2] * R[lc, 2]
         for c in range(3):
-            box_r[g, r, c] = rot[j, r, 0] * local_r[g, 0, c] + rot[j, r, 1] * local_r[g, 1, c] \
-                + rot[j, r, 2] * local_r[g, 2, c]
+            box_r[g, r, c] = rot[j, r, 0] * M[lr, 0, c] + rot[j, r, 1] * M[lr, 1, c] + rot[j, r, 2] * M[lr, 2, c]
