@@ -58,9 +58,12 @@ from robomax_py.world.prefilter_reach import _growth, _pair_reach
 def _forward(q: Any, R: Any, M: Any, I: Any, rot: Any, trans: Any) -> None:
     """Joint frames in the base frame: oMi[j] = oMi[parent] * placement[j] * motion_j(q)."""
     parent, kind, axis, jrot, jtrans, jq = I[PARENT], I[KIND], I[AXIS], I[JROT], I[JTRANS], I[JQ]
-    rot[0, :, :] = 0.0
-    rot[0, 0, 0] = rot[0, 1, 1] = rot[0, 2, 2] = 1.0
-    trans[0, :] = 0.0
+    # Loops, not slice assignments (`rot[0, :, :] = 0.0`): numba lowers each of those through its
+    # broadcasting setitem, much more code to compile for the same nine stores.
+    for r in range(3):
+        trans[0, r] = 0.0
+        for c in range(3):
+            rot[0, r, c] = 1.0 if r == c else 0.0
     m = np.empty((3, 3))
     for j in range(1, I[0]):
         p = I[parent + j]
@@ -135,9 +138,10 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     out = np.empty(n_cfg * P, dtype=np.int64)
     filled = 0
     # Pieces on the base (every obstacle) are where they are at any configuration: placed once.
-    rot[0, :, :] = 0.0
-    rot[0, 0, 0] = rot[0, 1, 1] = rot[0, 2, 2] = 1.0
-    trans[0, :] = 0.0
+    for r in range(3):
+        trans[0, r] = 0.0
+        for c in range(3):
+            rot[0, r, c] = 1.0 if r == c else 0.0
     moving = np.empty(G, dtype=np.int64)
     n_moving = 0
     for g in range(G):
@@ -171,7 +175,8 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
             _place(rot, trans, I[piece_joint + g], R, centre + g, world, g)
         for g in range(NG):
             _place(rot, trans, I[group_joint + g], R, g_centre + g, g_world, g)
-        placed[:] = False
+        for g in range(G):
+            placed[g] = False
         first = filled
         few = n_listed[row] >= 0
         end = n_listed[row] if few else N
@@ -336,7 +341,7 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
 
 @helper
 def _pair_cleared(F: Any, R: Any, M: Any, I: Any, k: Any, rot: Any, trans: Any, world: Any, grow: Any, box_c: Any,
-                  box_r: Any, boxed: Any, spread: Any, lo: Any, hi: Any, fine: bool, scratch: Any) -> bool:
+                  box_r: Any, boxed: Any, spread: Any, lo: Any, hi: Any, fine: bool | np.bool_, scratch: Any) -> bool:
     """Whether pair k clears its margin: the spheres of its pieces (centres in world, each radius
     grown by grow), then when `fine` an obstacle's chunk tree or the pieces' oriented boxes (placed
     in box_c, box_r when not yet `boxed`, the gap grown by spread; a spread < 0 is computed by
