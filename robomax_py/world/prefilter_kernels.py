@@ -117,9 +117,14 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     not clear, in pair order; blocks whose entry in row rows[i] of `blocks` (r, NB) is False are
     known cleared (`_near`) and skipped."""
     J, G, P, NG, NB, N = I[0], I[1], I[2], I[3], I[4], I[6]
-    centre, box_lo, box_hi, g_centre, g_radius = I[CENTRE], I[BOX_LO], I[BOX_HI], I[G_CENTRE], I[G_RADIUS]
-    b_margin, piece_joint, group_joint, walk = I[B_MARGIN], I[PIECE_JOINT], I[GROUP_JOINT], I[WALK]
-    b_kind, b_a, b_b, b_end, b_pairs = I[B_KIND], I[B_A], I[B_B], I[B_END], I[B_PAIRS]
+    centre, radius, box_lo, box_hi, margin = I[CENTRE], I[RADIUS], I[BOX_LO], I[BOX_HI], I[MARGIN]
+    g_centre, g_radius, b_margin, ch_c, ch_rad = I[G_CENTRE], I[G_RADIUS], I[B_MARGIN], I[CH_C], I[CH_RAD]
+    piece_joint, pair_a, pair_b, pair_obstacle = I[PIECE_JOINT], I[PAIR_A], I[PAIR_B], I[PAIR_OBSTACLE]
+    group_joint, b_kind, b_a, b_b, b_end, b_pairs = I[GROUP_JOINT], I[B_KIND], I[B_A], I[B_B], I[B_END], I[B_PAIRS]
+    ch_start, ch_end, ch_skip, walk = I[CH_START], I[CH_END], I[CH_SKIP], I[WALK]
+    # `boxes_apart` (shared with the clash descent) takes its boxes' tables as arrays.
+    obb_h = R[I[OBB_H]:I[OBB_H] + G]
+    ch_bc, ch_br, ch_h = R[I[CH_BC]:], M[I[CH_BR]:], R[I[CH_H]:]
 
     n_cfg = qs.shape[0]
     rot = np.empty((J, 3, 3))
@@ -130,10 +135,6 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     box_r = np.empty((G, 3, 3))
     placed = np.empty(G, dtype=np.bool_)     # world box of the piece computed for this configuration
     scratch = np.empty((7, 3))               # `boxes_apart`'s, allocated once
-    no_grow = np.empty(G)                    # `_pair_cleared`'s tests as they are, not grown
-    for g in range(G):
-        no_grow[g] = 0.0
-    fine = np.bool_(True)                    # not a literal True: `_pair_cleared` would compile again for it
     counts = np.empty(n_cfg, dtype=np.int64)
     out = np.empty(n_cfg * P, dtype=np.int64)
     filled = 0
@@ -208,8 +209,32 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
                     k = I[b_pairs + n]
                     if not active[row, k]:
                         continue
-                    ok = _pair_cleared(F, R, M, I, k, rot, trans, world, no_grow, box_c, box_r, placed, no_grow,
-                                       q, q, fine, scratch)
+                    a, b = I[pair_a + k], I[pair_b + k]
+                    if I[pair_obstacle + k]:
+                        ok = _sphere_box(world, a, F[radius + a] + F[margin + k], R, box_lo + b, box_hi + b)
+                        if not ok and I[ch_start + b] >= 0:   # near the obstacle's box: chunk by chunk
+                            if not placed[a]:
+                                _place_box(rot, trans, I[piece_joint + a], R, M, I, a, box_c, box_r)
+                                placed[a] = True
+                            ok = True
+                            c = I[ch_start + b]
+                            while c < I[ch_end + b]:          # the chunk tree, pre-order, without a stack
+                                if _sphere_point(world, a, R, ch_c + c, F[radius + a] + F[ch_rad + c] + F[margin + k]) or \
+                                        boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, F[margin + k], scratch):
+                                    c = I[ch_skip + c]    # cleared: past its subtree
+                                elif I[ch_skip + c] == c + 1:
+                                    ok = False            # a leaf it cannot clear
+                                    break
+                                else:
+                                    c += 1                # into its first child
+                    else:
+                        ok = _sphere_point(world, a, world, b, F[radius + a] + F[radius + b] + F[margin + k])
+                        if not ok:                # the spheres overlap: try the pieces' boxes
+                            for g in (a, b):
+                                if not placed[g]:
+                                    _place_box(rot, trans, I[piece_joint + g], R, M, I, g, box_c, box_r)
+                                    placed[g] = True
+                            ok = boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b, F[margin + k], scratch)
                     if not ok:
                         out[filled] = k
                         filled += 1
@@ -246,10 +271,14 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
     for each pair left when deep, how much its distance can shrink from the box's centre
     (`_pair_reach`; inf otherwise)."""
     J, G, P, NG, NB, N = I[0], I[1], I[2], I[3], I[4], I[6]
-    centre, box_lo, box_hi, g_centre, g_radius = I[CENTRE], I[BOX_LO], I[BOX_HI], I[G_CENTRE], I[G_RADIUS]
-    b_margin, piece_joint, group_joint, walk, kind = I[B_MARGIN], I[PIECE_JOINT], I[GROUP_JOINT], I[WALK], I[KIND]
-    b_kind, b_a, b_b, b_end, b_pairs = I[B_KIND], I[B_A], I[B_B], I[B_END], I[B_PAIRS]
-    pair_a, pair_b, pair_obstacle = I[PAIR_A], I[PAIR_B], I[PAIR_OBSTACLE]
+    centre, radius, box_lo, box_hi, margin = I[CENTRE], I[RADIUS], I[BOX_LO], I[BOX_HI], I[MARGIN]
+    g_centre, g_radius, b_margin, ch_c, ch_rad = I[G_CENTRE], I[G_RADIUS], I[B_MARGIN], I[CH_C], I[CH_RAD]
+    piece_joint, pair_a, pair_b, pair_obstacle = I[PIECE_JOINT], I[PAIR_A], I[PAIR_B], I[PAIR_OBSTACLE]
+    group_joint, b_kind, b_a, b_b, b_end, b_pairs = I[GROUP_JOINT], I[B_KIND], I[B_A], I[B_B], I[B_END], I[B_PAIRS]
+    ch_start, ch_end, ch_skip, walk, kind = I[CH_START], I[CH_END], I[CH_SKIP], I[WALK], I[KIND]
+    # `boxes_apart` (shared with the clash descent) takes its boxes' tables as arrays.
+    obb_h = R[I[OBB_H]:I[OBB_H] + G]
+    ch_bc, ch_br, ch_h = R[I[CH_BC]:], M[I[CH_BR]:], R[I[CH_H]:]
     # np.empty and loops, not np.ones, np.full or a copy: numba compiles each constructor (and each
     # dtype of it) as a function of its own, about 0.1 s apiece of a first plan.
     keep = np.empty(NB, dtype=np.bool_)
@@ -326,65 +355,51 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
             if not active[k]:
                 continue
             a, b = I[pair_a + k], I[pair_b + k]
-            for g in (a, b):
-                if grow[g] < 0.0 and (g == a or not I[pair_obstacle + k]):
-                    _place(rot, trans, I[piece_joint + g], R, centre + g, world, g)
-                    grow[g] = _growth(R, I, centre + g, I[piece_joint + g], lo, hi, 0.0, np.int64(0))
-            live[k] = not _pair_cleared(F, R, M, I, k, rot, trans, world, grow, box_c, box_r, boxed, spread, lo, hi,
-                                        deep, scratch)
+            if grow[a] < 0.0:
+                _place(rot, trans, I[piece_joint + a], R, centre + a, world, a)
+                grow[a] = _growth(R, I, centre + a, I[piece_joint + a], lo, hi, 0.0, np.int64(0))
+            if I[pair_obstacle + k]:
+                live[k] = not _sphere_box(world, a, F[radius + a] + F[margin + k] + grow[a], R, box_lo + b, box_hi + b)
+                if live[k] and deep and I[ch_start + b] >= 0:
+                    # The box and the spread are kept apart: `_pair_reach` may have computed the
+                    # spread (for an obstacle without chunks) without placing the box.
+                    if not boxed[a]:
+                        _place_box(rot, trans, I[piece_joint + a], R, M, I, a, box_c, box_r)
+                        boxed[a] = True
+                    if spread[a] < 0.0:
+                        spread[a] = _growth(R, I, centre + a, I[piece_joint + a], lo, hi, F[radius + a], np.int64(0))
+                    live[k] = False
+                    c = I[ch_start + b]
+                    while c < I[ch_end + b]:          # `_uncleared`'s traversal, every test grown
+                        if _sphere_point(world, a, R, ch_c + c, F[radius + a] + F[ch_rad + c] + F[margin + k] + grow[a]) or \
+                                boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, F[margin + k] + spread[a],
+                                            scratch):
+                            c = I[ch_skip + c]
+                        elif I[ch_skip + c] == c + 1:
+                            live[k] = True
+                            break
+                        else:
+                            c += 1
+            else:
+                if grow[b] < 0.0:
+                    _place(rot, trans, I[piece_joint + b], R, centre + b, world, b)
+                    grow[b] = _growth(R, I, centre + b, I[piece_joint + b], lo, hi, 0.0, np.int64(0))
+                live[k] = not _sphere_point(world, a, world, b, F[radius + a] + F[radius + b] + F[margin + k] + grow[a]
+                                            + grow[b])
+                if live[k] and deep:
+                    for g in (a, b):
+                        if not boxed[g]:
+                            _place_box(rot, trans, I[piece_joint + g], R, M, I, g, box_c, box_r)
+                            boxed[g] = True
+                        if spread[g] < 0.0:
+                            spread[g] = _growth(R, I, centre + g, I[piece_joint + g], lo, hi, F[radius + g], np.int64(0))
+                    live[k] = not boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b,
+                                              F[margin + k] + spread[a] + spread[b], scratch)
             if live[k] and deep:
                 reach[k] = _pair_reach(F, R, I, a, b, I[pair_obstacle + k], lo, hi, spread)
             any_live = any_live or live[k]
         keep[blk] = any_live             # a block without a live pair adds nothing
     return keep, live, reach
-
-
-@helper
-def _pair_cleared(F: Any, R: Any, M: Any, I: Any, k: Any, rot: Any, trans: Any, world: Any, grow: Any, box_c: Any,
-                  box_r: Any, boxed: Any, spread: Any, lo: Any, hi: Any, fine: bool | np.bool_, scratch: Any) -> bool:
-    """Whether pair k clears its margin: the spheres of its pieces (centres in world, each radius
-    grown by grow), then when `fine` an obstacle's chunk tree or the pieces' oriented boxes (placed
-    in box_c, box_r when not yet `boxed`, the gap grown by spread; a spread < 0 is computed by
-    `_growth` over the box [lo, hi]). `_uncleared` passes zeros for grow and spread (x + 0.0 is x:
-    the same tests), `_near` how far each piece moves: one body for both, compiled once."""
-    radius, margin, piece_joint, centre = I[RADIUS], I[MARGIN], I[PIECE_JOINT], I[CENTRE]
-    ch_start, ch_end, ch_skip, ch_c, ch_rad = I[CH_START], I[CH_END], I[CH_SKIP], I[CH_C], I[CH_RAD]
-    # `boxes_apart` (shared with the clash descent) takes its boxes' tables as arrays.
-    obb_h, ch_bc, ch_br, ch_h = R[I[OBB_H]:], R[I[CH_BC]:], M[I[CH_BR]:], R[I[CH_H]:]
-    a, b = I[I[PAIR_A] + k], I[I[PAIR_B] + k]
-    if I[I[PAIR_OBSTACLE] + k]:
-        if _sphere_box(world, a, F[radius + a] + F[margin + k] + grow[a], R, I[BOX_LO] + b, I[BOX_HI] + b):
-            return True
-        if not fine or I[ch_start + b] < 0:
-            return False
-        # Near the obstacle's box: chunk by chunk. The box and the spread are kept apart: `_pair_reach`
-        # may have computed the spread (for an obstacle without chunks) without placing the box.
-        if not boxed[a]:
-            _place_box(rot, trans, I[piece_joint + a], R, M, I, a, box_c, box_r)
-            boxed[a] = True
-        if spread[a] < 0.0:
-            spread[a] = _growth(R, I, centre + a, I[piece_joint + a], lo, hi, F[radius + a], np.int64(0))
-        c = I[ch_start + b]
-        while c < I[ch_end + b]:          # the chunk tree, pre-order, without a stack
-            if _sphere_point(world, a, R, ch_c + c, F[radius + a] + F[ch_rad + c] + F[margin + k] + grow[a]) or \
-                    boxes_apart(box_c, box_r, obb_h, a, ch_bc, ch_br, ch_h, c, F[margin + k] + spread[a], scratch):
-                c = I[ch_skip + c]        # cleared: past its subtree
-            elif I[ch_skip + c] == c + 1:
-                return False              # a leaf it cannot clear
-            else:
-                c += 1                    # into its first child
-        return True
-    if _sphere_point(world, a, world, b, F[radius + a] + F[radius + b] + F[margin + k] + grow[a] + grow[b]):
-        return True
-    if not fine:
-        return False
-    for g in (a, b):                      # the spheres overlap: try the pieces' boxes
-        if not boxed[g]:
-            _place_box(rot, trans, I[piece_joint + g], R, M, I, g, box_c, box_r)
-            boxed[g] = True
-        if spread[g] < 0.0:
-            spread[g] = _growth(R, I, centre + g, I[piece_joint + g], lo, hi, F[radius + g], np.int64(0))
-    return boxes_apart(box_c, box_r, obb_h, a, box_c, box_r, obb_h, b, F[margin + k] + spread[a] + spread[b], scratch)
 
 
 @helper
