@@ -301,3 +301,14 @@ def test_piece_bounds_find_each_point_sets_box_once(monkeypatch: Any) -> None:
     monkeypatch.setattr(prefilter, "_enclosing_box", real_box)
     c, r = prefilter._enclosing_sphere(got.placed)
     assert np.array_equal(got.sphere[0], c) and got.sphere[1] == r
+
+
+def test_each_packed_table_has_one_name() -> None:
+    """The kernels read every table at the start `prefilter_layout` names: two names for one slot (or a
+    slot without a name) would read one table as another."""
+    from robomax_py.world import prefilter_layout as layout
+
+    counts = {"N_HEADER", "N_FLOAT_TABLES", "N_INT_TABLES"}
+    slots = sorted(v for k, v in vars(layout).items() if k.isupper() and not k.startswith("_") and k not in counts)
+    first = layout.N_HEADER
+    assert slots == list(range(first, first + layout.N_FLOAT_TABLES + layout.N_INT_TABLES))
