@@ -32,6 +32,7 @@ SMOKE: dict[str, list[str]] = {
     "bench_collision.py": ["--cell", SMALL, "--quick"],
     "bench_dialects.py": ["--runs", "1", SMALL],
     "bench_ik.py": ["--quick"],
+    "bench_jit_compile.py": [SMALL],
     "bench_learned_cspace.py": [SMALL, "--quick"],
     "bench_import.py": ["--runs", "1", "--poses", "20"],
     "bench_pick_place.py": ["--quick", "--out", OUT],
