@@ -35,7 +35,7 @@ class CollisionWorldCore:
     """Scratch, pair activation and exact tests of one collision world (the base of `CollisionWorld`)."""
 
     __slots__ = ("_active", "_active_before", "_allowed", "_callback", "_data", "_gdata", "_manager", "_pf", "_present",
-                 "_s", "_windows")
+                 "_s", "_segments", "_windows")
 
     # ----------------------------------------------------------------------------------- set-up
 
@@ -59,6 +59,8 @@ class CollisionWorldCore:
         self._active = np.ones(len(shared.pair_a), dtype=bool)
         self._allowed = np.ones(len(shared.pair_a), dtype=bool)     # pairs this world checks at all
         self._pf = shared.prefilter if shared.options.broad_phase and shared.options.prefilter else None
+        # Verdicts of untimed swept checks by their exact ends and step (`SweptChecks.check_segment`).
+        self._segments: dict[tuple[bytes, bytes, float], SegmentCheck] = {}
 
     def _restrict(self, allowed: np.ndarray) -> None:
         self._allowed = allowed.copy()

@@ -16,6 +16,10 @@ from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision_core import CollisionWorldCore
 from robomax_py.world.collision_results import SegmentCheck, bisection_order
 
+# Untimed segment verdicts a world remembers (`check_segment`); past this many it forgets them all
+# at once (about 200 B each). A sequencing's detour searches ask a few thousand to tens of thousands.
+REMEMBERED_SEGMENTS = 200_000
+
 
 class SweptChecks(CollisionWorldCore):
     """Swept-segment and polyline checks (the base of `CollisionWorld`)."""
@@ -67,13 +71,34 @@ class SweptChecks(CollisionWorldCore):
             Times at q0 and q1 (both or neither); state k is at t0 + k/m (t1 - t0). Dynamic obstacles
             are included per the module docstring. None: every dynamic obstacle present.
         max_step : float, m
+
+        An untimed check (every dynamic obstacle present) is a function of q0, q1 and max_step
+        alone, the world's pairs being fixed when it is made: its answer is remembered by their
+        exact bytes and given again, with the checks it took then, for the same move asked again
+        (the sequencer's detour searches shortcut the same roadmap paths and try the same exit legs
+        for many candidate pairs). Budgets counted in checks thus spend the same whether or not a
+        verdict was remembered.
         """
         if (t0 is None) != (t1 is None):
             raise ValueError("give both t0 and t1, or neither")
         if not max_step > 0:
             raise ValueError(f"max_step must be > 0 m, got {max_step}")
-        q0 = np.asarray(q0, dtype=np.float64)
-        q1 = np.asarray(q1, dtype=np.float64)
+        q0 = np.ascontiguousarray(q0, dtype=np.float64)
+        q1 = np.ascontiguousarray(q1, dtype=np.float64)
+        timed = t0 is not None and t1 is not None and self._s.dynamic_ids.size > 0
+        if timed:
+            return self._check_segment(q0, q1, t0, t1, max_step)
+        key = (q0.tobytes(), q1.tobytes(), float(max_step))
+        known = self._segments.get(key)
+        if known is None:
+            if len(self._segments) >= REMEMBERED_SEGMENTS:
+                self._segments.clear()
+            known = self._segments[key] = self._check_segment(q0, q1, None, None, max_step)
+        return known
+
+    def _check_segment(self, q0: FloatArray, q1: FloatArray, t0: float | None, t1: float | None,
+                       max_step: float) -> SegmentCheck:
+        """`check_segment` of float64 ends, checked now."""
         dq = q1 - q0
         m = math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12)
         timed = t0 is not None and t1 is not None and self._s.dynamic_ids.size > 0
