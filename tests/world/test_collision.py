@@ -359,6 +359,37 @@ def test_segment_catches_a_thin_plate_that_a_coarse_check_misses(ur10: RobotMode
     assert fine.states == math.ceil(w.sweep_length(q_a, q_b) / 0.002) + 1
 
 
+def test_segment_asked_again_is_answered_from_memory(ur10: RobotModel, gun: ToolSpec,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    # The same untimed move asked again gives the first answer (checks included) without a scan;
+    # other ends, the reverse move, another step or a timed check among dynamic obstacles are checked.
+    q_a = UR10_Q0 + [-0.8, 0, 0, 0, 0, 0]
+    q_b = UR10_Q0 + [0.8, 0, 0, 0, 0, 0]
+    w = world_for(ur10, gun, cabin_objects(-0.6), (door(),))
+    scans = 0
+    scan = type(w)._scan
+
+    def counted(self: CollisionWorld, *args: object, **kwargs: object) -> object:
+        nonlocal scans
+        scans += 1
+        return scan(self, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(type(w), "_scan", counted)
+    first = w.check_segment(q_a, q_b)
+    assert scans == 1
+    assert w.check_segment(q_a.copy(), list(q_b)) == first and scans == 1
+    w.check_segment(q_b, q_a)
+    w.check_segment(q_a, q_b, max_step=0.01)
+    w.check_segment(q_a, q_b + 1e-12)
+    assert scans == 4
+    for _ in range(2):                                           # timed: checked each time
+        before = scans
+        w.check_segment(q_a, q_b, 0.0, 1.0)
+        assert scans > before
+    before = scans
+    assert w.copy().check_segment(q_a, q_b) == first and scans == before + 1   # a copy remembers its own
+
+
 def _step_bound_holds(world: CollisionWorld, robot: RobotModel, rng: np.random.Generator,
                       segments: int, max_step: float, max_dq: float) -> float:
     """Largest ratio (path length of any support point between consecutive states) / max_step."""
