@@ -28,6 +28,8 @@ from robomax_py.timing import (
 from robomax_py.transforms import invert
 
 LIFT_HEIGHTS_M = (0.08, 0.15, 0.25, 0.4)
+# The ways a lift moves each end (`Sequencer._lift_detour`): world up, back along the approach line, both.
+LIFT_KINDS = ("up", "back", "up_back")
 # Withdrawing the gun off a flange (`Sequencer._withdrawn_detour`): directions perpendicular to the
 # electrode axis, distances (m; spots lie ~20 mm from the edge the C wraps round, and its jaws
 # reach a little past the electrodes), and exit pairs tried per detour.
@@ -59,27 +61,19 @@ class SequencerDetours(SequencerKnowledge):
         where the clamps of the row above block the way up on a stacked flange); then both at once.
         """
         qa, qb = self.q(i)[a], self.q(j)[b]
-        up = self._up()
         checks = 0
         ends_at = [(qa, i, a), (qb, j, b)]
-        back = {idx: self._back_direction(idx, col) for _, idx, col in ends_at if idx != HOME}
-        tcp = {idx: fk_tcp(self.robot, q) for q, idx, _ in ends_at if idx != HOME}
-        for kind in ("up", "back", "up_back"):
+        for kind in LIFT_KINDS:
             for h in LIFT_HEIGHTS_M:
                 ends = []
                 for q, idx, col in ends_at:
                     if idx == HOME:
                         ends.append(q)
                         continue
-                    away = up if kind == "up" else back[idx] if kind == "back" else (up + back[idx]) / np.sqrt(2.0)
-                    T = tcp[idx].copy()
-                    T[:3, 3] += h * away
-                    table = solve_all(self.robot, T[None], q_hint=q)
-                    column = int(self.spots[idx].column[col])
-                    if not table.valid[0, column]:
+                    lifted = self._lifted(idx, col, kind, h)
+                    if lifted is None:
                         break
-                    lifted = table.q[0, column].copy()
-                    ends.append(q + wrap_to_pi(lifted - q))
+                    ends.append(lifted)
                 if len(ends) < 2 or not self.limits.contains(np.array(ends)).all():
                     continue
                 path = np.array([qa, ends[0], ends[1], qb])
@@ -90,6 +84,26 @@ class SequencerDetours(SequencerKnowledge):
                     return Detour(wp, polyline_time_estimate(wp, self.limits), checks)
         self.checks += checks
         return None
+
+    def _lifted(self, idx: int, col: int, kind: str, h: float) -> FloatArray | None:
+        """Spot idx's candidate col with its TCP moved h (m) `kind` of away (`_lift_detour`), in the
+        candidate's IK column, wrapped towards it; None where that column has no solution. Cached:
+        a candidate ends the lifts of every pair it is in, each asking the same inverse kinematics
+        (most of a clamped cell's lift searches, which mostly fail)."""
+        key = (idx, col, kind, h)
+        if key in self._lift_cache:
+            return self._lift_cache[key]
+        q = self.q(idx)[col]
+        up = self._up()
+        back = self._back_direction(idx, col)
+        away = up if kind == "up" else back if kind == "back" else (up + back) / np.sqrt(2.0)
+        T = fk_tcp(self.robot, q)
+        T[:3, 3] += h * away
+        table = solve_all(self.robot, T[None], q_hint=q)
+        column = int(self.spots[idx].column[col])
+        out = q + wrap_to_pi(table.q[0, column] - q) if table.valid[0, column] else None
+        self._lift_cache[key] = out
+        return out
 
     def _tcp_detour(self, i: int, a: int, j: int, b: int) -> Detour | None:
         """Straight TCP lines between two spots' candidates (`plan.tcp_detour`): the single line,

@@ -101,6 +101,7 @@ class SequencerKnowledge:
         self.unconnected: set[tuple[int, int]] = set()                            # unordered spot pairs given up
         self._exit_cache: dict[tuple[int, int], list[FloatArray]] = {}            # (spot, candidate) -> exits
         self._raised_cache: dict[tuple[int, int, int, float], FloatArray] = {}   # (spot, candidate, exit, h) -> q
+        self._lift_cache: dict[tuple[int, int, str, float], FloatArray | None] = {}  # (spot, candidate, kind, h) -> q
         self._inner: dict[tuple[int, bool], float] = {}                           # (detour, reversed) -> time
         self.tcp_detour_searches = 0          # `planner.detour_moves: lin`: searches for TCP lines
         self.tcp_detours_found = 0            # ... and those that found them
