@@ -137,3 +137,32 @@ def test_faster_takes_the_lower_estimate_and_counts_the_other(boxed: tuple[Seque
     equal = Detour(wp, 1.0, 3)
     assert seq._faster(fast, equal) is equal
     assert seq.checks == before + 207
+
+
+def test_a_lift_asks_each_lifted_end_once(boxed: tuple[Sequencer, Any, tuple[int, int]],
+                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    # Every pair a candidate ends lifts it the same way: the second lift from the same candidate
+    # solves no inverse kinematics and gives the same answer; each cached end sits at its offset.
+    from robomax_py.plan import graph_detours
+
+    seq, _, (a, b) = boxed
+    solves = 0
+    solve = graph_detours.solve_all
+
+    def counted(*args: Any, **kwargs: Any) -> Any:
+        nonlocal solves
+        solves += 1
+        return solve(*args, **kwargs)
+
+    monkeypatch.setattr(graph_detours, "solve_all", counted)
+    seq._lift_cache.clear()
+    first = seq._lift_detour(0, a, 1, b)
+    assert solves > 0
+    spent = solves
+    assert seq._lift_detour(0, a, 1, b) == first and solves == spent
+    up = seq._up()
+    for (idx, col, kind, h), q in seq._lift_cache.items():
+        if q is None or kind != "up":
+            continue
+        moved = fk_tcp(seq.robot, q)[:3, 3] - fk_tcp(seq.robot, seq.q(idx)[col])[:3, 3]
+        np.testing.assert_allclose(moved, h * up, atol=POS_TOL_M)
