@@ -118,10 +118,16 @@ def test_plan_reference_cell_twice_is_byte_identical(tmp_path: Path, reference_c
         assert result.exit_code == EXIT_OK, result.output
         report = json.loads(result.stdout)
         assert report["status"] == "planned" and len(report["spots"]) == 15
-        # The search's tour is the file's order reversed, estimated the same by the published
-        # method: timing the file's order again (1.1 s of a 4.5 s plan) could not make it kept.
+        # The cell is symmetric: the file's order and its reverse are estimated the same to the
+        # last bits, and which of the two the search settles on follows the rounding of the
+        # machine's floating point (the reverse on the machine this test was written on, the file's
+        # order itself on an AMD EPYC with AVX2). Either way the file's order is not timed again
+        # (1.1 s of a 4.5 s plan that could not make it kept). Within one machine the output is
+        # byte-identical (below).
         assert report["order"]["kept"] == "searched" and report["order"]["given_cycle"] is None
-        assert report["order"]["note"] == "the file's order is estimated the same"
+        assert report["order"]["note"] in ("the file's order is estimated the same",
+                                           "the search found the file's order")
+        assert report["order"]["searched_cycle"] == pytest.approx(20.719, abs=5e-4)
         outputs.append((out / "cabin_flange.json").read_bytes())
     assert outputs[0] == outputs[1]
     check_trajectory_file(tmp_path / "run0" / "cabin_flange.json", 15, [0, -90, 90, 0, 0, 0], 0.5)
