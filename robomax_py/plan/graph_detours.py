@@ -94,11 +94,8 @@ class SequencerDetours(SequencerKnowledge):
         if key in self._lift_cache:
             return self._lift_cache[key]
         q = self.q(idx)[col]
-        up = self._up()
-        back = self._back_direction(idx, col)
-        away = up if kind == "up" else back if kind == "back" else (up + back) / np.sqrt(2.0)
         T = fk_tcp(self.robot, q)
-        T[:3, 3] += h * away
+        T[:3, 3] += h * self._away(idx, col, kind)
         table = solve_all(self.robot, T[None], q_hint=q)
         column = int(self.spots[idx].column[col])
         out = q + wrap_to_pi(table.q[0, column] - q) if table.valid[0, column] else None
@@ -112,9 +109,7 @@ class SequencerDetours(SequencerKnowledge):
         if HOME in (i, j):
             return None
         self.tcp_detour_searches += 1
-        up = self._up()
-        back_a, back_b = self._back_direction(i, a), self._back_direction(j, b)
-        aways = [(up, up), (back_a, back_b), ((up + back_a) / np.sqrt(2.0), (up + back_b) / np.sqrt(2.0))]
+        aways = [(self._away(i, a, kind), self._away(j, b, kind)) for kind in LIFT_KINDS]
         options = self.options
         found = tcp_detour(self.robot, self.world_from(i), self.limits, self.q(i)[a], self.q(j)[b], aways,
                            LIFT_HEIGHTS_M, cell_program_frames(self.cell).written, options.speed,
@@ -324,6 +319,15 @@ class SequencerDetours(SequencerKnowledge):
             if on_map is None:
                 self.checks += spent           # a found detour's checks are counted with it
         return self._faster(on_map, on_roadmap)  # the roadmap's where both estimate the same
+
+    def _away(self, idx: int, col: int, kind: str) -> FloatArray:
+        """The direction (base frame) a lift of `kind` (LIFT_KINDS) moves spot idx's candidate col:
+        world up, back along its approach line, or halfway between."""
+        up = self._up()
+        if kind == "up":
+            return up
+        back = self._back_direction(idx, col)
+        return back if kind == "back" else (up + back) / np.sqrt(2.0)
 
     def _back_direction(self, idx: int, col: int) -> FloatArray:
         """Unit vector (base frame) from the spot to its approach point: away from the part."""
