@@ -316,7 +316,12 @@ def optimise(
         [(i, b.spots if b.ordered else b.spots[::-1]) for i, b in enumerate(blocks)],
         _insertion_start(blocks, costs),
     ]
-    best, best_cost = min((descend(s) for s in initial), key=lambda pair: pair[1])
+    # The first start's result among those within the search's tolerance of the best: a tour and
+    # its reverse over symmetric legs sum the same times in another order, and which one is a few
+    # ulps shorter follows the CPU's rounding; the tolerance makes the choice the same everywhere.
+    descents = [descend(s) for s in initial]
+    lowest = min(cost for _, cost in descents)
+    best, best_cost = next(pair for pair in descents if pair[1] <= lowest + 1e-9)
     can_kick = len(blocks) > 1 or any(not b.ordered and len(b.spots) >= 3 for b in blocks)
     # Kicks that only revisit known orders spend no budget; they grow stronger, and are capped so
     # the search always ends.
@@ -420,7 +425,7 @@ def _exact(blocks: Sequence[SeamBlock], costs: _Costs) -> Tour:
     best: Tour | None = None
     for order in admissible_orders(blocks):
         choice, cost = best_choice(order, costs)
-        if best is None or cost < best.cost - 1e-12:
+        if best is None or cost < best.cost - 1e-9:
             best = Tour(order, choice, cost)
     assert best is not None  # admissible_orders always yields at least one order
     return best

@@ -135,3 +135,29 @@ def test_deterministic(rng: np.random.Generator) -> None:
     a, _ = optimise(blocks, edge, node, rng=np.random.default_rng(1), exact_limit=0)
     b, _ = optimise(blocks, edge, node, rng=np.random.default_rng(1), exact_limit=0)
     assert a == b
+
+
+# Below the search's tolerance (1e-9 s): the size of the rounding by which a tour and its reverse
+# over symmetric legs can differ on one CPU and not on another.
+ROUNDING_S = 1e-11
+
+
+@pytest.mark.parametrize("exact_limit", [0, 10_000])
+def test_a_tour_and_its_reverse_within_rounding_keep_the_file_order(exact_limit: int) -> None:
+    """Spots on a line with home at one end: the file's order and its reverse are the optimum in
+    exact arithmetic. Each leg walked towards home is made ROUNDING_S cheaper, so the reverse is a
+    few rounding steps shorter; the search keeps the file's order whichever way a CPU rounds."""
+    n = 7
+    x = np.arange(n + 1, dtype=float)           # home at 0, spot i at i + 1
+
+    def pos(i: int) -> float:
+        return 0.0 if i == HOME else float(x[i + 1])
+
+    def edge(i: int, j: int) -> np.ndarray:
+        towards_home = pos(j) < pos(i)
+        return np.array([[abs(pos(j) - pos(i)) - (ROUNDING_S if towards_home else 0.0)]])
+
+    node = [np.zeros(1) for _ in range(n)]
+    blocks = [SeamBlock(tuple(range(n)), ordered=False)]
+    tour, _ = optimise(blocks, edge, node, exact_limit=exact_limit)
+    assert tour.order == tuple(range(n))
