@@ -67,8 +67,8 @@ def test_a_10000_spot_seam_is_refused_before_the_robot_is_even_looked_up(tmp_pat
 
 def test_the_spots_are_counted_from_the_parser_s_events_before_the_document_is_built(
         tmp_path: Path, write_small_cell: SmallCell, monkeypatch: pytest.MonkeyPatch) -> None:
-    """The guarded reader composes YAML in Python, 25 times slower than libyaml's events: a cell
-    of too many spots is refused from the events alone."""
+    """Building the document (and, without libyaml, composing it in Python, 25 times slower than
+    libyaml's events) is not spent on a cell of too many spots: it is refused from the events."""
     if count_items("a: 1", ()) is None:
         pytest.skip("PyYAML without libyaml: the spots are counted after reading")
     cell = _edit(write_small_cell(tmp_path), lambda d: d["seams"][0]["spots"].extend(_spot(k) for k in range(2_000)))
