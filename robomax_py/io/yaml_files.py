@@ -43,10 +43,21 @@ class _GuardedLoader(yaml.SafeLoader):
             self._depth -= 1
 
 
+_MERGE_TAG = "tag:yaml.org,2002:merge"
+
+
 def _construct_mapping(loader: _GuardedLoader, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
     seen: set[Any] = set()
     for key_node, _ in node.value:
         mark = key_node.start_mark
+        if key_node.tag == _MERGE_TAG:
+            # `<<: *shared` merges another mapping's keys (YAML's merge key, as `yaml.safe_load`
+            # reads it; `construct_mapping` below does the merging and refuses a value that is
+            # not a mapping): no text to check, but given once, as any key.
+            if _MERGE_TAG in seen:
+                raise yaml.constructor.ConstructorError(None, None, f"duplicate key '<<' (line {mark.line + 1})", mark)
+            seen.add(_MERGE_TAG)
+            continue
         if not isinstance(key_node, yaml.ScalarNode):
             raise yaml.constructor.ConstructorError(None, None, "a key must be plain text, not a list or mapping", mark)
         key = loader.construct_object(key_node, deep=deep)

@@ -70,6 +70,9 @@ D = LIMITS.yaml_depth       # the root mapping is the first level, so "a: " leav
     ("? [1, 2]\n: x\n", "line 1, column 3"),
     ("a: &x [1, *x]\n", "recursive alias"),
     ("n: " + "9" * (LIMITS.int_digits + 1), "line 1, column 4"),
+    ("base: &b {x: 1, y: 2}\nitems:\n- {<<: *b, y: 3}\n- {<<: [*b, {z: 4}]}\n", None),     # merge keys
+    ("base: &b {x: 1}\nitem: {<<: *b, <<: *b}\n", "line 2, column 16"),
+    ("item: {<<: 5}\n", "line 1, column 12"),
     ("a: b\x07\n", "offset 4: not valid YAML: character 0x07"),
     ("éé: b\x07\n", "offset 5: not valid YAML"),     # in characters (libyaml counts bytes: 7)
     ("a: [1, 2\nb: 3\n", ""),                    # not YAML: both refuse (libyaml words it its way)
