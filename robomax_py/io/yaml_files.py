@@ -35,9 +35,7 @@ class _GuardedLoader(yaml.SafeLoader):
         self._depth += 1
         try:
             if self._depth > LIMITS.yaml_depth:
-                mark = self.peek_event().start_mark  # type: ignore[no-untyped-call]
-                raise yaml.constructor.ConstructorError(
-                    None, None, f"nested more than {LIMITS.yaml_depth} levels deep", mark)
+                raise _too_deep(self.peek_event().start_mark)  # type: ignore[no-untyped-call]
             return super().compose_node(parent, index)
         finally:
             self._depth -= 1
@@ -94,8 +92,8 @@ if _WITH_LIBYAML:
 
 
 def _check_depth(text: str) -> None:
-    """ConstructorError at the first collection nested deeper than `LIMITS.yaml_depth`, the
-    message `_GuardedLoader.compose_node` gives, found on libyaml's events (about 1 µs each)."""
+    """ConstructorError at the first node nested deeper than `LIMITS.yaml_depth`, as
+    `_GuardedLoader.compose_node` counts nodes, found on libyaml's events (about 1 µs each)."""
     depth = 0
     for event in yaml.parse(text, Loader=yaml.CSafeLoader):
         if isinstance(event, yaml.CollectionStartEvent):
@@ -111,7 +109,7 @@ def _check_depth(text: str) -> None:
 
 
 def _too_deep(mark: Any) -> yaml.constructor.ConstructorError:
-    """The nesting error at libyaml's mark (its own Mark type, read as PyYAML's)."""
+    """The nesting error at a node's mark (PyYAML's, or libyaml's own Mark type, read alike)."""
     return yaml.constructor.ConstructorError(None, None, f"nested more than {LIMITS.yaml_depth} levels deep", mark)
 
 

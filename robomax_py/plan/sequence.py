@@ -43,6 +43,9 @@ MAX_STALE_KICKS = 50
 KEPT_NEIGHBOURHOODS = 16
 # Up to this many admissible orders, `optimise` evaluates every one (exact).
 EXACT_ORDERS = 720
+# Costs closer than this (s) are a tie: the search moves only for a larger gain, and of tied tours
+# keeps the one it met first (rounding, which differs between CPUs, never decides).
+TIE_S = 1e-9
 
 # cost(i, j) -> (N_i, N_j) float: motion time from every candidate of spot i to every candidate of
 # spot j (HOME has one candidate). Must be deterministic; the optimiser caches what it asks for.
@@ -298,11 +301,11 @@ def optimise(
                 # Past the `screen` most promising moves, a neighbour whose lower bound does not
                 # beat the current cost cannot improve it (and nor can any later one).
                 if counter["evaluations"] >= max_evaluations or (
-                    rank >= screen and bounds[idx] >= current_cost - 1e-9
+                    rank >= screen and bounds[idx] >= current_cost - TIE_S
                 ):
                     break
                 value = evaluate(options.flat(idx))
-                if value < current_cost - 1e-9:
+                if value < current_cost - TIE_S:
                     current, current_cost, improved = options.blocks(idx), value, True
                     counter["improvements"] += 1
                     break
@@ -321,7 +324,7 @@ def optimise(
     # ulps shorter follows the CPU's rounding; the tolerance makes the choice the same everywhere.
     descents = [descend(s) for s in initial]
     lowest = min(cost for _, cost in descents)
-    best, best_cost = next(pair for pair in descents if pair[1] <= lowest + 1e-9)
+    best, best_cost = next(pair for pair in descents if pair[1] <= lowest + TIE_S)
     can_kick = len(blocks) > 1 or any(not b.ordered and len(b.spots) >= 3 for b in blocks)
     # Kicks that only revisit known orders spend no budget; they grow stronger, and are capped so
     # the search always ends.
@@ -335,7 +338,7 @@ def optimise(
             kicked = _perturb(kicked, ordered, rng)
         cand, cand_cost = descend(kicked)
         stale = stale + 1 if counter["evaluations"] == before else 0
-        if cand_cost < best_cost - 1e-9:
+        if cand_cost < best_cost - TIE_S:
             best, best_cost = cand, cand_cost
     flat = _flatten(best)
     choice, cost = best_choice(flat, costs)
@@ -425,7 +428,7 @@ def _exact(blocks: Sequence[SeamBlock], costs: _Costs) -> Tour:
     best: Tour | None = None
     for order in admissible_orders(blocks):
         choice, cost = best_choice(order, costs)
-        if best is None or cost < best.cost - 1e-9:
+        if best is None or cost < best.cost - TIE_S:
             best = Tour(order, choice, cost)
     assert best is not None  # admissible_orders always yields at least one order
     return best

@@ -137,7 +137,7 @@ def test_deterministic(rng: np.random.Generator) -> None:
     assert a == b
 
 
-# Below the search's tolerance (1e-9 s): the size of the rounding by which a tour and its reverse
+# Below the search's tie (TIE_S, 1e-9 s): the size of the rounding by which a tour and its reverse
 # over symmetric legs can differ on one CPU and not on another.
 ROUNDING_S = 1e-11
 
