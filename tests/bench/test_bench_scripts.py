@@ -63,8 +63,10 @@ def test_bench_script_runs(script: str, tmp_path: Path, write_small_cell: SmallC
     small = write_small_cell(tmp_path, "small")
     out = tmp_path / "out"
     args = [a.replace(SMALL, str(small)).replace(OUT, str(out)) for a in SMOKE[script]]
+    # TMPDIR: a script that keeps its output in a temporary folder for the user to look at
+    # (bench_batch, bench_transfers) leaves it in the test's own folder, not in the system's.
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]),
-           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "TMPDIR": str(tmp_path)}
     done = subprocess.run([sys.executable, str(BENCH / script), *args], capture_output=True, text=True,
                           env=env, cwd=tmp_path, check=False)
     assert done.returncode == 0, (done.stdout[-2000:] + done.stderr[-3000:])
