@@ -148,10 +148,9 @@ def test_a_tour_and_its_reverse_within_rounding_keep_the_file_order(exact_limit:
     exact arithmetic. Each leg walked towards home is made ROUNDING_S cheaper, so the reverse is a
     few rounding steps shorter; the search keeps the file's order whichever way a CPU rounds."""
     n = 7
-    x = np.arange(n + 1, dtype=float)           # home at 0, spot i at i + 1
 
     def pos(i: int) -> float:
-        return 0.0 if i == HOME else float(x[i + 1])
+        return 0.0 if i == HOME else i + 1.0         # home at 0, spot i at i + 1
 
     def edge(i: int, j: int) -> np.ndarray:
         towards_home = pos(j) < pos(i)
