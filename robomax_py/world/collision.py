@@ -219,7 +219,7 @@ class CollisionWorld(SweptChecks):
         q = np.asarray(q, dtype=np.float64)
         if self._pf is not None:
             _, pairs = self._pf.uncleared(q[None], self._active)
-            return self._exact(q, pairs)[0]
+            return self._exact(q, pairs.tolist())[0]
         return not self._collides(q)
 
     def check(self, q: FloatArray, t: float | None = None) -> ConfigCheck:
@@ -230,7 +230,7 @@ class CollisionWorld(SweptChecks):
             # Free by the pre-filter and coal's exact test of what it left; a contact is named by
             # coal's broad phase, so a colliding configuration reports the same pair either way.
             _, pairs = self._pf.uncleared(q[None], self._active)
-            free, tests = self._exact(q, pairs)
+            free, tests = self._exact(q, pairs.tolist())
             if free:
                 return ConfigCheck(free=True, contact=None, narrow_phase_tests=tests)
         hit = self._collides(q)
@@ -265,8 +265,9 @@ class CollisionWorld(SweptChecks):
             offsets, pairs = self._pf.uncleared(qs, self._active)
             left = np.diff(offsets)
             out[:] = left == 0
+            at, listed = offsets.tolist(), pairs.tolist()
             for n in np.flatnonzero(left).tolist():
-                out[n] = self._exact(qs[n], pairs[offsets[n]:offsets[n + 1]])[0]
+                out[n] = self._exact(qs[n], listed[at[n]:at[n + 1]])[0]
         elif self._manager is not None:
             model, data, manager, callback = s.model, self._data, self._manager, self._callback
             for i in range(len(qs)):

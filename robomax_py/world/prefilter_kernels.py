@@ -115,7 +115,8 @@ def _placements(q: Any, F: Any, R: Any, M: Any, I: Any) -> Any:
 def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any, rows: Any) -> Any:
     """For each configuration i of qs, the pairs active in row rows[i] of `active` (r, P) it does
     not clear, in pair order; blocks whose entry in row rows[i] of `blocks` (r, NB) is False are
-    known cleared (`_near`) and skipped."""
+    known cleared (`_near`) and skipped. Returns (offsets (k + 1,), pairs): configuration i's pairs are
+    pairs[offsets[i]:offsets[i + 1]]."""
     J, G, P, NG, NB, N = I[0], I[1], I[2], I[3], I[4], I[6]
     centre, radius, box_lo, box_hi, margin = I[CENTRE], I[RADIUS], I[BOX_LO], I[BOX_HI], I[MARGIN]
     g_centre, g_radius, b_margin, ch_c, ch_rad = I[G_CENTRE], I[G_RADIUS], I[B_MARGIN], I[CH_C], I[CH_RAD]
@@ -135,7 +136,8 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     box_r = np.empty((G, 3, 3))
     placed = np.empty(G, dtype=np.bool_)     # world box of the piece computed for this configuration
     scratch = np.empty((7, 3))               # `boxes_apart`'s, allocated once
-    counts = np.empty(n_cfg, dtype=np.int64)
+    offsets = np.empty(n_cfg + 1, dtype=np.int64)     # configuration i's pairs: out[offsets[i]:offsets[i + 1]]
+    offsets[0] = 0
     out = np.empty(n_cfg * P, dtype=np.int64)
     filled = 0
     # Pieces on the base (every obstacle) are where they are at any configuration: placed once.
@@ -245,8 +247,8 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
                 out[m + 1] = out[m]
                 m -= 1
             out[m + 1] = k
-        counts[i] = filled - first
-    return counts, out[:filled]
+        offsets[i + 1] = filled
+    return offsets, out[:filled]
 
 
 @kernel
