@@ -172,6 +172,18 @@ def dp_choice(final: FloatArray, back: Sequence[IntArray]) -> tuple[tuple[int, .
     return tuple(reversed(choice)), float(final[last])
 
 
+def _layer(costs: _Costs, order: Sequence[int], k: int, value: FloatArray | None) -> FloatArray:
+    """Layer k of `best_choice`'s DP values for `order` from layer k - 1's (`value`; None for k = 0),
+    with `best_choice`'s arithmetic (a column's min is the value at its argmin): the same bits."""
+    node = costs.node[order[k]]
+    if k == 0:
+        first: FloatArray = costs(HOME, order[0])[0] + node
+        return first
+    assert value is not None
+    layer: FloatArray = np.min(value[:, None] + costs(order[k - 1], order[k]), axis=0) + node
+    return layer
+
+
 class _PrefixCost:
     """The DP cost of orders near an anchor order (a descent's current one): the anchor's layer
     values are kept, so an order that first differs from it at position p is costed from layer p
@@ -188,13 +200,7 @@ class _PrefixCost:
             self.anchor, self.values = order, []
 
     def _layer(self, order: tuple[int, ...], k: int, value: FloatArray | None) -> FloatArray:
-        node = self.costs.node[order[k]]
-        if k == 0:
-            first: FloatArray = self.costs(HOME, order[0])[0] + node
-            return first
-        assert value is not None
-        layer: FloatArray = np.min(value[:, None] + self.costs(order[k - 1], order[k]), axis=0) + node
-        return layer
+        return _layer(self.costs, order, k, value)
 
     def __call__(self, order: tuple[int, ...]) -> float:
         if not order:
@@ -425,10 +431,30 @@ def exact_tour(blocks: Sequence[SeamBlock], edge: EdgeCosts, node: Sequence[Floa
 
 
 def _exact(blocks: Sequence[SeamBlock], costs: _Costs) -> Tour:
-    best: Tour | None = None
+    """Every admissible order's `best_choice` cost, in `admissible_orders`' order, the first of tied
+    least kept. Consecutive orders mostly share a prefix (the enumeration varies the last spots
+    fastest): the DP's layers over the prefix shared with the previous order are kept, not computed
+    again, and only the winner's candidates are traced back (on an 8-spot cell of three free seams
+    with hundreds of candidates per spot, 576 orders, the layers of every order one by one were
+    88 % of the plan's CPU)."""
+    values: list[FloatArray] = []          # the previous order's DP layers
+    previous: tuple[int, ...] = ()
+    best_order: tuple[int, ...] | None = None
+    best_cost = np.inf
     for order in admissible_orders(blocks):
-        choice, cost = best_choice(order, costs)
-        if best is None or cost < best.cost - TIE_S:
-            best = Tour(order, choice, cost)
-    assert best is not None  # admissible_orders always yields at least one order
-    return best
+        if order:
+            shared, n = 0, min(len(order), len(previous))
+            while shared < n and order[shared] == previous[shared]:
+                shared += 1
+            del values[shared:]
+            for k in range(shared, len(order)):
+                values.append(_layer(costs, order, k, values[-1] if k else None))
+            cost = float(np.min(values[-1] + costs(order[-1], HOME)[:, 0]))
+        else:
+            cost = float(costs(HOME, HOME)[0, 0])
+        previous = order
+        if best_order is None or cost < best_cost - TIE_S:
+            best_order, best_cost = order, cost
+    assert best_order is not None  # admissible_orders always yields at least one order
+    choice, cost = best_choice(best_order, costs)
+    return Tour(best_order, choice, cost)

@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 from robomax_py.plan.sequence import (
     HOME,
+    TIE_S,
     SeamBlock,
     _Costs,
     _PrefixCost,
@@ -160,3 +161,34 @@ def test_a_tour_and_its_reverse_within_rounding_keep_the_file_order(exact_limit:
     blocks = [SeamBlock(tuple(range(n)), ordered=False)]
     tour, _ = optimise(blocks, edge, node, exact_limit=exact_limit)
     assert tour.order == tuple(range(n))
+
+
+def _every_order_one_by_one(blocks, edge, node):
+    """The enumeration by its definition: each admissible order's full DP, the first least kept
+    (a tie within TIE_S keeps the earlier)."""
+    costs = _Costs(edge, node)
+    best = None
+    for order in admissible_orders(blocks):
+        choice, cost = best_choice(order, costs)
+        if best is None or cost < best[2] - TIE_S:
+            best = (order, choice, cost)
+    return best
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), sizes=st.lists(st.integers(1, 3), min_size=1, max_size=3),
+       ordered=st.lists(st.booleans(), min_size=3, max_size=3), integral=st.booleans())
+def test_the_exact_enumeration_reusing_shared_prefixes_is_the_order_by_order_one(
+        seed: int, sizes: list[int], ordered: list[bool], integral: bool) -> None:
+    """Same order, candidates and cost, to the bit; integral costs make many tours tie exactly, so
+    the first of the tied is the one kept."""
+    rng = np.random.default_rng(seed)
+    edge, node = make_instance(rng, n_spots=sum(sizes), n_cand=4)
+    if integral:
+        rounded = edge
+        edge = lambda i, j: np.round(3 * rounded(i, j))
+        node = [np.round(3 * c) for c in node]
+    ids = iter(range(sum(sizes)))
+    blocks = [SeamBlock(tuple(next(ids) for _ in range(n)), ordered=ordered[b]) for b, n in enumerate(sizes)]
+    tour = exact_tour(blocks, edge, node)
+    assert (tour.order, tour.choice, tour.cost) == _every_order_one_by_one(blocks, edge, node)
