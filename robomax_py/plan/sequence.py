@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from robomax_py._typing import FloatArray, IntArray
+from robomax_py.plan.min_plus import min_plus, min_plus_arg
 from robomax_py.plan.sequence_moves import (
     OR_OPT_WINDOW,
     Blocks,
@@ -81,7 +82,7 @@ class _Costs:
 
     def __init__(self, edge: EdgeCosts, node: Sequence[FloatArray]) -> None:
         self._edge = edge
-        self.node = [np.asarray(c, dtype=float) for c in node]
+        self.node = [_costs_of(c, "node") for c in node]
         self._cache: dict[tuple[int, int], FloatArray] = {}
         self._bounds: dict[tuple[int, int], float] = {}
         self.node_min = [float(np.min(c)) for c in self.node]
@@ -90,8 +91,7 @@ class _Costs:
         key = (i, j)
         got = self._cache.get(key)
         if got is None:
-            got = np.asarray(self._edge(i, j), dtype=float)
-            self._cache[key] = got
+            got = self._cache[key] = _costs_of(self._edge(i, j), f"edge {i} -> {j}")
         return got
 
     def lower_bound(self, i: int, j: int) -> float:
@@ -100,6 +100,15 @@ class _Costs:
             got = self._bounds[(i, j)] = float(np.min(self(i, j)))
         return got
 
+
+
+def _costs_of(costs: FloatArray, what: str) -> FloatArray:
+    """Costs as the DP's compiled step takes them (float64, contiguous); NaN is refused, as the step
+    would skip it where numpy's reduction carries it (`min_plus`)."""
+    out = np.ascontiguousarray(costs, dtype=np.float64)
+    if np.isnan(out).any():
+        raise ValueError(f"{what} costs hold NaN")       # an internal contract, not user input
+    return out
 
 
 class _BoundTable:
@@ -156,9 +165,9 @@ def dp_layer(value: FloatArray, matrix: FloatArray, node: FloatArray) -> tuple[F
     """One layer of `best_choice`'s DP: the best cost ending at each candidate of the next spot
     (value (N_prev,) of the last layer, matrix (N_prev, N_next) of the move, node (N_next,)) and, for
     each, the candidate of the last spot it comes from (the lowest index among equals)."""
-    total = value[:, None] + matrix
-    arg = np.argmin(total, axis=0)
-    out: FloatArray = total[arg, np.arange(total.shape[1])] + node
+    if not len(value):
+        raise ValueError("a DP layer needs at least one candidate before it")
+    out, arg = min_plus_arg(*(np.ascontiguousarray(a, dtype=np.float64) for a in (value, matrix, node)))
     return out, arg
 
 
@@ -180,7 +189,9 @@ def _layer(costs: _Costs, order: Sequence[int], k: int, value: FloatArray | None
         first: FloatArray = costs(HOME, order[0])[0] + node
         return first
     assert value is not None
-    layer: FloatArray = np.min(value[:, None] + costs(order[k - 1], order[k]), axis=0) + node
+    if not len(value):
+        raise ValueError("a DP layer needs at least one candidate before it")
+    layer: FloatArray = min_plus(value, costs(order[k - 1], order[k]), node)
     return layer
 
 
