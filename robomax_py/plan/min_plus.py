@@ -7,8 +7,8 @@ their columns, and `argmin` down a column is a strided walk. One pass row by row
 once, in memory order: on 600 x 600 candidates about 2.5 times faster for the least, 6 times with
 the argmin. The sums are numpy's (one IEEE addition each, no reordering) and the least is exact, so
 the values are numpy's bit for bit; the argmin is the first index of the least, as `np.argmin`'s.
-Costs are times or inf, never NaN (`sequence._Costs` refuses them): numpy's reduction would carry a
-NaN where this comparison skips it.
+Costs are never NaN: the sequencer's are move-time estimates, finite or inf, and `sequence._Costs`
+refuses NaN; numpy's reduction would carry a NaN where this comparison skips it.
 """
 
 from __future__ import annotations
