@@ -138,12 +138,17 @@ def local_cluster(folder: Path, n_nodes: int, env: dict[str, str]) -> Iterator[C
     """A head and n_nodes - 1 worker nodes, each with 1 CPU, all alive when the block starts; every
     process of every node killed when it ends. Logs in `folder`; each node's temporary folder is a
     short one of its own under the system's (Ray's sockets live there, and a socket's path may have
-    at most 107 bytes), removed at the end."""
+    at most 107 bytes), removed at the end, and so is every file they put in their temporary folder.
+    The yielded Cluster's env has that folder as TMPDIR: a driver run with it keeps its files there too."""
     ports = iter(free_ports(2 + NODE_PORTS * n_nodes))       # all at once: no port given twice
     gcs, client = next(ports), next(ports)
     address = f"127.0.0.1:{gcs}"
     folder.mkdir(parents=True, exist_ok=True)
     temp = Path(tempfile.mkdtemp(prefix="rn"))
+    # The nodes' own temporary files (the tasks' copies of their cells) go under it too: a task killed
+    # with its node leaves its copies behind (`batch_ship.sweep_orphans` removes them only hours later).
+    (temp / "t").mkdir()
+    env = {**env, "TMPDIR": str(temp / "t")}
     nodes: list[Node] = []
     try:
         nodes.append(_start(["--head", "--port", str(gcs), "--ray-client-server-port", str(client),

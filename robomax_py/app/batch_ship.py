@@ -16,13 +16,24 @@ exists: an absolute path is the one thing a cell must not use on a cluster that 
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import tempfile
+import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 
 from robomax_py.io.robot_paths import ROBOTS_ENV, ROS_PACKAGE_PATH_ENV, robot_library
+
+# A task's folder is named for the process that made it: `robomax-cell-<pid>-<random>`.
+_PREFIX = "robomax-cell-"
+_OWNED = re.compile(re.escape(_PREFIX) + r"(\d+)-")
+# A folder whose process is gone is removed by the node's next task once it is this old (s). Its
+# process was killed (a lost node, an out-of-memory kill), so its own clean-up never ran; the age
+# keeps the folder of a live task that this process cannot see (another PID namespace sharing the
+# temporary folder) for longer than any task runs.
+ORPHAN_AGE_S = 6 * 3600.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -81,8 +92,9 @@ def unpacked(cell: ShippedCell, blobs: Sequence[bytes]) -> Iterator[Sandbox]:
     folder, removed when the block ends."""
     if len(blobs) != len(cell.paths):
         raise ValueError(f"{len(cell.paths)} files to ship, {len(blobs)} given")
+    sweep_orphans(tempfile.gettempdir())
     # The real path: messages name files as the loader reaches them, through /tmp's link if it is one.
-    root = os.path.realpath(tempfile.mkdtemp(prefix="robomax-cell-"))
+    root = os.path.realpath(tempfile.mkdtemp(prefix=f"{_PREFIX}{os.getpid()}-"))
     try:
         for path, data in zip(cell.paths, blobs, strict=True):
             target = root + path
@@ -96,3 +108,30 @@ def unpacked(cell: ShippedCell, blobs: Sequence[bytes]) -> Iterator[Sandbox]:
         yield Sandbox(root, root + cell.file, {ROBOTS_ENV: inside(cell.robots), ROS_PACKAGE_PATH_ENV: inside(cell.ros_packages)})
     finally:
         shutil.rmtree(root, ignore_errors=True)
+
+
+def sweep_orphans(folder: str, now: float | None = None) -> list[str]:
+    """Remove the task folders in `folder` whose process no longer runs and that are older than
+    ORPHAN_AGE_S; returns the names removed. A folder that cannot be judged (another user's
+    process, a name without a process number) is kept."""
+    removed = []
+    now = time.time() if now is None else now
+    for entry in os.scandir(folder):
+        owner = _OWNED.match(entry.name)
+        if owner is None or not entry.is_dir(follow_symlinks=False):
+            continue
+        try:
+            os.kill(int(owner.group(1)), 0)
+            continue                                 # its process still runs
+        except ProcessLookupError:
+            pass
+        except (PermissionError, OverflowError):
+            continue                                 # another user's process, or no process number
+        try:
+            if now - entry.stat(follow_symlinks=False).st_mtime < ORPHAN_AGE_S:
+                continue
+        except OSError:
+            continue
+        shutil.rmtree(entry.path, ignore_errors=True)
+        removed.append(entry.name)
+    return removed

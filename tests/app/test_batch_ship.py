@@ -6,7 +6,11 @@ only: the driver's paths given to the task lie under a folder that does not exis
 
 from __future__ import annotations
 
+import os
 import shutil
+import subprocess
+import sys
+import time
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
@@ -23,7 +27,13 @@ from robomax_py.app.batch import (
 )
 from robomax_py.app.batch_cell import file_digests
 from robomax_py.app.batch_ray import plan_unpacked, task_memory_mb
-from robomax_py.app.batch_ship import ShippedCell, survey
+from robomax_py.app.batch_ship import (
+    ORPHAN_AGE_S,
+    ShippedCell,
+    survey,
+    sweep_orphans,
+    unpacked,
+)
 from robomax_py.io.robot_paths import ROBOTS_ENV, shipped_robots_dir
 from robomax_py.safe_files import recording_reads
 
@@ -152,3 +162,42 @@ def test_a_lost_worker_is_submitted_again_and_a_failing_task_is_not(tmp_path: Pa
     assert isinstance(last, CellOutcome) and last.status == "crashed" and "each of 2 attempt(s)" in last.reasons
     failing = received(ray.exceptions.RayTaskError("plan_shipped", "Traceback ...", ValueError("a bug")), task)
     assert isinstance(failing, CellOutcome) and failing.status == "crashed" and failing.attempts == 1
+
+
+def _gone_pid() -> int:
+    """The number of a process that has ended (and been reaped)."""
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    child.wait()
+    return child.pid
+
+
+def test_a_killed_tasks_folder_is_removed_by_a_later_task_and_nothing_else_is(tmp_path: Path) -> None:
+    """A task killed with its node leaves its copies behind; a later task on the node removes them
+    once they are older than ORPHAN_AGE_S, and keeps every folder it cannot prove orphaned."""
+    gone, old = _gone_pid(), time.time() - ORPHAN_AGE_S - 60
+    folders = {
+        "orphan": f"robomax-cell-{gone}-a1",                    # process gone, old: removed
+        "young": f"robomax-cell-{gone}-b2",                     # process gone, recent: kept
+        "live": f"robomax-cell-{os.getpid()}-c3",               # process runs: kept
+        "unnumbered": "robomax-cell-d4",                        # made before folders were numbered: kept
+        "other": f"other-{gone}-e5",                            # not a task's: kept
+    }
+    for key, name in folders.items():
+        (tmp_path / name / "tmp").mkdir(parents=True)
+        if key != "young":
+            os.utime(tmp_path / name, (old, old))
+    (tmp_path / f"robomax-cell-{gone}-f6").write_text("a file, not a folder")
+    os.utime(tmp_path / f"robomax-cell-{gone}-f6", (old, old))
+    assert sweep_orphans(str(tmp_path)) == [folders["orphan"]]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [n for k, n in folders.items() if k != "orphan"] + [f"robomax-cell-{gone}-f6"])
+
+
+def test_a_tasks_folder_is_named_for_its_process_and_removed_when_it_ends(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr("tempfile.tempdir", str(tmp_path))
+    cell = ShippedCell(file="/d/cell.yaml", paths=("/d/cell.yaml",), robots=(), ros_packages=())
+    with unpacked(cell, [b"name: x\n"]) as box:
+        assert Path(box.root).name.startswith(f"robomax-cell-{os.getpid()}-")
+        assert Path(box.file).read_bytes() == b"name: x\n"
+    assert list(tmp_path.iterdir()) == []
