@@ -113,10 +113,15 @@ def unpacked(cell: ShippedCell, blobs: Sequence[bytes]) -> Iterator[Sandbox]:
 def sweep_orphans(folder: str, now: float | None = None) -> list[str]:
     """Remove the task folders in `folder` whose process no longer runs and that are older than
     ORPHAN_AGE_S; returns the names removed. A folder that cannot be judged (another user's
-    process, a name without a process number) is kept."""
-    removed = []
+    process, a name without a process number) is kept. POSIX only: elsewhere `os.kill(pid, 0)` does
+    not ask whether a process runs (on Windows it ends it), and nothing is removed."""
+    removed: list[str] = []
+    if os.name != "posix":
+        return removed
     now = time.time() if now is None else now
-    for entry in os.scandir(folder):
+    with os.scandir(folder) as entries:
+        found = list(entries)
+    for entry in found:
         owner = _OWNED.match(entry.name)
         if owner is None or not entry.is_dir(follow_symlinks=False):
             continue
