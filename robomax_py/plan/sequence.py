@@ -195,6 +195,14 @@ def _layer(costs: _Costs, order: Sequence[int], k: int, value: FloatArray | None
     return layer
 
 
+def _shared_prefix(a: tuple[int, ...], b: tuple[int, ...]) -> int:
+    """How many leading spots two orders share."""
+    p, n = 0, min(len(a), len(b))
+    while p < n and a[p] == b[p]:
+        p += 1
+    return p
+
+
 class _PrefixCost:
     """The DP cost of orders near an anchor order (a descent's current one): the anchor's layer
     values are kept, so an order that first differs from it at position p is costed from layer p
@@ -207,25 +215,22 @@ class _PrefixCost:
         self.values: list[FloatArray] = []      # values[k]: best cost ending at each node of layer k
 
     def set_anchor(self, order: tuple[int, ...]) -> None:
-        if order != self.anchor:
-            self.anchor, self.values = order, []
-
-    def _layer(self, order: tuple[int, ...], k: int, value: FloatArray | None) -> FloatArray:
-        return _layer(self.costs, order, k, value)
+        """Cost from `order` on; the layers of the prefix it shares with the last anchor are kept (a
+        layer depends on the order up to its spot only)."""
+        del self.values[_shared_prefix(order, self.anchor):]
+        self.anchor = order
 
     def __call__(self, order: tuple[int, ...]) -> float:
         if not order:
             return float(self.costs(HOME, HOME)[0, 0])
         anchor = self.anchor
-        p, n = 0, min(len(order), len(anchor))
-        while p < n and order[p] == anchor[p]:
-            p += 1
+        p = _shared_prefix(order, anchor)
         while len(self.values) < p:
             k = len(self.values)
-            self.values.append(self._layer(anchor, k, self.values[-1] if k else None))
+            self.values.append(_layer(self.costs, anchor, k, self.values[-1] if k else None))
         value = self.values[p - 1] if p else None
         for k in range(p, len(order)):
-            value = self._layer(order, k, value)
+            value = _layer(self.costs, order, k, value)
         assert value is not None
         return float(np.min(value + self.costs(order[-1], HOME)[:, 0]))
 
@@ -444,26 +449,16 @@ def exact_tour(blocks: Sequence[SeamBlock], edge: EdgeCosts, node: Sequence[Floa
 def _exact(blocks: Sequence[SeamBlock], costs: _Costs) -> Tour:
     """Every admissible order's `best_choice` cost, in `admissible_orders`' order, the first of tied
     least kept. Consecutive orders mostly share a prefix (the enumeration varies the last spots
-    fastest): the DP's layers over the prefix shared with the previous order are kept, not computed
-    again, and only the winner's candidates are traced back (on an 8-spot cell of three free seams
-    with hundreds of candidates per spot, 576 orders, the layers of every order one by one were
-    88 % of the plan's CPU)."""
-    values: list[FloatArray] = []          # the previous order's DP layers
-    previous: tuple[int, ...] = ()
+    fastest): each order is `_PrefixCost`'s anchor in turn, so the DP's layers over the prefix it
+    shares with the previous order are kept, not computed again, and only the winner's candidates
+    are traced back (on an 8-spot cell of three free seams with hundreds of candidates per spot,
+    576 orders, the layers of every order one by one were 88 % of the plan's CPU)."""
+    prefix = _PrefixCost(costs)
     best_order: tuple[int, ...] | None = None
     best_cost = np.inf
     for order in admissible_orders(blocks):
-        if order:
-            shared, n = 0, min(len(order), len(previous))
-            while shared < n and order[shared] == previous[shared]:
-                shared += 1
-            del values[shared:]
-            for k in range(shared, len(order)):
-                values.append(_layer(costs, order, k, values[-1] if k else None))
-            cost = float(np.min(values[-1] + costs(order[-1], HOME)[:, 0]))
-        else:
-            cost = float(costs(HOME, HOME)[0, 0])
-        previous = order
+        prefix.set_anchor(order)
+        cost = prefix(order)
         if best_order is None or cost < best_cost - TIE_S:
             best_order, best_cost = order, cost
     assert best_order is not None  # admissible_orders always yields at least one order
