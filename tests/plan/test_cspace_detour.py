@@ -12,12 +12,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import ndimage
 
 from robomax_py.cspace.grid import nearest_cell
 from robomax_py.errors import CellFileError
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions
 from robomax_py.plan.cspace_detour import (
+    ENCLOSURE_STEPS,
     LIMIT_INSET_RAD,
     MARGIN_RAD,
     RESOLUTION,
@@ -170,3 +174,130 @@ def test_the_grid_keeps_inside_the_joint_limits(at: str) -> None:
     assert np.all(configs[:, :3] >= lower[:3] + LIMIT_INSET_RAD - 1e-12)
     assert np.all(configs[:, :3] <= upper[:3] - LIMIT_INSET_RAD + 1e-12)
     assert abs(axes[2][-1 if at == "upper" else 0] - (edge[2] - (1 if at == "upper" else -1) * LIMIT_INSET_RAD)) < 1e-12
+
+
+class _BlockedCells:
+    """A stand-in world on the local map's grid: the configurations whose A1-A3 lie on a cell of
+    `blocked` ((r, r, r) bool) are blocked, every straight move is free; counts what it was asked."""
+
+    def __init__(self, axes: list[np.ndarray], blocked: np.ndarray) -> None:
+        self.axes, self.blocked, self.asked = axes, blocked, 0
+
+    def are_free(self, configs: np.ndarray) -> np.ndarray:
+        self.asked += len(configs)
+        i, j, k = (np.abs(configs[:, n, None] - self.axes[n][None, :]).argmin(axis=1) for n in range(3))
+        return np.asarray(~self.blocked[i, j, k])
+
+    def check_segment(self, q0: np.ndarray, q1: np.ndarray) -> SegmentCheck:
+        return SegmentCheck(free=True, checks=1, states=2, narrow_phase_tests=0, s_contact=None)
+
+
+def _joined(blocked: np.ndarray, a: tuple[int, ...], b: tuple[int, ...]) -> bool:
+    """Whether free cells a and b are 26-connected through free cells: scipy's labelling of the
+    whole grid, the definition the map's answer must agree with."""
+    labels, _ = ndimage.label(~blocked, structure=np.ones((3, 3, 3), dtype=bool))
+    return bool(labels[a] == labels[b])
+
+
+def _ends(robot, qa: np.ndarray, qb: np.ndarray):  # type: ignore[no-untyped-def]
+    axes, _ = local_grid(qa, qb, robot.limits.lower, robot.limits.upper, RESOLUTION, MARGIN_RAD)
+    return axes, nearest_cell(axes, qa), nearest_cell(axes, qb)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**31), walls=st.integers(0, 3), pockets=st.integers(0, 2), near=st.booleans())
+def test_the_map_finds_no_way_exactly_where_its_ends_are_not_joined(reference, seed: int, walls: int,  # type: ignore[no-untyped-def]
+                                                                    pockets: int, near: bool) -> None:
+    """Walls across the map and pockets round either end (a shell of blocked cells one to three
+    steps out, sometimes cut by the map's edge or holed), every straight move free: a detour exactly
+    where the two end cells are joined through free cells (scipy's labelling of the whole grid);
+    an end walled in close by is told without checking the whole map."""
+    _, robot, _ = reference
+    rng = np.random.default_rng(seed)
+    qa = np.radians([0.0, -90.0, 90.0, 0.0, 30.0, 0.0])
+    qb = qa + (rng.uniform(-0.08, 0.08, size=6) if near else rng.uniform(-0.8, 0.8, size=6))
+    axes, start, goal = _ends(robot, qa, qb)
+    r = RESOLUTION
+    blocked = np.zeros((r,) * 3, dtype=bool)
+    for _ in range(walls):
+        axis, at = int(rng.integers(3)), int(rng.integers(r))
+        wall = [slice(None)] * 3
+        wall[axis] = slice(at, at + 1)
+        blocked[tuple(wall)] = True
+        if rng.uniform() < 0.3:                                   # a hole in the wall
+            hole = [int(rng.integers(r)) for _ in range(3)]
+            hole[axis] = at
+            blocked[tuple(hole)] = False
+    for _ in range(pockets):
+        centre = start if rng.uniform() < 0.5 else goal
+        out = int(rng.integers(1, 4))
+        box = tuple(slice(max(0, c - out), c + out + 1) for c in centre)
+        inner = tuple(slice(max(0, c - out + 1), c + out) for c in centre)
+        shell = np.zeros_like(blocked)
+        shell[box] = True
+        shell[inner] = False
+        if rng.uniform() < 0.3:                                   # a hole in the shell
+            holes = np.argwhere(shell)
+            shell[tuple(holes[rng.integers(len(holes))])] = False
+        blocked |= shell
+    blocked[start] = blocked[goal] = False
+    world = _BlockedCells(axes, blocked)
+    det, checks = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
+    assert (det is not None) == _joined(blocked, start, goal)
+    assert checks >= world.asked
+
+
+def test_an_end_in_a_pocket_is_told_from_the_cells_round_it(reference) -> None:  # type: ignore[no-untyped-def]
+    """qb's cell walled in two steps out: no way, found from the two blocks round the ends."""
+    _, robot, _ = reference
+    qa = np.radians([0.0, -90.0, 90.0, 0.0, 30.0, 0.0])
+    qb = qa + np.array([0.6, 0.3, -0.2, 0.1, 0.0, 0.0])
+    axes, _, goal = _ends(robot, qa, qb)
+    blocked = np.zeros((RESOLUTION,) * 3, dtype=bool)
+    blocked[tuple(slice(g - 2, g + 3) for g in goal)] = True
+    blocked[tuple(slice(g - 1, g + 2) for g in goal)] = False
+    world = _BlockedCells(axes, blocked)
+    det, checks = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
+    assert det is None
+    assert world.asked <= 2 + 2 * ((2 * ENCLOSURE_STEPS + 1) ** 3 - 1) and checks == world.asked
+    # The same pocket with one hole in its shell: the map is checked whole and the way found.
+    blocked[goal[0] + 2, goal[1], goal[2]] = False
+    world = _BlockedCells(axes, blocked)
+    det, _ = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
+    assert det is not None
+    assert world.asked == RESOLUTION ** 3
+
+
+def test_two_ends_in_one_pocket_are_joined(reference) -> None:  # type: ignore[no-untyped-def]
+    """qa and qb a step apart inside one small pocket: their free cells stay inside the block round
+    each, but they hold each other, so the way between them is found."""
+    _, robot, _ = reference
+    qa = np.radians([0.0, -90.0, 90.0, 0.0, 30.0, 0.0])
+    qb = qa + np.array([0.05, 0.0, 0.0, 0.0, 0.0, 0.0])
+    axes, start, goal = _ends(robot, qa, qb)
+    assert start != goal and max(abs(a - b) for a, b in zip(start, goal)) <= 1
+    lo = [min(a, b) - 1 for a, b in zip(start, goal)]
+    hi = [max(a, b) + 2 for a, b in zip(start, goal)]
+    blocked = np.zeros((RESOLUTION,) * 3, dtype=bool)
+    blocked[tuple(slice(l, h) for l, h in zip(lo, hi))] = True
+    blocked[tuple(slice(l + 1, h - 1) for l, h in zip(lo, hi))] = False
+    world = _BlockedCells(axes, blocked)
+    det, _ = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
+    assert det is not None
+
+
+def test_an_end_against_the_maps_edge_is_walled_in_by_the_edge_and_its_pocket(reference) -> None:  # type: ignore[no-untyped-def]
+    """qb on A2's lower limit (the map's edge there): a pocket open only towards the edge walls it in."""
+    _, robot, _ = reference
+    qa = np.radians([0.0, -90.0, 90.0, 0.0, 30.0, 0.0])
+    qb = qa + np.array([0.4, 0.0, -0.2, 0.1, 0.0, 0.0])
+    qb[1] = robot.limits.lower[1] + 0.01
+    axes, _, goal = _ends(robot, qa, qb)
+    assert goal[1] == 0
+    blocked = np.zeros((RESOLUTION,) * 3, dtype=bool)
+    blocked[goal[0] - 2:goal[0] + 3, 0:3, goal[2] - 2:goal[2] + 3] = True
+    blocked[goal[0] - 1:goal[0] + 2, 0:2, goal[2] - 1:goal[2] + 2] = False
+    world = _BlockedCells(axes, blocked)
+    det, _ = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
+    assert det is None
+    assert world.asked <= 2 + 2 * ((2 * ENCLOSURE_STEPS + 1) ** 3 - 1)
