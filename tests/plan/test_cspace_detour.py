@@ -301,3 +301,26 @@ def test_an_end_against_the_maps_edge_is_walled_in_by_the_edge_and_its_pocket(re
     det, _ = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
     assert det is None
     assert world.asked <= 2 + 2 * ((2 * ENCLOSURE_STEPS + 1) ** 3 - 1)
+
+
+@pytest.mark.parametrize("side", [1, -1])
+def test_a_pocket_open_on_one_side_only_is_not_walled_in(reference, side: int) -> None:  # type: ignore[no-untyped-def]
+    """qb's cell inside a block of blocked cells as large as the box round it, a corridor leading
+    out through one A1 side of the block alone: its free cells reach that side, so the map is
+    checked whole and the way out found."""
+    _, robot, _ = reference
+    qa = np.radians([0.0, -90.0, 90.0, 0.0, 30.0, 0.0])
+    qb = qa + np.array([0.6, 0.3, -0.2, 0.1, 0.0, 0.0])
+    axes, start, goal = _ends(robot, qa, qb)
+    s = ENCLOSURE_STEPS
+    assert all(s < g < RESOLUTION - s - 1 for g in goal)
+    assert max(abs(a - b) for a, b in zip(start, goal)) > s
+    blocked = np.zeros((RESOLUTION,) * 3, dtype=bool)
+    blocked[tuple(slice(g - s, g + s + 1) for g in goal)] = True
+    blocked[tuple(slice(g - 1, g + 2) for g in goal)] = False                  # the pocket
+    corridor = slice(goal[0], goal[0] + s + 1) if side > 0 else slice(goal[0] - s, goal[0] + 1)
+    blocked[corridor, goal[1], goal[2]] = False
+    world = _BlockedCells(axes, blocked)
+    det, _ = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
+    assert det is not None
+    assert world.asked == RESOLUTION ** 3
