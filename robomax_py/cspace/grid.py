@@ -7,17 +7,21 @@ limits, ends included, so cell (i, j, k) is the configuration (q1[i], q2[j], q3[
 
 from __future__ import annotations
 
+import functools
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
 
-from robomax_py._typing import FloatArray
+from robomax_py._typing import FloatArray, IntArray
 from robomax_py.errors import RobomaxError
 from robomax_py.robot import RobotModel
 from robomax_py.robot.ik._chain import joint_axes_at_zero
 
 MIN_RESOLUTION = 4
 MAX_RESOLUTION = 400
+# The 26 steps to a cell's neighbours, in a fixed order (the maps' edge lists, and so Dijkstra's ties, follow it).
+_STEPS = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if d != (0, 0, 0)], dtype=np.int64)
 VERTICAL_TOL = 1e-6          # |cos| of A1's axis to the base z axis must be within this of 1
 
 
@@ -68,6 +72,21 @@ class CSpaceGrid:
         lo, hi = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
         axes = tuple(np.linspace(lo[a], hi[a], resolution) for a in range(3))
         return CSpaceGrid(axes=axes, wrist=wrist)  # type: ignore[arg-type]
+
+
+@functools.cache
+def neighbour_moves(shape: tuple[int, int, int]) -> tuple[IntArray, IntArray]:
+    """Every 26-connected move between the cells of a box of this shape (C order): the from-cell
+    and to-cell indices, step by step in `_STEPS`' order. Cached, so read-only."""
+    idx = np.arange(shape[0] * shape[1] * shape[2]).reshape(shape)
+    src, dst = [], []
+    for step in _STEPS:
+        src.append(idx[tuple(slice(max(0, -s), n - max(0, s)) for s, n in zip(step, shape))].ravel())
+        dst.append(idx[tuple(slice(max(0, s), n - max(0, -s)) for s, n in zip(step, shape))].ravel())
+    moves = np.concatenate(src), np.concatenate(dst)
+    for a in moves:
+        a.flags.writeable = False
+    return moves
 
 
 def nearest_cell(axes: tuple[FloatArray, ...] | list[FloatArray], q: FloatArray) -> tuple[int, int, int]:

@@ -20,15 +20,12 @@ learned` searches one learned map per plan instead (`plan.learned_detour`).
 
 from __future__ import annotations
 
-import functools
-import itertools
-
 import numpy as np
 from scipy.sparse import coo_matrix, csr_matrix
 from scipy.sparse.csgraph import connected_components, dijkstra
 
-from robomax_py._typing import BoolArray, FloatArray, IntArray
-from robomax_py.cspace.grid import nearest_cell
+from robomax_py._typing import BoolArray, FloatArray
+from robomax_py.cspace.grid import nearest_cell, neighbour_moves
 from robomax_py.plan.roadmap import Detour
 from robomax_py.plan.shortcut import swept_shortcut
 from robomax_py.robot import JointLimits
@@ -56,7 +53,6 @@ LIMIT_INSET_RAD = 1e-3
 # generated KR 16 bracket cell (corpus c114, an approach point in a pocket of the part) 8 of the 21
 # maps without a way were so, the end's free cells 3 to 9 of them; 2 steps told 1 of the 8, 4 all.
 ENCLOSURE_STEPS = 4
-_STEPS = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if d != (0, 0, 0)], dtype=np.int64)
 
 
 def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: FloatArray,
@@ -96,7 +92,7 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
     free[rest] = world.are_free(configs[rest])
     checks += len(rest)
     # Edges between free neighbouring cells, weighted by the straight move's time estimate.
-    src_all, dst_all = _moves((r, r, r))
+    src_all, dst_all = neighbour_moves((r, r, r))
     ok = free[src_all] & free[dst_all]
     src_a, dst_a = src_all[ok], dst_all[ok]
     weight = ptp_time_estimate(configs[src_a], configs[dst_a], limits) + 1e-9
@@ -113,25 +109,13 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
     return Detour(short, polyline_time_estimate(short, limits), checks), checks
 
 
-@functools.cache
-def _moves(shape: tuple[int, int, int]) -> tuple[IntArray, IntArray]:
-    """Every 26-connected move between the cells of a box of this shape (C order): the from-cell
-    and to-cell indices, step by step in `_STEPS`' order."""
-    idx = np.arange(shape[0] * shape[1] * shape[2]).reshape(shape)
-    src, dst = [], []
-    for step in _STEPS:
-        src.append(idx[tuple(slice(max(0, -s), n - max(0, s)) for s, n in zip(step, shape))].ravel())
-        dst.append(idx[tuple(slice(max(0, s), n - max(0, -s)) for s, n in zip(step, shape))].ravel())
-    return np.concatenate(src), np.concatenate(dst)
-
-
 def _walled_in(free: BoolArray, box: tuple[slice, ...], end: tuple[int, ...], other: tuple[int, ...], r: int) -> bool:
     """Whether the free cells 26-connected to `end` inside `box` (cells of the r x r x r map `free`,
     every one in the box checked) neither hold `other` nor reach a side of the box that lies inside
     the map: then they are all the free cells connected to `end` in the whole map, and the map has
     no way from one end to the other."""
     sub = free[box]
-    src, dst = _moves(sub.shape)
+    src, dst = neighbour_moves(sub.shape)
     flat_free = sub.ravel()
     ok = flat_free[src] & flat_free[dst]
     links = coo_matrix((np.ones(int(ok.sum())), (src[ok], dst[ok])), shape=(sub.size, sub.size))

@@ -55,7 +55,7 @@ from robomax_py.cspace import (
     surface_points,
 )
 from robomax_py.cspace.exact import BLOCK
-from robomax_py.cspace.grid import check_arm
+from robomax_py.cspace.grid import check_arm, neighbour_moves
 from robomax_py.cspace.learned import COARSE_TRAINING, LearnedModel, TrainingSettings
 from robomax_py.plan.candidates import SpotCandidates
 from robomax_py.plan.results import LearnedMapReport
@@ -79,7 +79,6 @@ ENTRY_SPREADS = (3, 6)
 ENTRY_POOL = 3000           # nearest free cells the entries are chosen from
 MAX_REPAIRS = 12            # refused path segments repaired per search before it gives up
 _BANNED = 1e9               # an edge's weight once the exact check refused it (no path uses it)
-_STEPS = np.array([d for d in itertools.product((-1, 0, 1), repeat=3) if d != (0, 0, 0)], dtype=np.int64)
 
 
 def training_settings(spec: LearnedMapSpec) -> TrainingSettings:
@@ -249,16 +248,10 @@ class LearnedDetours:
     def _unrepaired(self) -> csr_matrix:
         """The 26-connected moves between the map's free cells (before any repair)."""
         r = self.grid.resolution
-        idx = np.arange(r ** 3).reshape(r, r, r)
         free = ~(self.obstacle | self.self_contact).reshape(-1)
-        src, dst = [], []
-        for step in _STEPS:
-            a = idx[tuple(slice(max(0, -s), r - max(0, s)) for s in step)].ravel()
-            b = idx[tuple(slice(max(0, s), r - max(0, -s)) for s in step)].ravel()
-            ok = free[a] & free[b]
-            src.append(a[ok])
-            dst.append(b[ok])
-        s, d = np.concatenate(src), np.concatenate(dst)
+        src, dst = neighbour_moves((r, r, r))
+        ok = free[src] & free[dst]
+        s, d = src[ok], dst[ok]
         weight = ptp_time_estimate(self.configs[s], self.configs[d], self.limits) + 1e-9
         graph: csr_matrix = coo_matrix((weight, (s, d)), shape=(r ** 3, r ** 3)).tocsr()
         return graph
