@@ -24,6 +24,7 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 
+from robomax_py.app.process_ended import process_ended
 from robomax_py.io.robot_paths import ROBOTS_ENV, ROS_PACKAGE_PATH_ENV, robot_library
 
 # A task's folder is named for the process that made it: `robomax-cell-<pid>-<random>`.
@@ -113,25 +114,16 @@ def unpacked(cell: ShippedCell, blobs: Sequence[bytes]) -> Iterator[Sandbox]:
 def sweep_orphans(folder: str, now: float | None = None) -> list[str]:
     """Remove the task folders in `folder` whose process no longer runs and that are older than
     ORPHAN_AGE_S; returns the names removed. A folder that cannot be judged (another user's
-    process, a name without a process number) is kept. POSIX only: elsewhere `os.kill(pid, 0)` does
-    not ask whether a process runs (on Windows it ends it), and nothing is removed."""
+    process, a name without a process number) is kept. POSIX only (`process_ended`): elsewhere
+    nothing is removed."""
     removed: list[str] = []
-    if os.name != "posix":
-        return removed
     now = time.time() if now is None else now
     with os.scandir(folder) as entries:
         found = list(entries)
     for entry in found:
         owner = _OWNED.match(entry.name)
-        if owner is None or not entry.is_dir(follow_symlinks=False):
+        if owner is None or not entry.is_dir(follow_symlinks=False) or not process_ended(int(owner.group(1))):
             continue
-        try:
-            os.kill(int(owner.group(1)), 0)
-            continue                                 # its process still runs
-        except ProcessLookupError:
-            pass
-        except (PermissionError, OverflowError):
-            continue                                 # another user's process, or no process number
         try:
             if now - entry.stat(follow_symlinks=False).st_mtime < ORPHAN_AGE_S:
                 continue

@@ -14,6 +14,7 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
+from robomax_py.app.process_ended import process_ended
 from robomax_py.errors import RobotModelError
 from robomax_py.safe_files import MB, printable
 
@@ -94,8 +95,9 @@ def _make_folders(folder: Path) -> list[Path]:
 
 def clean_stale_staging(parent: Path) -> list[Path]:
     """Remove the staging folders in `parent` left by imports that were killed (their process has
-    ended): recognised by their name (`_STAGING`) and their marker file, or holding nothing but a
-    marker cut short (killed before or while the marker was written). A folder a killed replacement had moved aside (`old`) is put back first
+    ended, `process_ended`: never on Windows, where that cannot be told): recognised by their name
+    (`_STAGING`) and their marker file, or holding nothing but a marker cut short (killed before or
+    while the marker was written). A folder a killed replacement had moved aside (`old`) is put back first
     when its place is still empty. Returns the folders removed."""
     removed: list[Path] = []
     try:
@@ -104,7 +106,7 @@ def clean_stale_staging(parent: Path) -> list[Path]:
         return removed
     for entry in entries:
         m = _STAGING.fullmatch(entry.name)
-        if m is None or not entry.is_dir(follow_symlinks=False) or _alive(int(m["pid"])):
+        if m is None or not entry.is_dir(follow_symlinks=False) or not process_ended(int(m["pid"])):
             continue
         folder = Path(entry.path)
         out_name = _marked(folder / STAGING_MARKER)
@@ -160,16 +162,6 @@ def _half_marked(folder: Path, name: str) -> bool:
     except OSError:
         return False
     return f"{MARKER_TEXT}out {name}\n".encode().startswith(text)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError):
-        return True
-    return True
 
 
 def _commit(stage: Path, out: Path) -> None:
