@@ -218,8 +218,8 @@ class CollisionWorld(SweptChecks):
         self._set_presence(t, t)
         q = np.asarray(q, dtype=np.float64)
         if self._pf is not None:
-            _, pairs = self._pf.uncleared(q[None], self._active)
-            return self._exact(q, pairs.tolist())[0]
+            _, pairs, undecided = self._pf.left_for_coal(q[None], self._active)
+            return self._exact(q, pairs.tolist(), bool(undecided[0]))[0]
         return not self._collides(q)
 
     def check(self, q: FloatArray, t: float | None = None) -> ConfigCheck:
@@ -229,8 +229,8 @@ class CollisionWorld(SweptChecks):
         if self._pf is not None:
             # Free by the pre-filter and coal's exact test of what it left; a contact is named by
             # coal's broad phase, so a colliding configuration reports the same pair either way.
-            _, pairs = self._pf.uncleared(q[None], self._active)
-            free, tests = self._exact(q, pairs.tolist())
+            _, pairs, undecided = self._pf.left_for_coal(q[None], self._active)
+            free, tests = self._exact(q, pairs.tolist(), bool(undecided[0]))
             if free:
                 return ConfigCheck(free=True, contact=None, narrow_phase_tests=tests)
         hit = self._collides(q)
@@ -262,12 +262,12 @@ class CollisionWorld(SweptChecks):
         out = np.empty(len(qs), dtype=bool)
         s = self._s
         if self._pf is not None:
-            offsets, pairs = self._pf.uncleared(qs, self._active)
+            offsets, pairs, undecided = self._pf.left_for_coal(qs, self._active)
             left = np.diff(offsets)
             out[:] = left == 0
-            at, listed = offsets.tolist(), pairs.tolist()
+            at, listed, pending = offsets.tolist(), pairs.tolist(), undecided.tolist()
             for n in np.flatnonzero(left).tolist():
-                out[n] = self._exact(qs[n], listed[at[n]:at[n + 1]])[0]
+                out[n] = self._exact(qs[n], listed[at[n]:at[n + 1]], pending[n])[0]
         elif self._manager is not None:
             model, data, manager, callback = s.model, self._data, self._manager, self._callback
             for i in range(len(qs)):

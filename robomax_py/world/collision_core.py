@@ -12,6 +12,7 @@ import pinocchio as pin
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.world.acm import SharedGeometry, configure_requests
 from robomax_py.world.collision_results import Contact, SegmentCheck
+from robomax_py.world.pair_cells import CERTIFIED, UNCERTIFIED, UNKNOWN, CellTable
 
 _FIRST_CHUNK = 8     # states the first pre-filter call of a scan covers (blocked moves stop early)
 # A near scan (`_scan`) of fewer states tests every pair: finding the pairs to leave out costs about
@@ -70,12 +71,16 @@ class CollisionWorldCore:
 
     # ------------------------------------------------------------------------------- internals
 
-    def _exact(self, q: FloatArray, pairs: list[int]) -> tuple[bool, int]:
+    def _exact(self, q: FloatArray, pairs: list[int], undecided: bool) -> tuple[bool, int]:
         """coal's verdict on the pairs the pre-filter left (in pair order): (free, pairs tested).
+        undecided: one of them lies in a cell (`pair_cells`) not decided when the filter ran; such
+        cells are decided first, and a pair in a cell certified free is left out.
 
         pairs is a list, not an array: the scans convert a block's pairs once and slice the list per
         state (slicing the array by its offsets and converting each slice took about five times as
         long, over a million states of a 30-spot plan)."""
+        if undecided:
+            pairs = self._uncertified(q, pairs)
         if not pairs:
             return True, 0
         s, gd = self._s, self._gdata
@@ -85,6 +90,47 @@ class CollisionWorldCore:
             if pin.computeCollision(gm, gd, p):
                 return False, n + 1
         return True, len(pairs)
+
+    def _uncertified(self, q: FloatArray, pairs: list[int]) -> list[int]:
+        """`pairs` less those whose cell holding q is certified free, each undecided cell decided
+        now (the filter cleared the pairs of cells certified before)."""
+        assert self._pf is not None
+        cells = self._pf.cells
+        tables, decided = cells.tables, cells.decided
+        left: list[int] | None = None
+        for n, p in enumerate(pairs):
+            table = tables[p]
+            if table is None:
+                if left is not None:
+                    left.append(p)
+                continue
+            c = table.cell(q)
+            if c >= 0 and decided[c] == UNKNOWN:
+                decided[c] = self._decide(q, p, table, c)
+            if c >= 0 and decided[c] == CERTIFIED:
+                if left is None:
+                    left = pairs[:n]
+            elif left is not None:
+                left.append(p)
+        return pairs if left is None else left
+
+    def _decide(self, q: FloatArray, p: int, table: CellTable, cell: int) -> int:
+        """Whether pair p is free at every configuration of its cell `cell` (the other joints at
+        q's values: the pair's distance does not depend on them): CERTIFIED when the pre-filter's
+        grown bounds clear it over the cell's box, or coal's distance at the box's centre exceeds
+        the pair's margin by more than the distance can shrink within the box
+        (`Prefilter.near_reach`) plus CERTIFY_SLACK_M; UNCERTIFIED otherwise."""
+        assert self._pf is not None
+        lo, hi = table.box(q, cell)
+        active = np.zeros(len(self._active), dtype=bool)
+        active[p] = True
+        _, live, reach = self._pf.near_reach(np.stack([lo, hi]), active)
+        if not live[p]:
+            return CERTIFIED
+        s = self._s
+        pin.updateGeometryPlacements(s.model, self._data, s.geom_model, self._gdata, (lo + hi) / 2)
+        distance = pin.computeDistance(s.geom_model, self._gdata, p).min_distance
+        return CERTIFIED if distance - reach[p] > s.pair_margin[p] + CERTIFY_SLACK_M else UNCERTIFIED
 
     def _scan_timed(self, states: FloatArray, fractions: FloatArray, order: IntArray, m: int, start: float,
                     span: float) -> SegmentCheck:
@@ -128,11 +174,11 @@ class CollisionWorldCore:
             rows = run.astype(np.int64)
         while start < len(states):
             block = states[start:start + chunk]
-            offsets, pairs = self._pf.uncleared(block, active, blocks,
-                                                None if rows is None else rows[start:start + chunk])
-            at, left = offsets.tolist(), pairs.tolist()
+            offsets, pairs, undecided = self._pf.left_for_coal(block, active, blocks,
+                                                               None if rows is None else rows[start:start + chunk])
+            at, left, pending = offsets.tolist(), pairs.tolist(), undecided.tolist()
             for i in np.flatnonzero(np.diff(offsets)).tolist():
-                free, n = self._exact(block[i], left[at[i]:at[i + 1]])
+                free, n = self._exact(block[i], left[at[i]:at[i + 1]], pending[i])
                 tests += n
                 if not free:
                     k = start + i

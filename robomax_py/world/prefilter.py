@@ -13,7 +13,8 @@ piece, and for every enabled pair a lower bound on its distance,
 A pair whose bound exceeds its margin (the clearance, or 0 between robot bodies) by `SLACK_M` is
 *cleared*: its true distance exceeds the margin, so coal would call it free. Every other pair is
 returned, and the caller gives it to coal's exact test; so the verdict of a configuration is coal's
-exact verdict, only reached with fewer tests. Spheres enclose each piece's support points (hull
+exact verdict, only reached with fewer tests. A pair of two neighbouring robot pieces is also cleared where the cell of
+its joints holding the configuration was certified free (`pair_cells`). Spheres enclose each piece's support points (hull
 vertices, box corners), so they enclose the piece; obstacle AABBs are taken over the same points in
 the base frame.
 
@@ -35,6 +36,7 @@ import pinocchio as pin
 
 from robomax_py._typing import BoolArray, FloatArray, IntArray
 from robomax_py.world.bounds import support_points, triangles
+from robomax_py.world.pair_cells import PairCells, pair_cells
 from robomax_py.world.prefilter_kernels import _near, _placements, _uncleared
 from robomax_py.world.prefilter_layout import (
     B_MARGIN,
@@ -64,6 +66,7 @@ class Prefilter:
     matrices: FloatArray         # (n, 3, 3) view of floats: the tables of 3x3 matrices
     ints: IntArray               # every integer table and the offsets of both, packed
     every_block: BoolArray       # (blocks,) all True: `uncleared` without `blocks`
+    cells: PairCells             # the neighbouring pieces' cells and which are certified free (`pair_cells`)
 
     @staticmethod
     def of(model: pin.Model, gm: pin.GeometryModel, obstacle: list[bool], pair_a: IntArray, pair_b: IntArray,
@@ -149,20 +152,22 @@ class Prefilter:
         ch_half = np.array([b[2] for b in boxes]).reshape(-1, 3)
 
         walk = block_walk(block_kind, block_a, block_b, block_margin, box_lo, box_hi, tree_min_blocks)
+        cells, cell_ints, cell_lows = pair_cells(parent, kind, qi, model.lowerPositionLimit, model.upperPositionLimit,
+                                                 piece_joint, pa, pb, is_obs)
 
         # The walk's boxes and margins ride in the pieces' and blocks' tables, its ints in one table:
         # each table more is a slice more for numba to compile in every kernel.
         floats, vectors, matrices, ints = _pack(
             [axis, rot, trans, centre, radius, np.concatenate([box_lo, walk.lo]), np.concatenate([box_hi, walk.hi]),
              margin, g_centre, g_radius, np.concatenate([block_margin, walk.margin]),
-             obb_centre, obb_axes, obb_half, ch_centre, ch_radius, ch_box_c, ch_box_r, ch_half],
+             obb_centre, obb_axes, obb_half, ch_centre, ch_radius, ch_box_c, ch_box_r, ch_half, cell_lows.ravel()],
             [parent, kind, qi, piece_joint, robot_side, other, is_obs[other].astype(np.int64), group_joint,
              block_kind, block_a, block_b, block_end, block_pairs, ch_start, ch_end, ch_skip,
-             np.stack([walk.block, walk.group, walk.skip], axis=1).ravel()],
+             np.stack([walk.block, walk.group, walk.skip], axis=1).ravel(), cell_ints.ravel()],
             len(flat), len(walk.block),
         )
         return Prefilter(floats=floats, vectors=vectors, matrices=matrices, ints=ints,
-                         every_block=np.ones(len(keys), dtype=bool))
+                         every_block=np.ones(len(keys), dtype=bool), cells=cells)
 
     def uncleared(self, qs: FloatArray, active: BoolArray, blocks: BoolArray | None = None,
                   rows: IntArray | None = None) -> tuple[IntArray, IntArray]:
@@ -175,6 +180,13 @@ class Prefilter:
         Returns (offsets (k + 1,), pairs): configuration i's pairs are pairs[offsets[i]:offsets[i + 1]],
         in pair order.
         """
+        offsets, pairs, _ = self.left_for_coal(qs, active, blocks, rows)
+        return offsets, pairs
+
+    def left_for_coal(self, qs: FloatArray, active: BoolArray, blocks: BoolArray | None = None,
+                      rows: IntArray | None = None) -> tuple[IntArray, IntArray, BoolArray]:
+        """`uncleared`, and for each configuration whether one of its pairs lies in a cell not decided
+        yet (`pair_cells`: the caller decides it before coal's test, `CollisionWorldCore._exact`)."""
         if rows is None:
             rows = np.zeros(len(qs), dtype=np.int64)
             active = active[None]
@@ -183,10 +195,10 @@ class Prefilter:
             blocks = np.broadcast_to(self.every_block, (len(active), len(self.every_block)))
         # The offsets come from the kernel: numpy's concatenate and cumsum of per-configuration counts
         # cost about two configurations' tests on every call.
-        offsets, pairs = _uncleared(_read_only(qs), self.floats, self.vectors, self.matrices, self.ints,
-                                    np.ascontiguousarray(active), np.ascontiguousarray(blocks),
-                                    np.ascontiguousarray(rows, dtype=np.int64))
-        return offsets, pairs
+        offsets, pairs, undecided = _uncleared(_read_only(qs), self.floats, self.vectors, self.matrices, self.ints,
+                                               np.ascontiguousarray(active), np.ascontiguousarray(blocks),
+                                               np.ascontiguousarray(rows, dtype=np.int64), self.cells.decided)
+        return offsets, pairs, undecided
 
     def with_margin(self, distance: float) -> Prefilter:
         """This filter with `distance` (m) as every pair's margin (SLACK_M added, as to every margin):
@@ -202,7 +214,8 @@ class Prefilter:
         floats = self.floats.copy()        # only the scalar tables are read from it; the views stay
         floats[pairs_at:pairs_at + n_pairs] = distance + SLACK_M
         floats[blocks_at:blocks_at + n_blocks + n_nodes] = distance + SLACK_M
-        return replace(self, floats=floats)
+        # A cell certified free for the pairs' own margins says nothing of this distance.
+        return replace(self, floats=floats, cells=self.cells.undecided())
 
     def near(self, qs: FloatArray, active: BoolArray) -> tuple[BoolArray, BoolArray]:
         """(blocks (b,) bool, pairs (p,) bool): the blocks, and the pairs of `active`, that a

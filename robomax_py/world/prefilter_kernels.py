@@ -13,6 +13,13 @@ import numpy as np
 
 from robomax_py.jit import helper, kernel
 from robomax_py.world.box_separation import boxes_apart
+from robomax_py.world.pair_cells import (
+    CERTIFIED,
+    COLUMNS,
+    INV_CELL,
+    UNCERTIFIED,
+    UNKNOWN,
+)
 from robomax_py.world.prefilter_layout import (
     AXIS,
     B_A,
@@ -23,6 +30,8 @@ from robomax_py.world.prefilter_layout import (
     B_PAIRS,
     BOX_HI,
     BOX_LO,
+    CELL,
+    CELL_LO,
     CENTRE,
     CH_BC,
     CH_BR,
@@ -112,17 +121,19 @@ def _placements(q: Any, F: Any, R: Any, M: Any, I: Any) -> Any:
 
 
 @kernel
-def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any, rows: Any) -> Any:
+def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any, rows: Any, decided: Any) -> Any:
     """For each configuration i of qs, the pairs active in row rows[i] of `active` (r, P) it does
     not clear, in pair order; blocks whose entry in row rows[i] of `blocks` (r, NB) is False are
-    known cleared (`_near`) and skipped. Returns (offsets (k + 1,), pairs): configuration i's pairs are
-    pairs[offsets[i]:offsets[i + 1]]."""
+    known cleared (`_near`) and skipped; a pair of two robot pieces whose cell holding the
+    configuration is certified free in `decided` (`pair_cells`) is cleared. Returns (offsets (k + 1,),
+    pairs, undecided (k,) bool): configuration i's pairs are pairs[offsets[i]:offsets[i + 1]], and
+    undecided[i] tells whether one of them lies in a cell not decided yet."""
     J, G, P, NG, NB, N = I[0], I[1], I[2], I[3], I[4], I[6]
     centre, radius, box_lo, box_hi, margin = I[CENTRE], I[RADIUS], I[BOX_LO], I[BOX_HI], I[MARGIN]
     g_centre, g_radius, b_margin, ch_c, ch_rad = I[G_CENTRE], I[G_RADIUS], I[B_MARGIN], I[CH_C], I[CH_RAD]
     piece_joint, pair_a, pair_b, pair_obstacle = I[PIECE_JOINT], I[PAIR_A], I[PAIR_B], I[PAIR_OBSTACLE]
     group_joint, b_kind, b_a, b_b, b_end, b_pairs = I[GROUP_JOINT], I[B_KIND], I[B_A], I[B_B], I[B_END], I[B_PAIRS]
-    ch_start, ch_end, ch_skip, walk = I[CH_START], I[CH_END], I[CH_SKIP], I[WALK]
+    ch_start, ch_end, ch_skip, walk, cell = I[CH_START], I[CH_END], I[CH_SKIP], I[WALK], I[CELL]
     # `boxes_apart` (shared with the clash descent) takes its boxes' tables as arrays.
     obb_h = R[I[OBB_H]:I[OBB_H] + G]
     ch_bc, ch_br, ch_h = R[I[CH_BC]:], M[I[CH_BR]:], R[I[CH_H]:]
@@ -138,6 +149,7 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
     scratch = np.empty((7, 3))               # `boxes_apart`'s, allocated once
     offsets = np.empty(n_cfg + 1, dtype=np.int64)     # configuration i's pairs: out[offsets[i]:offsets[i + 1]]
     offsets[0] = 0
+    undecided = np.empty(n_cfg, dtype=np.bool_)
     out = np.empty(n_cfg * P, dtype=np.int64)
     filled = 0
     # Pieces on the base (every obstacle) are where they are at any configuration: placed once.
@@ -181,6 +193,7 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
         for g in range(G):
             placed[g] = False
         first = filled
+        undecided[i] = False
         few = n_listed[row] >= 0
         end = n_listed[row] if few else N
         nd = 0
@@ -212,6 +225,7 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
                     if not active[row, k]:
                         continue
                     a, b = I[pair_a + k], I[pair_b + k]
+                    pending = False                   # left for coal with its cell not decided yet
                     if I[pair_obstacle + k]:
                         ok = _sphere_box(world, a, F[radius + a] + F[margin + k], R, box_lo + b, box_hi + b)
                         if not ok and I[ch_start + b] >= 0:   # near the obstacle's box: chunk by chunk
@@ -231,6 +245,10 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
                                     c += 1                # into its first child
                     else:
                         ok = _sphere_point(world, a, world, b, F[radius + a] + F[radius + b] + F[margin + k])
+                        if not ok and I[cell + COLUMNS * k] > 0:    # neighbouring pieces: their cell
+                            decision = _cell_decision(q, F, I, k, decided)
+                            ok = decision == CERTIFIED
+                            pending = decision == UNKNOWN
                         if not ok:                # the spheres overlap: try the pieces' boxes
                             for g in (a, b):
                                 if not placed[g]:
@@ -240,6 +258,7 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
                     if not ok:
                         out[filled] = k
                         filled += 1
+                        undecided[i] = undecided[i] or pending
         for n in range(first + 1, filled):      # into pair order: a few entries, insertion sort
             k = out[n]
             m = n - 1
@@ -248,7 +267,7 @@ def _uncleared(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, blocks: Any
                 m -= 1
             out[m + 1] = k
         offsets[i + 1] = filled
-    return offsets, out[:filled]
+    return offsets, out[:filled], undecided
 
 
 @kernel
@@ -402,6 +421,26 @@ def _near(qs: Any, F: Any, R: Any, M: Any, I: Any, active: Any, deep: bool) -> A
             any_live = any_live or live[k]
         keep[blk] = any_live             # a block without a live pair adds nothing
     return keep, live, reach
+
+
+@helper
+def _cell_decision(q: Any, F: Any, I: Any, k: Any, decided: Any) -> int:
+    """The decision (`pair_cells`: UNKNOWN, CERTIFIED, UNCERTIFIED) of pair k's cell holding
+    configuration q; UNCERTIFIED off the table's range or for a NaN (tested, as every pair without
+    cells). `pair_cells.CellTable.cell`, operation for operation."""
+    row = I[CELL] + COLUMNS * k
+    lows = I[CELL_LO] + 2 * k
+    flat = 0
+    for m in range(I[row]):
+        x = (q[I[row + 1 + m]] - F[lows + m]) * INV_CELL
+        if not x >= 0.0:
+            return UNCERTIFIED
+        n = int(x)
+        count = I[row + 3 + m]
+        if n >= count:
+            return UNCERTIFIED
+        flat = flat * count + n
+    return int(decided[I[row + 5] + flat])
 
 
 @helper

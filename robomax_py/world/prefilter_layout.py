@@ -11,7 +11,7 @@ tuple of them, in every kernel (about a third of a first plan's compile).
 
 from __future__ import annotations
 
-N_HEADER, N_FLOAT_TABLES, N_INT_TABLES = 7, 19, 17
+N_HEADER, N_FLOAT_TABLES, N_INT_TABLES = 7, 20, 18
 _F = N_HEADER                          # where the float tables' starts are in ints
 _I = N_HEADER + N_FLOAT_TABLES         # where the int tables' starts are in ints
 
@@ -27,6 +27,8 @@ G_CENTRE, G_RADIUS, B_MARGIN = _F + 8, _F + 9, _F + 10
 # chunk of an obstacle's mesh its sphere (centre R, radius F) and box (centre R, rotation M, half R).
 OBB_C, OBB_R, OBB_H = _F + 11, _F + 12, _F + 13
 CH_C, CH_RAD, CH_BC, CH_BR, CH_H = _F + 14, _F + 15, _F + 16, _F + 17, _F + 18
+# Per pair the lowest value of each of its cells' joints (F, two per pair: `pair_cells`).
+CELL_LO = _F + 19
 
 # Int tables: the chain's parent, kind and q index per joint; per piece its joint; per pair its
 # pieces and whether b is an obstacle; per group its joint; per block its kind, groups and end; the
@@ -36,3 +38,5 @@ PARENT, KIND, JQ, PIECE_JOINT = _I + 0, _I + 1, _I + 2, _I + 3
 PAIR_A, PAIR_B, PAIR_OBSTACLE, GROUP_JOINT = _I + 4, _I + 5, _I + 6, _I + 7
 B_KIND, B_A, B_B, B_END, B_PAIRS = _I + 8, _I + 9, _I + 10, _I + 11, _I + 12
 CH_START, CH_END, CH_SKIP, WALK = _I + 13, _I + 14, _I + 15, _I + 16
+# Per pair its cells (`pair_cells.COLUMNS` ints: joints, their q indices, cells along each, first cell).
+CELL = _I + 17
