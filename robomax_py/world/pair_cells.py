@@ -14,7 +14,7 @@ cell is decided the first time a configuration in it reaches coal with the pair
 the distance can shrink within the cell (`Prefilter.near_reach`, by the joints between the two
 pieces only), exceeds the pair's margin by `CERTIFY_SLACK_M`: the test of the swept checks' near
 runs. The pre-filter then clears the pair at every configuration in a certified cell without a test
-(`prefilter_kernels._cell_certified`); a cell that cannot be certified is tested as before. A
+(`prefilter_kernels._cell_decision`); a cell that cannot be certified is tested as before. A
 certified pair is free at every configuration of its cell, so every verdict is coal's as before,
 reached with fewer tests.
 
@@ -59,7 +59,7 @@ class CellTable:
     def cell(self, q: FloatArray) -> int:
         """The index (into the decisions) of the cell holding configuration q, -1 outside the table
         (a value off the joint's range or NaN). The compiled filter's arithmetic, operation for
-        operation (`prefilter_kernels._cell_certified`)."""
+        operation (`prefilter_kernels._cell_decision`)."""
         flat = 0
         for i, low, count in zip(self.q_index, self.low, self.count):
             x = (float(q[i]) - low) * INV_CELL

@@ -13,10 +13,10 @@ piece, and for every enabled pair a lower bound on its distance,
 A pair whose bound exceeds its margin (the clearance, or 0 between robot bodies) by `SLACK_M` is
 *cleared*: its true distance exceeds the margin, so coal would call it free. Every other pair is
 returned, and the caller gives it to coal's exact test; so the verdict of a configuration is coal's
-exact verdict, only reached with fewer tests. A pair of two neighbouring robot pieces is also cleared where the cell of
-its joints holding the configuration was certified free (`pair_cells`). Spheres enclose each piece's support points (hull
-vertices, box corners), so they enclose the piece; obstacle AABBs are taken over the same points in
-the base frame.
+exact verdict, only reached with fewer tests. A pair of two neighbouring robot pieces is also
+cleared where the cell of its joints holding the configuration was certified free (`pair_cells`).
+Spheres enclose each piece's support points (hull vertices, box corners), so they enclose the piece;
+obstacle AABBs are taken over the same points in the base frame.
 
 The chain is modelled as Pinocchio models it (each joint's placement in its parent, then the joint's
 own motion); revolute and prismatic joints about any axis with one coordinate are supported. A model
