@@ -97,40 +97,26 @@ class CollisionWorldCore:
         assert self._pf is not None
         cells = self._pf.cells
         tables, decided = cells.tables, cells.decided
-        left: list[int] | None = None
-        for n, p in enumerate(pairs):
+        left = []
+        for p in pairs:
             table = tables[p]
-            if table is None:
-                if left is not None:
-                    left.append(p)
-                continue
-            c = table.cell(q)
-            if c >= 0 and decided[c] == UNKNOWN:
-                decided[c] = self._decide(q, p, table, c)
-            if c >= 0 and decided[c] == CERTIFIED:
-                if left is None:
-                    left = pairs[:n]
-            elif left is not None:
-                left.append(p)
-        return pairs if left is None else left
+            if table is not None:
+                c = table.cell(q)
+                if c >= 0 and decided[c] == UNKNOWN:
+                    decided[c] = self._decide(q, p, table, c)
+                if c >= 0 and decided[c] == CERTIFIED:
+                    continue
+            left.append(p)
+        return left
 
     def _decide(self, q: FloatArray, p: int, table: CellTable, cell: int) -> int:
         """Whether pair p is free at every configuration of its cell `cell` (the other joints at
-        q's values: the pair's distance does not depend on them): CERTIFIED when the pre-filter's
-        grown bounds clear it over the cell's box, or coal's distance at the box's centre exceeds
-        the pair's margin by more than the distance can shrink within the box
-        (`Prefilter.near_reach`) plus CERTIFY_SLACK_M; UNCERTIFIED otherwise."""
-        assert self._pf is not None
-        lo, hi = table.box(q, cell)
-        active = np.zeros(len(self._active), dtype=bool)
-        active[p] = True
-        _, live, reach = self._pf.near_reach(np.stack([lo, hi]), active)
-        if not live[p]:
-            return CERTIFIED
-        s = self._s
-        pin.updateGeometryPlacements(s.model, self._data, s.geom_model, self._gdata, (lo + hi) / 2)
-        distance = pin.computeDistance(s.geom_model, self._gdata, p).min_distance
-        return CERTIFIED if distance - reach[p] > s.pair_margin[p] + CERTIFY_SLACK_M else UNCERTIFIED
+        q's values: the pair's distance does not depend on them), by the near runs' test over the
+        cell's box (`_run_pairs`): CERTIFIED or UNCERTIFIED."""
+        only = np.zeros(len(self._active), dtype=bool)
+        only[p] = True
+        _, live = self._run_pairs(np.stack(table.box(q, cell)), only)
+        return UNCERTIFIED if live[p] else CERTIFIED
 
     def _scan_timed(self, states: FloatArray, fractions: FloatArray, order: IntArray, m: int, start: float,
                     span: float) -> SegmentCheck:
@@ -187,11 +173,13 @@ class CollisionWorldCore:
             chunk *= 4
         return SegmentCheck(True, len(states), n_states, tests, None)
 
-    def _run_pairs(self, states: FloatArray) -> tuple[np.ndarray, np.ndarray]:
-        """(blocks, pairs) a run of neighbouring states must still test: `Prefilter.near_reach`'s,
-        less the pairs coal's distance at the run's centre proves free at every state of it."""
+    def _run_pairs(self, states: FloatArray, active: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(blocks, pairs) a run of neighbouring states must still test, of the `active` pairs (None:
+        the world's): `Prefilter.near_reach`'s, less those proven free at every configuration of the
+        run's joint-space box (coal's distance at its centre, less how much the distance can shrink
+        within the box, above the pair's margin by CERTIFY_SLACK_M)."""
         assert self._pf is not None
-        blocks, live, reach = self._pf.near_reach(states, self._active)
+        blocks, live, reach = self._pf.near_reach(states, self._active if active is None else active)
         left = np.flatnonzero(live)
         if not left.size:
             return blocks, live
