@@ -11,6 +11,7 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.world.acm import SharedGeometry, configure_requests
+from robomax_py.world.chunk_reach import certified, chunks_of_pair
 from robomax_py.world.collision_results import Contact, SegmentCheck
 from robomax_py.world.pair_cells import CERTIFIED, UNCERTIFIED, UNKNOWN, CellTable
 
@@ -115,8 +116,27 @@ class CollisionWorldCore:
         cell's box (`_run_pairs`): CERTIFIED or UNCERTIFIED."""
         only = np.zeros(len(self._active), dtype=bool)
         only[p] = True
-        _, live = self._run_pairs(np.stack(table.box(q, cell)), only)
-        return UNCERTIFIED if live[p] else CERTIFIED
+        lo, hi = table.box(q, cell)
+        _, live = self._run_pairs(np.stack((lo, hi)), only)
+        if not live[p]:
+            return CERTIFIED
+        return CERTIFIED if self._certified_by_slabs(p, lo, hi) else UNCERTIFIED
+
+    def _certified_by_slabs(self, p: int, lo: FloatArray, hi: FloatArray) -> bool:
+        """The finer test of a cell the first one could not certify (`chunk_reach`): the moving
+        piece's slabs each grown by their own motion over the cell [lo, hi]."""
+        s, gd = self._s, self._gdata
+        gm = s.geom_model
+        pair = gm.collisionPairs[p]
+        chunks = chunks_of_pair(s.model, gm, int(pair.first), int(pair.second))
+        if chunks is None:
+            return False
+        centre = (lo + hi) / 2      # as `_run_pairs` takes it
+        pin.computeJointJacobians(s.model, self._data, centre)
+        pin.updateGeometryPlacements(s.model, self._data, gm, gd)
+        distance = pin.computeDistance(gm, gd, p).min_distance
+        bar = s.pair_margin[p] + CERTIFY_SLACK_M
+        return distance > bar and certified(chunks, self._data, distance, (hi - lo) / 2, bar)
 
     def _scan_timed(self, states: FloatArray, fractions: FloatArray, order: IntArray, m: int, start: float,
                     span: float) -> SegmentCheck:
