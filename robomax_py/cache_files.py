@@ -22,10 +22,12 @@ def cache_folder(kind: str) -> Path:
     return Path(root) / kind
 
 
-def store_arrays(path: Path, arrays: dict[str, np.ndarray]) -> bool:
-    """An .npz of `arrays` at `path`, written atomically; False when the folder cannot be written."""
+def store_arrays(path: Path, arrays: dict[str, np.ndarray], compressed: bool = False) -> bool:
+    """An .npz of `arrays` at `path` (deflated when `compressed`), written atomically; False when
+    the folder cannot be written."""
     buf = io.BytesIO()
-    np.savez(buf, **arrays)  # type: ignore[arg-type]  # numpy's stub types **kwds as its allow_pickle flag
+    save = np.savez_compressed if compressed else np.savez
+    save(buf, **arrays)  # type: ignore[arg-type]  # numpy's stub types **kwds as its allow_pickle flag
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=".", suffix=".tmp", dir=path.parent)

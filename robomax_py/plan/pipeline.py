@@ -40,6 +40,7 @@ from robomax_py.plan.roadmap import Roadmap
 from robomax_py.plan.sequence import Tour, choice_for_order
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
+from robomax_py.world.cell_cache import keep_decisions
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.collision_results import Contact
 from robomax_py.world.motion import min_clearance
@@ -58,7 +59,9 @@ def plan_cell(
     cell's objects with the same robot, home and process, as `seam_candidates` finds them (a station
     finds every robot's once for all the spots it may weld); a seam with a spot missing from it, or
     carrying a load, is found here."""
-    return _plan(cell, robot, resolved_options(cell, options), progress, known or {})
+    result = _plan(cell, robot, resolved_options(cell, options), progress, known or {})
+    keep_decisions()                        # the cells its worlds decided, for the next run
+    return result
 
 
 def _in_collision(what: str, contact: Contact, world: CollisionWorld, robot: RobotModel) -> str:

@@ -68,7 +68,7 @@ def _key(robot: RobotModel, gm: pin.GeometryModel, n_self: int, pair_sets: Seque
         g = gm.geometryObjects[i]
         h.update(f"{g.name}|{int(g.parentJoint)}|".encode())
         h.update(np.asarray(g.placement.homogeneous, dtype=float).tobytes())
-        shape = _shape_bytes(g.geometry)
+        shape = shape_bytes(g.geometry)
         if shape is None:
             return None
         h.update(shape)
@@ -77,7 +77,7 @@ def _key(robot: RobotModel, gm: pin.GeometryModel, n_self: int, pair_sets: Seque
     return h.hexdigest()
 
 
-def _shape_bytes(geometry: Any) -> bytes | None:
+def shape_bytes(geometry: Any) -> bytes | None:
     """The bytes that determine a coal shape: a convex hull by its points (coal does not pickle
     `ConvexBase`), any other shape by its pickle; None for neither."""
     # A triangle BVH (a tool mesh that is not convex pieces) has no swept-sphere radius in coal 3.

@@ -36,6 +36,7 @@ import pinocchio as pin
 
 from robomax_py._typing import BoolArray, FloatArray, IntArray
 from robomax_py.world.bounds import support_points, triangles
+from robomax_py.world.cell_cache import decisions_key, shared_decisions
 from robomax_py.world.pair_cells import PairCells, pair_cells
 from robomax_py.world.prefilter_kernels import _near, _placements, _uncleared
 from robomax_py.world.prefilter_layout import (
@@ -154,6 +155,9 @@ class Prefilter:
         walk = block_walk(block_kind, block_a, block_b, block_margin, box_lo, box_hi, tree_min_blocks)
         cells, cell_ints, cell_lows = pair_cells(parent, kind, qi, model.lowerPositionLimit, model.upperPositionLimit,
                                                  piece_joint, pa, pb, is_obs)
+        # The decisions other worlds of this arm and tool made, in this process or an earlier run.
+        cells_key = decisions_key(model, gm, pa, pb, np.asarray(pair_margin, dtype=float), cells.tables)
+        cells = replace(cells, decided=shared_decisions(cells_key, len(cells.decided)))
 
         # The walk's boxes and margins ride in the pieces' and blocks' tables, its ints in one table:
         # each table more is a slice more for numba to compile in every kernel.
