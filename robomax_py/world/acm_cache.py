@@ -60,7 +60,7 @@ def _key(robot: RobotModel, gm: pin.GeometryModel, n_self: int, pair_sets: Seque
     h.update(f"{coal.__version__}|{pin.__version__}|{options!r}".encode())
     model = robot.model
     for j in range(1, model.njoints):
-        h.update(model.joints[j].shortname().encode())
+        h.update(joint_bytes(model.joints[j]))
         h.update(np.asarray(model.jointPlacements[j].homogeneous, dtype=float).tobytes())
     h.update(np.asarray(robot.limits.lower, dtype=float).tobytes())
     h.update(np.asarray(robot.limits.upper, dtype=float).tobytes())
@@ -75,6 +75,18 @@ def _key(robot: RobotModel, gm: pin.GeometryModel, n_self: int, pair_sets: Seque
     for pairs in pair_sets:
         h.update(np.asarray(list(pairs), dtype=np.int64).reshape(-1, 2).tobytes() + b"|")
     return h.hexdigest()
+
+
+def joint_bytes(joint: Any) -> bytes:
+    """The bytes that determine how a Pinocchio joint moves: its kind, and the axis of a joint
+    whose kind does not name it (a revolute or prismatic joint about any axis, FANUC's J3 about
+    -y) and a passive joint's multiplier and offset."""
+    out = str(joint.shortname()).encode() + b"|"
+    model = joint.extract()
+    for name in ("axis", "scaling", "offset"):
+        if hasattr(model, name):
+            out += name.encode() + np.asarray(getattr(model, name), dtype=float).tobytes()
+    return out
 
 
 def shape_bytes(geometry: Any) -> bytes | None:

@@ -29,7 +29,7 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.cache_files import cache_folder, store_arrays
-from robomax_py.world.acm_cache import shape_bytes
+from robomax_py.world.acm_cache import joint_bytes, shape_bytes
 from robomax_py.world.pair_cells import (
     CELL_RAD,
     CERTIFIED,
@@ -67,7 +67,7 @@ def decisions_key(model: pin.Model, gm: pin.GeometryModel, pair_a: IntArray, pai
     h = hashlib.sha256(b"robomax cell decisions|" + _CODE)
     h.update(f"{coal.__version__}|{pin.__version__}|{CELL_RAD!r}".encode())
     for j in range(1, model.njoints):
-        h.update(model.joints[j].shortname().encode())
+        h.update(joint_bytes(model.joints[j]))
         h.update(np.asarray(model.jointPlacements[j].homogeneous, dtype=float).tobytes())
     for k, table in enumerate(tables):
         if table is None:

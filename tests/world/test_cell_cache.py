@@ -21,6 +21,7 @@ import pytest
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions, plan_cell
 from robomax_py.world import cell_cache
+from robomax_py.world.acm_cache import joint_bytes
 from robomax_py.world.cell_cache import decisions_key, keep_decisions
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.pair_cells import CERTIFIED, UNCERTIFIED, UNKNOWN
@@ -165,3 +166,15 @@ def test_a_plan_from_kept_decisions_is_the_plan_deciding_them(cache: Path, monke
     assert second.trajectory is not None and first.trajectory is not None
     np.testing.assert_array_equal(second.trajectory.q, first.trajectory.q)
     assert [(s.name, s.config) for s in second.spots] == [(s.name, s.config) for s in first.spots]
+
+
+def test_a_joint_about_another_axis_is_another_key() -> None:
+    """Joints Pinocchio names alike (a revolute joint about any axis; FANUC's J3 turns about -y) but
+    that move otherwise give other keys, as do passive joints of other multipliers."""
+    model = pin.Model()
+    about = [model.addJoint(0, pin.JointModelRevoluteUnaligned(np.array(axis)), pin.SE3.Identity(), f"j{k}")
+             for k, axis in enumerate(([0.0, 1.0, 0.0], [0.0, -1.0, 0.0]))]
+    assert joint_bytes(model.joints[about[0]]) != joint_bytes(model.joints[about[1]])
+    followers = [model.addJoint(about[0], pin.JointModelMimic(model.joints[about[0]], scale, 0.0), pin.SE3.Identity(),
+                                f"m{k}") for k, scale in enumerate((1.0, -1.0))]
+    assert joint_bytes(model.joints[followers[0]]) != joint_bytes(model.joints[followers[1]])
