@@ -1,8 +1,10 @@
-"""The definition a certified cell stands for, checked the same way for every certificate: coal's
-distance of the pair at configurations spread over the cell, the other joints anywhere."""
+"""The cells' tests' common ground: a world whose cells start undecided, and the definition a
+certified cell stands for, checked the same way for every certificate (coal's distance of the pair
+at configurations spread over the cell, the other joints anywhere)."""
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -11,6 +13,20 @@ import pinocchio as pin
 from robomax_py.robot import RobotModel
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.pair_cells import CellTable
+from robomax_py.world.scene import build_scene
+
+
+def undecided_world(path: Path) -> tuple[RobotModel, CollisionWorld]:
+    """The world of the cell at `path`, its cells undecided (the worlds of one arm and tool share
+    their decisions: those earlier tests or runs made are cleared)."""
+    from robomax_py.io.cell import load_cell, load_cell_robot
+
+    cell = load_cell(path)
+    robot = load_cell_robot(cell)
+    world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
+    assert world._s.prefilter is not None
+    world._s.prefilter.cells.decided[:] = 0
+    return robot, world
 
 
 def free_throughout(world: CollisionWorld, robot: RobotModel, pair: int, table: CellTable, lo: np.ndarray,

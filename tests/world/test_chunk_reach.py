@@ -30,29 +30,16 @@ from robomax_py.world.chunk_reach import (
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.collision_core import CollisionWorldCore
 from robomax_py.world.pair_cells import CERTIFIED, UNCERTIFIED, CellTable
-from robomax_py.world.scene import build_scene
-from tests.world.cell_checks import free_throughout
+from tests.world.cell_checks import free_throughout, undecided_world
 
 REPO = Path(__file__).resolve().parents[2]
 UR10_CELL = REPO / "cells" / "ur10_tray.yaml"
 REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
 
 
-def _world(path: Path) -> tuple[RobotModel, CollisionWorld]:
-    """A world of its own (its cells' decisions start empty)."""
-    from robomax_py.io.cell import load_cell, load_cell_robot
-
-    cell = load_cell(path)
-    robot = load_cell_robot(cell)
-    world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
-    assert world._s.prefilter is not None
-    world._s.prefilter.cells.decided[:] = 0
-    return robot, world
-
-
 @pytest.fixture()
 def ur10() -> tuple[RobotModel, CollisionWorld]:
-    return _world(UR10_CELL)
+    return undecided_world(UR10_CELL)
 
 
 def _pair(world: CollisionWorld, first: str, second: str) -> int:
@@ -74,7 +61,7 @@ def _table(world: CollisionWorld, pair: int) -> CellTable:
 def test_the_slabs_cover_every_piece(path: Path) -> None:
     """Points of each robot and tool piece's hull (on its faces, and between two of its vertices)
     lie in one of its slabs' spheres; the sphere's own rounding (1e-9 relative) is the tolerance."""
-    _, world = _world(path)
+    _, world = undecided_world(path)
     gm = world._s.geom_model
     rng = np.random.default_rng(7)
     covered = 0

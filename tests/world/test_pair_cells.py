@@ -27,8 +27,7 @@ from robomax_py.world.pair_cells import (
     UNCERTIFIED,
     CellTable,
 )
-from robomax_py.world.scene import build_scene
-from tests.world.cell_checks import free_throughout
+from tests.world.cell_checks import free_throughout, undecided_world
 
 REFERENCE_CELL = Path(__file__).resolve().parents[2] / "tests" / "data" / "reference" / "cabin_flange.yaml"
 
@@ -37,14 +36,7 @@ REFERENCE_CELL = Path(__file__).resolve().parents[2] / "tests" / "data" / "refer
 def reference() -> tuple[RobotModel, CollisionWorld]:
     """A world of its own (its cells' decisions start empty), the KR 16-class arm of the reference
     cell with its gun (three pairs get cells: the forearm against the flange and two gun pieces)."""
-    from robomax_py.io.cell import load_cell, load_cell_robot
-
-    cell = load_cell(REFERENCE_CELL)
-    robot = load_cell_robot(cell)
-    world = CollisionWorld(robot, build_scene(cell, robot), cell.process.clearance)
-    assert world._s.prefilter is not None
-    world._s.prefilter.cells.decided[:] = 0
-    return robot, world
+    return undecided_world(REFERENCE_CELL)
 
 
 def _tables(world: CollisionWorld) -> tuple[CellTable | None, ...]:
