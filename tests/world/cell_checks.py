@@ -29,6 +29,16 @@ def undecided_world(path: Path) -> tuple[RobotModel, CollisionWorld]:
     return robot, world
 
 
+def either_side(exact: CollisionWorld, hit: np.ndarray, free: np.ndarray, steps: int = 20) -> tuple[np.ndarray, np.ndarray]:
+    """Two configurations either side of a contact, `steps` halvings apart on the segment from a
+    colliding configuration `hit` to a free one (by the world `exact`)."""
+    a, b = hit, free
+    for _ in range(steps):
+        mid = (a + b) / 2
+        a, b = (mid, b) if not exact.is_free(mid) else (a, mid)
+    return a, b
+
+
 def free_throughout(world: CollisionWorld, robot: RobotModel, pair: int, table: CellTable, lo: np.ndarray,
                     hi: np.ndarray, rng: np.random.Generator, scratch: tuple[Any, Any], samples: int = 5) -> int:
     """Assert that `pair` is farther apart than its margin at `samples` configurations: the table's

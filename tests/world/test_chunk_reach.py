@@ -30,7 +30,7 @@ from robomax_py.world.chunk_reach import (
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.collision_core import CollisionWorldCore
 from robomax_py.world.pair_cells import CERTIFIED, UNCERTIFIED, CellTable
-from tests.world.cell_checks import free_throughout, undecided_world
+from tests.world.cell_checks import either_side, free_throughout, undecided_world
 
 REPO = Path(__file__).resolve().parents[2]
 UR10_CELL = REPO / "cells" / "ur10_tray.yaml"
@@ -153,10 +153,7 @@ def test_the_same_verdicts_as_coal_alone(ur10: tuple[RobotModel, CollisionWorld]
         free[1] = -np.pi / 2                      # the upper arm upright: clear of the base
         if not exact.is_free(free):
             continue
-        a, b = q, free
-        for _ in range(20):
-            mid = (a + b) / 2
-            a, b = (mid, b) if not exact.is_free(mid) else (a, mid)
+        a, b = either_side(exact, q, free)
         near.extend([a, b])
         for _ in range(3):
             other = b.copy()

@@ -27,7 +27,7 @@ from robomax_py.world.pair_cells import (
     UNCERTIFIED,
     CellTable,
 )
-from tests.world.cell_checks import free_throughout, undecided_world
+from tests.world.cell_checks import either_side, free_throughout, undecided_world
 
 REFERENCE_CELL = Path(__file__).resolve().parents[2] / "tests" / "data" / "reference" / "cabin_flange.yaml"
 
@@ -102,10 +102,7 @@ def _near_the_gun(robot: RobotModel, world: CollisionWorld, rng: np.random.Gener
         free[4:] = rng.uniform(lo[4:], hi[4:])
         if not exact.is_free(free):
             continue
-        a, b = q, free                      # only A5 and A6 differ: the self pairs' joints
-        for _ in range(20):
-            mid = (a + b) / 2
-            a, b = (mid, b) if not exact.is_free(mid) else (a, mid)
+        a, b = either_side(exact, q, free)  # only A5 and A6 differ: the self pairs' joints
         out.extend([a, b])
         # Others in the same cells (A5 and A6 within a cell's width), the arm elsewhere.
         for _ in range(4):
