@@ -29,7 +29,7 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.world.bounds import joint_path, support_points
-from robomax_py.world.prefilter import _enclosing_box
+from robomax_py.world.prefilter import _enclosing_box, _enclosing_sphere
 
 # Slabs the moving piece is cut into. On the UR10 box cell's uncertified base/upper-arm cells,
 # 8 slabs certified 61 % of a sample, 24 slabs 65 %: the slab nearest the base, not their number,
@@ -115,7 +115,7 @@ def slabs_of(geom: Any, placement: FloatArray, count: int = SLABS) -> Slabs:
     try:
         hull = ConvexHull(points)
     except (QhullError, ValueError):
-        return _covering([points])
+        return _spheres([points])
     vertices = points[hull.vertices]
     centred = vertices - vertices.mean(axis=0)
     _, axes = np.linalg.eigh(centred.T @ centred)
@@ -137,18 +137,14 @@ def slabs_of(geom: Any, placement: FloatArray, count: int = SLABS) -> Slabs:
         group = np.concatenate(parts)
         if len(group):
             groups.append(group)
-    return _covering(groups)
+    return _spheres(groups)
 
 
-def _covering(groups: list[FloatArray]) -> Slabs:
-    """One sphere per point group: centred on the group's box, its radius measured to every point
-    and padded against rounding."""
-    centres, radii = [], []
-    for group in groups:
-        centre = (group.min(axis=0) + group.max(axis=0)) / 2
-        centres.append(centre)
-        radii.append(float(np.linalg.norm(group - centre, axis=1).max()) * (1 + 1e-9) + 1e-9)
-    return Slabs(np.array(centres, dtype=float).reshape(-1, 3), np.array(radii, dtype=float))
+def _spheres(groups: list[FloatArray]) -> Slabs:
+    """One sphere per point group, each the pre-filter's enclosing sphere of its points."""
+    spheres = [_enclosing_sphere(group) for group in groups]
+    return Slabs(np.array([c for c, _ in spheres], dtype=float).reshape(-1, 3),
+                 np.array([r for _, r in spheres], dtype=float))
 
 
 def certified(chunks: PairChunks, data: Any, distance: float, half: FloatArray, bar: float) -> bool:
