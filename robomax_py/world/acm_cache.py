@@ -40,16 +40,17 @@ Analysis = tuple[SampledPairs, set[Pair]]
 _MEMORY: dict[str, Analysis] = {}
 
 
-def _code_digest() -> bytes:
-    """The analysis code's own bytes: a change to it makes every older entry miss."""
+def source_digest(*names: str) -> bytes:
+    """SHA-256 of the named modules' source in this folder: the code a cache's entries came from,
+    so that a change to it makes every older entry miss."""
     here = Path(__file__).parent
     h = hashlib.sha256()
-    for name in ("acm.py", "acm_cache.py", "bounds.py"):
+    for name in names:
         h.update((here / name).read_bytes())
     return h.digest()
 
 
-_CODE = _code_digest()
+_CODE = source_digest("acm.py", "acm_cache.py", "bounds.py")    # the analysis code
 
 
 def _key(robot: RobotModel, gm: pin.GeometryModel, n_self: int, pair_sets: Sequence[Sequence[Pair]],

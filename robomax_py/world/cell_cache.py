@@ -29,7 +29,7 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray, IntArray
 from robomax_py.cache_files import cache_folder, store_arrays
-from robomax_py.world.acm_cache import joint_bytes, shape_bytes
+from robomax_py.world.acm_cache import joint_bytes, shape_bytes, source_digest
 from robomax_py.world.pair_cells import (
     CELL_RAD,
     CERTIFIED,
@@ -39,19 +39,8 @@ from robomax_py.world.pair_cells import (
 )
 
 # The code that decides a cell, and this file: a change to any makes every older entry miss.
-_DECIDING = ("pair_cells.py", "chunk_reach.py", "collision_core.py", "prefilter.py", "prefilter_kernels.py",
-             "prefilter_reach.py", "prefilter_layout.py", "bounds.py", "cell_cache.py")
-
-
-def _code_digest() -> bytes:
-    here = Path(__file__).parent
-    h = hashlib.sha256()
-    for name in _DECIDING:
-        h.update((here / name).read_bytes())
-    return h.digest()
-
-
-_CODE = _code_digest()
+_CODE = source_digest("pair_cells.py", "chunk_reach.py", "collision_core.py", "prefilter.py", "prefilter_kernels.py",
+                      "prefilter_reach.py", "prefilter_layout.py", "bounds.py", "cell_cache.py")
 # Decisions by key, shared by the worlds of this process (a few arms and tools at most; each array
 # is at most a few hundred kB), with how many were decided when the array was last read or written.
 _MEMORY: OrderedDict[str, tuple[np.ndarray, int]] = OrderedDict()
