@@ -120,23 +120,22 @@ class CollisionWorldCore:
         _, live = self._run_pairs(np.stack((lo, hi)), only)
         if not live[p]:
             return CERTIFIED
-        return CERTIFIED if self._certified_by_slabs(p, lo, hi) else UNCERTIFIED
+        # Left live, the pair was measured by coal at the cell's centre just now (`_run_pairs`).
+        distance = float(self._gdata.distanceResults[p].min_distance)
+        return CERTIFIED if self._certified_by_slabs(p, lo, hi, distance) else UNCERTIFIED
 
-    def _certified_by_slabs(self, p: int, lo: FloatArray, hi: FloatArray) -> bool:
+    def _certified_by_slabs(self, p: int, lo: FloatArray, hi: FloatArray, distance: float) -> bool:
         """The finer test of a cell the first one could not certify (`chunk_reach`): the moving
-        piece's slabs each grown by their own motion over the cell [lo, hi]."""
-        s, gd = self._s, self._gdata
-        gm = s.geom_model
-        pair = gm.collisionPairs[p]
-        chunks = chunks_of_pair(s.model, gm, int(pair.first), int(pair.second))
-        if chunks is None:
-            return False
-        centre = (lo + hi) / 2      # as `_run_pairs` takes it
-        pin.computeJointJacobians(s.model, self._data, centre)
-        pin.updateGeometryPlacements(s.model, self._data, gm, gd)
-        distance = pin.computeDistance(gm, gd, p).min_distance
+        piece's slabs each grown by their own motion over the cell [lo, hi], the pieces `distance`
+        apart at its centre."""
+        s = self._s
+        pair = s.geom_model.collisionPairs[p]
+        chunks = chunks_of_pair(s.model, s.geom_model, int(pair.first), int(pair.second))
         bar = s.pair_margin[p] + CERTIFY_SLACK_M
-        return distance > bar and certified(chunks, self._data, distance, (hi - lo) / 2, bar)
+        if chunks is None or not distance > bar:
+            return False
+        pin.computeJointJacobians(s.model, self._data, (lo + hi) / 2)     # the centre, as `_run_pairs` takes it
+        return certified(chunks, self._data, distance, (hi - lo) / 2, bar)
 
     def _scan_timed(self, states: FloatArray, fractions: FloatArray, order: IntArray, m: int, start: float,
                     span: float) -> SegmentCheck:

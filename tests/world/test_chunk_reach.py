@@ -111,7 +111,7 @@ def test_the_base_and_upper_arm_of_a_ur10_certify(ur10: tuple[RobotModel, Collis
         return [world._decide(q, pair, table, table.cell(q)) for q in qs]
 
     with monkeypatch.context() as patch:
-        patch.setattr(CollisionWorldCore, "_certified_by_slabs", lambda self, p, lo, hi: False)
+        patch.setattr(CollisionWorldCore, "_certified_by_slabs", lambda self, p, lo, hi, distance: False)
         assert set(decide_all()) == {UNCERTIFIED}
     verdicts = decide_all()
     assert verdicts.count(CERTIFIED) >= 0.5 * len(qs), verdicts.count(CERTIFIED)
@@ -130,7 +130,8 @@ def test_a_cell_certified_by_slabs_is_free_throughout(ur10: tuple[RobotModel, Co
         assert chunks_of_pair(s.model, s.geom_model, int(s.pair_a[pair]), int(s.pair_b[pair])) is not None
         for q in _cells_of(robot, world, pair, rng, 40):
             lo, hi = table.box(q, table.cell(q))
-            if world._certified_by_slabs(pair, lo, hi):
+            centre = world.pair_distances((lo + hi) / 2, np.array([pair]))[0]
+            if world._certified_by_slabs(pair, lo, hi, float(centre)):
                 checked += free_throughout(world, robot, pair, table, lo, hi, rng, scratch)
     assert checked >= 100
 
