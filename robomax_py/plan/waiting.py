@@ -131,22 +131,36 @@ def trapped(world: CollisionWorld, q_rest: FloatArray, t: float, seconds: float,
 
 def first_dynamic_hit(world: CollisionWorld, block: Sequence[Segment], t0: float) -> tuple[str, float] | None:
     """(obstacle name, time) of the block's first contact with a dynamic obstacle, or None."""
+    if not block:
+        return None
+    q0s, q1s, t0s, t1s = _sampled_moves(block, t0)
+    start = 0
+    while (blocked := world.first_blocked(q0s[start:], q1s[start:], t0s[start:], t1s[start:])) is not None:
+        i, res = start + blocked[0], blocked[1]
+        qa, qb, ta, tb = q0s[i], q1s[i], float(t0s[i]), float(t1s[i])
+        s = res.s_contact or 0.0
+        tc = float(ta + s * (tb - ta))
+        # At rest, the obstacle that hits may only appear later in the span: look when each does.
+        for at in [tc, *(world.window_starts(ta, tb) if np.array_equal(qa, qb) else [])]:
+            contact = world.first_contact(qa + s * (qb - qa), at)
+            if contact is not None and contact.kind_b == KIND_DYNAMIC:
+                return contact.body_b, at
+        start = i + 1
+    return None
+
+
+def _sampled_moves(block: Sequence[Segment], t0: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """(q0s, q1s, t0s, t1s): the block as straight moves between its samples, in time order (a weld
+    or a wait: one move at rest over its whole time)."""
+    parts = []
     t = t0
     for seg in block:
         times = t + np.asarray(seg.t)
-        q = np.asarray(seg.q)
-        pairs = [(q[0], q[0], times[0], times[-1])] if len(times) == 1 or seg.kind in ("weld", "wait") else \
-            [(q[i], q[i + 1], times[i], times[i + 1]) for i in range(len(times) - 1)]
-        for qa, qb, ta, tb in pairs:
-            res = world.check_segment(qa, qb, float(ta), float(tb))
-            if res.free:
-                continue
-            s = res.s_contact or 0.0
-            tc = float(ta + s * (tb - ta))
-            # At rest, the obstacle that hits may only appear later in the span: look when each does.
-            for at in [tc, *(world.window_starts(float(ta), float(tb)) if np.array_equal(qa, qb) else [])]:
-                contact = world.first_contact(qa + s * (qb - qa), at)
-                if contact is not None and contact.kind_b == KIND_DYNAMIC:
-                    return contact.body_b, at
+        q = np.asarray(seg.q, dtype=float)
+        if len(times) == 1 or seg.kind in ("weld", "wait"):
+            parts.append((q[:1], q[:1], times[:1], times[-1:]))
+        else:
+            parts.append((q[:-1], q[1:], times[:-1], times[1:]))
         t += seg.duration
-    return None
+    q0s, q1s, t0s, t1s = (np.concatenate([p[n] for p in parts]) for n in range(4))
+    return q0s, q1s, t0s, t1s

@@ -36,8 +36,8 @@ CERTIFY_SLACK_M = 1e-4
 class CollisionWorldCore:
     """Scratch, pair activation and exact tests of one collision world (the base of `CollisionWorld`)."""
 
-    __slots__ = ("_active", "_active_before", "_allowed", "_callback", "_data", "_gdata", "_manager", "_pf", "_present",
-                 "_s", "_segments", "_windows")
+    __slots__ = ("_active", "_active_before", "_allowed", "_callback", "_data", "_first_window", "_gdata", "_manager",
+                 "_pf", "_present", "_s", "_segments", "_windows")
 
     # ----------------------------------------------------------------------------------- set-up
 
@@ -57,6 +57,7 @@ class CollisionWorldCore:
         spans = [(float(w0), float(w1), k) for k, i in enumerate(shared.dynamic_ids)
                  for w0, w1 in (shared.obstacles[int(i)].present or ((-np.inf, np.inf),))]
         self._windows = np.array(spans, dtype=float).reshape(-1, 3)
+        self._first_window = np.searchsorted(self._windows[:, 2], np.arange(len(shared.dynamic_ids)))
         self._active_before = np.arange(len(shared.pair_a) + 1, dtype=np.int64)
         self._active = np.ones(len(shared.pair_a), dtype=bool)
         self._allowed = np.ones(len(shared.pair_a), dtype=bool)     # pairs this world checks at all
@@ -142,20 +143,15 @@ class CollisionWorldCore:
         """`_scan` where dynamic obstacles come and go: state k (of `order`) counts the obstacles
         present during the time between its neighbouring steps, so the states are scanned in runs
         that share one presence, each with the pairs active then, stopping at the first collision."""
-        windows = [(start + max(int(step) - 1, 0) / m * span, start + min(int(step) + 1, m) / m * span) for step in order]
-        presence = [self._presence(min(a, b), max(a, b)) for a, b in windows]
-        tests, k0 = 0, 0
-        while k0 < len(order):
-            k1 = k0 + 1
-            while k1 < len(order) and np.array_equal(presence[k1], presence[k0]):
-                k1 += 1
-            a, b = windows[k0]
-            self._set_presence(min(a, b), max(a, b))
+        lo, hi = step_windows(np.asarray(order, dtype=np.int64), m, start, span)
+        presence = self._presences(lo, hi)
+        tests = 0
+        for k0, k1 in _runs(presence):
+            self._apply_presence(presence[k0])
             res = self._scan(states[k0:k1], fractions[k0:k1], m + 1)
             tests += res.narrow_phase_tests
             if not res.free:
                 return SegmentCheck(False, k0 + res.checks, m + 1, tests, res.s_contact)
-            k0 = k1
         return SegmentCheck(True, len(order), m + 1, tests, None)
 
     def _scan(self, states: FloatArray, fractions: FloatArray, n_states: int, near: bool = False,
@@ -237,10 +233,12 @@ class CollisionWorldCore:
 
     def _set_presence(self, ta: float | None, tb: float | None) -> None:
         """Activate the pairs of dynamic obstacles present at some time in [ta, tb] (None: present)."""
+        if self._s.dynamic_ids.size:
+            self._apply_presence(self._presence(ta, tb))
+
+    def _apply_presence(self, present: np.ndarray) -> None:
+        """Activate the pairs of the dynamic obstacles `present` (d,) marks, deactivate the others'."""
         s = self._s
-        if not s.dynamic_ids.size:
-            return
-        present = self._presence(ta, tb)
         changed = np.flatnonzero(present != self._present)
         if not changed.size:
             return
@@ -257,12 +255,17 @@ class CollisionWorldCore:
 
     def _presence(self, ta: float | None, tb: float | None) -> np.ndarray:
         """(d,) bool: which dynamic obstacles are present at some time in [ta, tb] (None: all)."""
-        n = len(self._s.dynamic_ids)
         if ta is None or tb is None:
-            return np.ones(n, dtype=bool)
+            return np.ones(len(self._s.dynamic_ids), dtype=bool)
+        row: np.ndarray = self._presences(np.array([ta]), np.array([tb]))[0]
+        return row
+
+    def _presences(self, lo: FloatArray, hi: FloatArray) -> np.ndarray:
+        """(k, d) bool: row i marks the dynamic obstacles present at some time in [lo[i], hi[i]]."""
         w = self._windows
-        meets = (w[:, 0] <= tb) & (w[:, 1] >= ta)
-        return np.bincount(w[meets, 2].astype(np.int64), minlength=n) > 0
+        meets = (w[None, :, 0] <= hi[:, None]) & (w[None, :, 1] >= lo[:, None])
+        # Every obstacle has at least one window, and its windows are consecutive in `_windows`.
+        return np.logical_or.reduceat(meets, self._first_window, axis=1)
 
     def _refresh_active(self) -> None:
         active = np.fromiter(self._gdata.activeCollisionPairs, dtype=bool, count=len(self._s.pair_a))
@@ -273,3 +276,22 @@ class CollisionWorldCore:
         s = self._s
         a, b = s.pieces[int(s.pair_a[pair])], s.pieces[int(s.pair_b[pair])]
         return Contact(body_a=a.body, kind_a=a.kind, body_b=b.body, kind_b=b.kind, piece_a=a.name, piece_b=b.name)
+
+
+def step_windows(steps: IntArray, m: IntArray | int, start: FloatArray | float,
+                 span: FloatArray | float) -> tuple[FloatArray, FloatArray]:
+    """(lo, hi): the time each state of a timed swept check stands for, state k (of m steps from
+    `start`, `span` seconds long) the time from its previous step to its next; m = 0: one state at
+    one instant. m, start and span are one move's, or each state's own."""
+    m, start, span = np.asarray(m, dtype=np.int64), np.asarray(start, dtype=float), np.asarray(span, dtype=float)
+    whole = np.maximum(m, 1)
+    a = start + np.maximum(steps - 1, 0) / whole * span
+    b = start + np.minimum(steps + 1, m) / whole * span
+    a, b = np.where(m > 0, a, start), np.where(m > 0, b, start)
+    return np.minimum(a, b), np.maximum(a, b)
+
+
+def _runs(presence: np.ndarray) -> list[tuple[int, int]]:
+    """[k0, k1) of each run of consecutive rows of `presence` (k, d) that are equal."""
+    breaks = (np.flatnonzero(np.any(presence[1:] != presence[:-1], axis=1)) + 1).tolist()
+    return list(zip([0, *breaks], [*breaks, len(presence)]))

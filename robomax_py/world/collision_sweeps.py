@@ -13,7 +13,7 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray
 from robomax_py.tolerances import DEFAULT as TOL
-from robomax_py.world.collision_core import CollisionWorldCore
+from robomax_py.world.collision_core import CollisionWorldCore, _runs, step_windows
 from robomax_py.world.collision_results import SegmentCheck, bisection_order
 
 # Untimed segment verdicts a world remembers (`check_segment`); past this many it forgets them all
@@ -95,6 +95,59 @@ class SweptChecks(CollisionWorldCore):
                 self._segments.clear()
             known = self._segments[key] = self._check_segment(q0, q1, None, None, max_step)
         return known
+
+    def first_blocked(self, q0s: FloatArray, q1s: FloatArray, t0s: FloatArray, t1s: FloatArray,
+                      max_step: float = TOL.sweep_step_m) -> tuple[int, SegmentCheck] | None:
+        """The first of the timed moves q0s[i] -> q1s[i] (from t0s[i] to t1s[i] s) that
+        `check_segment` finds blocked, and that check; None when every move is free.
+
+        The answer of `check_segment` on each move in turn, from fewer calls: a sampled motion is
+        hundreds of moves of a few states each. Every state of every move is checked once against
+        the obstacles present around its own time (the window `check_segment` gives it), in time
+        order, neighbouring states of one presence together, stopping at the first collision; the
+        move that state belongs to is then checked by `check_segment` itself, for its own answer.
+        """
+        if not max_step > 0:
+            raise ValueError(f"max_step must be > 0 m, got {max_step}")
+        q0s, q1s = np.asarray(q0s, dtype=np.float64), np.asarray(q1s, dtype=np.float64)
+        t0s, t1s = np.asarray(t0s, dtype=float), np.asarray(t1s, dtype=float)
+        start = 0
+        while start < len(q0s):
+            if self._pf is None or not self._s.dynamic_ids.size:
+                k = start                                   # nothing to batch: each move as asked
+            else:
+                k = start + self._first_colliding_move(q0s[start:], q1s[start:], t0s[start:], t1s[start:], max_step)
+                if k == len(q0s):
+                    return None
+            res = self.check_segment(q0s[k], q1s[k], float(t0s[k]), float(t1s[k]), max_step)
+            if not res.free:
+                return k, res
+            start = k + 1
+        return None
+
+    def _first_colliding_move(self, q0s: FloatArray, q1s: FloatArray, t0s: FloatArray, t1s: FloatArray,
+                              max_step: float) -> int:
+        """The index of the first timed move with a state that collides (as `_check_segment` builds
+        its states and their windows), len(q0s) when none has."""
+        counts = []
+        for q0, q1, t0, t1 in zip(q0s, q1s, t0s, t1s):
+            n = math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12)
+            counts.append(n if n else (1 if t0 != t1 else 0))
+        m = np.asarray(counts, dtype=np.int64)
+        move = np.repeat(np.arange(len(m)), m + 1)
+        k = np.arange(len(move)) - np.repeat(np.cumsum(m + 1) - (m + 1), m + 1)      # the step within its move
+        fractions = np.where(m[move] > 0, k / np.maximum(m[move], 1), 0.0)
+        states = q0s[move] + fractions[:, None] * (q1s[move] - q0s[move])
+        at_end = k == m[move]
+        states[at_end] = q1s[move[at_end]]                  # the end exactly, as `_check_segment`
+        lo, hi = step_windows(k, m[move], t0s[move], (t1s - t0s)[move])
+        presence = self._presences(lo, hi)
+        for k0, k1 in _runs(presence):
+            self._apply_presence(presence[k0])
+            res = self._scan(states[k0:k1], fractions[k0:k1], k1 - k0, near=True)
+            if not res.free:
+                return int(move[k0 + res.checks - 1])
+        return len(q0s)
 
     def _check_segment(self, q0: FloatArray, q1: FloatArray, t0: float | None, t1: float | None,
                        max_step: float) -> SegmentCheck:
