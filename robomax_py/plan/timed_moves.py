@@ -69,17 +69,25 @@ class DynamicConflicts:
         scene = build_scene(replace(cell, objects=()), robot)
         self.windows = tuple(d.present if d.present is not None else ((0.0, math.inf),) for d in scene.dynamic)
         self._all = CollisionWorld(robot, scene, cell.process.clearance).restricted(obstacles=True, self_pairs=False)
+        # Answers by the moves' exact bytes: the searches of every junction of a cell ask about the
+        # same roadmap edges and nodes again.
+        self._known: dict[bytes, frozenset[int]] = {}
 
     def point(self, q: FloatArray) -> frozenset[int]:
-        # Most configurations touch none, and then one check answers.
-        if self._all.is_free(q):
-            return frozenset()
-        return self._all.obstacles_touched(np.asarray(q, dtype=float)[None])
+        q = np.asarray(q, dtype=float)
+        key = q.tobytes()
+        if key not in self._known:
+            # Most configurations touch none, and then one check answers.
+            self._known[key] = frozenset() if self._all.is_free(q) else self._all.obstacles_touched(q[None])
+        return self._known[key]
 
     def segment(self, qa: FloatArray, qb: FloatArray) -> frozenset[int]:
-        if self._all.check_segment(qa, qb).free:
-            return frozenset()
-        return self._all.obstacles_touched(self._all.segment_states(qa, qb))
+        qa, qb = np.asarray(qa, dtype=float), np.asarray(qb, dtype=float)
+        key = qa.tobytes() + qb.tobytes()
+        if key not in self._known:
+            self._known[key] = frozenset() if self._all.check_segment(qa, qb).free else \
+                self._all.obstacles_touched(self._all.segment_states(qa, qb))
+        return self._known[key]
 
     def windows_of(self, objects: frozenset[int]) -> Windows:
         return merge_windows([w for i in sorted(objects) for w in self.windows[i]])

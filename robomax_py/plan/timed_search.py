@@ -119,11 +119,15 @@ def timed_astar(graph: TimedGraph, start: int, goal: int, t0: float, max_wait: f
         return NoRoute("start_blocked", f"the start is blocked at t = {t0:.3f} s", 0)
     goal_free = safe_intervals(graph.node_windows(goal))
 
+    heuristics: dict[int, float] = {}                 # a node is queued again and again: h once each
+
     def rank(t: float, u: int) -> tuple[float, float]:
         """f = the goal's first free time from g + h on (still a lower bound of the arrival), then h:
         while a window holds the goal shut, the states nearest it go first instead of every state
         that could arrive before it opens."""
-        h = graph.heuristic(u)
+        h = heuristics.get(u)
+        if h is None:
+            h = heuristics[u] = graph.heuristic(u)
         return _free_from(goal_free, t + h), h
 
     # Edges are checked lazily (Lazy A*): a successor is queued on the time it would have if its
