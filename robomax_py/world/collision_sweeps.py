@@ -5,7 +5,6 @@ module docstring."""
 
 from __future__ import annotations
 
-import itertools
 import math
 
 import numpy as np
@@ -37,7 +36,15 @@ class SweptChecks(CollisionWorldCore):
         c is the child of i towards j).
         """
         dq = np.abs(np.asarray(q1, dtype=float) - np.asarray(q0, dtype=float))
-        return float(np.dot(self._s.lever, dq))
+        # A sum, not np.dot: `sweep_lengths` sums each row the same way, to the same last bit (numpy
+        # adds a row of a contiguous array as it adds a vector), so a polyline checked in one call
+        # has exactly the states its segments checked one by one have.
+        return float((self._s.lever * dq).sum())
+
+    def sweep_lengths(self, points: FloatArray) -> FloatArray:
+        """(k - 1,) `sweep_length` of each segment of the joint-space polyline through points (k, n)."""
+        pts = np.asarray(points, dtype=float)
+        return np.asarray((self._s.lever * np.abs(pts[1:] - pts[:-1])).sum(axis=1), dtype=float)
 
     def segment_free(
         self,
@@ -129,11 +136,9 @@ class SweptChecks(CollisionWorldCore):
                               max_step: float) -> int:
         """The index of the first timed move with a state that collides (as `_check_segment` builds
         its states and their windows), len(q0s) when none has."""
-        counts = []
-        for q0, q1, t0, t1 in zip(q0s, q1s, t0s, t1s):
-            n = math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12)
-            counts.append(n if n else (1 if t0 != t1 else 0))
-        m = np.asarray(counts, dtype=np.int64)
+        lengths = (self._s.lever * np.abs(q1s - q0s)).sum(axis=1)          # each `sweep_length`
+        m = np.ceil(lengths / max_step - 1e-12).astype(np.int64)
+        m[(m == 0) & (t0s != t1s)] = 1                   # at rest over a time: both ends, as `_check_segment`
         move = np.repeat(np.arange(len(m)), m + 1)
         k = np.arange(len(move)) - np.repeat(np.cumsum(m + 1) - (m + 1), m + 1)      # the step within its move
         fractions = np.where(m[move] > 0, k / np.maximum(m[move], 1), 0.0)
@@ -204,15 +209,14 @@ class SweptChecks(CollisionWorldCore):
         pts = np.asarray(points, dtype=np.float64)
         if pts.ndim != 2 or len(pts) == 0:
             raise ValueError("points must be a non-empty (k, n) array")
-        pieces = [pts[:1]]
-        for q0, q1 in itertools.pairwise(pts):
-            m = math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12)
-            if m == 0:
-                continue                  # check_segment checks q0 alone: already in
-            states = q0 + (np.arange(1, m + 1) / m)[:, None] * (q1 - q0)
-            states[-1] = q1               # the end exactly, as check_segment
-            pieces.append(states)
-        states = np.concatenate(pieces)
+        m = np.ceil(self.sweep_lengths(pts) / max_step - 1e-12).astype(np.int64)
+        # Segment i's states 1..m[i] (check_segment checks q0 alone where m = 0: already in).
+        seg = np.repeat(np.arange(len(m)), m)
+        step = np.arange(len(seg)) - np.repeat(np.cumsum(m) - m, m) + 1
+        states = pts[seg] + (step / m[seg])[:, None] * (pts[seg + 1] - pts[seg])
+        at_end = step == m[seg]
+        states[at_end] = pts[seg[at_end] + 1]        # the end exactly, as check_segment
+        states = np.concatenate([pts[:1], states])
         self._set_presence(None, None)
         last = len(states) - 1
         order = bisection_order(last)

@@ -433,6 +433,16 @@ def test_path_check_equals_its_segments_checked_one_by_one(
     assert verdicts == {True, False}                             # both cases were exercised
 
 
+def test_a_polylines_sweep_lengths_are_its_segments_to_the_last_bit(
+    reference: tuple[CellSpec, RobotModel, CollisionWorld], rng: np.random.Generator
+) -> None:
+    # check_path subdivides every segment at once: it must find the step counts check_segment finds
+    # one by one, so the two check the same states (a last-bit difference can change a count).
+    _, robot, world = reference
+    pts = rng.uniform(-3.0, 3.0, size=(2000, robot.dof)) * 10.0 ** rng.integers(-6, 1, size=(2000, 1))
+    assert world.sweep_lengths(pts).tolist() == [world.sweep_length(a, b) for a, b in itertools.pairwise(pts)]
+
+
 def test_step_bound_no_point_moves_more_than_max_step(ur10: RobotModel, gun: ToolSpec, rng: np.random.Generator) -> None:
     w = world_for(ur10, gun, options=CollisionOptions())
     ratio = _step_bound_holds(w, ur10, rng, segments=6, max_step=0.05, max_dq=0.5)
