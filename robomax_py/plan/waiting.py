@@ -135,8 +135,11 @@ def first_dynamic_hit(world: CollisionWorld, block: Sequence[Segment], t0: float
         return None
     q0s, q1s, t0s, t1s = _sampled_moves(block, t0)
     start = 0
-    while (blocked := world.first_blocked(q0s[start:], q1s[start:], t0s[start:], t1s[start:])) is not None:
-        i, res = start + blocked[0], blocked[1]
+    while start < len(q0s):
+        blocked = world.first_blocked(q0s[start:], q1s[start:], t0s[start:], t1s[start:])
+        if blocked.index is None or blocked.check is None:
+            return None
+        i, res = start + blocked.index, blocked.check
         qa, qb, ta, tb = q0s[i], q1s[i], float(t0s[i]), float(t1s[i])
         s = res.s_contact or 0.0
         tc = float(ta + s * (tb - ta))

@@ -90,6 +90,7 @@ from robomax_py.world.bounds import support_points
 from robomax_py.world.collision_results import (
     ConfigCheck,
     Contact,
+    MovesCheck,
     Proximity,
     SegmentCheck,
     bisection_order,
@@ -383,6 +384,7 @@ class CollisionWorld(SweptChecks):
 
 __all__ = [
     "KIND_DYNAMIC", "KIND_LINK", "KIND_OBJECT", "KIND_TOOL_BODY", "KIND_TOOL_TIPS", "AllowedCollisions",
-    "CollisionOptions", "CollisionWorld", "ConfigCheck", "Contact", "DisabledPair", "Proximity", "SegmentCheck",
+    "CollisionOptions", "CollisionWorld", "ConfigCheck", "Contact", "DisabledPair", "MovesCheck", "Proximity",
+    "SegmentCheck",
     "acm_samples", "bisection_order", "support_points",
 ]

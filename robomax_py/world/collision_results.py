@@ -73,6 +73,20 @@ class SegmentCheck:
         return self.free
 
 
+@dataclass(frozen=True, slots=True)
+class MovesCheck:
+    """Consecutive swept moves checked until the first blocked one (`SweptChecks.first_blocked`).
+
+    index : the first blocked move, None when every move is free.
+    check : its `SegmentCheck` (as `check_segment` gives it), None when every move is free.
+    free_checks : configurations the free moves before it took, as their own checks count them.
+    """
+
+    index: int | None
+    check: SegmentCheck | None
+    free_checks: int
+
+
 def bisection_order(m: int) -> IntArray:
     """State indices 0..m in coarse-to-fine (dyadic) order, each exactly once.
 

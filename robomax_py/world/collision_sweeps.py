@@ -13,7 +13,7 @@ import pinocchio as pin
 from robomax_py._typing import FloatArray
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.collision_core import CollisionWorldCore, _runs, step_windows
-from robomax_py.world.collision_results import SegmentCheck, bisection_order
+from robomax_py.world.collision_results import MovesCheck, SegmentCheck, bisection_order
 
 # Untimed segment verdicts a world remembers (`check_segment`); past this many it forgets them all
 # at once (about 200 B each). A sequencing's detour searches ask a few thousand to tens of thousands.
@@ -104,55 +104,67 @@ class SweptChecks(CollisionWorldCore):
         return known
 
     def first_blocked(self, q0s: FloatArray, q1s: FloatArray, t0s: FloatArray, t1s: FloatArray,
-                      max_step: float = TOL.sweep_step_m) -> tuple[int, SegmentCheck] | None:
-        """The first of the timed moves q0s[i] -> q1s[i] (from t0s[i] to t1s[i] s) that
-        `check_segment` finds blocked, and that check; None when every move is free.
+                      max_step: float = TOL.sweep_step_m) -> MovesCheck:
+        """The first of the moves q0s[i] -> q1s[i] (from t0s[i] to t1s[i] s) that `check_segment`
+        finds blocked, with that check, and the checks the free moves before it took.
 
         The answer of `check_segment` on each move in turn, from fewer calls: a sampled motion is
-        hundreds of moves of a few states each. Every state of every move is checked once against
-        the obstacles present around its own time (the window `check_segment` gives it), in time
-        order, neighbouring states of one presence together, stopping at the first collision; the
-        move that state belongs to is then checked by `check_segment` itself, for its own answer.
+        hundreds of moves of a few states each. Every state of every move is checked once (against
+        the dynamic obstacles present around its own time, the window `check_segment` gives it), in
+        time order, neighbouring states of one presence together, stopping at the first collision;
+        the move that state belongs to is then checked by `check_segment` itself, for its own answer.
         """
         if not max_step > 0:
             raise ValueError(f"max_step must be > 0 m, got {max_step}")
         q0s, q1s = np.asarray(q0s, dtype=np.float64), np.asarray(q1s, dtype=np.float64)
         t0s, t1s = np.asarray(t0s, dtype=float), np.asarray(t1s, dtype=float)
-        start = 0
+        start, spent = 0, 0
         while start < len(q0s):
-            if self._pf is None or not self._s.dynamic_ids.size:
-                k = start                                   # nothing to batch: each move as asked
+            if self._pf is None:
+                k = start                                   # no pre-filter to batch with: each move as asked
             else:
-                k = start + self._first_colliding_move(q0s[start:], q1s[start:], t0s[start:], t1s[start:], max_step)
+                k, states = self._first_colliding_move(q0s[start:], q1s[start:], t0s[start:], t1s[start:], max_step)
+                k += start
+                spent += states                             # a free move's check takes all its states
                 if k == len(q0s):
-                    return None
+                    return MovesCheck(None, None, spent)
             res = self.check_segment(q0s[k], q1s[k], float(t0s[k]), float(t1s[k]), max_step)
             if not res.free:
-                return k, res
+                return MovesCheck(k, res, spent)
+            spent += res.checks
             start = k + 1
-        return None
+        return MovesCheck(None, None, spent)
 
     def _first_colliding_move(self, q0s: FloatArray, q1s: FloatArray, t0s: FloatArray, t1s: FloatArray,
-                              max_step: float) -> int:
-        """The index of the first timed move with a state that collides (as `_check_segment` builds
-        its states and their windows), len(q0s) when none has."""
+                              max_step: float) -> tuple[int, int]:
+        """(the index of the first move with a state that collides, len(q0s) when none has; the
+        states of the moves before it), the states and their windows as `_check_segment` builds them."""
+        timed = self._s.dynamic_ids.size > 0
         lengths = (self._s.lever * np.abs(q1s - q0s)).sum(axis=1)          # each `sweep_length`
         m = np.ceil(lengths / max_step - 1e-12).astype(np.int64)
-        m[(m == 0) & (t0s != t1s)] = 1                   # at rest over a time: both ends, as `_check_segment`
+        if timed:
+            m[(m == 0) & (t0s != t1s)] = 1               # at rest over a time: both ends, as `_check_segment`
         move = np.repeat(np.arange(len(m)), m + 1)
         k = np.arange(len(move)) - np.repeat(np.cumsum(m + 1) - (m + 1), m + 1)      # the step within its move
         fractions = np.where(m[move] > 0, k / np.maximum(m[move], 1), 0.0)
         states = q0s[move] + fractions[:, None] * (q1s[move] - q0s[move])
         at_end = k == m[move]
         states[at_end] = q1s[move[at_end]]                  # the end exactly, as `_check_segment`
-        lo, hi = step_windows(k, m[move], t0s[move], (t1s - t0s)[move])
-        presence = self._presences(lo, hi)
-        for k0, k1 in _runs(presence):
-            self._apply_presence(presence[k0])
+        if timed:
+            lo, hi = step_windows(k, m[move], t0s[move], (t1s - t0s)[move])
+            presence = self._presences(lo, hi)
+            runs = _runs(presence)
+        else:
+            self._set_presence(None, None)
+            runs = [(0, len(states))]
+        for k0, k1 in runs:
+            if timed:
+                self._apply_presence(presence[k0])
             res = self._scan(states[k0:k1], fractions[k0:k1], k1 - k0, near=True)
             if not res.free:
-                return int(move[k0 + res.checks - 1])
-        return len(q0s)
+                first = int(move[k0 + res.checks - 1])
+                return first, int(np.sum(m[:first] + 1))
+        return len(q0s), int(np.sum(m + 1))
 
     def _check_segment(self, q0: FloatArray, q1: FloatArray, t0: float | None, t1: float | None,
                        max_step: float) -> SegmentCheck:

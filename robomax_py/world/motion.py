@@ -84,7 +84,7 @@ def check_motion(
     limit = 1 if stop_at_first else max_collisions
     collisions: list[Violation] = []
     rest_end = _rest_ends(q)
-    skip_to = 0
+    skip_to, checks = _free_prefix(world, t, q, rest_end)
     for i in range(len(t) - 1):
         if i < skip_to:
             continue
@@ -116,6 +116,28 @@ def check_motion(
             break
     out.extend(collisions)
     return MotionCheck(tuple(out), checks)
+
+
+def _free_prefix(world: CollisionWorld, t: FloatArray, q: FloatArray, rest_end: IntArray) -> tuple[int, int]:
+    """(the sample the loop of `check_motion` must start from, the checks it would have spent
+    before it): its moves up to the first blocked one, checked in one call (`first_blocked`, the
+    same answers and checks as its `check_segment`s one by one). From there on the loop checks as
+    it always does."""
+    starts, q0s, q1s, t0s, t1s = [], [], [], [], []
+    i = 0
+    while i < len(t) - 1:
+        j = int(rest_end[i])
+        nxt = max(i + 1, j)                      # a rest is one move at rest over all its time
+        starts.append(i)
+        q0s.append(q[i])
+        q1s.append(q[i] if j > i + 1 else q[i + 1])
+        t0s.append(t[i])
+        t1s.append(t[nxt])
+        i = nxt
+    if not starts:
+        return 0, 0
+    found = world.first_blocked(np.array(q0s), np.array(q1s), np.array(t0s), np.array(t1s))
+    return (len(t) if found.index is None else starts[found.index]), found.free_checks
 
 
 def _rest_ends(q: FloatArray) -> IntArray:
