@@ -155,6 +155,9 @@ def test_timeout_is_reported_the_worker_killed_and_exit_3(batch_run: Batch, tmp_
     assert sorted(p.name for p in out.iterdir()) == ["results.jsonl", "summary.csv", "summary.md"]
 
 
+DEADLINE_S = 60.0      # a cell's deadline in the tests where one must time out (it sleeps far longer)
+
+
 def fake_worker(file: str, settings: PlanSettings) -> CellOutcome:
     """Test worker (imported by name in each cell's process): dies as the file's stem says, else 'plans'."""
     stem = Path(file).stem
@@ -165,7 +168,7 @@ def fake_worker(file: str, settings: PlanSettings) -> CellOutcome:
     if stem == "raises":
         raise ValueError("a bug")
     if stem == "sleeps":
-        time.sleep(120)
+        time.sleep(600)
     return CellOutcome(file, stem, PLANNED, 0.0, cycle_time=1.0, spots=1, detours=0)
 
 
@@ -220,11 +223,13 @@ def test_ray_reports_crashed_and_timed_out_tasks_and_finishes_the_others(tmp_pat
     # Real cell files (the driver loads each to ship its files), planned by the fake worker.
     files = [str(write_small_cell(tmp_path, stem)) for stem in ("ok1", "exits", "sleeps", "ok2")]
     path = os.pathsep.join([str(Path(__file__).parent), *sys.path])   # Ray workers import this module
-    outcomes = run_ray(files, BatchOptions(jobs=2, timeout=20.0), worker=fake_worker,
+    # The deadline covers starting a cell's process too: about 20 s was seen on a loaded 2-core
+    # machine, where a deadline of 20 s timed out a cell that plans at once.
+    outcomes = run_ray(files, BatchOptions(jobs=2, timeout=DEADLINE_S), worker=fake_worker,
                        init_kwargs={"runtime_env": {"env_vars": {"PYTHONPATH": path}}})
     assert [o.status for o in outcomes] == [PLANNED, CRASHED, TIMEOUT, PLANNED]
     # A cell's own crash and deadline are found in the task, as in the local pool: not retried.
-    assert "exited with code 7" in outcomes[1].reasons and "20 s" in outcomes[2].reasons
+    assert "exited with code 7" in outcomes[1].reasons and f"{DEADLINE_S:g} s" in outcomes[2].reasons
     assert [o.attempts for o in outcomes] == [1, 1, 1, 1]      # (the sleeping cell would be planned, not timed out,
                                                                # had its worker not been killed)
 
