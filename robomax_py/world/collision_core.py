@@ -146,7 +146,7 @@ class CollisionWorldCore:
         lo, hi = step_windows(np.asarray(order, dtype=np.int64), m, start, span)
         presence = self._presences(lo, hi)
         tests = 0
-        for k0, k1 in _runs(presence):
+        for k0, k1 in presence_runs(presence):
             self._apply_presence(presence[k0])
             res = self._scan(states[k0:k1], fractions[k0:k1], m + 1)
             tests += res.narrow_phase_tests
@@ -291,7 +291,7 @@ def step_windows(steps: IntArray, m: IntArray | int, start: FloatArray | float,
     return np.minimum(a, b), np.maximum(a, b)
 
 
-def _runs(presence: np.ndarray) -> list[tuple[int, int]]:
+def presence_runs(presence: np.ndarray) -> list[tuple[int, int]]:
     """[k0, k1) of each run of consecutive rows of `presence` (k, d) that are equal."""
     breaks = (np.flatnonzero(np.any(presence[1:] != presence[:-1], axis=1)) + 1).tolist()
     return list(zip([0, *breaks], [*breaks, len(presence)]))

@@ -12,7 +12,11 @@ import pinocchio as pin
 
 from robomax_py._typing import FloatArray
 from robomax_py.tolerances import DEFAULT as TOL
-from robomax_py.world.collision_core import CollisionWorldCore, _runs, step_windows
+from robomax_py.world.collision_core import (
+    CollisionWorldCore,
+    presence_runs,
+    step_windows,
+)
 from robomax_py.world.collision_results import MovesCheck, SegmentCheck, bisection_order
 
 # Untimed segment verdicts a world remembers (`check_segment`); past this many it forgets them all
@@ -153,7 +157,7 @@ class SweptChecks(CollisionWorldCore):
         if timed:
             lo, hi = step_windows(k, m[move], t0s[move], (t1s - t0s)[move])
             presence = self._presences(lo, hi)
-            runs = _runs(presence)
+            runs = presence_runs(presence)
         else:
             self._set_presence(None, None)
             runs = [(0, len(states))]
