@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -64,6 +64,9 @@ class TcpSpace:
     voxels: VoxelMap
     centres: FloatArray              # (N, 3) m, the free leaves' centres
     door_windows: tuple[Windows, ...]  # per free leaf: windows in which a dynamic object is near it
+    # Whether the straight line between two points is free, by their bytes: the routes of a cell's
+    # junctions ask about the same lines between leaves again (a third of the lines, on the tending cell).
+    lines: dict[bytes, bool] = field(default_factory=dict, repr=False, compare=False)
 
 
 def tcp_space(scene: Scene, robot: RobotModel, clearance: float,
@@ -98,8 +101,12 @@ def dynamic_boxes(scene: Scene) -> tuple[tuple[FloatArray, FloatArray, Windows],
 
 
 def _line_free(space: TcpSpace, a: FloatArray, b: FloatArray) -> bool:
-    n = max(2, math.ceil(float(np.linalg.norm(b - a)) / (PRECISION_M / 2)) + 1)
-    return bool(space.voxels.is_free(a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)).all())
+    key = a.tobytes() + b.tobytes()
+    known = space.lines.get(key)
+    if known is None:
+        n = max(2, math.ceil(float(np.linalg.norm(b - a)) / (PRECISION_M / 2)) + 1)
+        known = space.lines[key] = bool(space.voxels.is_free(a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)).all())
+    return known
 
 
 def tcp_route(space: TcpSpace, p_start: FloatArray, p_goal: FloatArray, t0: float,

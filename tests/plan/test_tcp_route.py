@@ -74,3 +74,23 @@ def test_the_route_waits_outside_while_the_door_is_closed(cell_world: dict[str, 
     # The door is closed over [0, 9] s: no route may take it before then.
     short = tcp_route(space, p0, p1, 0.0, max_wait=2.0)  # type: ignore[arg-type]
     assert isinstance(short, NoRoute) and short.reason == "wait_limit"
+
+
+def test_a_line_asked_again_gets_the_answer_of_the_voxels(cell_world: dict[str, object]) -> None:
+    """The lines a space keeps answer as its voxels do (the first time and again), both ways on
+    random lines through the cell, free and blocked, two from each start."""
+    from robomax_py.plan.tcp_route import PRECISION_M, TcpSpace, _line_free
+
+    space = cell_world["space"]
+    assert isinstance(space, TcpSpace)
+    rng = np.random.default_rng(5)
+    answers = set()
+    for _ in range(150):
+        a, *ends = rng.uniform([-1.5, -1.5, 0.0], [1.5, 1.5, 2.0], size=(3, 3))     # two lines from a
+        for b in ends:
+            n = max(2, int(np.ceil(np.linalg.norm(b - a) / (PRECISION_M / 2))) + 1)
+            want = bool(space.voxels.is_free(a + np.linspace(0.0, 1.0, n)[:, None] * (b - a)).all())
+            assert _line_free(space, a, b) == want and _line_free(space, a, b) == want
+            assert _line_free(space, b, a) == bool(space.voxels.is_free(b + np.linspace(0.0, 1.0, n)[:, None] * (a - b)).all())
+            answers.add(want)
+    assert answers == {True, False}
