@@ -144,15 +144,21 @@ class CollisionWorldCore:
         present during the time between its neighbouring steps, so the states are scanned in runs
         that share one presence, each with the pairs active then, stopping at the first collision."""
         lo, hi = step_windows(np.asarray(order, dtype=np.int64), m, start, span)
+        return self._scan_in_time(states, fractions, lo, hi, m + 1)
+
+    def _scan_in_time(self, states: FloatArray, fractions: FloatArray, lo: FloatArray, hi: FloatArray,
+                      n_states: int, near: bool = False) -> SegmentCheck:
+        """`_scan` with state k against the dynamic obstacles present at some time in [lo[k], hi[k]]:
+        in runs of neighbouring states of one presence, in order, stopping at the first collision."""
         presence = self._presences(lo, hi)
         tests = 0
-        for k0, k1 in presence_runs(presence):
+        for k0, k1 in _presence_runs(presence):
             self._apply_presence(presence[k0])
-            res = self._scan(states[k0:k1], fractions[k0:k1], m + 1)
+            res = self._scan(states[k0:k1], fractions[k0:k1], n_states, near)
             tests += res.narrow_phase_tests
             if not res.free:
-                return SegmentCheck(False, k0 + res.checks, m + 1, tests, res.s_contact)
-        return SegmentCheck(True, len(order), m + 1, tests, None)
+                return SegmentCheck(False, k0 + res.checks, n_states, tests, res.s_contact)
+        return SegmentCheck(True, len(states), n_states, tests, None)
 
     def _scan(self, states: FloatArray, fractions: FloatArray, n_states: int, near: bool = False,
               place: IntArray | None = None) -> SegmentCheck:
@@ -291,7 +297,7 @@ def step_windows(steps: IntArray, m: IntArray | int, start: FloatArray | float,
     return np.minimum(a, b), np.maximum(a, b)
 
 
-def presence_runs(presence: np.ndarray) -> list[tuple[int, int]]:
+def _presence_runs(presence: np.ndarray) -> list[tuple[int, int]]:
     """[k0, k1) of each run of consecutive rows of `presence` (k, d) that are equal."""
     breaks = (np.flatnonzero(np.any(presence[1:] != presence[:-1], axis=1)) + 1).tolist()
     return list(zip([0, *breaks], [*breaks, len(presence)]))

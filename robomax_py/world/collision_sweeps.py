@@ -10,13 +10,9 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from robomax_py._typing import FloatArray
+from robomax_py._typing import FloatArray, IntArray
 from robomax_py.tolerances import DEFAULT as TOL
-from robomax_py.world.collision_core import (
-    CollisionWorldCore,
-    presence_runs,
-    step_windows,
-)
+from robomax_py.world.collision_core import CollisionWorldCore, step_windows
 from robomax_py.world.collision_results import MovesCheck, SegmentCheck, bisection_order
 
 # Untimed segment verdicts a world remembers (`check_segment`); past this many it forgets them all
@@ -45,10 +41,14 @@ class SweptChecks(CollisionWorldCore):
         # has exactly the states its segments checked one by one have.
         return float((self._s.lever * dq).sum())
 
-    def sweep_lengths(self, points: FloatArray) -> FloatArray:
-        """(k - 1,) `sweep_length` of each segment of the joint-space polyline through points (k, n)."""
-        pts = np.asarray(points, dtype=float)
-        return np.asarray((self._s.lever * np.abs(pts[1:] - pts[:-1])).sum(axis=1), dtype=float)
+    def sweep_lengths(self, q0s: FloatArray, q1s: FloatArray) -> FloatArray:
+        """(k,) `sweep_length` of each move q0s[i] -> q1s[i] (k, n)."""
+        dq = np.abs(np.asarray(q1s, dtype=float) - np.asarray(q0s, dtype=float))
+        return np.asarray((self._s.lever * dq).sum(axis=1), dtype=float)
+
+    def _step_counts(self, q0s: FloatArray, q1s: FloatArray, max_step: float) -> IntArray:
+        """(k,) the steps `_check_segment` splits each move into (before a timed move at rest gets one)."""
+        return np.ceil(self.sweep_lengths(q0s, q1s) / max_step - 1e-12).astype(np.int64)
 
     def segment_free(
         self,
@@ -144,31 +144,20 @@ class SweptChecks(CollisionWorldCore):
         """(the index of the first move with a state that collides, len(q0s) when none has; the
         states of the moves before it), the states and their windows as `_check_segment` builds them."""
         timed = self._s.dynamic_ids.size > 0
-        lengths = (self._s.lever * np.abs(q1s - q0s)).sum(axis=1)          # each `sweep_length`
-        m = np.ceil(lengths / max_step - 1e-12).astype(np.int64)
+        m = self._step_counts(q0s, q1s, max_step)
         if timed:
             m[(m == 0) & (t0s != t1s)] = 1               # at rest over a time: both ends, as `_check_segment`
-        move = np.repeat(np.arange(len(m)), m + 1)
-        k = np.arange(len(move)) - np.repeat(np.cumsum(m + 1) - (m + 1), m + 1)      # the step within its move
-        fractions = np.where(m[move] > 0, k / np.maximum(m[move], 1), 0.0)
-        states = q0s[move] + fractions[:, None] * (q1s[move] - q0s[move])
-        at_end = k == m[move]
-        states[at_end] = q1s[move[at_end]]                  # the end exactly, as `_check_segment`
+        move, step, fractions, states = _subdivided(q0s, q1s, m)
         if timed:
-            lo, hi = step_windows(k, m[move], t0s[move], (t1s - t0s)[move])
-            presence = self._presences(lo, hi)
-            runs = presence_runs(presence)
+            lo, hi = step_windows(step, m[move], t0s[move], (t1s - t0s)[move])
+            res = self._scan_in_time(states, fractions, lo, hi, len(states), near=True)
         else:
             self._set_presence(None, None)
-            runs = [(0, len(states))]
-        for k0, k1 in runs:
-            if timed:
-                self._apply_presence(presence[k0])
-            res = self._scan(states[k0:k1], fractions[k0:k1], k1 - k0, near=True)
-            if not res.free:
-                first = int(move[k0 + res.checks - 1])
-                return first, int(np.sum(m[:first] + 1))
-        return len(q0s), int(np.sum(m + 1))
+            res = self._scan(states, fractions, len(states), near=True)
+        if res.free:
+            return len(q0s), int(np.sum(m + 1))
+        first = int(move[res.checks - 1])
+        return first, int(np.sum(m[:first] + 1))
 
     def _check_segment(self, q0: FloatArray, q1: FloatArray, t0: float | None, t1: float | None,
                        max_step: float) -> SegmentCheck:
@@ -225,14 +214,10 @@ class SweptChecks(CollisionWorldCore):
         pts = np.asarray(points, dtype=np.float64)
         if pts.ndim != 2 or len(pts) == 0:
             raise ValueError("points must be a non-empty (k, n) array")
-        m = np.ceil(self.sweep_lengths(pts) / max_step - 1e-12).astype(np.int64)
-        # Segment i's states 1..m[i] (check_segment checks q0 alone where m = 0: already in).
-        seg = np.repeat(np.arange(len(m)), m)
-        step = np.arange(len(seg)) - np.repeat(np.cumsum(m) - m, m) + 1
-        states = pts[seg] + (step / m[seg])[:, None] * (pts[seg + 1] - pts[seg])
-        at_end = step == m[seg]
-        states[at_end] = pts[seg[at_end] + 1]        # the end exactly, as check_segment
-        states = np.concatenate([pts[:1], states])
+        _, step, _, states = _subdivided(pts[:-1], pts[1:], self._step_counts(pts[:-1], pts[1:], max_step))
+        # Each segment's states after its first, which is the one before's last (where m = 0,
+        # check_segment checks q0 alone: already in).
+        states = np.concatenate([pts[:1], states[step > 0]])
         self._set_presence(None, None)
         last = len(states) - 1
         order = bisection_order(last)
@@ -249,3 +234,15 @@ class SweptChecks(CollisionWorldCore):
     def path_free(self, points: FloatArray, max_step: float = TOL.sweep_step_m) -> bool:
         """Whether the joint-space polyline through `points` is collision-free (see `check_path`)."""
         return self.check_path(points, max_step).free
+
+
+def _subdivided(q0s: FloatArray, q1s: FloatArray, m: IntArray) -> tuple[IntArray, IntArray, FloatArray, FloatArray]:
+    """(move, step, fraction, state) of each state k = 0..m[i] of each move q0s[i] -> q1s[i], in
+    order, as `_check_segment` builds them: q0 + k / m (q1 - q0), the last exactly q1 (m = 0: q1)."""
+    move = np.repeat(np.arange(len(m)), m + 1)
+    step = np.arange(len(move)) - np.repeat(np.cumsum(m + 1) - (m + 1), m + 1)
+    fractions = np.where(m[move] > 0, step / np.maximum(m[move], 1), 0.0)
+    states = q0s[move] + fractions[:, None] * (q1s[move] - q0s[move])
+    at_end = step == m[move]
+    states[at_end] = q1s[move[at_end]]
+    return move, step, fractions, states

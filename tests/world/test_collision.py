@@ -440,7 +440,7 @@ def test_a_polylines_sweep_lengths_are_its_segments_to_the_last_bit(
     # one by one, so the two check the same states (a last-bit difference can change a count).
     _, robot, world = reference
     pts = rng.uniform(-3.0, 3.0, size=(2000, robot.dof)) * 10.0 ** rng.integers(-6, 1, size=(2000, 1))
-    assert world.sweep_lengths(pts).tolist() == [world.sweep_length(a, b) for a, b in itertools.pairwise(pts)]
+    assert world.sweep_lengths(pts[:-1], pts[1:]).tolist() == [world.sweep_length(a, b) for a, b in itertools.pairwise(pts)]
 
 
 def test_step_bound_no_point_moves_more_than_max_step(ur10: RobotModel, gun: ToolSpec, rng: np.random.Generator) -> None:
