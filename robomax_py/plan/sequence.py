@@ -341,12 +341,19 @@ def optimise(
         [(i, b.spots if b.ordered else b.spots[::-1]) for i, b in enumerate(blocks)],
         _insertion_start(blocks, costs),
     ]
-    # The first start's result among those within the search's tolerance of the best: a tour and
-    # its reverse over symmetric legs sum the same times in another order, and which one is a few
-    # ulps shorter follows the CPU's rounding; the tolerance makes the choice the same everywhere.
+    # Among the results within the search's tolerance of the best, the file's order's, then its
+    # reverse's, then the others' in the order above: a tour and its reverse over symmetric legs sum
+    # the same times in another order, and which one is a few ulps shorter follows the CPU's
+    # rounding; the tolerance makes the choice the same everywhere. The file's order goes before
+    # the earlier rounds' tours (`starts`), which follow their own rounds' costs and so the CPU as
+    # well: on cells/cabin_flange.yaml one CPU's second round found the reverse shorter, and the
+    # third, which priced both the same, kept it. (The descents still run in the order above: which
+    # one spends the evaluation budget first changes the tours found.)
     descents = [descend(s) for s in initial]
     lowest = min(cost for _, cost in descents)
-    best, best_cost = next(pair for pair in descents if pair[1] <= lowest + TIE_S)
+    first = len(starts)
+    preferred = [*descents[first:first + 2], *descents[:first], *descents[first + 2:]]
+    best, best_cost = next(pair for pair in preferred if pair[1] <= lowest + TIE_S)
     can_kick = len(blocks) > 1 or any(not b.ordered and len(b.spots) >= 3 for b in blocks)
     # Kicks that only revisit known orders spend no budget; they grow stronger, and are capped so
     # the search always ends.
