@@ -34,6 +34,7 @@ from robomax_py.timing import (
     spline_path,
     time_path,
 )
+from robomax_py.timing.blend import blend_chain
 
 # Finite-difference limit checks allow this fraction over a limit (toppra enforces its constraints
 # at grid points only; ruckig's samples are exact and use far less).
@@ -337,6 +338,24 @@ def test_blend_corner_is_g2_and_within_radius(a: np.ndarray, c: np.ndarray, b: n
         + JOIN_CURVATURE_RTOL / corner.radius
     # Within the radius of the corner.
     assert np.max(np.linalg.norm(path(s) - c, axis=1)) <= corner.radius * (1 + RADIUS_RTOL)
+
+
+# A blend's radius comes back as asked to this fraction: the cut is bisected to neighbouring floats.
+CUT_RTOL = 1e-9
+
+
+def test_a_chain_blends_at_the_radius_asked_wherever_the_grid_falls() -> None:
+    """A corner between two straight moves, the first one just over twice the radius long: the
+    radius is reached within the move's half, between its last grid step and the half. The blend
+    is the radius asked for every length, not the half (up to one grid step, radius / 16, wider)
+    for the lengths whose grid steps leave that stretch empty."""
+    radius = 0.05
+    used = []
+    for length in np.linspace(2.0 * radius, 2.0 * radius * (1.0 + 1.5 / 16.0), 301):
+        first = line_path(np.zeros(3), np.array([length, 0.0, 0.0]))
+        second = line_path(np.array([length, 0.0, 0.0]), np.array([length, 1.0, 0.0]))
+        used.append(float(blend_chain([first, second], [radius]).radii[0]))
+    assert_allclose(used, radius, rtol=CUT_RTOL)
 
 
 def test_blended_polyline_is_c2_at_every_join() -> None:

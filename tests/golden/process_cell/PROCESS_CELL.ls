@@ -24,7 +24,7 @@ CONTROL_CODE	= 00000000 00000000;
    3:  !+ cell file sha256 ;
    4:  !+ 88859a5ee20f1866af51228139925b ;
    5:  !+98ff8d83876345bd50c8fce2a9b032b ;
-   6:  !+924, planned cycle 5.463 s ;
+   6:  !+924, planned cycle 5.462 s ;
    7:  !robot kr125, tool spot_gun_c, ;
    8:  !+ axes joint_a1 joint_a2 ;
    9:  !+ joint_a3 joint_a4 joint_a5 ;

@@ -1,5 +1,5 @@
 .PROGRAM process_cell()
-  ; robomax_py 0.1.0 | cell process_cell | cell file sha256 88859a5ee20f1866af51228139925b98ff8d83876345bd50c8fce2a9b032b924 | planned cycle 5.463 s
+  ; robomax_py 0.1.0 | cell process_cell | cell file sha256 88859a5ee20f1866af51228139925b98ff8d83876345bd50c8fce2a9b032b924 | planned cycle 5.462 s
   ; robot kr125 | tool spot_gun_c | axes joint_a1 joint_a2 joint_a3 joint_a4 joint_a5 joint_a6
   POINT tool2 = TRANS(200.000,0.000,270.000,0.00000,90.00000,-90.00000)
   POINT base3 = TRANS(1800.000,0.000,710.000,0.00000,0.00000,0.00000)

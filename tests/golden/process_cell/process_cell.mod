@@ -4,7 +4,7 @@
 %%%
 
 MODULE process_cell
-  ! robomax_py 0.1.0 | cell process_cell | cell file sha256 88859a5ee20f1866af51228139925b98ff8d83876345bd50c8fce2a9b032b924 | planned cycle 5.463 s
+  ! robomax_py 0.1.0 | cell process_cell | cell file sha256 88859a5ee20f1866af51228139925b98ff8d83876345bd50c8fce2a9b032b924 | planned cycle 5.462 s
   ! robot kr125 | tool spot_gun_c | axes joint_a1 joint_a2 joint_a3 joint_a4 joint_a5 joint_a6
   ! RAPID module: mm, deg, quaternions [w, x, y, z], speeddata mm/s, zonedata mm
   CONST jointtarget jt1 := [[0.0000, -90.0000, 90.0000, 0.0000, 0.0000, 0.0000], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
@@ -28,7 +28,7 @@ MODULE process_cell
   CONST jointtarget jt11 := [[0.0000, -90.0000, 90.0000, 0.0000, 0.0000, 0.0000], [9E9, 9E9, 9E9, 9E9, 9E9, 9E9]];
 
   PROC main()
-    ! start at home; 2 spots, planned cycle 5.463 s
+    ! start at home; 2 spots, planned cycle 5.462 s
     VelSet 100.0, 5000;
     AccSet 100.0, 100;
     MoveAbsJ jt1, vmax, fine, gun2;  ! home
@@ -36,7 +36,7 @@ MODULE process_cell
     WaitDI diClamp1Closed, 1;
     MoveAbsJ jt2, vmax, z_1, gun2;  ! home -> s7, t 0.000 s, detour point 1
     MoveAbsJ jt3, vmax, z_2, gun2;
-    ! flange/s7: arrive 1.682 s, leave 2.182 s, alpha -10.0 beta 10.0 gamma 0.0 deg
+    ! flange/s7: arrive 1.681 s, leave 2.181 s, alpha -10.0 beta 10.0 gamma 0.0 deg
     MoveL p4, v_lin1, fine, gun2 \WObj:=fixture_plate;  ! approach
     spot_weld 1, 0.500;  ! flange/s7 gun 2 schedule 4
     MoveL p5, v_lin1, z_3, gun2 \WObj:=fixture_plate;  ! retract
