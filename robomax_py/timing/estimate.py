@@ -26,6 +26,7 @@ import numpy as np
 from robomax_py._typing import FloatArray
 from robomax_py.robot import JointLimits
 from robomax_py.timing._common import ZERO_MOVE, scaled_limits
+from robomax_py.timing._estimate_kernels import straight_times
 
 
 def ptp_time_estimate(
@@ -67,10 +68,23 @@ def ptp_time_estimate(
         return np.full((1,) * (max(q0.ndim, q1.ndim) - 1), t)
     if not straight:
         return _largest(_trapezoid_time(r_v, r_a) for r_v, r_a in _joint_ratios(q0, q1, lim.v, lim.a))
-    # Joint by joint into two running maxima, reusing buffers: the candidate-pair matrices this
-    # ranks are (N, M, 6), where a reduction over a last axis of 6 and fresh temporaries cost numpy
-    # more than the arithmetic (measured on 32 x 32: 31 us against 50 us allocating per joint, and
-    # 100 us as one (N, M, 6) array).
+    n = q0.shape[-1] if q0.ndim else 0
+    if 0 < n <= len(lim.v) and q1.ndim == q0.ndim and q1.shape[-1] == n:
+        # The candidate matrices (k, 1, n) x (1, m, n) and paired rows (k, n), (k, n) in one
+        # compiled pass (`_estimate_kernels`), the same floats.
+        if q0.ndim == 3 and q0.shape[1] == 1 and q1.shape[0] == 1:
+            matrix: FloatArray = straight_times(np.ascontiguousarray(q0[:, 0].T), np.ascontiguousarray(q1[0].T),
+                                                lim.v_array[:n], lim.a_array[:n], ZERO_MOVE, True)
+            return matrix
+        if q0.ndim == 2 and q0.shape == q1.shape:
+            paired: FloatArray = straight_times(np.ascontiguousarray(q0.T), np.ascontiguousarray(q1.T),
+                                                lim.v_array[:n], lim.a_array[:n], ZERO_MOVE, False)[0]
+            return paired
+    # Any other broadcast, joint by joint into two running maxima, reusing buffers: a reduction over
+    # a last axis of 6 and fresh temporaries cost numpy more than the arithmetic (measured on
+    # 32 x 32 candidate matrices, before they were compiled: 31 us against 50 us allocating per
+    # joint, and 100 us as one (N, M, 6) array). This is also the definition the compiled pass
+    # follows.
     d = np.abs(q1[..., 0] - q0[..., 0])
     r_v, r_a = d / lim.v[0], d / lim.a[0]
     ratio = np.empty_like(d)
@@ -137,6 +151,8 @@ class _Scaled:
     j: tuple[float, ...]
     still_v: float        # ZERO_MOVE / min(v), s: no ratio d / v of a joint that does not move exceeds it
     still_a: float        # ZERO_MOVE / min(a), s^2
+    v_array: FloatArray   # v and a as arrays, for the compiled matrices (never written)
+    a_array: FloatArray
 
 
 # (velocity, acceleration, jerk bytes, speed, accel) -> the scaled limits. A plan asks with the same
@@ -155,7 +171,8 @@ def _scaled(limits: JointLimits, speed: float, accel: float) -> _Scaled:
         if len(_SCALED) >= _SCALED_MAX:
             _SCALED.clear()
         v, a = tuple(lim.velocity.tolist()), tuple(lim.acceleration.tolist())
-        got = _SCALED[full] = _Scaled(v, a, tuple(lim.jerk.tolist()), ZERO_MOVE / min(v), ZERO_MOVE / min(a))
+        got = _SCALED[full] = _Scaled(v, a, tuple(lim.jerk.tolist()), ZERO_MOVE / min(v), ZERO_MOVE / min(a),
+                                      np.array(v), np.array(a))
     return got
 
 
