@@ -94,3 +94,37 @@ def test_near_scan_gives_the_plain_scans_verdicts_from_fewer_exact_tests(
         theirs_tests += theirs.narrow_phase_tests
     assert outcomes == {True, False}
     assert mine_tests < theirs_tests
+
+
+def test_each_run_is_given_the_states_of_its_places(
+    reference: tuple[CellSpec, RobotModel, CollisionWorld], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A near scan's run r is bounded over `states[run == r]`, run = place // _NEAR_RUN, in the given
+    order, for every r up to the largest: along the path, in a shuffled order, and with places that
+    skip every other number (runs of half as many states)."""
+    from robomax_py.world import collision_core
+
+    _, robot, world = reference
+    seen: list[np.ndarray] = []
+    run_pairs = collision_core.CollisionWorldCore._run_pairs
+
+    def spy(self: collision_core.CollisionWorldCore, states: np.ndarray,
+            active: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        seen.append(states.copy())
+        return run_pairs(self, states, active)
+
+    monkeypatch.setattr(collision_core.CollisionWorldCore, "_run_pairs", spy)
+    rng = np.random.default_rng(5)
+    n = 3 * collision_core._NEAR_RUN + 5
+    states = rng.uniform(robot.limits.lower, robot.limits.upper, size=(n, robot.dof))
+    run_len = collision_core._NEAR_RUN
+    gappy = 2 * np.arange(n)
+    world._set_presence(None, None)
+    for place in (None, rng.permutation(n), gappy[rng.permutation(n)]):
+        seen.clear()
+        world._scan(states, np.linspace(0.0, 1.0, n), n, near=True, place=place)
+        run = (np.arange(n) if place is None else place) // run_len
+        want = [states[run == r] for r in range(int(run.max()) + 1)]
+        assert len(seen) == len(want)
+        assert all(np.array_equal(got, w) for got, w in zip(seen, want))
+    assert len(want) == -(-2 * n // run_len) and len(want[0]) == run_len // 2
