@@ -73,7 +73,6 @@ import pinocchio as pin
 
 from robomax_py._typing import BoolArray, FloatArray, IntArray
 from robomax_py.robot import RobotModel
-from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.world.acm import (
     KIND_DYNAMIC,
     KIND_LINK,
@@ -356,15 +355,6 @@ class CollisionWorld(SweptChecks):
                 if int(owner[p]) not in hit and pin.computeCollision(gm, gd, p):
                     hit.add(int(owner[p]))
         return frozenset(hit)
-
-    def segment_states(self, q0: FloatArray, q1: FloatArray, max_step: float = TOL.sweep_step_m) -> FloatArray:
-        """(m + 1, n): the states `check_segment` checks on q0 -> q1, in order from q0."""
-        q0 = np.asarray(q0, dtype=np.float64)
-        q1 = np.asarray(q1, dtype=np.float64)
-        m = max(1, math.ceil(self.sweep_length(q0, q1) / max_step - 1e-12))
-        states = q0 + (np.arange(m + 1) / m)[:, None] * (q1 - q0)
-        states[-1] = q1
-        return states
 
     def window_starts(self, ta: float, tb: float) -> list[float]:
         """Times in (ta, tb] at which a dynamic obstacle appears, in order."""

@@ -50,6 +50,13 @@ class SweptChecks(CollisionWorldCore):
         """(k,) the steps `_check_segment` splits each move into (before a timed move at rest gets one)."""
         return np.ceil(self.sweep_lengths(q0s, q1s) / max_step - 1e-12).astype(np.int64)
 
+    def segment_states(self, q0: FloatArray, q1: FloatArray, max_step: float = TOL.sweep_step_m) -> FloatArray:
+        """(m + 1, n): the states `check_segment` checks on q0 -> q1, in order from q0 (both ends
+        where the move does not displace the robot)."""
+        q0s = np.asarray(q0, dtype=np.float64)[None]
+        q1s = np.asarray(q1, dtype=np.float64)[None]
+        return _subdivided(q0s, q1s, np.maximum(self._step_counts(q0s, q1s, max_step), 1))[3]
+
     def segment_free(
         self,
         q0: FloatArray,
