@@ -89,6 +89,21 @@ def neighbour_moves(shape: tuple[int, int, int]) -> tuple[IntArray, IntArray]:
     return moves
 
 
+@functools.cache
+def neighbour_graph(shape: tuple[int, int, int]) -> tuple[IntArray, IntArray, IntArray]:
+    """`neighbour_moves` as a graph in CSR form: (indptr, indices, order), the moves out of cell u
+    being indices[indptr[u]:indptr[u + 1]], in `neighbour_moves`' order; order[e] is the place in
+    `neighbour_moves` of the graph's move e (a move's cost array `w` is `w[order]` in the graph).
+    Cached, so read-only."""
+    src, dst = neighbour_moves(shape)
+    order = np.argsort(src, kind="stable")
+    indptr = np.searchsorted(src[order], np.arange(shape[0] * shape[1] * shape[2] + 1))
+    graph = indptr.astype(np.int64), np.ascontiguousarray(dst[order], dtype=np.int64), order.astype(np.int64)
+    for a in graph:
+        a.flags.writeable = False
+    return graph
+
+
 def nearest_cell(axes: tuple[FloatArray, ...] | list[FloatArray], q: FloatArray) -> tuple[int, int, int]:
     """Indices of the samples of three axes nearest to q's first three values."""
     return tuple(int(np.argmin(np.abs(axes[a] - q[a]))) for a in range(3))  # type: ignore[return-value]
