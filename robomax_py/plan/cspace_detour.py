@@ -3,11 +3,12 @@ or a complement to the roadmap (`planner.detours: roadmap | cspace | both`).
 
 Between two configurations qa and qb: a grid of A1-A3 over the box they span, widened by
 `MARGIN_RAD` (within the joint limits), with the wrist interpolated along the way (each cell takes
-the wrist at its projection onto the straight A1-A3 line from qa to qb); every cell is checked
-exactly (the exact map, with the pre-filter: a 24³ grid costs ~14,000 checks); the shortest
-26-connected path of free cells in a time metric (Dijkstra, scipy) joins the cells nearest qa and
+the wrist at its projection onto the straight A1-A3 line from qa to qb); the shortest 26-connected
+path of free cells in a time metric (Dijkstra, `cspace.grid_path`) joins the cells nearest qa and
 qb. The cells round each end are checked first: an end walled in there (an approach point in a
-pocket of the part) ends the search before the rest of the map is checked. The published method
+pocket of the part) ends the search before the rest of the map is checked. The others are checked
+exactly (with the pre-filter) where the search's paths pass, not all 24³ of them: the path found
+is the one the fully checked map gives (`_repaired_path`). The published method
 finds its path over the map's nodes alone (Pashkevich & Kozhevnikov, the A1-A3 map of ROBOMAX) and
 tests the program afterwards; here every consecutive segment of the path, qa and qb included, is
 checked exactly by the swept check, a blocked move between two free cells is removed from the
@@ -21,11 +22,12 @@ learned` searches one learned map per plan instead (`plan.learned_detour`).
 from __future__ import annotations
 
 import numpy as np
-from scipy.sparse import coo_matrix, csr_matrix
-from scipy.sparse.csgraph import connected_components, dijkstra
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
-from robomax_py._typing import BoolArray, FloatArray
-from robomax_py.cspace.grid import nearest_cell, neighbour_moves
+from robomax_py._typing import BoolArray, FloatArray, IntArray
+from robomax_py.cspace.grid import nearest_cell, neighbour_graph, neighbour_moves
+from robomax_py.cspace.grid_path import shortest_path
 from robomax_py.plan.roadmap import Detour
 from robomax_py.plan.shortcut import swept_shortcut
 from robomax_py.robot import JointLimits
@@ -53,6 +55,9 @@ LIMIT_INSET_RAD = 1e-3
 # generated KR 16 bracket cell (corpus c114, an approach point in a pocket of the part) 8 of the 21
 # maps without a way were so, the end's free cells 3 to 9 of them; 2 steps told 1 of the 8, 4 all.
 ENCLOSURE_STEPS = 4
+# Searches of the map through cells not checked yet (`_repaired_path`), each checking the cells
+# round its path, before the cells left are all checked at once.
+LAZY_ROUNDS = 8
 
 
 def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: FloatArray,
@@ -88,17 +93,14 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
         checks += len(near)
         if _walled_in(free.reshape(r, r, r), box, end, other, r):
             return None, checks
-    rest = np.flatnonzero(~checked)
-    free[rest] = world.are_free(configs[rest])
-    checks += len(rest)
-    # Edges between free neighbouring cells, weighted by the straight move's time estimate.
+    # The rest of the map is checked where a way is looked for (`_repaired_path`): the free cells
+    # of the map's shortest way are the same whether every cell was checked first or not.
     src_all, dst_all = neighbour_moves((r, r, r))
-    ok = free[src_all] & free[dst_all]
-    src_a, dst_a = src_all[ok], dst_all[ok]
-    weight = ptp_time_estimate(configs[src_a], configs[dst_a], limits) + 1e-9
-    graph = coo_matrix((weight, (src_a, dst_a)), shape=(r ** 3, r ** 3)).tocsr()
-    path, spent = _repaired_path(world, graph, configs, qa, qb, flat(start), flat(goal),
+    weight = ptp_time_estimate(configs[src_all], configs[dst_all], limits) + 1e-9
+    cells = _LazyCells(world, configs, free, checked)
+    path, spent = _repaired_path(world, cells, r, src_all, dst_all, weight, qa, qb, flat(start), flat(goal),
                                  max_checks=int(REPAIR_BUDGET * len(configs)))
+    checks += cells.checks
     checks += spent
     if path is None:
         return None, checks
@@ -131,37 +133,86 @@ def _walled_in(free: BoolArray, box: tuple[slice, ...], end: tuple[int, ...], ot
     return True
 
 
-def _repaired_path(world: CollisionWorld, graph: csr_matrix, configs: FloatArray, qa: FloatArray,
-                   qb: FloatArray, start: int, goal: int, max_checks: int) -> tuple[FloatArray | None, int]:
-    """The map's shortest path from qa to qb whose every consecutive segment is free by the swept
-    check, and the checks spent: None when the map has no path left, a segment into or out of the
-    map is blocked, or `MAX_REPAIR_ROUNDS` searches or `max_checks` checks are spent.
+class _LazyCells:
+    """The map's cells and what is known of them: each is checked once, when a way through the map
+    first looks at it (`check`), or all that are left at once (`check_rest`)."""
+
+    def __init__(self, world: CollisionWorld, configs: FloatArray, free: BoolArray, checked: BoolArray) -> None:
+        self.world, self.configs, self.free, self.checked = world, configs, free, checked
+        self.checks = 0                          # cells checked here (the ends' were counted before)
+
+    def blocked(self) -> BoolArray:
+        return self.checked & ~self.free
+
+    def check(self, cells: IntArray) -> bool:
+        """Check those of `cells` not checked yet; whether one of them is blocked."""
+        new = cells[~self.checked[cells]]
+        if not new.size:
+            return False
+        ok = self.world.are_free(self.configs[new])
+        self.free[new], self.checked[new] = ok, True
+        self.checks += len(new)
+        return not bool(ok.all())
+
+    def check_rest(self) -> bool:
+        return self.check(np.flatnonzero(~self.checked))
+
+
+def _tube(cells: IntArray, r: int) -> IntArray:
+    """`cells` of the r x r x r map and every cell one step (26-connected) from one of them."""
+    ijk = np.stack(np.unravel_index(cells, (r, r, r)), axis=1)
+    steps = np.stack(np.meshgrid(*([np.arange(-1, 2)] * 3), indexing="ij"), axis=-1).reshape(-1, 3)
+    near = (ijk[:, None, :] + steps[None, :, :]).reshape(-1, 3)
+    near = near[((near >= 0) & (near < r)).all(axis=1)]
+    return np.unique(np.ravel_multi_index(tuple(near.T), (r, r, r)))
+
+
+def _repaired_path(world: CollisionWorld, cells: _LazyCells, r: int, src: IntArray, dst: IntArray, weight: FloatArray,
+                   qa: FloatArray, qb: FloatArray, start: int, goal: int,
+                   max_checks: int) -> tuple[FloatArray | None, int]:
+    """The map's shortest path from qa to qb whose every cell is free and every consecutive segment
+    free by the swept check, and the swept checks spent: None when the map has no path left, a
+    segment into or out of the map is blocked, or `MAX_REPAIR_ROUNDS` searches of paths of free
+    cells or `max_checks` swept checks are spent. r: the map's samples per axis; src, dst,
+    weight: its moves (`neighbour_moves`) and their time estimates.
+
+    Cells not checked yet are taken to be free (the lazy way of Lazy PRM, Bohlin & Kavraki, "Path
+    planning using lazy PRM", ICRA 2000, for the map's cells): a path through unchecked cells has
+    them checked, with the cells one step round them (`_tube`: the next path mostly runs there), and
+    the map is searched again without the blocked ones. A path whose cells are all free is the
+    shortest over the free cells, as the fully checked map would give it: every path of free cells
+    is a path of the searched map too. After `LAZY_ROUNDS` such searches the cells left are checked
+    at once, which bounds the searches on a map with no way through.
 
     The map checked only cell centres; a move between two free neighbouring cells can still be
-    blocked (an obstacle edge between the samples). The lazy way of Lazy PRM (Bohlin & Kavraki,
-    "Path planning using lazy PRM", ICRA 2000): search the map, check the path's segments, remove
-    the blocked ones from the graph (both directions) and search again. A segment's answer is kept
-    across rounds, so a later path pays only for its new segments.
+    blocked (an obstacle edge between the samples). The lazy way again, for the moves: check the
+    path's segments, remove the blocked ones from the graph (both directions) and search again. A
+    segment's answer is kept across rounds, so a later path pays only for its new segments.
     """
+    indptr, indices, order = neighbour_graph((r, r, r))
+    cost = np.ascontiguousarray(weight[order])
+    cut = np.zeros(len(indices), dtype=bool)          # moves found blocked by the swept check
     # (cell, cell), low first -> free by the swept check (a straight move is blocked both ways)
     known: dict[tuple[int, int], bool] = {}
-    checks = 0
-    for _ in range(MAX_REPAIR_ROUNDS):
-        dist, pred = dijkstra(graph, directed=True, indices=start, return_predecessors=True)
-        if not np.isfinite(dist[goal]):
+    checks = rounds = lazy_rounds = 0
+    while True:
+        path = shortest_path(indptr, indices, cost, ~cells.blocked(), cut, start, goal).tolist()
+        if not path:
             return None, checks
-        cells = [goal]
-        while cells[-1] != start:
-            cells.append(int(pred[cells[-1]]))
-        cells.reverse()
-        waypoints = np.vstack([qa, configs[cells], qb])
+        on_path = np.array(path)
+        if not cells.checked[on_path].all():
+            lazy_rounds += 1
+            if cells.check_rest() if lazy_rounds > LAZY_ROUNDS else cells.check(_tube(on_path, r)):
+                continue                              # a blocked cell on the path: search again
+        rounds += 1
+        waypoints = np.vstack([qa, cells.configs[path], qb])
         # The segments into and out of the map (qa -> start cell, goal cell -> qb) are not edges of
         # the graph: one blocked, no other path of the map helps.
         last = len(waypoints) - 2
         blocked = []
         for k in range(last + 1):
             key = (-1, -1) if k == 0 else (-2, -2) if k == last else \
-                (min(cells[k - 1], cells[k]), max(cells[k - 1], cells[k]))
+                (min(path[k - 1], path[k]), max(path[k - 1], path[k]))
             if key not in known:
                 if checks >= max_checks:
                     return None, checks
@@ -174,17 +225,11 @@ def _repaired_path(world: CollisionWorld, graph: csr_matrix, configs: FloatArray
                 blocked.append(key)
         if not blocked:
             return waypoints, checks
-        for u, v in blocked:
-            _remove_edge(graph, u, v)
-            _remove_edge(graph, v, u)
-        graph.eliminate_zeros()
-    return None, checks
-
-
-def _remove_edge(graph: csr_matrix, u: int, v: int) -> None:
-    """Zero the edge u -> v of a CSR graph in place (`eliminate_zeros` then drops it)."""
-    row = slice(graph.indptr[u], graph.indptr[u + 1])
-    graph.data[row][graph.indices[row] == v] = 0.0
+        if rounds >= MAX_REPAIR_ROUNDS:
+            return None, checks
+        for u, v in blocked:                          # both directions
+            for x, y in ((u, v), (v, u)):
+                cut[indptr[x] + int(np.flatnonzero(indices[indptr[x]:indptr[x + 1]] == y)[0])] = True
 
 
 def local_grid(qa: FloatArray, qb: FloatArray, lower: FloatArray, upper: FloatArray, resolution: int,

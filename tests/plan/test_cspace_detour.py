@@ -15,8 +15,10 @@ import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import ndimage
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import dijkstra
 
-from robomax_py.cspace.grid import nearest_cell
+from robomax_py.cspace.grid import nearest_cell, neighbour_moves
 from robomax_py.errors import CellFileError
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions
@@ -24,11 +26,15 @@ from robomax_py.plan.cspace_detour import (
     ENCLOSURE_STEPS,
     LIMIT_INSET_RAD,
     MARGIN_RAD,
+    REPAIR_BUDGET,
     RESOLUTION,
+    _LazyCells,
+    _repaired_path,
     grid_detour,
     local_grid,
 )
 from robomax_py.plan.results import resolved_options
+from robomax_py.timing import ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.collision_results import SegmentCheck
 from robomax_py.world.scene import build_scene
@@ -260,12 +266,13 @@ def test_an_end_in_a_pocket_is_told_from_the_cells_round_it(reference) -> None: 
     det, checks = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
     assert det is None
     assert world.asked <= 2 + 2 * ((2 * ENCLOSURE_STEPS + 1) ** 3 - 1) and checks == world.asked
-    # The same pocket with one hole in its shell: the map is checked whole and the way found.
+    # The same pocket with one hole in its shell: the way out is found, the cells beyond the blocks
+    # round the ends checked where the map's paths look at them, not all of them.
     blocked[goal[0] + 2, goal[1], goal[2]] = False
     world = _BlockedCells(axes, blocked)
     det, _ = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
     assert det is not None
-    assert world.asked == RESOLUTION ** 3
+    assert 2 * (2 * ENCLOSURE_STEPS + 1) ** 3 - 1 < world.asked < RESOLUTION ** 3
 
 
 def test_two_ends_in_one_pocket_are_joined(reference) -> None:  # type: ignore[no-untyped-def]
@@ -306,8 +313,8 @@ def test_an_end_against_the_maps_edge_is_walled_in_by_the_edge_and_its_pocket(re
 @pytest.mark.parametrize("side", [1, -1])
 def test_a_pocket_open_on_one_side_only_is_not_walled_in(reference, side: int) -> None:  # type: ignore[no-untyped-def]
     """qb's cell inside a block of blocked cells as large as the box round it, a corridor leading
-    out through one A1 side of the block alone: its free cells reach that side, so the map is
-    checked whole and the way out found."""
+    out through one A1 side of the block alone: its free cells reach that side, so the end is not taken
+    for walled in and the way out is found."""
     _, robot, _ = reference
     qa = np.radians([0.0, -90.0, 90.0, 0.0, 30.0, 0.0])
     qb = qa + np.array([0.6, 0.3, -0.2, 0.1, 0.0, 0.0])
@@ -323,4 +330,74 @@ def test_a_pocket_open_on_one_side_only_is_not_walled_in(reference, side: int) -
     world = _BlockedCells(axes, blocked)
     det, _ = grid_detour(world, robot.limits, qa, qb)  # type: ignore[arg-type]
     assert det is not None
-    assert world.asked == RESOLUTION ** 3
+
+
+class _BlockedCellsAndMoves(_BlockedCells):
+    """`_BlockedCells`, and the straight moves between the cell pairs of `cut` ((low, high) cell
+    indices, C order) blocked."""
+
+    def __init__(self, axes: list[np.ndarray], blocked: np.ndarray, cut: set[tuple[int, int]]) -> None:
+        super().__init__(axes, blocked)
+        self.cut = cut
+
+    def _cell(self, q: np.ndarray) -> int:
+        return int(np.ravel_multi_index(tuple(int(np.abs(self.axes[n] - q[n]).argmin()) for n in range(3)),
+                                        self.blocked.shape))
+
+    def check_segment(self, q0: np.ndarray, q1: np.ndarray) -> SegmentCheck:
+        a, b = sorted((self._cell(q0), self._cell(q1)))
+        return SegmentCheck(free=(a, b) not in self.cut, checks=1, states=2, narrow_phase_tests=0, s_contact=None)
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**31), walls=st.integers(0, 3), cut_share=st.sampled_from([0.0, 0.002, 0.01]))
+def test_the_lazy_search_finds_the_fully_checked_maps_shortest_path(reference, seed: int, walls: int,  # type: ignore[no-untyped-def]
+                                                                     cut_share: float) -> None:
+    """Cells checked only where the map's paths look (`_repaired_path`), the path found costs what
+    the shortest path over the free cells and free moves of the fully known map costs (scipy's
+    Dijkstra over every cell's and move's answer, asked up front; relative 1e-12), and a path is
+    found exactly where that map joins the ends."""
+    _, robot, _ = reference
+    rng = np.random.default_rng(seed)
+    qa = np.radians([0.0, -90.0, 90.0, 0.0, 30.0, 0.0])
+    qb = qa + rng.uniform(-0.8, 0.8, size=6)
+    axes, configs = local_grid(qa, qb, robot.limits.lower, robot.limits.upper, RESOLUTION, MARGIN_RAD)
+    r = RESOLUTION
+    start, goal = (int(np.ravel_multi_index(nearest_cell(axes, q), (r, r, r))) for q in (qa, qb))
+    blocked = np.zeros((r,) * 3, dtype=bool)
+    for _ in range(walls):
+        axis, at = int(rng.integers(3)), int(rng.integers(r))
+        wall = [slice(None)] * 3
+        wall[axis] = slice(at, at + 1)
+        blocked[tuple(wall)] = True
+        for _ in range(int(rng.integers(0, 4))):                  # holes in the wall
+            hole = [int(rng.integers(r)) for _ in range(3)]
+            hole[axis] = at
+            blocked[tuple(hole)] = False
+    flat_blocked = blocked.ravel()
+    flat_blocked[[start, goal]] = False
+    src, dst = neighbour_moves((r, r, r))
+    free_move = ~flat_blocked[src] & ~flat_blocked[dst]
+    picked = free_move & (src < dst) & (rng.uniform(size=len(src)) < cut_share)
+    cut = set(zip(src[picked].tolist(), dst[picked].tolist()))
+    world = _BlockedCellsAndMoves(axes, blocked, cut)
+
+    weight = ptp_time_estimate(configs[src], configs[dst], robot.limits) + 1e-9
+    n = r ** 3
+    cut_codes = [u * n + v for u, v in cut] + [v * n + u for u, v in cut]
+    known = free_move & ~np.isin(src * n + dst, cut_codes)
+    graph = coo_matrix((weight[known], (src[known], dst[known])), shape=(n, n)).tocsr()
+    expected = dijkstra(graph, directed=True, indices=start)[goal]
+
+    free = np.zeros(r ** 3, dtype=bool)
+    checked = np.zeros(r ** 3, dtype=bool)
+    free[[start, goal]] = checked[[start, goal]] = True
+    cells = _LazyCells(world, configs, free, checked)  # type: ignore[arg-type]
+    path, _ = _repaired_path(world, cells, r, src, dst, weight, qa, qb, start, goal,  # type: ignore[arg-type]
+                             max_checks=int(REPAIR_BUDGET * len(configs)))
+    assert (path is not None) == bool(np.isfinite(expected))
+    if path is not None:
+        inner = path[1:-1]
+        total = float(np.sum(ptp_time_estimate(inner[:-1], inner[1:], robot.limits) + 1e-9))
+        assert abs(total - expected) <= 1e-12 * expected
+        assert cells.checks <= r ** 3 - 2
