@@ -104,6 +104,22 @@ def neighbour_graph(shape: tuple[int, int, int]) -> tuple[IntArray, IntArray, In
     return graph
 
 
+@functools.cache
+def reverse_moves(shape: tuple[int, int, int]) -> tuple[IntArray, IntArray]:
+    """(one, reverse): the places in `neighbour_moves` of the moves from a lower cell to a higher
+    one (one of each pair of opposite moves), and for every move the place of the opposite move.
+    Cached, so read-only."""
+    src, dst = neighbour_moves(shape)
+    n = shape[0] * shape[1] * shape[2]
+    code = src * n + dst
+    order = np.argsort(code)
+    reverse = order[np.searchsorted(code, dst * n + src, sorter=order)]
+    moves = np.flatnonzero(src < dst), reverse.astype(np.int64)
+    for a in moves:
+        a.flags.writeable = False
+    return moves
+
+
 def nearest_cell(axes: tuple[FloatArray, ...] | list[FloatArray], q: FloatArray) -> tuple[int, int, int]:
     """Indices of the samples of three axes nearest to q's first three values."""
     return tuple(int(np.argmin(np.abs(axes[a] - q[a]))) for a in range(3))  # type: ignore[return-value]

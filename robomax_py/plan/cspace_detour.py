@@ -26,7 +26,12 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from robomax_py._typing import BoolArray, FloatArray, IntArray
-from robomax_py.cspace.grid import nearest_cell, neighbour_graph, neighbour_moves
+from robomax_py.cspace.grid import (
+    nearest_cell,
+    neighbour_graph,
+    neighbour_moves,
+    reverse_moves,
+)
 from robomax_py.cspace.grid_path import shortest_path
 from robomax_py.plan.roadmap import Detour
 from robomax_py.plan.shortcut import swept_shortcut
@@ -96,7 +101,7 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
     # The rest of the map is checked where a way is looked for (`_repaired_path`): the free cells
     # of the map's shortest way are the same whether every cell was checked first or not.
     src_all, dst_all = neighbour_moves((r, r, r))
-    weight = ptp_time_estimate(configs[src_all], configs[dst_all], limits) + 1e-9
+    weight = move_times(configs, (r, r, r), limits) + 1e-9
     cells = _LazyCells(world, configs, free, checked)
     path, spent = _repaired_path(world, cells, r, src_all, dst_all, weight, qa, qb, flat(start), flat(goal),
                                  max_checks=int(REPAIR_BUDGET * len(configs)))
@@ -109,6 +114,21 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
     checks += spent
     assert short is not None                            # without check_neighbours it keeps a path
     return Detour(short, polyline_time_estimate(short, limits), checks), checks
+
+
+def move_times(configs: FloatArray, shape: tuple[int, int, int], limits: JointLimits) -> FloatArray:
+    """`ptp_time_estimate` of every move of `neighbour_moves(shape)` between the cells' configurations
+    (C order), the same floats. A move's estimate is its opposite's (|q1 - q0| is the same float
+    either way), so each pair of opposite moves is estimated once; the configurations are gathered
+    joint by joint, the layout the estimate's compiled pass reads (it then copies nothing)."""
+    src, dst = neighbour_moves(shape)
+    one, reverse = reverse_moves(shape)
+    columns = configs.T
+    times = ptp_time_estimate(columns[:, src[one]].T, columns[:, dst[one]].T, limits)
+    out = np.empty(len(src))
+    out[one] = times
+    out[reverse[one]] = times
+    return out
 
 
 def _walled_in(free: BoolArray, box: tuple[slice, ...], end: tuple[int, ...], other: tuple[int, ...], r: int) -> bool:

@@ -32,6 +32,7 @@ from robomax_py.plan.cspace_detour import (
     _repaired_path,
     grid_detour,
     local_grid,
+    move_times,
 )
 from robomax_py.plan.results import resolved_options
 from robomax_py.timing import ptp_time_estimate
@@ -401,3 +402,19 @@ def test_the_lazy_search_finds_the_fully_checked_maps_shortest_path(reference, s
         total = float(np.sum(ptp_time_estimate(inner[:-1], inner[1:], robot.limits) + 1e-9))
         assert abs(total - expected) <= 1e-12 * expected
         assert cells.checks <= r ** 3 - 2
+
+
+@settings(max_examples=20, deadline=None)
+@given(seed=st.integers(0, 2**31), r=st.integers(2, 7), coincide=st.booleans())
+def test_the_maps_move_times_are_the_estimates_bit_for_bit(reference, seed: int, r: int,  # type: ignore[no-untyped-def]
+                                                            coincide: bool) -> None:
+    """`move_times` estimates each pair of opposite moves once: the floats are `ptp_time_estimate`'s
+    of every move (cells that coincide on some joints too, whose differences are exactly zero)."""
+    _, robot, _ = reference
+    rng = np.random.default_rng(seed)
+    configs = rng.uniform(-2.0, 2.0, size=(r ** 3, 6))
+    if coincide:
+        configs[:, rng.integers(6)] = 0.25
+    src, dst = neighbour_moves((r, r, r))
+    expected = ptp_time_estimate(configs[src], configs[dst], robot.limits)
+    np.testing.assert_array_equal(move_times(configs, (r, r, r), robot.limits), expected)
