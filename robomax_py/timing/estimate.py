@@ -73,11 +73,11 @@ def ptp_time_estimate(
         # The candidate matrices (k, 1, n) x (1, m, n) and paired rows (k, n), (k, n) in one
         # compiled pass (`_estimate_kernels`), the same floats.
         if q0.ndim == 3 and q0.shape[1] == 1 and q1.shape[0] == 1:
-            matrix: FloatArray = straight_times(np.ascontiguousarray(q0[:, 0].T), np.ascontiguousarray(q1[0].T),
+            matrix: FloatArray = straight_times(_columns(q0[:, 0]), _columns(q1[0]),
                                                 lim.v_array[:n], lim.a_array[:n], ZERO_MOVE, True)
             return matrix
         if q0.ndim == 2 and q0.shape == q1.shape:
-            paired: FloatArray = straight_times(np.ascontiguousarray(q0.T), np.ascontiguousarray(q1.T),
+            paired: FloatArray = straight_times(_columns(q0), _columns(q1),
                                                 lim.v_array[:n], lim.a_array[:n], ZERO_MOVE, False)[0]
             return paired
     # Any other broadcast, joint by joint into two running maxima, reusing buffers: a reduction over
@@ -112,6 +112,15 @@ def ptp_time_estimate(
     np.divide(r_a, r_v, out=r_a, where=cruise)
     np.add(r_v, r_a, out=times, where=cruise)
     return times
+
+
+def _columns(q: FloatArray) -> FloatArray:
+    """q (k, n) transposed to contiguous (n, k), as a read-only view: numba compiles a kernel once
+    per array type, and a writable and a read-only argument are two (configurations come both ways:
+    a roadmap's nodes and cached candidates are read-only), each about 0.25 s of a first plan."""
+    columns = np.ascontiguousarray(q.T).view()
+    columns.flags.writeable = False
+    return columns
 
 
 def polyline_time_estimate(waypoints: FloatArray, limits: JointLimits, speed: float = 1.0) -> float:

@@ -121,3 +121,23 @@ def test_changed_limits_are_not_served_from_before() -> None:
     assert float(ptp_time_estimate(q0, q1, limits, 0.5)) > float(ptp_time_estimate(q0, q1, limits))
     with pytest.raises(TimingError):
         ptp_time_estimate(q0, q1, limits, 0.0)
+
+
+def test_the_compiled_estimate_is_compiled_once_for_writable_and_read_only_configurations() -> None:
+    """Candidates and roadmap nodes come read-only, other configurations writable: numba compiles
+    a kernel per array type, so the estimate hands its kernel one type (read-only views) and the
+    first plan compiles it once (about 0.25 s each)."""
+    from robomax_py.timing._estimate_kernels import straight_times
+
+    limits = JointLimits(lower=np.full(6, -3.0), upper=np.full(6, 3.0), velocity=np.full(6, 2.0),
+                         acceleration=np.full(6, 8.0), jerk=np.full(6, 80.0))
+    rng = np.random.default_rng(3)
+    many = rng.uniform(-1, 1, (5, 6))
+    # One configuration against many: its transpose is contiguous already, and was passed as it came.
+    one = rng.uniform(-1, 1, (1, 6))
+    one.flags.writeable = False
+    ptp_time_estimate(many, many[::-1], limits)
+    ptp_time_estimate(many[:, None, :], many[None, :, :], limits)
+    ptp_time_estimate(one[:, None, :], many[None, :, :], limits)
+    ptp_time_estimate(many[:, None, :], one[None, :, :], limits)
+    assert len(straight_times.signatures) == 1
