@@ -4,7 +4,7 @@ or a complement to the roadmap (`planner.detours: roadmap | cspace | both`).
 Between two configurations qa and qb: a grid of A1-A3 over the box they span, widened by
 `MARGIN_RAD` (within the joint limits), with the wrist interpolated along the way (each cell takes
 the wrist at its projection onto the straight A1-A3 line from qa to qb); the shortest 26-connected
-path of free cells in a time metric (Dijkstra, `cspace.grid_path`) joins the cells nearest qa and
+path of free cells in a time metric (Dijkstra, `cspace.dijkstra`) joins the cells nearest qa and
 qb. The cells round each end are checked first: an end walled in there (an approach point in a
 pocket of the part) ends the search before the rest of the map is checked. The others are checked
 exactly (with the pre-filter) where the search's paths pass, not all 24³ of them: the path found
@@ -26,13 +26,13 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from robomax_py._typing import BoolArray, FloatArray, IntArray
+from robomax_py.cspace.dijkstra import shortest_path
 from robomax_py.cspace.grid import (
     nearest_cell,
     neighbour_graph,
     neighbour_moves,
     reverse_moves,
 )
-from robomax_py.cspace.grid_path import shortest_path
 from robomax_py.plan.roadmap import Detour
 from robomax_py.plan.shortcut import swept_shortcut
 from robomax_py.robot import JointLimits

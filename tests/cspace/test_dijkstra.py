@@ -1,4 +1,4 @@
-"""robomax_py.cspace.grid_path: the compiled shortest path that stops at its goal.
+"""robomax_py.cspace.dijkstra: the compiled shortest path that stops at its goal.
 
 What must hold, against scipy's `dijkstra` over the same graph with the closed cells and moves left
 out (a second implementation): a path exactly where scipy reaches the goal, of scipy's distance
@@ -15,8 +15,8 @@ from hypothesis import strategies as st
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
+from robomax_py.cspace.dijkstra import shortest_path, shortest_path_to_any
 from robomax_py.cspace.grid import neighbour_graph, neighbour_moves
-from robomax_py.cspace.grid_path import shortest_path
 
 DIST_RTOL = 1e-12
 
@@ -70,3 +70,44 @@ def test_start_is_goal_is_a_path_of_one_cell() -> None:
     path = shortest_path(indptr, indices, np.ones(len(indices)), np.zeros(27, dtype=bool),
                          np.zeros(len(indices), dtype=bool), 13, 13)
     assert path.tolist() == [13]
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 2**31), n=st.integers(2, 300), degree=st.integers(1, 8), n_goals=st.integers(1, 8),
+       blocked_share=st.floats(0.0, 0.5), ties=st.booleans())
+def test_the_path_to_any_goal_is_scipys_shortest_and_argmin(seed: int, n: int, degree: int, n_goals: int,
+                                                            blocked_share: float, ties: bool) -> None:
+    """A roadmap-like graph (random edges both ways, some at infinity: blocked) and a goal reached
+    through one of several links, each with its own cost (some unusable: inf): the path ends at the
+    link scipy's distances and `np.argmin` over dist + cost choose, and costs that total."""
+    rng = np.random.default_rng(seed)
+    a = rng.integers(0, n, size=n * degree)
+    b = rng.integers(0, n, size=n * degree)
+    # Each pair once, as a roadmap holds its edges (scipy would add parallel entries up).
+    pairs = np.unique(np.sort(np.stack([a, b], axis=1), axis=1), axis=0)
+    a, b = pairs[pairs[:, 0] != pairs[:, 1]].T
+    w = rng.integers(1, 4, size=len(a)).astype(float) if ties else rng.uniform(0.01, 1.0, size=len(a))
+    w[rng.uniform(size=len(a)) < blocked_share] = np.inf
+    rows, cols, weight = np.concatenate([a, b]), np.concatenate([b, a]), np.concatenate([w, w])
+    order = np.lexsort((cols, rows))
+    rows, cols, weight = rows[order], cols[order], weight[order]
+    indptr = np.searchsorted(rows, np.arange(n + 1)).astype(np.int64)
+    start = int(rng.integers(n))
+    goals = rng.choice(n, size=min(n_goals, n), replace=False).astype(np.int64)
+    cost = rng.integers(0, 3, size=len(goals)).astype(float) if ties else rng.uniform(0.0, 1.0, size=len(goals))
+    cost[rng.uniform(size=len(goals)) < 0.2] = np.inf
+    path = shortest_path_to_any(indptr, cols.astype(np.int64), weight, start, goals, cost)
+
+    finite = np.isfinite(weight)
+    graph = coo_matrix((weight[finite], (rows[finite], cols[finite])), shape=(n, n)).tocsr()
+    dist = dijkstra(graph, directed=True, indices=start)
+    total = dist[goals] + cost
+    if not np.isfinite(total.min()):
+        assert path.size == 0
+        return
+    assert path[0] == start and path[-1] == goals[int(np.argmin(total))]
+    length = 0.0
+    for u, v in zip(path[:-1].tolist(), path[1:].tolist()):
+        row = slice(indptr[u], indptr[u + 1])
+        length += float(weight[row][cols[row] == v].min())
+    assert abs(length - dist[path[-1]]) <= DIST_RTOL * max(dist[path[-1]], 1.0)
