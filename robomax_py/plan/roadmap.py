@@ -15,19 +15,16 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
 from scipy.spatial import cKDTree
 
-from robomax_py._typing import FloatArray, IntArray
+from robomax_py._typing import BoolArray, FloatArray, IntArray
+from robomax_py.cspace.dijkstra import shortest_path_to_any
 from robomax_py.plan.shortcut import swept_shortcut
 from robomax_py.robot import JointLimits
 from robomax_py.timing import polyline_time_estimate, ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
 
 # scipy.sparse.csgraph's index arrays.
-Int32Array = npt.NDArray[np.int32]
 
 # Sampling box margin around the work's joint-space spread, rad (or m), per joint.
 BOX_MARGIN = 0.6
@@ -37,13 +34,6 @@ NEAR_FRACTION = 0.5
 NEAR_SIGMA = 0.25
 # Lazy search gives up after this many blocked edges in one query.
 MAX_BLOCKED_PER_QUERY = 60
-# A query's shortest-path search first settles only the nodes within this multiple of the straight
-# move's estimate from its start, growing the bound SEARCH_GROWTH-fold until the way found fits in
-# it (`Roadmap._shortest`); past MAX_BOUNDED_REACH (s) it searches unbounded. Bounds change only
-# how much of the roadmap is searched, never the path found.
-SEARCH_REACH = 3.0
-SEARCH_GROWTH = 4.0
-MAX_BOUNDED_REACH = 1e3
 
 
 @dataclass(frozen=True, slots=True)
@@ -125,7 +115,7 @@ class Roadmap:
         self._checked: dict[tuple[int, int], bool] = {}
         self.edge_checks = 0
         self._csr: tuple[IntArray, IntArray, FloatArray, IntArray] | None = None   # `_both_ways`
-        self._search: tuple[FloatArray, Int32Array, Int32Array] | None = None         # `_search_arrays`
+        self._search: tuple[FloatArray, IntArray, IntArray] | None = None         # `_search_arrays`
 
     def fresh(self) -> Roadmap:
         """This roadmap as it was built, before any edge was known: its queries find what a new
@@ -194,11 +184,8 @@ class Roadmap:
         blocked = 0
         start_w = ptp_time_estimate(q_start[None, :], self.nodes[start_links], self._limits)
         goal_w = ptp_time_estimate(self.nodes[goal_links], q_goal[None, :], self._limits)
-        # The first search's reach (`_shortest`); blocked edges only lengthen the way, so each
-        # search starts from the reach the one before needed.
-        reach = SEARCH_REACH * float(ptp_time_estimate(q_start, q_goal, self._limits))
         while blocked < MAX_BLOCKED_PER_QUERY:
-            path, reach = self._shortest(start_links, start_w, goal_links, goal_w, extra_free, reach)
+            path = self._shortest(start_links, start_w, goal_links, goal_w, extra_free)
             if path is None:
                 return None
             bad = None
@@ -226,23 +213,19 @@ class Roadmap:
         return None
 
     def _shortest(self, start_links: list[int], start_w: FloatArray, goal_links: list[int], goal_w: FloatArray,
-                  extra_free: dict[tuple[int, int], bool], reach: float = np.inf) -> tuple[list[int] | None, float]:
-        """Dijkstra (scipy, in C) on time estimates from the start S = -1 through the roadmap to the
-        goal G = -2, skipping edges known to be blocked; the path as node indices, S and G included.
+                  extra_free: dict[tuple[int, int], bool]) -> list[int] | None:
+        """Dijkstra (compiled, `cspace.dijkstra.shortest_path_to_any`) on time estimates from the
+        start S = -1 through the roadmap to the goal G = -2, skipping edges known to be blocked;
+        the path as node indices, S and G included (None: no way).
 
-        The roadmap holds every spot candidate as a node (tens of thousands on a large cell), which
-        a Python heap search walked one dict look-up at a time. A lazy query searches again after
-        each blocked edge it meets: the graph's arrays are made once (`_both_ways`), a blocked
-        edge weighs infinity (scipy never relaxes it), the start is one row appended, and the goal
-        is reached through whichever of its links ends the shortest way (no node of its own).
-
-        The search is bounded to `reach` (s; scipy's `limit`), then SEARCH_GROWTH times that until
-        the way found is no longer than the bound, then unbounded: each search settled every node
-        of a roadmap that grows with the spots (tens of thousands of candidates) for a detour
-        between two neighbouring spots, a search per detour query and blocked edge. Within the
-        bound Dijkstra's distances and predecessors are the unbounded search's, and a goal link
-        beyond it ends a longer way than one within it: the path is the same. Returns the path
-        (None: no way) and the bound that found it.
+        The roadmap holds every spot candidate as a node (tens of thousands on a large cell), and a
+        lazy query searches again after each blocked edge it meets: the graph's arrays are made
+        once (`_both_ways`), a blocked edge weighs infinity (never taken), the start is one row
+        appended, and the goal is reached through whichever of its links ends the shortest way (no
+        node of its own). The search stops once no node nearer than the best way found so far is
+        left, instead of settling every node of the roadmap for a detour between two neighbouring
+        spots (scipy's `dijkstra` did, bounded by a reach it grew until the way fitted; 2.8 s of a
+        240-spot clamped cell's plan).
         """
         n = len(self.nodes)
         slots = self._both_ways()[3]
@@ -252,39 +235,28 @@ class Roadmap:
         data[slots[blocked]] = np.inf
         data[slots[blocked + len(self._pairs)]] = np.inf
 
-        def usable(links: list[int], label: int) -> FloatArray:
+        def usable(links: list[int], label: int) -> BoolArray:
             return np.array([extra_free.get((min(label, v), max(label, v))) is not False for v in links], dtype=bool)
 
         s_ok = usable(start_links, -1)
         s_links = np.asarray(start_links, dtype=np.int64)[s_ok]
-        # csgraph reads a stored zero as no edge: coinciding configurations get the least positive weight.
+        # The roadmap's own edges weigh at least the least positive float (`_both_ways`); the
+        # start's links alike, so that every edge of the search has a positive weight.
         s_w = np.maximum(np.asarray(start_w, dtype=float)[s_ok], np.finfo(float).tiny)
-        # The start's row overwrites the end of the buffers; the matrix views them (no copy: the
-        # indices are already csgraph's int32, which scipy would otherwise convert every search).
+        # The start's row overwrites the end of the buffers.
         edges = int(indptr[n])
         end = edges + len(s_links)
         data[edges:end] = s_w
         indices[edges:end] = s_links
         indptr[n + 1] = end
-        graph = csr_matrix((data[:end], indices[:end], indptr), shape=(n + 1, n + 1))
-        g_ok = usable(goal_links, -2)
+        if not goal_links:
+            return None
         goal_at = np.asarray(goal_links, dtype=np.int64)
-        if not len(goal_at):
-            return None, reach
-        reach = reach if np.isfinite(reach) and reach > 0 else np.inf
-        while True:
-            dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True, limit=reach)
-            total = np.where(g_ok, dist[goal_at] + np.asarray(goal_w, dtype=float), np.inf)
-            least = float(np.min(total))
-            if np.isfinite(least) and least <= reach:
-                break
-            if not np.isfinite(reach):
-                return None, reach
-            reach = reach * SEARCH_GROWTH if reach * SEARCH_GROWTH < MAX_BOUNDED_REACH else np.inf
-        path = [goal_links[int(np.argmin(total))]]
-        while path[-1] != n:
-            path.append(int(pred[path[-1]]))
-        return [-1 if u == n else u for u in reversed(path)] + [-2], reach
+        cost = np.where(usable(goal_links, -2), np.asarray(goal_w, dtype=float), np.inf)
+        found = shortest_path_to_any(indptr, indices[:end], data[:end], n, goal_at, cost)
+        if not len(found):
+            return None
+        return [-1 if u == n else int(u) for u in found] + [-2]
 
     def _both_ways(self) -> tuple[IntArray, IntArray, FloatArray, IntArray]:
         """The roadmap's edges stored both ways as CSR arrays of its n rows (the start's row is
@@ -302,20 +274,20 @@ class Roadmap:
             self._csr = (indptr, cols[order].astype(np.int64), weight[order], slots)
         return self._csr
 
-    def _search_arrays(self, room: int) -> tuple[FloatArray, Int32Array, Int32Array]:
+    def _search_arrays(self, room: int) -> tuple[FloatArray, IntArray, IntArray]:
         """This roadmap's graph for `_shortest` in buffers kept between its searches: data (its
         blocked edges at infinity) and indices with room for a start row of `room` links after the
-        edges, indptr (n + 2,). Indices in scipy's csgraph index type (int32: its searches take no
-        other). Made once per roadmap and per `fresh` copy (whose blocked edges differ)."""
+        edges, indptr (n + 2,). Made once per roadmap and per `fresh` copy (whose blocked edges
+        differ)."""
         edges = len(self._both_ways()[2])
         if self._search is None or len(self._search[0]) < edges + room:
             indptr, indices, weights, _ = self._both_ways()
             n, room = len(self.nodes), max(room, self._k)
             data = np.empty(edges + room)
             data[:edges] = weights
-            idx = np.empty(edges + room, dtype=np.int32)
+            idx = np.empty(edges + room, dtype=np.int64)
             idx[:edges] = indices
-            ptr = np.empty(n + 2, dtype=np.int32)
+            ptr = np.empty(n + 2, dtype=np.int64)
             ptr[:n + 1] = indptr
             self._search = (data, idx, ptr)
         return self._search
