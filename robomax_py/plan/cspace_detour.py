@@ -100,10 +100,9 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
             return None, checks
     # The rest of the map is checked where a way is looked for (`_repaired_path`): the free cells
     # of the map's shortest way are the same whether every cell was checked first or not.
-    src_all, dst_all = neighbour_moves((r, r, r))
     weight = move_times(configs, (r, r, r), limits) + 1e-9
     cells = _LazyCells(world, configs, free, checked)
-    path, spent = _repaired_path(world, cells, r, src_all, dst_all, weight, qa, qb, flat(start), flat(goal),
+    path, spent = _repaired_path(world, cells, r, weight, qa, qb, flat(start), flat(goal),
                                  max_checks=int(REPAIR_BUDGET * len(configs)))
     checks += cells.checks
     checks += spent
@@ -187,14 +186,13 @@ def _tube(cells: IntArray, r: int) -> IntArray:
     return np.unique(np.ravel_multi_index(tuple(near.T), (r, r, r)))
 
 
-def _repaired_path(world: CollisionWorld, cells: _LazyCells, r: int, src: IntArray, dst: IntArray, weight: FloatArray,
-                   qa: FloatArray, qb: FloatArray, start: int, goal: int,
-                   max_checks: int) -> tuple[FloatArray | None, int]:
+def _repaired_path(world: CollisionWorld, cells: _LazyCells, r: int, weight: FloatArray, qa: FloatArray,
+                   qb: FloatArray, start: int, goal: int, max_checks: int) -> tuple[FloatArray | None, int]:
     """The map's shortest path from qa to qb whose every cell is free and every consecutive segment
     free by the swept check, and the swept checks spent: None when the map has no path left, a
     segment into or out of the map is blocked, or `MAX_REPAIR_ROUNDS` searches of paths of free
-    cells or `max_checks` swept checks are spent. r: the map's samples per axis; src, dst,
-    weight: its moves (`neighbour_moves`) and their time estimates.
+    cells or `max_checks` swept checks are spent. r: the map's samples per axis; weight: the
+    time estimates of its moves, in `neighbour_moves`' order.
 
     Cells not checked yet are taken to be free (the lazy way of Lazy PRM, Bohlin & Kavraki, "Path
     planning using lazy PRM", ICRA 2000, for the map's cells): a path through unchecked cells has
@@ -222,7 +220,8 @@ def _repaired_path(world: CollisionWorld, cells: _LazyCells, r: int, src: IntArr
         on_path = np.array(path)
         if not cells.checked[on_path].all():
             lazy_rounds += 1
-            if cells.check_rest() if lazy_rounds > LAZY_ROUNDS else cells.check(_tube(on_path, r)):
+            found_blocked = cells.check_rest() if lazy_rounds > LAZY_ROUNDS else cells.check(_tube(on_path, r))
+            if found_blocked:
                 continue                              # a blocked cell on the path: search again
         rounds += 1
         waypoints = np.vstack([qa, cells.configs[path], qb])

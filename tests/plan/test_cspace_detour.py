@@ -394,7 +394,7 @@ def test_the_lazy_search_finds_the_fully_checked_maps_shortest_path(reference, s
     checked = np.zeros(r ** 3, dtype=bool)
     free[[start, goal]] = checked[[start, goal]] = True
     cells = _LazyCells(world, configs, free, checked)  # type: ignore[arg-type]
-    path, _ = _repaired_path(world, cells, r, src, dst, weight, qa, qb, start, goal,  # type: ignore[arg-type]
+    path, _ = _repaired_path(world, cells, r, weight, qa, qb, start, goal,  # type: ignore[arg-type]
                              max_checks=int(REPAIR_BUDGET * len(configs)))
     assert (path is not None) == bool(np.isfinite(expected))
     if path is not None:
