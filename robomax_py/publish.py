@@ -126,7 +126,15 @@ def publish(result: PlanResult, cell: CellSpec, robot: RobotModel, formats: tupl
     checked = []
     reference: list[PlannedPath] = []            # made once, by the first dialect that needs it
     for fmt in formats:
-        one = _checked(fmt, planned, result, cell, robot, name, reference, station)
+        try:
+            one = _checked(fmt, planned, result, cell, robot, name, reference, station)
+        except ExportError as exc:
+            others = [f for f in formats if f != fmt]
+            if not others:
+                raise
+            # Nothing is written when one format fails its proof: say how to have the others.
+            raise ExportError(f"{exc}; nothing was written (--format {','.join(others)} asks for the other "
+                              "formats alone)") from None
         for file_name in one.files:
             if file_name in files and files[file_name] != one.files[file_name]:
                 raise ExportError(f"two formats write {file_name} with different contents")

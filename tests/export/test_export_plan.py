@@ -128,3 +128,32 @@ def test_baseline_files_are_named_apart(small: dict[str, Any]) -> None:
 @pytest.mark.parametrize(("name", "ident"), [("door-L 2", "door_L_2"), ("7up", "_7up"), ("s1", "s1")])
 def test_identifier(name: str, ident: str) -> None:
     assert identifier(name) == ident
+
+
+def test_a_format_whose_program_does_not_prove_says_how_to_have_the_others(small: dict[str, Any],
+                                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    """A dialect writing a program that runs otherwise than planned (here RAPID's with the first
+    joint move's A1 0.5 deg off) stops the whole publication, nothing written: the message names
+    the format, and when others were asked for, how to have them alone."""
+    import dataclasses
+
+    from robomax_py import publish as publishing
+    from robomax_py.errors import ExportError
+    from robomax_py.program import PtpMove
+
+    rapid = DIALECTS["rapid"]
+
+    def nudged(planned, robot):  # type: ignore[no-untyped-def]
+        program = rapid.adapt(planned, robot)
+        at = next(k for k, ins in enumerate(program.instructions) if isinstance(ins, PtpMove))
+        move = program.instructions[at]
+        moved = dataclasses.replace(move, target_deg=(move.target_deg[0] + 0.5, *move.target_deg[1:]))
+        return dataclasses.replace(program, instructions=(*program.instructions[:at], moved,
+                                                          *program.instructions[at + 1:]))
+
+    monkeypatch.setitem(publishing.DIALECTS, "rapid", dataclasses.replace(rapid, adapt=nudged))
+    with pytest.raises(ExportError, match=r"^rapid: the rebuilt motion differs .*; nothing was written "
+                                          r"\(--format srcl,krl asks for the other formats alone\)$"):
+        publish(small["result"], small["cell"], small["robot"], ("srcl", "rapid", "krl"))
+    with pytest.raises(ExportError, match=r"^rapid: the rebuilt motion differs [^;]*$"):
+        publish(small["result"], small["cell"], small["robot"], ("rapid",))
