@@ -7,6 +7,7 @@ blocked straight moves; the cell key takes roadmap / cspace / both and refuses a
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -206,6 +207,22 @@ def _joined(blocked: np.ndarray, a: tuple[int, ...], b: tuple[int, ...]) -> bool
     return bool(labels[a] == labels[b])
 
 
+def _walls(rng: np.random.Generator, r: int, walls: int, holes: Callable[[], int]) -> np.ndarray:
+    """(r, r, r) bool: `walls` blocked planes of cells across the map, each across a random axis
+    at a random place, with holes() random cells of it free again."""
+    blocked = np.zeros((r,) * 3, dtype=bool)
+    for _ in range(walls):
+        axis, at = int(rng.integers(3)), int(rng.integers(r))
+        wall = [slice(None)] * 3
+        wall[axis] = slice(at, at + 1)
+        blocked[tuple(wall)] = True
+        for _ in range(holes()):
+            hole = [int(rng.integers(r)) for _ in range(3)]
+            hole[axis] = at
+            blocked[tuple(hole)] = False
+    return blocked
+
+
 def _ends(robot, qa: np.ndarray, qb: np.ndarray):  # type: ignore[no-untyped-def]
     axes, _ = local_grid(qa, qb, robot.limits.lower, robot.limits.upper, RESOLUTION, MARGIN_RAD)
     return axes, nearest_cell(axes, qa), nearest_cell(axes, qb)
@@ -225,16 +242,7 @@ def test_the_map_finds_no_way_exactly_where_its_ends_are_not_joined(reference, s
     qb = qa + (rng.uniform(-0.08, 0.08, size=6) if near else rng.uniform(-0.8, 0.8, size=6))
     axes, start, goal = _ends(robot, qa, qb)
     r = RESOLUTION
-    blocked = np.zeros((r,) * 3, dtype=bool)
-    for _ in range(walls):
-        axis, at = int(rng.integers(3)), int(rng.integers(r))
-        wall = [slice(None)] * 3
-        wall[axis] = slice(at, at + 1)
-        blocked[tuple(wall)] = True
-        if rng.uniform() < 0.3:                                   # a hole in the wall
-            hole = [int(rng.integers(r)) for _ in range(3)]
-            hole[axis] = at
-            blocked[tuple(hole)] = False
+    blocked = _walls(rng, r, walls, lambda: int(rng.uniform() < 0.3))      # a hole in a wall or none
     for _ in range(pockets):
         centre = start if rng.uniform() < 0.5 else goal
         out = int(rng.integers(1, 4))
@@ -365,16 +373,7 @@ def test_the_lazy_search_finds_the_fully_checked_maps_shortest_path(reference, s
     axes, configs = local_grid(qa, qb, robot.limits.lower, robot.limits.upper, RESOLUTION, MARGIN_RAD)
     r = RESOLUTION
     start, goal = (int(np.ravel_multi_index(nearest_cell(axes, q), (r, r, r))) for q in (qa, qb))
-    blocked = np.zeros((r,) * 3, dtype=bool)
-    for _ in range(walls):
-        axis, at = int(rng.integers(3)), int(rng.integers(r))
-        wall = [slice(None)] * 3
-        wall[axis] = slice(at, at + 1)
-        blocked[tuple(wall)] = True
-        for _ in range(int(rng.integers(0, 4))):                  # holes in the wall
-            hole = [int(rng.integers(r)) for _ in range(3)]
-            hole[axis] = at
-            blocked[tuple(hole)] = False
+    blocked = _walls(rng, r, walls, lambda: int(rng.integers(0, 4)))       # up to three holes in a wall
     flat_blocked = blocked.ravel()
     flat_blocked[[start, goal]] = False
     src, dst = neighbour_moves((r, r, r))
