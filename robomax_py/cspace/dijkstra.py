@@ -18,7 +18,76 @@ from typing import Any
 
 import numpy as np
 
-from robomax_py.jit import kernel
+from robomax_py.jit import helper, kernel
+
+
+@helper
+def _before(d1: float, u1: int, d2: float, u2: int) -> bool:
+    """Heap order: the nearer first, of equal distances the lower node."""
+    return d1 < d2 or (d1 == d2 and u1 < u2)
+
+
+@helper
+def _pop(heap_d: Any, heap_u: Any, size: int) -> int:
+    """Remove the heap's first entry (read heap_d[0], heap_u[0] before): the last entry sifted down
+    from the root. Returns the new size."""
+    size -= 1
+    last_d, last_u = heap_d[size], heap_u[size]
+    i = 0
+    while True:
+        c = 2 * i + 1
+        if c >= size:
+            break
+        if c + 1 < size and _before(heap_d[c + 1], heap_u[c + 1], heap_d[c], heap_u[c]):
+            c += 1
+        if not _before(heap_d[c], heap_u[c], last_d, last_u):
+            break
+        heap_d[i], heap_u[i] = heap_d[c], heap_u[c]
+        i = c
+    if size > 0:
+        heap_d[i], heap_u[i] = last_d, last_u
+    return size
+
+
+@helper
+def _push(heap_d: Any, heap_u: Any, size: int, d: float, u: int) -> int:
+    """Add (d, u), sifted up from the end. Returns the new size."""
+    i = size
+    while i > 0:
+        p = (i - 1) // 2
+        if not _before(d, u, heap_d[p], heap_u[p]):
+            break
+        heap_d[i], heap_u[i] = heap_d[p], heap_u[p]
+        i = p
+    heap_d[i], heap_u[i] = d, u
+    return size + 1
+
+
+@helper
+def _relax(dist: Any, pred: Any, heap_d: Any, heap_u: Any, size: int, u: int, v: int, nd: float) -> int:
+    """Node v reached from u at distance nd: kept, and pushed, where nearer than known. Returns the
+    heap's size."""
+    if nd < dist[v]:
+        dist[v] = nd
+        pred[v] = u
+        return _push(heap_d, heap_u, size, nd, v)
+    return size
+
+
+@helper
+def _traced(pred: Any, start: int, end: int) -> Any:
+    """The nodes from start to end along the predecessors (start first)."""
+    length = 1
+    u = end
+    while u != start:
+        u = pred[u]
+        length += 1
+    path = np.empty(length, dtype=np.int64)
+    u = end
+    for k in range(length - 1, -1, -1):
+        path[k] = u
+        u = pred[u]
+    return path
 
 
 @kernel
@@ -38,67 +107,23 @@ def shortest_path(indptr: Any, indices: Any, weight: Any, usable: Any, cut: Any,
         dist[u] = np.inf
         pred[u] = -1
         done[u] = False
-    capacity = indices.shape[0] + 1
-    heap_d = np.empty(capacity)
-    heap_u = np.empty(capacity, dtype=np.int64)
-    heap_d[0], heap_u[0] = 0.0, start
-    size = 1
+    heap_d = np.empty(indices.shape[0] + 1)     # an entry per relaxation at most, and the start's
+    heap_u = np.empty(indices.shape[0] + 1, dtype=np.int64)
+    size = _push(heap_d, heap_u, 0, 0.0, start)
     dist[start] = 0.0
-    found = False
     while size > 0:
         d, u = heap_d[0], heap_u[0]
-        size -= 1                               # pop: the last entry sifted down from the root
-        last_d, last_u = heap_d[size], heap_u[size]
-        i = 0
-        while True:
-            c = 2 * i + 1
-            if c >= size:
-                break
-            if c + 1 < size and (heap_d[c + 1] < heap_d[c] or (heap_d[c + 1] == heap_d[c] and heap_u[c + 1] < heap_u[c])):
-                c += 1
-            if heap_d[c] < last_d or (heap_d[c] == last_d and heap_u[c] < last_u):
-                heap_d[i], heap_u[i] = heap_d[c], heap_u[c]
-                i = c
-            else:
-                break
-        if size > 0:
-            heap_d[i], heap_u[i] = last_d, last_u
+        size = _pop(heap_d, heap_u, size)
         if done[u] or d > dist[u]:
             continue                            # an entry left behind by a shorter one
         done[u] = True
         if u == goal:
-            found = True
-            break
+            return _traced(pred, start, goal)
         for e in range(indptr[u], indptr[u + 1]):
             v = indices[e]
-            if cut[e] or done[v] or not (usable[v] or v == goal):
-                continue
-            nd = d + weight[e]
-            if nd < dist[v]:
-                dist[v] = nd
-                pred[v] = u
-                i = size                        # push: sifted up from the end
-                size += 1
-                while i > 0:
-                    p = (i - 1) // 2
-                    if heap_d[p] < nd or (heap_d[p] == nd and heap_u[p] < v):
-                        break
-                    heap_d[i], heap_u[i] = heap_d[p], heap_u[p]
-                    i = p
-                heap_d[i], heap_u[i] = nd, v
-    if not found:
-        return np.empty(0, dtype=np.int64)
-    length = 1
-    u = goal
-    while u != start:
-        u = pred[u]
-        length += 1
-    path = np.empty(length, dtype=np.int64)
-    u = goal
-    for k in range(length - 1, -1, -1):
-        path[k] = u
-        u = pred[u]
-    return path
+            if not (cut[e] or done[v] or not (usable[v] or v == goal)):
+                size = _relax(dist, pred, heap_d, heap_u, size, u, v, d + weight[e])
+    return np.empty(0, dtype=np.int64)
 
 
 @kernel
@@ -113,63 +138,32 @@ def shortest_path_to_any(indptr: Any, indices: Any, weight: Any, start: int, goa
     dist = np.empty(n)
     pred = np.empty(n, dtype=np.int64)
     done = np.empty(n, dtype=np.bool_)
+    ends = np.empty(n)                          # the least goal cost of each node (inf: not a goal)
     for u in range(n):
         dist[u] = np.inf
         pred[u] = -1
         done[u] = False
-    ends = np.empty(n)                          # the least goal cost of each node (inf: not a goal)
-    for u in range(n):
         ends[u] = np.inf
     for k in range(goals.shape[0]):
         ends[goals[k]] = min(ends[goals[k]], goal_cost[k])
-    capacity = indices.shape[0] + 1
-    heap_d = np.empty(capacity)
-    heap_u = np.empty(capacity, dtype=np.int64)
-    heap_d[0], heap_u[0] = 0.0, start
-    size = 1
+    heap_d = np.empty(indices.shape[0] + 1)
+    heap_u = np.empty(indices.shape[0] + 1, dtype=np.int64)
+    size = _push(heap_d, heap_u, 0, 0.0, start)
     dist[start] = 0.0
     best = np.inf
     while size > 0:
         d, u = heap_d[0], heap_u[0]
         if d > best:
             break                               # every node at most `best` away is settled
-        size -= 1
-        last_d, last_u = heap_d[size], heap_u[size]
-        i = 0
-        while True:
-            c = 2 * i + 1
-            if c >= size:
-                break
-            if c + 1 < size and (heap_d[c + 1] < heap_d[c] or (heap_d[c + 1] == heap_d[c] and heap_u[c + 1] < heap_u[c])):
-                c += 1
-            if heap_d[c] < last_d or (heap_d[c] == last_d and heap_u[c] < last_u):
-                heap_d[i], heap_u[i] = heap_d[c], heap_u[c]
-                i = c
-            else:
-                break
-        if size > 0:
-            heap_d[i], heap_u[i] = last_d, last_u
+        size = _pop(heap_d, heap_u, size)
         if done[u] or d > dist[u]:
             continue
         done[u] = True
         best = min(best, d + ends[u])
         for e in range(indptr[u], indptr[u + 1]):
             v = indices[e]
-            if done[v]:
-                continue
-            nd = d + weight[e]
-            if nd < dist[v]:
-                dist[v] = nd
-                pred[v] = u
-                i = size
-                size += 1
-                while i > 0:
-                    p = (i - 1) // 2
-                    if heap_d[p] < nd or (heap_d[p] == nd and heap_u[p] < v):
-                        break
-                    heap_d[i], heap_u[i] = heap_d[p], heap_u[p]
-                    i = p
-                heap_d[i], heap_u[i] = nd, v
+            if not done[v]:
+                size = _relax(dist, pred, heap_d, heap_u, size, u, v, d + weight[e])
     chosen = -1
     least = np.inf
     for k in range(goals.shape[0]):
@@ -180,14 +174,4 @@ def shortest_path_to_any(indptr: Any, indices: Any, weight: Any, start: int, goa
             chosen = g
     if chosen < 0:
         return np.empty(0, dtype=np.int64)
-    length = 1
-    u = chosen
-    while u != start:
-        u = pred[u]
-        length += 1
-    path = np.empty(length, dtype=np.int64)
-    u = chosen
-    for k in range(length - 1, -1, -1):
-        path[k] = u
-        u = pred[u]
-    return path
+    return _traced(pred, start, chosen)

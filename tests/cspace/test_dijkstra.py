@@ -111,3 +111,14 @@ def test_the_path_to_any_goal_is_scipys_shortest_and_argmin(seed: int, n: int, d
         row = slice(indptr[u], indptr[u + 1])
         length += float(weight[row][cols[row] == v].min())
     assert abs(length - dist[path[-1]]) <= DIST_RTOL * max(dist[path[-1]], 1.0)
+
+
+def test_a_goal_as_far_as_the_best_total_is_still_settled_and_taken_first_in_order() -> None:
+    """start -> 1 (1.0) and start -> 2 (2.0); goals [2, 1] with costs [0, 1]: both total 2.0, and
+    np.argmin takes the first, goal 2, which lies exactly as far as the best total found through
+    goal 1: the search must settle it before stopping."""
+    indptr = np.array([0, 2, 3, 4], dtype=np.int64)
+    indices = np.array([1, 2, 0, 0], dtype=np.int64)
+    weight = np.array([1.0, 2.0, 1.0, 2.0])
+    path = shortest_path_to_any(indptr, indices, weight, 0, np.array([2, 1], dtype=np.int64), np.array([0.0, 1.0]))
+    assert path.tolist() == [0, 2]
