@@ -50,8 +50,9 @@ def _pop(heap_d: Any, heap_u: Any, size: int) -> int:
 
 
 @helper
-def _push(heap_d: Any, heap_u: Any, size: int, d: float, u: int) -> int:
-    """Add (d, u), sifted up from the end. Returns the new size."""
+def _push(heap_d: Any, heap_u: Any, size: Any, d: float, u: int) -> Any:
+    """Add (d, u), sifted up from the end. Returns the new size. size: an int64, never a literal
+    (numba compiles a function again for each literal it is called with)."""
     i = size
     while i > 0:
         p = (i - 1) // 2
@@ -64,7 +65,7 @@ def _push(heap_d: Any, heap_u: Any, size: int, d: float, u: int) -> int:
 
 
 @helper
-def _relax(dist: Any, pred: Any, heap_d: Any, heap_u: Any, size: int, u: int, v: int, nd: float) -> int:
+def _relax(dist: Any, pred: Any, heap_d: Any, heap_u: Any, size: Any, u: int, v: int, nd: float) -> Any:
     """Node v reached from u at distance nd: kept, and pushed, where nearer than known. Returns the
     heap's size."""
     if nd < dist[v]:
@@ -75,8 +76,8 @@ def _relax(dist: Any, pred: Any, heap_d: Any, heap_u: Any, size: int, u: int, v:
 
 
 @helper
-def _traced(pred: Any, start: int, end: int) -> Any:
-    """The nodes from start to end along the predecessors (start first)."""
+def _traced(pred: Any, start: int, end: Any) -> Any:
+    """The nodes from start to end along the predecessors (start first); end as `_push`'s size."""
     length = 1
     u = end
     while u != start:
@@ -109,7 +110,7 @@ def shortest_path(indptr: Any, indices: Any, weight: Any, usable: Any, cut: Any,
         done[u] = False
     heap_d = np.empty(indices.shape[0] + 1)     # an entry per relaxation at most, and the start's
     heap_u = np.empty(indices.shape[0] + 1, dtype=np.int64)
-    size = _push(heap_d, heap_u, 0, 0.0, start)
+    size = _push(heap_d, heap_u, np.int64(0), 0.0, start)
     dist[start] = 0.0
     while size > 0:
         d, u = heap_d[0], heap_u[0]
@@ -148,7 +149,7 @@ def shortest_path_to_any(indptr: Any, indices: Any, weight: Any, start: int, goa
         ends[goals[k]] = min(ends[goals[k]], goal_cost[k])
     heap_d = np.empty(indices.shape[0] + 1)
     heap_u = np.empty(indices.shape[0] + 1, dtype=np.int64)
-    size = _push(heap_d, heap_u, 0, 0.0, start)
+    size = _push(heap_d, heap_u, np.int64(0), 0.0, start)
     dist[start] = 0.0
     best = np.inf
     while size > 0:
@@ -164,7 +165,7 @@ def shortest_path_to_any(indptr: Any, indices: Any, weight: Any, start: int, goa
             v = indices[e]
             if not done[v]:
                 size = _relax(dist, pred, heap_d, heap_u, size, u, v, d + weight[e])
-    chosen = -1
+    chosen = np.int64(-1)                       # not a literal (`_push`)
     least = np.inf
     for k in range(goals.shape[0]):
         g = goals[k]
