@@ -24,8 +24,6 @@ from robomax_py.robot import JointLimits
 from robomax_py.timing import polyline_time_estimate, ptp_time_estimate
 from robomax_py.world.collision import CollisionWorld
 
-# scipy.sparse.csgraph's index arrays.
-
 # Sampling box margin around the work's joint-space spread, rad (or m), per joint.
 BOX_MARGIN = 0.6
 # Share of samples drawn near the anchors (Gaussian, this sigma per joint) rather than uniformly:
