@@ -98,8 +98,8 @@ def grid_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: 
         checks += len(near)
         if _walled_in(free.reshape(r, r, r), box, end, other, r):
             return None, checks
-    # The rest of the map is checked where a way is looked for (`_repaired_path`): the free cells
-    # of the map's shortest way are the same whether every cell was checked first or not.
+    # The rest of the map is checked where a way is looked for (`_repaired_path`): its shortest
+    # way through free cells costs the same whether every cell was checked first or not.
     weight = move_times(configs, (r, r, r), limits) + 1e-9
     cells = _LazyCells(world, configs, free, checked)
     path, spent = _repaired_path(world, cells, r, weight, qa, qb, flat(start), flat(goal),
