@@ -173,3 +173,15 @@ class _PackageCacheImpl(caching.CompileResultCacheImpl):
 
 class _PackageFunctionCache(caching.FunctionCache):
     _impl_class = _PackageCacheImpl
+
+
+def is_cached(dispatcher: Dispatcher[Any], args: tuple[Any, ...]) -> bool:
+    """Whether the cache folder holds `dispatcher`'s machine code for argument types `args` (numba
+    types), for this source and this machine: what its first call with those types would load
+    instead of compiling. Reads the function's index only (`Cache.load_overload` reads the code
+    too)."""
+    cache = getattr(dispatcher, "_cache", None)
+    if not isinstance(cache, _PackageFunctionCache):
+        return False
+    key = cache._index_key(args, dispatcher.targetctx.codegen())  # type: ignore[attr-defined,no-untyped-call]  # numba's own key
+    return key in cache._cache_file._load_index()                  # type: ignore[no-untyped-call]
