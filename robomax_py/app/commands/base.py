@@ -8,7 +8,7 @@ import signal
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated, Any, TypeVar
+from typing import TYPE_CHECKING, Annotated, Any, TypeVar
 
 import typer
 from rich.console import Console
@@ -16,6 +16,9 @@ from typer.core import TyperCommand, TyperGroup
 
 from robomax_py._version import __version__
 from robomax_py.errors import RobomaxError
+
+if TYPE_CHECKING:
+    from robomax_py.app.compile_ahead import Compiling
 
 EXIT_OK = 0
 EXIT_VIOLATIONS = 1
@@ -213,6 +216,15 @@ class _Process:
 # thousand, few of them in cycles; a tenth as many collections halve their cost (~0.06 s of CPU in
 # a plan) and leave at most a few thousand objects' garbage waiting a little longer.
 YOUNG_COLLECTION_THRESHOLD = 7000
+
+
+def _compile_ahead() -> Compiling:
+    """The kernels every plan calls, compiled side by side where the cache has not got them
+    (`app.compile_ahead`); only in a command's own process (a caller's process, tests among them,
+    compiles at the first call as before)."""
+    from robomax_py.app.compile_ahead import Compiling, start
+
+    return start() if _Process.own else Compiling(())
 
 
 @contextmanager

@@ -17,7 +17,9 @@ from robomax_py.app.commands.base import (
     RAY_LOCAL,
     JsonFlag,
     _command,
+    _compile_ahead,
     _guarded,
+    _honour_signals,
     _json_failure,
     _method,
     _num,
@@ -104,6 +106,9 @@ def batch(
         where = (f"Ray ({resolve_address(address)})" if use_ray else
                  f"{jobs or os.cpu_count() or 1} process(es)")
         part = f" (shard {picked_shard.index} of {picked_shard.count})" if picked_shard else ""
+        # The kernels every cell's process calls, compiled once here where the cache has not got
+        # them (each process would otherwise compile them all at once, side by side).
+        _compile_ahead().wait(_honour_signals)
         with Progress(TextColumn("planning"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                       console=err, transient=False) as progress:
             task = progress.add_task("cells", total=n)

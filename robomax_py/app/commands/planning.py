@@ -13,6 +13,7 @@ from robomax_py.app.commands.base import (
     EXIT_VIOLATIONS,
     JsonFlag,
     _command,
+    _compile_ahead,
     _guarded,
     _heavy_imports,
     _honour_signals,
@@ -55,6 +56,7 @@ def plan(
         # import that catches BaseException would swallow the interrupt and leave half-imported
         # modules behind. A signal that arrived meanwhile is delivered when the imports are done.
         with signals_held(), _heavy_imports():
+            compiling = _compile_ahead()         # side by side with the imports and the files' reading
             from robomax_py.app.progress import configure_logging, stage_bars
             from robomax_py.app.report import plan_report, report_tables
             from robomax_py.export import SHARED_FILES, choose_formats
@@ -80,6 +82,7 @@ def plan(
 
                 raise CellFileError(cell, "robots", "--baseline plans single-robot cells; a station "
                                     "compares its methods in tests/bench/bench_station.py")
+            compiling.wait(_honour_signals)
             return plan_station_files(cell, out_dir, formats, speed, as_json,
                                       datetime.date.today().isoformat() if stamp else "", plot)
         t0 = time.perf_counter()
@@ -92,6 +95,7 @@ def plan(
         names = chosen.names
         _warn([s.message for s in chosen.skipped])
         set_name = spec.name + method_suffix(method)
+        compiling.wait(_honour_signals)
         with stage_bars(err, enabled=not verbose) as bars:
             def progress(stage: str, done: int, total: int) -> None:
                 _honour_signals()

@@ -13,6 +13,7 @@ from robomax_py.app.commands.base import (
     EXIT_VIOLATIONS,
     JsonFlag,
     _command,
+    _compile_ahead,
     _guarded,
     _honour_signals,
     _print_json,
@@ -46,6 +47,7 @@ def replan(
 
     def run() -> int:
         with signals_held():
+            compiling = _compile_ahead()         # side by side with the imports and the files' reading
             from robomax_py.app.replan import continuation_file, summary
             from robomax_py.app.replan import replan as replan_program
             from robomax_py.export import SHARED_FILES, choose_formats
@@ -67,6 +69,7 @@ def replan(
         robot = load_cell_robot(spec)
         chosen = choose_formats(formats, robot)
         _warn([s.message for s in chosen.skipped])
+        compiling.wait(_honour_signals)
         outcome = replan_program(spec, robot, program, at, tuple(events))
         _honour_signals()
         report = summary(outcome)
