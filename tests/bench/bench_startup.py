@@ -1,5 +1,6 @@
 """`robomax plan` as a user runs it: one process from start to exit, its CPU (user + sys, of the
-process and any it waits for), on the cell of the README's quick start unless given another.
+process and any it waits for: the processes that compile a first plan's kernels side by side
+included) and its wall time, on the cell of the README's quick start unless given another.
 
     python tests/bench/bench_startup.py [CELL] [--runs 3]
 
@@ -10,7 +11,9 @@ Python reads and writes its bytecode (`__pycache__`, ignored by git) whatever th
 environment says, as an installed package has it: with PYTHONDONTWRITEBYTECODE set, every run
 compiled robomax's ~190 modules again, ~0.2 s of CPU that a user's run never pays.
 Each run has its own cache folder and output folder. The figures are medians over --runs; the
-ratio cold / warm is of the same run, so a busy machine shifts both alike. The split of a warm
+ratio cold / warm is of the same run, so a busy machine shifts both alike. Wall time is what the
+user waits: on an idle machine with two CPUs or more the first plan's compile is shared out
+(`app.compile_ahead`), so cold wall is below cold CPU; on a loaded machine it swings. The split of a warm
 run (imports, the command's own work) comes from `python -X importtime` and a profile.
 """
 
@@ -23,27 +26,30 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[2]
 QUICK_START_CELL = REPO / "cells" / "cabin_flange.yaml"
 
 
-def plan_cpu(cell: Path, cache: Path, out: Path) -> float:
-    """CPU seconds (user + sys) of one `python -m robomax_py plan cell --out out` with its caches in
-    `cache`; raises when the command fails."""
+def plan_cpu(cell: Path, cache: Path, out: Path) -> tuple[float, float]:
+    """(CPU seconds (user + sys), wall seconds) of one `python -m robomax_py plan cell --out out`
+    with its caches in `cache`; raises when the command fails."""
     env = {**os.environ,
            "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]),
            "ROBOMAX_CACHE": str(cache / "robomax"), "NUMBA_CACHE_DIR": str(cache / "numba"),
            "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    started = time.perf_counter()
     done = subprocess.run([sys.executable, "-m", "robomax_py", "plan", str(cell), "--out", str(out)],
                           capture_output=True, text=True, env=env, check=False)
+    wall = time.perf_counter() - started
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if done.returncode != 0:
         raise SystemExit(f"robomax plan {cell} failed ({done.returncode}):\n{done.stderr[-3000:]}")
-    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), wall
 
 
 def main() -> None:
@@ -51,19 +57,25 @@ def main() -> None:
     ap.add_argument("cell", nargs="?", type=Path, default=QUICK_START_CELL)
     ap.add_argument("--runs", type=int, default=3)
     args = ap.parse_args()
-    cold, warm, ratio = [], [], []
+    cold, warm, ratio, cold_wall, warm_wall, extra_wall = [], [], [], [], [], []
     for _ in range(args.runs):
         with tempfile.TemporaryDirectory() as tmp:
             root = Path(tmp)
-            c = plan_cpu(args.cell, root / "cache", root / "out_cold")
-            w = plan_cpu(args.cell, root / "cache", root / "out_warm")
+            c, cw = plan_cpu(args.cell, root / "cache", root / "out_cold")
+            w, ww = plan_cpu(args.cell, root / "cache", root / "out_warm")
         cold.append(c)
         warm.append(w)
         ratio.append(c / w)
-    print(f"robomax plan {args.cell.name}: process CPU s (user + sys), median of {args.runs}")
-    print(f"{'cold (empty caches)':>22} {statistics.median(cold):8.2f}")
-    print(f"{'warm':>22} {statistics.median(warm):8.2f}")
-    print(f"{'cold / warm':>22} {statistics.median(ratio):8.2f}")
+        cold_wall.append(cw)
+        warm_wall.append(ww)
+        extra_wall.append(cw - ww)
+    m = statistics.median
+    print(f"robomax plan {args.cell.name}: median of {args.runs}")
+    print(f"{'':>22} {'CPU s':>8} {'wall s':>8}")
+    print(f"{'cold (empty caches)':>22} {m(cold):8.2f} {m(cold_wall):8.2f}")
+    print(f"{'warm':>22} {m(warm):8.2f} {m(warm_wall):8.2f}")
+    print(f"{'cold / warm':>22} {m(ratio):8.2f}")
+    print(f"{'cold - warm':>22} {m(cold) - m(warm):8.2f} {m(extra_wall):8.2f}")
 
 
 if __name__ == "__main__":
