@@ -5,9 +5,10 @@ files; the plan then loads them from the cache.
 
 numba compiles a function at its first call, one at a time (its compiler holds a lock, and most
 of the work is Python): on the reference cell about 6 s of a 9 s first plan, of which the
-pre-filter's two kernels are 5 s. Shared out among two processes the first plan ends about 2.5 s
-sooner; it costs about 1 s more CPU, as each process compiles the helpers its kernels call. With
-one CPU nothing is started: the kernels compile at their first call, as they would anyway.
+pre-filter's two kernels are 5 s. The helpers the two share are compiled first, in one process,
+while the command imports and reads its files; then the kernels, shared out among one process per
+CPU. With one CPU nothing is started: the kernels compile at their first call, as they would
+anyway.
 
 A process that fails or is killed costs nothing but its time: its kernels compile at their first
 call. numba writes each cache file whole (a temporary file renamed), so a killed process leaves no
@@ -67,55 +68,73 @@ def shares(kernels: Sequence[KernelEntry], count: int) -> list[list[KernelEntry]
 
 @dataclass(frozen=True, slots=True)
 class Compiling:
-    """The compiling processes of one command (none when there was nothing to share out)."""
+    """The compiling of one command: the processes under way and the kernels' groups still to start,
+    each in a process of its own once those have ended (the helpers' process: the kernels then load
+    the helpers from the cache). Empty when there is nothing to compile."""
 
-    processes: tuple[BaseProcess, ...]
+    started: tuple[BaseProcess, ...] = ()
+    groups: tuple[tuple[KernelEntry, ...], ...] = ()
 
     def wait(self, between: Callable[[], None] = lambda: None, limit_s: float = WAIT_S) -> int:
-        """Wait until every process has ended (at most `limit_s`, then stop those left); `between`
-        is called every tenth of a second meanwhile (a command's signal check). Returns how many
-        ended without an error."""
+        """Wait until every process has ended, the groups' started in their turn (at most `limit_s`
+        in all, then those left are stopped); `between` is called every tenth of a second meanwhile
+        (a command's signal check). Returns how many processes ended without an error."""
         deadline = time.monotonic() + limit_s
-        for p in self.processes:
-            while p.is_alive() and time.monotonic() < deadline:
-                p.join(_POLL_S)
-                between()
-            if p.is_alive():
-                p.terminate()
-                p.join()
-        return sum(p.exitcode == 0 for p in self.processes)
+        ended = _join(self.started, between, deadline)
+        later = tuple(_launch(g) for g in self.groups)
+        return ended + _join(later, between, deadline)
 
 
 def start(kernels: Sequence[KernelEntry] = PLAN_KERNELS, helpers: Sequence[KernelEntry] = SHARED_HELPERS,
           cpus: int | None = None) -> Compiling:
-    """Start compiling the kernels of `kernels` that the cache has not got, shared out among one
-    process per CPU (`cpus`, default `usable_cpus()`), after `helpers` (those the cache has not
-    got) are compiled here; nothing when all kernels are cached or only one CPU is there. The
+    """Start compiling what the cache has not got: `helpers` in one process now, `kernels` shared
+    out among one process per CPU (`cpus`, default `usable_cpus()`) once it has ended (at once when
+    no helper is missing); nothing when every kernel is cached or only one CPU is there. The
     processes are daemons: a command that ends early stops them."""
     todo = cold(kernels)
     cpus = usable_cpus() if cpus is None else cpus
     if not todo or cpus < 2:
-        return Compiling(())
-    # fork on Linux: the child has the parent's modules already (spawn would import numba and the
-    # kernels' modules again, about 0.5 s each); elsewhere the platform's safe default.
-    fork = sys.platform.startswith("linux")
-    if fork:
+        return Compiling()
+    if _context() == "fork":
         # numba's typing and target registries, filled here once rather than in every child (about
         # 0.15 s each); the command needs them anyway to load the kernels.
         d = _dispatcher(todo[0])
         d.typingctx.refresh()                   # type: ignore[no-untyped-call]  # numba is untyped
         d.targetctx.refresh()                   # type: ignore[no-untyped-call]
-    # The helpers several kernels call, compiled once here: each child has them from the fork (or
-    # the cache) instead of compiling them for its own kernels.
-    _compile_all(cold(helpers))
-    ctx: ForkContext | SpawnContext = (multiprocessing.get_context("fork") if fork
+    groups = tuple(tuple(g) for g in shares(todo, cpus))
+    first = tuple(cold(helpers))
+    if not first:
+        return Compiling(tuple(_launch(g) for g in groups))
+    # The helpers several kernels call, compiled once, while the command imports and reads its
+    # files; each kernel's process would otherwise compile them again for itself.
+    return Compiling((_launch(first),), groups)
+
+
+def _context() -> str:
+    """fork on Linux: the child has the parent's modules already (spawn would import numba and the
+    kernels' modules again, about 0.5 s each); elsewhere the platform's safe default."""
+    return "fork" if sys.platform.startswith("linux") else "spawn"
+
+
+def _launch(group: Sequence[KernelEntry]) -> BaseProcess:
+    ctx: ForkContext | SpawnContext = (multiprocessing.get_context("fork") if _context() == "fork"
                                        else multiprocessing.get_context("spawn"))
-    processes = []
-    for i, group in enumerate(shares(todo, cpus)):
-        p = ctx.Process(target=_compile, args=(group,), name=f"robomax-compile-{i}", daemon=True)
-        p.start()
-        processes.append(p)
-    return Compiling(tuple(processes))
+    p = ctx.Process(target=_compile, args=(tuple(group),), name="robomax-compile", daemon=True)
+    p.start()
+    return p
+
+
+def _join(processes: Sequence[BaseProcess], between: Callable[[], None], deadline: float) -> int:
+    """Join `processes` until `deadline` (time.monotonic), calling `between` every tenth of a second;
+    those left then are stopped. How many ended without an error."""
+    for p in processes:
+        while p.is_alive() and time.monotonic() < deadline:
+            p.join(_POLL_S)
+            between()
+        if p.is_alive():
+            p.terminate()
+            p.join()
+    return sum(p.exitcode == 0 for p in processes)
 
 
 def _compile(group: Sequence[KernelEntry]) -> None:
@@ -129,11 +148,7 @@ def _compile(group: Sequence[KernelEntry]) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
     gc.enable()                                 # a command disables it around its imports
-    _compile_all(group)
-
-
-def _compile_all(entries: Sequence[KernelEntry]) -> None:
-    for k in entries:
+    for k in group:
         _dispatcher(k).compile(k.args)
 
 

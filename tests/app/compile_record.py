@@ -41,7 +41,7 @@ def main() -> None:
     from robomax_py.app.kernel_table import PLAN_KERNELS, SHARED_HELPERS
 
     if mode == "lazy":
-        compile_ahead.start = lambda *a, **k: compile_ahead.Compiling(())
+        compile_ahead.start = lambda *a, **k: compile_ahead.Compiling()
     else:
         compile_ahead.usable_cpus = lambda: 2
     sys.argv = ["robomax", "plan", cell, "--out", out]

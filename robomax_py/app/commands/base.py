@@ -224,7 +224,7 @@ def _compile_ahead() -> Compiling:
     compiles at the first call as before)."""
     from robomax_py.app.compile_ahead import Compiling, start
 
-    return start() if _Process.own else Compiling(())
+    return start() if _Process.own else Compiling()
 
 
 @contextmanager
