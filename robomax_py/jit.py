@@ -175,6 +175,12 @@ class _PackageFunctionCache(caching.FunctionCache):
     _impl_class = _PackageCacheImpl
 
 
+def has_cache(fn: object) -> bool:
+    """Whether `fn` is a compiled function whose machine code is kept in a folder (the cache folder,
+    else beside the sources): not where neither can be written, nor under NUMBA_DISABLE_JIT."""
+    return isinstance(getattr(fn, "_cache", None), _PackageFunctionCache)
+
+
 def is_cached(dispatcher: Dispatcher[Any], args: tuple[Any, ...]) -> bool:
     """Whether the cache folder holds `dispatcher`'s machine code for argument types `args` (numba
     types), for this source and this machine: what its first call with those types would load

@@ -33,7 +33,7 @@ from typing import Any
 from numba.core.dispatcher import Dispatcher
 
 from robomax_py.app.kernel_table import PLAN_KERNELS, SHARED_HELPERS, KernelEntry
-from robomax_py.jit import is_cached
+from robomax_py.jit import has_cache, is_cached
 
 # The longest a command waits for the compiling processes (a first plan's compile is about 3 s on
 # two CPUs); past it they are stopped and what they did not finish compiles at its first call.
@@ -50,8 +50,13 @@ def usable_cpus() -> int:
 
 
 def cold(kernels: Sequence[KernelEntry] = PLAN_KERNELS) -> list[KernelEntry]:
-    """The kernels of `kernels` the cache has not got for this source and this machine."""
-    return [k for k in kernels if not is_cached(_dispatcher(k), k.args)]
+    """The kernels of `kernels` the cache has not got for this source and this machine. None where
+    no folder keeps them (nor under NUMBA_DISABLE_JIT): what another process compiled would be
+    lost, and the command would compile it again."""
+    found = [(k, _dispatcher(k)) for k in kernels]
+    if not all(has_cache(d) for _, d in found):
+        return []
+    return [k for k, d in found if not is_cached(d, k.args)]
 
 
 def shares(kernels: Sequence[KernelEntry], count: int) -> list[list[KernelEntry]]:

@@ -107,6 +107,29 @@ def test_a_process_past_the_limit_is_stopped() -> None:
     assert checks                               # the signal check ran while it waited
 
 
+def _plain(x: float) -> float:
+    return x + 1.0
+
+
+def test_nothing_is_compiled_ahead_where_no_folder_keeps_it(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A kernel without a cache (no folder could be written: numba's own NullCache) or not compiled
+    at all (NUMBA_DISABLE_JIT): another process's compile would be lost, so none is started."""
+    import numba
+
+    from robomax_py.app import compile_ahead
+
+    module = sys.modules[__name__]
+    monkeypatch.setattr(module, "uncached", numba.njit(_plain), raising=False)
+    monkeypatch.setattr(module, "not_compiled", _plain, raising=False)
+    for name in ("uncached", "not_compiled"):
+        entry = KernelEntry(__name__, name, (numba.float64,), 1.0)
+        assert compile_ahead.cold([entry]) == []
+        assert compile_ahead.start([entry], [], cpus=4) == Compiling()
+    # One such kernel among cached ones: none is compiled ahead (the command compiles them all).
+    entries = [*PLAN_KERNELS, KernelEntry(__name__, "uncached", (numba.float64,), 1.0)]
+    assert compile_ahead.cold(entries) == []
+
+
 def _children(pid: int) -> list[int]:
     found = []
     for task in Path(f"/proc/{pid}/task").iterdir():
