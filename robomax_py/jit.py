@@ -22,6 +22,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
+import pickle
 import re
 from collections.abc import Callable
 from pathlib import Path
@@ -57,7 +58,7 @@ def _cached(fn: _F, options: dict[str, Any]) -> Dispatcher[_F]:
     if isinstance(dispatcher, Dispatcher):                     # not under NUMBA_DISABLE_JIT
         try:
             # What `Dispatcher.enable_caching` does, with this module's locator.
-            dispatcher._cache = _PackageFunctionCache(fn)  # type: ignore[attr-defined,no-untyped-call]  # numba's slot
+            dispatcher._cache = _PackageFunctionCache(fn)  # type: ignore[attr-defined]  # numba's slot
         except RuntimeError:
             pass                                               # no folder to write: compiled every run
     return dispatcher
@@ -171,8 +172,32 @@ class _PackageCacheImpl(caching.CompileResultCacheImpl):
     _locator_classes = [_PackageLocator, _InTreeLocator]          # noqa: RUF012  # numba's own class attribute, read only
 
 
+class _ReadableCacheFile(caching.IndexDataCacheFile):
+    """numba's index and code files of a function, where a file that does not unpickle (cut short by
+    a full disk or a crash, damaged) is read as missing: the function is compiled again and its
+    files written anew. numba's own raises out of the first call, and a plan ended on a traceback."""
+
+    def _load_index(self) -> dict[Any, str]:
+        try:
+            found: dict[Any, str] = super()._load_index()        # type: ignore[no-untyped-call]
+        except (pickle.UnpicklingError, EOFError, ValueError, TypeError, AttributeError, ImportError):
+            return {}
+        return found
+
+    def _load_data(self, name: str) -> Any:
+        try:
+            return super()._load_data(name)                      # type: ignore[no-untyped-call]
+        except (pickle.UnpicklingError, EOFError, ValueError, TypeError, AttributeError, ImportError) as exc:
+            raise OSError(f"unreadable cache file {name}") from exc   # `load` reads an OSError as missing
+
+
 class _PackageFunctionCache(caching.FunctionCache):
     _impl_class = _PackageCacheImpl
+
+    def __init__(self, py_func: Callable[..., object]) -> None:
+        super().__init__(py_func)                                 # type: ignore[no-untyped-call]
+        self._cache_file = _ReadableCacheFile(                    # type: ignore[no-untyped-call]
+            self._cache_path, self._impl.filename_base, self._impl.locator.get_source_stamp())
 
 
 def has_cache(fn: object) -> bool:

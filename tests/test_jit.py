@@ -117,3 +117,25 @@ def test_an_unwritable_cache_folder_keeps_the_kernels_beside_the_sources(tmp_pat
     assert _run(package.parent, blocker) == (4.0, 0)
     assert list((package / "__pycache__").glob("_probe_b.twice-*.nbi"))
     assert _run(package.parent, blocker) == (4.0, 1)
+
+
+def test_a_damaged_cache_file_is_read_as_missing_and_written_anew(tmp_path: Path) -> None:
+    """A file cut short or damaged (a full disk, a crash) is a cache miss: the function compiles
+    again and the file is written anew, where numba's own reading raises out of the first call."""
+    from numba.core.caching import IndexDataCacheFile
+
+    files = jit._ReadableCacheFile(str(tmp_path), "f", "stamp")
+    files.save(("sig",), ("code", 1))
+    assert files.load(("sig",)) == ("code", 1)
+    index = tmp_path / "f.nbi"
+    data = next(tmp_path.glob("f.*.nbc"))
+    for damaged in (index, data):
+        whole = damaged.read_bytes()
+        damaged.write_bytes(whole[:len(whole) // 2])            # cut short
+        with pytest.raises(Exception):                          # noqa: B017  # numba's own: any unpickling error
+            IndexDataCacheFile(str(tmp_path), "f", "stamp").load(("sig",))
+        assert files.load(("sig",)) is None
+        files.save(("sig",), ("code", 2))                       # compiled again: written anew
+        assert files.load(("sig",)) == ("code", 2)
+    index.write_bytes(b"garbage")
+    assert files.load(("sig",)) is None
