@@ -1,7 +1,7 @@
 """A first plan's kernels compiled side by side: when the cache folder has not got the kernels every
 plan calls (`kernel_table.PLAN_KERNELS`: after an install, an upgrade that changed them, a new
-machine), they are compiled in processes of their own, one per CPU, while the command reads its
-files; the plan then loads them from the cache.
+machine), they are compiled in processes of their own, one per CPU, the first while the command
+imports and reads its files; the plan then loads them from the cache.
 
 numba compiles a function at its first call, one at a time (its compiler holds a lock, and most
 of the work is Python): on the reference cell about 6 s of a 9 s first plan, of which the
@@ -83,7 +83,8 @@ class Compiling:
     def wait(self, between: Callable[[], None] = lambda: None, limit_s: float = WAIT_S) -> int:
         """Wait until every process has ended, the groups' started in their turn (at most `limit_s`
         in all, then those left are stopped); `between` is called every tenth of a second meanwhile
-        (a command's signal check). Returns how many processes ended without an error."""
+        (a command's signal check). Returns how many processes ended without an error. Once per
+        `start`: each call starts the groups' processes."""
         deadline = time.monotonic() + limit_s
         ended = _join(self.started, between, deadline)
         later = tuple(_launch(g) for g in self.groups)
@@ -153,8 +154,13 @@ def _compile(group: Sequence[KernelEntry]) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
     gc.enable()                                 # a command disables it around its imports
-    for k in group:
-        _dispatcher(k).compile(k.args)
+    try:
+        for k in group:
+            _dispatcher(k).compile(k.args)
+    except Exception:                           # noqa: BLE001  # any failure: the command compiles it itself
+        # No traceback of this process on the command's terminal: the kernel compiles again at its
+        # first call in the command, which reports a failure as it would have without this process.
+        sys.exit(1)
 
 
 def _dispatcher(k: KernelEntry) -> Dispatcher[Any]:

@@ -130,6 +130,21 @@ def test_nothing_is_compiled_ahead_where_no_folder_keeps_it(monkeypatch: pytest.
     assert compile_ahead.cold(entries) == []
 
 
+def _mistyped(x: float) -> float:
+    return x.no_such_attribute  # type: ignore[attr-defined,no-any-return]  # fails numba's typing
+
+
+def test_a_kernel_that_fails_to_compile_ends_its_process_without_a_traceback(
+        monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]) -> None:
+    """The command then compiles it at its first call and reports the failure as it always did."""
+    import numba
+
+    monkeypatch.setattr(sys.modules[__name__], "mistyped", numba.njit(_mistyped), raising=False)
+    bad = KernelEntry(__name__, "mistyped", (numba.float64,), 1.0)
+    assert Compiling((), ((bad,),)).wait() == 0
+    assert "Traceback" not in capfd.readouterr().err
+
+
 def _children(pid: int) -> list[int]:
     found = []
     for task in Path(f"/proc/{pid}/task").iterdir():
