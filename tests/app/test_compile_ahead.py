@@ -154,9 +154,13 @@ def _children(pid: int) -> list[int]:
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads the process tree from /proc")
 def test_ctrl_c_while_the_kernels_compile_ends_the_command_and_its_processes(tmp_path: Path) -> None:
-    run = subprocess.Popen([sys.executable, "-m", "robomax_py", "plan", str(REFERENCE_CELL), "--out",
-                            str(tmp_path / "out")], env=_fresh_env(tmp_path), start_new_session=True,
-                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # Ctrl-C answered as at a terminal even where this test runs with SIGINT ignored (a job started
+    # in the background: the command then rightly ignores it too).
+    command = ("import runpy, signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+               "sys.argv = ['robomax', *sys.argv[1:]]; runpy.run_module('robomax_py', run_name='__main__')")
+    run = subprocess.Popen([sys.executable, "-c", command, "plan", str(REFERENCE_CELL), "--out", str(tmp_path / "out")],
+                           env=_fresh_env(tmp_path), start_new_session=True, stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + PROCESS_LIMIT_S
     while not _children(run.pid) and run.poll() is None and time.monotonic() < deadline:
         time.sleep(0.02)
