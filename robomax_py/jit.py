@@ -172,6 +172,10 @@ class _PackageCacheImpl(caching.CompileResultCacheImpl):
     _locator_classes = [_PackageLocator, _InTreeLocator]          # noqa: RUF012  # numba's own class attribute, read only
 
 
+# What unpickling a damaged file raises (cut short: EOFError or UnpicklingError; other bytes: any).
+_UNREADABLE = (pickle.UnpicklingError, EOFError, ValueError, TypeError, AttributeError, ImportError)
+
+
 class _ReadableCacheFile(caching.IndexDataCacheFile):
     """numba's index and code files of a function, where a file that does not unpickle (cut short by
     a full disk or a crash, damaged) is read as missing: the function is compiled again and its
@@ -180,14 +184,14 @@ class _ReadableCacheFile(caching.IndexDataCacheFile):
     def _load_index(self) -> dict[Any, str]:
         try:
             found: dict[Any, str] = super()._load_index()        # type: ignore[no-untyped-call]
-        except (pickle.UnpicklingError, EOFError, ValueError, TypeError, AttributeError, ImportError):
+        except _UNREADABLE:
             return {}
         return found
 
     def _load_data(self, name: str) -> Any:
         try:
             return super()._load_data(name)                      # type: ignore[no-untyped-call]
-        except (pickle.UnpicklingError, EOFError, ValueError, TypeError, AttributeError, ImportError) as exc:
+        except _UNREADABLE as exc:
             raise OSError(f"unreadable cache file {name}") from exc   # `load` reads an OSError as missing
 
 
