@@ -28,9 +28,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar
 
+import numba
 from numba import njit
 from numba.core import caching
 from numba.core.dispatcher import Dispatcher
+from numba.core.runtime.nrt import rtsys
 
 from robomax_py.cache_files import cache_folder
 
@@ -195,6 +197,15 @@ class _ReadableCacheFile(caching.IndexDataCacheFile):
             raise OSError(f"unreadable cache file {name}") from exc   # `load` reads an OSError as missing
 
 
+# numba releases (major, minor) whose sources were read for where the symbols that machine code links
+# against are registered (`_PackageFunctionCache.load_overload`): numba/__init__.py, core/base.py
+# (`_load_global_helpers`, at a context's creation), core/cpu.py and core/externals.py (the CPU
+# context's `init`), core/runtime/nrt.py (`rtsys.initialize`), cpython/hashing.py (at its import),
+# np/ufunc/parallel.py (the parallel back end, which no kernel here uses) and misc/numba_sysinfo.py.
+_READ_NUMBA = frozenset({(0, 68)})
+_LEAN_LOAD = tuple(int(part) for part in numba.__version__.split(".")[:2]) in _READ_NUMBA
+
+
 class _PackageFunctionCache(caching.FunctionCache):
     _impl_class = _PackageCacheImpl
 
@@ -202,6 +213,24 @@ class _PackageFunctionCache(caching.FunctionCache):
         super().__init__(py_func)                                 # type: ignore[no-untyped-call]
         self._cache_file = _ReadableCacheFile(                    # type: ignore[no-untyped-call]
             self._cache_path, self._impl.filename_base, self._impl.locator.get_source_stamp())
+
+    def load_overload(self, sig: Any, target_context: Any) -> Any:
+        """numba's `load_overload` without its refresh of the CPU target, which imports some forty
+        modules of lowering code and fills the typing and lowering tables: about 0.12 s of every
+        process that loads a kernel (4 % of a warm plan of the reference cell), and loading machine
+        code reads none of those tables. What loading needs is that every symbol the code links
+        against is known to LLVM; numba registers them at its import and at the CPU context's
+        creation (its C helpers, the math functions, the exception types), in `rtsys.initialize` (the
+        NRT_ runtime) and at the import of `numba.cpython.hashing` (the hash secret), and nowhere
+        else (`_READ_NUMBA`). A symbol left unknown would end the process in LLVM's fatal error, not
+        in an exception, so on a numba release not read for this, numba's own load runs. A cache
+        miss compiles, and every compile refreshes both tables first (`CompilerBase.__init__`)."""
+        if not _LEAN_LOAD:
+            return super().load_overload(sig, target_context)         # type: ignore[no-untyped-call]
+        rtsys.initialize(target_context)
+        import numba.cpython.hashing  # noqa: F401  # registers the hash secret's symbols
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)         # type: ignore[no-untyped-call]
 
 
 def has_cache(fn: object) -> bool:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import ast
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -139,3 +140,70 @@ def test_a_damaged_cache_file_is_read_as_missing_and_written_anew(tmp_path: Path
         assert files.load(("sig",)) == ("code", 2)
     index.write_bytes(b"garbage")
     assert files.load(("sig",)) is None
+
+
+# Where numba registers the symbols machine code links against, as read for `jit._READ_NUMBA`
+# (`_PackageFunctionCache.load_overload`): a release that adds a place is to be read again.
+SYMBOL_SOURCES = {"__init__.py", "core/base.py", "core/cpu.py", "core/externals.py", "core/runtime/nrt.py",
+                  "cpython/hashing.py", "misc/numba_sysinfo.py", "np/ufunc/parallel.py"}
+# A kernel whose code links against numba's runtime (the array) and the hash secret (a string's hash).
+PROBE_LINKED = ("import numpy as np\n\nfrom robomax_py.jit import kernel\n\n\n@kernel\ndef filled(n, word):\n"
+                "    out = np.empty(n)\n    for i in range(n):\n        out[i] = i + (hash(word) == hash(word))\n"
+                "    return out.sum()\n")
+LOAD_SCRIPT = ("from robomax_py._probe_linked import filled\n"
+               "from numba.core.registry import cpu_target\n"
+               "print(filled(3, 'ab'), sum(filled.stats.cache_hits.values()), len(cpu_target.target_context._registries))\n")
+
+
+def test_numba_registers_link_symbols_only_where_the_lean_load_was_read_for() -> None:
+    import numba
+
+    release = tuple(int(part) for part in numba.__version__.split(".")[:2])
+    if release not in jit._READ_NUMBA:
+        assert not jit._LEAN_LOAD                   # numba's own load, refresh and all
+        return
+    assert jit._LEAN_LOAD
+    root = Path(numba.__file__).parent
+    found = {path.relative_to(root).as_posix() for path in root.rglob("*.py")
+             if "tests" not in path.relative_to(root).parts
+             and re.search(r"add_symbol\(|load_library_permanently\(", path.read_text(encoding="utf-8"))}
+    assert found == SYMBOL_SOURCES
+
+
+def test_numbas_own_load_runs_on_a_release_not_read(monkeypatch: pytest.MonkeyPatch) -> None:
+    from numba.core.runtime.nrt import rtsys
+
+    from robomax_py.world.prefilter_kernels import _placements
+
+    calls: list[str] = []
+
+    class Target:
+        def refresh(self) -> None:
+            calls.append("refresh")
+
+    cache = jit._PackageFunctionCache(_placements.py_func)
+    monkeypatch.setattr(cache, "_load_overload", lambda sig, target: "code")
+    monkeypatch.setattr(rtsys, "initialize", lambda target: calls.append("runtime"))
+    monkeypatch.setattr(jit, "_LEAN_LOAD", False)
+    assert cache.load_overload((), Target()) == "code"
+    assert calls == ["refresh"]
+    calls.clear()
+    monkeypatch.setattr(jit, "_LEAN_LOAD", True)
+    assert cache.load_overload((), Target()) == "code"
+    assert calls == ["runtime"]
+
+
+@pytest.mark.slow
+def test_a_cached_kernel_loads_without_numbas_tables_and_gives_the_same(tmp_path: Path) -> None:
+    """The second process loads the kernel (and the helper inside its code) without filling numba's
+    lowering tables; the first compiled it, which fills them."""
+    package = _install(tmp_path / "site")
+    (package / "_probe_linked.py").write_text(PROBE_LINKED)
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env.update(PYTHONPATH=str(package.parent), ROBOMAX_CACHE=str(tmp_path / "cache"), PYTHONDONTWRITEBYTECODE="1")
+    runs = [subprocess.run([sys.executable, "-c", LOAD_SCRIPT], capture_output=True, text=True, env=env,
+                           cwd=package.parent, check=True, timeout=300).stdout.split() for _ in range(2)]
+    (value, hits, tables), (value_again, hits_again, tables_again) = runs
+    assert (value, hits, value_again, hits_again) == ("6.0", "0", "6.0", "1")
+    assert int(tables) > 0
+    assert int(tables_again) == (0 if jit._LEAN_LOAD else int(tables))
