@@ -32,7 +32,7 @@ from robomax_py.robot.solve import (
     config_text,
     ik_columns,
     ik_table_bytes,
-    solve_branches,
+    solve_lines,
 )
 from robomax_py.spec import CellSpec, SeamSpec
 from robomax_py.transforms import invert
@@ -130,7 +130,7 @@ def seam_candidates(
         T_spot = T_base_world @ spot_poses(spots, grid)                     # (S, m, 4, 4)
         T_line = np.stack([approach_poses(T_spot, cell.process.approach * f) for f in fractions], axis=2)
         # The IK branches of every pose; each spot expands the turn variants it needs (`_spot_candidates`).
-        branches = solve_branches(robot, T_line)                            # (S, m, L, K, n)
+        branches = solve_lines(robot, T_line)                               # (S, m, L, K, n)
         branch_of_column = np.repeat(np.arange(branches.q.shape[-2]), branches.variants.count)
         for row in range(len(spots)):
             s = first + row

@@ -188,6 +188,55 @@ def solve_branches(
     return Branches(q=q, valid=np.asarray(valid, dtype=bool), status=status, variants=variants)
 
 
+def solve_lines(robot: RobotModel, T_base_tcp: FloatArray) -> Branches:
+    """`solve_branches` of TCP poses along lines (..., L, 4, 4), each line ending at its last pose
+    (a spot), where a column of a line is one motion along it.
+
+    An arm with more joints than the six a pose fixes has a continuum of solutions in each branch
+    (its self-motion: an iiwa's elbow turning about the shoulder-wrist line), and the first solution
+    found from random starts at one pose is unrelated to the one found at the next: a line of them
+    jumps between every two samples. So for such an arm every pose but the last is solved again from
+    its neighbour nearer the end, in the same column (damped least squares from there converges to
+    the nearby solution), and kept where it has the neighbour's status: a line follows its spot's
+    configuration as the robot would move along it."""
+    branches = solve_branches(robot, T_base_tcp)
+    return _followed(robot, T_base_tcp, branches) if redundant(robot) else branches
+
+
+def _followed(robot: RobotModel, T_base_tcp: FloatArray, branches: Branches) -> Branches:
+    """`branches` of lines (..., L, K, n) with every pose but the last solved from its successor."""
+    q, valid, status = branches.q.copy(), branches.valid.copy(), branches.status.copy()
+    for at in range(q.shape[-3] - 2, -1, -1):
+        nearer = valid[..., at + 1, :]                                       # (..., K)
+        where = np.nonzero(nearer)
+        poses = np.broadcast_to(np.asarray(T_base_tcp)[..., at, None, :, :], nearer.shape + (4, 4))[where]
+        found, ok = continuation(robot, poses, q[..., at + 1, :, :][where])
+        found_status = status_generic(robot.model, robot.flange_frame_id, found)
+        keep = ok & (found_status == status[..., at + 1, :][where])
+        kept = tuple(w[keep] for w in where)
+        q[..., at, :, :] = np.nan
+        valid[..., at, :] = False
+        status[..., at, :] = -1
+        q[..., at, :, :][kept] = found[keep]
+        valid[..., at, :][kept] = True
+        status[..., at, :][kept] = found_status[keep]
+    return Branches(q=q, valid=valid, status=status, variants=branches.variants)
+
+
+def continuation(robot: RobotModel, T_base_tcp: FloatArray, q_from: FloatArray) -> tuple[FloatArray, BoolArray]:
+    """The solution damped least squares reaches for each TCP pose (..., 4, 4) from q_from (..., n)
+    alone, revolute angles in (-pi, pi], and whether it did (within the limits): for a redundant
+    arm the continuation of a motion through q_from, which random starts would not give."""
+    T_flange = np.asarray(T_base_tcp, dtype=float) @ invert(np.asarray(robot.T_flange_tcp, dtype=float))
+    params = robot.ik_params
+    iterations = params.max_iterations if isinstance(params, NumericIkParams) else NumericIkParams().max_iterations
+    found, ok = numeric_ik(robot.model, robot.flange_frame_id, T_flange, np.asarray(robot.limits.lower, dtype=float),
+                           np.asarray(robot.limits.upper, dtype=float), np.random.default_rng(0), 0,
+                           np.asarray(q_from, dtype=float), max_solutions=1, max_iterations=iterations)
+    found = found[..., 0, :]
+    return np.where(revolute_mask(robot.model), wrap_to_pi(found), found), ok[..., 0]
+
+
 # Bytes `solve_all` may hold for one table column of one pose, per joint value and per flag: the
 # table (q float64; valid, reachable bool; status, turn int64) and, for temporaries (the solver's
 # arrays before the turn variants are expanded, `np.where` copies), as much again.
@@ -220,6 +269,12 @@ def _has_status(model: Any, frame_id: int) -> bool:
     chain = chain_to_frame(model, frame_id)
     act = active_positions(chain)
     return len(act) >= 5 and bool(np.all(chain.revolute[act[:5]]))
+
+
+def redundant(robot: RobotModel) -> bool:
+    """Whether the arm has more driven joints than the six a pose fixes: each of its IK branches is a
+    continuum of solutions (the self-motion), not one."""
+    return len(active_positions(chain_to_frame(robot.model, robot.flange_frame_id))) > 6
 
 
 def _by_status(q: FloatArray, valid: BoolArray, status: IntArray) -> tuple[FloatArray, BoolArray, IntArray]:

@@ -10,6 +10,7 @@ from scipy.spatial.transform import Rotation
 
 from robomax_py._typing import FloatArray
 from robomax_py.robot import RobotModel, fk_tcp, prismatic_mask
+from robomax_py.robot.solve import continuation, redundant
 from robomax_py.timing._common import TimingError
 from robomax_py.timing.paths import spline_path
 from robomax_py.tolerances import DEFAULT as TOL
@@ -74,6 +75,10 @@ class Tracker:
         self.max_step = max_step
         self._solve = solve
         self._revolute = ~prismatic_mask(robot.model)
+        # An arm with more joints than six: a column of its table at one pose and at the next are
+        # unrelated points of the self-motion, so a motion is continued from its own last
+        # configuration only (`continued`), never from a table.
+        self.redundant = redundant(robot)
 
     def solve(self, u: FloatArray, q_hint: FloatArray | None = None) -> Any:
         """The IK table at line fractions u (k,); `q_hint` seeds a numeric solver first."""
@@ -117,6 +122,15 @@ class Tracker:
         cand = self.unwrap(q[valid], q_prev)
         k = int(np.argmin(np.max(np.abs(cand - q_prev), axis=1)))
         return np.asarray(cand[k], dtype=float)
+
+    def continued(self, u: float, q_prev: FloatArray) -> FloatArray | None:
+        """A redundant arm's continuation of q_prev at line fraction u (`solve.continuation`), or None
+        where there is none within max_step."""
+        q, ok = continuation(self.robot, self.line.poses(np.array([u])), np.asarray(q_prev, dtype=float)[None])
+        if not ok[0]:
+            return None
+        near = self.unwrap(q, q_prev)[0]
+        return np.asarray(near, dtype=float) if float(np.max(np.abs(near - q_prev))) <= self.max_step else None
 
     def follow(self, table: Any, row: int, q_prev: FloatArray) -> FloatArray | None:
         """The continuation of q_prev at this row: own column first, else any solution within max_step."""

@@ -216,10 +216,15 @@ def refine(tracker: Tracker, u: FloatArray, q: FloatArray, path_tol: float) -> t
         if not np.any(bad):
             break
         mids = 0.5 * (u[:-1][bad] + u[1:][bad])
-        table = tracker.solve(mids)
+        table = None if tracker.redundant else tracker.solve(mids)
         new_q = []
         for j, i in enumerate(np.nonzero(bad)[0]):
-            q_mid = tracker.follow(table, j, q[i])
+            if table is None:
+                q_mid = tracker.continued(float(mids[j]), q[i])
+            else:
+                q_mid = tracker.follow(table, j, q[i])
+                if q_mid is None and tracker.seeded:   # as `_follow`: the continuation, seeded from q[i]
+                    q_mid = tracker.follow(tracker.solve(mids[j:j + 1], q[i]), 0, q[i])
             if q_mid is None:
                 return Unrefined(int(i), float(mids[j]), u[: i + 1], q[: i + 1])
             new_q.append(q_mid)
@@ -234,16 +239,23 @@ def _follow(tracker: Tracker, grid: FloatArray, q0: FloatArray) -> tuple[FloatAr
     robot, line = tracker.robot, tracker.line
     lower = np.asarray(robot.limits.lower) - LIMIT_TOL
     upper = np.asarray(robot.limits.upper) + LIMIT_TOL
-    table = tracker.solve(grid)
+    # A redundant arm continues from its last configuration alone (`Tracker.continued`): its table
+    # is solved only where the line stops, to say why.
+    table = None if tracker.redundant else tracker.solve(grid)
     us: list[float] = [0.0]
     qs: list[FloatArray] = [q0]
     todo: deque[tuple[float, int]] = deque((float(u), i) for i, u in enumerate(grid) if i > 0)
     while todo:
         u_b, row = todo[0]
-        sol, r = (table, row) if row >= 0 else (tracker.solve(np.array([u_b])), 0)
-        q_b = tracker.follow(sol, r, qs[-1])
-        if q_b is None and tracker.seeded:
-            q_b = tracker.follow(tracker.solve(np.array([u_b]), qs[-1]), 0, qs[-1])
+        sol, r = (table, row) if table is not None and row >= 0 else (None, 0)
+        if tracker.redundant:
+            q_b = tracker.continued(u_b, qs[-1])
+        else:
+            if sol is None:
+                sol = tracker.solve(np.array([u_b]))
+            q_b = tracker.follow(sol, r, qs[-1])
+            if q_b is None and tracker.seeded:
+                q_b = tracker.follow(tracker.solve(np.array([u_b]), qs[-1]), 0, qs[-1])
         if q_b is not None:
             if np.any(q_b < lower) or np.any(q_b > upper):
                 return _failed(line, "joint_limit", "the line leaves the joint limits", u_b, us, qs)
@@ -251,6 +263,8 @@ def _follow(tracker: Tracker, grid: FloatArray, q0: FloatArray) -> tuple[FloatAr
             qs.append(q_b)
             todo.popleft()
             continue
+        if sol is None:
+            sol = tracker.solve(np.array([u_b]))
         if not tracker.any_valid(sol, r):
             reason = "joint_limit" if tracker.reachable(sol, r) else "unreachable"
             return _failed(line, reason, "no IK solution on the line here", u_b, us, qs)
@@ -259,7 +273,7 @@ def _follow(tracker: Tracker, grid: FloatArray, q0: FloatArray) -> tuple[FloatAr
             todo.appendleft((0.5 * (u_a + u_b), -1))
             continue
         branch = tracker.branch
-        if tracker.column(sol, r) is not None:
+        if tracker.redundant or tracker.column(sol, r) is not None:
             reason = "discontinuous"
             detail = f"the joints jump by more than {tracker.max_step} rad (branch change or singularity)"
         elif tracker.own_reachable(sol, r):
