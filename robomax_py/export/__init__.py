@@ -154,15 +154,19 @@ def format_names(spec: str, brand: str, robot_file: object = None) -> tuple[str,
 
 @dataclasses.dataclass(frozen=True, slots=True)
 class SkippedFormat:
-    """A dialect `--format all` passes over: the robot file does not state `key`, which it needs."""
+    """A dialect `--format all` passes over: the robot file does not state `key`, which it needs;
+    or (`unfit`) the dialect cannot state the robot's programs at all, for `why`."""
 
     format: str
     robot_file: str
     key: str
     why: str
+    unfit: bool = False
 
     @property
     def message(self) -> str:
+        if self.unfit:
+            return f"{self.robot_file}: no {self.format} program written ({self.why})"
         return (f"{self.robot_file}: {self.key} is not given: no {self.format} program written ({self.why}); "
                 f"state it to have one")
 
@@ -192,11 +196,17 @@ def choose_formats(spec: str, robot: RobotModel) -> FormatChoice:
     names: list[str] = []
     skipped: list[SkippedFormat] = []
     for name, dialect in DIALECTS.items():
+        unfit = dialect.unfit(robot)
         if name in named:
+            if unfit:
+                raise ExportError(f"--format {name}: {robot.source}: {unfit}")
             require_calibration(name, robot)
             names.append(name)
         elif name in every:
             lacking = dialect.needs(robot)
+            if unfit:
+                skipped.append(SkippedFormat(name, str(robot.source), "urdf", unfit, unfit=True))
+                continue
             if lacking:
                 skipped.extend(SkippedFormat(name, str(robot.source), key, why) for key, why in lacking)
             else:

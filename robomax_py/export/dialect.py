@@ -196,6 +196,15 @@ class Dialect:
     splines: bool = False
     # Whether `--format all` takes it in (a dialect left out is written only when named).
     in_all: bool = True
+    # Its programs drive six axes (every vendor dialect here): a robot with another number of
+    # joints is refused before planning when it is named, and passed over by `--format all`.
+    six_axes: bool = True
+
+    def unfit(self, robot: RobotModel) -> str:
+        """Why this dialect cannot state `robot`'s programs at all ("" when it can)."""
+        if self.six_axes and robot.dof != 6:
+            return f"{self.name} programs are for 6-axis arms; {robot.name} has {robot.dof} joints"
+        return ""
 
 
 def with_frame_names(program: Program, name_of: Callable[[FrameDef], str]) -> Program:

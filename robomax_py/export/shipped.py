@@ -12,7 +12,7 @@ from robomax_py.export.dialect import Dialect
 
 __all__ = ["AS", "FANUC", "INFORM", "KRL", "RAPID", "SHIPPED", "SRCL", "URSCRIPT"]
 
-SRCL = Dialect("srcl", (".srcl",), "", srcl.adapt, srcl.write, srcl.parse, splines=True)
+SRCL = Dialect("srcl", (".srcl",), "", srcl.adapt, srcl.write, srcl.parse, splines=True, six_axes=False)
 KRL = Dialect("krl", (".src", ".dat"), "kuka", krl.adapt, krl.write, krl.parse, krl.frame_name,
               (krl.FRAMES_FILE,), krl.FILE_ENCODING, program_name=krl.program_name, splines=True)
 RAPID = Dialect("rapid", (".mod",), "abb", rapid.adapt, rapid.write, rapid.parse, companions=(rapid.FRAMES_FILE,),
