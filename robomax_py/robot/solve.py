@@ -328,7 +328,15 @@ def brand_text_of(robot: RobotModel, q: FloatArray, brand: str, controller: bool
     counts them (`controller_values`): the turn bits, the wrist bit (A5 < 0), ABB's quadrants, FANUC's
     flip and turn numbers, Yaskawa's R/T/S halves. The shoulder and elbow bits are geometric (where
     the wrist point lies, docs/cell-files.md, "Controller programs") and do not depend on how the joints are counted. Without it (SRCL,
-    the trajectory file, the planner) the URDF's joint values, as those state them."""
+    the trajectory file, the planner) the URDF's joint values, as those state them.
+
+    None ("") for an arm with more than six joints: the bits are those of a six-axis arm (the wrist
+    point against the A2-A3 line), which its third joint, a roll of the upper arm on a KUKA LBR
+    iiwa or a Yaskawa SIA, leaves undefined (they flipped between two programs' readings of one
+    configuration), and no six-axis word picks one of its continuum of configurations anyway; its
+    LIN moves follow the configuration they start in (docs/srcl.md)."""
+    if redundant(robot):
+        return ""
     q = np.asarray(q, dtype=float)
     ind = config_of(robot, q)
     q_c = controller_values(robot, q) if controller else q

@@ -56,7 +56,9 @@ def test_a_seven_joint_arm_plans_and_its_program_verifies(tmp_path: Path) -> Non
     done = runner.invoke(app, ["plan", str(cell), "--out", str(tmp_path / "out")])
     assert done.exit_code == 0, done.output
     program = tmp_path / "out" / "iiwa_panel.srcl"
-    assert "AXES(joint_a1, joint_a2, joint_a3, joint_a4, joint_a5, joint_a6, joint_a7)" in program.read_text()
+    text = program.read_text()
+    assert "AXES(joint_a1, joint_a2, joint_a3, joint_a4, joint_a5, joint_a6, joint_a7)" in text
+    assert text.count("MOVE LIN") == text.count("CONFIG ''") == 8       # four spots: approach, retract
     checked = runner.invoke(app, ["verify", str(cell), str(program)])
     assert checked.exit_code == 0 and "clean" in checked.output, checked.output
 

@@ -13,7 +13,7 @@ import robomax_py.timing._lin_track as lin_track
 from robomax_py.app.import_urdf import import_urdf
 from robomax_py.io.robot import load_robot_spec, shipped_robots_dir
 from robomax_py.robot import RobotModel, fk_flange, load_robot
-from robomax_py.robot.solve import redundant, solve_branches, solve_lines
+from robomax_py.robot.solve import config_text, redundant, solve_branches, solve_lines
 from robomax_py.timing.lin import lin_path
 from robomax_py.timing.paths import spline_path
 from robomax_py.timing.topp import time_path
@@ -55,8 +55,11 @@ def _jumps(q: np.ndarray) -> np.ndarray:
 
 
 def test_the_arm_is_redundant_and_a_six_axis_arm_is_not(iiwa: RobotModel) -> None:
-    assert redundant(iiwa)
-    assert not redundant(load_robot(load_robot_spec(shipped_robots_dir() / "kr16" / "robot.yaml")))
+    kr16 = load_robot(load_robot_spec(shipped_robots_dir() / "kr16" / "robot.yaml"))
+    assert redundant(iiwa) and not redundant(kr16)
+    # No configuration word: a six-axis arm's bits do not name one of its configurations.
+    assert config_text(iiwa, np.full(7, 0.3)) == ""
+    assert config_text(kr16, np.full(6, 0.3)) != ""
 
 
 def test_approach_lines_follow_their_spot_configuration(iiwa: RobotModel) -> None:
