@@ -137,8 +137,8 @@ def bench_arm(name: str, source: str, srdf: str, packages: Path | None, seed: in
 
             robot = load_robot(load_robot_spec(robot_yaml))
             brand = robot.controller.brand
-            if robot.dof != 6:
-                row.planned = f"not planned: {robot.dof} joints (the panel cell is for six-axis arms)"
+            if robot.dof < 6:
+                row.planned = f"not planned: {robot.dof} joints (the panel cell needs six or more)"
                 return row
             lower, upper = np.asarray(robot.limits.lower), np.asarray(robot.limits.upper)
             shape = arm_shape(robot_yaml, list(robot.joint_names), lower, upper, np.random.default_rng(seed))
@@ -156,7 +156,10 @@ def bench_arm(name: str, source: str, srdf: str, packages: Path | None, seed: in
             if result.status != "planned":
                 row.planned = f"{result.status}: {one_line(Exception(result.message), 100)}"
                 return row
-            dialects = tuple(d for d in WRITERS if d == {"kuka": "krl", "abb": "rapid", "ur": "urscript"}.get(brand, brand))
+            # The native dialect; SRCL where there is none or it cannot drive the arm (seven axes).
+            dialects = tuple(d for d, dialect in WRITERS.items()
+                             if d == {"kuka": "krl", "abb": "rapid", "ur": "urscript"}.get(brand, brand)
+                             and not dialect.unfit(robot))
             publish(result, cell, load_cell_robot(cell), dialects or ("srcl",))
             row.planned, row.cycle_s = "planned", result.cycle_time
         except RobomaxError as exc:
