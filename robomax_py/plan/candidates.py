@@ -32,6 +32,7 @@ from robomax_py.robot.solve import (
     config_text,
     ik_columns,
     ik_table_bytes,
+    redundant,
     solve_lines,
 )
 from robomax_py.spec import CellSpec, SeamSpec
@@ -163,9 +164,16 @@ def spot_table_bytes(robot: RobotModel, orientations: int, n_line: int, cell: Ce
 
 
 def check_ik_work(cell: CellSpec, robot: RobotModel) -> None:
-    """Refuse, before planning, a cell one of whose spots' IK tables alone exceeds the budget."""
-    for seam in cell.seams:
+    """Refuse, before planning, a cell one of whose spots' IK tables alone exceeds the budget, or
+    that pins configuration data on an arm whose targets carry none (`solve.brand_text_of`)."""
+    for i, seam in enumerate(cell.seams):
         spot_table_bytes(robot, len(orientation_grid(seam).angles), approach_samples(cell), cell, seam.name)
+        pinned = [j for j, spot in enumerate(seam.spots) if spot.config is not None]
+        if pinned and redundant(robot):
+            raise CellFileError(cell.source, f"seams[{i}].spots[{pinned[0]}].config",
+                                f"{robot.name} has {robot.dof} joints: its targets carry no configuration data "
+                                "(a six-axis arm's words do not name one of its configurations), so none can be "
+                                "pinned; remove the key")
 
 
 def _spot_candidates(

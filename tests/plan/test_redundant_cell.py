@@ -20,7 +20,7 @@ UP = [0.0, 0.0, 1.0]
 ALONG = [0.978148, -0.207912, 0.0]           # the panel's long edge: the panel turned -12 deg
 
 
-def _cell(folder: Path) -> Path:
+def _cell(folder: Path, pin: str | None = None) -> Path:
     import_urdf(iiwa14_urdf(folder / "iiwa.urdf"), folder / "robots" / "iiwa")
     tolerance = {"alpha": 15, "beta": 15, "gamma": [-180, 180]}
     data: dict[str, Any] = {
@@ -45,6 +45,8 @@ def _cell(folder: Path) -> Path:
         "process": {"weld_time": 0.3, "approach": 0.03, "clearance": 0.005},
         "planner": {"seed": 0},
     }
+    if pin is not None:
+        data["seams"][0]["spots"][1]["config"] = pin
     path = folder / "cells" / "iiwa_panel.yaml"
     path.parent.mkdir()
     path.write_text(yaml.safe_dump(data, sort_keys=False))
@@ -76,3 +78,14 @@ def test_six_axis_dialects_are_refused_before_planning_and_passed_over_by_all(tm
         "iiwa_panel.json", "iiwa_panel.manifest.json", "iiwa_panel.srcl"]
     for dialect in ("krl", "rapid", "fanuc", "urscript", "inform", "as"):
         assert f"no {dialect} program written ({dialect} programs are for 6-axis arms" in done.output
+
+
+def test_configuration_data_pinned_on_it_is_refused_naming_the_key(tmp_path: Path) -> None:
+    cell = _cell(tmp_path, pin="S010 T000000")
+    done = runner.invoke(app, ["plan", str(cell), "--out", str(tmp_path / "out")])
+    assert done.exit_code == 2 and "Traceback" not in done.output
+    assert f"{cell}: seams[0].spots[1].config: iiwa has 7 joints: its targets carry no configuration data" in \
+        " ".join(done.output.split())
+    assert not (tmp_path / "out").exists()
+    checked = runner.invoke(app, ["check", str(cell)])
+    assert checked.exit_code == 2 and "seams[0].spots[1].config" in " ".join(checked.output.split())

@@ -70,6 +70,7 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
         from robomax_py.io.cell import load_cell, load_cell_robot, read_cell_frames
         from robomax_py.io.frames import format_tree
         from robomax_py.io.station import is_station_file
+        from robomax_py.plan.candidates import check_ik_work
         from robomax_py.plan.reach import (
             always_touching_text,
             reach_report,
@@ -84,6 +85,7 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
         _warn([str(n) for n in spec.notices])   # probable mistakes: warnings, the cell is still valid
         robot = load_cell_robot(spec)
         _warn(robot.warnings)
+        check_ik_work(spec, robot)             # what `plan` refuses before it plans
         if not as_json:
             out.print(cell_summary(spec, robot))
             for file in included:
