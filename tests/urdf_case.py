@@ -1,4 +1,4 @@
-"""A six-joint URDF written by a test, without meshes: the import tests' arms that no package ships."""
+"""Serial-arm URDFs written by tests, without meshes: the arms that no package the tests keep ships."""
 
 from __future__ import annotations
 
@@ -6,20 +6,30 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 
+def serial_urdf(path: Path, name: str, joints: Sequence[tuple[str, str, float, float, float]], tool0: str, *,
+                link: str = "l{}", joint: str = "j{}", tool0_joint: str = "j_t",
+                collisions: Mapping[int, str] = {}) -> Path:
+    """A serial arm: links `link`.format(0..n) joined by revolute joints `joint`.format(1..n), each
+    (origin "x y z", axis "x y z", lower, upper rad, velocity rad/s); `collisions` the <collision>
+    element of link i; tool0 fixed on the last link at `tool0` (an <origin> element)."""
+    links = "".join(f'<link name="{link.format(i)}">{collisions.get(i, "")}</link>' for i in range(len(joints) + 1))
+    body = "".join(
+        f'<joint name="{joint.format(i + 1)}" type="revolute"><parent link="{link.format(i)}"/>'
+        f'<child link="{link.format(i + 1)}"/><origin xyz="{origin}"/><axis xyz="{axis}"/>'
+        f'<limit lower="{lower}" upper="{upper}" effort="1" velocity="{velocity}"/></joint>'
+        for i, (origin, axis, lower, upper, velocity) in enumerate(joints))
+    path.write_text(f'<robot name="{name}">{links}{body}<link name="tool0"/><joint name="{tool0_joint}" type="fixed">'
+                    f'<parent link="{link.format(len(joints))}"/><child link="tool0"/>{tool0}</joint></robot>')
+    return path
+
+
 def six_joint_urdf(path: Path, name: str, axes: Sequence[str], origins: Sequence[str],
                    collisions: Mapping[int, str] = {}) -> Path:
     """Links l0..l6 joined by revolute j1..j6 (limits ±3 rad, 2 rad/s) with the given axes and
     origins ("x y z"), `collisions` as the <collision> element of link i, and tool0 5 cm beyond l6
     with z along l6's x (the flange convention of ROS-Industrial)."""
-    links = "".join(f'<link name="l{i}">{collisions.get(i, "")}</link>' for i in range(7))
-    joints = "".join(
-        f'<joint name="j{i + 1}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
-        f'<origin xyz="{o}"/><axis xyz="{a}"/><limit lower="-3" upper="3" effort="1" velocity="2"/></joint>'
-        for i, (a, o) in enumerate(zip(axes, origins)))
-    path.write_text(f'<robot name="{name}">{links}{joints}<link name="tool0"/><joint name="j_t" type="fixed">'
-                    f'<parent link="l6"/><child link="tool0"/><origin xyz="0.05 0 0" rpy="0 1.5707963267948966 0"/>'
-                    f'</joint></robot>')
-    return path
+    return serial_urdf(path, name, [(o, a, -3, 3, 2) for a, o in zip(axes, origins)],
+                       '<origin xyz="0.05 0 0" rpy="0 1.5707963267948966 0"/>', collisions=collisions)
 
 
 # The KUKA LBR iiwa 14 R820's chain as ros-industrial/kuka_experimental@e78bbd1 states it
@@ -39,14 +49,8 @@ IIWA14_BODIES = ((0.07, 0.15, 0.075), (0.065, 0.115, 0.2225), (0.065, 0.06, 0.0)
 def iiwa14_urdf(path: Path) -> Path:
     """A seven-joint arm with the LBR iiwa 14 R820's kinematics (`IIWA14_JOINTS`), cylinders for
     links and tool0 0.126 m along link 7's z, as the package has it."""
-    links = "".join(
-        f'<link name="link_{i}"><collision><origin xyz="0 0 {z}"/><geometry><cylinder radius="{r}" length="{h}"/>'
-        f'</geometry></collision></link>' for i, (r, h, z) in enumerate(IIWA14_BODIES))
-    joints = "".join(
-        f'<joint name="joint_a{i + 1}" type="revolute"><parent link="link_{i}"/><child link="link_{i + 1}"/>'
-        f'<origin xyz="{o}"/><axis xyz="{a}"/><limit lower="-{lim}" upper="{lim}" effort="0" velocity="{v}"/></joint>'
-        for i, (o, a, lim, v) in enumerate(IIWA14_JOINTS))
-    path.write_text(f'<robot name="lbr_iiwa_14_r820">{links}{joints}<link name="tool0"/>'
-                    f'<joint name="joint_a7-tool0" type="fixed"><parent link="link_7"/><child link="tool0"/>'
-                    f'<origin xyz="0 0 0.126"/></joint></robot>')
-    return path
+    bodies = {i: f'<collision><origin xyz="0 0 {z}"/><geometry><cylinder radius="{r}" length="{h}"/></geometry>'
+                 f'</collision>' for i, (r, h, z) in enumerate(IIWA14_BODIES)}
+    return serial_urdf(path, "lbr_iiwa_14_r820", [(o, a, -lim, lim, v) for o, a, lim, v in IIWA14_JOINTS],
+                       '<origin xyz="0 0 0.126"/>', link="link_{}", joint="joint_a{}", tool0_joint="joint_a7-tool0",
+                       collisions=bodies)

@@ -18,7 +18,7 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
-from urdf_case import six_joint_urdf
+from urdf_case import serial_urdf, six_joint_urdf
 
 from robomax_py.app.cli import app
 from robomax_py.app.import_urdf import guess_brand, import_urdf
@@ -131,18 +131,11 @@ def test_offsets_off_the_axes_are_fitted_exactly(arms: dict[str, Path]) -> None:
 def _irb4400_like_urdf(path: Path, tool0_xyz: str, tool0_rpy: str) -> Path:
     """The joints of abb_irb4400_support/urdf/irb4400l_30_243_macro.xacro (axis 6 along link_6's x),
     no meshes, with tool0 placed on link_6 as given; that package publishes xyz "0.14 0 0", rpy "0 0 0"."""
-    joints = [("0 0 0", "0 0 1", -2.87979, 2.87979), ("0.2 0 0.68", "0 1 0", -1.2217, 1.658),
-              ("0 0 0.89", "0 1 0", -1.0472, 1.1345), ("1.38 0 0.15", "1 0 0", -3.49, 3.49),
-              ("0 0 0", "0 1 0", -2.0944, 2.0944), ("0 0 0", "1 0 0", -6.9813, 6.9813)]
-    links = "".join(f'<link name="link_{i}"/>' for i in range(7))
-    body = "".join(
-        f'<joint name="joint_{i + 1}" type="revolute"><parent link="link_{i}"/><child link="link_{i + 1}"/>'
-        f'<origin xyz="{xyz}"/><axis xyz="{axis}"/><limit lower="{lo}" upper="{hi}" effort="1" velocity="2"/></joint>'
-        for i, (xyz, axis, lo, hi) in enumerate(joints))
-    path.write_text(f'<robot name="irb4400_like">{links}{body}<link name="tool0"/><joint name="joint_6-tool0" '
-                    f'type="fixed"><parent link="link_6"/><child link="tool0"/><origin xyz="{tool0_xyz}" '
-                    f'rpy="{tool0_rpy}"/></joint></robot>')
-    return path
+    joints = [("0 0 0", "0 0 1", -2.87979, 2.87979, 2), ("0.2 0 0.68", "0 1 0", -1.2217, 1.658, 2),
+              ("0 0 0.89", "0 1 0", -1.0472, 1.1345, 2), ("1.38 0 0.15", "1 0 0", -3.49, 3.49, 2),
+              ("0 0 0", "0 1 0", -2.0944, 2.0944, 2), ("0 0 0", "1 0 0", -6.9813, 6.9813, 2)]
+    return serial_urdf(path, "irb4400_like", joints, f'<origin xyz="{tool0_xyz}" rpy="{tool0_rpy}"/>',
+                       link="link_{}", joint="joint_{}", tool0_joint="joint_6-tool0")
 
 
 @pytest.mark.parametrize(("xyz", "rpy"), [("0.14 0 0", "0 0 0"), ("0.14 0.003 -0.002", "0.4 -0.7 1.1")])
