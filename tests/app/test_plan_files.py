@@ -33,8 +33,9 @@ from robomax_py.app.cli import app
 
 ROBOMAX = [sys.executable, "-m", "robomax_py"]
 StateOf = Callable[[Path, str], "str | None"]
-# Wide lines, so that a log line is never wrapped by the console.
-ENV = {**os.environ, "COLUMNS": "400"}
+# Wide lines, so that a log line is never wrapped by the console; a run that crashes (a fatal
+# signal in native code) prints its Python stack (faulthandler), which the failure shows.
+ENV = {**os.environ, "COLUMNS": "400", "PYTHONFAULTHANDLER": "1"}
 NAME = "small_cell"
 # What `plan --format all` writes for the small cell (the set's own files and FANUC's shared routine).
 # No INFORM job: the test arm's robot.yaml states no encoder pulses per degree.
@@ -220,13 +221,15 @@ def test_an_early_interrupt_ends_the_run_non_zero_with_nothing_written(
         folder = tmp_path / f"t{k}"
         # Early: a whole warm run is now about 1.9-2.0 s CPU (-v, --format all); a signal at its
         # end, the programs written and the process exiting, ends it 0, as it should.
-        code, stderr, sent = _trial(sets, folder, sig, float(rng.uniform(0.05, 1.2)), "-v")
+        sent_at = float(rng.uniform(0.05, 1.2))
+        code, stderr, sent = _trial(sets, folder, sig, sent_at, "-v")
         assert "Traceback" not in stderr, stderr
         if not sent:                               # the run finished first: a plain run
             assert code == 0 and plan_set_state(folder, "small_cell") == sets.new_plan, stderr[-2000:]
             continue
         interrupted += 1
-        assert code in expected, (code, stderr[-2000:])
+        if code not in expected:                  # pytest.fail: its message is shown whole, not cut short
+            pytest.fail(f"signal at {sent_at:.3f} s CPU: exit {code}\n{stderr[-4000:]}")
         if "timing: cycle" not in stderr:          # interrupted before the motion was timed
             assert _snapshot(folder) == _snapshot(sets.old)
         assert plan_set_state(folder, "small_cell") in (sets.old_plan, sets.new_plan)
