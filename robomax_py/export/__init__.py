@@ -203,10 +203,10 @@ def choose_formats(spec: str, robot: RobotModel) -> FormatChoice:
             require_calibration(name, robot)
             names.append(name)
         elif name in every:
-            lacking = dialect.needs(robot)
             if unfit:
                 skipped.append(SkippedFormat(name, str(robot.source), "urdf", unfit, unfit=True))
                 continue
+            lacking = dialect.needs(robot)
             if lacking:
                 skipped.extend(SkippedFormat(name, str(robot.source), key, why) for key, why in lacking)
             else:

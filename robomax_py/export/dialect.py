@@ -202,9 +202,7 @@ class Dialect:
 
     def unfit(self, robot: RobotModel) -> str:
         """Why this dialect cannot state `robot`'s programs at all ("" when it can)."""
-        if self.six_axes and robot.dof != 6:
-            return f"{self.name} programs are for 6-axis arms; {robot.name} has {robot.dof} joints"
-        return ""
+        return not_six_axes(robot, self.name) if self.six_axes else ""
 
 
 def with_frame_names(program: Program, name_of: Callable[[FrameDef], str]) -> Program:
@@ -470,6 +468,12 @@ def percent(fraction: float) -> int:
     return max(1, min(100, int(round(fraction * 100))))
 
 
+def not_six_axes(robot: RobotModel, dialect: str) -> str:
+    """Why `dialect`'s programs, which drive six axes, cannot be `robot`'s ("" when they can)."""
+    return f"{dialect} programs are for 6-axis arms; {robot.name} has {robot.dof} joints" if robot.dof != 6 else ""
+
+
 def require_six_axes(robot: RobotModel, dialect: str) -> None:
-    if robot.dof != 6:
-        raise ExportError(f"{dialect} programs are for 6-axis arms; {robot.name} has {robot.dof} joints")
+    why = not_six_axes(robot, dialect)
+    if why:
+        raise ExportError(why)
