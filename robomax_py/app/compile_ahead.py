@@ -103,7 +103,8 @@ def start(kernels: Sequence[KernelEntry] = PLAN_KERNELS, helpers: Sequence[Kerne
         return Compiling()
     if _context() == "fork":
         # numba's typing and target registries, filled here once rather than in every child (about
-        # 0.15 s each); the command needs them anyway to load the kernels.
+        # 0.15 s each), each of which compiles and so needs them. The command itself would not: it
+        # loads the kernels without them (`jit._PackageFunctionCache.load_overload`).
         d = _dispatcher(todo[0])
         d.typingctx.refresh()                   # type: ignore[no-untyped-call]  # numba is untyped
         d.targetctx.refresh()                   # type: ignore[no-untyped-call]
