@@ -46,6 +46,7 @@ PLAN_KERNELS = (
                 (_F2_READ, _F2_READ, _F1, _F1, nt.float64, nt.boolean), 0.3),
     KernelEntry("robomax_py.plan.min_plus", "min_plus_arg", (_F1, _F2, _F1), 0.25),
     KernelEntry("robomax_py.plan.min_plus", "min_plus", (_F1, _F2, _F1), 0.15),
+    KernelEntry("robomax_py.plan.min_plus", "min_plus_product", (_F2, _F2), 0.2),
 )
 
 SHARED_HELPERS = (

@@ -14,6 +14,7 @@ from robomax_py.plan.candidates import SpotCandidates
 from robomax_py.plan.choice_memo import ChoiceMemo
 from robomax_py.plan.learned_detour import LearnedDetours
 from robomax_py.plan.loads import Loads
+from robomax_py.plan.min_plus import min_plus_product
 from robomax_py.plan.results import Progress, ResolvedOptions, _no_progress
 from robomax_py.plan.roadmap import Detour, Roadmap
 from robomax_py.plan.sequence import (
@@ -46,8 +47,6 @@ MAX_FAILED_DETOURS = 6
 # A detour of TCP lines starts and ends in the configurations it was found between: another
 # candidate this close (rad, any joint) is that configuration (`plan.tcp_detour.GOAL_TOL_RAD`).
 JOIN_TOL_RAD = 1e-6
-# Detours priced together in one array by `_via_costs` (bounds its rows x detours x cols memory).
-VIA_CHUNK = 16
 
 
 def _same(a: FloatArray, b: FloatArray) -> np.ndarray:
@@ -204,29 +203,27 @@ class SequencerKnowledge:
             leave = np.where(lines[:, None] & ~_same(ends[:, None, :], self.q(j)[cols][None, :, :]), np.inf, leave)
         bad = self.legs_bad.get((i, j), set())
         verified_only = len(bad) >= MAX_BLOCKED_LEGS
-        marks: dict[int, list[tuple[int, int]]] = {}
-        for a, b, vv in (self.legs_ok.get((i, j), ()) if verified_only else bad):
-            if pi[a] >= 0 and pj[b] >= 0:
-                marks.setdefault(vv, []).append((int(pi[a]), int(pj[b])))
-        inner = np.array([self._inner_time(v, vias[v]) for v in usable])
         column = {v: k for k, v in enumerate(usable)}
-        # Every detour's sum at once, a few at a time (rows x detours x cols), its least kept: the
-        # same sums and the same least as detour by detour (per detour, the numpy calls on a few
-        # rows cost their overhead dozens of times per matrix, and the matrices are asked N^2 times).
-        for k0 in range(0, len(usable), VIA_CHUNK):
-            k1 = min(k0 + VIA_CHUNK, len(usable))
-            via = (enter[:, k0:k1, None] + inner[None, k0:k1, None]) + leave[None, k0:k1, :]
-            cells = [(r, column[v] - k0, c) for v, rc in marks.items() if v in column and k0 <= column[v] < k1
-                     for r, c in rc]
-            if verified_only:
-                verified = np.full_like(via, np.inf)
-                for r, k, c in cells:
-                    verified[r, k, c] = via[r, k, c]
-                via = verified
-            else:
-                for r, k, c in cells:
-                    via[r, k, c] = np.inf
-            out = np.minimum(out, np.min(via, axis=1))
+        # (row, col) -> the detours (columns of `enter`) its mark names: banned, or the only ones
+        # offered once verified_only. A handful: fewer than MAX_BLOCKED_LEGS banned, a few verified.
+        marks: dict[tuple[int, int], set[int]] = {}
+        for a, b, vv in (self.legs_ok.get((i, j), ()) if verified_only else bad):
+            if pi[a] >= 0 and pj[b] >= 0 and vv in column:
+                marks.setdefault((int(pi[a]), int(pj[b])), set()).add(column[vv])
+        inner = np.array([self._inner_time(v, vias[v]) for v in usable])
+        # The sum of a detour's three parts is (enter + inner) + leave, so numpy's first addition
+        # feeds the (min, +) product its rows: every sum and every least as priced one detour at a
+        # time. The product reads the legs once: numpy's broadcast wrote out the rows x detours x
+        # cols sums first, tens of megabytes for two spots of 800 candidates and a dozen detours.
+        enter_inner = enter + inner[None, :]
+        if verified_only:
+            for (r, c), ks in marks.items():
+                out[r, c] = min(enter_inner[r, k] + leave[k, c] for k in ks)
+        else:
+            out = min_plus_product(enter_inner, np.ascontiguousarray(leave))
+            for (r, c), ks in marks.items():
+                out[r, c] = min((enter_inner[r, k] + leave[k, c] for k in range(len(usable)) if k not in ks),
+                                default=np.inf)
         return out
 
     def _detour_speed(self) -> float:

@@ -55,3 +55,21 @@ def min_plus_arg(value: Any, matrix: Any, node: Any) -> Any:
     for j in range(m):
         out[j] += node[j]
     return out, arg
+
+
+@kernel
+def min_plus_product(a: Any, b: Any) -> Any:
+    """out[r, c] = min_k (a[r, k] + b[k, c]); a (n, p), b (p, m), p >= 1: the (min, +) matrix
+    product, row by row in memory order (numpy's broadcast writes out the (n, p, m) sums first)."""
+    n, p = a.shape
+    m = b.shape[1]
+    out = np.empty((n, m))
+    for r in range(n):
+        v = a[r, 0]
+        for c in range(m):
+            out[r, c] = v + b[0, c]
+        for k in range(1, p):
+            v = a[r, k]
+            for c in range(m):
+                out[r, c] = min(out[r, c], v + b[k, c])
+    return out

@@ -143,14 +143,9 @@ def _via_costs_one_by_one(seq: Sequencer, i: int, j: int, rows: np.ndarray, cols
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("chunk", [2, 16])
-def test_detour_prices_batched_equal_one_by_one(reference: tuple[Any, Any, CollisionWorld, list[Any]], chunk: int,
-                                                monkeypatch: pytest.MonkeyPatch) -> None:
-    from robomax_py.plan import graph_knowledge
+def test_detour_prices_batched_equal_one_by_one(reference: tuple[Any, Any, CollisionWorld, list[Any]]) -> None:
     from robomax_py.plan.graph import MAX_BLOCKED_LEGS
     from robomax_py.plan.roadmap import Detour
-
-    monkeypatch.setattr(graph_knowledge, "VIA_CHUNK", chunk)       # detours priced a few at a time, or all at once
 
     cell, robot, world, spots = reference
     seq = Sequencer(cell, robot, world, None, spots, resolved_options(cell, PlanOptions()), np.random.default_rng(0))
@@ -163,9 +158,21 @@ def test_detour_prices_batched_equal_one_by_one(reference: tuple[Any, Any, Colli
     rows, cols = np.arange(len(seq.q(i))), seq._rows(j)
     pi, pj = seq._positions(i, rows), seq._positions(j, cols)
     assert np.isfinite(_via_costs_one_by_one(seq, i, j, rows, cols)).all()
+    free = _via_costs_one_by_one(seq, i, j, rows, cols)
     for count in (0, MAX_BLOCKED_LEGS - 1, MAX_BLOCKED_LEGS + 2):
         seq.legs_bad[(i, j)] = {(int(rng.integers(len(rows))), int(cols[rng.integers(len(cols))]), int(rng.integers(7)))
                                 for _ in range(count)}
+        if 0 < count < MAX_BLOCKED_LEGS:
+            # Two of the bans on the detour a leg's least goes through, so that they change the price.
+            bans = set(list(seq.legs_bad[(i, j)])[:count - 2])
+            while len(bans) < count:
+                a, b = int(rng.integers(len(rows))), int(cols[rng.integers(len(cols))])
+                for v in range(7):
+                    seq.legs_bad[(i, j)] = {(a, b, v)}
+                    if not np.array_equal(_via_costs_one_by_one(seq, i, j, rows, cols), free):
+                        bans.add((a, b, v))
+                        break
+            seq.legs_bad[(i, j)] = bans
         seq.legs_ok[(i, j)] = {(int(rng.integers(len(rows))), int(cols[rng.integers(len(cols))]), int(rng.integers(7)))
                                for _ in range(5)}
         got = seq._via_costs(i, j, seq.vias_for(i, j), rows, cols, pi, pj)
