@@ -9,6 +9,7 @@ import itertools
 import numpy as np
 
 from robomax_py._typing import FloatArray
+from robomax_py.plan.cheapest_first import cheapest_first
 from robomax_py.plan.cspace_detour import grid_detour
 from robomax_py.plan.graph_knowledge import MAX_FAILED_DETOURS, SequencerKnowledge
 from robomax_py.plan.program_frames import cell_program_frames
@@ -397,7 +398,7 @@ class SequencerDetours(SequencerKnowledge):
         known = self.straight.get((i, j), {})
         banned = self.no_way.get((i, j), set())
         tried = 0
-        for flat in np.argsort(est, axis=None, kind="stable"):
+        for flat in cheapest_first(est):
             if tried >= self.options.straight_tries:
                 break
             a, b = (int(x) for x in np.unravel_index(int(flat), est.shape))

@@ -24,6 +24,7 @@ from typing import Literal
 import numpy as np
 
 from robomax_py._typing import FloatArray
+from robomax_py.plan.cheapest_first import cheapest_first
 from robomax_py.plan.graph_detours import SequencerDetours
 from robomax_py.timing import ptp_time_estimate
 
@@ -56,7 +57,7 @@ class SequencerLookahead(SequencerDetours):
         est = self.estimate(i, j)
         known_pairs = self.straight.get((i, j), {})
         tried = sum(1 for free in known_pairs.values() if not free)
-        for flat in np.argsort(est, axis=None, kind="stable"):
+        for flat in cheapest_first(est):
             if tried >= self.options.straight_tries:
                 break
             aa, bb = np.unravel_index(int(flat), est.shape)
