@@ -82,6 +82,19 @@ def _rconf_by_table(q_deg: list[float], overhead: bool, elbow: bool) -> str:
     return ",".join(map(str, [0 if flip else 1, 0 if elbow else 1, 1 if overhead else 0, *over, 0, 0]))
 
 
+def test_as_states_a_blend_to_the_micrometre(robot6) -> None:  # type: ignore[no-untyped-def]
+    """ACCURACY's distance with three decimals, as RoboDK's Kawasaki post writes it: a blend of a
+    big arm rounded to 0.1 mm came back 0.02 deg off the plan at the wrist."""
+    from robomax_py.program import Header, Program
+
+    header = Header("c", "kr16", "gun", 1.0, tuple(f"a{i}" for i in range(6)))
+    moves = (PtpMove((10, -80, 90, 5, 40, 0), 0.5, flyby_mm=33.2449), PtpMove((0, -90, 90, 0, 30, 0), 1.0))
+    files = kawasaki_as.write(Program("c", header, (), moves), robot6)
+    assert "ACCURACY 33.245\r\n" in files[".as"]
+    got = kawasaki_as.parse(files, "x", robot6).program.instructions
+    assert [m.flyby_mm for m in got] == [33.245, 0.0]      # type: ignore[union-attr]
+
+
 @settings(max_examples=80, deadline=None)
 @given(st.lists(st.floats(-359.0, 359.0), min_size=6, max_size=6), st.booleans(), st.booleans())
 def test_rconf_against_the_table(q_deg: list[float], overhead: bool, elbow: bool) -> None:

@@ -27,7 +27,8 @@ examples/Kawasaki.pg):
   the cell's frame numbers;
 - per motion (no ALWAYS: "applies to the next motion only"): `SPEED <%>` (joint moves, whole % of
   the maximum, 1 decimal) or `SPEED <v> MM/S` (linear, 1 decimal), and `ACCURACY <mm>`: a fly-by
-  as the planned blend's TCP distance (1 decimal), and `ACCURACY 1 FINE` at every stop; a motion
+  as the planned blend's TCP distance (3 decimals, as RoboDK's post writes it, Kawasaki.py:178-180),
+  and `ACCURACY 1 FINE` at every stop; a motion
   slower to accelerate than the axes allow (a part in the gripper: robot.yaml `limits.loaded`)
   `ACCEL <%>` and `DECEL <%>` (1 decimal), the share of the maximum acceleration and deceleration
   the next motion uses (RoboDK's post writes the same statement, robodk_postprocessors@d7e6c1c0

@@ -1,5 +1,5 @@
 """An AS program from a planned program: `adapt` states it in AS's terms (frames as variables, OAT
-angles, ACCURACY blends, speeds with 1 decimal), `write` prints the `.as` file with its routines."""
+angles, ACCURACY blends with 3 decimals, speeds with 1), `write` prints the `.as` file with its routines."""
 
 from __future__ import annotations
 
@@ -37,6 +37,11 @@ from robomax_py.program import (
 from robomax_py.robot import RobotModel
 
 INPUT_BASE = 1000            # external input k is signal 1000 + k
+# ACCURACY's distance (mm) as RoboDK's Kawasaki post states it: `'ACCURACY %.3f ALWAYS'`
+# (ros-industrial-attic/robodk_postprocessors@d7e6c1c0 Kawasaki.py:178-180, setZoneData). With one
+# decimal a blend of a big arm came back up to 0.02 deg off the plan at the wrist, beyond the
+# proof's tolerance of 0.01 deg.
+ACCURACY_DECIMALS = 3
 EXT = ".as"
 ROUTINES = ("spot_weld", "grip", "release")
 
@@ -51,8 +56,8 @@ def _program_name(name: str) -> str:
 
 
 def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
-    """The program as AS states it: frames as variables, OAT angles, ACCURACY blends (mm), speeds
-    with 1 decimal, no configuration on transformation locations."""
+    """The program as AS states it: frames as variables, OAT angles, ACCURACY blends (mm, 3
+    decimals), speeds with 1 decimal, no configuration on transformation locations."""
     require_six_axes(robot, "AS")
     if planned.program.setup.weld == "package":
         raise ControllerSetupError("robot.controller.weld", "AS programs weld with a call of spot_weld (weld: call)")
@@ -63,11 +68,11 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     for ins in program.instructions:
         if isinstance(ins, PtpMove):
             ins = dataclasses.replace(ins, speed=max(0.001, round(ins.speed * 100, 1) / 100), accel=_accel(ins.accel),
-                                      flyby_mm=round(ins.flyby_mm, 1))
+                                      flyby_mm=round(ins.flyby_mm, ACCURACY_DECIMALS))
         elif isinstance(ins, LinMove):
             ins = dataclasses.replace(ins, zyx_deg=zyx_from_oat(oat_from_zyx(ins.zyx_deg)), config="",
                                       speed_mm_s=max(0.1, round(ins.speed_mm_s, 1)), accel=_accel(ins.accel),
-                                      flyby_mm=round(ins.flyby_mm, 1))
+                                      flyby_mm=round(ins.flyby_mm, ACCURACY_DECIMALS))
         out.append(ins)
     frames = tuple(dataclasses.replace(f, zyx_deg=zyx_from_oat(oat_from_zyx(f.zyx_deg))) for f in program.frames)
     return dataclasses.replace(program, name=_program_name(program.name), frames=frames, instructions=tuple(out))
@@ -96,7 +101,7 @@ def write(program: Program, robot: RobotModel) -> dict[str, str]:
     calls: dict[str, int] = {}
     for ins in program.instructions:
         if isinstance(ins, (PtpMove, LinMove)):
-            accuracy = f"ACCURACY {_num(ins.flyby_mm, 1)}" if ins.flyby_mm > 0 else "ACCURACY 1 FINE"
+            accuracy = f"ACCURACY {_num(ins.flyby_mm, ACCURACY_DECIMALS)}" if ins.flyby_mm > 0 else "ACCURACY 1 FINE"
             if ins.accel < 1.0:
                 body += [f"ACCEL {_num(ins.accel * 100, 1)}", f"DECEL {_num(ins.accel * 100, 1)}"]
             if isinstance(ins, PtpMove):
