@@ -1,6 +1,7 @@
 """The step of the candidate-choice DP (`sequence.best_choice`) in one compiled pass: for every
 candidate j of the next spot, the least of value[i] + matrix[i, j] over the candidates i of the last
-spot (and which i), plus j's own cost.
+spot (and which i), plus j's own cost. And the (min, +) matrix product that prices the known detours
+between two spots' candidates (`graph_knowledge`), each sum one IEEE addition as numpy's.
 
 numpy spends the step in two passes: the (N_prev, N_next) sums are written out, then reduced down
 their columns, and `argmin` down a column is a strided walk. One pass row by row reads the matrix
