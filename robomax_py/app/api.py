@@ -193,7 +193,7 @@ def write_programs(cell: LoadedCell, result: PlanResult, out_dir: str | Path,
     Raises ExportError for a plan that is not complete, a dialect named that the robot file lacks
     data for, or a program that does not prove: nothing is written then.
     """
-    from robomax_py.export import SHARED_FILES, choose_formats
+    from robomax_py.export import SHARED_FILES, choose_formats, setup_signals
     from robomax_py.io.files import MANIFEST_SUFFIX, commit_set
     from robomax_py.plan import method_suffix
     from robomax_py.publish import publish
@@ -207,7 +207,7 @@ def write_programs(cell: LoadedCell, result: PlanResult, out_dir: str | Path,
         if not formats or any(not isinstance(f, str) or not f.strip() or "," in f for f in formats):
             raise ExportError(f"formats: expected one dialect name per item (e.g. ['srcl', 'krl']), got {formats!r}")
         asked = ",".join(formats)
-    chosen = choose_formats(asked, cell.robot)
+    chosen = choose_formats(asked, cell.robot, setup_signals(cell.spec.controller), cell.spec.source)
     for skipped in chosen.skipped:
         warnings.warn(skipped.message, FormatSkippedWarning, stacklevel=2)
     files, checked = publish(result, cell.spec, cell.robot, chosen.names, stamp=stamp, method=result.method)

@@ -92,7 +92,7 @@ def plan_cell_file(file: str, settings: PlanSettings) -> CellOutcome:
     Every file it reads is listed, with its sha256, in the outcome's `inputs` (what `--resume`
     compares)."""
     from robomax_py.errors import RobomaxError
-    from robomax_py.export import choose_formats
+    from robomax_py.export import choose_formats, setup_signals
     from robomax_py.io.cell import load_cell, load_cell_robot
     from robomax_py.plan import method_options, plan_cell
     from robomax_py.publish import publish
@@ -103,7 +103,7 @@ def plan_cell_file(file: str, settings: PlanSettings) -> CellOutcome:
         with recording_reads() as reads:
             spec = load_cell(file)
             robot = load_cell_robot(spec)
-        chosen = choose_formats(settings.formats, robot)
+        chosen = choose_formats(settings.formats, robot, setup_signals(spec.controller), spec.source)
         result = plan_cell(spec, robot, method_options(settings.method))
         programs = (tuple(publish(result, spec, robot, chosen.names, method=settings.method)[0].items())
                     if result.status == PLANNED else ())

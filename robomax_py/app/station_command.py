@@ -25,6 +25,7 @@ def plan_station_files(path: Path, out_dir: Path, formats: str, speed: float | N
         allocate,
         interlock_edit,
         station_block,
+        station_signals,
         station_summary,
         with_interlock_io,
         with_station_block,
@@ -41,7 +42,8 @@ def plan_station_files(path: Path, out_dir: Path, formats: str, speed: float | N
     station = load_station(path)
     _warn([str(n) for n in station.notices])
     models = {r.name: load_cell_robot(r.cell) for r in station.robots}
-    chosen = {name: choose_formats(formats, m) for name, m in models.items()}
+    chosen = {r.name: choose_formats(formats, models[r.name], station_signals(i, r), station.source)
+              for i, r in enumerate(station.robots)}
     _warn([f"{name}: {s.message}" for name, c in chosen.items() for s in c.skipped])
     plan = plan_station(station, models, StationOptions(plan=PlanOptions(speed=speed)))
     if plan.status != "planned" or plan.coordination is None:

@@ -10,15 +10,29 @@ import json
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from robomax_py.export.dialect import PlannedProgram
+from robomax_py.export.dialect import NumberedSignal, PlannedProgram, setup_signals
 from robomax_py.plan import PlanResult
 from robomax_py.program import Comment, Instruction, PtpMove, SetSignal, Spot, WaitFor
+from robomax_py.spec_station import StationRobot
 from robomax_py.station.interlocks import StationInterlock, allocate, with_interlock_io
 from robomax_py.station.pipeline import StationPlan
 
 STATION_FORMAT = "robomax.station/1"
 # An own-clock time of the plan and the same time read back from a spot's leave time agree this well.
 SAME_TIME_S = 1e-6
+
+
+def station_signals(index: int, robot: StationRobot) -> tuple[NumberedSignal, ...]:
+    """The input and output numbers the station file gives robot `index` (robots[index]): its
+    controller's signals, and both ends of the ranges it lends to interlocks (the planner may
+    allocate any number of them)."""
+    prefix = f"robots[{index}].controller"
+    io = f"{prefix}.interlock_io"
+    ends = (NumberedSignal(f"{io}.inputs", "input", robot.interlock_inputs.first),
+            NumberedSignal(f"{io}.inputs", "input", robot.interlock_inputs.last),
+            NumberedSignal(f"{io}.outputs", "output", robot.interlock_outputs.first),
+            NumberedSignal(f"{io}.outputs", "output", robot.interlock_outputs.last))
+    return (*setup_signals(robot.cell.controller, prefix), *ends)
 
 
 def interlock_edit(robot: str, result: PlanResult, interlocks: Sequence[StationInterlock]

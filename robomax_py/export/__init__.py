@@ -11,6 +11,7 @@ module owns its adapter, writer and reader (`srcl`, `krl`, `rapid`, `fanuc`, `ur
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from importlib import metadata
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -18,9 +19,15 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from robomax_py._typing import FloatArray
-from robomax_py.errors import ExportError
+from robomax_py.errors import CellFileError, ExportError
 from robomax_py.export import trajectory_json
-from robomax_py.export.dialect import Dialect, Parsed, in_controller_joints
+from robomax_py.export.dialect import (
+    Dialect,
+    NumberedSignal,
+    Parsed,
+    in_controller_joints,
+    setup_signals,
+)
 from robomax_py.export.mount import mount_rotation, robroot
 from robomax_py.export.plan_program import frame_defs, identifier
 from robomax_py.plan import PlanResult
@@ -33,10 +40,10 @@ from robomax_py.transforms import invert
 if TYPE_CHECKING:
     from robomax_py.export.rebuild.result import Rebuilt
 
-__all__ = ["DIALECTS", "ENTRY_POINT_GROUP", "SHARED_FILES", "Dialect", "FormatChoice", "SkippedFormat",
+__all__ = ["DIALECTS", "ENTRY_POINT_GROUP", "SHARED_FILES", "Dialect", "FormatChoice", "NumberedSignal", "SkippedFormat",
            "choose_formats", "controller_frames", "controller_rebuild", "controller_world", "dialect_for_file", "format_names",
            "load_dialects", "native_dialect",
-           "render_trajectory", "require_calibration"]
+           "render_trajectory", "require_calibration", "setup_signals"]
 
 # The entry point group program dialects register under (pyproject.toml): each entry point names a
 # `Dialect` object; its name is the `--format` name.
@@ -155,18 +162,23 @@ def format_names(spec: str, brand: str, robot_file: object = None) -> tuple[str,
 @dataclasses.dataclass(frozen=True, slots=True)
 class SkippedFormat:
     """A dialect `--format all` passes over: the robot file does not state `key`, which it needs;
-    or (`unfit`) the dialect cannot state the robot's programs at all, for `why`."""
+    or (`unfit`) the dialect cannot state the robot's programs at all, for `why`; or (`signal`) the
+    cell file (`robot_file` then names it) gives `key` a controller input or output number the
+    dialect's programs cannot address."""
 
     format: str
     robot_file: str
     key: str
     why: str
     unfit: bool = False
+    signal: bool = False
 
     @property
     def message(self) -> str:
         if self.unfit:
             return f"{self.robot_file}: no {self.format} program written ({self.why})"
+        if self.signal:
+            return f"{self.robot_file}: {self.key}: {self.why}: no {self.format} program written"
         return (f"{self.robot_file}: {self.key} is not given: no {self.format} program written ({self.why}); "
                 f"state it to have one")
 
@@ -187,24 +199,34 @@ def require_calibration(fmt: str, robot: RobotModel) -> None:
         raise ExportError(f"--format {fmt}: {robot.source}: {key} is not given for {robot.name}: {why}")
 
 
-def choose_formats(spec: str, robot: RobotModel) -> FormatChoice:
+def choose_formats(spec: str, robot: RobotModel, signals: Sequence[NumberedSignal] = (),
+                   cell_file: Path | None = None) -> FormatChoice:
     """`--format` LIST for `robot` (`format_names`): a dialect named (or `native`) that needs data
-    the robot file lacks is an ExportError naming the file and the key (checked before anything is
-    planned or written); `all` means every dialect the robot can be written in, the others skipped
-    with the reason (`FormatChoice.skipped`), so that a whole set never fails for a missing calibration."""
+    the robot file lacks is an ExportError naming the file and the key, and one whose programs
+    cannot address an input or output number of `signals` (the cell file's, `setup_signals`) a
+    CellFileError naming `cell_file` and the key (both checked before anything is planned or
+    written); `all` means every dialect the robot can be written in, the others skipped with the
+    reason (`FormatChoice.skipped`), so that a whole set never fails for a missing calibration or a
+    vendor's I/O numbering."""
     named, every = _requested(spec, robot.controller.brand, robot.source)
     names: list[str] = []
     skipped: list[SkippedFormat] = []
     for name, dialect in DIALECTS.items():
         unfit = dialect.unfit(robot)
+        io = dialect.signal_problem(signals)
         if name in named:
             if unfit:
                 raise ExportError(f"--format {name}: {robot.source}: {unfit}")
             require_calibration(name, robot)
+            if io is not None:
+                raise CellFileError(cell_file or Path("<cell>"), io[0], f"{io[1]} (--format {name})")
             names.append(name)
         elif name in every:
             if unfit:
                 skipped.append(SkippedFormat(name, str(robot.source), "urdf", unfit, unfit=True))
+                continue
+            if io is not None:
+                skipped.append(SkippedFormat(name, str(cell_file or "<cell>"), io[0], io[1], signal=True))
                 continue
             lacking = dialect.needs(robot)
             if lacking:

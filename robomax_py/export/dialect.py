@@ -17,6 +17,7 @@ import math
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Literal
 
 from lark import Token, Tree
 
@@ -155,6 +156,31 @@ def own_name(frame: FrameDef) -> str:
     return frame.name
 
 
+@dataclass(frozen=True, slots=True)
+class SignalNumbers:
+    """The controller inputs and outputs a dialect's programs address by number (ends included),
+    and the dialect's name in messages."""
+
+    label: str
+    inputs: tuple[int, int]
+    outputs: tuple[int, int]
+
+
+@dataclass(frozen=True, slots=True)
+class NumberedSignal:
+    """A number the cell (or station) file gives a controller input or output, and its key there."""
+
+    key: str
+    kind: Literal["input", "output"]
+    number: int
+
+
+def setup_signals(setup: ControllerSetup, prefix: str = "robot.controller") -> tuple[NumberedSignal, ...]:
+    """The numbered inputs and outputs of a cell's controller section (`prefix`: its key in the file)."""
+    return (*(NumberedSignal(f"{prefix}.inputs.{i.signal}", "input", i.number) for i in setup.inputs),
+            *(NumberedSignal(f"{prefix}.outputs.{o.signal}", "output", o.number) for o in setup.outputs))
+
+
 def needs_nothing(robot: RobotModel) -> tuple[tuple[str, str], ...]:
     """What a dialect that can write a program for any arm needs of robot.yaml: nothing."""
     return ()
@@ -199,10 +225,24 @@ class Dialect:
     # Its programs drive six axes (every vendor dialect here): a robot with another number of
     # joints is refused before planning when it is named, and passed over by `--format all`.
     six_axes: bool = True
+    # The inputs and outputs its programs address by number (None: it names signals, as SRCL, or
+    # addresses them otherwise, as RAPID's I/O configuration).
+    signals: SignalNumbers | None = None
 
     def unfit(self, robot: RobotModel) -> str:
         """Why this dialect cannot state `robot`'s programs at all ("" when it can)."""
         return not_six_axes(robot, self.name) if self.six_axes else ""
+
+    def signal_problem(self, numbered: Sequence[NumberedSignal]) -> tuple[str, str] | None:
+        """The first number the file gives that this dialect's programs cannot address, as (key,
+        problem); None when every one fits."""
+        if self.signals is None:
+            return None
+        for s in numbered:
+            low, high = self.signals.inputs if s.kind == "input" else self.signals.outputs
+            if not low <= s.number <= high:
+                return s.key, f"{s.kind} {s.number} is outside {self.signals.label}'s {s.kind}s {low}..{high}"
+        return None
 
 
 def with_frame_names(program: Program, name_of: Callable[[FrameDef], str]) -> Program:

@@ -57,6 +57,7 @@ from robomax_py.errors import ControllerSetupError, ExportError, ProgramError
 from robomax_py.export.dialect import (
     Parsed,
     PlannedProgram,
+    SignalNumbers,
     controller_identifier,
     header_lines,
     numbered_frames,
@@ -89,12 +90,13 @@ from robomax_py.program import (
 )
 from robomax_py.robot import RobotModel
 
-__all__ = ["ROUTINES", "adapt", "frame_name", "needs", "parse", "program_name", "write"]
+__all__ = ["ROUTINES", "SIGNALS", "adapt", "frame_name", "needs", "parse", "program_name", "write"]
 
 NAME_CHARS = 32              # a job name (DX100; the NX100 took 8)
 TOOL_SLOTS, USER_SLOTS = 23, 23       # ///TOOL 0..23, ///USER 0..23 (NX100 §4.1.3)
 INPUTS = 1024                # general inputs IN#(1..)
 OUTPUTS = 1024               # general outputs OT#(1..)
+SIGNALS = SignalNumbers("INFORM", (1, INPUTS), (1, OUTPUTS))
 WELD_JOB = "SPOTWELD"
 ROUTINES = (WELD_JOB,)
 ANGLE_DECIMALS = 4           # Rx, Ry, Rz (RoboDK writes 2; robomax's angles carry 4)
@@ -153,8 +155,8 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     require_six_axes(robot, "INFORM")
     ppd = _pulses(robot)
     numbered_frames(planned.program, "INFORM", TOOL_SLOTS, USER_SLOTS)
-    numbered_inputs(planned.program, "INFORM", 1, INPUTS)
-    numbered_outputs(planned.program, "INFORM", 1, OUTPUTS)
+    numbered_inputs(planned.program, SIGNALS.label, *SIGNALS.inputs)
+    numbered_outputs(planned.program, SIGNALS.label, *SIGNALS.outputs)
     program = with_tcp_blends(planned, robot)
     program = with_package_welds(with_frame_names(program, frame_name), "INFORM")
     program = without_comments(with_brand_configs(program, planned.joints, robot, "yaskawa"))

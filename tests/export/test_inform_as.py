@@ -234,6 +234,35 @@ def test_all_passes_over_inform_for_an_arm_without_pulse_counts(robot6) -> None:
     assert export.choose_formats("srcl", bare) == export.FormatChoice(("srcl",))
 
 
+def test_all_passes_over_a_dialect_that_cannot_address_the_cells_signals(robot6) -> None:  # type: ignore[no-untyped-def]
+    """The cell's input and output numbers are checked against each vendor's numbering before
+    anything is planned: URScript addresses standard digital I/O 0..7, KRL, FANUC TP, INFORM and AS
+    count from 1. `all` passes over a dialect that cannot address one, naming the cell file and the
+    key; named, it is refused with that file and key; SRCL and RAPID name their signals."""
+    from robomax_py.errors import CellFileError
+    from robomax_py.spec import ControllerInput, ControllerOutput, ControllerSetup
+
+    cell = Path("station.yaml")
+    setup = ControllerSetup(inputs=(ControllerInput("clamp_closed", 12),), outputs=(ControllerOutput("zone_clear", 0),))
+    signals = export.setup_signals(setup, "robots[1].controller")
+    assert [(s.key, s.kind, s.number) for s in signals] == [
+        ("robots[1].controller.inputs.clamp_closed", "input", 12), ("robots[1].controller.outputs.zone_clear", "output", 0)]
+    chosen = export.choose_formats("all", robot6, signals, cell)
+    assert chosen.names == ("srcl", "rapid")
+    assert [(k.format, k.key) for k in chosen.skipped] == [
+        ("krl", "robots[1].controller.outputs.zone_clear"), ("fanuc", "robots[1].controller.outputs.zone_clear"),
+        ("urscript", "robots[1].controller.inputs.clamp_closed"), ("inform", "robots[1].controller.outputs.zone_clear"),
+        ("as", "robots[1].controller.outputs.zone_clear")]
+    assert chosen.skipped[2].message == ("station.yaml: robots[1].controller.inputs.clamp_closed: input 12 is outside "
+                                         "URScript's inputs 0..7: no urscript program written")
+    with pytest.raises(CellFileError, match=r"station.yaml: robots\[1\].controller.inputs.clamp_closed: input 12 is "
+                                            r"outside URScript's inputs 0..7 \(--format urscript\)"):
+        export.choose_formats("srcl,urscript", robot6, signals, cell)
+    fits = export.setup_signals(ControllerSetup(inputs=(ControllerInput("clamp_closed", 7),)))
+    assert export.choose_formats("all", robot6, fits, cell).names == tuple(export.DIALECTS)
+    assert export.choose_formats("urscript", robot6, fits, cell).names == ("urscript",)
+
+
 def test_publish_refuses_inform_without_pulse_counts_before_proving_any(robot6) -> None:  # type: ignore[no-untyped-def]
     """publish checks every format's calibration first: no dialect is proven for a set that cannot
     be whole (the plan is not even looked at)."""

@@ -59,7 +59,7 @@ def plan(
             compiling = _compile_ahead()         # side by side with the imports and the files' reading
             from robomax_py.app.progress import configure_logging, stage_bars
             from robomax_py.app.report import plan_report, report_tables
-            from robomax_py.export import SHARED_FILES, choose_formats
+            from robomax_py.export import SHARED_FILES, choose_formats, setup_signals
             from robomax_py.io.cell import load_cell, load_cell_robot
             from robomax_py.io.files import commit_set
             from robomax_py.plan import (
@@ -91,7 +91,7 @@ def plan(
         robot = load_cell_robot(spec)
         _honour_signals()
         _warn(robot.warnings)
-        chosen = choose_formats(formats, robot)
+        chosen = choose_formats(formats, robot, setup_signals(spec.controller), spec.source)
         names = chosen.names
         _warn([s.message for s in chosen.skipped])
         set_name = spec.name + method_suffix(method)

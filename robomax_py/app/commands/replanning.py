@@ -50,7 +50,7 @@ def replan(
             compiling = _compile_ahead()         # side by side with the imports and the files' reading
             from robomax_py.app.replan import continuation_file, summary
             from robomax_py.app.replan import replan as replan_program
-            from robomax_py.export import SHARED_FILES, choose_formats
+            from robomax_py.export import SHARED_FILES, choose_formats, setup_signals
             from robomax_py.io.cell import cell_from_mapping, load_cell, load_cell_robot
             from robomax_py.io.files import commit_set
             from robomax_py.io.plan_set_check import CELL_FILE_SUFFIX
@@ -67,7 +67,7 @@ def replan(
         spec = load_cell(cell)
         _warn([str(n) for n in spec.notices])
         robot = load_cell_robot(spec)
-        chosen = choose_formats(formats, robot)
+        chosen = choose_formats(formats, robot, setup_signals(spec.controller), spec.source)
         _warn([s.message for s in chosen.skipped])
         compiling.wait(_honour_signals)
         outcome = replan_program(spec, robot, program, at, tuple(events))

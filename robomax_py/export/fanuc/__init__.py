@@ -95,6 +95,7 @@ from robomax_py.export.fanuc.write import (
     NAME_CHARS,
     REMARK_CHARS,
     ROUTINES,
+    SIGNALS,
     adapt,
     frame_name,
     program_name,
@@ -104,5 +105,5 @@ from robomax_py.export.fanuc.write import (
 from robomax_py.export.fanuc.write import FRAMES_SUFFIX as FRAMES_SUFFIX
 from robomax_py.program import FrameDef as FrameDef
 
-__all__ = ["CNT_DEG", "FRAMES_FILE", "NAME_CHARS", "REMARK_CHARS", "ROUTINES", "adapt", "frame_name", "parse",
+__all__ = ["CNT_DEG", "FRAMES_FILE", "NAME_CHARS", "REMARK_CHARS", "ROUTINES", "SIGNALS", "adapt", "frame_name", "parse",
            "program_name", "remarks", "write"]

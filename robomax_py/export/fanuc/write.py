@@ -10,6 +10,7 @@ import re
 from robomax_py.errors import ControllerSetupError, ExportError
 from robomax_py.export.dialect import (
     PlannedProgram,
+    SignalNumbers,
     fitted_identifier,
     gripper_label,
     header_lines,
@@ -52,6 +53,7 @@ ROUTINES = (WEAPON, "GRIP", "RELEASE")
 # R-30iB: tool frames UTOOL[1..10], user frames UFRAME[1..9] (0 is the world frame).
 TOOL_SLOTS, BASE_SLOTS, INPUTS = 10, 9, 9999
 OUTPUTS = INPUTS     # DO[k], numbered as DI[k]
+SIGNALS = SignalNumbers("FANUC TP", (1, INPUTS), (1, OUTPUTS))
 
 CNT_DEG = 0.12            # joint-space fly-by radius of CNT1, deg
 # Angles (W, P, R and joint values) with 4 decimals, as every robomax program states them (TP's
@@ -142,8 +144,8 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     and mm/sec, waits on DI numbers, SpotTool+ welds with `weld: package`."""
     require_six_axes(robot, "FANUC TP")
     numbered_frames(planned.program, "FANUC TP", TOOL_SLOTS, BASE_SLOTS)
-    numbered_inputs(planned.program, "FANUC TP", 1, INPUTS)
-    numbered_outputs(planned.program, "FANUC TP", 1, OUTPUTS)
+    numbered_inputs(planned.program, SIGNALS.label, *SIGNALS.inputs)
+    numbered_outputs(planned.program, SIGNALS.label, *SIGNALS.outputs)
     registers = planned.program.setup.position_registers
     if registers and len(registers) < len(planned.program.frames):
         raise ControllerSetupError("robot.controller.registers.position", f"the frames setup program sets "

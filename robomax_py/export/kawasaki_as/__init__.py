@@ -54,7 +54,7 @@ from robomax_py.export.kawasaki_as.oat import (
            zyx_from_oat,
 )
 from robomax_py.export.kawasaki_as.read import parse
-from robomax_py.export.kawasaki_as.write import adapt, frame_name, write
+from robomax_py.export.kawasaki_as.write import SIGNALS, adapt, frame_name, write
 
-__all__ = ["adapt", "frame_name", "matrix_from_oat", "oat_from_matrix", "oat_from_zyx", "parse", "write",
+__all__ = ["SIGNALS", "adapt", "frame_name", "matrix_from_oat", "oat_from_matrix", "oat_from_zyx", "parse", "write",
            "zyx_from_oat"]

@@ -8,6 +8,7 @@ import dataclasses
 from robomax_py.errors import ControllerSetupError, ExportError
 from robomax_py.export.dialect import (
     PlannedProgram,
+    SignalNumbers,
     controller_identifier,
     gripper_label,
     header_lines,
@@ -37,6 +38,8 @@ from robomax_py.program import (
 from robomax_py.robot import RobotModel
 
 INPUT_BASE = 1000            # external input k is signal 1000 + k
+# External inputs and outputs 1-999 (input k read as signal 1000 + k).
+SIGNALS = SignalNumbers("AS", (1, 999), (1, 999))
 # ACCURACY's distance (mm) as RoboDK's Kawasaki post states it: `'ACCURACY %.3f ALWAYS'`
 # (ros-industrial-attic/robodk_postprocessors@d7e6c1c0 Kawasaki.py:178-180, setZoneData). With one
 # decimal a blend of a big arm came back up to 0.02 deg off the plan at the wrist, beyond the
@@ -61,8 +64,8 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     require_six_axes(robot, "AS")
     if planned.program.setup.weld == "package":
         raise ControllerSetupError("robot.controller.weld", "AS programs weld with a call of spot_weld (weld: call)")
-    numbered_inputs(planned.program, "AS", 1, 999)
-    numbered_outputs(planned.program, "AS", 1, 999)
+    numbered_inputs(planned.program, SIGNALS.label, *SIGNALS.inputs)
+    numbered_outputs(planned.program, SIGNALS.label, *SIGNALS.outputs)
     program = without_comments(with_frame_names(with_tcp_blends(planned, robot), frame_name))
     out: list[Instruction] = []
     for ins in program.instructions:

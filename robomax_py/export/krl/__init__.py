@@ -109,10 +109,11 @@ from robomax_py.export.krl.read import parse
 from robomax_py.export.krl.write import (
     FILE_ENCODING,
     FRAMES_FILE,
+    SIGNALS,
     adapt,
     frame_name,
     program_name,
     write,
 )
 
-__all__ = ["FILE_ENCODING", "FRAMES_FILE", "adapt", "frame_name", "parse", "program_name", "write"]
+__all__ = ["FILE_ENCODING", "FRAMES_FILE", "SIGNALS", "adapt", "frame_name", "parse", "program_name", "write"]

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 from robomax_py.errors import ExportError
 from robomax_py.export.dialect import (
     PlannedProgram,
+    SignalNumbers,
     fitted_identifier,
     gripper_label,
     header_lines,
@@ -49,6 +50,7 @@ FILE_ENCODING = "cp1252"
 TOOL_SLOTS, BASE_SLOTS, INPUTS = 16, 32, 4096
 # ... and 4096 digital outputs $OUT[1..4096] (KSS 8 system variables).
 OUTPUTS = 4096
+SIGNALS = SignalNumbers("KRL", (1, INPUTS), (1, OUTPUTS))
 # $config.dat factory values (NAQIU KRC/R1/System/$config.dat 18-41) that BAS.SRC applies.
 DEF_VEL_CP_M_S = 2.0
 DEF_APO_CDIS_MM = 3.0
@@ -111,8 +113,8 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     of its own (`_robot_base_slot`)."""
     require_six_axes(robot, "KRL")
     numbered_frames(planned.program, "KRL", TOOL_SLOTS, BASE_SLOTS)
-    numbered_inputs(planned.program, "KRL", 1, INPUTS)
-    numbered_outputs(planned.program, "KRL", 1, OUTPUTS)
+    numbered_inputs(planned.program, SIGNALS.label, *SIGNALS.inputs)
+    numbered_outputs(planned.program, SIGNALS.label, *SIGNALS.outputs)
     tilted = planned.program.setup.tilted_mount
     program = _robot_base_slot(planned.program) if tilted else planned.program
     # $BASE is relative to $WORLD (mount.py); on a tilted mount the frames are stated relative to

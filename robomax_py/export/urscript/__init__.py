@@ -41,6 +41,6 @@ them above the slowest joint's limits, and lines above the cell's line speed).
 from __future__ import annotations
 
 from robomax_py.export.urscript.read import parse
-from robomax_py.export.urscript.write import adapt, reference_limits, write
+from robomax_py.export.urscript.write import SIGNALS, adapt, reference_limits, write
 
-__all__ = ["adapt", "parse", "reference_limits", "write"]
+__all__ = ["SIGNALS", "adapt", "parse", "reference_limits", "write"]

@@ -9,6 +9,7 @@ import math
 from robomax_py.errors import ExportError
 from robomax_py.export.dialect import (
     PlannedProgram,
+    SignalNumbers,
     gripper_label,
     header_lines,
     numbered_inputs,
@@ -47,14 +48,15 @@ INPUTS = 7
 # Its standard digital outputs: set_standard_digital_out(n, b), n in [0:7] (UR Script Manual,
 # "set_standard_digital_out").
 OUTPUTS = 7
+SIGNALS = SignalNumbers("URScript", (0, INPUTS), (0, OUTPUTS))
 
 
 def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     """The program as URScript states it: no configuration data, TCP-distance blends, frames as
     pose variables, waits on standard digital inputs."""
     require_six_axes(robot, "URScript")
-    numbered_inputs(planned.program, "URScript", 0, INPUTS)
-    numbered_outputs(planned.program, "URScript", 0, OUTPUTS)
+    numbered_inputs(planned.program, SIGNALS.label, *SIGNALS.inputs)
+    numbered_outputs(planned.program, SIGNALS.label, *SIGNALS.outputs)
     program = with_brand_configs(planned.program, planned.joints, robot, "ur")
     # URScript refers to poses by variable name: the frames carry no slot number.
     program = dataclasses.replace(program, frames=tuple(dataclasses.replace(f, number=0) for f in program.frames))
