@@ -86,6 +86,9 @@ def plan_station_files(path: Path, out_dir: Path, formats: str, speed: float | N
                                    "lower_bound": round(plan.bound.value, 4), "gap": round(gap, 4),
                                    "interlocks": len(interlocks), "cpu_s": round(cpu, 2),
                                    "files": [str(f) for f in (*committed.paths, committed.manifest)],
+                                   "skipped_formats": [{"robot": name, "format": k.format, "robot_file": k.robot_file,
+                                                        "key": k.key, "why": k.why}
+                                                       for name, c in chosen.items() for k in c.skipped],
                                    **({"replay_clean": replay_clean, "charts": [str(c) for c in charts]}
                                       if plot else {})})
         return code

@@ -7,6 +7,7 @@ the station file does not have)."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -51,3 +52,17 @@ def test_a_named_dialect_that_cannot_address_a_robots_io_is_refused_before_plann
            "(--format urscript)" in text
     assert "Traceback" not in refused.output and "sequencing" not in text
     assert not out.exists()
+
+
+@pytest.mark.slow
+def test_the_json_report_names_what_was_passed_over(two_brands: Path, tmp_path: Path) -> None:
+    planned = runner.invoke(app, ["plan", str(two_brands), "-o", str(tmp_path / "out"), "--format", "srcl,rapid,krl",
+                                  "--json"])
+    assert planned.exit_code == EXIT_BAD_INPUT                      # KRL named: the UR10's inputs 0 and 1
+    planned = runner.invoke(app, ["plan", str(two_brands), "-o", str(tmp_path / "out"), "--format", "all", "--json"])
+    assert planned.exit_code == EXIT_OK, planned.output
+    report = json.loads(planned.stdout)
+    skipped = {(k["robot"], k["format"]): k for k in report["skipped_formats"]}
+    assert skipped[("r1", "urscript")]["key"] == "robots[0].controller.inputs.clamp_left_closed"
+    assert skipped[("r2", "krl")]["why"] == "input 0 is outside KRL's inputs 1..4096"
+    assert ("r1", "krl") not in skipped and ("r2", "urscript") not in skipped
