@@ -33,11 +33,11 @@ def plan_report(result: PlanResult, seconds: float, written: list[Path],
             {"format": c.format, "files": list(c.files), "bytes": sum(len(t.encode()) for t in c.files.values()),
              "rebuilt_joint_deg": round(c.difference.joint_deg, 6), "rebuilt_tcp_mm": round(c.difference.tcp_mm, 6),
              "rebuilt_time_ms": round(c.difference.time_s * 1000, 3), "write_cpu_s": round(c.write_seconds, 3),
-             "prove_cpu_s": round(c.check_seconds, 3)}
+             "prove_cpu_s": round(c.check_seconds, 3), "blends_rounded": c.blends_rounded}
             for c in checked
         ],
-        "skipped_formats": [{"format": k.format, "robot_file": k.robot_file, "key": k.key, "why": k.why}
-                            for k in skipped],
+        "skipped_formats": [{"format": k.format, "robot_file": k.robot_file, "key": k.key, "why": k.why,
+                             "message": k.message} for k in skipped],
     }
     if result.trajectory is None:
         return report
@@ -159,10 +159,12 @@ def report_tables(report: dict[str, Any]) -> list[Any]:
                      f"{m['wrist_deg']} deg; {m['found']} of {m['searches']} detour searches found, "
                      f"{m['refused_segments']} path segments refused by the exact check and repaired")
     for p in report.get("programs", []):
+        rounded = " (its blends as the dialect rounds them; as planned, within the tolerances)" \
+            if p.get("blends_rounded") else ""
         head.add_row("proven", f"{p['format']}: read back, rebuilt within {p['rebuilt_joint_deg']:.4f} deg, "
-                               f"{p['rebuilt_tcp_mm']:.3f} mm, {p['rebuilt_time_ms']:.1f} ms of the plan")
+                               f"{p['rebuilt_tcp_mm']:.3f} mm, {p['rebuilt_time_ms']:.1f} ms of the plan{rounded}")
     for k in report.get("skipped_formats", []):
-        head.add_row("not written", f"{k['format']}: {k['robot_file']} does not state {k['key']}")
+        head.add_row("not written", k["message"])
     for f in report["files"]:
         head.add_row("wrote", f)
     for f in report.get("removed", []):
