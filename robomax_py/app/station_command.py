@@ -87,7 +87,7 @@ def plan_station_files(path: Path, out_dir: Path, formats: str, speed: float | N
                                    "interlocks": len(interlocks), "cpu_s": round(cpu, 2),
                                    "files": [str(f) for f in (*committed.paths, committed.manifest)],
                                    "skipped_formats": [{"robot": name, "format": k.format, "robot_file": k.robot_file,
-                                                        "key": k.key, "why": k.why}
+                                                        "key": k.key, "why": k.why, "message": k.message}
                                                        for name, c in chosen.items() for k in c.skipped],
                                    **({"replay_clean": replay_clean, "charts": [str(c) for c in charts]}
                                       if plot else {})})

@@ -25,6 +25,7 @@ from robomax_py.export.dialect import (
     Dialect,
     NumberedSignal,
     Parsed,
+    SignalNumbers,
     in_controller_joints,
     setup_signals,
 )
@@ -40,7 +41,7 @@ from robomax_py.transforms import invert
 if TYPE_CHECKING:
     from robomax_py.export.rebuild.result import Rebuilt
 
-__all__ = ["DIALECTS", "ENTRY_POINT_GROUP", "SHARED_FILES", "Dialect", "FormatChoice", "NumberedSignal", "SkippedFormat",
+__all__ = ["DIALECTS", "ENTRY_POINT_GROUP", "SHARED_FILES", "Dialect", "FormatChoice", "NumberedSignal", "SignalNumbers", "SkippedFormat",
            "choose_formats", "controller_frames", "controller_rebuild", "controller_world", "dialect_for_file", "format_names",
            "load_dialects", "native_dialect",
            "render_trajectory", "require_calibration", "setup_signals"]
