@@ -132,6 +132,17 @@ class Tracker:
         near = self.unwrap(q, q_prev)[0]
         return np.asarray(near, dtype=float) if float(np.max(np.abs(near - q_prev))) <= self.max_step else None
 
+    def step(self, table: Any, row: int, u: float, q_prev: FloatArray) -> FloatArray | None:
+        """The motion's configuration at line fraction u after q_prev: a redundant arm's continuation
+        (`continued`, `table` unused); else `follow` at `row` of `table` (the IK table at u), and for
+        a seeded solver, where that finds none, `follow` in the table solved from q_prev."""
+        if self.redundant:
+            return self.continued(u, q_prev)
+        q = self.follow(table, row, q_prev)
+        if q is None and self.seeded:
+            q = self.follow(self.solve(np.array([u]), q_prev), 0, q_prev)
+        return q
+
     def follow(self, table: Any, row: int, q_prev: FloatArray) -> FloatArray | None:
         """The continuation of q_prev at this row: own column first, else any solution within max_step."""
         own = self.column(table, row)

@@ -219,12 +219,7 @@ def refine(tracker: Tracker, u: FloatArray, q: FloatArray, path_tol: float) -> t
         table = None if tracker.redundant else tracker.solve(mids)
         new_q = []
         for j, i in enumerate(np.nonzero(bad)[0]):
-            if table is None:
-                q_mid = tracker.continued(float(mids[j]), q[i])
-            else:
-                q_mid = tracker.follow(table, j, q[i])
-                if q_mid is None and tracker.seeded:   # as `_follow`: the continuation, seeded from q[i]
-                    q_mid = tracker.follow(tracker.solve(mids[j:j + 1], q[i]), 0, q[i])
+            q_mid = tracker.step(table, j, float(mids[j]), q[i])
             if q_mid is None:
                 return Unrefined(int(i), float(mids[j]), u[: i + 1], q[: i + 1])
             new_q.append(q_mid)
@@ -248,14 +243,9 @@ def _follow(tracker: Tracker, grid: FloatArray, q0: FloatArray) -> tuple[FloatAr
     while todo:
         u_b, row = todo[0]
         sol, r = (table, row) if table is not None and row >= 0 else (None, 0)
-        if tracker.redundant:
-            q_b = tracker.continued(u_b, qs[-1])
-        else:
-            if sol is None:
-                sol = tracker.solve(np.array([u_b]))
-            q_b = tracker.follow(sol, r, qs[-1])
-            if q_b is None and tracker.seeded:
-                q_b = tracker.follow(tracker.solve(np.array([u_b]), qs[-1]), 0, qs[-1])
+        if sol is None and not tracker.redundant:
+            sol = tracker.solve(np.array([u_b]))
+        q_b = tracker.step(sol, r, u_b, qs[-1])
         if q_b is not None:
             if np.any(q_b < lower) or np.any(q_b > upper):
                 return _failed(line, "joint_limit", "the line leaves the joint limits", u_b, us, qs)
