@@ -112,7 +112,8 @@ def load_station(path: str | Path) -> StationSpec:
     shared = {k: v for k, v in data.items() if k != "robots"}
     seams_given = shared.get("seams")
     allowed = _allowed_robots(seams_given, names, path)
-    shared["seams"] = _without_robot_keys(seams_given)
+    if "seams" in shared:                   # absent: the spots come from `spot_lists` (a CAD export)
+        shared["seams"] = _without_robot_keys(seams_given)
     expansion = expand_includes(shared, path, IncludeFile)
     digest = expansion.digest(text.encode("utf-8"))
     name = keys.name or path.stem

@@ -127,3 +127,26 @@ def test_shipped_station_is_valid() -> None:
     done = CliRunner().invoke(app, ["check", str(shipped)])
     assert done.exit_code == 0, done.output
     assert "4 robots, 120 spots" in done.output
+
+
+def test_spots_from_a_spot_list_alone(tmp_path: Path) -> None:
+    """A station handed over as CAD data has a spot list and no `seams:`: every robot may weld every
+    spot of the list, and the spots are those the seams above give."""
+    data = _data()
+    seams = data.pop("seams")
+    rows = ["id,x,y,z,nx,ny,nz,group"]
+    for seam in seams[1:]:
+        for s in seam["spots"]:
+            rows.append(",".join([s["name"], *map(str, s["xyz"]), *map(str, s["normal"]), seam["name"]]))
+    (tmp_path / "spots.csv").write_text("\n".join(rows) + "\n")
+    data["spot_lists"] = [{"file": "spots.csv", "part": "frame", "units": "m", "grid": 3,
+                           "tolerance": {"alpha": 10, "beta": 10, "gamma": [-180, 180]}}]
+    station = load_station(_write(tmp_path, data))
+    assert {s.key: s.robots for s in station.spots} == {
+        ("left_rail", "l1"): ("r1", "r2"), ("left_rail", "l4"): ("r1", "r2"),
+        ("right_rail", "r1"): ("r1", "r2"), ("right_rail", "r4"): ("r1", "r2")}
+    from_list = {(seam.name, s.name): s.xyz for seam in station.robots[1].cell.seams for s in seam.spots}
+    given = {(seam["name"], s["name"]): s["xyz"] for seam in seams[1:] for s in seam["spots"]}
+    assert from_list.keys() == given.keys()
+    for key, xyz in given.items():
+        assert from_list[key] == pytest.approx(xyz, abs=1e-12)
