@@ -159,11 +159,13 @@ def own_name(frame: FrameDef) -> str:
 @dataclass(frozen=True, slots=True)
 class SignalNumbers:
     """The controller inputs and outputs a dialect's programs address by number (ends included),
-    and the dialect's name in messages."""
+    the dialect's name in messages, and what a number out of range most likely means there (`hint`,
+    added to the message: e.g. a dialect that states input k under another number)."""
 
     label: str
     inputs: tuple[int, int]
     outputs: tuple[int, int]
+    hint: str = ""
 
 
 @dataclass(frozen=True, slots=True)
@@ -241,7 +243,8 @@ class Dialect:
         for s in numbered:
             low, high = self.signals.inputs if s.kind == "input" else self.signals.outputs
             if not low <= s.number <= high:
-                return s.key, f"{s.kind} {s.number} is outside {self.signals.label}'s {s.kind}s {low}..{high}"
+                hint = f" ({self.signals.hint})" if self.signals.hint else ""
+                return s.key, f"{s.kind} {s.number} is outside {self.signals.label}'s {s.kind}s {low}..{high}{hint}"
         return None
 
 

@@ -261,6 +261,11 @@ def test_all_passes_over_a_dialect_that_cannot_address_the_cells_signals(robot6)
     fits = export.setup_signals(ControllerSetup(inputs=(ControllerInput("clamp_closed", 7),)))
     assert export.choose_formats("all", robot6, fits, cell).names == tuple(export.DIALECTS)
     assert export.choose_formats("urscript", robot6, fits, cell).names == ("urscript",)
+    # A Kawasaki user may give the number AS waits on (SWAIT 1020) for external input 20: told so.
+    as_number = export.setup_signals(ControllerSetup(inputs=(ControllerInput("clamp_closed", 1020),)))
+    with pytest.raises(CellFileError, match=r"input 1020 is outside AS's inputs 1..999 \(give external input k, "
+                                            r"which AS waits for as signal 1000 \+ k: 1 for SWAIT 1001\)"):
+        export.choose_formats("as", robot6, as_number, cell)
 
 
 def test_publish_refuses_inform_without_pulse_counts_before_proving_any(robot6) -> None:  # type: ignore[no-untyped-def]

@@ -39,7 +39,8 @@ from robomax_py.robot import RobotModel
 
 INPUT_BASE = 1000            # external input k is signal 1000 + k
 # External inputs and outputs 1-999 (input k read as signal 1000 + k).
-SIGNALS = SignalNumbers("AS", (1, 999), (1, 999))
+SIGNALS = SignalNumbers("AS", (1, 999), (1, 999),
+                        hint=f"give external input k, which AS waits for as signal {INPUT_BASE} + k: 1 for SWAIT 1001")
 # ACCURACY's distance (mm) as RoboDK's Kawasaki post states it: `'ACCURACY %.3f ALWAYS'`
 # (ros-industrial-attic/robodk_postprocessors@d7e6c1c0 Kawasaki.py:178-180, setZoneData). With one
 # decimal a blend of a big arm came back up to 0.02 deg off the plan at the wrist, beyond the
