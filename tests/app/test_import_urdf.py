@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -644,3 +645,16 @@ def test_cartesian_targets_are_stated_in_the_controller_base(arms: dict[str, Pat
     assert min(np.linalg.norm(root[:3] - s) for s in spots) < 2e-6
     assert np.linalg.norm(invert(C)[:3, 3]) > 0.1          # the frame really moved the numbers
     assert "BASE FRAME" not in srcl                          # stated in the controller base itself
+
+
+def test_import_says_whether_an_srdf_was_read(tmp_path: Path) -> None:
+    """The summary line counts the SRDF's disabled pairs only when one was given; without it, it
+    says none was (a count of 0 'from the SRDF' read as if one had been read)."""
+    args = ["import-urdf", str(ARMS["irb2400"]), "--packages", str(ROSI)]
+    without = runner.invoke(app, [*args, "-o", str(tmp_path / "a")])
+    assert without.exit_code == 0, without.output
+    said = " ".join(without.output.split())
+    assert "no SRDF given" in said and "from the SRDF" not in said
+    given = runner.invoke(app, [*args, "-o", str(tmp_path / "b"), "--srdf", str(SRDF["irb2400"])])
+    assert given.exit_code == 0, given.output
+    assert re.search(r"[1-9][0-9]* disabled pairs from the SRDF", " ".join(given.output.split()))

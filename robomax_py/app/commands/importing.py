@@ -78,9 +78,11 @@ def import_urdf_command(
                                     "samples": r.always_touching.samples}})
             return
         what = "unchanged" if r.unchanged else "wrote"
+        pairs_from = (f"{r.disabled_pairs} disabled pairs from the SRDF" if srdf is not None
+                      else "no SRDF given (--srdf keeps a MoveIt config's disabled pairs)")
         out.print(f"{what} {r.folder}: robot {r.name}, IK {r.solver} (FK agrees with the URDF within "
-                  f"{r.fk_error_m:.1e} m), controller {r.brand}, {r.meshes} meshes, {r.disabled_pairs} disabled "
-                  f"pairs from the SRDF ({r.seconds:.1f} s)", markup=False, highlight=False, soft_wrap=True)
+                  f"{r.fk_error_m:.1e} m), controller {r.brand}, {r.meshes} meshes, {pairs_from} "
+                  f"({r.seconds:.1f} s)", markup=False, highlight=False, soft_wrap=True)
         if r.always_touching.pairs:
             pairs = ", ".join(f"[{a}, {b}]" for a, b in r.always_touching.pairs)
             out.print(f"collision.disable: {pairs} touch in every one of {r.always_touching.samples} sampled "
