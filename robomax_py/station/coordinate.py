@@ -214,7 +214,7 @@ def coordinate(timelines: Sequence[Timeline], pairs: Sequence[PairMap], fcfs: bo
         while True:
             schedule = simulate(timelines, locks)
             if schedule.deadlock:
-                stuck = Coordination(tuple(locks), schedule, "the interlocks wait on each other (deadlock)")
+                stuck = Coordination(tuple(locks), schedule, _deadlock_text(locks))
             elif (hit := _first_clash(pairs, schedule)) is None:
                 return Coordination(tuple(locks), schedule)
             elif len(locks) >= MAX_INTERLOCKS:
@@ -263,6 +263,18 @@ def coordinate(timelines: Sequence[Timeline], pairs: Sequence[PairMap], fcfs: bo
         if not again.unresolved:
             done = again
     return Coordination(_without_implied(done.interlocks), done.schedule, done.unresolved)
+
+
+def _deadlock_text(locks: Sequence[Interlock]) -> str:
+    """What a deadlock is made of: the interlocks of the robots the last one orders, on each robot's
+    own clock (the segment the leader must finish, the point the waiter waits at)."""
+    last = locks[-1]
+    pair = {last.leader, last.waiter}
+    held = [x for x in locks if {x.leader, x.waiter} == pair]
+    said = "; ".join(f"{x.waiter} waits at {x.wait_at:.2f} s for {x.leader} to finish "
+                     f"{x.leader_span[0]:.2f}-{x.leader_span[1]:.2f} s" for x in held[-4:])
+    return (f"the interlocks wait on each other (deadlock): {said} (each on its own clock); {last.pair[0]} and "
+            f"{last.pair[1]} move through each other's rest postures or paths in every order tried")
 
 
 def _without_implied(locks: Sequence[Interlock]) -> tuple[Interlock, ...]:

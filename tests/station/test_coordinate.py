@@ -139,3 +139,19 @@ def test_a_robot_that_has_ended_stands_at_home_in_the_others_way() -> None:
     assert not done.unresolved
     assert _clashes_to_the_end(pair, done.schedule) == 0
     assert [(x.waiter, x.wait_at, x.signal_at) for x in done.interlocks] == [("b", 4.0, 7.0)]
+
+
+def test_a_deadlock_names_the_robots_and_the_waits_it_is_made_of() -> None:
+    """a's move from 1 to 2 s sweeps through b wherever b is, at rest or moving, and b's move from 1
+    to 2 s through a: whichever goes first, the other stands in its way. The message names both
+    robots and each wait on its own clock, not only that there is a deadlock."""
+    lines = [_timeline("a", 4.0, [1.0, 2.0, 3.0]), _timeline("b", 4.0, [1.0, 2.0, 3.0])]
+    t = np.arange(0.0, 4.0 + DT, DT)
+    moving = (t > 1.05) & (t < 1.95)
+    pair = PairMap("a", "b", DT, moving[:, None] | moving[None, :])
+    done = coordinate(lines, [pair])
+    assert done.unresolved.startswith("the interlocks wait on each other (deadlock): ")
+    assert "a and b move through each other's rest postures or paths in every order tried" in done.unresolved
+    for lock in done.interlocks[-2:]:
+        assert (f"{lock.waiter} waits at {lock.wait_at:.2f} s for {lock.leader} to finish "
+                f"{lock.leader_span[0]:.2f}-{lock.leader_span[1]:.2f} s") in done.unresolved
