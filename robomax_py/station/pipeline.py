@@ -42,6 +42,7 @@ from robomax_py.station.bound import (
     spot_work,
 )
 from robomax_py.station.coordinate import Coordination, PairMap, Timeline, coordinate
+from robomax_py.station.homes import homes_touching
 from robomax_py.station.reach import RobotReach, cost_matrix, robot_reach, tour_legs
 from robomax_py.station.reorder import (
     OrderChange,
@@ -152,11 +153,17 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         return StationPlan(station.name, "infeasible", f"{len(nobody)} spot(s) no robot allowed to weld them can "
                            f"reach collision-free: {names}", (), Assignment({}, {}), bound, None, clock)
     t0 = time.process_time()
+    scenes = {r.name: build_scene(r.cell, models[r.name]) for r in station.robots}
+    touching = homes_touching(station, models, scenes)
+    clock["homes"] = time.process_time() - t0
+    if touching is not None:
+        return StationPlan(station.name, "infeasible", touching.message(), (), Assignment({}, {}), bound, None, clock)
+    t0 = time.process_time()
     prior = side_prior(station, reaches, SIDE_PRIOR_S_PER_M)
     chosen = nearest(station, reaches, keys, groups) if options.method == "nearest" \
         else assign(reaches, keys, groups, prior)
     clock["assignment"] = time.process_time() - t0
-    bodies = {r.name: robot_body(r.name, models[r.name], build_scene(r.cell, models[r.name])) for r in station.robots}
+    bodies = {r.name: robot_body(r.name, models[r.name], scenes[r.name]) for r in station.robots}
     made = _Made()
     by_robot = {r.robot: r for r in reaches}
     best = _realise(station, models, bodies, by_robot, chosen, options, clock, bound, made)

@@ -4,6 +4,7 @@ with one message naming the file and the station's key."""
 from __future__ import annotations
 
 import copy
+import re
 from pathlib import Path
 from typing import Any
 
@@ -150,3 +151,30 @@ def test_spots_from_a_spot_list_alone(tmp_path: Path) -> None:
     assert from_list.keys() == given.keys()
     for key, xyz in given.items():
         assert from_list[key] == pytest.approx(xyz, abs=1e-12)
+
+
+def test_robots_touching_at_home_are_named_by_check_and_refused_by_plan(tmp_path: Path) -> None:
+    """Both arms turned to face each other at home (A1 = 0) touch across the table: no program can
+    start. `check` warns naming both robots, the pieces and the keys; `plan` exits 3 before planning
+    anything, with the same words, and writes nothing."""
+    from typer.testing import CliRunner
+
+    from robomax_py.app.cli import app
+
+    data = _data()
+    for robot in data["robots"]:
+        robot["home"] = [0, -90, 90, 0, 0, 0]
+    path = _write(tmp_path, data)
+    runner = CliRunner()
+    done = runner.invoke(app, ["check", str(path)])
+    said = " ".join(done.output.split())
+    assert done.exit_code == 0, done.output
+    assert re.search(r"r1 and r2 touch where they stand at home \(r1's \S+ within 5 mm of r2's \S+\)", said), said
+    assert "robots[0].home, robots[1].home" in said and "`plan` refuses this station" in said
+    out = tmp_path / "out"
+    done = runner.invoke(app, ["plan", str(path), "-o", str(out)])
+    assert done.exit_code == 3 and not out.exists()
+    assert "r1 and r2 touch where they stand at home" in " ".join(done.output.split())
+    # The shipped layout (A1 = 60 deg) stands apart: no warning.
+    done = runner.invoke(app, ["check", str(STATION)])
+    assert "touch where they stand" not in done.output

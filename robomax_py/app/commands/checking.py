@@ -132,13 +132,16 @@ def _check_station(path: Path, as_json: bool) -> None:
     from robomax_py.io.cell import load_cell_robot
     from robomax_py.io.station import load_station
     from robomax_py.plan.reach import reach_report
+    from robomax_py.station.homes import homes_touching
+    from robomax_py.world.scene import build_scene
 
     station = load_station(path)
     _warn([str(n) for n in station.notices])
     rows = []
     reachable: dict[tuple[str, str], list[str]] = {}
+    models = {}
     for r in station.robots:
-        robot = load_cell_robot(r.cell)
+        robot = models[r.name] = load_cell_robot(r.cell)
         _warn([f"{r.name}: {w}" for w in robot.warnings])
         allowed = set(station.allowed(r.name))
         reach = [x for x in reach_report(r.cell, robot) if (x.seam, x.name) in allowed]
@@ -155,9 +158,13 @@ def _check_station(path: Path, as_json: bool) -> None:
         more = f" ({len(orphan) - 1} more spot(s) out of every robot's reach)" if len(orphan) > 1 else ""
         raise CellFileError(path, "seams", f"spot {orphan[0].seam}/{orphan[0].spot} is out of the reach of every robot "
                             f"that may weld it ({', '.join(orphan[0].robots)}){more}")
+    # Robots that touch at home: `plan` refuses the station (no program can start); told here first.
+    touching = homes_touching(station, models, {r.name: build_scene(r.cell, models[r.name]) for r in station.robots})
+    _warn([f"{touching.message()}; `plan` refuses this station"] if touching is not None else [])
     if as_json:
         _print_json("check", True, {"cell": str(path), "name": station.name, "station": True, "robots": rows,
-                                    "spots": len(station.spots)})
+                                    "spots": len(station.spots),
+                                    "homes_touching": None if touching is None else touching.message()})
         return
     out.print(f"station {station.name}: {len(station.robots)} robots, {len(station.spots)} spots", markup=False,
               highlight=False)
