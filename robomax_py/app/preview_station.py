@@ -79,8 +79,9 @@ class StationPreviewContent:
 
 def read_zones(path: Path) -> tuple[InterlockZone, ...]:
     """The interlock zones of `<station>.station.json` (`interlocks[].zone`: `{box: [x, y, z], pose:
-    {xyz, rpy (deg)}}` or `{min: [x, y, z], max: [x, y, z]}`, m, in the world); none when the file
-    or its zones are missing."""
+    {xyz, rpy (deg)}}` or `{min: [x, y, z], max: [x, y, z]}`, m, in the world; a zone given by name,
+    as `robomax plan` writes it, is drawn from its `region`, `{min, max}`, where the robots would
+    meet); none when the file or its zones are missing."""
     if not path.is_file():
         return ()
     try:
@@ -91,6 +92,9 @@ def read_zones(path: Path) -> tuple[InterlockZone, ...]:
     interlocks = data.get("interlocks", []) if isinstance(data, dict) else []
     for i, entry in enumerate(interlocks if isinstance(interlocks, list) else []):
         zone = entry.get("zone") if isinstance(entry, dict) else None
+        key = f"interlocks[{i}].zone"
+        if not isinstance(zone, dict) and isinstance(entry, dict) and isinstance(entry.get("region"), dict):
+            zone, key = entry["region"], f"interlocks[{i}].region"
         if not isinstance(zone, dict):
             continue
         signal = str(entry.get("signal", f"zone{i}"))
@@ -104,9 +108,9 @@ def read_zones(path: Path) -> tuple[InterlockZone, ...]:
                                 np.radians(np.asarray(pose.get("rpy", [0, 0, 0]), dtype=float)))
                 size = np.asarray(zone["box"], dtype=float)
         except (KeyError, TypeError, ValueError) as exc:
-            raise ProgramError(path, f"interlocks[{i}].zone", f"expected {{box, pose}} or {{min, max}}: {exc}") from None
+            raise ProgramError(path, key, f"expected {{box, pose}} or {{min, max}}: {exc}") from None
         if size.shape != (3,) or not np.all(np.isfinite(size)) or np.any(size <= 0):
-            raise ProgramError(path, f"interlocks[{i}].zone", "a zone needs three positive extents")
+            raise ProgramError(path, key, "a zone needs three positive extents")
         out.append(InterlockZone(signal, T, (float(size[0]), float(size[1]), float(size[2]))))
     return tuple(out)
 

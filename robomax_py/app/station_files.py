@@ -16,6 +16,7 @@ from robomax_py.program import Comment, Instruction, PtpMove, SetSignal, Spot, W
 from robomax_py.spec_station import StationRobot
 from robomax_py.station.interlocks import StationInterlock, allocate, with_interlock_io
 from robomax_py.station.pipeline import StationPlan
+from robomax_py.station.zones import ZoneBox
 
 STATION_FORMAT = "robomax.station/1"
 # An own-clock time of the plan and the same time read back from a spot's leave time agree this well.
@@ -131,13 +132,21 @@ def station_summary(plan: StationPlan, interlocks: Sequence[StationInterlock]) -
         "interlocks": [{"zone": x.zone, "leader": x.leader, "waiter": x.waiter, "signal": x.signal,
                         "leader_output": x.output, "waiter_input": x.input, "signal_at": round(x.signal_at, 6),
                         "wait_at": round(x.wait_at, 6), "leader_span": [round(v, 6) for v in x.leader_span],
-                        "waiter_span": [round(v, 6) for v in x.waiter_span]} for x in interlocks],
+                        "waiter_span": [round(v, 6) for v in x.waiter_span],
+                        **({} if box is None else {"region": {"min": [round(v, 6) for v in box.lo],
+                                                              "max": [round(v, 6) for v in box.hi]}})}
+                       for x, box in zip(interlocks, _regions(plan, len(interlocks)), strict=True)],
         "robot_margin_m": round(plan.margin, 6), "reassignments": plan.rounds,
         "orders_tried": plan.orders_tried, "orders_skipped": plan.orders_skipped,
         "order_changes": [{"robot": c.robot, "spots": [f"{seam}/{name}" for seam, name in c.order], "why": c.why}
                           for c in plan.order_changes],
     }
     return json.dumps(data, indent=2) + "\n"
+
+
+def _regions(plan: StationPlan, count: int) -> tuple[ZoneBox | None, ...]:
+    """Each interlock's meeting box, in the interlocks' order (none where the plan has not got them)."""
+    return plan.zones if len(plan.zones) == count else (None,) * count
 
 
 __all__ = ["allocate", "interlock_edit", "station_block", "station_summary", "with_interlock_io",

@@ -54,6 +54,7 @@ from robomax_py.station.reorder import (
 )
 from robomax_py.station.reorder import candidates as order_candidates
 from robomax_py.station.unload import bottleneck, tour_estimator, unloads
+from robomax_py.station.zones import ZoneBox, meeting_box
 from robomax_py.timing.trajectory import evaluate
 from robomax_py.world.scene import build_scene
 
@@ -117,6 +118,7 @@ class StationPlan:
     orders_tried: int = 0        # spot orders planned instead of waiting (`reorder`) and spot moves' trials (`unload`)
     orders_skipped: int = 0      # spot orders not planned: they could not gain enough (`reorder.most_gain`)
     order_changes: tuple[OrderChange, ...] = ()    # those kept, in order
+    zones: tuple[ZoneBox | None, ...] = ()         # where each interlock's robots would meet (`zones`), in order
 
     @property
     def makespan(self) -> float:
@@ -169,8 +171,10 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     made = _Made()
     by_robot = {r.robot: r for r in reaches}
     best = _realise(station, models, bodies, by_robot, chosen, options, clock, bound, made)
-    if options.method != "full" or best.status != "planned":
+    if best.status != "planned":
         return best
+    if options.method != "full":
+        return dataclasses.replace(best, zones=_zones(best, bodies, made, options.dt))
     # Another spot order instead of waiting, where the robot that ends last waits; before the
     # re-assignment, whose new tours are each robot's own best again (on a generated station of four
     # KR 125-class arms the other way round ended 15 % later: 18.10 s against 15.79 s).
@@ -244,7 +248,37 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     best, moved, unloaded = _unload(station, models, bodies, by_robot, best, options, clock, bound, made, robot_plans,
                                     prior, fixed, costs)
     return dataclasses.replace(best, seconds=clock, rounds=rounds, orders_tried=tried + unloaded,
-                               orders_skipped=skipped, order_changes=(*kept, *moved))
+                               orders_skipped=skipped, order_changes=(*kept, *moved),
+                               zones=_zones(best, bodies, made, options.dt))
+
+
+def _zones(plan: StationPlan, bodies: Mapping[str, RobotBody], made: _Made, dt: float) -> tuple[ZoneBox | None, ...]:
+    """Where each interlock's two robots would meet (`zones.meeting_box`), from their diagram."""
+    if plan.coordination is None:
+        return ()
+    by_name = {p.robot: p for p in plan.robots}
+    clearance = max((p.cell.process.clearance for p in plan.robots), default=0.0)
+    out: list[ZoneBox | None] = []
+    for lock in plan.coordination.interlocks:
+        pa, pb = by_name[lock.pair[0]], by_name[lock.pair[1]]
+        pair = made.pairs.get((pa, pb))
+        if pair is None:
+            out.append(None)
+            continue
+        (poses_a, half_a), (poses_b, half_b) = made.motion[pa], made.motion[pb]
+        span_a, span_b = (lock.leader_span, lock.waiter_span) if lock.leader == pa.robot else \
+            (lock.waiter_span, lock.leader_span)
+        rows = _span_samples(span_a, dt, len(poses_a))
+        cols = _span_samples(span_b, dt, len(poses_b))
+        out.append(meeting_box(bodies[pa.robot], poses_a, rows, bodies[pb.robot], poses_b, cols, pair.clash,
+                               clearance, half_a, half_b))
+    return tuple(out)
+
+
+def _span_samples(span: tuple[float, float], dt: float, count: int) -> slice:
+    """The diagram's samples (every dt of the robot's own clock) within a time span, ends included."""
+    first = max(0, min(count - 1, int(np.floor(span[0] / dt + 1e-9))))
+    return slice(first, max(first + 1, min(count, int(np.ceil(span[1] / dt - 1e-9)) + 1)))
 
 
 def _orders(plan: StationPlan) -> dict[str, tuple[SpotKey, ...]]:
