@@ -1,47 +1,24 @@
 """Robot-robot collision: the prefiltered check (link spheres over blocks of samples, then link and
 piece spheres per sample pair, before coal) gives exactly the answer of asking coal about every pair
 of pieces, on random configurations and random motions of two robots placed close enough to collide
-often."""
+often (`bodies`, tests/station/conftest.py)."""
 
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from robomax_py.io.cell import load_cell_robot
-from robomax_py.io.station import load_station
-from robomax_py.station.bodies import body_poses, clash_map, robot_body, sample_step
-from robomax_py.world.scene import build_scene
-
-STATION = Path(__file__).parents[1] / "data" / "station" / "two_robots.yaml"
-
-
-@pytest.fixture(scope="module")
-def bodies():  # type: ignore[no-untyped-def]
-    station = load_station(STATION)
-    out = []
-    for r in station.robots:
-        model = load_cell_robot(r.cell)
-        out.append(robot_body(r.name, model, build_scene(r.cell, model)))
-    # r2 brought to 2.2 m from r1 (facing it), so that random postures often touch.
-    T = np.array(out[1].T_world_base)
-    T[0, 3] = 2.2
-    return out[0], dataclasses.replace(out[1], T_world_base=T)
+from robomax_py.station.bodies import body_poses, clash_map, sample_step
 
 
 @pytest.mark.parametrize("margin", [0.0, 0.05])
-def test_prefiltered_equals_every_pair(bodies, margin: float) -> None:  # type: ignore[no-untyped-def]
+def test_prefiltered_equals_every_pair(bodies, random_poses, margin: float) -> None:  # type: ignore[no-untyped-def]
     a, b = bodies
-    rng = np.random.default_rng(7)
-    lim = a.robot.limits
-    qa = rng.uniform(lim.lower, lim.upper, (14, a.robot.dof))
-    qb = rng.uniform(lim.lower, lim.upper, (14, b.robot.dof))
-    pa, pb = body_poses(a, qa), body_poses(b, qb)
+    pa, pb = random_poses(7, 14)
     fast = clash_map(a, pa, b, pb, margin)
     exact = clash_map(a, pa, b, pb, margin, prefilter=False)
     assert 0 < exact.sum() < exact.size          # both answers occur, so the comparison can fail

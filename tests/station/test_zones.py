@@ -7,7 +7,6 @@ orders, which the preview then draws."""
 
 from __future__ import annotations
 
-import dataclasses
 import json
 from pathlib import Path
 
@@ -15,38 +14,18 @@ import coal
 import numpy as np
 import pytest
 
-from robomax_py.io.cell import load_cell_robot
-from robomax_py.io.station import load_station
-from robomax_py.station.bodies import body_poses, clash_map, robot_body
+from robomax_py.station.bodies import clash_map
 from robomax_py.station.zones import meeting_box
-from robomax_py.world.scene import build_scene
 
-STATION = Path(__file__).parents[1] / "data" / "station" / "two_robots.yaml"
 # coal's nearest points are exact to its own distance tolerance; overlapping pieces are not judged
 # by them (their witness points need not lie in the overlap).
 POINT_TOL_M = 1e-4
 
 
-@pytest.fixture(scope="module")
-def bodies():  # type: ignore[no-untyped-def]
-    station = load_station(STATION)
-    out = []
-    for r in station.robots:
-        model = load_cell_robot(r.cell)
-        out.append(robot_body(r.name, model, build_scene(r.cell, model)))
-    T = np.array(out[1].T_world_base)
-    T[0, 3] = 2.2                                 # r2 at 2.2 m from r1, facing it
-    return out[0], dataclasses.replace(out[1], T_world_base=T)
-
-
 @pytest.mark.parametrize("margin", [0.05, 0.2])
-def test_the_zone_holds_every_contact(bodies, margin: float) -> None:  # type: ignore[no-untyped-def]
+def test_the_zone_holds_every_contact(bodies, random_poses, margin: float) -> None:  # type: ignore[no-untyped-def]
     a, b = bodies
-    rng = np.random.default_rng(7)
-    lim = a.robot.limits
-    qa = rng.uniform(lim.lower, lim.upper, (14, a.robot.dof))
-    qb = rng.uniform(lim.lower, lim.upper, (14, b.robot.dof))
-    pa, pb = body_poses(a, qa), body_poses(b, qb)
+    pa, pb = random_poses(7, 14)
     clash = clash_map(a, pa, b, pb, margin)
     rows, cols = slice(0, 10), slice(2, 14)
     inside = clash[rows, cols]
