@@ -16,7 +16,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -216,17 +216,22 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
         if trial.status == "planned" and trial.makespan < best.makespan - 1e-6:
             best = trial
     # The estimates above know nothing of the other robots, and the waits charged to the waiter's
-    # spots cannot tell which robot crossed into the other's side. Where the best plan still waits,
-    # the nearest-robot assignment (each robot on its own side) is planned too and kept when its
-    # coordinated makespan is shorter: on a hat section welded from both sides by two arms set off
-    # along it, the min-max estimate gave each the far end of the other's flange (17.80 s, 4
-    # interlocks), each flange to its own robot ends at 11.31 s with none.
+    # spots cannot tell which robot crossed into the other's side. Where the best plan still has
+    # interlocks, the nearest-robot assignment (each robot on its own side) is planned too and kept
+    # when its coordinated makespan is shorter: on a hat section welded from both sides by two arms
+    # set off along it, the min-max estimate gave each the far end of the other's flange (17.80 s,
+    # 4 interlocks), each flange to its own robot ends at 11.31 s with none. It is not planned where
+    # a robot's own cycle is predicted no shorter than the best makespan, as `unload` predicts one
+    # (the shipped example's: 37.76 s against 38.48 s then, so planned, and not kept).
     assert best.coordination is not None
     if best.coordination.interlocks and best.coordination.schedule.makespan > 0:
         t0 = time.process_time()
         near = nearest(station, reaches, keys, groups)
+        longest = _predicted_longest(best, near, tour_estimator(by_robot, prior, costs))
         clock["assignment"] += time.process_time() - t0
-        if _frozen(near) not in assignments:
+        log.debug("nearest-robot assignment: longest own cycle predicted %.3f s (best makespan %.3f s)", longest,
+                  best.makespan)
+        if _frozen(near) not in assignments and longest < best.makespan - 1e-6:
             assignments.add(_frozen(near))
             rounds += 1
             trial = _realise(station, models, bodies, by_robot, near, options, clock, bound, made,
@@ -250,6 +255,21 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     return dataclasses.replace(best, seconds=clock, rounds=rounds, orders_tried=tried + unloaded,
                                orders_skipped=skipped, order_changes=(*kept, *moved),
                                zones=_zones(best, bodies, made, options.dt))
+
+
+def _predicted_longest(plan: StationPlan, other: Assignment,
+                       tour_time: Callable[[str, tuple[SpotKey, ...]], float]) -> float:
+    """The longest own cycle predicted for another assignment: each robot's planned own cycle scaled
+    by its estimated tour there over its estimated tour now (a robot idle now: its estimate)."""
+    now = _orders(plan)
+    own = {p.robot: p.own_cycle for p in plan.robots}
+    out = 0.0
+    for robot, spots in other.spots.items():
+        est_now = tour_time(robot, now.get(robot, ()))
+        est_other = tour_time(robot, tuple(spots))
+        scale = own.get(robot, 0.0) / est_now if est_now > 0 and own.get(robot, 0.0) > 0 else 1.0
+        out = max(out, scale * est_other)
+    return out
 
 
 def _zones(plan: StationPlan, bodies: Mapping[str, RobotBody], made: _Made, dt: float) -> tuple[ZoneBox | None, ...]:

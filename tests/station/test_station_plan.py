@@ -212,3 +212,28 @@ def test_the_nearest_robots_assignment_is_planned_where_the_min_max_ones_wait(
     kept = plan_station(station, models)
     assert {r: set(s) for r, s in kept.assignment.spots.items()} == {r: set(s) for r, s in crossing.spots.items()}
     assert plan.makespan < kept.makespan - 1.0
+    # Not planned where a robot's own cycle is predicted to reach the best makespan.
+    monkeypatch.undo()
+    monkeypatch.setattr(pipeline, "assign", lambda *args, **kwargs: crossing)
+    monkeypatch.setattr(pipeline, "_predicted_longest", lambda *args, **kwargs: float("inf"))
+    skipped = plan_station(station, models)
+    assert skipped.rounds == 0 and skipped.makespan == pytest.approx(kept.makespan, abs=1e-9)
+
+
+def test_the_prediction_of_another_assignments_longest_own_cycle() -> None:
+    """Each robot's planned own cycle scaled by its estimated tour there over its estimated tour
+    now; a robot idle now counts its estimate."""
+    from types import SimpleNamespace
+
+    from robomax_py.station.assign import Assignment
+    from robomax_py.station.pipeline import _predicted_longest
+
+    def robot(name: str, own: float, spots: list[str]) -> SimpleNamespace:
+        done = [SimpleNamespace(seam="s", name=n) for n in spots]
+        return SimpleNamespace(robot=name, own_cycle=own, result=SimpleNamespace(spots=done))
+
+    plan = SimpleNamespace(robots=(robot("r1", 10.0, ["a", "b"]), robot("r2", 0.0, [])))
+    other = Assignment({"r1": (("s", "a"),), "r2": (("s", "b"), ("s", "c"))}, {"r1": 0.0, "r2": 0.0})
+    tour = {("r1", 2): 4.0, ("r1", 1): 2.0, ("r2", 0): 0.0, ("r2", 2): 7.0}
+    longest = _predicted_longest(plan, other, lambda r, order: tour[(r, len(order))])  # type: ignore[arg-type]
+    assert longest == pytest.approx(max(10.0 * 2.0 / 4.0, 7.0))
