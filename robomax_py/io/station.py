@@ -117,9 +117,17 @@ def load_station(path: str | Path) -> StationSpec:
     expansion = expand_includes(shared, path, IncludeFile)
     digest = expansion.digest(text.encode("utf-8"))
     name = keys.name or path.stem
-    robots = tuple(_robot(shared_data=expansion.data, robot=r, index=i, station=name, path=path, digest=digest,
+    shared_data, listed = _without_list_robots(expansion.data, names, path)
+    robots = tuple(_robot(shared_data=shared_data, robot=r, index=i, station=name, path=path, digest=digest,
                           expansion=expansion, count=len(names))
                    for i, r in enumerate(keys.robots))
+    for i, list_robots in listed.items():
+        # The spots list i gives, as the cell reader forms them: that list read alone, in the first
+        # robot's cell (a list's seams do not depend on the others'; the whole cell was read above).
+        alone = {**shared_data, "seams": [], "spot_lists": [shared_data["spot_lists"][i]]}
+        view = _robot(shared_data=alone, robot=keys.robots[0], index=0, station=name, path=path, digest=digest,
+                      expansion=expansion, count=len(names))
+        allowed.update({(seam.name, spot.name): list_robots for seam in view.cell.seams for spot in seam.spots})
     spots = tuple(StationSpot(seam.name, spot.name, allowed.get((seam.name, spot.name), names))
                   for seam in robots[0].cell.seams for spot in seam.spots)
     notices = tuple(dict.fromkeys(n for r in robots for n in r.cell.notices))
@@ -168,6 +176,23 @@ def _robot_list(given: Any, within: tuple[str, ...], names: tuple[str, ...], pat
     if len(set(given)) != len(given):
         raise CellFileError(path, key, "names a robot twice")
     return tuple(n for n in names if n in given)
+
+
+def _without_list_robots(data: dict[str, Any], names: tuple[str, ...], path: Path
+                         ) -> tuple[dict[str, Any], dict[int, tuple[str, ...]]]:
+    """The station's data with each spot list's `robots` key taken out (a cell's list has none), and
+    the robots each list that had one allows, by the list's index."""
+    lists = data.get("spot_lists")
+    if not isinstance(lists, list):
+        return data, {}
+    listed: dict[int, tuple[str, ...]] = {}
+    kept = []
+    for i, entry in enumerate(lists):
+        if isinstance(entry, dict) and "robots" in entry:
+            listed[i] = _robot_list(entry["robots"], names, names, path, f"spot_lists[{i}].robots")
+            entry = {k: v for k, v in entry.items() if k != "robots"}
+        kept.append(entry)
+    return {**data, "spot_lists": kept}, listed
 
 
 def _without_robot_keys(seams: Any) -> Any:

@@ -178,3 +178,30 @@ def test_robots_touching_at_home_are_named_by_check_and_refused_by_plan(tmp_path
     # The shipped layout (A1 = 60 deg) stands apart: no warning.
     done = runner.invoke(app, ["check", str(STATION)])
     assert "touch where they stand" not in done.output
+
+
+def test_a_spot_list_may_name_the_robots_that_weld_its_spots(tmp_path: Path) -> None:
+    """A CAD export per robot: `spot_lists[i].robots` allows only those robots the list's spots (a
+    station key: taken out before each robot's cell is read); a list without it allows every robot.
+    An unknown robot is named with the list's key."""
+    data = _data()
+    seams = data.pop("seams")
+    lists = []
+    for k, seam in enumerate(seams[1:]):
+        rows = ["id,x,y,z,nx,ny,nz,group"]
+        rows += [",".join([s["name"], *map(str, s["xyz"]), *map(str, s["normal"]), seam["name"]]) for s in seam["spots"]]
+        (tmp_path / f"spots{k}.csv").write_text("\n".join(rows) + "\n")
+        lists.append({"file": f"spots{k}.csv", "part": "frame", "units": "m", "grid": 3,
+                      "tolerance": {"alpha": 10, "beta": 10, "gamma": [-180, 180]}})
+    lists[1]["robots"] = ["r2"]
+    data["spot_lists"] = lists
+    station = load_station(_write(tmp_path, data))
+    assert {s.key: s.robots for s in station.spots} == {
+        ("left_rail", "l1"): ("r1", "r2"), ("left_rail", "l4"): ("r1", "r2"),
+        ("right_rail", "r1"): ("r2",), ("right_rail", "r4"): ("r2",)}
+    view = robot_view(station, "r1", station.allowed("r1"))
+    assert [seam.name for seam in view.seams] == ["left_rail"]
+    lists[1]["robots"] = ["r3"]
+    with pytest.raises(CellFileError, match="unknown robot 'r3'") as err:
+        load_station(_write(tmp_path, data))
+    assert err.value.key == "spot_lists[1].robots"
