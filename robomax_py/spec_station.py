@@ -81,6 +81,12 @@ class StationSpec:
                 return r
         raise KeyError(name)
 
+    @property
+    def clearance(self) -> float:
+        """The margin kept between robots, m: the station's `process.clearance` (the one section every
+        robot's cell shares)."""
+        return max(r.cell.process.clearance for r in self.robots)
+
     def allowed(self, robot: str) -> tuple[SpotKey, ...]:
         """The spots `robot` may weld, in file order."""
         return tuple(s.key for s in self.spots if robot in s.robots)

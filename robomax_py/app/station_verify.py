@@ -143,6 +143,6 @@ def verify_station_files(station_file: Path, given: list[Path]) -> list[tuple[di
     out = []
     for programs in station_programs(station, given):
         members = members_of(station, programs)
-        margin = station.robots[0].cell.process.clearance
-        out.append((programs, members, verify_station(members, margin=margin, spots=[s.key for s in station.spots])))
+        out.append((programs, members, verify_station(members, margin=station.clearance,
+                                                       spots=[s.key for s in station.spots])))
     return out

@@ -39,7 +39,7 @@ class HomesTouching:
 def homes_touching(station: StationSpec, models: Mapping[str, RobotModel],
                    scenes: Mapping[str, Scene]) -> HomesTouching | None:
     """The first pair of robots, in the file's order, that touch at home; None when all stand apart."""
-    margin = max(r.cell.process.clearance for r in station.robots)
+    margin = station.clearance
     bodies = [robot_body(r.name, models[r.name], scenes[r.name]) for r in station.robots]
     homes = [np.asarray(r.cell.home, dtype=float) for r in station.robots]
     for i, a in enumerate(bodies):
