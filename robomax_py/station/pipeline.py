@@ -53,7 +53,7 @@ from robomax_py.station.reorder import (
     ordered_view,
 )
 from robomax_py.station.reorder import candidates as order_candidates
-from robomax_py.station.unload import bottleneck, tour_estimator, unloads
+from robomax_py.station.unload import bottleneck, cycle_scales, tour_estimator, unloads
 from robomax_py.station.zones import ZoneBox, meeting_box
 from robomax_py.timing.trajectory import evaluate
 from robomax_py.world.scene import build_scene
@@ -262,14 +262,9 @@ def _predicted_longest(plan: StationPlan, other: Assignment,
     """The longest own cycle predicted for another assignment: each robot's planned own cycle scaled
     by its estimated tour there over its estimated tour now (a robot idle now: its estimate)."""
     now = _orders(plan)
-    own = {p.robot: p.own_cycle for p in plan.robots}
-    out = 0.0
-    for robot, spots in other.spots.items():
-        est_now = tour_time(robot, now.get(robot, ()))
-        est_other = tour_time(robot, tuple(spots))
-        scale = own.get(robot, 0.0) / est_now if est_now > 0 and own.get(robot, 0.0) > 0 else 1.0
-        out = max(out, scale * est_other)
-    return out
+    scale = cycle_scales(now, {p.robot: p.own_cycle for p in plan.robots}, tour_time)
+    return max((scale.get(robot, 1.0) * tour_time(robot, tuple(spots)) for robot, spots in other.spots.items()),
+               default=0.0)
 
 
 def _zones(plan: StationPlan, bodies: Mapping[str, RobotBody], made: _Made, clearance: float,

@@ -58,6 +58,14 @@ def bottleneck(own: Mapping[str, float], ends: Mapping[str, float], tol: float =
     return last if ends[last] <= own.get(last, 0.0) + tol else None
 
 
+def cycle_scales(orders: Mapping[str, Order], own: Mapping[str, float],
+                 tour_time: Callable[[str, Order], float]) -> dict[str, float]:
+    """Each robot's planned own cycle over its estimated tour in its planned order (1 where either is
+    0): what turns a change of its estimated tour into a predicted change of its cycle."""
+    return {r: (own[r] / t if (t := tour_time(r, o)) > 0 and own.get(r, 0.0) > 0 else 1.0)
+            for r, o in orders.items()}
+
+
 def unloads(orders: Mapping[str, Order], own: Mapping[str, float], giver: str,
             able: Mapping[SpotKey, Sequence[str]], tour_time: Callable[[str, Order], float],
             fixed: frozenset[SpotKey] = frozenset()) -> list[Unload]:
@@ -66,8 +74,7 @@ def unloads(orders: Mapping[str, Order], own: Mapping[str, float], giver: str,
     orders : each robot's spots in its planned order. own : each robot's own planned cycle, s.
     able : the robots that reach each spot. tour_time : a robot's estimated tour in an order, s.
     fixed : spots that may not move (an ordered seam's: it goes to one robot whole)."""
-    scale = {r: (own[r] / t if (t := tour_time(r, o)) > 0 and own.get(r, 0.0) > 0 else 1.0)
-             for r, o in orders.items()}
+    scale = cycle_scales(orders, own, tour_time)
     now = dict(orders)
     pred = {r: own.get(r, 0.0) for r in orders}
     steps: list[Unload] = []
