@@ -127,6 +127,8 @@ DESCRIPTIONS: dict[str, str] = {
     "ToleranceFile.alpha": "Tilt about the TCP x axis allowed either way, deg.",
     "ToleranceFile.beta": "Tilt about the TCP y axis allowed either way, deg.",
     "ToleranceFile.gamma": "[min, max] spin about the electrode (TCP z) axis, deg.",
+    "ToleranceFile.sides": "normal: the gun on the normal's side; either: on either side of the sheet, the "
+                           "grid searched again turned 180 deg about the TCP x axis (extension).",
     "SpotFile.name": "Spot name, unique in its seam.",
     "SpotFile.xyz": "The weld point, m.",
     "SpotFile.normal": "Unit vector out of the sheet on the side the moving electrode comes from.",

@@ -301,6 +301,9 @@ class SeamSpec:
     gamma_range: tuple[float, float]          # rad, min <= max
     grid: int                                 # samples per angle, ends included
     spots: tuple[SpotSpec, ...]
+    # The gun may also stand on the sheet's other side: the grid again, turned 180 deg about the
+    # seam direction (tolerance.sides: either; `plan.poses.orientation_grid`).
+    either_side: bool = False
 
 
 @dataclass(frozen=True, slots=True)

@@ -344,7 +344,9 @@ def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> lis
                 out.append(Violation(t0, "spot", f"{label}: orientation alpha {math.degrees(alpha):.2f} beta "
                                                  f"{math.degrees(beta):.2f} gamma {math.degrees(gamma):.2f} deg is not the "
                                                  "pinned one"))
-        if abs(alpha) > seam.alpha_max + ANGLE_TOL_RAD or abs(beta) > seam.beta_max + ANGLE_TOL_RAD or not gamma_ok:
+        # On the sheet's other side (a seam whose gun may stand on either) the tilt is alpha -+ 180 deg.
+        tilt = alpha - math.copysign(math.pi, alpha) if seam.either_side and abs(alpha) > math.pi / 2 else alpha
+        if abs(tilt) > seam.alpha_max + ANGLE_TOL_RAD or abs(beta) > seam.beta_max + ANGLE_TOL_RAD or not gamma_ok:
             out.append(Violation(t0, "spot", f"{label}: orientation alpha {math.degrees(alpha):.2f} beta "
                                              f"{math.degrees(beta):.2f} gamma {math.degrees(gamma):.2f} deg outside the tolerance"))
         written = entry.get("config")

@@ -93,8 +93,9 @@ def cell_summary(cell: CellSpec, robot: Any) -> Group:
         g0, g1 = (math.degrees(a) for a in seam.gamma_range)
         seams.add_row(
             seam.name, str(len(seam.spots)), "given" if seam.ordered else "free",
-            f"±{math.degrees(seam.alpha_max):g} / ±{math.degrees(seam.beta_max):g}",
-            f"[{g0:g}, {g1:g}]", str(seam.grid), str(seam.grid ** 3),
+            f"±{math.degrees(seam.alpha_max):g} / ±{math.degrees(seam.beta_max):g}"
+            + (", either side" if seam.either_side else ""),
+            f"[{g0:g}, {g1:g}]", str(seam.grid), str(seam.grid ** 3 * (2 if seam.either_side else 1)),
         )
     if not cell.machines:
         return Group(head, objects, seams)

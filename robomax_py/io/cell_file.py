@@ -109,6 +109,10 @@ class ToleranceFile(_Strict):
     beta: Annotated[float, Field(ge=0, le=90, allow_inf_nan=False)] = 0.0    # deg
     gamma: Annotated[list[Annotated[float, Field(ge=-360, le=360, allow_inf_nan=False)]],
                      Field(min_length=2, max_length=2)] = [0.0, 0.0]          # deg
+    # Extension (docs/cell-files.md): "either" lets the gun stand on either side of the sheet, the
+    # planner choosing per spot (a C-gun's jaws reach both sides; the normal's sign is then a
+    # preference only, as where a CAD export gives none).
+    sides: Literal["normal", "either"] = "normal"
 
     @field_validator("gamma")
     @classmethod

@@ -128,11 +128,16 @@ def _pick_place_seams(job: PickPlaceFile, objects: set[str], path: Path) -> tupl
 
 
 def _check_pinned(spot: SpotFile, tol: ToleranceFile, path: Path, key: str) -> None:
-    """A pinned orientation must lie inside its seam's tolerance window."""
+    """A pinned orientation must lie inside its seam's tolerance window (on the other side of the
+    sheet, alpha 180 deg from it, where the seam's gun may stand on either side)."""
     for name, value, lo, hi in (("alpha", spot.alpha, -tol.alpha, tol.alpha), ("beta", spot.beta, -tol.beta, tol.beta)):
-        if value is not None and not lo - 1e-9 <= value <= hi + 1e-9:
-            raise CellFileError(path, f"{key}.{name}", f"pinned {name} {value:g} deg is outside the seam's tolerance "
-                                                      f"[{lo:g}, {hi:g}]")
+        if value is None or lo - 1e-9 <= value <= hi + 1e-9:
+            continue
+        if name == "alpha" and tol.sides == "either" and 180.0 - abs(value) <= tol.alpha + 1e-9:
+            continue
+        sides = " or 180 deg from it (sides: either)" if name == "alpha" and tol.sides == "either" else ""
+        raise CellFileError(path, f"{key}.{name}", f"pinned {name} {value:g} deg is outside the seam's tolerance "
+                                                  f"[{lo:g}, {hi:g}]{sides}")
     g0, g1 = tol.gamma
     g = spot.gamma
     if g is not None and g1 - g0 < 360 and not any(g0 - 1e-9 <= g + k * 360 <= g1 + 1e-9 for k in (-1, 0, 1)):
@@ -224,6 +229,7 @@ def _seam(seam: SeamFile, path: Path, key: str, problems: _Problems) -> SeamSpec
         gamma_range=(deg_to_rad(tol.gamma[0]), deg_to_rad(tol.gamma[1])),
         grid=seam.grid,
         spots=tuple(spots),
+        either_side=tol.sides == "either",
     )
 
 

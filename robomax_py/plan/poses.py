@@ -2,7 +2,9 @@
 
 For a spot with outward normal n and seam direction d the nominal TCP frame has z = -n (the electrode
 closes into the sheet), x = d orthogonal to n, y = z x x. A candidate orientation is
-R = R_nominal · Rx(alpha) · Ry(beta) · Rz(gamma).
+R = R_nominal · Rx(alpha) · Ry(beta) · Rz(gamma). A seam whose gun may stand on either side of the
+sheet (`SeamSpec.either_side`) has the grid twice: the second time turned 180 deg about x, the
+nominal z then along +n, alpha = the tilt ± 180 deg.
 """
 
 from __future__ import annotations
@@ -55,6 +57,12 @@ def orientation_grid(seam: SeamSpec) -> OrientationGrid:
     # towards the nominal one (the published baseline's choice); stable for equal distances.
     order = np.argsort(np.abs(combos).sum(axis=1), kind="stable")
     combos = combos[order]
+    if seam.either_side:
+        # The other side's orientations after this side's (ties still resolve toward the nominal):
+        # Rx(pi + alpha), alpha kept in (-pi, pi].
+        turned = combos.copy()
+        turned[:, 0] = np.where(turned[:, 0] > 0.0, turned[:, 0] - np.pi, turned[:, 0] + np.pi)
+        combos = np.vstack([combos, turned])
     # Orientations pinned by a spot (cell-file extension) join the grid after its own samples.
     pins = [np.array(spot.angles) for spot in seam.spots if spot.angles is not None]
     if pins:
