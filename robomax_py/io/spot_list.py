@@ -5,8 +5,9 @@ key `spot_lists` (`io.cell`) and `robomax import-spots` (`app.import_spots`), wh
 into a new cell file. What a list leaves out is recovered from the part:
 
 - a missing normal is the normal of the part's surface nearest the spot, turned to the side the gun
-  can reach (the side whose approach line is free of the part and the other objects; toward the
-  robot base when both are, and the spot is reported as ambiguous);
+  can reach (the side whose approach line is free of the part and the other objects; outward where
+  the spot lies on a closed part's face and that side is free; else toward the robot base when both
+  are, and the spot is reported as ambiguous);
 - a missing direction follows the seam's course (its spots in the seam's order: the list's for a
   group column, along the chain for seams formed from the geometry);
 - without a group column, spots are grouped into seams by the part's geometry: chains that turn
@@ -43,8 +44,16 @@ UNITS = {"m": 1.0, "mm": 0.001}
 DEFAULT_MAX_DISTANCE = 0.002        # m: a spot further from the part's surface is an error
 # Coordinates in metres beyond this, in the part's own frame, are probably millimetres.
 LOOKS_LIKE_MM = 10.0
-# The side test starts this far off the surface (a ray from the surface itself hits it at zero).
+# The side test's lines start this far inside the face nearest the spot (a line from the surface
+# itself may or may not meet it, at zero).
 SIDE_OFFSET = 5e-4
+# The widest step between the surfaces of sheets stacked at a spot (m): a sheet's thickness, or the
+# gap a model leaves between two that touch; a spot weld joins sheets of 0.5-4 mm.
+STACK_GAP = 0.005
+# A spot this close to a closed part's face lies on it (m): the face's outward sense is the side the
+# list means, where it is free. Further in (a sheet's middle plane: 0.25 mm in a 0.5 mm sheet), or on
+# an open mesh, whose faces' senses are the drawing's accident, both sides are weighed.
+ON_FACE = 1e-4
 # Rounding of what is written: 0.1 um and 1e-9 of a unit vector, far below any weld's accuracy, so
 # the YAML stays readable and both callers give byte-identical cells.
 XYZ_DECIMALS = 7
@@ -296,14 +305,18 @@ def spot_list_seams(spots: SpotList, part: ObjectSpec, others: Sequence[ObjectSp
         sides = _reachable_sides(surface, [o for o in others if o is not part], closest[need],
                                  np.asarray(surface.face_normals)[triangle[need]], approach)
         base = np.asarray(T_world_base, dtype=float)[:3, 3]
+        closed = bool(surface.is_watertight)
         for k, i in enumerate(need):
             n, (plus, minus) = np.asarray(surface.face_normals[triangle[i]], dtype=float), sides[k]
             toward_base = float(np.dot(base - closest[i], n)) >= 0
-            if plus and minus:
+            if plus and closed and distance[i] <= ON_FACE:
+                pass                # on a solid's face: its outward sense is the side the list meant
+            elif plus and minus:
                 n = n if toward_base else -n
                 result.ambiguous.append(rows[i].id)
                 result.sides.append(f"row {rows[i].row}: spot '{rows[i].id}': both sides of the part are free; "
-                                     "the normal points toward the robot base, check it")
+                                     "the normal points toward the robot base, check it (tolerance.sides: "
+                                     "either lets the planner choose)")
             elif minus:
                 n = -n
             elif not plus:
@@ -357,21 +370,48 @@ def _rows_text(rows: list[int]) -> str:
 def _reachable_sides(surface: trimesh.Trimesh, others: Sequence[ObjectSpec], points: FloatArray,
                      normals: FloatArray, approach: float) -> list[tuple[bool, bool]]:
     """Per surface point: whether the approach line on the face normal's side, and on the other
-    side, is free of the part and the other objects (starts outside every closed one and meets no
-    surface within `approach`)."""
+    side, is free of the part and the other objects.
+
+    A side's line starts where the sheets stacked at the spot end, not at the face nearest the spot:
+    a spot given on the sheet's middle plane (or on the faying surface of two sheets, as weld-spot
+    exports place it) is as near the one face as the other, and which of the two is taken is a
+    rounding accident. From the face taken, the other side's line runs through the sheet itself,
+    and the sheet must not count as what blocks it, or the normals of one seam's spots point now up,
+    now down. Sheets are stacked where each begins within `STACK_GAP` of the one before (a spot weld
+    joins sheets of 0.5-4 mm that touch). The line is blocked where it starts inside a closed object
+    or meets a surface within `approach` of where the stack ends."""
     meshes = [surface] + [world_mesh(o) for o in others if o.present is None]
     n = len(points)
-    origins = np.concatenate([points + SIDE_OFFSET * normals, points - SIDE_OFFSET * normals])
     directions = np.concatenate([normals, -normals])
-    blocked = np.zeros(2 * n, dtype=bool)
+    # Both lines start just inside the face taken: on the normal's side the stack is then the sheet's
+    # own face (at SIDE_OFFSET), on the other side the sheet's thickness.
+    origins = np.concatenate([points - SIDE_OFFSET * normals, points + SIDE_OFFSET * normals])
+    hits: list[list[float]] = [[] for _ in range(2 * n)]
+    for mesh in meshes:
+        found, ray_index, _ = mesh.ray.intersects_location(origins, directions, multiple_hits=True)
+        along = np.einsum("ij,ij->i", np.reshape(found, (-1, 3)) - origins[ray_index], directions[ray_index])
+        for t, i in zip(along, ray_index, strict=True):
+            if t > 0.0:
+                hits[i].append(float(t))
+    ends = np.array([_stack_end(sorted(h)) for h in hits])
+    # Just past the stack (past the face itself where a line from inside missed it at a triangle's edge).
+    past = origins + (np.maximum(ends, SIDE_OFFSET) + SIDE_OFFSET)[:, None] * directions
+    blocked = np.array([any(t > end and t <= end + approach for t in h) for h, end in zip(hits, ends, strict=True)])
     for mesh in meshes:
         if mesh.is_watertight:
-            blocked |= mesh.contains(origins)
-        hits, ray_index, _ = mesh.ray.intersects_location(origins, directions, multiple_hits=False)
-        if len(ray_index):
-            reach = np.linalg.norm(hits - origins[ray_index], axis=1)
-            blocked[ray_index[reach <= approach]] = True
+            blocked |= mesh.contains(past)
     return [(not blocked[i], not blocked[n + i]) for i in range(n)]
+
+
+def _stack_end(distances: Sequence[float]) -> float:
+    """How far along a line (sorted hit distances from its start) the sheets stacked at its start
+    reach: each hit within STACK_GAP of the last one taken (the first of the start) is part of it."""
+    end = 0.0
+    for t in distances:
+        if t - end > STACK_GAP:
+            break
+        end = t
+    return end
 
 
 def _groups(rows: Sequence[SpotRow]) -> list[SpotGroup]:

@@ -147,6 +147,30 @@ def test_open_sheet_is_ambiguous_toward_the_base(tmp_path: Path) -> None:
     assert np.allclose(spot.normal, [0, 0, 1]) and np.allclose(spot.direction, [1, 0, 0])
 
 
+def test_spots_on_a_sheets_middle_plane_take_the_free_side_whatever_face_is_nearest(tmp_path: Path) -> None:
+    """A 1.5 mm sheet with a block 10 mm under it (the approach is 30 mm), spots given on the sheet's
+    middle plane as weld-spot exports place them: each is as near the top face as the bottom one.
+    Every spot's normal points up, the one side free; the sheet itself does not block the line that
+    starts at its lower face."""
+    data = cell_data()
+    data["objects"] = [{"name": "sheet", "box": [0.4, 0.3, 0.0015], "pose": {"xyz": [1.4, 0.0, 0.9]}, "workpiece": True},
+                       {"name": "block", "box": [0.4, 0.3, 0.05], "pose": {"xyz": [1.4, 0.0, 0.864]}}]
+    cell = write_cell(tmp_path / "cell.yaml", data)
+    rows = "".join(f"m{i},{x:.3f},{y:.3f},0\n" for i, (x, y) in enumerate((x, y) for x in (-0.15, -0.05, 0.05, 0.15)
+                                                                          for y in (-0.1, 0.0, 0.1)))
+    (tmp_path / "s.csv").write_text("id,x,y,z\n" + rows)
+    seams, result = spot_list_seams(read_cell_file(cell), cell, "", tmp_path / "s.csv", "sheet", "m", 0.002)
+    normals = np.array([s.normal for seam in seams for s in seam.spots])
+    assert len(normals) == 12 and not result.sides, result.sides
+    np.testing.assert_allclose(normals, np.tile([0.0, 0.0, 1.0], (12, 1)), atol=1e-9)
+    # With room under the sheet too (the block gone), both sides are free: reported, toward the base.
+    data["objects"] = data["objects"][:1]
+    cell = write_cell(tmp_path / "open.yaml", data)
+    seams, result = spot_list_seams(read_cell_file(cell), cell, "", tmp_path / "s.csv", "sheet", "m", 0.002)
+    assert len(result.sides) == 12 and all("both sides" in line for line in result.sides)
+    assert all(s.normal[2] == -1.0 for seam in seams for s in seam.spots)      # the base is below the sheet
+
+
 def test_list_in_a_named_frame_equals_the_part_frame(tmp_path: Path) -> None:
     write_csv(tmp_path / "part.csv", known_spots()[:80], mm=True, groups=True)
     write_csv(tmp_path / "station.csv", station_spots(), mm=True, groups=True)
