@@ -98,7 +98,9 @@ def _rot(axis: int, a: float) -> np.ndarray:
 def spot_frames(spot: Any, seam: Any) -> np.ndarray:
     """(m, 4, 4) TCP poses (world) of a spot over its seam's tolerance grid, as SPEC §3 states
     them: z = -n, x = d made orthogonal to n, y = z x x; R = R_nominal Rx(a) Ry(b) Rz(g), `grid`
-    values per angle with the ends included; nearest the nominal orientation first."""
+    values per angle with the ends included; nearest the nominal orientation first. A seam whose gun
+    may stand on either side (docs/cell-files.md, `sides: either`) has them all again on the other
+    side: the nominal frame turned half a turn about its x axis (z = +n)."""
     n = np.asarray(spot.normal, dtype=float)
     z = -n / np.linalg.norm(n)
     x = np.asarray(spot.direction, dtype=float)
@@ -112,12 +114,14 @@ def spot_frames(spot: Any, seam: Any) -> np.ndarray:
     angles = [(a, b, g) for a in axis(-seam.alpha_max, seam.alpha_max) for b in axis(-seam.beta_max, seam.beta_max)
               for g in axis(*seam.gamma_range)]
     angles.sort(key=lambda abg: sum(abs(v) for v in abg))
+    nominals = [R0, R0 @ np.diag([1.0, -1.0, -1.0])] if seam.either_side else [R0]
     out = []
-    for a, b, g in angles:
-        T = np.eye(4)
-        T[:3, :3] = R0 @ _rot(0, a) @ _rot(1, b) @ _rot(2, g)
-        T[:3, 3] = spot.xyz
-        out.append(T)
+    for R in nominals:
+        for a, b, g in angles:
+            T = np.eye(4)
+            T[:3, :3] = R @ _rot(0, a) @ _rot(1, b) @ _rot(2, g)
+            T[:3, 3] = spot.xyz
+            out.append(T)
     return np.array(out)
 
 
