@@ -45,6 +45,9 @@ class Timeline:
     end: float
     wait_points: tuple[float, ...]
     signal_points: tuple[float, ...]
+    # What the robot rests at at each of its points (`_segments`: home, each spot, home), for
+    # messages; () where not known.
+    stops: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -214,7 +217,7 @@ def coordinate(timelines: Sequence[Timeline], pairs: Sequence[PairMap], fcfs: bo
         while True:
             schedule = simulate(timelines, locks)
             if schedule.deadlock:
-                stuck = Coordination(tuple(locks), schedule, _deadlock_text(locks))
+                stuck = Coordination(tuple(locks), schedule, _deadlock_text(locks, by_name))
             elif (hit := _first_clash(pairs, schedule)) is None:
                 return Coordination(tuple(locks), schedule)
             elif len(locks) >= MAX_INTERLOCKS:
@@ -265,16 +268,38 @@ def coordinate(timelines: Sequence[Timeline], pairs: Sequence[PairMap], fcfs: bo
     return Coordination(_without_implied(done.interlocks), done.schedule, done.unresolved)
 
 
-def _deadlock_text(locks: Sequence[Interlock]) -> str:
+def _deadlock_text(locks: Sequence[Interlock], timelines: dict[str, Timeline]) -> str:
     """What a deadlock is made of: the interlocks of the robots the last one orders, on each robot's
-    own clock (the segment the leader must finish, the point the waiter waits at)."""
+    own clock (the segment the leader must finish, the point the waiter waits at), each named by
+    the spots it lies between where the timelines know them: a person finds "w6 -> home" in the
+    cell, not 12.82 s."""
     last = locks[-1]
     pair = {last.leader, last.waiter}
     held = [x for x in locks if {x.leader, x.waiter} == pair]
-    said = "; ".join(f"{x.waiter} waits at {x.wait_at:.2f} s for {x.leader} to finish "
-                     f"{x.leader_span[0]:.2f}-{x.leader_span[1]:.2f} s" for x in held[-4:])
+    said = "; ".join(f"{x.waiter} waits at {x.wait_at:.2f} s{_at(timelines[x.waiter], x.wait_at)} for {x.leader} "
+                     f"to finish {x.leader_span[0]:.2f}-{x.leader_span[1]:.2f} s{_move(timelines[x.leader], x.leader_span)}"
+                     for x in held[-4:])
     return (f"the interlocks wait on each other (deadlock): {said} (each on its own clock); {last.pair[0]} and "
             f"{last.pair[1]} move through each other's rest postures or paths in every order tried")
+
+
+def _stop(line: Timeline, own: float) -> int | None:
+    """The index of the robot's rest point at its own time `own`, None where its stops are not known."""
+    points = _segments(line)
+    if len(line.stops) != len(points):
+        return None
+    k = _segment(points, own)
+    return k if abs(points[k] - own) <= TIME_EPS else None
+
+
+def _at(line: Timeline, own: float) -> str:
+    k = _stop(line, own)
+    return "" if k is None else f" (at {line.stops[k]})"
+
+
+def _move(line: Timeline, span: tuple[float, float]) -> str:
+    k = _stop(line, span[0])
+    return "" if k is None or k + 1 >= len(line.stops) else f" ({line.stops[k]} -> {line.stops[k + 1]})"
 
 
 def _without_implied(locks: Sequence[Interlock]) -> tuple[Interlock, ...]:

@@ -503,7 +503,8 @@ def _timeline(p: RobotPlan) -> Timeline:
     t0 = float(p.result.trajectory.t[0])
     leave = tuple(s.t_leave - t0 for s in p.result.spots)
     end = p.result.trajectory.duration
-    return Timeline(p.robot, end, (0.0, *leave), (*leave, end))
+    return Timeline(p.robot, end, (0.0, *leave), (*leave, end),
+                    ("home", *(f"{s.seam}/{s.name}" for s in p.result.spots), "home"))
 
 
 def _samples(p: RobotPlan, dt: float) -> np.ndarray:

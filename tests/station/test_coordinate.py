@@ -4,6 +4,8 @@ interlocks that wait on each other are a deadlock."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -155,3 +157,11 @@ def test_a_deadlock_names_the_robots_and_the_waits_it_is_made_of() -> None:
     for lock in done.interlocks[-2:]:
         assert (f"{lock.waiter} waits at {lock.wait_at:.2f} s for {lock.leader} to finish "
                 f"{lock.leader_span[0]:.2f}-{lock.leader_span[1]:.2f} s") in done.unresolved
+    # With the spots the robots rest at known, each wait and each move is named by them too.
+    named = [dataclasses.replace(line, stops=("home", "s1", "s2", "s3", "home")) for line in lines]
+    done = coordinate(named, [pair])
+    at = dict(zip((0.0, 1.0, 2.0, 3.0), ("home", "s1", "s2", "s3"), strict=True))
+    for lock in done.interlocks[-2:]:
+        a, b = lock.leader_span
+        assert (f"{lock.waiter} waits at {lock.wait_at:.2f} s (at {at[lock.wait_at]}) for {lock.leader} to finish "
+                f"{a:.2f}-{b:.2f} s ({at[a]} -> {at[b]})") in done.unresolved, done.unresolved
