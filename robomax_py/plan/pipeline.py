@@ -74,6 +74,16 @@ def _in_collision(what: str, contact: Contact, world: CollisionWorld, robot: Rob
     return text
 
 
+def home_collision(cell: CellSpec, robot: RobotModel, world: CollisionWorld | None = None) -> str | None:
+    """Why the robot cannot stand at its home ('home is in collision: a vs b'), None where it can:
+    every program starts and ends there, so `plan` refuses such a cell, and `check` tells it first.
+    `world`: the cell's world without its dynamic objects (built here when not given)."""
+    if world is None:
+        world = CollisionWorld(robot, build_scene(replace(cell, dynamic=()), robot), cell.process.clearance)
+    contact = world.first_contact(cell.home)
+    return None if contact is None else _in_collision("home", contact, world, robot)
+
+
 def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress: Progress,
           known: Mapping[tuple[str, str], SpotCandidates]) -> PlanResult:
     check_ik_work(cell, robot)              # before anything large is built
@@ -88,9 +98,9 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
     log.debug("%s: collision world of %d pieces, %d pairs in %.2f s", cell.name, world.geometry_model.ngeoms,
               world.n_pairs, clock["world"])
 
-    home_contact = world.first_contact(cell.home)
-    if home_contact is not None:
-        return PlanResult(cell.name, robot.name, "infeasible", _in_collision("home", home_contact, world, robot))
+    at_home = home_collision(cell, robot, world)
+    if at_home is not None:
+        return PlanResult(cell.name, robot.name, "infeasible", at_home)
     if cell.start is not None:
         start_contact = full_world.first_contact(cell.start, 0.0)
         if start_contact is not None:

@@ -24,6 +24,7 @@ import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.plan import PlanOptions, PlanResult, plan_cell
+from robomax_py.plan.pipeline import home_collision
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.spec_station import SpotKey, StationSpec, robot_view
@@ -158,6 +159,11 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
                            f"reach collision-free: {names}", (), Assignment({}, {}), bound, None, clock)
     t0 = time.process_time()
     scenes = {r.name: build_scene(r.cell, models[r.name]) for r in station.robots}
+    blocked = next(((r.name, text) for r in station.robots if (text := home_collision(r.cell, models[r.name]))), None)
+    if blocked is not None:
+        clock["homes"] = time.process_time() - t0
+        return StationPlan(station.name, "infeasible", f"{blocked[0]}: {blocked[1]}", (), Assignment({}, {}), bound,
+                           None, clock)
     touching = homes_touching(station, models, scenes)
     clock["homes"] = time.process_time() - t0
     if touching is not None:

@@ -50,6 +50,28 @@ def test_bad_cell_exits_2_and_writes_nothing(tmp_path: Path, write_small_cell: S
     assert not out.exists()
 
 
+def test_check_warns_of_a_home_in_collision_that_plan_refuses(tmp_path: Path, write_small_cell: SmallCell) -> None:
+    """A box where the gun stands at home (its TCP): `check` still reads the cell (exit 0) but names
+    the pieces that touch and that `plan` refuses it; `plan` exits 3 with the same words."""
+    import yaml
+
+    from robomax_py.io.cell import load_cell, load_cell_robot
+    from robomax_py.robot import fk_tcp
+
+    cell = write_small_cell(tmp_path, "small")
+    spec = load_cell(cell)
+    at = (np.asarray(spec.T_world_base) @ fk_tcp(load_cell_robot(spec), np.asarray(spec.home)))[:3, 3]
+    data = yaml.safe_load(cell.read_text())
+    data["objects"].append({"name": "post", "box": [0.1, 0.1, 0.1], "pose": {"xyz": [float(c) for c in at]}})
+    cell.write_text(yaml.safe_dump(data, sort_keys=False))
+    done = runner.invoke(app, ["check", str(cell)])
+    said = " ".join(done.output.split())
+    assert done.exit_code == EXIT_OK and "home is in collision: " in said and "vs post; `plan` refuses this cell" in said
+    assert json.loads(runner.invoke(app, ["check", str(cell), "--json"]).stdout)["home_collision"].endswith("vs post")
+    done = runner.invoke(app, ["plan", str(cell), "-o", str(tmp_path / "out")])
+    assert done.exit_code == EXIT_INFEASIBLE and "home is in collision: " in " ".join(done.output.split())
+
+
 def test_inform_on_an_arm_without_pulse_counts_exits_2_and_writes_nothing(tmp_path: Path,
                                                                            write_small_cell: SmallCell) -> None:
     """`--format inform` on an arm whose robot.yaml states no encoder pulses per degree: one message

@@ -180,6 +180,34 @@ def test_robots_touching_at_home_are_named_by_check_and_refused_by_plan(tmp_path
     assert "touch where they stand" not in done.output
 
 
+def test_a_robot_that_cannot_stand_at_home_is_named_by_check_and_refused_by_plan(tmp_path: Path) -> None:
+    """A post where r2's gun stands at home: no program of r2 can start. `check` warns naming the
+    robot and the pieces; `plan` exits 3 with the same words before any robot is planned, and
+    writes nothing."""
+    import numpy as np
+    from typer.testing import CliRunner
+
+    from robomax_py.app.cli import app
+    from robomax_py.io.cell import load_cell_robot
+    from robomax_py.robot import fk_tcp
+
+    r2 = load_station(STATION).robots[1].cell
+    at = (np.asarray(r2.T_world_base) @ fk_tcp(load_cell_robot(r2), np.asarray(r2.home)))[:3, 3]
+    data = _data()
+    data["objects"].append({"name": "post", "box": [0.1, 0.1, 0.1], "pose": {"xyz": [float(c) for c in at]}})
+    path = _write(tmp_path, data)
+    runner = CliRunner()
+    done = runner.invoke(app, ["check", str(path)])
+    said = " ".join(done.output.split())
+    assert done.exit_code == 0, done.output
+    assert re.search(r"r2: home is in collision: \S+ vs post; `plan` refuses this station", said), said
+    assert "r1: home" not in said
+    out = tmp_path / "out"
+    done = runner.invoke(app, ["plan", str(path), "-o", str(out)])
+    assert done.exit_code == 3 and not out.exists()
+    assert re.search(r"r2: home is in collision: \S+ vs post", " ".join(done.output.split())), done.output
+
+
 def test_a_spot_list_may_name_the_robots_that_weld_its_spots(tmp_path: Path) -> None:
     """A CAD export per robot: `spot_lists[i].robots` allows only those robots the list's spots (a
     station key: taken out before each robot's cell is read); a list without it allows every robot.

@@ -71,6 +71,7 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
         from robomax_py.io.frames import format_tree
         from robomax_py.io.station import is_station_file
         from robomax_py.plan.candidates import check_ik_work
+        from robomax_py.plan.pipeline import home_collision
         from robomax_py.plan.reach import (
             always_touching_text,
             reach_report,
@@ -106,6 +107,9 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
         if tight is not None and not as_json:
             out.print(f"reach: all {len(reach)} {stop}s within reach (least margin {-tight.out_by_m * 1000:.0f} mm "
                       f"at {tight.seam}/{tight.name})")
+        # Where the robot cannot stand at home no program can start: `plan` refuses the cell; told here.
+        home_blocked = home_collision(spec, robot)
+        _warn([f"{home_blocked}; `plan` refuses this cell"] if home_blocked is not None else [])
         at_home, always = self_contacts(robot, spec.home)
         _warn([f"{robot.name}: links {a} and {b} touch at home; if they touch by design, add "
                f"[{a}, {b}] to collision.disable in {robot.source}" for a, b in at_home])
@@ -117,6 +121,7 @@ def check(cell: Annotated[Path, typer.Argument(help="cell file (YAML)")], as_jso
                 "objects": [obj.name for obj in (*spec.objects, *spec.dynamic)],
                 "reach": None if tight is None else {
                     stop + "s": len(reach), "least_margin_m": round(-tight.out_by_m, 6), "at": f"{tight.seam}/{tight.name}"},
+                "home_collision": home_blocked,
                 "self_contacts_at_home": [list(p) for p in at_home],
                 "self_contacts_always": [list(p) for p in always],
                 "frames": [node.as_dict() for node in tree], "includes": [str(file) for file in included]})
@@ -131,6 +136,7 @@ def _check_station(path: Path, as_json: bool) -> None:
     from robomax_py.errors import CellFileError
     from robomax_py.io.cell import load_cell_robot
     from robomax_py.io.station import load_station
+    from robomax_py.plan.pipeline import home_collision
     from robomax_py.plan.reach import reach_report
     from robomax_py.station.homes import homes_touching
     from robomax_py.world.scene import build_scene
@@ -158,12 +164,16 @@ def _check_station(path: Path, as_json: bool) -> None:
         more = f" ({len(orphan) - 1} more spot(s) out of every robot's reach)" if len(orphan) > 1 else ""
         raise CellFileError(path, "seams", f"spot {orphan[0].seam}/{orphan[0].spot} is out of the reach of every robot "
                             f"that may weld it ({', '.join(orphan[0].robots)}){more}")
-    # Robots that touch at home: `plan` refuses the station (no program can start); told here first.
+    # A robot that cannot stand at home, or robots that touch there: `plan` refuses the station (no
+    # program can start); told here first.
+    blocked = {r.name: text for r in station.robots if (text := home_collision(r.cell, models[r.name])) is not None}
+    _warn([f"{name}: {text}; `plan` refuses this station" for name, text in blocked.items()])
     touching = homes_touching(station, models, {r.name: build_scene(r.cell, models[r.name]) for r in station.robots})
     _warn([f"{touching.message()}; `plan` refuses this station"] if touching is not None else [])
     if as_json:
         _print_json("check", True, {"cell": str(path), "name": station.name, "station": True, "robots": rows,
                                     "spots": len(station.spots),
+                                    "home_collisions": blocked,
                                     "homes_touching": None if touching is None else touching.message()})
         return
     out.print(f"station {station.name}: {len(station.robots)} robots, {len(station.spots)} spots", markup=False,
