@@ -29,6 +29,7 @@ from robomax_py.io.cell_file_values import (
     Name,
     NonNegative,
     ObjectFile,
+    Place,
     PoseFile,
     Reference,
     Vec3,
@@ -129,7 +130,7 @@ Angle = Annotated[float, Field(ge=-360, le=360, allow_inf_nan=False)]
 
 class SpotFile(_Strict):
     name: Name
-    xyz: Vec3
+    xyz: Place
     normal: Vec3
     direction: Vec3
     # Extensions (docs/cell-extensions.md): per-spot process and pinned choices.

@@ -13,6 +13,7 @@ from pydantic import Field, field_validator, model_validator
 from robomax_py.io.cell_file_values import (
     _SHAPE_KEYS,
     ObjectFile,
+    Place,
     PoseFile,
     Positive,
     Reference,
@@ -30,7 +31,7 @@ class PathPoseFile(_Strict):
     """One timed pose of a moving object (`dynamic[i].path`), in the world frame."""
 
     t: WindowTime                             # s from program start
-    xyz: Vec3                                 # m
+    xyz: Place                                # m
     rpy: Vec3 = [0.0, 0.0, 0.0]               # deg
 
 

@@ -13,6 +13,7 @@ from robomax_py.io.cell_file_values import (
     Name,
     NonNegative,
     ObjectFile,
+    Place,
     PoseFile,
     Positive,
     Vec3,
@@ -33,7 +34,7 @@ PICK_PLACE_SEAM = "transfers"
 
 class StationFile(_Strict):
     name: Name
-    xyz: Vec3                                 # m, the TCP at the station
+    xyz: Place                                # m, the TCP at the station
     rpy: Vec3 = [0.0, 0.0, 0.0]               # deg: the TCP frame there; the tool arrives and leaves along +z
     action: Literal["grip", "release"]
     machine: Name | None = None               # the machine whose door the station lies behind

@@ -36,6 +36,12 @@ Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
+# A place in a cell or station, m: beyond a kilometre it is a typo (or hostile), and the geometry
+# code squares such coordinates past the floats' range (1e308 m made the collision world's
+# eigen-solver fail).
+MAX_COORDINATE_M = 1_000.0
+Coordinate = Annotated[float, Field(ge=-MAX_COORDINATE_M, le=MAX_COORDINATE_M, allow_inf_nan=False)]
+Place = Annotated[list[Coordinate], Field(min_length=3, max_length=3)]
 # Names end up in messages, program identifiers and (the cell's) file names: printable text of a
 # bounded length; a cell name is also a file stem, so no path separators and at most 100 characters.
 MAX_NAME_CHARS = 200
@@ -98,7 +104,7 @@ class _Strict(BaseModel):
 
 
 class PoseFile(_Strict):
-    xyz: Vec3 = [0.0, 0.0, 0.0]      # m
+    xyz: Place = [0.0, 0.0, 0.0]     # m
     rpy: Vec3 = [0.0, 0.0, 0.0]      # deg
 
 

@@ -15,6 +15,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from robomax_py.errors import RobotModelError
+from robomax_py.io.cell_file_values import Place
 from robomax_py.io.mesh_keys import MeshScale, MeshTolerance, MeshUnits, mesh_shape
 from robomax_py.io.robot_paths import (
     PACKAGE_SEARCH_DEPTH,
@@ -76,7 +77,7 @@ class _Strict(BaseModel):
 
 
 class PoseFile(_Strict):
-    xyz: Vec3 = [0.0, 0.0, 0.0]
+    xyz: Place = [0.0, 0.0, 0.0]              # m
     rpy: Vec3 = [0.0, 0.0, 0.0]               # deg
 
 
