@@ -36,10 +36,11 @@ Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 Vec3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
-# A place in a cell or station, m: beyond a kilometre it is a typo (or hostile), and the geometry
-# code squares such coordinates past the floats' range (1e308 m made the collision world's
-# eigen-solver fail).
-MAX_COORDINATE_M = 1_000.0
+# A place in a cell or station, m: beyond 1000 km it is no place at all (a hostile or broken file),
+# and the geometry code squares such coordinates past the floats' range (1e308 m made the collision
+# world's eigen-solver fail). A cell written in millimetres (thousands of "metres") is read, and
+# `cell_lint` names it.
+MAX_COORDINATE_M = 1e6
 Coordinate = Annotated[float, Field(ge=-MAX_COORDINATE_M, le=MAX_COORDINATE_M, allow_inf_nan=False)]
 Place = Annotated[list[Coordinate], Field(min_length=3, max_length=3)]
 # Names end up in messages, program identifiers and (the cell's) file names: printable text of a
