@@ -40,8 +40,9 @@ def spot_list_seams(parsed: CellFile, path: Path, key: str, csv_file: Path, part
         checked_file(csv_file, LIMITS.cell, named_by(CellFileError, path, f"{key}.file"), f"spot list {csv_file}")
     T_frame = None if frame is None else _frame_world(frame, tree, parsed, path, f"{key}.frame" if key else "--frame")
     spots = read_spot_list(csv_file, units)
+    either = ((seam or {}).get("tolerance") or {}).get("sides") == "either"
     result = list_seams(spots, objects[index], objects, _pose(parsed.robot.base), parsed.process.approach,
-                        max_distance, T_frame)
+                        max_distance, T_frame, either_side=either)
     seams = [SeamFile.model_validate({**(seam or {}), **s}) for s in result.seams]
     return seams, result
 

@@ -277,10 +277,12 @@ def world_mesh(obj: ObjectSpec) -> trimesh.Trimesh:
 
 def spot_list_seams(spots: SpotList, part: ObjectSpec, others: Sequence[ObjectSpec], T_world_base: FloatArray,
                     approach: float, max_distance: float = DEFAULT_MAX_DISTANCE,
-                    T_world_frame: FloatArray | None = None) -> SpotListResult:
+                    T_world_frame: FloatArray | None = None, either_side: bool = False) -> SpotListResult:
     """The list's spots as seams in the world: each moved by the pose of the frame its coordinates
     are in (`T_world_frame`; the part's own frame when None), its normal and direction recovered
-    where the list has none, grouped by the group column or the part's geometry."""
+    where the list has none, grouped by the group column or the part's geometry. `either_side`: the
+    seams' gun may stand on either side (`tolerance.sides: either`), so a spot free on both is no
+    question for a person: the planner chooses, and it is not reported."""
     T = np.asarray(part.T_world_object if T_world_frame is None else T_world_frame, dtype=float)
     R = T[:3, :3]
     R_part = np.asarray(part.T_world_object, dtype=float)[:3, :3]
@@ -311,6 +313,8 @@ def spot_list_seams(spots: SpotList, part: ObjectSpec, others: Sequence[ObjectSp
             toward_base = float(np.dot(base - closest[i], n)) >= 0
             if plus and closed and distance[i] <= ON_FACE:
                 pass                # on a solid's face: its outward sense is the side the list meant
+            elif plus and minus and either_side:
+                n = n if toward_base else -n
             elif plus and minus:
                 n = n if toward_base else -n
                 result.ambiguous.append(rows[i].id)

@@ -169,6 +169,10 @@ def test_spots_on_a_sheets_middle_plane_take_the_free_side_whatever_face_is_near
     seams, result = spot_list_seams(read_cell_file(cell), cell, "", tmp_path / "s.csv", "sheet", "m", 0.002)
     assert len(result.sides) == 12 and all("both sides" in line for line in result.sides)
     assert all(s.normal[2] == -1.0 for seam in seams for s in seam.spots)      # the base is below the sheet
+    # Where the seams' gun may stand on either side the planner chooses: nothing for a person to check.
+    seams, result = spot_list_seams(read_cell_file(cell), cell, "", tmp_path / "s.csv", "sheet", "m", 0.002,
+                                    {"tolerance": {"sides": "either"}})
+    assert not result.sides and all(s.normal[2] == -1.0 for seam in seams for s in seam.spots)
 
 
 def test_list_in_a_named_frame_equals_the_part_frame(tmp_path: Path) -> None:
