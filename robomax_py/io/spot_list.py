@@ -313,14 +313,13 @@ def spot_list_seams(spots: SpotList, part: ObjectSpec, others: Sequence[ObjectSp
             toward_base = float(np.dot(base - closest[i], n)) >= 0
             if plus and closed and distance[i] <= ON_FACE:
                 pass                # on a solid's face: its outward sense is the side the list meant
-            elif plus and minus and either_side:
-                n = n if toward_base else -n
             elif plus and minus:
                 n = n if toward_base else -n
-                result.ambiguous.append(rows[i].id)
-                result.sides.append(f"row {rows[i].row}: spot '{rows[i].id}': both sides of the part are free; "
-                                     "the normal points toward the robot base, check it (tolerance.sides: "
-                                     "either lets the planner choose)")
+                if not either_side:
+                    result.ambiguous.append(rows[i].id)
+                    result.sides.append(f"row {rows[i].row}: spot '{rows[i].id}': both sides of the part are free; "
+                                         "the normal points toward the robot base, check it (tolerance.sides: "
+                                         "either lets the planner choose)")
             elif minus:
                 n = -n
             elif not plus:
