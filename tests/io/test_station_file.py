@@ -164,20 +164,30 @@ def test_robots_touching_at_home_are_named_by_check_and_refused_by_plan(tmp_path
     data = _data()
     for robot in data["robots"]:
         robot["home"] = [0, -90, 90, 0, 0, 0]
-    path = _write(tmp_path, data)
-    runner = CliRunner()
-    done = runner.invoke(app, ["check", str(path)])
-    said = " ".join(done.output.split())
-    assert done.exit_code == 0, done.output
+    said, refused = _checked_and_refused(tmp_path, data)
     assert re.search(r"r1 and r2 touch where they stand at home \(r1's \S+ within 5 mm of r2's \S+\)", said), said
     assert "robots[0].home, robots[1].home" in said and "`plan` refuses this station" in said
-    out = tmp_path / "out"
-    done = runner.invoke(app, ["plan", str(path), "-o", str(out)])
-    assert done.exit_code == 3 and not out.exists()
-    assert "r1 and r2 touch where they stand at home" in " ".join(done.output.split())
+    assert "r1 and r2 touch where they stand at home" in refused
     # The shipped layout (A1 = 60 deg) stands apart: no warning.
-    done = runner.invoke(app, ["check", str(STATION)])
+    done = CliRunner().invoke(app, ["check", str(STATION)])
     assert "touch where they stand" not in done.output
+
+
+def _checked_and_refused(tmp_path: Path, data: dict[str, Any]) -> tuple[str, str]:
+    """What `check` of the station `data` says (exit 0) and what `plan` says refusing it (exit 3,
+    nothing written), each with its lines joined."""
+    from typer.testing import CliRunner
+
+    from robomax_py.app.cli import app
+
+    path = _write(tmp_path, data)
+    runner = CliRunner()
+    checked = runner.invoke(app, ["check", str(path)])
+    assert checked.exit_code == 0, checked.output
+    out = tmp_path / "out"
+    planned = runner.invoke(app, ["plan", str(path), "-o", str(out)])
+    assert planned.exit_code == 3 and not out.exists(), planned.output
+    return " ".join(checked.output.split()), " ".join(planned.output.split())
 
 
 def test_a_robot_that_cannot_stand_at_home_is_named_by_check_and_refused_by_plan(tmp_path: Path) -> None:
@@ -185,9 +195,7 @@ def test_a_robot_that_cannot_stand_at_home_is_named_by_check_and_refused_by_plan
     robot and the pieces; `plan` exits 3 with the same words before any robot is planned, and
     writes nothing."""
     import numpy as np
-    from typer.testing import CliRunner
 
-    from robomax_py.app.cli import app
     from robomax_py.io.cell import load_cell_robot
     from robomax_py.robot import fk_tcp
 
@@ -195,17 +203,10 @@ def test_a_robot_that_cannot_stand_at_home_is_named_by_check_and_refused_by_plan
     at = (np.asarray(r2.T_world_base) @ fk_tcp(load_cell_robot(r2), np.asarray(r2.home)))[:3, 3]
     data = _data()
     data["objects"].append({"name": "post", "box": [0.1, 0.1, 0.1], "pose": {"xyz": [float(c) for c in at]}})
-    path = _write(tmp_path, data)
-    runner = CliRunner()
-    done = runner.invoke(app, ["check", str(path)])
-    said = " ".join(done.output.split())
-    assert done.exit_code == 0, done.output
+    said, refused = _checked_and_refused(tmp_path, data)
     assert re.search(r"r2: home is in collision: \S+ vs post; `plan` refuses this station", said), said
     assert "r1: home" not in said
-    out = tmp_path / "out"
-    done = runner.invoke(app, ["plan", str(path), "-o", str(out)])
-    assert done.exit_code == 3 and not out.exists()
-    assert re.search(r"r2: home is in collision: \S+ vs post", " ".join(done.output.split())), done.output
+    assert re.search(r"r2: home is in collision: \S+ vs post", refused), refused
 
 
 def test_a_spot_list_may_name_the_robots_that_weld_its_spots(tmp_path: Path) -> None:
