@@ -217,7 +217,7 @@ def coordinate(timelines: Sequence[Timeline], pairs: Sequence[PairMap], fcfs: bo
         while True:
             schedule = simulate(timelines, locks)
             if schedule.deadlock:
-                stuck = Coordination(tuple(locks), schedule, _deadlock_text(locks, by_name))
+                stuck = Coordination(tuple(locks), schedule, _deadlock_text(locks, by_name, pairs))
             elif (hit := _first_clash(pairs, schedule)) is None:
                 return Coordination(tuple(locks), schedule)
             elif len(locks) >= MAX_INTERLOCKS:
@@ -268,19 +268,40 @@ def coordinate(timelines: Sequence[Timeline], pairs: Sequence[PairMap], fcfs: bo
     return Coordination(_without_implied(done.interlocks), done.schedule, done.unresolved)
 
 
-def _deadlock_text(locks: Sequence[Interlock], timelines: dict[str, Timeline]) -> str:
+def _deadlock_text(locks: Sequence[Interlock], timelines: dict[str, Timeline], pairs: Sequence[PairMap]) -> str:
     """What a deadlock is made of: the interlocks of the robots the last one orders, on each robot's
     own clock (the segment the leader must finish, the point the waiter waits at), each named by
     the spots it lies between where the timelines know them: a person finds "w6 -> home" in the
-    cell, not 12.82 s."""
+    cell, not 12.82 s. Where a robot standing at home is in the other's way, that is said too:
+    no order of the two tours gets past it, and a home elsewhere may."""
     last = locks[-1]
     pair = {last.leader, last.waiter}
     held = [x for x in locks if {x.leader, x.waiter} == pair]
     said = "; ".join(f"{x.waiter} waits at {x.wait_at:.2f} s{_at(timelines[x.waiter], x.wait_at)} for {x.leader} "
                      f"to finish {x.leader_span[0]:.2f}-{x.leader_span[1]:.2f} s{_move(timelines[x.leader], x.leader_span)}"
                      for x in held[-4:])
+    diagram = next((p for p in pairs if (p.a, p.b) == last.pair), None)
+    homes = "" if diagram is None else _homes_in_the_way(diagram, timelines)
     return (f"the interlocks wait on each other (deadlock): {said} (each on its own clock); {last.pair[0]} and "
-            f"{last.pair[1]} move through each other's rest postures or paths in every order tried")
+            f"{last.pair[1]} move through each other's rest postures or paths in every order tried{homes}")
+
+
+def _homes_in_the_way(p: PairMap, timelines: dict[str, Timeline]) -> str:
+    """'; at home, a is in b's way (home -> s1, ...)' for each robot of the pair whose home posture
+    (its first and last sample) the other's moves pass through (the first three named), or ''."""
+    said = []
+    for still, mover, at_home in ((p.a, p.b, p.clash[0, :] | p.clash[-1, :]),
+                                  (p.b, p.a, p.clash[:, 0] | p.clash[:, -1])):
+        line = timelines[mover]
+        points = _segments(line)
+        hit = sorted({_segment(points, k * p.dt) for k in np.flatnonzero(at_home)})
+        if not hit:
+            continue
+        names = [_move(line, (points[k], points[k + 1])).strip(" ()") or f"{points[k]:.2f}-{points[k + 1]:.2f} s"
+                 for k in hit[:3]]
+        more = f" and {len(hit) - 3} more" if len(hit) > 3 else ""
+        said.append(f"at home, {still} is in {mover}'s way ({', '.join(names)}{more})")
+    return "" if not said else "; " + "; ".join(said) + ": a home elsewhere may untangle them"
 
 
 def _stop(line: Timeline, own: float) -> int | None:

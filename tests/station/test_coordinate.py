@@ -143,6 +143,23 @@ def test_a_robot_that_has_ended_stands_at_home_in_the_others_way() -> None:
     assert [(x.waiter, x.wait_at, x.signal_at) for x in done.interlocks] == [("b", 4.0, 7.0)]
 
 
+def test_a_home_in_the_way_is_named_only_where_the_diagram_says_so() -> None:
+    """b standing at home (its first and last sample) is in a's way while a moves from s2 to s3;
+    a at home is in nobody's way."""
+    from robomax_py.station.coordinate import _homes_in_the_way
+
+    lines = {name: dataclasses.replace(_timeline(name, 4.0, [1.0, 2.0, 3.0]), stops=("home", "s1", "s2", "s3", "home"))
+             for name in ("a", "b")}
+    t = np.arange(0.0, 4.0 + DT, DT)
+    clash = np.zeros((len(t), len(t)), dtype=bool)
+    clash[(t > 2.05) & (t < 2.95), 0] = True
+    clash[(t > 2.05) & (t < 2.95), -1] = True
+    clash[(t > 1.05) & (t < 1.95), 10] = True            # b moving: not at home, not said
+    said = _homes_in_the_way(PairMap("a", "b", DT, clash), lines)
+    assert said == "; at home, b is in a's way (s2 -> s3): a home elsewhere may untangle them"
+    assert _homes_in_the_way(PairMap("a", "b", DT, np.zeros_like(clash)), lines) == ""
+
+
 def test_a_deadlock_names_the_robots_and_the_waits_it_is_made_of() -> None:
     """a's move from 1 to 2 s sweeps through b wherever b is, at rest or moving, and b's move from 1
     to 2 s through a: whichever goes first, the other stands in its way. The message names both
@@ -161,6 +178,9 @@ def test_a_deadlock_names_the_robots_and_the_waits_it_is_made_of() -> None:
     named = [dataclasses.replace(line, stops=("home", "s1", "s2", "s3", "home")) for line in lines]
     done = coordinate(named, [pair])
     at = dict(zip((0.0, 1.0, 2.0, 3.0), ("home", "s1", "s2", "s3"), strict=True))
+    # Each sweeps through the other standing at home too: said, with the move that does it.
+    assert done.unresolved.endswith("; at home, a is in b's way (s1 -> s2); at home, b is in a's way (s1 -> s2): a "
+                                    "home elsewhere may untangle them"), done.unresolved
     for lock in done.interlocks[-2:]:
         a, b = lock.leader_span
         assert (f"{lock.waiter} waits at {lock.wait_at:.2f} s (at {at[lock.wait_at]}) for {lock.leader} to finish "
