@@ -116,8 +116,10 @@ def controller_rebuild(dialect: Dialect, cell: CellSpec, robot: RobotModel, main
     from robomax_py.export.rebuild import rebuild
 
     program = in_controller_joints(parsed.program, robot, inverse=True) if dialect.brand else parsed.program
-    return rebuild(program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
-                   controller=bool(dialect.brand), station=station, T_base_world=controller_world(dialect, cell))
+    rebuilt = rebuild(program, cell, robot, main, parsed.lines, parsed.brand, controller_frames(dialect, cell),
+                      controller=bool(dialect.brand), station=station, T_base_world=controller_world(dialect, cell))
+    rebuilt.joint_step = parsed.joint_step
+    return rebuilt
 
 
 def native_dialect(brand: str, dialects: dict[str, Dialect] | None = None) -> str | None:

@@ -88,6 +88,9 @@ class Parsed:
     brand: str
     ignored: tuple[tuple[int, str], ...] = ()
     problems: tuple[tuple[int, str, str], ...] = ()
+    # rad per axis: the finest step the program's joint values can state, where coarser than any
+    # check's tolerance (INFORM: one encoder pulse); () otherwise.
+    joint_step: tuple[float, ...] = ()
 
 
 

@@ -422,8 +422,11 @@ def parse(texts: dict[str, str], file: str, robot: RobotModel) -> Parsed:
             continue
         ignored.append((number, stmt))
     header = read_header([c.replace(", ", " | ") for c in header_comments])
+    # A job states joint positions in whole pulses: one is 1/ppd deg (2e-3 deg on a wrist axis of
+    # 455 pulses/deg), coarser than the home check's 1e-6 rad.
+    step = tuple(math.radians(1.0 / p) for p in ppd) if len(ppd) == 6 else ()
     return Parsed(Program(name, header, (), tuple(instructions)), tuple(where), "yaskawa", tuple(ignored),
-                  tuple(problems))
+                  tuple(problems), joint_step=step)
 
 
 def _frame_ref(kind: str, number: int) -> str:

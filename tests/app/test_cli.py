@@ -86,6 +86,44 @@ def test_inform_on_an_arm_without_pulse_counts_exits_2_and_writes_nothing(tmp_pa
     assert not out.exists()
 
 
+def test_inform_of_a_home_between_two_pulses_is_written_and_verifies(tmp_path: Path,
+                                                                     write_small_cell: SmallCell) -> None:
+    """A job states joints in whole encoder pulses (here 512 per degree on A6, 0.002 deg each): a
+    home between two pulses starts the job half a pulse from it at most, where the controller puts
+    the robot. The job is proven and written, and verifies clean; it used to be refused ("program
+    does not start at robot.home"), as was every continuation `replan` wrote from a stop."""
+    import shutil
+
+    import yaml
+
+    from robomax_py.io.robot import shipped_robots_dir
+    from tests.conftest import TEST_PULSES_PER_DEGREE
+
+    robot = tmp_path / "robots" / "kr125p"
+    shutil.copytree(shipped_robots_dir() / "kr125", robot)
+    spec = yaml.safe_load((robot / "robot.yaml").read_text())
+    spec["name"] = "kr125p"
+    spec.setdefault("controller", {})["pulses_per_degree"] = list(TEST_PULSES_PER_DEGREE)
+    (robot / "robot.yaml").write_text(yaml.safe_dump(spec, sort_keys=False))
+    cell = write_small_cell(tmp_path, "small")
+    data = yaml.safe_load(cell.read_text())
+    data["robot"]["model"] = "kr125p"
+    data["robot"]["home"] = [0.0123, -90.0007, 90.0011, 0.0009, 0.0013, 0.0007]
+    cell.write_text(yaml.safe_dump(data, sort_keys=False))
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["--robots", str(tmp_path / "robots"), "plan", str(cell), "-o", str(out),
+                                 "--format", "inform"])
+    assert result.exit_code == EXIT_OK, result.output
+    (job,) = [p for p in out.iterdir() if p.suffix.lower() == ".jbi" and p.stem.upper() == "SMALL"]
+    checked = runner.invoke(app, ["--robots", str(tmp_path / "robots"), "verify", str(cell), str(job)])
+    assert checked.exit_code == EXIT_OK and "clean" in checked.output, checked.output
+    # Off by more than half a pulse (0.01 deg on A1: 12 pulses), the start is still refused.
+    data["robot"]["home"][0] = 0.0223
+    cell.write_text(yaml.safe_dump(data, sort_keys=False))
+    refused = runner.invoke(app, ["--robots", str(tmp_path / "robots"), "verify", str(cell), str(job)])
+    assert refused.exit_code == 1 and "program does not start at robot.home" in " ".join(refused.output.split())
+
+
 def check_trajectory_file(path: Path, n_spots: int, home_deg: list[float], weld_time: float) -> dict:
     """SPEC §5: keys, strictly increasing t at most 10 ms apart, home at both ends, spots."""
     data = json.loads(path.read_text())

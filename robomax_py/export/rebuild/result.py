@@ -62,6 +62,8 @@ class Rebuilt:
     spans: list[Span] = field(default_factory=list)
     # Waits for and settings of signals between robots, in program order (station replay).
     events: list[SignalEvent] = field(default_factory=list)
+    # rad per axis: the finest step the program's joint values can state (`Parsed.joint_step`).
+    joint_step: tuple[float, ...] = ()
 
     def line_at(self, t: float | None) -> int | None:
         """The program line whose statement commands the motion at time t (s)."""
