@@ -297,8 +297,7 @@ def _homes_in_the_way(p: PairMap, timelines: dict[str, Timeline]) -> str:
         hit = sorted({_segment(points, k * p.dt) for k in np.flatnonzero(at_home)})
         if not hit:
             continue
-        names = [_move(line, (points[k], points[k + 1])).strip(" ()") or f"{points[k]:.2f}-{points[k + 1]:.2f} s"
-                 for k in hit[:3]]
+        names = [_move_name(line, k) or f"{points[k]:.2f}-{points[k + 1]:.2f} s" for k in hit[:3]]
         more = f" and {len(hit) - 3} more" if len(hit) > 3 else ""
         said.append(f"at home, {still} is in {mover}'s way ({', '.join(names)}{more})")
     return "" if not said else "; " + "; ".join(said) + ": a home elsewhere may untangle them"
@@ -320,7 +319,14 @@ def _at(line: Timeline, own: float) -> str:
 
 def _move(line: Timeline, span: tuple[float, float]) -> str:
     k = _stop(line, span[0])
-    return "" if k is None or k + 1 >= len(line.stops) else f" ({line.stops[k]} -> {line.stops[k + 1]})"
+    name = None if k is None else _move_name(line, k)
+    return "" if name is None else f" ({name})"
+
+
+def _move_name(line: Timeline, k: int) -> str | None:
+    """'s1 -> s2' of the robot's segment k, None where its stops are not known."""
+    known = len(line.stops) == len(_segments(line)) and k + 1 < len(line.stops)
+    return f"{line.stops[k]} -> {line.stops[k + 1]}" if known else None
 
 
 def _without_implied(locks: Sequence[Interlock]) -> tuple[Interlock, ...]:
