@@ -29,6 +29,14 @@ Allowed-collision matrix (pairs never checked), deterministic for a given `Colli
   So each remaining pair must also be proved apart by branch and bound over the joints between its
   two pieces (`_prove_never_close`, a Lipschitz bound on the distance); pairs moved by more than
   `acm_proof_joints` (3) joints, or not proved within the budget, stay checked.
+- "held part on its support, checked lifted": a part in the gripper may rest on the objects it
+  lies on where it is gripped and released (its supports), sinking in by at most
+  `HELD_SUPPORT_PENETRATION_M`. Where both are convex or primitive, that is coal's negative
+  security margin on the pair. coal has none for a triangle mesh (its BVH collider refuses a
+  negative margin), so where the part or the support is one the part is checked against the support
+  lifted by that much along the way the gripper takes it off (+TCP z, the approach line's
+  direction), at margin 0: it may rest on the support and sink in up to 1 mm along that way, as
+  the margin allows; a part pressed flat against a support's side wall counts as touching it.
 """
 
 from __future__ import annotations
@@ -56,6 +64,7 @@ from robomax_py.world.acm_types import (
     HELD_SUPPORT_PENETRATION_M,
     KIND_DYNAMIC,
     KIND_HELD,
+    KIND_HELD_LIFTED,
     KIND_LINK,
     KIND_OBJECT,
     KIND_TOOL_BODY,
@@ -102,11 +111,21 @@ def _pieces(robot: RobotModel, scene: Scene) -> tuple[pin.GeometryModel, list[Pi
             )
             pieces.append(Piece(name, kind, kind, int(flange.parentJoint), -1))
     if scene.held is not None:
-        placement = flange.placement * pin.SE3(np.asarray(scene.held.T_flange_part, dtype=float))
+        T_flange_part = np.asarray(scene.held.T_flange_part, dtype=float)
+        placement = flange.placement * pin.SE3(T_flange_part)
         for i, geom in enumerate(scene.held.pieces):
             name = f"{KIND_HELD}:{scene.held.name}[{i}]"
             gm.addGeometryObject(pin.GeometryObject(name, int(flange.parentJoint), int(scene.flange_frame_id), placement, geom))
             pieces.append(Piece(name, scene.held.name, KIND_HELD, int(flange.parentJoint), -1))
+        if _held_meets_mesh(scene):
+            # The stand-ins against the supports (module docstring): each piece lifted along +TCP z.
+            lift = np.eye(4)
+            lift[:3, 3] = HELD_SUPPORT_PENETRATION_M * np.asarray(scene.tool.T_flange_tcp, dtype=float)[:3, 2]
+            lifted = flange.placement * pin.SE3(lift @ T_flange_part)
+            for i, geom in enumerate(scene.held.pieces):
+                name = f"{KIND_HELD_LIFTED}:{scene.held.name}[{i}]"
+                gm.addGeometryObject(pin.GeometryObject(name, int(flange.parentJoint), int(scene.flange_frame_id), lifted, geom))
+                pieces.append(Piece(name, scene.held.name, KIND_HELD_LIFTED, int(flange.parentJoint), -1))
 
     obstacles = (*scene.obstacles, *scene.dynamic)
     for o, obj in enumerate(obstacles):
@@ -120,9 +139,24 @@ def _pieces(robot: RobotModel, scene: Scene) -> tuple[pin.GeometryModel, list[Pi
     return gm, pieces, obstacles
 
 
-def _classify_pairs(robot: RobotModel, scene: Scene, pieces: list[Piece], obstacles: tuple[Any, ...],
-                    far: set[int]) -> _PairRules:
+def _is_mesh(geom: coal.CollisionGeometry) -> bool:
+    return isinstance(geom, coal.BVHModelBase)
+
+
+def _held_meets_mesh(scene: Scene) -> bool:
+    """A held part that is a triangle mesh, or rests on a support that is one."""
+    held = scene.held
+    if held is None:
+        return False
+    supports = set(held.supports)
+    return any(_is_mesh(g) for g in held.pieces) or any(
+        _is_mesh(g) for obj in scene.obstacles if obj.name in supports for g in obj.pieces)
+
+
+def _classify_pairs(robot: RobotModel, scene: Scene, gm: pin.GeometryModel, pieces: list[Piece],
+                    obstacles: tuple[Any, ...], far: set[int]) -> _PairRules:
     model = robot.model
+    supports = set(scene.held.supports) if scene.held is not None else set()
     flange = model.frames[scene.flange_frame_id]
     rules = _PairRules()
     disabled, obstacle_pairs, self_candidates = rules.disabled, rules.obstacle_pairs, rules.self_candidates
@@ -140,6 +174,15 @@ def _classify_pairs(robot: RobotModel, scene: Scene, pieces: list[Piece], obstac
                 continue  # obstacles never move relative to each other: not a pair at all
             if pb.kind in OBSTACLE_KINDS or pa.kind in OBSTACLE_KINDS:
                 rob, obs = (pa, pb) if pb.kind in OBSTACLE_KINDS else (pb, pa)
+                if rob.kind in (KIND_HELD, KIND_HELD_LIFTED):
+                    r, o = (a, b) if rob is pa else (b, a)
+                    lifted = obstacles[obs.obstacle].name in supports and (
+                        _is_mesh(gm.geometryObjects[r].geometry) or _is_mesh(gm.geometryObjects[o].geometry))
+                    if rob.kind == KIND_HELD_LIFTED and not lifted:
+                        continue  # the stand-in meets its supports only: not a pair at all
+                    if rob.kind == KIND_HELD and lifted:
+                        disabled.append(DisabledPair(pa.name, pb.name, "held part on its support, checked lifted"))
+                        continue
                 if rob.kind == KIND_TOOL_TIPS and obstacles[obs.obstacle].workpiece:
                     disabled.append(DisabledPair(pa.name, pb.name, "tips on workpiece"))
                 elif rob.joint == 0:
@@ -150,6 +193,8 @@ def _classify_pairs(robot: RobotModel, scene: Scene, pieces: list[Piece], obstac
                 else:
                     obstacle_pairs.append((a, b))
                 continue
+            if KIND_HELD_LIFTED in (pa.kind, pb.kind):
+                continue  # the stand-in meets its supports only: not a pair at all
             if pa.joint == pb.joint:
                 disabled.append(DisabledPair(pa.name, pb.name, "rigid"))
                 continue
@@ -174,7 +219,7 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
     model = robot.model
     gm, pieces, obstacles = _pieces(robot, scene)
     n_geom = len(pieces)
-    rules = _classify_pairs(robot, scene, pieces, obstacles, _out_of_reach(model, gm, pieces, max(clearance, 0.0) + max((o.margin for o in obstacles), default=0.0)))
+    rules = _classify_pairs(robot, scene, gm, pieces, obstacles, _out_of_reach(model, gm, pieces, max(clearance, 0.0) + max((o.margin for o in obstacles), default=0.0)))
     disabled, obstacle_pairs, self_candidates = rules.disabled, rules.obstacle_pairs, rules.self_candidates
     flange_candidates, base_obstacle = rules.flange_candidates, rules.base_obstacle
 
@@ -228,7 +273,9 @@ def build_shared(robot: RobotModel, scene: Scene, clearance: float, options: Col
         pa, pb = pieces[a], pieces[b]
         if pa.kind not in OBSTACLE_KINDS and pb.kind not in OBSTACLE_KINDS:
             return 0.0
-        held, obstacle = (pa, pb) if pa.kind == KIND_HELD else (pb, pa)
+        held, obstacle = (pa, pb) if pa.kind in (KIND_HELD, KIND_HELD_LIFTED) else (pb, pa)
+        if held.kind == KIND_HELD_LIFTED:
+            return 0.0                          # lifted by the depth it may sink in (module docstring)
         if held.kind == KIND_HELD and obstacles[obstacle.obstacle].name in supports:
             return -HELD_SUPPORT_PENETRATION_M
         # A moving object's span counts larger by its sweep margin (`world.moving`).
@@ -286,7 +333,7 @@ def always_touching_links(robot: RobotModel, options: CollisionOptions = Collisi
     eye = np.eye(4)
     bare = Scene("", (), (), ToolGeometry("", (), (), "", "", eye), eye, int(robot.flange_frame_id))
     gm, pieces, obstacles = _pieces(robot, bare)
-    rules = _classify_pairs(robot, bare, pieces, obstacles, set())
+    rules = _classify_pairs(robot, bare, gm, pieces, obstacles, set())
     sampled = _sample_self_pairs(robot, gm, rules.self_candidates, set(), set(), options)
     links = (
         (pieces[a].body, pieces[b].body) for a, b in rules.self_candidates

@@ -16,7 +16,11 @@ KIND_TOOL_TIPS = "tool_tips"
 KIND_OBJECT = "object"
 KIND_DYNAMIC = "dynamic"
 KIND_HELD = "held"            # a part in the gripper: moves with the tool, collides like its body
-ROBOT_KINDS = (KIND_LINK, KIND_TOOL_BODY, KIND_TOOL_TIPS, KIND_HELD)
+# A held part's stand-in against the supports it rests on, where the part or the support is a
+# triangle mesh (`world.acm._lifted_pairs`): the part lifted HELD_SUPPORT_PENETRATION_M along the
+# way the gripper takes it off.
+KIND_HELD_LIFTED = "held_lifted"
+ROBOT_KINDS = (KIND_LINK, KIND_TOOL_BODY, KIND_TOOL_TIPS, KIND_HELD, KIND_HELD_LIFTED)
 # A held part may touch its supports (the objects it rests on where it is gripped or released)
 # but not sink into them by more than this (m): resting is a contact at distance 0.
 HELD_SUPPORT_PENETRATION_M = 1e-3

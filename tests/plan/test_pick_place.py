@@ -109,6 +109,38 @@ def test_a_held_part_rests_on_its_support_but_may_not_sink_into_it() -> None:
         assert free or (contact is not None and "rack_low" in contact.describe())
 
 
+@pytest.mark.parametrize(("part_mesh", "support_mesh"), [(True, False), (False, True), (True, True)])
+def test_a_mesh_part_or_support_rests_but_may_not_sink_in(tmp_path: Path, part_mesh: bool, support_mesh: bool) -> None:
+    """coal has no negative margin for a triangle mesh (its BVH collider raises); where the part or
+    its support is one, the part is checked against the support lifted 1 mm along +TCP z. At rest
+    (distance 0) and 0.5 mm in: free; 2 mm in: a collision with the support. The meshes are rings
+    (closed, not convex: one BVH each)."""
+    import trimesh
+
+    edits: dict[str, object] = {}
+    if part_mesh:       # the housing's 0.1 m height, its frame at its centre like the box's
+        trimesh.creation.annulus(0.02, 0.06, 0.1).export(tmp_path / "ring.stl")
+        edits["pick_place.parts.0"] = {"name": "housing", "mesh": "ring.stl", "mass": 4.0,
+                                       "grasp": {"xyz": [0, 0, 0.03]}}
+    if support_mesh:    # a ring board under low_1, its top at the box board's (0.45 m)
+        trimesh.creation.annulus(0.03, 0.2, 0.03).export(tmp_path / "board.stl")
+        edits["objects.0"] = {"name": "rack_low", "mesh": "board.stl", "pose": {"xyz": [0.8, -0.3, 0.435]}}
+    cell = load_cell(_cell_file(tmp_path, **edits))
+    robot = load_cell_robot(cell)
+    world = CollisionWorld(robot, build_scene(cell, robot, held=cell.part("housing")), cell.process.clearance)
+    assert any("checked lifted" in d.reason for d in world.acm.disabled)
+    T = np.eye(4)
+    T[:3, 3] = cell.seams[0].spots[0].xyz
+    for dz, free in ((0.0, True), (-0.5e-3, True), (-2 * HELD_SUPPORT_PENETRATION_M, False)):
+        Tz = T.copy()
+        Tz[2, 3] += dz
+        table = solve_all(robot, (invert(np.asarray(cell.T_world_base)) @ Tz)[None])
+        q = table.q[0][table.valid[0]][0]
+        assert world.is_free(q) is free, dz
+        contact = world.first_contact(q)
+        assert free or (contact is not None and "rack_low" in contact.describe())
+
+
 FENCE_CELL = """
 robomax: 1
 name: fence
