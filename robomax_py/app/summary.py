@@ -57,8 +57,21 @@ def controller_summary(cell: CellSpec) -> str:
                                                             ("R", setup.numeric_registers)) if regs]
     if registers:
         parts.append("registers " + ", ".join(registers))
-    parts.append(f"welds: {'the controller package' if setup.weld == 'package' else 'spot_weld calls'}")
+    if not cell.tending:
+        parts.append(f"welds: {'the controller package' if setup.weld == 'package' else 'spot_weld calls'}")
     return "; ".join(parts)
+
+
+def _process_line(cell: CellSpec) -> str:
+    """The process's times and distances: a weld cell's weld time; a gripper cell's (tending, pick
+    and place) close and open times instead, which it keeps as its stops' times at rest."""
+    p = cell.process
+    lines = f"approach {p.approach * 1000:.1f} mm, clearance {p.clearance * 1000:.1f} mm"
+    if not cell.tending:
+        return f"weld {p.weld_time:.2f} s, {lines}"
+    at_rest = {spot.action: p.weld_time_of(spot) for seam in cell.seams for spot in seam.spots if spot.action}
+    times = ", ".join(f"{action} {at_rest[action]:.2f} s" for action in ("grip", "release") if action in at_rest)
+    return f"gripper {times}; {lines}"
 
 
 def cell_summary(cell: CellSpec, robot: Any) -> Group:
@@ -71,9 +84,7 @@ def cell_summary(cell: CellSpec, robot: Any) -> Group:
     load = cell.tool.load
     weight = "" if load is None else f", {load.mass:g} kg at [{', '.join(f'{v:.3f}' for v in load.cog)}] m"
     head.add_row("tool", f"{cell.tool.name}: TCP at [{', '.join(f'{v:.3f}' for v in tcp)}] m from the flange{weight}")
-    p = cell.process
-    head.add_row("process", f"weld {p.weld_time:.2f} s, approach {p.approach * 1000:.1f} mm, "
-                            f"clearance {p.clearance * 1000:.1f} mm")
+    head.add_row("process", _process_line(cell))
     head.add_row("controller", controller_summary(cell))
 
     objects = Table(title="objects", title_justify="left")

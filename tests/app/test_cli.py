@@ -192,3 +192,17 @@ def test_plan_reference_cell_twice_is_byte_identical(tmp_path: Path, reference_c
         outputs.append((out / "cabin_flange.json").read_bytes())
     assert outputs[0] == outputs[1]
     check_trajectory_file(tmp_path / "run0" / "cabin_flange.json", 15, [0, -90, 90, 0, 0, 0], 0.5)
+
+
+@pytest.mark.parametrize(("cell", "said", "not_said"), [
+    ("pick_place.yaml", "gripper grip 0.30 s, release 0.25 s; approach 100.0 mm", ("weld ", "spot_weld")),
+    ("tending.yaml", "gripper grip 0.40 s, release 0.30 s; approach 100.0 mm", ("weld ", "spot_weld")),
+    ("frame.yaml", "weld 0.50 s, approach 30.0 mm, clearance 5.0 mm", ("gripper",)),
+])
+def test_check_states_a_gripper_cells_times_not_a_weld_time(cell: str, said: str, not_said: tuple[str, ...]) -> None:
+    """A gripper cell (tending, pick and place) has no welds: `check` gives its grip and release
+    times, and no weld time nor the weld calls its programs do not make."""
+    done = runner.invoke(app, ["check", str(Path(__file__).resolve().parents[2] / "cells" / cell)], terminal_width=200)
+    head = " ".join(done.output.split("objects")[0].split())
+    assert done.exit_code == EXIT_OK and said in head
+    assert not any(word in head for word in not_said), head
