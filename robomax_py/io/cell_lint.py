@@ -66,6 +66,11 @@ SURFACE_TOLERANCE_M = 0.010
 # (3.1416). With at least one fractional value (1.57, -0.785: radians are written with decimals,
 # degrees mostly whole), such a home is read as radians written into a degrees file.
 RADIAN_LIKE_DEG = 3.2
+# A part lies on its supports where it is gripped and released: touching them, or within the
+# round-off of coordinates copied from CAD to a tenth of a millimetre and a sheet's flatness.
+# Further from every one, the gripper closes on air (or lets the part drop): the location's height,
+# or the part's frame in its mesh, is off.
+SUPPORT_GAP_M = 0.002
 # A notice lists at most this many further keys of the same kind (the rest are counted).
 LISTED = 5
 
@@ -86,7 +91,8 @@ def lint_cell(parsed: CellFile, cell: CellSpec, path: Path) -> tuple[Notice, ...
     meshes: dict[MeshShape, Any] = {}
     units = _millimetre_positions(parsed, file) + _oversized_objects(parsed, cell, file, meshes)
     out = [*units, *_tool_sizes(cell, meshes), *_process_lengths(parsed, file), *_home_in_radians(parsed, cell, file),
-           *_zero_clearance(parsed, cell, file), *_transfers_without_parts(parsed, file)]
+           *_zero_clearance(parsed, cell, file), *_transfers_without_parts(parsed, file),
+           *_parts_off_supports(parsed, cell, file, meshes)]
     if not units:                   # in millimetres, every spot is off every surface: one mistake, named above
         out += _spots_and_objects(parsed, cell, file, meshes)
     return tuple(out)
@@ -245,6 +251,65 @@ def _transfers_without_parts(parsed: CellFile, file: str) -> list[Notice]:
         return []
     return [Notice(file, "planner.transfers", f"{parsed.planner.transfers} plans the carried moves of a "
                                               "`pick_place` job, and this cell has none: it changes nothing")]
+
+
+def _parts_off_supports(parsed: CellFile, cell: CellSpec, file: str, meshes: dict[MeshShape, Any]) -> list[Notice]:
+    """A part at a location farther than SUPPORT_GAP_M from every support the location names, as
+    coal measures the part's shape (at the location's pose) against each support's."""
+    job = parsed.pick_place
+    if job is None:
+        return []
+    import coal
+
+    index = {loc.name: i for i, loc in enumerate(job.locations)}
+    objects = {obj.name: obj for obj in cell.objects}
+    found, seen = [], set()
+    for spot in (s for seam in cell.seams for s in seam.spots):
+        if spot.part is None:
+            continue
+        at = spot.name.split("_", 2)[2]                 # t<k>_pick_<location>, t<k>_place_<location>
+        i = index[at]
+        if (spot.part, at) in seen or not job.locations[i].support:
+            continue
+        seen.add((spot.part, at))
+        part = cell.part(spot.part)
+        T_part = _tcp_frame(spot) @ np.asarray(part.T_tcp_part, dtype=float)
+        gaps = []
+        for name in job.locations[i].support:
+            obj = objects[name]
+            d = min(_distance(a, T_part, b, np.asarray(obj.T_world_object, dtype=float), coal)
+                    for a in _pieces(part.shape, meshes) for b in _pieces(obj.shape, meshes))
+            gaps.append((d, name))
+        gap, nearest = min(gaps)
+        if gap > SUPPORT_GAP_M:
+            found.append((f"pick_place.locations[{i}].pose",
+                          (f"{spot.part} at {at} lies {gap * 1000:.0f} mm from its nearest support ({nearest}): "
+                           "a part rests on its support where it is gripped and released, so the gripper would "
+                           "close on air or let it drop; the location's height, or the part's frame, is off?")))
+    return _grouped(file, found, "parts off their supports")
+
+
+def _tcp_frame(spot: Any) -> np.ndarray:
+    """(4, 4) the TCP pose a stop states (SPEC: z = -normal, x = direction)."""
+    z = -np.asarray(spot.normal, dtype=float)
+    x = np.asarray(spot.direction, dtype=float)
+    T = np.eye(4)
+    T[:3, :3] = np.column_stack([x, np.cross(z, x), z])
+    T[:3, 3] = spot.xyz
+    return T
+
+
+def _pieces(shape: Any, meshes: dict[MeshShape, Any]) -> list[Any]:
+    from robomax_py.robot.geometry import mesh_collision_shapes, primitive_shape
+
+    return mesh_collision_shapes(_mesh(shape, meshes)) if isinstance(shape, MeshShape) else [primitive_shape(shape)]
+
+
+def _distance(a: Any, Ta: np.ndarray, b: Any, Tb: np.ndarray, coal: Any) -> float:
+    result = coal.DistanceResult()
+    coal.distance(a, coal.Transform3s(Ta[:3, :3], Ta[:3, 3]), b, coal.Transform3s(Tb[:3, :3], Tb[:3, 3]),
+                  coal.DistanceRequest(), result)
+    return float(result.min_distance)
 
 
 def _zero_clearance(parsed: CellFile, cell: CellSpec, file: str) -> list[Notice]:

@@ -115,6 +115,19 @@ def test_a_part_not_marked_workpiece_is_named(tmp_path: Path) -> None:
     assert "process.clearance" not in _keys(path)       # no workpiece, no clearance to it
 
 
+def test_a_part_above_its_support_is_named(tmp_path: Path) -> None:
+    """low_2 raised 50 mm: the housing there lies 50 mm above the low board (a box on a box, so the
+    gap is exact); 1 mm (CAD round-off) is not named."""
+    def raise_by(dz: float) -> Callable[[dict[str, Any]], None]:
+        def edit(data: dict[str, Any]) -> None:
+            data["pick_place"]["locations"][1]["pose"]["xyz"][2] += dz
+        return edit
+
+    notice = _only(_copy(tmp_path, raise_by(0.05), "pick_place"), "pick_place.locations[1].pose")
+    assert "housing at low_2 lies 50 mm from its nearest support (rack_low)" in notice.message
+    assert _keys(_copy(tmp_path, raise_by(0.001), "pick_place")) == []
+
+
 def test_a_home_in_radians_is_named_and_whole_degrees_are_not(tmp_path: Path) -> None:
     path = _copy(tmp_path, lambda d: d["robot"].update(home=[0, -1.5708, 1.5708, 0, 0, 0]))
     notice = _only(path, "robot.home")
