@@ -6,8 +6,8 @@ the gun must turn about its electrode axis, lies in a corridor the shared roadma
 thinly and the local map (the wrist interpolated along A1-A3) cannot express. OMPL's RRT-Connect
 grows two trees from the ends, within the joint limits, each extension a swept-checked straight
 move of at most `STEP_FRACTION` of the joint box's diagonal in time-scaled joint distance; the
-search stops after `budget` swept checks (a count, not a clock). The path found is shortened
-greedily.
+search stops after `budget` swept checks or `CHECK_BUDGET` configurations checked, whichever
+comes first (counts, not a clock). The path found is shortened greedily.
 """
 
 from __future__ import annotations
@@ -29,6 +29,12 @@ from robomax_py.world.collision import CollisionWorld
 # iterations, not within a connect run, so a try may overrun its share by one connect run.
 BUDGET = 2400
 TRY_BUDGET = 100
+# Configurations checked per search, whatever the swept checks' lengths: a swept check samples
+# the move every few millimetres of the arm's travel, so a tree edge of a fast small arm (an LR
+# Mate's 0.08 s of joint time sweeps the TCP 0.6 m) checks some 300 configurations. 2,400 such
+# edges were 770,000 checks, 20 s of CPU per search on a cell with meshed obstacles and a meshed
+# part in the gripper, three searches per dead end, where "a few CPU seconds" was meant.
+CHECK_BUDGET = 150_000
 # Longest tree edge, as a share of the joint-limit box's diagonal (time-scaled). OMPL's default
 # (0.2) leaves a gun wrapped round a flange almost no free first step: on a generated flange cell
 # one seed in four met within 2,400 checks, against every seed at this step.
@@ -38,7 +44,7 @@ STEP_FRACTION = 0.05
 def rrt_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: FloatArray,
                rng: np.random.Generator, budget: int = BUDGET) -> tuple[Detour | None, int]:
     """A swept-checked detour from qa to qb (None when the trees have not met within `budget`
-    swept checks), and the collision checks spent.
+    swept checks or `CHECK_BUDGET` configurations checked), and the collision checks spent.
 
     OMPL's random numbers come from a process-wide seed, set here from `rng` before the search,
     so the same planner state gives the same detour.
@@ -92,7 +98,7 @@ def rrt_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: F
         start[k], goal[k] = float(qa[k] * scale[k]), float(qb[k] * scale[k])
 
     path = None
-    while path is None and segments < budget:
+    while path is None and segments < budget and checks < CHECK_BUDGET:
         # A fresh pair of trees per try, its random numbers drawn from `rng`: OMPL seeds each new
         # generator (the planner's, the sampler's) from one process-wide sequence, which setSeed
         # restarts even after the first seeds were handed out (OMPL logs a complaint, silenced
@@ -104,7 +110,8 @@ def rrt_detour(world: CollisionWorld, limits: JointLimits, qa: FloatArray, qb: F
         planner.setRange(step)
         setup.setPlanner(planner)
         stop = min(budget, segments + TRY_BUDGET)
-        solved = setup.solve(ob.PlannerTerminationCondition(lambda stop=stop: segments >= stop))
+        solved = setup.solve(ob.PlannerTerminationCondition(
+            lambda stop=stop: segments >= stop or checks >= CHECK_BUDGET))
         if solved and setup.haveExactSolutionPath():
             found = setup.getSolutionPath()
             path = np.array([joints(found.getState(i)) for i in range(found.getStateCount())])

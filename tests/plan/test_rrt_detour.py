@@ -107,3 +107,28 @@ def test_a_stop_that_sees_no_way_to_its_first_stop_goes_home_and_follows_the_tou
     with pytest.raises(lead.LeadInError, match="nor back to home"):
         lead.lead_in(world, None, stop, [Transition("move", np.vstack([unseen, first_stop]), "home -> s1")],
                      robot.limits, np.random.default_rng(0))
+
+
+def test_a_search_stops_once_its_configurations_are_spent(pillar_world: tuple[RobotModel, CollisionWorld]) -> None:
+    """The trees stop at `CHECK_BUDGET` configurations checked, however few swept checks that took:
+    a world where every move is blocked and each swept check costs 300 configurations (a long tree
+    edge of a fast arm) stops after about CHECK_BUDGET / 300 of them, not after BUDGET."""
+    from robomax_py.plan.rrt_detour import BUDGET, CHECK_BUDGET
+    from robomax_py.world.collision_results import SegmentCheck
+
+    robot, _ = pillar_world
+
+    class Walled:
+        swept = 0
+
+        def is_free(self, q: np.ndarray) -> bool:
+            return True
+
+        def check_segment(self, a: np.ndarray, b: np.ndarray) -> SegmentCheck:
+            self.swept += 1
+            return SegmentCheck(False, 300, 300, 300, 0.0)
+
+    world = Walled()
+    det, spent = rrt_detour(world, robot.limits, UR10_Q0, -UR10_Q0, np.random.default_rng(0))  # type: ignore[arg-type]
+    assert det is None
+    assert CHECK_BUDGET <= spent <= CHECK_BUDGET + 300 * 4 and world.swept < BUDGET, (spent, world.swept)
