@@ -33,6 +33,7 @@ from robomax_py.app.commands.base import (
     EXIT_BAD_INPUT,
     EXIT_CODES,
     EXIT_INFEASIBLE,
+    EXIT_INTERNAL,
     EXIT_INTERRUPTED,
     EXIT_OK,
     EXIT_TERMINATED,
@@ -53,7 +54,7 @@ from robomax_py.app.commands.base import (
 )
 
 # What the app and tests take from here: the command's conventions live in commands.base.
-__all__ = ["EPILOG", "EXIT_BAD_INPUT", "EXIT_CODES", "EXIT_INFEASIBLE", "EXIT_INTERRUPTED", "EXIT_OK",
+__all__ = ["EPILOG", "EXIT_BAD_INPUT", "EXIT_CODES", "EXIT_INFEASIBLE", "EXIT_INTERNAL", "EXIT_INTERRUPTED", "EXIT_OK",
            "EXIT_TERMINATED", "EXIT_VIOLATIONS", "JSON_VERSION", "RAY_LOCAL", "_Received", "app", "err",
            "json_schema", "main", "out"]
 

@@ -206,3 +206,44 @@ def test_check_states_a_gripper_cells_times_not_a_weld_time(cell: str, said: str
     head = " ".join(done.output.split("objects")[0].split())
     assert done.exit_code == EXIT_OK and said in head
     assert not any(word in head for word in not_said), head
+
+
+FAULTY_CHECK = """
+import sys
+import robomax_py.plan.reach as reach
+def broken(*args):                      # a fault of the program, not of the input
+    raise ZeroDivisionError("division by zero\\n  and a second line")
+reach.reach_report = broken
+from robomax_py.app.cli import main
+sys.argv = ["robomax", "check", sys.argv[1], *sys.argv[2:]]
+main()
+"""
+
+
+@pytest.mark.parametrize("as_json", [False, True])
+def test_an_internal_fault_is_one_line_and_exit_70_and_the_traceback_on_request(tmp_path: Path,
+                                                                                 as_json: bool) -> None:
+    """A command's own process that meets an exception other than a bad input's says it is a fault
+    of robomax_py, names it in one line (no traceback) and exits 70 (sysexits' EX_SOFTWARE); with
+    --json the error object too. ROBOMAX_TRACEBACK=1 shows the traceback instead."""
+    import os
+    import subprocess
+    import sys
+
+    from robomax_py.app.cli import EXIT_INTERNAL
+
+    cell = Path(__file__).resolve().parents[2] / "cells" / "frame.yaml"
+    args = [sys.executable, "-c", FAULTY_CHECK, str(cell), *(["--json"] if as_json else [])]
+    env = {k: v for k, v in os.environ.items() if k != "ROBOMAX_TRACEBACK"}
+    done = subprocess.run(args, check=False, capture_output=True, text=True, env=env, cwd=tmp_path, timeout=300)
+    assert done.returncode == EXIT_INTERNAL == 70, done.stderr
+    said = " ".join(done.stderr.split())
+    assert "internal fault in robomax_py, not in your files: ZeroDivisionError: division by zero." in said
+    assert "Traceback" not in done.stderr and "second line" not in said and "ROBOMAX_TRACEBACK=1" in said
+    if as_json:
+        doc = json.loads(done.stdout)
+        assert doc["ok"] is False and "ZeroDivisionError" in doc["error"]["message"]
+    shown = subprocess.run(args, check=False, capture_output=True, text=True, env={**env, "ROBOMAX_TRACEBACK": "1"},
+                           cwd=tmp_path, timeout=300)
+    assert shown.returncode not in (0, EXIT_INTERNAL) and "ZeroDivisionError" in shown.stderr
+    assert "internal fault" not in shown.stderr

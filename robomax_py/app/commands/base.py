@@ -24,6 +24,7 @@ EXIT_OK = 0
 EXIT_VIOLATIONS = 1
 EXIT_BAD_INPUT = 2
 EXIT_INFEASIBLE = 3
+EXIT_INTERNAL = 70                      # sysexits.h EX_SOFTWARE: an internal software error
 EXIT_INTERRUPTED = 130                  # 128 + SIGINT
 EXIT_TERMINATED = 143                   # 128 + SIGTERM
 
@@ -33,6 +34,7 @@ EXIT_CODES = (
     (EXIT_VIOLATIONS, "verify found violations"),
     (EXIT_BAD_INPUT, "bad input: a file (named with its key) or the command line is wrong"),
     (EXIT_INFEASIBLE, "infeasible: a spot left unplanned (batch: or a cell timed out or crashed)"),
+    (EXIT_INTERNAL, "internal fault: a bug in robomax_py, not in the files (ROBOMAX_TRACEBACK=1 shows where)"),
     (EXIT_INTERRUPTED, "interrupted (Ctrl-C)"),
     (EXIT_TERMINATED, "terminated (SIGTERM)"),
 )
@@ -151,11 +153,21 @@ def _warn(lines: tuple[str, ...] | list[str]) -> None:
         err.print(f"[yellow]warning:[/] {escape(line)}", soft_wrap=True, highlight=False)
 
 
+# Set (to anything but empty) to see an internal fault's traceback instead of its one line.
+TRACEBACK_ENV = "ROBOMAX_TRACEBACK"
+
+
 def _guarded(action: Callable[[], T], json_command: str | None = None) -> T:
     """Run a command body; a RobomaxError becomes one message on stderr and exit code 2 (with
-    `json_command`, the --json error object on stdout as well)."""
+    `json_command`, the --json error object on stdout as well). Any other error, in a command's
+    own process, is a fault of this program: one line naming it and exit code 70, no traceback
+    (unless ROBOMAX_TRACEBACK is set). A caller's process (tests, scripts) gets the exception."""
+    import click
+
     try:
         return action()
+    except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort):
+        raise
     except RobomaxError as exc:
         from rich.markup import escape
 
@@ -164,6 +176,26 @@ def _guarded(action: Callable[[], T], json_command: str | None = None) -> T:
             _print_json(json_command, False, {"error": {
                 "file": getattr(exc, "file", None), "key": getattr(exc, "key", None), "message": str(exc)}})
         raise typer.Exit(EXIT_BAD_INPUT) from None
+    except Exception as exc:
+        import os
+
+        if not _Process.own or _Received.signum is not None or os.environ.get(TRACEBACK_ENV):
+            raise                               # a signal's exception ends the run in `cli.main`
+        _internal_fault(exc, json_command)
+        raise typer.Exit(EXIT_INTERNAL) from None
+
+
+def _internal_fault(exc: Exception, json_command: str | None) -> None:
+    """Say that the run met a fault of this program, not of its input, and how to report it."""
+    from rich.markup import escape
+
+    first = next((line.strip() for line in str(exc).splitlines() if line.strip()), "")
+    message = (f"internal fault in robomax_py, not in your files: {type(exc).__name__}"
+               + (f": {first}" if first else "") + f". Run again with {TRACEBACK_ENV}=1 "
+               "for the traceback, and report it with the command and the files it read")
+    err.print(f"[bold red]error:[/] {escape(message)}", markup=True, soft_wrap=True)
+    if json_command is not None:
+        _print_json(json_command, False, {"error": {"file": None, "key": None, "message": message}})
 
 
 def _num(value: float | None) -> float | None:
