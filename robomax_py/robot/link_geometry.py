@@ -10,7 +10,13 @@ import numpy as np
 import pinocchio as pin
 
 from robomax_py.errors import RobotModelError
-from robomax_py.robot.geometry import hull_shape, hull_vertices, load_mesh
+from robomax_py.robot.geometry import (
+    LINK_HULL_EXCESS_M,
+    LINK_HULL_MAX_VERTICES,
+    hull_shape,
+    load_mesh,
+    outer_hull,
+)
 from robomax_py.robot.kinematics import _urdf_text, pinocchio_urdf_text
 from robomax_py.robot.mesh_cache import kept_arrays
 from robomax_py.spec import RobotSpec
@@ -61,18 +67,20 @@ def _build_geometry(model: pin.Model, spec: RobotSpec, kind: Any, package_dirs: 
 
 
 def _make_meshes_convex(geom_model: pin.GeometryModel, spec: RobotSpec) -> None:
-    """Replace link meshes by their convex hulls: fast GJK instead of BVH, and conservative."""
+    """Replace link meshes by their convex hulls: fast GJK instead of BVH, and conservative. A hull
+    of many vertices by an outer polytope of fewer, within LINK_HULL_EXCESS_M of it (`outer_hull`)."""
     for obj in geom_model.geometryObjects:
         if not obj.meshPath or obj.meshPath in ("BOX", "SPHERE", "CYLINDER", "CAPSULE", "CONE"):
             continue
         path, scale = Path(obj.meshPath), np.asarray(obj.meshScale, dtype=float)
 
         def hull(path: Path = path, scale: np.ndarray = scale) -> dict[str, np.ndarray]:
-            return {"vertices": hull_vertices(load_mesh(path, scale).vertices)}
+            return {"vertices": outer_hull(load_mesh(path, scale).vertices)}
 
         try:
             # The hull read back from the cache when an earlier run built it from the same file.
-            vertices = kept_arrays("hull", path, ("link hull", tuple(scale.tolist())), hull)["vertices"]
+            params = ("link hull", tuple(scale.tolist()), "outer", LINK_HULL_EXCESS_M, LINK_HULL_MAX_VERTICES)
+            vertices = kept_arrays("hull", path, params, hull)["vertices"]
         except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds for unreadable files
             raise RobotModelError(spec.urdf, f"link {obj.name}", f"cannot read mesh {obj.meshPath}: {exc}") from None
         obj.geometry = hull_shape(vertices)
