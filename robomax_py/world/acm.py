@@ -34,9 +34,10 @@ Allowed-collision matrix (pairs never checked), deterministic for a given `Colli
   `HELD_SUPPORT_PENETRATION_M`. Where both are convex or primitive, that is coal's negative
   security margin on the pair. coal has none for a triangle mesh (its BVH collider refuses a
   negative margin), so where the part or the support is one the part is checked against the support
-  lifted by that much along the way the gripper takes it off (+TCP z, the approach line's
-  direction), at margin 0: it may rest on the support and sink in up to 1 mm along that way, as
-  the margin allows; a part pressed flat against a support's side wall counts as touching it.
+  lifted by that much, at margin 0: lifted along the world's up as it lies where it is gripped and
+  released (`HeldPart.up`, the way a part comes off what it rests on, whichever way the gripper
+  holds it). It may rest on the support and sink in up to 1 mm, as the margin allows; a part
+  pressed flat against a support's side wall counts as touching it.
 """
 
 from __future__ import annotations
@@ -118,10 +119,11 @@ def _pieces(robot: RobotModel, scene: Scene) -> tuple[pin.GeometryModel, list[Pi
             gm.addGeometryObject(pin.GeometryObject(name, int(flange.parentJoint), int(scene.flange_frame_id), placement, geom))
             pieces.append(Piece(name, scene.held.name, KIND_HELD, int(flange.parentJoint), -1))
         if _held_meets_mesh(scene):
-            # The stand-ins against the supports (module docstring): each piece lifted along +TCP z.
+            # The stand-ins against the supports (module docstring): each piece lifted along the
+            # world's up as the part lies (a direction in the part's own frame).
             lift = np.eye(4)
-            lift[:3, 3] = HELD_SUPPORT_PENETRATION_M * np.asarray(scene.tool.T_flange_tcp, dtype=float)[:3, 2]
-            lifted = flange.placement * pin.SE3(lift @ T_flange_part)
+            lift[:3, 3] = HELD_SUPPORT_PENETRATION_M * np.asarray(scene.held.up, dtype=float)
+            lifted = flange.placement * pin.SE3(T_flange_part @ lift)
             for i, geom in enumerate(scene.held.pieces):
                 name = f"{KIND_HELD_LIFTED}:{scene.held.name}[{i}]"
                 gm.addGeometryObject(pin.GeometryObject(name, int(flange.parentJoint), int(scene.flange_frame_id), lifted, geom))

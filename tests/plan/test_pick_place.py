@@ -109,11 +109,14 @@ def test_a_held_part_rests_on_its_support_but_may_not_sink_into_it() -> None:
         assert free or (contact is not None and "rack_low" in contact.describe())
 
 
-@pytest.mark.parametrize(("part_mesh", "support_mesh"), [(True, False), (False, True), (True, True)])
-def test_a_mesh_part_or_support_rests_but_may_not_sink_in(tmp_path: Path, part_mesh: bool, support_mesh: bool) -> None:
+@pytest.mark.parametrize(("part_mesh", "support_mesh", "side"), [
+    (True, False, False), (False, True, False), (True, True, False), (True, False, True)])
+def test_a_mesh_part_or_support_rests_but_may_not_sink_in(tmp_path: Path, part_mesh: bool, support_mesh: bool,
+                                                          side: bool) -> None:
     """coal has no negative margin for a triangle mesh (its BVH collider raises); where the part or
-    its support is one, the part is checked against the support lifted 1 mm along +TCP z. At rest
-    (distance 0) and 0.5 mm in: free; 2 mm in: a collision with the support. The meshes are rings
+    its support is one, the part is checked against the support lifted 1 mm along the world's up
+    as it lies. At rest (distance 0) and 0.5 mm in: free; 2 mm in: a collision with the support,
+    also where the gripper holds the part from the side (TCP z horizontal). The meshes are rings
     (closed, not convex: one BVH each)."""
     import trimesh
 
@@ -121,7 +124,7 @@ def test_a_mesh_part_or_support_rests_but_may_not_sink_in(tmp_path: Path, part_m
     if part_mesh:       # the housing's 0.1 m height, its frame at its centre like the box's
         trimesh.creation.annulus(0.02, 0.06, 0.1).export(tmp_path / "ring.stl")
         edits["pick_place.parts.0"] = {"name": "housing", "mesh": "ring.stl", "mass": 4.0,
-                                       "grasp": {"xyz": [0, 0, 0.03]}}
+                                       "grasp": {"xyz": [0, 0, 0.03], "rpy": [90, 0, 0] if side else [0, 0, 0]}}
     if support_mesh:    # a ring board under low_1, its top at the box board's (0.45 m)
         trimesh.creation.annulus(0.03, 0.2, 0.03).export(tmp_path / "board.stl")
         edits["objects.0"] = {"name": "rack_low", "mesh": "board.stl", "pose": {"xyz": [0.8, -0.3, 0.435]}}
@@ -129,8 +132,11 @@ def test_a_mesh_part_or_support_rests_but_may_not_sink_in(tmp_path: Path, part_m
     robot = load_cell_robot(cell)
     world = CollisionWorld(robot, build_scene(cell, robot, held=cell.part("housing")), cell.process.clearance)
     assert any("checked lifted" in d.reason for d in world.acm.disabled)
+    spot = cell.seams[0].spots[0]
+    z, x = -np.asarray(spot.normal), np.asarray(spot.direction)
     T = np.eye(4)
-    T[:3, 3] = cell.seams[0].spots[0].xyz
+    T[:3, :3] = np.column_stack([x, np.cross(z, x), z])          # SPEC: z = -normal, x = direction
+    T[:3, 3] = spot.xyz
     for dz, free in ((0.0, True), (-0.5e-3, True), (-2 * HELD_SUPPORT_PENETRATION_M, False)):
         Tz = T.copy()
         Tz[2, 3] += dz
