@@ -72,6 +72,8 @@ def import_spots_command(
     force: Annotated[bool, typer.Option("--force", help="replace the -o file if it exists")] = False,
     frame: Annotated[str | None, typer.Option("--frame", help="the frame the list's coordinates are in, when not "
                                                               "the part's: a frame of the cell, an object or world")] = None,
+    sides: Annotated[str, typer.Option("--sides", help="normal | either: the new seams' gun on the normal's side "
+                                                       "of the sheet, or on either (tolerance.sides)")] = "normal",
     as_json: JsonFlag = False,
 ) -> None:
     """Write a new cell with a spot list's spots added as seams (docs/spot-lists.md).
@@ -86,7 +88,9 @@ def import_spots_command(
 
         if units not in (None, "m", "mm"):
             raise CellFileError(None, "--units", f"expected m or mm, got {units!r}")
-        r = import_spots(cell, spots, part, out_file, units, tolerance_mm / 1000, force, frame)
+        if sides not in ("normal", "either"):
+            raise CellFileError(None, "--sides", f"expected normal or either, got {sides!r}")
+        r = import_spots(cell, spots, part, out_file, units, tolerance_mm / 1000, force, frame, sides == "either")
         _warn([*r.warnings, *r.sides])
         for line in r.formed:
             err.print(line, markup=False, highlight=False, soft_wrap=True)

@@ -37,10 +37,12 @@ class ImportedSpots:
 
 def import_spots(cell: Path, spots: Path, part: str, out: Path, units: str | None = None,
                  max_distance: float = DEFAULT_MAX_DISTANCE, force: bool = False,
-                 frame: str | None = None) -> ImportedSpots:
+                 frame: str | None = None, either_side: bool = False) -> ImportedSpots:
     """Write `out`: the cell `cell` with the list's spots added as seams after its own, checked as
     `robomax check` checks it; nothing is written when anything is wrong. The list's coordinates
-    are in the part's frame, or in `frame` (a named frame of the cell, an object, or the world)."""
+    are in the part's frame, or in `frame` (a named frame of the cell, an object, or the world).
+    `either_side`: the new seams' gun may stand on either side of the sheet (`tolerance.sides:
+    either`), and a spot free on both sides is not reported."""
     start = time.process_time()
     if out.resolve() == cell.resolve():
         raise OutputError(out, None, "is the cell read: the new cell is written to another file")
@@ -52,7 +54,8 @@ def import_spots(cell: Path, spots: Path, part: str, out: Path, units: str | Non
     parsed = read_cell_file(cell)
     taken = {s.name for s in parsed.seams}
     tree = read_cell_frames(cell)[0] if frame is not None else ()    # `parsed` is flat: its named frames are gone
-    seams, result = spot_list_seams(parsed, cell, "", spots, part, units, max_distance, frame=frame, tree=tree)
+    settings = {"tolerance": {"sides": "either"}} if either_side else None
+    seams, result = spot_list_seams(parsed, cell, "", spots, part, units, max_distance, settings, frame, tree)
     clash = next((s.name for s in seams if s.name in taken), None)
     if clash is not None:
         raise CellFileError(spots, None, f"the list's seam '{clash}' is also a seam of {cell}; rename one")

@@ -70,3 +70,30 @@ def test_frame_option_gives_the_cell_keys_spots(tmp_path: Path) -> None:
                                    "--frame", "nowhere", "-o", str(tmp_path / "bad.yaml")])
     assert bad.exit_code == 2 and "--frame: unknown frame 'nowhere'" in bad.output
     assert not (tmp_path / "bad.yaml").exists()
+
+
+def test_sides_either_writes_seams_the_gun_may_weld_from_either_side(tmp_path: Path) -> None:
+    """An open sheet whose spots are free on both sides: without `--sides` the spots are reported
+    as ambiguous and the seams keep the default; with `--sides either` nothing is reported and every
+    new seam says `tolerance.sides: either`, which `check` accepts."""
+    data = cell_data()
+    data["objects"] = [{"name": "sheet", "box": [0.4, 0.3, 0.0015], "pose": {"xyz": [1.4, 0.0, 0.9]}, "workpiece": True}]
+    cell = write_cell(tmp_path / "cell.yaml", data)
+    rows = "".join(f"m{i},{x:.3f},{y:.3f},0\n" for i, (x, y) in enumerate((x, y) for x in (-0.15, 0.0, 0.15)
+                                                                          for y in (-0.1, 0.1)))
+    (tmp_path / "s.csv").write_text("id,x,y,z\n" + rows)
+    reports = {}
+    for sides in ("normal", "either"):
+        out = tmp_path / f"{sides}.yaml"
+        done = CliRunner().invoke(app, ["import-spots", str(cell), str(tmp_path / "s.csv"), "--part", "sheet",
+                                        "--sides", sides, "-o", str(out), "--json"])
+        assert done.exit_code == 0, done.output
+        reports[sides] = (json.loads(done.stdout), yaml.safe_load(out.read_text())["seams"])
+        assert CliRunner().invoke(app, ["check", str(out)]).exit_code == 0
+    assert len(reports["normal"][0]["ambiguous"]) == 6 and not reports["either"][0]["ambiguous"]
+    assert all((s.get("tolerance") or {}).get("sides", "normal") == "normal" for s in reports["normal"][1])
+    assert reports["either"][1] and all(s["tolerance"]["sides"] == "either" for s in reports["either"][1])
+    bad = CliRunner().invoke(app, ["import-spots", str(cell), str(tmp_path / "s.csv"), "--part", "sheet",
+                                   "--sides", "both", "-o", str(tmp_path / "bad.yaml")])
+    assert bad.exit_code == 2 and "--sides: expected normal or either, got 'both'" in bad.output
+    assert not (tmp_path / "bad.yaml").exists()
