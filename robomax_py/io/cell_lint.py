@@ -254,49 +254,37 @@ def _transfers_without_parts(parsed: CellFile, file: str) -> list[Notice]:
 
 
 def _parts_off_supports(parsed: CellFile, cell: CellSpec, file: str, meshes: dict[MeshShape, Any]) -> list[Notice]:
-    """A part at a location farther than SUPPORT_GAP_M from every support the location names, as
-    coal measures the part's shape (at the location's pose) against each support's."""
+    """A part at a location it is gripped or released at, farther than SUPPORT_GAP_M from every
+    support the location names, as coal measures the part's shape (at the location's pose, which
+    the file states in the world) against each support's."""
     job = parsed.pick_place
     if job is None:
         return []
     import coal
 
+    from robomax_py.transforms import pose_matrix
+    from robomax_py.units import deg_to_rad
+
     index = {loc.name: i for i, loc in enumerate(job.locations)}
     objects = {obj.name: obj for obj in cell.objects}
-    found, seen = [], set()
-    for spot in (s for seam in cell.seams for s in seam.spots):
-        if spot.part is None:
-            continue
-        at = spot.name.split("_", 2)[2]                 # t<k>_pick_<location>, t<k>_place_<location>
+    lying = dict.fromkeys((t.part, at) for t in job.transfers for at in (t.from_, t.to))
+    found = []
+    for part_name, at in lying:
         i = index[at]
-        if (spot.part, at) in seen or not job.locations[i].support:
+        location = job.locations[i]
+        if not location.support:
             continue
-        seen.add((spot.part, at))
-        part = cell.part(spot.part)
-        T_part = _tcp_frame(spot) @ np.asarray(part.T_tcp_part, dtype=float)
-        gaps = []
-        for name in job.locations[i].support:
-            obj = objects[name]
-            d = min(_distance(a, T_part, b, np.asarray(obj.T_world_object, dtype=float), coal)
-                    for a in _pieces(part.shape, meshes) for b in _pieces(obj.shape, meshes))
-            gaps.append((d, name))
-        gap, nearest = min(gaps)
+        part = cell.part(part_name)
+        T_part = pose_matrix(location.pose.xyz, [deg_to_rad(a) for a in location.pose.rpy])
+        gap, nearest = min((min(_distance(a, T_part, b, np.asarray(objects[name].T_world_object, dtype=float), coal)
+                                for a in _pieces(part.shape, meshes) for b in _pieces(objects[name].shape, meshes)),
+                            name) for name in location.support)
         if gap > SUPPORT_GAP_M:
             found.append((f"pick_place.locations[{i}].pose",
-                          (f"{spot.part} at {at} lies {gap * 1000:.0f} mm from its nearest support ({nearest}): "
+                          (f"{part_name} at {at} lies {gap * 1000:.0f} mm from its nearest support ({nearest}): "
                            "a part rests on its support where it is gripped and released, so the gripper would "
                            "close on air or let it drop; the location's height, or the part's frame, is off?")))
     return _grouped(file, found, "parts off their supports")
-
-
-def _tcp_frame(spot: Any) -> np.ndarray:
-    """(4, 4) the TCP pose a stop states (SPEC: z = -normal, x = direction)."""
-    z = -np.asarray(spot.normal, dtype=float)
-    x = np.asarray(spot.direction, dtype=float)
-    T = np.eye(4)
-    T[:3, :3] = np.column_stack([x, np.cross(z, x), z])
-    T[:3, 3] = spot.xyz
-    return T
 
 
 def _pieces(shape: Any, meshes: dict[MeshShape, Any]) -> list[Any]:
