@@ -155,6 +155,11 @@ def _warn(lines: tuple[str, ...] | list[str]) -> None:
 
 # Set (to anything but empty) to see an internal fault's traceback instead of its one line.
 TRACEBACK_ENV = "ROBOMAX_TRACEBACK"
+# What ends a command or reports a usage error through typer: its to handle, never a fault. click's
+# ClickException is found through typer's own BadParameter: newer typer carries click inside (no
+# click distribution is installed with it), older typer used the separate one.
+_CLI_ENDINGS: tuple[type[BaseException], ...] = (
+    typer.Exit, typer.Abort, *(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException"))
 
 
 def _guarded(action: Callable[[], T], json_command: str | None = None) -> T:
@@ -162,11 +167,9 @@ def _guarded(action: Callable[[], T], json_command: str | None = None) -> T:
     `json_command`, the --json error object on stdout as well). Any other error, in a command's
     own process, is a fault of this program: one line naming it and exit code 70, no traceback
     (unless ROBOMAX_TRACEBACK is set). A caller's process (tests, scripts) gets the exception."""
-    import click
-
     try:
         return action()
-    except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort):
+    except _CLI_ENDINGS:
         raise
     except RobomaxError as exc:
         from rich.markup import escape
