@@ -92,7 +92,7 @@ def lint_cell(parsed: CellFile, cell: CellSpec, path: Path) -> tuple[Notice, ...
     units = _millimetre_positions(parsed, file) + _oversized_objects(parsed, cell, file, meshes)
     out = [*units, *_tool_sizes(cell, meshes), *_process_lengths(parsed, file), *_home_in_radians(parsed, cell, file),
            *_zero_clearance(parsed, cell, file), *_transfers_without_parts(parsed, file),
-           *_parts_off_supports(parsed, cell, file, meshes)]
+           *_parts_off_supports(parsed, cell, file, meshes), *_carried_without_ratings(parsed, cell, file)]
     if not units:                   # in millimetres, every spot is off every surface: one mistake, named above
         out += _spots_and_objects(parsed, cell, file, meshes)
     return tuple(out)
@@ -285,6 +285,26 @@ def _parts_off_supports(parsed: CellFile, cell: CellSpec, file: str, meshes: dic
                            "a part rests on its support where it is gripped and released, so the gripper would "
                            "close on air or let it drop; the location's height, or the part's frame, is off?")))
     return _grouped(file, found, "parts off their supports")
+
+
+def _carried_without_ratings(parsed: CellFile, cell: CellSpec, file: str) -> list[Notice]:
+    """A pick-and-place cell whose robot.yaml states no rated `payload` or no `limits.loaded`: the
+    parts' masses are then not checked against what the arm may carry, nor do they slow it. An
+    imported arm has neither (no URDF states them), and its plan would carry any mass at the
+    unloaded limits without a word."""
+    if parsed.pick_place is None or not cell.parts:
+        return []
+    robot = cell.robot
+    missing = [key for key, value in (("payload", robot.payload_kg), ("limits.loaded", robot.loaded)) if value is None]
+    if not missing:
+        return []
+    heaviest = max(cell.parts, key=lambda p: p.mass)
+    what = ("its parts' masses are not checked against what the arm may carry, and they are carried at the "
+            "unloaded joint limits" if robot.payload_kg is None
+            else "its parts are carried at the unloaded joint limits, whatever their mass")
+    return [Notice(file, "pick_place.parts", f"{robot.name} states no {' and no '.join(missing)} ({robot.source}): "
+                                             f"{what} (the heaviest, {heaviest.name}, {heaviest.mass:g} kg); "
+                                             "give them from the arm's data sheet")]
 
 
 def _pieces(shape: Any, meshes: dict[MeshShape, Any]) -> list[Any]:

@@ -128,6 +128,18 @@ def test_a_part_above_its_support_is_named(tmp_path: Path) -> None:
     assert _keys(_copy(tmp_path, raise_by(0.001), "pick_place")) == []
 
 
+def test_parts_carried_by_an_arm_without_loaded_limits_are_named(tmp_path: Path) -> None:
+    """The shipped UR10 states its payload but no loaded limits: a part in its gripper is carried at
+    the unloaded limits, which the cell is told (the KR 16 states both: nothing, as above)."""
+    def on_the_ur10(data: dict[str, Any]) -> None:
+        data["robot"]["model"] = "ur10"
+        data["pick_place"]["parts"][0]["mass"] = 2.0
+
+    notice = _only(_copy(tmp_path, on_the_ur10, "pick_place"), "pick_place.parts")
+    assert notice.message.startswith("ur10 states no limits.loaded (")
+    assert "carried at the unloaded joint limits, whatever their mass (the heaviest, housing, 2 kg)" in notice.message
+
+
 def test_a_home_in_radians_is_named_and_whole_degrees_are_not(tmp_path: Path) -> None:
     path = _copy(tmp_path, lambda d: d["robot"].update(home=[0, -1.5708, 1.5708, 0, 0, 0]))
     notice = _only(path, "robot.home")
