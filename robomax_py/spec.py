@@ -392,6 +392,9 @@ class PartSpec:
     T_tcp_part: FloatArray                    # (4, 4) the part's frame in the TCP frame while held
     limits: TcpLimits | None                  # TCP limits while it is carried; None: the unloaded ones
     supports: tuple[str, ...] = ()            # objects it rests on at its locations
+    # (3,) unit: the world's up in the part's own frame where it lies (the mean over its locations):
+    # the way it comes off its supports (`world.acm`, a meshed part).
+    up: FloatArray = field(default_factory=lambda: frozen_array([0.0, 0.0, 1.0]))
 
 
 @dataclass(frozen=True, slots=True)

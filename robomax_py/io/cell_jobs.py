@@ -59,10 +59,16 @@ def _parts(parsed: CellFile, path: Path, robot: RobotSpec, triangles: list[int])
                                 f"{robot.payload_kg:g} kg ({robot.source})")
         shape = _object(part, path, key, triangles).shape
         at = {t.from_ for t in job.transfers if t.part == part.name} | {t.to for t in job.transfers if t.part == part.name}
-        supports = sorted({name for loc in job.locations if loc.name in at for name in loc.support})
+        lying = [loc for loc in job.locations if loc.name in at]
+        supports = sorted({name for loc in lying for name in loc.support})
+        # The world's up in the part's frame where it lies (each location pose's third row), their
+        # mean; the world's z where there is none (a part no transfer moves) or the mean vanishes
+        # (laid down upside down as often as not).
+        up = np.mean([_pose(loc.pose)[2, :3] for loc in lying], axis=0) if lying else np.zeros(3)
+        up = up / norm if (norm := float(np.linalg.norm(up))) > 1e-9 else np.array([0.0, 0.0, 1.0])
         out.append(PartSpec(name=part.name, shape=shape, mass=part.mass,
                             T_tcp_part=frozen_array(invert(_pose(part.grasp))),
-                            limits=_tcp_limits(part.limits), supports=tuple(supports)))
+                            limits=_tcp_limits(part.limits), supports=tuple(supports), up=frozen_array(up)))
     return tuple(out)
 
 

@@ -211,7 +211,7 @@ def build_scene(cell: CellSpec, robot: RobotModel, held: PartSpec | None = None)
     if held is not None:
         pieces, _ = shape_pieces(held.shape, cell.source, f"pick_place.parts[{cell.parts.index(held)}].mesh")
         carried = HeldPart(held.name, pieces, frozen_array(np.asarray(cell.tool.T_flange_tcp) @ held.T_tcp_part),
-                           held.supports, frozen_array(_up_in_part(cell, held)))
+                           held.supports, held.up)
     return Scene(
         cell_name=cell.name,
         obstacles=obstacles,
@@ -221,21 +221,6 @@ def build_scene(cell: CellSpec, robot: RobotModel, held: PartSpec | None = None)
         flange_frame_id=int(robot.flange_frame_id),
         held=carried,
     )
-
-
-def _up_in_part(cell: CellSpec, part: PartSpec) -> FloatArray:
-    """(3,) unit: the world's up in the part's own frame where it lies (the poses of its grips and
-    releases, the TCP's frame times the grasp), their mean where it lies turned differently; the
-    world's z where the cell never puts it down."""
-    ups = []
-    for spot in (s for seam in cell.seams for s in seam.spots if s.part == part.name):
-        z = -np.asarray(spot.normal, dtype=float)
-        x = np.asarray(spot.direction, dtype=float)
-        R_world_part = np.column_stack([x, np.cross(z, x), z]) @ np.asarray(part.T_tcp_part, dtype=float)[:3, :3]
-        ups.append(R_world_part.T[:, 2])
-    mean = np.mean(ups, axis=0) if ups else np.zeros(3)
-    norm = float(np.linalg.norm(mean))
-    return mean / norm if norm > 1e-9 else np.array([0.0, 0.0, 1.0])
 
 
 def shape_pieces(shape: Shape, file: Path | None = None, key: str | None = None) -> tuple[tuple[coal.CollisionGeometry, ...], str]:
