@@ -262,8 +262,7 @@ def _parts_off_supports(parsed: CellFile, cell: CellSpec, file: str, meshes: dic
         return []
     import coal
 
-    from robomax_py.transforms import pose_matrix
-    from robomax_py.units import deg_to_rad
+    from robomax_py.io.cell_objects import _pose
 
     index = {loc.name: i for i, loc in enumerate(job.locations)}
     objects = {obj.name: obj for obj in cell.objects}
@@ -275,7 +274,7 @@ def _parts_off_supports(parsed: CellFile, cell: CellSpec, file: str, meshes: dic
         if not location.support:
             continue
         part = cell.part(part_name)
-        T_part = pose_matrix(location.pose.xyz, [deg_to_rad(a) for a in location.pose.rpy])
+        T_part = _pose(location.pose)
         gap, nearest = min((min(_distance(a, T_part, b, np.asarray(objects[name].T_world_object, dtype=float), coal)
                                 for a in _pieces(part.shape, meshes) for b in _pieces(objects[name].shape, meshes)),
                             name) for name in location.support)
