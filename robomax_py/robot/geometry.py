@@ -85,20 +85,18 @@ def outer_hull(vertices: np.ndarray, excess: float = LINK_HULL_EXCESS_M,
     vertices (the distance to a convex set is convex), so that bound holds for all of it, and it
     contains the hull because every plane supports it."""
     import trimesh
-    from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
+    from scipy.spatial import ConvexHull, HalfspaceIntersection
 
-    points = hull_vertices(vertices)
+    surface = trimesh.convex.convex_hull(np.asarray(vertices, dtype=float))    # as `hull_vertices` builds it
+    points = np.asarray(surface.vertices, dtype=float)
     if len(points) <= above:
         return points
-    try:
-        hull = ConvexHull(points)
-    except QhullError:                          # flat or degenerate: kept as it is
-        return points
-    faces = hull.equations                      # (m, 4): n . x + d <= 0 inside, n a unit vector
+    normals = np.asarray(surface.face_normals, dtype=float)
+    # (m, 4): n . x + d <= 0 inside, n the outward unit normal of each hull face.
+    faces = np.column_stack([normals, -np.einsum("ij,ij->i", normals, np.asarray(surface.triangles)[:, 0])])
     inside = points.mean(axis=0)
-    if not np.all(faces[:, :3] @ inside + faces[:, 3] < -1e-6):
+    if not np.all(faces[:, :3] @ inside + faces[:, 3] < -1e-6):   # flat or degenerate: kept as it is
         return points
-    surface = trimesh.convex.convex_hull(points)
     dirs = np.asarray(trimesh.creation.icosphere(subdivisions=_START_DIRECTIONS).vertices, dtype=float)
     planes = np.column_stack([dirs, -(points @ dirs.T).max(axis=0)])
     for _ in range(len(faces)):
