@@ -241,3 +241,17 @@ def test_check_names_the_tool_file_and_key(tmp_path: Path, write_small_cell: Any
     assert done.exit_code == EXIT_BAD_INPUT
     assert f"{tool}: units: input should be 'm' or 'mm', got 'inch'" in done.output
     assert "Traceback" not in done.output
+
+
+def test_a_tool_mesh_that_does_not_read_is_named_by_its_path(tmp_path: Path, write_small_cell: Any) -> None:
+    """A tool body that is not a mesh: the message names the file's path (not the program's own
+    record of the mesh) and the key."""
+    broken = tmp_path / "broken.stl"
+    broken.write_text("solid broken\n  this is not an STL facet\nendsolid broken\n")
+    tool = _tool(tmp_path / "gun", {"name": "g", "body": "body.stl", "tips": "tips.stl"},
+                 {"body.stl": broken, "tips.stl": GUN / "tips.stl"})
+    cell = _cell_with_tool(tmp_path / "c", write_small_cell, "../gun/tool.yaml")
+    done = runner.invoke(app, ["check", str(cell)])
+    said = " ".join(done.output.split())
+    assert done.exit_code == EXIT_BAD_INPUT and "Traceback" not in done.output
+    assert f"{tool}: body: cannot read mesh {tool.parent / 'body.stl'}" in said and "MeshShape(" not in said
