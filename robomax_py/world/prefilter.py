@@ -122,8 +122,13 @@ class Prefilter:
         blocks: dict[tuple[int, int, int], list[int]] = {}
         for k, (a, b) in enumerate(zip(robot_side, other)):
             ga = group_of[int(piece_joint[a])]
-            gb = group_of[int(piece_joint[b])]
-            key = (0, ga, int(b)) if is_obs[b] else (1, min(ga, gb), max(ga, gb))
+            if is_obs[b]:
+                key = (0, ga, int(b))
+            else:
+                # (An obstacle's joint, the universe, has a group only when some robot piece is
+                # fixed there too: not on an arm whose root link carries no geometry.)
+                gb = group_of[int(piece_joint[b])]
+                key = (1, min(ga, gb), max(ga, gb))
             blocks.setdefault(key, []).append(k)
         keys = list(blocks)
         block_kind = np.array([key[0] for key in keys], dtype=np.int64)

@@ -14,8 +14,12 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 import pytest
+from urdf_case import six_joint_urdf
 
-from robomax_py.robot import RobotModel
+from robomax_py.app.import_urdf import import_urdf
+from robomax_py.io.cell import load_cell
+from robomax_py.io.robot import load_robot_spec
+from robomax_py.robot import RobotModel, load_robot
 from robomax_py.spec import CellSpec
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.prefilter import SLACK_M, Prefilter
@@ -30,7 +34,7 @@ REFERENCE_CELL = REPO / "tests" / "data" / "reference" / "cabin_flange.yaml"
 @pytest.fixture(scope="module")
 def reference() -> tuple[CellSpec, RobotModel, CollisionWorld]:
     assert REFERENCE_CELL.is_file(), "the reference cell (tests/data/reference) is shipped with the repository"
-    from robomax_py.io.cell import load_cell, load_cell_robot
+    from robomax_py.io.cell import load_cell_robot
 
     cell = load_cell(REFERENCE_CELL)
     robot = load_cell_robot(cell)
@@ -43,6 +47,23 @@ def test_no_filter_for_a_joint_it_does_not_model() -> None:
     model.addJointFrame(j)
     assert Prefilter.of(model, pin.GeometryModel(), [], np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
                         np.zeros(0)) is None
+
+
+def test_an_arm_whose_root_link_has_no_geometry(tmp_path: Path) -> None:
+    """Obstacles hang on the universe joint; an arm whose root link carries no geometry (a track
+    left unmodelled, an empty world link) has no robot piece there. Its filter used to look the
+    universe up among the robot's joints (a KeyError in every plan of such an arm)."""
+    body = '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'
+    urdf = six_joint_urdf(tmp_path / "bare.urdf", "bare", ["0 0 1", "0 1 0", "0 1 0", "1 0 0", "0 1 0", "1 0 0"],
+                          ["0 0 0.4", "0.1 0 0", "0 0 0.5", "0.4 0 0", "0 0 0", "0.1 0 0"],
+                          collisions={i: body for i in (1, 2, 3)})
+    robot = load_robot(load_robot_spec(import_urdf(urdf, tmp_path / "bare").folder / "robot.yaml"))
+    cell = load_cell(REFERENCE_CELL)          # its fixtures as obstacles, in reach of this arm
+    world = CollisionWorld(robot, build_scene(cell, robot), 0.0)
+    exact = world.copy(prefilter=False)
+    rng = np.random.default_rng(5)
+    q = rng.uniform(robot.limits.lower, robot.limits.upper, size=(200, robot.dof))
+    assert [world.is_free(x) for x in q] == [exact.is_free(x) for x in q]
 
 
 def _configs(world: CollisionWorld, robot: RobotModel, rng: np.random.Generator, n: int) -> np.ndarray:
