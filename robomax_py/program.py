@@ -7,7 +7,7 @@ decimals the program files carry, so ``parse(write(p)) == p`` holds exactly:
 =================================  =========  ========
 quantity                           unit       decimals
 =================================  =========  ========
-joint values (`PtpMove.target_deg`)  deg        4
+joint values (`PtpMove.target_deg`)  deg (mm)   4
 fly-by radii (joint space)         deg        4
 positions, frame offsets           mm         3
 ZYX orientation angles             deg        4
@@ -15,6 +15,11 @@ PTP speed / acceleration           fraction   3
 LIN speed                          mm/s       3
 weld, wait and cycle times         s          3
 =================================  =========  ========
+
+A prismatic joint's value (a robot on a track) is stated in mm, not deg; `stated_joints` and
+`ptp_target` convert with the robot's joint kinds. A fly-by radius is the joint-space distance over
+the values in rad (m for a prismatic joint), stated times 180/pi: in deg on a robot of revolute
+joints.
 
 Rounding is Python's correctly rounded `round` (half-even on the exact binary value), which agrees
 digit for digit with ``f"{x:.{n}f}"``; ``-0.0`` is stored as ``0.0``. Non-finite values are kept as
@@ -27,6 +32,7 @@ Orientations are ZYX angles ``(a, b, c)`` in degrees, R = Rz(a)·Ry(b)·Rx(c), a
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -92,6 +98,7 @@ __all__ = [
     "lin_pose",
     "pose_mm_zyx",
     "ptp_target",
+    "stated_joints",
     "to_frame",
     "written_seconds",
     "written_speed",
@@ -200,21 +207,39 @@ def pose_mm_zyx(T: FloatArray) -> tuple[tuple[float, ...], tuple[float, ...]]:
     return xyz, (math.degrees(yaw), math.degrees(pitch), math.degrees(roll))
 
 
-def ptp_target(move: PtpMove) -> FloatArray:
-    """The joint target a PTP move states, rad."""
-    target: FloatArray = np.deg2rad(np.asarray(move.target_deg, dtype=float))
+def _kinds(prismatic: Sequence[bool] | np.ndarray, n: int) -> np.ndarray:
+    mask = np.asarray(prismatic, dtype=bool)
+    if mask.shape != (n,):
+        raise ValueError(f"{n} joint values but {mask.size} joint kinds")
+    return mask
+
+
+def stated_joints(q: FloatArray, prismatic: Sequence[bool] | np.ndarray) -> tuple[float, ...]:
+    """Joint values q (n,), rad (m for a prismatic joint), as a program states them: deg (mm for
+    a prismatic joint), before rounding."""
+    q = np.asarray(q, dtype=float)
+    # np.degrees and np.deg2rad below, as for every arm before tracks: the same values to the bit.
+    return tuple(float(v) for v in np.where(_kinds(prismatic, q.size), q * 1000.0, np.degrees(q)))
+
+
+def ptp_target(move: PtpMove, prismatic: Sequence[bool] | np.ndarray) -> FloatArray:
+    """The joint target a PTP move states, rad (m for a prismatic joint): its values are deg, or mm
+    for the joints `prismatic` marks."""
+    values = np.asarray(move.target_deg, dtype=float)
+    target: FloatArray = np.where(_kinds(prismatic, values.size), values / 1000.0, np.deg2rad(values))
     return target
 
 
-def as_written_joints(q: FloatArray) -> FloatArray:
-    """q (n,) or (m, n) rad as PTP statements give it back: rounded to the program's decimals.
+def as_written_joints(q: FloatArray, prismatic: Sequence[bool] | np.ndarray) -> FloatArray:
+    """q (n,) or (m, n) rad (m for prismatic joints) as PTP statements give it back: rounded to the
+    program's decimals (of deg, or of mm for a prismatic joint).
 
     The planner times and checks these values, so the program is exactly what was checked.
     """
     q = np.asarray(q, dtype=float)
     if q.ndim == 2:
-        return np.array([as_written_joints(row) for row in q]).reshape(q.shape)
-    return ptp_target(PtpMove(tuple(float(v) for v in np.degrees(q))))
+        return np.array([as_written_joints(row, prismatic) for row in q]).reshape(q.shape)
+    return ptp_target(PtpMove(stated_joints(q, prismatic)), prismatic)
 
 
 def as_written_pose(T: FloatArray) -> FloatArray:

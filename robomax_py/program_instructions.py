@@ -130,7 +130,8 @@ class PtpMove:
     Attributes
     ----------
     target_deg : (n_joints,) tuple of float
-        Joint values, deg (4 decimals).
+        Joint values, deg (4 decimals); mm for a prismatic joint (a track), which the robot's joint
+        kinds tell (`program.ptp_target`).
     speed, accel : float
         Fractions of the maximum joint speed / acceleration, in (0, 1] (3 decimals).
     flyby : float

@@ -8,13 +8,15 @@ from pathlib import Path
 
 def serial_urdf(path: Path, name: str, joints: Sequence[tuple[str, str, float, float, float]], tool0: str, *,
                 link: str = "l{}", joint: str = "j{}", tool0_joint: str = "j_t",
-                collisions: Mapping[int, str] = {}) -> Path:
+                collisions: Mapping[int, str] = {}, prismatic: frozenset[int] = frozenset()) -> Path:
     """A serial arm: links `link`.format(0..n) joined by revolute joints `joint`.format(1..n), each
     (origin "x y z", axis "x y z", lower, upper rad, velocity rad/s); `collisions` the <collision>
-    element of link i; tool0 fixed on the last link at `tool0` (an <origin> element)."""
+    element of link i; tool0 fixed on the last link at `tool0` (an <origin> element). The joints
+    numbered in `prismatic` (1..n) slide instead (limits in m, velocity in m/s)."""
     links = "".join(f'<link name="{link.format(i)}">{collisions.get(i, "")}</link>' for i in range(len(joints) + 1))
     body = "".join(
-        f'<joint name="{joint.format(i + 1)}" type="revolute"><parent link="{link.format(i)}"/>'
+        f'<joint name="{joint.format(i + 1)}" type="{"prismatic" if i + 1 in prismatic else "revolute"}">'
+        f'<parent link="{link.format(i)}"/>'
         f'<child link="{link.format(i + 1)}"/><origin xyz="{origin}"/><axis xyz="{axis}"/>'
         f'<limit lower="{lower}" upper="{upper}" effort="1" velocity="{velocity}"/></joint>'
         for i, (origin, axis, lower, upper, velocity) in enumerate(joints))
@@ -54,3 +56,26 @@ def iiwa14_urdf(path: Path) -> Path:
     return serial_urdf(path, "lbr_iiwa_14_r820", [(o, a, -lim, lim, v) for o, a, lim, v in IIWA14_JOINTS],
                        '<origin xyz="0 0 0.126"/>', link="link_{}", joint="joint_a{}", tool0_joint="joint_a7-tool0",
                        collisions=bodies)
+
+
+# A six-axis arm of the KR 16's proportions on a 3 m floor track along x: joint 1 slides (0 to 3 m,
+# 1 m/s), the arm stands 0.2 m above the track's zero. Cylinders for the arm's links.
+TRACK_JOINTS = (
+    ("0 0 0", "1 0 0", 0.0, 3.0, 1.0),
+    ("0 0 0.6", "0 0 1", -3.0, 3.0, 2.5), ("0.26 0 0", "0 1 0", -3.0, 1.2, 2.5),
+    ("0 0 0.68", "0 1 0", -2.0, 2.6, 2.5), ("0.3 0 0.035", "1 0 0", -3.0, 3.0, 5.0),
+    ("0.37 0 0", "0 1 0", -2.0, 2.0, 5.0), ("0.08 0 0", "1 0 0", -3.0, 3.0, 7.0),
+)
+TRACK_BODIES = {
+    1: '<collision><origin xyz="0 0 0.3"/><geometry><cylinder radius="0.12" length="0.5"/></geometry></collision>',
+    3: '<collision><origin xyz="0 0 0.34"/><geometry><cylinder radius="0.07" length="0.5"/></geometry></collision>',
+    4: '<collision><origin xyz="0.2 0 0.035" rpy="0 1.5708 0"/><geometry><cylinder radius="0.06" length="0.3"/>'
+       '</geometry></collision>',
+}
+
+
+def track_arm_urdf(path: Path) -> Path:
+    """`TRACK_JOINTS`: a prismatic track (joint j1) carrying a six-axis arm (joints j2..j7),
+    tool0 on the last link with z along its x (the flange convention of ROS-Industrial)."""
+    return serial_urdf(path, "track_arm", TRACK_JOINTS, '<origin xyz="0 0 0" rpy="0 1.5707963267948966 0"/>',
+                       collisions=TRACK_BODIES, prismatic=frozenset({1}))

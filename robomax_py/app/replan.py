@@ -150,14 +150,14 @@ def replan(cell: CellSpec, robot: RobotModel, program: Path, at: float, events: 
     if contact is not None:
         return outcome("infeasible", f"the stop configuration is in collision at t = {stop.t_stop:.3f} s: "
                                      f"{contact.describe()}")
-    cont = continuation_cell(changed, stop, name)
+    cont = continuation_cell(changed, stop, name, robot)
     result = plan_cell(cont, robot, options)
     if result.status != "planned":
         return outcome("infeasible", result.message, result, cont)
     return replace(outcome("planned", "planned", result, cont), as_it_stands=_as_it_stands(changed, robot, program) if compare else None)
 
 
-def continuation_cell(changed: CellSpec, stop: Stop, name: str) -> CellSpec:
+def continuation_cell(changed: CellSpec, stop: Stop, name: str, robot: RobotModel) -> CellSpec:
     """The cell the rest of the work is planned in (`io.cell_continuation`): `changed` (the events
     applied) from the stop on, its start the stop configuration as the programs write it.
     ReplanInputError when nothing is left to do."""
@@ -165,7 +165,7 @@ def continuation_cell(changed: CellSpec, stop: Stop, name: str) -> CellSpec:
     if not cont.seams:
         raise ReplanInputError(f"nothing left to do after the stop at t = {stop.t_stop:.3f} s: every "
                                f"{'station' if changed.tending else 'spot'} is done")
-    return replace(cont, name=name, start=as_written_joints(stop.q))
+    return replace(cont, name=name, start=as_written_joints(stop.q, robot.prismatic))
 
 
 def continuation_file(source: Path, out_dir: Path, cell: CellSpec, robot: RobotModel,

@@ -78,8 +78,9 @@ def cell_summary(cell: CellSpec, robot: Any) -> Group:
     """Robot, tool, objects, seams and spots of a cell, as rich tables."""
     head = Table.grid(padding=(0, 2))
     head.add_row("cell", f"{cell.name}  ({cell.source})")
-    home_deg = ", ".join(f"{v:.1f}" for v in np.degrees(cell.home))
-    head.add_row("robot", f"{robot.name}: {robot.dof} axes, IK {robot.ik_solver}, home [{home_deg}] deg")
+    # As the cell file states it: deg, m for a prismatic joint (a track), marked.
+    home = ", ".join(f"{v:.3f} m" if prismatic else f"{np.degrees(v):.1f}" for v, prismatic in zip(cell.home, robot.prismatic))
+    head.add_row("robot", f"{robot.name}: {robot.dof} axes, IK {robot.ik_solver}, home [{home}] deg")
     tcp = cell.tool.T_flange_tcp[:3, 3]
     load = cell.tool.load
     weight = "" if load is None else f", {load.mass:g} kg at [{', '.join(f'{v:.3f}' for v in load.cog)}] m"

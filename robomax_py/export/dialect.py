@@ -515,8 +515,15 @@ def percent(fraction: float) -> int:
 
 
 def not_six_axes(robot: RobotModel, dialect: str) -> str:
-    """Why `dialect`'s programs, which drive six axes, cannot be `robot`'s ("" when they can)."""
-    return f"{dialect} programs are for 6-axis arms; {robot.name} has {robot.dof} joints" if robot.dof != 6 else ""
+    """Why `dialect`'s programs, which drive six revolute axes, cannot be `robot`'s ("" when they can)."""
+    if robot.dof != 6:
+        return f"{dialect} programs are for 6-axis arms; {robot.name} has {robot.dof} joints"
+    linear = [name for name, prismatic in zip(robot.joint_names, robot.prismatic) if prismatic]
+    if linear:
+        # These dialects state every joint of the arm in deg; a linear axis is an external axis
+        # there (KRL E1, RAPID extax, a FANUC extended axis), configured on the controller.
+        return f"{dialect} programs are for arms of six revolute axes; {robot.name}'s {', '.join(linear)} is prismatic"
+    return ""
 
 
 def require_six_axes(robot: RobotModel, dialect: str) -> None:

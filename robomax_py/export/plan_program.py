@@ -44,6 +44,7 @@ from robomax_py.program import (
     Spot,
     Wait,
     WaitFor,
+    stated_joints,
 )
 from robomax_py.spec import ControllerSetup
 
@@ -73,10 +74,15 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
     cell_sha256 : SHA-256 of the cell file, for the header; stamp : a date for the header, or "".
     """
     traj = result.trajectory
-    if traj is None or result.T_flange_tcp is None or result.T_world_base is None or result.home is None:
+    if traj is None or result.T_flange_tcp is None or result.T_world_base is None or result.home is None \
+            or len(result.prismatic) != len(result.home):
         raise ExportError(f"cell {result.cell} has no complete plan to export")
     opts = result.options
     setup = result.controller
+    prismatic = result.prismatic
+
+    def stated(q: FloatArray) -> tuple[float, ...]:
+        return stated_joints(q, prismatic)      # deg, or mm for a prismatic joint (a track)
     # Cartesian targets are stated in the program's user frame (docs/cell-files.md, "Controller programs"): by default the
     # controller's robot base frame itself; never the robot's placement in the cell.
     C = np.eye(4) if result.T_root_controller is None else result.T_root_controller
@@ -103,7 +109,7 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
     where = "stop" if transitions and transitions[0].label.startswith(f"{START_LABEL} ->") else "home"
     emit(home, Comment(f"start at {'the stop configuration' if where == 'stop' else 'home'}; {len(result.spots)} "
                        f"spots, planned cycle {traj.duration:.3f} s"),
-         PtpMove(tuple(np.degrees(home)), opts.speed, 1.0, comment=where))
+         PtpMove(stated(home), opts.speed, 1.0, comment=where))
     if result.spots and result.spots[0].interlocks:
         emit(home, *_interlocks(result.spots[0].interlocks, setup))
     if transitions and transitions[0].wait is not None:
@@ -139,7 +145,7 @@ def planned_program(result: PlanResult, cell_sha256: str = "", stamp: str = "") 
                 emit(q, lin(trans.lin_targets[w - 1], trans.lin_configs[w - 1], trans.lin_speed * 1000.0,
                             comment=note.strip(", "), accel=trans.accel))
             else:
-                emit(q, PtpMove(tuple(np.degrees(q)), speed, trans.accel, flyby=math.degrees(radius),
+                emit(q, PtpMove(stated(q), speed, trans.accel, flyby=math.degrees(radius),
                                 comment=note.strip(", ")))
             for stage in trans.stages:
                 if stage.index == w and stage.wait is not None:

@@ -299,7 +299,7 @@ def associative_moves(robot: RobotModel, loads: Loads, tour: Tour, transitions: 
             continue
         # From the two ends as the program states them, so that the route is the one the written
         # ends give (the table's grid is laid out from them).
-        wp = as_written_joints(np.asarray(trans.waypoints, dtype=float))
+        wp = as_written_joints(np.asarray(trans.waypoints, dtype=float), robot.prismatic)
         found = plan_transfer(robot, loads.worlds[part], wp[0], wp[-1], settings, points)
         if found.status != "routed":
             return AssociativeMoves((), tuple(planned), f"{trans.label} carrying {part}: {found.detail}")

@@ -80,7 +80,7 @@ def _checked_timing(cell: CellSpec, robot: RobotModel, world: CollisionWorld, fu
     try:
         if cell.start is not None:
             # A continuation's first move is made again from its start, once for every timing below.
-            found = lead_in(world, roadmap, np.asarray(cell.start), list(found), robot.limits,
+            found = lead_in(world, roadmap, np.asarray(cell.start), list(found), robot,
                             np.random.default_rng(cell.planner.seed))
         timings = _timed_tours(cell, robot, world, spots, tour, list(found), options, progress, roadmap, loads,
                                memo=memo)

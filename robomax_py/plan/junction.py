@@ -323,7 +323,7 @@ def _extension(robot: RobotModel, q_start: FloatArray, waypoints: FloatArray, be
         q_ext[revolute] = q_app[revolute] + wrap_to_pi(q_ext[revolute] - q_app[revolute])
         if float(np.abs(q_ext - q_app).max()) > MAX_EXTENSION_JOINT_RAD or not bool(robot.limits.contains(q_ext)):
             return None
-        approach_q = as_written_joints(q_ext)
+        approach_q = as_written_joints(q_ext, robot.prismatic)
     return Extension(retract_T, retract_q, approach_q)
 
 

@@ -22,7 +22,7 @@ from robomax_py.plan.results import Transition, TransitionKind
 from robomax_py.plan.roadmap import Roadmap
 from robomax_py.plan.rrt_detour import rrt_detour
 from robomax_py.program import as_written_joints
-from robomax_py.robot import JointLimits
+from robomax_py.robot import JointLimits, RobotModel
 from robomax_py.world.collision import CollisionWorld
 
 # The first move of a continuation is labelled `stop -> <first stop>` (a whole program's: `home -> ...`).
@@ -34,18 +34,19 @@ class LeadInError(RobomaxError):
 
 
 def lead_in(world: CollisionWorld, roadmap: Roadmap | None, start: np.ndarray,
-            transitions: list[Transition], limits: JointLimits, rng: np.random.Generator) -> list[Transition]:
+            transitions: list[Transition], robot: RobotModel, rng: np.random.Generator) -> list[Transition]:
     """The transitions with the first one starting at `start` (n,) rad instead of home.
 
     world : the static obstacles (the plan's world); roadmap : the plan's detour roadmap.
-    limits, rng : the robot's joint limits and the plan's random generator, for the last resort, the
+    robot, rng : the robot (its joint limits, and its joint kinds for the values as written) and the
+    plan's random generator, for the last resort, the
     random trees of `plan.rrt_detour` (as between two spots no other detour joins).
     LeadInError when neither the straight move, a roadmap path, a join to the first move nor the
     random trees within their budget of checks is free."""
     if not transitions:
         return transitions
     first = transitions[0]
-    q0 = as_written_joints(np.asarray(start, dtype=float))
+    q0 = as_written_joints(np.asarray(start, dtype=float), robot.prismatic)
     goal = np.asarray(first.waypoints[-1], dtype=float)
     label = f"{START_LABEL} ->" + first.label.partition("->")[2] if "->" in first.label else first.label
     first = replace(first, label=label)
@@ -60,18 +61,18 @@ def lead_in(world: CollisionWorld, roadmap: Roadmap | None, start: np.ndarray,
         return led("move", np.vstack([q0, goal]), 0)
     detour = roadmap.query(q0, goal) if roadmap is not None else None
     if detour is not None:
-        return led("detour", as_written_joints(detour.waypoints), detour.checks)
+        return led("detour", as_written_joints(detour.waypoints, robot.prismatic), detour.checks)
     waypoints = np.asarray(first.waypoints, dtype=float)
     joined = _joined(world, q0, waypoints)
     if joined is None:
-        searched, _ = rrt_detour(world, limits, q0, goal, rng)
+        searched, _ = rrt_detour(world, robot.limits, q0, goal, rng)
         joined = None if searched is None else searched.waypoints
     if joined is None:
-        joined = _via_home(world, roadmap, q0, waypoints, limits, rng)
+        joined = _via_home(world, roadmap, q0, waypoints, robot.limits, rng)
     if joined is None:
         raise LeadInError(f"no collision-free move from the stop configuration to the first stop of the rest "
                           f"({first.label}), nor back to home")
-    return led("detour", as_written_joints(joined), 0)
+    return led("detour", as_written_joints(joined, robot.prismatic), 0)
 
 
 def _via_home(world: CollisionWorld, roadmap: Roadmap | None, q0: np.ndarray, waypoints: np.ndarray,

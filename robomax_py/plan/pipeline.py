@@ -215,6 +215,7 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
     )
     return PlanResult(cell.name, robot.name, "planned", "planned", spots=tuple(plans), transitions=tuple(transitions),
                       trajectory=trajectory, stats=plan_stats, baseline=options.method != "optimised", joint_names=robot.joint_names,
+                      prismatic=robot.prismatic,
                       tool=cell.tool.name, T_flange_tcp=np.asarray(robot.T_flange_tcp), tool_load=cell.tool.load,
                       T_world_base=np.asarray(cell.T_world_base),
                       T_root_controller=np.asarray(cell.robot.controller.T_root_base), controller=cell.controller,

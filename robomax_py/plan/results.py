@@ -319,6 +319,7 @@ class PlanResult:
     stats: PlanStats | None = None
     baseline: bool = False           # planned by a baseline method (`options.method` says which)
     joint_names: tuple[str, ...] = ()
+    prismatic: tuple[bool, ...] = ()         # per joint: prismatic (m), else revolute (rad)
     tool: str = ""
     T_flange_tcp: FloatArray | None = None   # (4, 4)
     tool_load: ToolLoad | None = None        # the tool's stated load, which some dialects declare

@@ -273,7 +273,7 @@ def _timed(ctx: JunctionContext, index: int, t_block: float, q_rest: FloatArray,
     cuts = [i for i, s in enumerate(route.steps) if 0 < i < len(nodes) - 1 and s.depart - s.arrive > 1e-6]
     bounds = [0, *cuts, len(nodes) - 1]
     # Rounded as the program states them, so the written program is exactly the motion timed.
-    pieces = [as_written_joints(_shortcut(ctx, points[nodes[a:b + 1]])) for a, b in itertools.pairwise(bounds)]
+    pieces = [as_written_joints(_shortcut(ctx, points[nodes[a:b + 1]]), ctx.robot.prismatic) for a, b in itertools.pairwise(bounds)]
     # One corner and one junction radius for every piece (the program states one per transition),
     # the largest that times and stays free in every piece; the pieces stop where they wait.
     for rj_deg, rd_deg in STAGED_RADII_DEG:

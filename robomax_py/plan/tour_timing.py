@@ -109,7 +109,7 @@ def time_tour(
         welded.append((i, a, end.T_spot, end.T_app))
     blocks: list[list[Segment]] = []
     timed: list[Transition] = []
-    q_now = as_written_joints(cell.q_start)         # home, or where a continuation starts
+    q_now = as_written_joints(cell.q_start, robot.prismatic)         # home, or where a continuation starts
     spec_of = [cell.seams[spots[i].seam_index].spots[spots[i].spot_index] for i in tour.order]
     weld_times = [written_seconds(cell.process.weld_time_of(spot)) for spot in spec_of]
     def junction_block(k: int, q_start: FloatArray) -> tuple[list[Segment], Transition]:
@@ -127,7 +127,7 @@ def time_tour(
     def _junction_block(k: int, q_start: FloatArray, flyby: bool) -> tuple[list[Segment], Transition]:
         before = ends[k - 1] if k > 0 else None
         after = ends[k] if k < len(ends) else None
-        waypoints = as_written_joints(transitions[k].waypoints)      # the first row: where the retract ends
+        waypoints = as_written_joints(transitions[k].waypoints, robot.prismatic)      # the first row: where the retract ends
         trans = replace(transitions[k], waypoints=waypoints)
         leaving = tour.order[k - 1] if k > 0 else HOME
         part = loads.part_after(leaving) if loads is not None else None
@@ -212,7 +212,7 @@ def time_tour(
         # the spot and changes sign over the approach line.
         q_retract = retract_q[k]
         plans.append(SpotPlan(seam.name, c.name, c.angles[a], config_text(robot, c.q_spot[a]), q_spot,
-                              as_written_joints(c.q_app[a]), float(phase.t_start), float(phase.t_end), T_spot, T_app,
+                              as_written_joints(c.q_app[a], robot.prismatic), float(phase.t_start), float(phase.t_end), T_spot, T_app,
                               config_text(robot, q_retract if q_retract is not None else c.q_app[a]),
                               weld_times[k], cell.process.gun,
                               cell.process.schedule_of(spec_of[k]), waits_for[k], spec_of[k].action))

@@ -88,6 +88,11 @@ class RobotModel:
     def dof(self) -> int:
         return int(self.model.nq)
 
+    @property
+    def prismatic(self) -> tuple[bool, ...]:
+        """Per joint: prismatic (its values are metres; a program states them in mm), else revolute."""
+        return tuple(bool(v) for v in prismatic_mask(self.model))
+
     def limits_carrying(self, mass: float) -> JointLimits:
         """The joint limits carrying `mass` kg: linear in the mass from the unloaded limits to those
         with the rated payload (our model: robot data sheets give the two ends only); the unloaded

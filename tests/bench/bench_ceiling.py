@@ -118,7 +118,7 @@ class LegTimer:
                 continue
             timed += 1
             junction = time_junction(
-                self.robot, self.world, lim, ci.q_spot[a], as_written_joints(np.array([ci.q_app[a], cj.q_app[b]])),
+                self.robot, self.world, lim, ci.q_spot[a], as_written_joints(np.array([ci.q_app[a], cj.q_app[b]]), self.robot.prismatic),
                 "move", f"{ci.name} -> {cj.name}", self.end(i, a), self.end(j, b),
                 tcp_speed=written_tcp_speed(o.tcp_speed * o.speed), speed=written_speed(o.speed),
                 jerk_limited=o.jerk_limited, flyby=o.blend)

@@ -17,7 +17,7 @@ from robomax_py.app.replan import continuation_cell
 from robomax_py.io.cell import load_cell
 from robomax_py.io.cell_continuation import shifted_windows
 from robomax_py.plan.replan import Action, ReplanInputError, stop_at
-from robomax_py.robot import JointLimits
+from robomax_py.robot import JointLimits, load_robot
 from robomax_py.tolerances import DEFAULT as TOL
 
 REPO = Path(__file__).resolve().parents[2]
@@ -133,7 +133,8 @@ def test_the_continuations_cell_keeps_what_is_left() -> None:
     t, q, _ = _program(np.array([0.5, 0.5]), np.array([0.5, 0.5]))
     done = (Action("tending", spots[0].name, 1.0, 1.4), Action("tending", spots[1].name, 9.8, 10.1))
     stop = replace(stop_at(t, q, [], 0.1, LIMITS), t_stop=20.0, done=done, q=np.asarray(cell.home))
-    cont = continuation_cell(cell, stop, "tending_from_20")
+    robot = load_robot(cell.robot)
+    cont = continuation_cell(cell, stop, "tending_from_20", robot)
     assert [s.name for s in cont.seams[0].spots] == [s.name for s in spots[2:]]
     assert cont.name == "tending_from_20" and cont.start is not None
     np.testing.assert_allclose(cont.start, cell.home, atol=1e-6)

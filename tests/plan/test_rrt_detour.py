@@ -94,7 +94,7 @@ def test_a_stop_that_sees_no_way_to_its_first_stop_goes_home_and_follows_the_tou
     monkeypatch.setattr(lead, "rrt_detour", lambda *args: (None, 0))      # the trees' budget spent
     tour = [Transition("move", np.vstack([home, first_stop]), "home -> s1")]
 
-    moved = lead.lead_in(world, None, stop, tour, robot.limits, np.random.default_rng(0))
+    moved = lead.lead_in(world, None, stop, tour, robot, np.random.default_rng(0))
     path = moved[0].waypoints
     assert moved[0].kind == "detour" and moved[0].label == "stop -> s1"
     np.testing.assert_allclose(path[0], stop, atol=1e-6)                    # as written: 1e-4 deg rounding
@@ -106,7 +106,7 @@ def test_a_stop_that_sees_no_way_to_its_first_stop_goes_home_and_follows_the_tou
     assert world.is_free(unseen) and not world.check_segment(stop, unseen).free
     with pytest.raises(lead.LeadInError, match="nor back to home"):
         lead.lead_in(world, None, stop, [Transition("move", np.vstack([unseen, first_stop]), "home -> s1")],
-                     robot.limits, np.random.default_rng(0))
+                     robot, np.random.default_rng(0))
 
 
 def test_a_search_stops_once_its_configurations_are_spent(pillar_world: tuple[RobotModel, CollisionWorld]) -> None:

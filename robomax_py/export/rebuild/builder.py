@@ -115,7 +115,7 @@ def rebuild(program: Program, cell: CellSpec, robot: RobotModel, file: Path | st
     if len(first.target_deg) != robot.dof:
         raise ProgramError(file, f"line {moves[0][1]}" if moves[0][1] else "BEGIN",
                            f"the first move gives {len(first.target_deg)} axis values, the robot has {robot.dof} joints")
-    builder.start(ptp_target(first))
+    builder.start(ptp_target(first, robot.prismatic))
     for k in range(1, len(moves)):
         ins, builder.line = moves[k]
         if isinstance(ins, PtpMove) and len(ins.target_deg) != robot.dof:
@@ -276,7 +276,7 @@ class _Builder:
         return dataclasses.replace(ins, accel=min(ins.accel, 1.0))
 
     def _step(self, ins: PtpMove, following: Any, index: int) -> Step:
-        return PtpStep(ptp_target(ins), speed=ins.speed, accel=ins.accel, flyby=math.radians(ins.flyby),
+        return PtpStep(ptp_target(ins, self.robot.prismatic), speed=ins.speed, accel=ins.accel, flyby=math.radians(ins.flyby),
                        kind="move", label=ins.comment or f"statement {index + 1}", flyby_tcp=ins.flyby_mm / 1000.0)
 
     def _lin_step(self, ins: LinMove, T_ctrl_frame: FloatArray, kind: str, index: int) -> Step:
