@@ -18,7 +18,7 @@ import yaml
 from hypothesis import given
 from hypothesis import strategies as st
 from typer.testing import CliRunner
-from urdf_case import track_arm_urdf
+from urdf_case import TRACK_JOINTS, serial_urdf, track_arm_urdf
 
 from robomax_py.app.cli import app
 from robomax_py.app.import_urdf import import_urdf
@@ -111,6 +111,17 @@ def test_six_axis_dialects_refuse_a_prismatic_joint(planned: tuple[Path, Path], 
     assert "7 joints" in not_six_axes(robot, "krl")
     done = runner.invoke(app, ["plan", str(cell), "--out", str(tmp_path / "o"), "--format", "rapid"])
     assert done.exit_code == 2 and "rapid programs are for 6-axis arms" in done.output
+
+
+
+def test_a_six_joint_arm_with_a_track_is_not_taken_for_a_six_axis_arm(tmp_path: Path) -> None:
+    """A track under a five-axis arm makes six joints; a dialect stating every joint in deg must
+    still refuse it."""
+    urdf = serial_urdf(tmp_path / "track5.urdf", "track5", TRACK_JOINTS[:6], '<origin xyz="0 0 0"/>',
+                       prismatic=frozenset({1}))
+    robot = load_robot(load_robot_spec(import_urdf(urdf, tmp_path / "track5").folder / "robot.yaml"))
+    assert robot.dof == 6
+    assert not_six_axes(robot, "krl") == "krl programs are for arms of six revolute axes; track5's j1 is prismatic"
 
 
 @given(st.lists(st.floats(-6.0, 6.0), min_size=7, max_size=7), st.lists(st.booleans(), min_size=7, max_size=7))
