@@ -137,6 +137,11 @@ def read_program_files(robot: RobotModel, path: Path) -> tuple[Any, Path, Any, t
         known = ", ".join(sorted({e for d in DIALECTS.values() for e in d.extensions}))
         raise ProgramError(path, None, f"expected a trajectory file (.json) or a program ({known})")
     _not_a_setup_file(dialect, path)
+    unfit = dialect.unfit(robot)
+    if unfit:
+        # Read as this robot's, its values would be misread: a track's deg taken for mm, or a
+        # seventh joint left unstated.
+        raise ProgramError(path, None, f"cannot be this robot's program: {unfit}")
     texts = {}
     read = []
     if dialect.any_extension:

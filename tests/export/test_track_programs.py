@@ -22,12 +22,15 @@ from urdf_case import TRACK_JOINTS, serial_urdf, track_arm_urdf
 
 from robomax_py.app.cli import app
 from robomax_py.app.import_urdf import import_urdf
+from robomax_py.errors import ProgramError
 from robomax_py.export.dialect import not_six_axes
 from robomax_py.io.robot import load_robot_spec
 from robomax_py.program import PtpMove, as_written_joints, ptp_target, stated_joints
 from robomax_py.robot import load_robot
+from robomax_py.verify import read_program_files
 
 runner = CliRunner()
+GOLDEN_KRL = Path(__file__).resolve().parents[1] / "golden" / "small_cell" / "small_cell.src"
 UP = [0.0, 0.0, 1.0]
 # SRCL states joint values with 4 decimals: 5e-5 mm (5e-8 m) or 5e-5 deg (8.7e-7 rad) of rounding.
 STATED_M = 1e-7
@@ -122,6 +125,9 @@ def test_a_six_joint_arm_with_a_track_is_not_taken_for_a_six_axis_arm(tmp_path: 
     robot = load_robot(load_robot_spec(import_urdf(urdf, tmp_path / "track5").folder / "robot.yaml"))
     assert robot.dof == 6
     assert not_six_axes(robot, "krl") == "krl programs are for arms of six revolute axes; track5's j1 is prismatic"
+    # Nor does verify read a KRL program as this arm's: its A1 in deg would be taken for the track in mm.
+    with pytest.raises(ProgramError, match="cannot be this robot's program: krl programs are for arms of six revolute"):
+        read_program_files(robot, GOLDEN_KRL)
 
 
 @given(st.lists(st.floats(-6.0, 6.0), min_size=7, max_size=7), st.lists(st.booleans(), min_size=7, max_size=7))
