@@ -65,7 +65,12 @@ from robomax_py.app.import_urdf_staging import (
 )
 from robomax_py.app.xacro_sandbox.expansion import _package_candidates
 from robomax_py.errors import RobotModelError
-from robomax_py.io.robot import check_urdf, srdf_disabled_pairs, urdf_base_link
+from robomax_py.io.robot import (
+    bound_continuous_joints,
+    check_urdf,
+    srdf_disabled_pairs,
+    urdf_base_link,
+)
 from robomax_py.safe_files import (
     LIMITS,
     MB,
@@ -322,6 +327,10 @@ def import_urdf(
     if root.tag != "robot":
         raise RobotModelError(source, None, f"not a URDF: the root element is <{printable(root.tag)}>, not <robot>")
     warnings = [f"{source}: {note}" for note in expansion.notes]
+    endless = bound_continuous_joints(root)
+    if endless:
+        warnings.append(f"{source}: joint(s) {', '.join(endless)} continuous: imported as revolute within ±360 deg; "
+                        f"set the controller's software limits in {out / (name + '.urdf')}")
     warnings.extend(check_urdf(root, source))
     T_root_base = urdf_base_link(root, source)
     meshes, mesh_warnings = _collect_meshes(root, source, roots, limits)

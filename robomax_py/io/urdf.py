@@ -145,6 +145,33 @@ def check_urdf(root: ET.Element, urdf: Path) -> tuple[str, ...]:
     return _check_collision_geometry(links, joints, urdf)
 
 
+# The bounds `bound_continuous_joints` gives a `continuous` joint: a full turn either way, the
+# software limits a controller puts on its endless axes when nobody set others (UR's ±360 deg of
+# every joint; KUKA's A6 of ±350 deg is inside them).
+CONTINUOUS_BOUND_RAD = 2.0 * math.pi
+
+
+def bound_continuous_joints(root: ET.Element) -> tuple[str, ...]:
+    """Every active `continuous` joint of a URDF made `revolute` within ±CONTINUOUS_BOUND_RAD
+    (its `<limit>` velocity and effort kept), in place; the names of those changed.
+
+    robomax_py plans joints with bounds (a configuration is one angle per joint, and a controller
+    limits every axis in software); a `continuous` joint mimicking another is left to
+    `robot.kinematics`, which bounds it alike."""
+    changed = []
+    for joint in root.findall("joint"):
+        if joint.get("type") != "continuous" or joint.find("mimic") is not None:
+            continue
+        joint.set("type", "revolute")
+        limit = joint.find("limit")
+        if limit is None:
+            limit = ET.SubElement(joint, "limit")
+        limit.set("lower", repr(-CONTINUOUS_BOUND_RAD))
+        limit.set("upper", repr(CONTINUOUS_BOUND_RAD))
+        changed.append(str(joint.get("name")))
+    return tuple(changed)
+
+
 def _urdf_number(element: ET.Element, attr: str, default: float | None, urdf: Path, key: str) -> float:
     text = element.get(attr)
     if text is None:

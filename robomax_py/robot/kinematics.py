@@ -115,7 +115,13 @@ def kinematic_model(spec: RobotSpec) -> pin.Model:
         if is_passive(model, j):
             continue
         if model.joints[j].nq != 1 or model.joints[j].nv != 1:
-            raise RobotModelError(spec.urdf, f"joint {model.names[j]}", "only revolute and prismatic joints are supported")
+            # A `continuous` joint: JointModelRUBX/Y/Z, or JointModelRevoluteUnboundedUnaligned.
+            name = model.joints[j].shortname()
+            unbounded = name.startswith("JointModelRUB") or "Unbounded" in name
+            raise RobotModelError(spec.urdf, f"joint {model.names[j]}", "is continuous: give it the controller's "
+                                  "software limits as a revolute joint, or import the URDF with `robomax import-urdf`, "
+                                  "which bounds it at ±360 deg" if unbounded else
+                                  "only revolute and prismatic joints are supported")
         i = model.joints[j].idx_q
         lo, hi, v = model.lowerPositionLimit[i], model.upperPositionLimit[i], model.velocityLimit[i]
         if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):

@@ -194,6 +194,33 @@ def test_fall_back_to_numeric_ik_says_why_and_what_it_costs(tmp_path: Path) -> N
     assert asked.brand == "abb" and not [w for w in asked.warnings if w.startswith("the controller brand")]
 
 
+def test_continuous_joints_are_imported_within_a_full_turn_and_named(tmp_path: Path) -> None:
+    """Many descriptions make the endless wrist axes `continuous` (no limits); a controller still
+    bounds them in software, and the planner needs bounds. The import makes them revolute within
+    ±360 deg and says so; a robot folder written by hand with one is refused, naming the joint and
+    the two ways out."""
+    axes = ["0 0 1", "0 1 0", "0 1 0", "1 0 0", "0 1 0", "1 0 0"]
+    origins = ["0 0 0.4", "0.1 0 0", "0 0 0.5", "0.4 0 0.05", "0 0 0", "0.1 0 0"]
+    text = six_joint_urdf(tmp_path / "src.urdf", "endless6", axes, origins).read_text()
+    for j in ("j4", "j6"):
+        text = text.replace(f'<joint name="{j}" type="revolute">', f'<joint name="{j}" type="continuous">')
+    text = text.replace('<limit lower="-3" upper="3" effort="1" velocity="2"/></joint><joint name="j5"',
+                        '<limit effort="1" velocity="2"/></joint><joint name="j5"')      # j4: no bounds at all
+    assert text.count('type="continuous"') == 2 and text.count('lower="-3"') == 5
+    (tmp_path / "endless6.urdf").write_text(text)
+    result = import_urdf(tmp_path / "endless6.urdf", tmp_path / "endless6")
+    [note] = [w for w in result.warnings if "imported as revolute" in w]
+    assert "j4, j6 continuous: imported as revolute within ±360 deg" in note and "endless6.urdf" in note
+    robot = load_robot(load_robot_spec(tmp_path / "endless6" / "robot.yaml"))
+    assert result.solver == "opw"
+    np.testing.assert_allclose(robot.limits.lower[[3, 5]], -2 * math.pi)
+    np.testing.assert_allclose(robot.limits.upper[[3, 5]], 2 * math.pi)
+    np.testing.assert_allclose(robot.limits.velocity[[3, 5]], 2.0)
+    (tmp_path / "endless6" / "endless6.urdf").write_text(text)              # the folder's URDF edited by hand
+    with pytest.raises(RobotModelError, match=r"joint j4: is continuous: give it the controller's software limits"):
+        load_robot(load_robot_spec(tmp_path / "endless6" / "robot.yaml"))
+
+
 def test_import_warns_where_the_controllers_joint_convention_is_not_known(tmp_path: Path) -> None:
     """KUKA URDFs that follow KUKA's axis directions and zero (kr120), FANUC (driver passes the
     values through but for the J2/J3 linkage, j23_coupling) and ABB arms whose support package
