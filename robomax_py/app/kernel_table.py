@@ -2,7 +2,7 @@
 `compile_ahead` compiles before a first plan. The reference cell's plan (`tests/data/reference`)
 compiles exactly these in a fresh cache (a test plans it and compares, naming the entries to write
 here when they differ). Kernels that only some cells call (the C-space searches, the held part's
-voxels, a station's clash tests) compile at their first call, as before.
+voxels, a station's clash tests, the numeric IK's iterations) compile at their first call, as before.
 
 SHARED_HELPERS are the compiled helpers two of those kernels call (each kernel's compile would
 compile them again in its own process): compiled once before the kernels are shared out.

@@ -14,12 +14,8 @@ import numpy as np
 import pinocchio as pin
 
 from robomax_py._typing import BoolArray, FloatArray
-from robomax_py.robot.ik._chain import (
-    chain_to_frame,
-    frame_pose,
-    frame_pose_and_jacobian,
-    revolute_mask,
-)
+from robomax_py.robot.ik._chain import chain_to_frame, frame_pose, revolute_mask
+from robomax_py.robot.ik.numeric_kernel import iterate_seeds
 from robomax_py.robot.ik.turns import wrap_to_pi
 
 TWO_PI = 2.0 * np.pi
@@ -117,42 +113,13 @@ def numeric_ik(
     if q_hint is not None:
         hint = np.broadcast_to(np.asarray(q_hint, dtype=float), batch + (nq,)).reshape(-1, nq)
         start[:, 0] = np.clip(hint, lower, upper)
-    q = start.reshape(-1, nq)
+    q = np.ascontiguousarray(start.reshape(-1, nq))
     pose_of = np.repeat(np.arange(n_pose), n_start)
-    R_des = T[:, :3, :3].transpose(1, 2, 0)                            # (3, 3, n_pose)
-    p_des = T[:, :3, 3].T                                              # (3, n_pose)
-
-    active = np.arange(q.shape[0])
-    for _ in range(max_iterations):
-        if active.size == 0:
-            break
-        qa = q[active]
-        R, p, J = frame_pose_and_jacobian(chain, qa)
-        target = pose_of[active]
-        e_pos = p_des[:, target] - p                                   # (3, m)
-        e_rot = _rotation_log(np.einsum("ikm,jkm->ijm", R_des[:, :, target], R))
-        err_p = np.sqrt(np.einsum("im,im->m", e_pos, e_pos))
-        err_r = np.sqrt(np.einsum("im,im->m", e_rot, e_rot))
-        done = (err_p < _STOP_POS_M) & (err_r < _STOP_ROT_RAD)
-        go = ~done
-        if not go.any():
-            break
-        e = np.concatenate([e_pos, e_rot], axis=0).T[go]               # (m', 6)
-        Jg = J[go]
-        # Levenberg-Marquardt damping: large far from the target, vanishing near it.
-        lam = np.clip(1e-2 * (err_p[go] ** 2 + err_r[go] ** 2), 1e-10, 1e-1)
-        A = Jg @ Jg.transpose(0, 2, 1)
-        A[:, range(6), range(6)] += lam[:, None]
-        try:
-            x = np.linalg.solve(A, e[..., None])
-        except np.linalg.LinAlgError:                                  # a numerically singular A
-            x = np.linalg.pinv(A) @ e[..., None]
-        dq = (Jg.transpose(0, 2, 1) @ x)[..., 0]
-        step = np.max(np.abs(dq), axis=-1, keepdims=True)
-        dq *= np.minimum(1.0, _MAX_STEP / np.maximum(step, 1e-300))
-        idx = active[go]
-        q[idx] = _into_limits(qa[go] + dq, rev, lower, upper)
-        active = idx
+    iterate_seeds(np.ascontiguousarray(chain.K), np.asarray(chain.scale, dtype=float),
+                  np.asarray(chain.offset, dtype=float), np.asarray(chain.active, dtype=bool),
+                  np.asarray(chain.revolute, dtype=bool), np.asarray(chain.q_index, dtype=np.int64), q, pose_of,
+                  np.ascontiguousarray(T[:, :3, :3]), np.ascontiguousarray(T[:, :3, 3]), lower, upper,
+                  np.asarray(rev, dtype=bool), int(max_iterations), _STOP_POS_M, _STOP_ROT_RAD, _MAX_STEP)
 
     # Accept, canonicalise, dedupe.
     T_got = frame_pose(chain, q)
@@ -182,16 +149,6 @@ def numeric_ik(
     return q_out.reshape(batch + (max_solutions, nq)), valid.reshape(batch + (max_solutions,))
 
 
-def _into_limits(q: FloatArray, revolute: BoolArray, lower: FloatArray, upper: FloatArray) -> FloatArray:
-    """A revolute joint that stepped past a limit re-enters 2 pi further round if that is inside; then clip.
-
-    Without the wrap, seeds of joints with +-2 pi (or +-pi) limits pile up on the limit and stall.
-    """
-    q = np.where(revolute & (q > upper) & (q - TWO_PI >= lower), q - TWO_PI, q)
-    q = np.where(revolute & (q < lower) & (q + TWO_PI <= upper), q + TWO_PI, q)
-    return np.clip(q, lower, upper)
-
-
 def _canonical(q: FloatArray, revolute: BoolArray, lower: FloatArray, upper: FloatArray) -> FloatArray:
     """Revolute joints moved by 2 pi k to the in-limit value nearest (-pi, pi]; others unchanged."""
     wrapped = wrap_to_pi(q)
@@ -201,30 +158,3 @@ def _canonical(q: FloatArray, revolute: BoolArray, lower: FloatArray, upper: Flo
         take = revolute & np.isnan(out) & (cand >= lower) & (cand <= upper)
         out = np.where(take, cand, out)
     return np.where(np.isnan(out), q, out)
-
-
-def _rotation_log(M: FloatArray) -> FloatArray:
-    """Rotation vectors (3, m), rad, of rotation matrices stored as (3, 3, m)."""
-    v = 0.5 * np.stack([M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1]])   # sin(theta) * axis
-    cos = np.clip(0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0), -1.0, 1.0)
-    sin = np.sqrt(np.einsum("im,im->m", v, v))
-    theta = np.arctan2(sin, cos)
-    factor = np.where(sin > 1e-12, theta / np.maximum(sin, 1e-300), 1.0)
-    out = v * factor
-    near_pi = (sin < 1e-6) & (cos < 0.0)
-    if near_pi.any():
-        # theta ~ pi: sin(theta) * axis carries no direction; read the axis off the symmetric part,
-        # (M + M^T) / 2 = cos I + (1 - cos) a a^T.
-        Mp = M[:, :, near_pi]
-        c = cos[near_pi]
-        diag = np.stack([Mp[0, 0], Mp[1, 1], Mp[2, 2]])
-        aa = np.clip((diag - c) / (1.0 - c), 0.0, None)               # a_i^2
-        j = np.argmax(aa, axis=0)
-        cols = np.arange(Mp.shape[2])
-        a_j = np.sqrt(aa[j, cols])
-        sym = 0.5 * (Mp[:, j, cols] + Mp[j, :, cols].T)                # (3, k): (1 - cos) a_i a_j, i != j
-        axis = sym / ((1.0 - c) * a_j)
-        axis[j, cols] = a_j
-        axis /= np.linalg.norm(axis, axis=0)
-        out[:, near_pi] = axis * theta[near_pi]
-    return out
