@@ -118,7 +118,7 @@ def _yaml_text(text: str) -> str:
 # ROS-Industrial's KR 210 L150 planning a four-spot flange cell (tests/app/test_import_urdf.py's
 # `_flange_cell`), one thread, warm: 6.6 s CPU with numeric IK against 1.4 to 2.1 s with the fitted
 # OPW solver.
-NUMERIC_COST = ("planning several times slower (about 4x CPU on a KR 210 L150 cell), and the IK branches of each "
+NUMERIC_COST = ("planning several times slower (about 3x CPU on a KR 210 L150 cell), and the IK branches of each "
                 "pose found by sampling from random starts, not enumerated, so a branch can be missed")
 
 
