@@ -32,6 +32,7 @@ Orientations are ZYX angles ``(a, b, c)`` in degrees, R = Rz(a)·Ry(b)·Rx(c), a
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Sequence
 
 import numpy as np
@@ -70,6 +71,7 @@ __all__ = [
     "ANGLE_DECIMALS",
     "FLYBY_MM_DECIMALS",
     "JOINT_DECIMALS",
+    "KEYWORDS",
     "MM_DECIMALS",
     "NULL_FRAME",
     "SPEED_DECIMALS",
@@ -95,6 +97,7 @@ __all__ = [
     "find_problem",
     "frame_in_world",
     "from_frame",
+    "identifier",
     "lin_pose",
     "pose_mm_zyx",
     "ptp_target",
@@ -104,6 +107,29 @@ __all__ = [
     "written_speed",
     "written_tcp_speed",
 ]
+
+
+# The upper-case keywords of SRCL, the program's own text (docs/srcl.md); no name may be one
+# (names are case-sensitive, so `spot` is a name).
+KEYWORDS: frozenset[str] = frozenset(
+    ["PROGRAM", "CELL", "ROBOT", "AXES", "TOOL", "CYCLE", "SEC", "VAR", "FRAME", "BASE", "POS", "ORI", "BEGIN",
+     "ENDPROGRAM", "MOVE", "PTP", "LIN", "AXIS", "SPEED", "ACCEL", "FLYBY", "CONFIG", "SPOT", "SEAM", "TIME", "WAIT",
+     "FOR", "GUN", "SCHEDULE", "GRIP", "RELEASE", "INPUT", "SET", "OUTPUT", "TRUE", "FALSE", "SPL", "SLIN"]
+)
+_NOT_IDENT = re.compile(r"[^A-Za-z0-9_]")
+
+
+def identifier(name: str) -> str:
+    """The name a program states for a cell's seam, spot, frame or signal: letters, digits and `_`
+    (every other character, `ß` and `点` among them, becomes `_`), not a digit first, not a
+    keyword. 'door-L 2' -> 'door_L_2'. Two names of a cell that give the same identifier are
+    refused when the cell is read (`io.cell`): a program could not tell them apart."""
+    ident = _NOT_IDENT.sub("_", name) or "_"
+    if ident[0].isdigit():
+        ident = "_" + ident
+    if ident.upper() in KEYWORDS or ident in KEYWORDS:
+        ident += "_"
+    return ident
 
 
 def _finite(label: str, values: tuple[float, ...]) -> str | None:

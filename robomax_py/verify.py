@@ -305,7 +305,7 @@ def _verify_motion(cell: CellSpec, robot: RobotModel, name: str, data: dict[str,
 def _check_spots(cell: CellSpec, robot: RobotModel, data: dict[str, Any]) -> list[Violation]:
     t, q = data["t"], data["q"]
     out: list[Violation] = []
-    from robomax_py.export.plan_program import identifier
+    from robomax_py.program import identifier
 
     wanted = {(seam.name, spot.name): (seam, spot) for seam in cell.seams for spot in seam.spots}
     # A controller program names a spot by its identifiers (a seam called `seam`, a keyword, is

@@ -25,10 +25,9 @@ from typer.testing import CliRunner
 
 from robomax_py.app.cli import EXIT_OK, app
 from robomax_py.export import dialect_for_file
-from robomax_py.export.plan_program import identifier
 from robomax_py.export.srcl import parse_program
 from robomax_py.io.cell import load_cell, load_cell_robot
-from robomax_py.program import Gripper, Spot, WaitFor
+from robomax_py.program import Gripper, Spot, WaitFor, identifier
 
 REPO = Path(__file__).resolve().parents[1]
 CELLS = sorted((REPO / "cells").glob("*.yaml"))

@@ -20,7 +20,7 @@ def station_programs(station: StationSpec, given: list[Path]) -> list[dict[str, 
     the robots' own controllers' programs (`plan --format native`: a KUKA and a FANUC robot in one
     station each run their own dialect) where they are not one dialect's set already."""
     from robomax_py.export import DIALECTS, Dialect, native_dialect
-    from robomax_py.export.plan_program import identifier
+    from robomax_py.program import identifier
 
     def program_file(folder: Path, robot: str, d: Dialect) -> Path:
         # FANUC, KRL and RAPID name their files after the program (CROSSING_R1.ls): the dialect's
@@ -105,9 +105,8 @@ def interlock_io(station: StationSpec, folder: Path) -> dict[str, tuple[dict[str
 
 def members_of(station: StationSpec, programs: dict[str, Path]) -> list[StationMember]:
     """Each robot's member: its cell narrowed to the spots its program welds, with its interlock I/O."""
-    from robomax_py.export.plan_program import identifier
     from robomax_py.io.cell import load_cell_robot
-    from robomax_py.program import Spot
+    from robomax_py.program import Spot, identifier
     from robomax_py.verify import read_program
 
     io = interlock_io(station, next(iter(programs.values())).parent)

@@ -30,10 +30,10 @@ from robomax_py.export.dialect import (
     setup_signals,
 )
 from robomax_py.export.mount import mount_rotation, robroot
-from robomax_py.export.plan_program import frame_defs, identifier
+from robomax_py.export.plan_program import frame_defs
 from robomax_py.plan import PlanResult
 from robomax_py.plan.program_frames import cell_program_frames
-from robomax_py.program import FrameDef
+from robomax_py.program import FrameDef, identifier
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.transforms import invert

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import re
 from typing import Any
 
 import numpy as np
@@ -44,23 +43,10 @@ from robomax_py.program import (
     Spot,
     Wait,
     WaitFor,
+    identifier,
     stated_joints,
 )
 from robomax_py.spec import ControllerSetup
-
-_NOT_IDENT = re.compile(r"[^A-Za-z0-9_]")
-
-
-def identifier(name: str) -> str:
-    """'door-L 2' -> 'door_L_2'; a leading digit gets an underscore; keywords are avoided."""
-    from robomax_py.export.srcl import RESERVED
-
-    ident = _NOT_IDENT.sub("_", name) or "_"
-    if ident[0].isdigit():
-        ident = "_" + ident
-    if ident.upper() in RESERVED or ident in RESERVED:
-        ident += "_"
-    return ident
 
 
 def program_from_plan(result: PlanResult, cell_sha256: str = "", stamp: str = "") -> Program:

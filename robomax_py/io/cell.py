@@ -37,6 +37,7 @@ from robomax_py.io.cell_jobs import (
     _parts,
     _tcp_limits,
     check_tool_load,
+    same_identifier,
 )
 from robomax_py.io.cell_limits import (
     _check_counts,
@@ -282,6 +283,9 @@ def _check_unique_names(parsed: CellFile, path: Path) -> None:
                     f"duplicate spot name '{spot.name}' (also spots[{spots[spot.name]}])",
                 )
             spots[spot.name] = j
+        same_identifier([spot.name for spot in seam.spots], f"seams[{i}].spots", path)
+    same_identifier([seam.name for seam in parsed.seams], "seams", path)
+
 
 
 def _stem_name(path: Path) -> str:

@@ -19,6 +19,7 @@ from robomax_py.io.cell_file_jobs import (
 from robomax_py.io.cell_file_values import MAX_WINDOW_S, MIN_DIRECTION_SINE
 from robomax_py.io.cell_objects import _object, _pose
 from robomax_py.io.cell_problems import _Problems
+from robomax_py.program import identifier
 from robomax_py.spec import (
     MachineSpec,
     ObjectSpec,
@@ -89,6 +90,20 @@ def check_tool_load(robot: RobotSpec, tool: ToolSpec, parts: tuple[PartSpec, ...
                         f"above the robot's rated payload {robot.payload_kg:g} kg ({robot.source})")
 
 
+def same_identifier(names: list[str], key: str, path: Path) -> None:
+    """Refuse two names of the list at `key` that a program states alike (`program.identifier`:
+    other characters than letters, digits and `_` become `_`): its statements, and `verify`
+    reading them, could not tell the two apart."""
+    seen: dict[str, int] = {}
+    for i, name in enumerate(names):
+        ident = identifier(name)
+        k = seen.setdefault(ident, i)
+        if k != i:
+            raise CellFileError(path, f"{key}[{i}].name", f"'{name}' and '{names[k]}' ({key.split('.')[-1]}[{k}]) are "
+                                f"both written {ident} in programs, which name things with letters, digits and '_' "
+                                "only: give names that differ there")
+
+
 def _index_by_name(names: list[str], what: str, key: str, path: Path) -> dict[str, int]:
     """name -> index in the list at `key`; a repeated name is refused with both places."""
     out: dict[str, int] = {}
@@ -96,6 +111,7 @@ def _index_by_name(names: list[str], what: str, key: str, path: Path) -> dict[st
         if name in out:
             raise CellFileError(path, f"{key}[{i}].name", f"duplicate {what} name '{name}' (also {key.split('.')[-1]}[{out[name]}])")
         out[name] = i
+    same_identifier(names, key, path)
     return out
 
 

@@ -120,9 +120,8 @@ def verify_station(members: Sequence[StationMember], margin: float = 0.0,
     than this count as in contact; `spots`: the station's (seam, spot), each to be welded by one
     program exactly (each program's own verify checks the spots of its cell view). ProgramError
     when a program cannot be read (bad input)."""
-    from robomax_py.export.plan_program import identifier
     from robomax_py.export.rebuild.signals import output_signal
-    from robomax_py.program import SetSignal, Spot
+    from robomax_py.program import SetSignal, Spot, identifier
     from robomax_py.world.robot_pairs import robot_body
     from robomax_py.world.scene import build_scene
 

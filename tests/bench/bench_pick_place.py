@@ -19,10 +19,10 @@ from pathlib import Path
 import yaml
 
 from robomax_py.export.fanuc import program_name
-from robomax_py.export.plan_program import identifier
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.plan import PlanOptions, plan_cell
 from robomax_py.plan.loads import Loads, check_carried_motion
+from robomax_py.program import identifier
 from robomax_py.world.collision import CollisionWorld
 from robomax_py.world.scene import build_scene
 

@@ -19,7 +19,7 @@ from typer.testing import CliRunner
 
 from robomax_py.app.cli import app
 from robomax_py.export import fanuc, krl, rapid
-from robomax_py.export.plan_program import identifier
+from robomax_py.program import identifier
 
 KRL_NAME = re.compile(r"[A-Za-z_$][A-Za-z0-9_$]{0,23}")
 RAPID_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,31}")

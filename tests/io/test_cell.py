@@ -96,6 +96,22 @@ def _append_object(obj: dict[str, Any], key: str = "objects") -> Callable[[dict[
     return mutate
 
 
+def _both(*mutations: Callable[[dict[str, Any]], None]) -> Callable[[dict[str, Any]], None]:
+    def mutate(data: dict[str, Any]) -> None:
+        for m in mutations:
+            m(data)
+    return mutate
+
+
+def _second_seam(name: str) -> Callable[[dict[str, Any]], None]:
+    def mutate(data: dict[str, Any]) -> None:
+        seam = copy.deepcopy(data["seams"][0])
+        seam["name"] = name
+        seam["spots"] = seam["spots"][:2]
+        data["seams"].append(seam)
+    return mutate
+
+
 # (id, mutation, expected key path, expected words in the problem)
 BROKEN_CELLS: list[tuple[str, Callable[[dict[str, Any]], None], str, str]] = [
     ("unknown key", _set("seams.0.tolerence", {"alpha": 5}), "seams[0].tolerence", "did you mean 'tolerance'"),
@@ -134,6 +150,12 @@ BROKEN_CELLS: list[tuple[str, Callable[[dict[str, Any]], None], str, str]] = [
     ("unsupported version", _set("robomax", 2), "robomax", "unsupported format version 2"),
     ("duplicate object", _set("objects.1.name", "table"), "objects[1].name", "duplicate name 'table'"),
     ("duplicate spot", _set("seams.0.spots.1.name", "s1"), "seams[0].spots[1].name", "duplicate spot name 's1'"),
+    # Names a program states alike (programs name spots with letters, digits and '_' only): its
+    # statements and verify reading them could not tell the spots apart.
+    ("spots written alike", _both(_set("seams.0.spots.0.name", "点1"), _set("seams.0.spots.1.name", "线1")),
+     "seams[0].spots[1].name", "'线1' and '点1' (spots[0]) are both written _1 in programs"),
+    ("seams written alike", _both(_set("seams.0.name", "left-1"), _second_seam("left 1")),
+     "seams[1].name", "'left 1' and 'left-1' (seams[0]) are both written left_1 in programs"),
     ("gamma reversed", _set("seams.0.tolerance.gamma", [90, -90]), "seams[0].tolerance.gamma", "min <= max"),
     ("gamma three numbers", _set("seams.0.tolerance.gamma", [0, 1, 2]), "seams[0].tolerance.gamma",
      "at most 2 items"),

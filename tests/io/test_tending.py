@@ -90,6 +90,8 @@ _DROP = object()
     ("tending.machines.0.schedule.start", 1e6, "tending.machines[0].schedule.start", "less than or equal"),
     ("tending.stations.1.machine", "cnc9", "tending.stations[1].machine", "unknown machine 'cnc9'"),
     ("tending.stations.1.name", "conveyor_pick", "tending.stations[1].name", "duplicate station name"),
+    ("tending.stations.1.name", "conveyor-pick", "tending.stations[1].name",
+     "'conveyor-pick' and 'conveyor_pick' (stations[0]) are both written conveyor_pick in programs"),
     ("tending.stations.0.action", "weld", "tending.stations[0].action", "'grip' or 'release'"),
     ("tending.sequence", ["conveyor_pick", "lathe"], "tending.sequence[1]", "unknown station 'lathe'"),
     ("tending.machines.1.door.name", "conveyor", "tending.machines[1].door.name", "duplicate name 'conveyor'"),

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from robomax_py.export import DIALECTS
-from robomax_py.export.plan_program import identifier
+from robomax_py.program import identifier
 from robomax_py.robot import RobotModel
 from robomax_py.spec import CellSpec
 from robomax_py.verify import VerifyReport, verify_program

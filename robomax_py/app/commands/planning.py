@@ -166,8 +166,8 @@ def _stale_programs(out_dir: Path, name: str, every: bool = False) -> list[str]:
     files named as its programs (an older robomax's, or put there by hand; a plan writes its set
     as links into the set's folder). With `every`, the current set's files too."""
     from robomax_py.export import DIALECTS
-    from robomax_py.export.plan_program import identifier
     from robomax_py.io.files import MANIFEST_SUFFIX
+    from robomax_py.program import identifier
 
     # FANUC's files are named as its TP program (capitals), the others' as the cell.
     stems = {name, *(d.program_name(identifier(name)) for d in DIALECTS.values() if d.program_name)}

@@ -17,7 +17,6 @@ from robomax_py.export.dialect import (
     with_package_welds,
     with_tcp_blends,
 )
-from robomax_py.export.plan_program import identifier
 from robomax_py.export.quaternions import quaternion_from_zyx
 from robomax_py.program import (
     UNSET_FRAME,
@@ -33,6 +32,7 @@ from robomax_py.program import (
     ToolLoad,
     Wait,
     WaitFor,
+    identifier,
 )
 from robomax_py.robot import RobotModel
 

@@ -392,7 +392,7 @@ class _Builder:
 
     def _check_action(self, ins: Spot | Gripper, label: str) -> None:
         """A tending station gets its gripper action, a weld spot a weld."""
-        from robomax_py.export.plan_program import identifier
+        from robomax_py.program import identifier
 
         seam = next((s for s in self.cell.seams if identifier(s.name) == ins.seam), None)
         spec = next((p for p in seam.spots if identifier(p.name) == ins.name), None) if seam else None
@@ -407,7 +407,7 @@ class _Builder:
 
     def _check_interlocks(self, spot: Spot, label: str) -> None:
         """A weld near a clamp with an input comes after waiting for that input."""
-        from robomax_py.export.plan_program import identifier
+        from robomax_py.program import identifier
 
         seam = next((s for s in self.cell.seams if identifier(s.name) == spot.seam), None)
         spec = next((p for p in seam.spots if identifier(p.name) == spot.name), None) if seam else None
@@ -430,7 +430,7 @@ class _Builder:
     def _wait_for(self, ins: WaitFor) -> None:
         """A wait on an input number means the cell signal mapped to that number (the controller
         knows numbers, not names); a wait by name, the cell signal of that name."""
-        from robomax_py.export.plan_program import identifier
+        from robomax_py.program import identifier
 
         signal = input_signal(self.cell, ins)
         if signal is None:

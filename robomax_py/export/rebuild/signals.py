@@ -11,7 +11,7 @@ from robomax_py.spec import CellSpec
 def output_signal(cell: CellSpec, ins: SetSignal) -> str | None:
     """The signal an output statement sets: by number, the signal `robot.controller.outputs` maps
     to that output (None: none); by name, the signal whose controller name (RAPID) or own name it is."""
-    from robomax_py.export.plan_program import identifier
+    from robomax_py.program import identifier
 
     outputs = cell.controller.outputs
     if ins.number is not None:
@@ -31,7 +31,7 @@ def input_signal(cell: CellSpec, ins: WaitFor) -> str | None:
     """The signal a wait means: on an input number, the cell signal mapped to that number (the
     controller knows numbers, not names; None: none); by name, the cell signal whose controller
     name it is, else the name itself."""
-    from robomax_py.export.plan_program import identifier
+    from robomax_py.program import identifier
 
     inputs = cell.controller.inputs
     if ins.number is not None:

@@ -10,7 +10,7 @@ from robomax_py.spec import CellSpec, SpotSpec
 
 def _spot_of(cell: CellSpec, spot: Spot) -> SpotSpec | None:
     """The cell's spot a weld names (as the program writes names: `identifier`)."""
-    from robomax_py.export.plan_program import identifier
+    from robomax_py.program import identifier
 
     seam = next((s for s in cell.seams if identifier(s.name) == spot.seam), None)
     return next((p for p in seam.spots if identifier(p.name) == spot.name), None) if seam else None

@@ -10,6 +10,7 @@ from robomax_py.export.dialect import PlannedProgram
 from robomax_py.program import (
     ANGLE_DECIMALS,
     JOINT_DECIMALS,
+    KEYWORDS,
     MM_DECIMALS,
     NULL_FRAME,
     SPEED_DECIMALS,
@@ -34,10 +35,7 @@ from robomax_py.robot import RobotModel
 DIALECT = "robomax SRCL/1"
 
 # Upper-case keywords; they cannot be used as names (names are case-sensitive, so `spot` is a name).
-RESERVED: frozenset[str] = frozenset(
-    ["PROGRAM", "CELL", "ROBOT", "AXES", "TOOL", "CYCLE", "SEC", "VAR", "FRAME", "BASE", "POS", "ORI", "BEGIN", "ENDPROGRAM", "MOVE", "PTP", "LIN", "AXIS", "SPEED", "ACCEL", "FLYBY", "CONFIG", "SPOT", "SEAM", "TIME", "WAIT", "FOR", "GUN", "SCHEDULE", "GRIP", "RELEASE", "INPUT",
-     "SET", "OUTPUT", "TRUE", "FALSE", "SPL", "SLIN"]
-)
+RESERVED = KEYWORDS
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _INDENT = "  "
