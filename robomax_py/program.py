@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 import re
+import unicodedata
 from collections.abc import Sequence
 
 import numpy as np
@@ -101,6 +102,7 @@ __all__ = [
     "lin_pose",
     "pose_mm_zyx",
     "ptp_target",
+    "spelled_out",
     "stated_joints",
     "to_frame",
     "written_seconds",
@@ -117,14 +119,27 @@ KEYWORDS: frozenset[str] = frozenset(
      "FOR", "GUN", "SCHEDULE", "GRIP", "RELEASE", "INPUT", "SET", "OUTPUT", "TRUE", "FALSE", "SPL", "SLIN"]
 )
 _NOT_IDENT = re.compile(r"[^A-Za-z0-9_]")
+# German letters written out as German does without them; other accented letters lose their
+# accents (NFKD): what a controller's names and comments, in ASCII, can keep of a name.
+_SPELLED = str.maketrans({"ä": "ae", "ö": "oe", "ü": "ue", "Ä": "Ae", "Ö": "Oe", "Ü": "Ue", "ß": "ss"})
+
+
+def spelled_out(text: str, other: str) -> str:
+    """`text` in ASCII: German letters spelled out, accents dropped, every other character outside
+    ASCII replaced by `other`. 'Naht_Äußen' -> 'Naht_Aeussen', 'café' -> 'cafe'."""
+    if text.isascii():
+        return text
+    plain = unicodedata.normalize("NFKD", text.translate(_SPELLED))
+    return "".join(c if c.isascii() else other for c in plain if not unicodedata.combining(c))
 
 
 def identifier(name: str) -> str:
     """The name a program states for a cell's seam, spot, frame or signal: letters, digits and `_`
-    (every other character, `ß` and `点` among them, becomes `_`), not a digit first, not a
-    keyword. 'door-L 2' -> 'door_L_2'. Two names of a cell that give the same identifier are
-    refused when the cell is read (`io.cell`): a program could not tell them apart."""
-    ident = _NOT_IDENT.sub("_", name) or "_"
+    (`spelled_out`, then every other character becomes `_`: `Schweißpunkt 1` is
+    `Schweisspunkt_1`, `点1` is `_1`), not a digit first, not a keyword. Two names of a cell that
+    give the same identifier are refused when the cell is read (`io.cell_jobs.same_identifier`): a
+    program could not tell them apart."""
+    ident = _NOT_IDENT.sub("_", spelled_out(name, "_")) or "_"
     if ident[0].isdigit():
         ident = "_" + ident
     if ident.upper() in KEYWORDS or ident in KEYWORDS:

@@ -35,6 +35,7 @@ from robomax_py.program import (
     SetSignal,
     Spot,
     WaitFor,
+    spelled_out,
 )
 from robomax_py.robot import RobotModel
 from robomax_py.robot.solve import brand_text_of
@@ -103,7 +104,8 @@ def controller_identifier(name: str, *, upper: bool, max_chars: int, reserved: S
     ('DOOR_L_2', 'p7up')
     """
     letters, first, suffix = ("A-Z", "P", "_PROG") if upper else ("a-z", "p", "_prog")
-    ident = re.sub(f"[^{letters}0-9_]", "_", name.upper() if upper else name.lower()) or first
+    plain = spelled_out(name, "_")
+    ident = re.sub(f"[^{letters}0-9_]", "_", plain.upper() if upper else plain.lower()) or first
     if not re.match(f"[{letters}]", ident):
         ident = first + ident
     ident = ident[:max_chars]
@@ -129,7 +131,7 @@ def fitted_identifier(name: str, *, max_chars: int, reserved: Sequence[str] = ()
     >>> fitted_identifier("side_frame_station_4_r1", max_chars=17)
     'side_fr_B7E6_4_r1'
     """
-    ident = re.sub(r"[^A-Za-z0-9_]", "_", name) or "P"
+    ident = re.sub(r"[^A-Za-z0-9_]", "_", spelled_out(name, "_")) or "P"
     if not ("A" <= ident[0] <= "Z" or "a" <= ident[0] <= "z"):
         ident = "P" + ident
     if ident.upper() in {r.upper() for r in reserved}:
@@ -487,6 +489,25 @@ def in_controller_joints(program: Program, robot: RobotModel, inverse: bool = Fa
     out = tuple(dataclasses.replace(i, target_deg=convert(i.target_deg)) if isinstance(i, PtpMove) else i
                 for i in program.instructions)
     return dataclasses.replace(program, instructions=out)
+
+
+def ascii_text(text: str) -> str:
+    """`text` in ASCII (`program.spelled_out`, '?' for what has no spelling): 'Schweißpunkt' ->
+    'Schweisspunkt', '点1' -> '?1'."""
+    return spelled_out(text, "?")
+
+
+def ascii_comments(program: Program) -> Program:
+    """The program with its comment lines and move notes in ASCII (`ascii_text`), for controllers
+    that read their files in a code page of their own: KSS writes and reads Windows-1252, where the
+    two bytes of a UTF-8 'ß' show as two other letters; an ASCII comment reads alike everywhere."""
+    def plain(i: Instruction) -> Instruction:
+        if isinstance(i, Comment):
+            return Comment(ascii_text(i.text))
+        if isinstance(i, (PtpMove, LinMove)) and not i.comment.isascii():
+            return dataclasses.replace(i, comment=ascii_text(i.comment))
+        return i
+    return dataclasses.replace(program, instructions=tuple(plain(i) for i in program.instructions))
 
 
 def without_comments(program: Program) -> Program:

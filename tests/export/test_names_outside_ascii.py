@@ -1,6 +1,7 @@
 """Names a German or Chinese integrator writes (`Schweißpunkt_1`, `Naht_ÄÖÜ`, `点1`): every program
-names things with letters, digits and '_' only, so other characters become '_'; each dialect's
-program of such a cell is written, read back and verified clean. Two names that would be written
+names things with letters, digits and '_' only, German letters spelled out (`Schweisspunkt_1`) and
+other characters made '_'; each dialect's program of such a cell is written, read back and
+verified clean. Two names that would be written
 alike are refused when the cell is read (tests/io/test_cell.py)."""
 
 from __future__ import annotations
@@ -32,7 +33,13 @@ def test_a_cell_named_in_german_and_chinese_is_written_in_every_dialect(tmp_path
     # SRCL, KRL, RAPID, FANUC TP, URScript, AS (INFORM needs the arm's pulses per degree).
     assert len(programs) == 6, sorted(p.name for p in out.iterdir())
     srcl = next(p for p in programs if p.suffix == ".srcl").read_text()
-    assert "SPOT Schwei_punkt_2 SEAM Naht____0" in srcl and "SPOT _1 SEAM Naht____0" in srcl
+    assert "SPOT Schweisspunkt_2 SEAM Naht_AeOeUe0" in srcl and "SPOT _1 SEAM Naht_AeOeUe0" in srcl
+    # KSS reads its files in Windows-1252, RAPID's in a code page of the controller: their comments
+    # are written in ASCII, German letters spelled out.
+    for program in programs:
+        if program.suffix in (".src", ".mod"):
+            text = program.read_text(encoding="utf-8")
+            assert text.isascii() and "Naht_AeOeUe0/Schweisspunkt_2" in text, program.name
     for program in programs:
         checked = runner.invoke(app, ["verify", str(path), str(program)])
         assert checked.exit_code == 0 and "clean" in checked.output, (program.name, checked.output)

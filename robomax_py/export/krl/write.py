@@ -11,6 +11,7 @@ from robomax_py.errors import ExportError
 from robomax_py.export.dialect import (
     PlannedProgram,
     SignalNumbers,
+    ascii_comments,
     fitted_identifier,
     gripper_label,
     header_lines,
@@ -126,6 +127,7 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     program = with_brand_configs(program, planned.joints, robot, "kuka")
     program = with_tcp_blends(dataclasses.replace(planned, program=program), robot)
     program = with_package_welds(program, "KRL")
+    program = ascii_comments(program)         # KSS reads its files in Windows-1252 (FILE_ENCODING)
     out: list[Instruction] = []
     for ins in program.instructions:
         if isinstance(ins, (PtpMove, LinMove)) and ins.comment:

@@ -8,6 +8,7 @@ import dataclasses
 from robomax_py.errors import ControllerSetupError, ExportError
 from robomax_py.export.dialect import (
     PlannedProgram,
+    ascii_comments,
     fitted_identifier,
     gripper_label,
     header_lines,
@@ -101,6 +102,7 @@ def adapt(planned: PlannedProgram, robot: RobotModel) -> Program:
     # RAPID refers to data by name: the frames carry no slot number.
     frames = tuple(dataclasses.replace(f, number=0) for f in program.frames if (f.kind, f.name) not in existing)
     program = with_package_welds(dataclasses.replace(program, frames=frames, instructions=tuple(out)), "RAPID")
+    program = ascii_comments(program)         # comments read alike in any code page the controller uses
     _check_weld_data_names(program)
     program = with_brand_configs(program, planned.joints, robot, "abb")
     program = dataclasses.replace(program, name=program_name(program.name))
