@@ -5,7 +5,10 @@
   forearm length of the axis-2 origin, which itself turns on a circle about axis 1; a spot all of
   whose grid orientations put that point farther from the circle is unreachable, and by how much
   is a figure the user can act on. Arms without a spherical wrist use the whole chain's length to
-  the TCP instead (a weaker bound, still never wrong).
+  the TCP instead (a weaker bound, still never wrong). An arm on a track or a gantry (prismatic
+  joints before its first revolute one) has its circle moved along their travel: the distance is
+  the least over a grid of the travel, less the most the grid can miss by (a distance moves by at
+  most what the arm moves); a chain with a prismatic joint after a revolute one is not checked.
 - Self contact: link pairs (neither adjacent nor disabled) that touch at home, or in every one of the
   collision world's seeded samples: candidates for robot.yaml `collision.disable`.
 """
@@ -20,7 +23,11 @@ import pinocchio as pin
 from robomax_py._typing import FloatArray
 from robomax_py.plan.poses import orientation_grid, spot_poses
 from robomax_py.robot import RobotModel
-from robomax_py.robot.ik._chain import joint_axes_at_zero
+from robomax_py.robot.ik._chain import (
+    active_positions,
+    chain_to_frame,
+    joint_axes_at_zero,
+)
 from robomax_py.spec import CellSpec
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.transforms import closest_on_line, invert
@@ -48,6 +55,11 @@ class SpotReach:
         return self.out_by_m <= 0.0
 
 
+# A track's (or a gantry's) travel is sampled at most this many times in all, for the bound below:
+# 8 mm apart on a 4 m track, the bound weaker by 4 mm; each sample costs a pass over the spots.
+TRAVEL_SAMPLES = 512
+
+
 @dataclass(frozen=True, slots=True)
 class _ReachModel:
     axis_point: FloatArray   # (3,) on axis 1
@@ -55,11 +67,25 @@ class _ReachModel:
     shoulder: FloatArray     # (3,) the axis-2 origin at q = 0
     p_tcp_ref: FloatArray    # (3,) the reference point in the TCP frame
     reach: float
+    # Prismatic joints before the arm (a track, a gantry): the arm's offsets from where it stands at
+    # q = 0, sampled over their travel (m, 3), and how far the nearest sample may be from any
+    # offset of the travel (the bound subtracts it: distances change by at most the offset's move).
+    offsets: FloatArray
+    offset_slack_m: float
 
 
-def _reach_model(robot: RobotModel) -> _ReachModel:
+def _reach_model(robot: RobotModel) -> _ReachModel | None:
+    """The bound's model of the arm; None for a chain it does not cover (a prismatic joint after
+    a revolute one), whose spots are then not checked."""
     axes = joint_axes_at_zero(robot.model, robot.flange_frame_id)
-    u, p = list(axes.u), list(axes.p)
+    chain = chain_to_frame(robot.model, robot.flange_frame_id)
+    active = active_positions(chain)
+    revolute = [bool(chain.revolute[i]) for i in active]
+    slides = next((k for k, r in enumerate(revolute) if r), len(revolute))
+    if not all(revolute[slides:]) or len(revolute) - slides < 2:
+        return None
+    offsets, slack = _travel(robot, axes.u[:slides], [chain.q_index[i] for i in active[:slides]])
+    u, p = list(axes.u[slides:]), list(axes.p[slides:])
     T_tcp = axes.T_flange @ np.asarray(robot.T_flange_tcp)
     wrist = _wrist_centre(p, u) if len(p) >= 6 else None
     if wrist is not None:
@@ -69,7 +95,24 @@ def _reach_model(robot: RobotModel) -> _ReachModel:
         ref = T_tcp[:3, 3]
         reach = float(sum(np.linalg.norm(p[i + 1] - p[i]) for i in range(1, len(p) - 1)) + np.linalg.norm(ref - p[-1]))
     p_ref = (invert(T_tcp) @ np.append(ref, 1.0))[:3]
-    return _ReachModel(p[0], u[0], p[1], p_ref, reach)
+    return _ReachModel(p[0], u[0], p[1], p_ref, reach, offsets, slack)
+
+
+def _travel(robot: RobotModel, slides: FloatArray, index: list[int]) -> tuple[FloatArray, float]:
+    """Offsets (m, 3) of the arm over the leading prismatic joints' travel, on a grid of at most
+    TRAVEL_SAMPLES points, and the most any offset of the travel lies from its nearest sample
+    (half a grid step along each slide, summed)."""
+    if not index:
+        return np.zeros((1, 3)), 0.0
+    per_axis = max(2, int(TRAVEL_SAMPLES ** (1.0 / len(index))))
+    grids, slack = [], 0.0
+    for q in index:
+        lo, hi = float(robot.limits.lower[q]), float(robot.limits.upper[q])
+        grids.append(np.linspace(lo, hi, per_axis))
+        slack += 0.5 * (hi - lo) / (per_axis - 1)
+    values = np.stack(np.meshgrid(*grids, indexing="ij"), axis=-1).reshape(-1, len(index))
+    offsets: FloatArray = values @ np.asarray(slides, dtype=float)
+    return offsets, slack
 
 
 def _wrist_centre(p: list[FloatArray], u: list[FloatArray]) -> FloatArray | None:
@@ -82,16 +125,21 @@ def _wrist_centre(p: list[FloatArray], u: list[FloatArray]) -> FloatArray | None
 
 
 def reach_report(cell: CellSpec, robot: RobotModel) -> list[SpotReach]:
-    """Every spot's reach figure, in cell order (see the module docstring)."""
+    """Every spot's reach figure, in cell order (see the module docstring); none for a chain the
+    bound does not cover."""
     rm = _reach_model(robot)
+    if rm is None:
+        return []
     T_base_world = invert(np.asarray(cell.T_world_base))
-    out = []
+    out: list[SpotReach] = []
     for i, seam in enumerate(cell.seams):
         grid = orientation_grid(seam)
         poses = spot_poses(seam.spots, grid)                      # (s, o, 4, 4) world
         ref = np.einsum("...ij,j->...i", T_base_world @ poses, np.append(rm.p_tcp_ref, 1.0))[..., :3]
-        d = _distance_to_circle(ref, rm)                            # (s, o)
-        best = d.min(axis=1)
+        best = np.full(len(seam.spots), np.inf)
+        for offset in rm.offsets:                                  # the arm where a track puts it
+            best = np.minimum(best, _distance_to_circle(ref - offset, rm).min(axis=1))   # (s, o) -> (s,)
+        best = np.maximum(best - rm.offset_slack_m, 0.0)
         for j, spot in enumerate(seam.spots):
             out.append(SpotReach(seam.name, spot.name, spot.key or f"seams[{i}].spots[{j}]", float(best[j]), rm.reach))
     return out

@@ -117,6 +117,42 @@ def test_six_axis_dialects_refuse_a_prismatic_joint(planned: tuple[Path, Path], 
 
 
 
+def test_check_counts_the_track_in_the_arms_reach(planned: tuple[Path, Path], tmp_path: Path) -> None:
+    """`check` bounds each spot's reach without IK; the bound moved the arm's shoulder along the
+    track's travel. Before, it took the track for axis 1 and refused this cell, which plans."""
+    cell, _ = planned
+    done = runner.invoke(app, ["check", str(cell)])
+    assert done.exit_code == 0 and "all 2 spots within reach" in done.output, done.output
+    data = yaml.safe_load(cell.read_text())
+    data["seams"][0]["spots"][1]["xyz"] = [-2.5, -0.17, 0.8015]      # 2.5 m beyond the track's far end
+    far = cell.parent / "beyond.yaml"
+    far.write_text(yaml.safe_dump(data, sort_keys=False))
+    done = runner.invoke(app, ["check", str(far)])
+    assert done.exit_code == 2 and "seams[0].spots[1]: spot edge/far is out of track_arm's reach by" in \
+        " ".join(done.output.split()), done.output
+
+
+def test_the_reach_bound_never_refuses_a_pose_the_arm_takes(planned: tuple[Path, Path]) -> None:
+    """Every TCP pose of a configuration within the limits (the track anywhere on its travel) lies
+    within the bound: the bound may only be weaker than the arm, never stronger."""
+    from robomax_py.plan import reach
+    from robomax_py.robot import fk_tcp, mount_tool
+
+    cell, _ = planned
+    robot = load_robot(load_robot_spec(cell.parent.parent / "robots" / "track_arm" / "robot.yaml"))
+    robot = mount_tool(robot, np.eye(4))
+    model = reach._reach_model(robot)
+    assert model is not None and len(model.offsets) == reach.TRAVEL_SAMPLES
+    rng = np.random.default_rng(7)
+    q = rng.uniform(robot.limits.lower, robot.limits.upper, (2000, robot.dof))
+    T = fk_tcp(robot, q)
+    points = np.einsum("nij,j->ni", T, np.append(model.p_tcp_ref, 1.0))[:, :3]
+    best = np.full(len(q), np.inf)
+    for offset in model.offsets:
+        best = np.minimum(best, reach._distance_to_circle(points - offset, model))
+    assert np.all(best - model.offset_slack_m <= model.reach + 1e-9)
+
+
 def test_a_six_joint_arm_with_a_track_is_not_taken_for_a_six_axis_arm(tmp_path: Path) -> None:
     """A track under a five-axis arm makes six joints; a dialect stating every joint in deg must
     still refuse it."""
