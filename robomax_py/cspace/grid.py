@@ -129,6 +129,11 @@ def check_arm(robot: RobotModel) -> None:
     """The map's method needs a 6-axis arm whose A1 turns about the base's vertical axis."""
     if robot.dof != 6:
         raise CSpaceError(f"robot {robot.name} has {robot.dof} axes; the C-space map needs a 6-axis arm")
+    linear = [name for name, prismatic in zip(robot.joint_names, robot.prismatic) if prismatic]
+    if linear:
+        # Its grid is of the angles of A1-A3 and its bounds of the wrist's turns: a lift or a
+        # track is neither (a vertical lift would pass the test below as a vertical A1).
+        raise CSpaceError(f"robot {robot.name}: {', '.join(linear)} is prismatic; the C-space map needs six revolute axes")
     axes = joint_axes_at_zero(robot.model, robot.flange_frame_id)
     if abs(abs(float(axes.u[0][2])) - 1.0) > VERTICAL_TOL:
         raise CSpaceError(f"robot {robot.name}: A1 is not vertical (axis {np.round(axes.u[0], 6).tolist()} in the "
