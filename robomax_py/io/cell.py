@@ -287,7 +287,6 @@ def _check_unique_names(parsed: CellFile, path: Path) -> None:
     same_identifier([seam.name for seam in parsed.seams], "seams", path)
 
 
-
 def _stem_name(path: Path) -> str:
     """The cell's name when the file gives none: its file stem, under the rules of `name`."""
     stem = path.stem

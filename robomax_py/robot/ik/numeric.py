@@ -1,9 +1,11 @@
 """Numeric IK for any serial arm: damped least squares from many seeds, batched.
 
 For robots without a closed form (robot.yaml `ik.solver: numeric`). Every seed of every pose is
-iterated at once with array operations; kinematics come from the Pinocchio model's constant data via
+iterated by Levenberg-Marquardt (damping large far from the target, vanishing near it) in one
+compiled loop (`numeric_kernel`), its kinematics from the Pinocchio model's constant data via
 `_chain` (agreeing with `pin.framesForwardKinematics` to round-off), since calling Pinocchio once
-per seed and iteration would cost milliseconds per pose.
+per seed and iteration would cost milliseconds per pose; the solutions are then accepted,
+canonicalised and told apart here with array operations.
 """
 
 from __future__ import annotations
