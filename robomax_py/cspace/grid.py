@@ -129,7 +129,7 @@ def check_arm(robot: RobotModel) -> None:
     """The map's method needs a 6-axis arm whose A1 turns about the base's vertical axis."""
     if robot.dof != 6:
         raise CSpaceError(f"robot {robot.name} has {robot.dof} axes; the C-space map needs a 6-axis arm")
-    linear = [name for name, prismatic in zip(robot.joint_names, robot.prismatic) if prismatic]
+    linear = robot.prismatic_joints
     if linear:
         # Its grid is of the angles of A1-A3 and its bounds of the wrist's turns: a lift or a
         # track is neither (a vertical lift would pass the test below as a vertical A1).

@@ -539,7 +539,7 @@ def not_six_axes(robot: RobotModel, dialect: str) -> str:
     """Why `dialect`'s programs, which drive six revolute axes, cannot be `robot`'s ("" when they can)."""
     if robot.dof != 6:
         return f"{dialect} programs are for 6-axis arms; {robot.name} has {robot.dof} joints"
-    linear = [name for name, prismatic in zip(robot.joint_names, robot.prismatic) if prismatic]
+    linear = robot.prismatic_joints
     if linear:
         # These dialects state every joint of the arm in deg; a linear axis is an external axis
         # there (KRL E1, RAPID extax, a FANUC extended axis), configured on the controller.

@@ -23,11 +23,7 @@ import pinocchio as pin
 from robomax_py._typing import FloatArray
 from robomax_py.plan.poses import orientation_grid, spot_poses
 from robomax_py.robot import RobotModel
-from robomax_py.robot.ik._chain import (
-    active_positions,
-    chain_to_frame,
-    joint_axes_at_zero,
-)
+from robomax_py.robot.ik._chain import joint_axes_at_zero
 from robomax_py.spec import CellSpec
 from robomax_py.tolerances import DEFAULT as TOL
 from robomax_py.transforms import closest_on_line, invert
@@ -78,13 +74,11 @@ def _reach_model(robot: RobotModel) -> _ReachModel | None:
     """The bound's model of the arm; None for a chain it does not cover (a prismatic joint after
     a revolute one), whose spots are then not checked."""
     axes = joint_axes_at_zero(robot.model, robot.flange_frame_id)
-    chain = chain_to_frame(robot.model, robot.flange_frame_id)
-    active = active_positions(chain)
-    revolute = [bool(chain.revolute[i]) for i in active]
+    revolute = [bool(r) for r in axes.revolute]
     slides = next((k for k, r in enumerate(revolute) if r), len(revolute))
     if not all(revolute[slides:]) or len(revolute) - slides < 2:
         return None
-    offsets, slack = _travel(robot, axes.u[:slides], [chain.q_index[i] for i in active[:slides]])
+    offsets, slack = _travel(robot, axes.u[:slides], list(axes.q_index[:slides]))
     u, p = list(axes.u[slides:]), list(axes.p[slides:])
     T_tcp = axes.T_flange @ np.asarray(robot.T_flange_tcp)
     wrist = _wrist_centre(p, u) if len(p) >= 6 else None

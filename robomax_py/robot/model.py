@@ -93,6 +93,11 @@ class RobotModel:
         """Per joint: prismatic (its values are metres; a program states them in mm), else revolute."""
         return tuple(bool(v) for v in prismatic_mask(self.model))
 
+    @property
+    def prismatic_joints(self) -> tuple[str, ...]:
+        """The names of the prismatic joints (a track, a lift), in joint order."""
+        return tuple(name for name, linear in zip(self.joint_names, self.prismatic) if linear)
+
     def limits_carrying(self, mass: float) -> JointLimits:
         """The joint limits carrying `mass` kg: linear in the mass from the unloaded limits to those
         with the rated payload (our model: robot data sheets give the two ends only); the unloaded

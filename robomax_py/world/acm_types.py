@@ -17,8 +17,8 @@ KIND_OBJECT = "object"
 KIND_DYNAMIC = "dynamic"
 KIND_HELD = "held"            # a part in the gripper: moves with the tool, collides like its body
 # A held part's stand-in against the supports it rests on, where the part or the support is a
-# triangle mesh (`world.acm._lifted_pairs`): the part lifted HELD_SUPPORT_PENETRATION_M along the
-# way the gripper takes it off.
+# triangle mesh (`world.acm`, module docstring): the part lifted HELD_SUPPORT_PENETRATION_M along
+# the world's up as it lies (`HeldPart.up`).
 KIND_HELD_LIFTED = "held_lifted"
 ROBOT_KINDS = (KIND_LINK, KIND_TOOL_BODY, KIND_TOOL_TIPS, KIND_HELD, KIND_HELD_LIFTED)
 # A held part may touch its supports (the objects it rests on where it is gripped or released)

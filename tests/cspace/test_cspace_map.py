@@ -91,11 +91,11 @@ def test_bad_requests_are_cspace_errors(small) -> None:  # type: ignore[no-untyp
         check_arm(types.SimpleNamespace(dof=5, name="five"))  # type: ignore[arg-type]
     sample = pin.buildSampleModelManipulator()                  # six axes, A1 about x
     arm = types.SimpleNamespace(dof=6, name="sample", model=sample, flange_frame_id=sample.getFrameId("effector_body"),
-                                joint_names=tuple(f"j{i}" for i in range(1, 7)), prismatic=(False,) * 6)
+                                prismatic_joints=())
     with pytest.raises(CSpaceError, match="A1 is not vertical"):
         check_arm(arm)  # type: ignore[arg-type]
     # A vertical lift under five revolute axes would pass for a vertical A1: its axis is the base's z.
-    lift = types.SimpleNamespace(dof=6, name="lift", joint_names=arm.joint_names, prismatic=(True,) + (False,) * 5)
+    lift = types.SimpleNamespace(dof=6, name="lift", prismatic_joints=("j1",))
     with pytest.raises(CSpaceError, match="lift: j1 is prismatic; the C-space map needs six revolute axes"):
         check_arm(lift)  # type: ignore[arg-type]
 

@@ -248,12 +248,15 @@ def frame_pose_and_jacobian(chain: Chain, q: FloatArray) -> tuple[FloatArray, Fl
 
 @dataclass(frozen=True, slots=True, eq=False)
 class JointAxes:
-    """The chain to a frame at q = 0, in the root frame: unit joint axes (k, 3), their origins (k, 3)
-    and the frame's pose (4, 4)."""
+    """The chain to a frame at q = 0, in the root frame: unit joint axes (k, 3) (a prismatic joint's:
+    the way it slides), their origins (k, 3), the frame's pose (4, 4), and per axis whether it turns
+    (k,) and its index in q (k,)."""
 
     u: FloatArray
     p: FloatArray
     T_flange: FloatArray
+    revolute: BoolArray
+    q_index: tuple[int, ...]
 
 
 def joint_axes_at_zero(model: pin.Model, frame_id: int) -> JointAxes:
@@ -266,4 +269,5 @@ def joint_axes_at_zero(model: pin.Model, frame_id: int) -> JointAxes:
     p = np.array([F[i, :3, 3] for i in act])
     data = model.createData()
     pin.framesForwardKinematics(model, data, np.zeros(model.nq))
-    return JointAxes(u / np.linalg.norm(u, axis=1, keepdims=True), p, np.asarray(data.oMf[frame_id].homogeneous))
+    return JointAxes(u / np.linalg.norm(u, axis=1, keepdims=True), p, np.asarray(data.oMf[frame_id].homogeneous),
+                     np.array([bool(chain.revolute[i]) for i in act], dtype=bool), tuple(chain.q_index[i] for i in act))
