@@ -38,6 +38,7 @@ from robomax_py.io.cell_jobs import (
     _tcp_limits,
     check_tool_load,
     same_identifier,
+    signals_apart,
 )
 from robomax_py.io.cell_limits import (
     _check_counts,
@@ -72,6 +73,7 @@ from robomax_py.spec import (
     LearnedMapSpec,
     PlannerSpec,
     ProcessSpec,
+    dynamic_signal,
     frozen_array,
 )
 
@@ -262,6 +264,12 @@ def _check_unique_names(parsed: CellFile, path: Path) -> None:
         if obj.name in seen:
             raise CellFileError(path, f"{key}.name", f"duplicate name '{obj.name}' (also {seen[obj.name]})")
         seen[obj.name] = key
+    clamps = [(f"objects[{i}].signal", obj.signal) for i, obj in enumerate(parsed.objects) if obj.signal]
+    cleared = [(f"dynamic[{i}].name", dynamic_signal(obj.name, False)) for i, obj in enumerate(parsed.dynamic)]
+    opened = [(f"{key}.name", dynamic_signal(door.name, True)) for key, door in doors]
+    signals_apart(clamps + cleared + opened, path)
+    outputs = parsed.robot.controller.outputs
+    signals_apart([(f"robot.controller.outputs.{name}", name) for name in outputs], path)
     jobs = [key for key, given in (("seams", bool(parsed.seams)), ("tending", parsed.tending is not None),
                                    ("pick_place", parsed.pick_place is not None)) if given]
     if len(jobs) > 1:

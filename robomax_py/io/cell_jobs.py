@@ -104,6 +104,20 @@ def same_identifier(names: list[str], key: str, path: Path) -> None:
                                 "only: give names that differ there")
 
 
+def signals_apart(signals: list[tuple[str, str]], path: Path) -> None:
+    """Refuse two different signals, given as (key, name) pairs, that a program states alike: the
+    same name twice is one input (two clamps may share one), but `clamp-1` and `clamp 1` would both
+    be waited for as `clamp_1`, one input standing for two, without a word."""
+    seen: dict[str, tuple[str, str]] = {}
+    for key, name in signals:
+        ident = identifier(name)
+        first_key, first = seen.setdefault(ident, (key, name))
+        if first != name:
+            raise CellFileError(path, key, f"the signal '{name}' and the signal '{first}' ({first_key}) are both "
+                                f"written {ident} in programs, which name signals with letters, digits and '_' "
+                                "only: give names that differ there")
+
+
 def _index_by_name(names: list[str], what: str, key: str, path: Path) -> dict[str, int]:
     """name -> index in the list at `key`; a repeated name is refused with both places."""
     out: dict[str, int] = {}

@@ -156,6 +156,15 @@ BROKEN_CELLS: list[tuple[str, Callable[[dict[str, Any]], None], str, str]] = [
      "seams[0].spots[1].name", "'线1' and '点1' (spots[0]) are both written _1 in programs"),
     ("seams written alike", _both(_set("seams.0.name", "left-1"), _second_seam("left 1")),
      "seams[1].name", "'left 1' and 'left-1' (seams[0]) are both written left_1 in programs"),
+    # Two signals a program waits for alike: one input would stand for both.
+    ("signals written alike", _both(_set("objects.3.signal", "clamp-1"), _set("objects.6.signal", "clamp 1")),
+     "objects[6].signal", "the signal 'clamp 1' and the signal 'clamp-1' (objects[3].signal) are both written clamp_1"),
+    ("clear signal written as a clamp's",
+     _both(_set("objects.3.signal", "press 1_clear"),
+           _append_object({"name": "press-1", "box": [0.8, 0.05, 0.6], "present": [[0, 6]]}, "dynamic")),
+     "dynamic[0].name", "the signal 'press-1_clear' and the signal 'press 1_clear' (objects[3].signal)"),
+    ("outputs written alike", _set("robot.controller", {"outputs": {"r1-done": 1, "r1 done": 2}}),
+     "robot.controller.outputs.r1 done", "the signal 'r1 done' and the signal 'r1-done'"),
     ("gamma reversed", _set("seams.0.tolerance.gamma", [90, -90]), "seams[0].tolerance.gamma", "min <= max"),
     ("gamma three numbers", _set("seams.0.tolerance.gamma", [0, 1, 2]), "seams[0].tolerance.gamma",
      "at most 2 items"),
@@ -177,6 +186,13 @@ def test_broken_cell_gives_one_located_message(
     flat = " ".join(message.split())
     assert f"{path}: {key}: " in flat, flat
     assert words in flat, flat
+
+
+def test_two_clamps_may_share_one_signal(tmp_path: Path, good_cell: dict[str, Any], reference_cell_path: Path) -> None:
+    # One name twice is one input, the refusal above is only for two names written alike.
+    data = copy.deepcopy(good_cell)
+    _both(_set("objects.3.signal", "clamps-closed"), _set("objects.6.signal", "clamps-closed"))(data)
+    assert load_cell(write_cell(tmp_path, data, reference_cell_path)).signals == ("clamps-closed",)
 
 
 def test_unreadable_mesh(tmp_path: Path, good_cell: dict[str, Any], reference_cell_path: Path) -> None:
