@@ -8,6 +8,7 @@ otherwise it stays an exact BVH, so a shortcut never changes a collision answer.
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -34,7 +35,31 @@ def load_mesh(path: Path, scale: np.ndarray | None = None, tolerance: float | No
 
     A vertex that is not finite is an error: trimesh's processing would drop it and the faces using
     it without a word, and the collision geometry would have holes.
+
+    Each call returns a mesh of its own (a caller may move or change it), but a file read before in
+    this process, unchanged since, is not parsed again: a run whose cache folder has nothing of a
+    mesh asks for it four or five times (its triangle count, the lint's checks, its collision
+    pieces, its extents), and a tessellated CAD part of 800,000 triangles takes about 2 s to parse.
     """
+    try:
+        info = Path(path).stat()
+    except OSError:
+        return _load_mesh(Path(path), scale, tolerance)         # raises as it would have
+    scale_key = None if scale is None else (np.shape(scale), tuple(float(v) for v in np.ravel(scale)))
+    return _parsed_mesh(str(Path(path).resolve()), info.st_size, info.st_mtime_ns, info.st_ino,
+                        scale_key, tolerance).copy()
+
+
+@functools.lru_cache(maxsize=8)
+def _parsed_mesh(path: str, size: int, mtime_ns: int, inode: int,
+                 scale: tuple[tuple[int, ...], tuple[float, ...]] | None, tolerance: float | None) -> trimesh.Trimesh:
+    """`_load_mesh`, once per process while the file's size, modification time and inode are the
+    same (a failure is not kept: it raises again at the next call)."""
+    factor = None if scale is None else np.asarray(scale[1], dtype=float).reshape(scale[0])
+    return _load_mesh(Path(path), factor, tolerance)
+
+
+def _load_mesh(path: Path, scale: np.ndarray | None, tolerance: float | None) -> trimesh.Trimesh:
     import trimesh
 
     loaded = (load_step(path, None if tolerance is None else tolerance * 1000.0) if is_step(path)
@@ -146,9 +171,25 @@ def collision_piece_arrays(mesh: trimesh.Trimesh) -> dict[str, np.ndarray]:
     """`mesh_collision_shapes`' choice as arrays, to keep: the hull vertices of each convex piece
     (hull_0, hull_1, ...) when the mesh is a set of closed convex shells, else the mesh's vertices
     and faces for one exact BVH."""
-    pieces = mesh.split(only_watertight=False)
-    if len(pieces) > 0 and all(is_convex_piece(p) for p in pieces):
+    import trimesh
+
+    # trimesh's `split` (its pieces' holes of a triangle or a quad filled), one piece at a time,
+    # stopping at the first that is no closed convex shell: splitting all of a tessellated CAD part
+    # (often a soup of tens of thousands of open patches) first cost seconds.
+    components = trimesh.graph.connected_components(edges=mesh.face_adjacency, nodes=np.arange(len(mesh.faces)),
+                                                    min_len=1)
+    pieces: list[trimesh.Trimesh] = []
+    for faces in components:
+        piece = mesh.submesh([faces], only_watertight=False, repair=True)[0]
+        if not is_convex_piece(piece):
+            return _whole(mesh)
+        pieces.append(piece)
+    if pieces:
         return {f"hull_{i}": hull_vertices(p.vertices) for i, p in enumerate(pieces)}
+    return _whole(mesh)
+
+
+def _whole(mesh: trimesh.Trimesh) -> dict[str, np.ndarray]:
     return {"vertices": np.asarray(mesh.vertices, dtype=float), "faces": np.asarray(mesh.faces, dtype=np.int64)}
 
 
