@@ -180,7 +180,8 @@ def collision_piece_arrays(mesh: trimesh.Trimesh) -> dict[str, np.ndarray]:
                                                     min_len=1)
     pieces: list[trimesh.Trimesh] = []
     for faces in components:
-        piece = mesh.submesh([faces], only_watertight=False, repair=True)[0]
+        made = mesh.submesh([faces], only_watertight=False, repair=True)
+        piece = made[0] if isinstance(made, list) else made        # a list of one, for a list of one
         if not is_convex_piece(piece):
             return _whole(mesh)
         pieces.append(piece)
