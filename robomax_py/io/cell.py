@@ -28,8 +28,8 @@ from robomax_py.io.cell_file import CellFile, IncludeFile
 from robomax_py.io.cell_file_jobs import PICK_PLACE_SEAM, TENDING_SEAM
 from robomax_py.io.cell_file_values import (
     CELL_LIMITS,
-    MAX_CELL_NAME_CHARS,
     SUPPORTED_VERSIONS,
+    stem_name,
 )
 from robomax_py.io.cell_jobs import (
     _job_seams,
@@ -186,7 +186,7 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
                                  named_by(CellFileError, path, "tool"),
                                  f"unknown tool '{parsed.tool}'{library_hint(parsed.tool, 'tool')}:")
     if parsed.name is None:
-        problems.attempt(_stem_name, path)
+        problems.attempt(stem_name, path)
     problems.raise_found()
     assert robot_file is not None and tool_file is not None and seams is not None   # else raised above
     robot_spec = load_robot_spec(robot_file)
@@ -210,7 +210,7 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
                             f"more than the {CELL_LIMITS.cell_triangles:,} a cell may have (cell_triangles)")
 
     cell = CellSpec(
-        name=parsed.name or _stem_name(path),
+        name=parsed.name or stem_name(path),
         source=path.resolve(),
         robot=robot_spec,
         T_world_base=frozen_array(_pose(parsed.robot.base)),
@@ -293,12 +293,3 @@ def _check_unique_names(parsed: CellFile, path: Path) -> None:
             spots[spot.name] = j
         same_identifier([spot.name for spot in seam.spots], f"seams[{i}].spots", path)
     same_identifier([seam.name for seam in parsed.seams], "seams", path)
-
-
-def _stem_name(path: Path) -> str:
-    """The cell's name when the file gives none: its file stem, under the rules of `name`."""
-    stem = path.stem
-    if len(stem) > MAX_CELL_NAME_CHARS:
-        raise CellFileError(path, "name", f"not given, and the file name is longer than {MAX_CELL_NAME_CHARS} "
-                            "characters (the programs are named after the cell); give a shorter name:")
-    return stem

@@ -8,6 +8,7 @@ none of them.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Annotated, TypeVar
 
 from pydantic import (
@@ -18,6 +19,7 @@ from pydantic import (
     model_validator,
 )
 
+from robomax_py.errors import CellFileError
 from robomax_py.io.mesh_keys import (
     MESH_ONLY_KEYS,
     MeshScale,
@@ -79,11 +81,45 @@ def _printable_name(v: str) -> str:
     return v
 
 
-def _file_stem(v: str) -> str:
+# Names Windows keeps for devices, whatever extension follows ("con.srcl" opens the console), and
+# characters it refuses in a file name (Microsoft, "Naming Files, Paths, and Namespaces").
+_WINDOWS_DEVICES = frozenset({"con", "prn", "aux", "nul", *(f"com{i}" for i in range(1, 10)),
+                              *(f"lpt{i}" for i in range(1, 10))})
+_WINDOWS_REFUSED = '<>:"|?*'
+
+
+def file_stem(v: str) -> str:
+    """A name the programs' files are named after: one file name on every system a cell may be
+    planned on (a cell folder is shared between Linux and the integrator's Windows laptop)."""
     _printable_name(v)
     if any(sep in v for sep in "/\\") or v in (".", ".."):
         raise ValueError(f"is the program's file name: no '/', '\\', '.' or '..', got {v!r}")
+    if v.startswith("."):
+        raise ValueError(f"is the program's file name: it must not start with '.' (a hidden file), got {v!r}")
+    refused = next((ch for ch in v if ch in _WINDOWS_REFUSED), None)
+    if refused is not None:
+        raise ValueError(f"is the program's file name: no {refused!r} (Windows refuses {_WINDOWS_REFUSED} in file "
+                         f"names), got {v!r}")
+    if v.endswith((".", " ")):
+        raise ValueError(f"is the program's file name: it must not end with '.' or ' ' (Windows drops them), "
+                         f"got {v!r}")
+    if v.split(".")[0].rstrip(" ").lower() in _WINDOWS_DEVICES:
+        raise ValueError(f"is the program's file name: {v!r} is a name Windows keeps for a device "
+                         "(CON, PRN, AUX, NUL, COM1-9, LPT1-9)")
     return v
+
+
+def stem_name(path: Path) -> str:
+    """The name of a cell or station whose file gives none: its file stem, under the rules of
+    `name` (CellFileError naming `name` otherwise)."""
+    stem = path.stem
+    if len(stem) > MAX_CELL_NAME_CHARS:
+        raise CellFileError(path, "name", f"not given, and the file name is longer than {MAX_CELL_NAME_CHARS} "
+                            "characters (the programs are named after the cell); give a shorter name:")
+    try:
+        return file_stem(stem)
+    except ValueError as exc:
+        raise CellFileError(path, "name", f"not given, and the file's stem {exc}: give a name") from None
 
 
 def _reference(v: str) -> str:
@@ -95,7 +131,7 @@ def _reference(v: str) -> str:
 
 
 Name = Annotated[str, Field(min_length=1, max_length=MAX_NAME_CHARS), AfterValidator(_printable_name)]
-CellName = Annotated[str, Field(min_length=1, max_length=MAX_CELL_NAME_CHARS), AfterValidator(_file_stem)]
+CellName = Annotated[str, Field(min_length=1, max_length=MAX_CELL_NAME_CHARS), AfterValidator(file_stem)]
 Reference = Annotated[str, Field(min_length=1), AfterValidator(_reference)]
 WindowTime = Annotated[float, Field(ge=0, le=MAX_WINDOW_S, allow_inf_nan=False)]
 

@@ -26,6 +26,7 @@ from robomax_py.io.cell_file_values import (
     PoseFile,
     Reference,
     _Strict,
+    stem_name,
 )
 from robomax_py.io.cell_problems import _located
 from robomax_py.io.includes import expand_includes
@@ -116,7 +117,7 @@ def load_station(path: str | Path) -> StationSpec:
         shared["seams"] = _without_robot_keys(seams_given)
     expansion = expand_includes(shared, path, IncludeFile)
     digest = expansion.digest(text.encode("utf-8"))
-    name = keys.name or path.stem
+    name = keys.name or stem_name(path)
     shared_data, listed = _without_list_robots(expansion.data, names, path)
     robots = tuple(_robot(shared_data=shared_data, robot=r, index=i, station=name, path=path, digest=digest,
                           expansion=expansion, count=len(names))

@@ -165,6 +165,10 @@ BROKEN_CELLS: list[tuple[str, Callable[[dict[str, Any]], None], str, str]] = [
      "dynamic[0].name", "the signal 'press-1_clear' and the signal 'press 1_clear' (objects[3].signal)"),
     ("outputs written alike", _set("robot.controller", {"outputs": {"r1-done": 1, "r1 done": 2}}),
      "robot.controller.outputs.r1 done", "the signal 'r1 done' and the signal 'r1-done'"),
+    # The programs are named after the cell: a name no file system would take as it is given.
+    ("hidden file name", _set("name", ".cell"), "name", "it must not start with '.'"),
+    ("device file name", _set("name", "AUX"), "name", "'AUX' is a name Windows keeps for a device"),
+    ("colon in the name", _set("name", "line:3"), "name", "no ':' (Windows refuses"),
     ("gamma reversed", _set("seams.0.tolerance.gamma", [90, -90]), "seams[0].tolerance.gamma", "min <= max"),
     ("gamma three numbers", _set("seams.0.tolerance.gamma", [0, 1, 2]), "seams[0].tolerance.gamma",
      "at most 2 items"),

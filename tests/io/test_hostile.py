@@ -253,7 +253,8 @@ def _yaml_mutants(base: dict[str, Any], cell: str) -> list[Mutant]:
 
 def _name_mutants(base: dict[str, Any], cell: str) -> list[Mutant]:
     names = {"long": "n" * 300, "slash": "a/b", "dotdot": "..", "nul": "a\x00b", "control": "a\x07b",
-             "unicode": "zelle_ß_✓", "empty": "", "spaces": "   ", "backslash": "a\\b", "newline": "a\nb"}
+             "unicode": "zelle_ß_✓", "empty": "", "spaces": "   ", "backslash": "a\\b", "newline": "a\nb",
+             "hidden": ".hidden", "device": "con", "colon": "a:b", "trailing_dot": "x."}
     out = []
     for k, v in names.items():
         for field in ("name", "robot.model", "tool"):
