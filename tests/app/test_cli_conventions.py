@@ -173,3 +173,22 @@ def test_verify_with_program_and_cell_swapped_says_so(tmp_path: Path, write_smal
     assert result.exit_code == EXIT_BAD_INPUT
     assert "takes the cell first" in result.output and "Traceback" not in result.output
     assert f"robomax verify {cell} {written}" in " ".join(result.output.split())
+
+
+@pytest.mark.parametrize("args", [["plan", "{cell}"], ["batch", "{cell}"], ["variants", "{cell}", "-n", "2"],
+                                  ["replan", "{cell}", "{cell}"]], ids=lambda a: a[0])
+@pytest.mark.parametrize("below", [False, True], ids=["the folder", "a folder above"])
+def test_an_output_folder_that_is_a_file_is_refused_before_any_work(tmp_path: Path, args: list[str],
+                                                                   below: bool) -> None:
+    # Before, plan ran to its end and then failed on writing, with an internal fault.
+    cell = tmp_path / "cell.yaml"
+    cell.write_text("not read: the option is checked first\n")
+    taken = tmp_path / "programs"
+    taken.write_text("a file\n")
+    out = taken / "sub" if below else taken
+    result = runner.invoke(app, [a.format(cell=cell) for a in args] + ["-o", str(out)])
+    assert result.exit_code == EXIT_BAD_INPUT, result.output
+    flat = " ".join(result.output.replace("│", " ").split())        # rich's box and line breaks taken out
+    assert f"{taken} is a file, not a folder" in flat or f"{taken} (above {out}) is a file, not a folder" in flat, flat
+    assert taken.read_text() == "a file\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cell.yaml", "programs"]

@@ -217,6 +217,18 @@ def _json_failure(command: str, as_json: bool, file: str | None, message: str) -
     return EXIT_BAD_INPUT
 
 
+def output_folder(value: Path) -> Path:
+    """An `-o/--out` folder, refused before any work when it, or the nearest folder above it that
+    exists, is a file: the command would otherwise plan to its end and fail on writing."""
+    for at in (value, *value.parents):
+        if at.is_symlink() or at.exists():
+            if not at.is_dir():
+                where = "" if at == value else f" (above {value})"
+                raise typer.BadParameter(f"{at}{where} is a file, not a folder", param_hint="'-o' / '--out'")
+            break
+    return value
+
+
 def _method(baseline: str | None) -> str:
     """The planning method `--baseline` names (None: the optimiser); a usage error otherwise."""
     if baseline is None:

@@ -27,6 +27,7 @@ from robomax_py.app.commands.base import (
     _warn,
     err,
     out,
+    output_folder,
 )
 
 if TYPE_CHECKING:                     # the command imports what it uses when it runs
@@ -37,7 +38,7 @@ if TYPE_CHECKING:                     # the command imports what it uses when it
 def batch(
     cells: Annotated[list[Path], typer.Argument(help="cell files (YAML)")],
     jobs: Annotated[int | None, typer.Option("-j", "--jobs", min=1, help="cells planned at once: local processes (default: the number of CPUs); with --ray, tasks in flight (default: all, queued by Ray for the cluster's CPUs and memory) and the CPUs of a local Ray")] = None,
-    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder for programs, summary.csv / summary.md and the journal results.jsonl, written as each cell finishes")] = Path("programs"),
+    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder for programs, summary.csv / summary.md and the journal results.jsonl, written as each cell finishes", callback=output_folder)] = Path("programs"),
     timeout: Annotated[float | None, typer.Option("--timeout", min=0.0, help="seconds per cell from its start (on Ray, the task's start) before its worker is killed")] = None,
     formats: Annotated[str, typer.Option("--format", help="program dialects, comma-separated, as plan takes them: srcl, krl, rapid, fanuc, urscript, inform, as, native or all")] = "srcl",
     ray_address: Annotated[str | None, typer.Option("--ray", metavar="[ADDRESS]",
@@ -191,7 +192,7 @@ def variants(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
     n: Annotated[int, typer.Option("--n", "-n", min=1, help="number of variants")] = 20,
     seed: Annotated[int, typer.Option("--seed", min=0, help="seed: the same seed writes the same files")] = 0,
-    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder")] = Path("variants"),
+    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder", callback=output_folder)] = Path("variants"),
     as_json: JsonFlag = False,
 ) -> None:
     """Write seeded perturbed copies of a cell (clamps ±15 mm, part ±5 mm / ±1°, spot order of free seams)."""

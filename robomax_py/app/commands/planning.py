@@ -23,6 +23,7 @@ from robomax_py.app.commands.base import (
     _warn,
     err,
     out,
+    output_folder,
 )
 from robomax_py.io.files import signals_held
 
@@ -33,7 +34,7 @@ if TYPE_CHECKING:                     # the commands import what they use when t
 @_command()
 def plan(
     cell: Annotated[Path, typer.Argument(help="cell file (YAML)")],
-    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder")] = Path("programs"),
+    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder", callback=output_folder)] = Path("programs"),
     baseline: Annotated[str | None, typer.Option("--baseline", metavar="published|teach-in", help="plan a baseline instead and write <name>_published.* or <name>_teach_in.*: published = the published method (paper 003: the cell's spot order, the DP over every orientation sample and IK branch, the same detours and timing), teach-in = the cell's order, nominal orientation, first branch")] = None,
     as_json: JsonFlag = False,
     speed: Annotated[float | None, typer.Option("--speed", min=0.01, max=1.0, help="override of every programmed speed, fraction in (0, 1] (default: the cell's planner.speed, else 1)")] = None,

@@ -20,6 +20,7 @@ from robomax_py.app.commands.base import (
     _warn,
     err,
     out,
+    output_folder,
 )
 from robomax_py.errors import CellFileError, RobotModelError
 from robomax_py.io.files import signals_held
@@ -36,7 +37,7 @@ def replan(
     program: Annotated[Path, typer.Argument(help="the program running: its trajectory file (.json) or a program of any dialect robomax writes")],
     at: Annotated[float, typer.Option("--at", min=0.0, max=86_400.0, help="when the change is known, s from the program's start")],
     events: Annotated[list[str], typer.Option("--event", help=EVENT_HELP)],
-    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder")] = Path("programs"),
+    out_dir: Annotated[Path, typer.Option("-o", "--out", help="output folder", callback=output_folder)] = Path("programs"),
     formats: Annotated[str, typer.Option("--format", help="program dialects, comma-separated (as `robomax plan --format`)")] = "srcl",
     as_json: JsonFlag = False,
 ) -> None:
