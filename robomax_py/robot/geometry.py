@@ -50,7 +50,9 @@ def load_mesh(path: Path, scale: np.ndarray | None = None, tolerance: float | No
                         scale_key, tolerance).copy()
 
 
-@functools.lru_cache(maxsize=8)
+# Meshes kept parsed: a cell's part, fixtures and tool (a batch worker plans cell after cell, and a
+# tessellated part of 800,000 triangles holds about 60 MB).
+@functools.lru_cache(maxsize=4)
 def _parsed_mesh(path: str, size: int, mtime_ns: int, inode: int,
                  scale: tuple[tuple[int, ...], tuple[float, ...]] | None, tolerance: float | None) -> trimesh.Trimesh:
     """`_load_mesh`, once per process while the file's size, modification time and inode are the
