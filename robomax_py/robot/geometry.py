@@ -51,7 +51,7 @@ def load_mesh(path: Path, scale: np.ndarray | None = None, tolerance: float | No
 
 
 # Meshes kept parsed: a cell's part, fixtures and tool (a batch worker plans cell after cell, and a
-# tessellated part of 800,000 triangles holds about 60 MB).
+# tessellated part of 790,528 triangles holds 77 MB, by tracemalloc).
 @functools.lru_cache(maxsize=4)
 def _parsed_mesh(path: str, size: int, mtime_ns: int, inode: int,
                  scale: tuple[tuple[int, ...], tuple[float, ...]] | None, tolerance: float | None) -> trimesh.Trimesh:
