@@ -133,7 +133,7 @@ def _plan(cell: CellSpec, robot: RobotModel, options: ResolvedOptions, progress:
     for c in spots:
         log.debug("spot %s/%s: %d candidates; rejected %s", cell.seams[c.seam_index].name, c.name, len(c),
                   dict(c.rejected.most_common()) or "none")
-    failures = tuple(_failure(cell, c) for c in spots if len(c) == 0)
+    failures = tuple(spot_failure(cell, c) for c in spots if len(c) == 0)
     if failures:
         names = ", ".join(f"{f.seam}/{f.name} ({f.reason})" for f in failures)
         what = "station(s) cannot be reached" if cell.tending else "spot(s) cannot be welded"
@@ -315,7 +315,7 @@ def _workpiece_hint(cell: CellSpec, spots: list[SpotCandidates]) -> str:
             f"{named[0]} is the part being welded, mark it `workpiece: true` in the cell file")
 
 
-def _failure(cell: CellSpec, c: SpotCandidates) -> SpotFailure:
+def spot_failure(cell: CellSpec, c: SpotCandidates) -> SpotFailure:
     """The dominant reason a spot has no candidate."""
     seam = cell.seams[c.seam_index].name
     if not c.rejected:

@@ -138,6 +138,23 @@ class _Made:
     pairs: dict[tuple[RobotPlan, RobotPlan], PairMap] = field(default_factory=dict)
 
 
+# Spots named with their robots' reasons when no robot can weld them; the rest only counted.
+NOBODY_LISTED = 10
+
+
+def _nobody_message(nobody: Sequence[SpotKey], reaches: Sequence[RobotReach]) -> str:
+    """The spots no robot can weld, each with every allowed robot's reason, as the single-robot
+    planner states them (one spot a line)."""
+    lines = [f"{len(nobody)} spot(s) no robot allowed to weld them can reach collision-free:"]
+    for seam, name in nobody[:NOBODY_LISTED]:
+        reasons = "; ".join(f"{r.robot}: {r.why.get((seam, name), 'no candidate')}" for r in reaches
+                            if (seam, name) in r.unreachable)
+        lines.append(f"  {seam}/{name}: {reasons}")
+    if len(nobody) > NOBODY_LISTED:
+        lines.append(f"  and {len(nobody) - NOBODY_LISTED} more")
+    return "\n".join(lines)
+
+
 def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
                  options: StationOptions = StationOptions()) -> StationPlan:
     """Plan every robot of a station; `models[name]` is each robot's model with its tool mounted."""
@@ -154,9 +171,8 @@ def plan_station(station: StationSpec, models: Mapping[str, RobotModel],
     clock["bound"] = time.process_time() - t0
     nobody = [k for k in keys if not any(k in r.index() for r in reaches)]
     if nobody:
-        names = ", ".join(f"{s}/{n}" for s, n in nobody[:10])
-        return StationPlan(station.name, "infeasible", f"{len(nobody)} spot(s) no robot allowed to weld them can "
-                           f"reach collision-free: {names}", (), Assignment({}, {}), bound, None, clock)
+        return StationPlan(station.name, "infeasible", _nobody_message(nobody, reaches), (), Assignment({}, {}), bound,
+                           None, clock)
     t0 = time.process_time()
     scenes = {r.name: build_scene(r.cell, models[r.name]) for r in station.robots}
     blocked = next(((r.name, text) for r in station.robots if (text := home_collision(r.cell, models[r.name]))), None)

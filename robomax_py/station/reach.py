@@ -6,12 +6,13 @@ candidate's weld and approach configuration (and their box) for the lower bound.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from robomax_py._typing import FloatArray
 from robomax_py.plan.candidates import SpotCandidates, seam_candidates
+from robomax_py.plan.pipeline import spot_failure
 from robomax_py.plan.reach import reach_report
 from robomax_py.robot import RobotModel
 from robomax_py.spec_station import SpotKey, StationSpec, robot_view
@@ -37,6 +38,8 @@ class RobotReach:
     dwell : (len(keys),) s, the weld time of each spot.
     line_s : s per approach or retract line (at the planner's TCP speed), for the estimate only.
     candidates : each key's candidates, as the single-robot planner finds them (`plan_cell(known=)`).
+    why : each unreachable spot's reason, as the single-robot planner states it ("collision
+        (tool_body vs frame x12, ...)", "0.412 m out of reach at the best orientation").
     """
 
     robot: str
@@ -53,6 +56,7 @@ class RobotReach:
     candidates: Mapping[SpotKey, SpotCandidates]
     weld_q: tuple[FloatArray, ...] = ()
     app_q: tuple[FloatArray, ...] = ()
+    why: Mapping[SpotKey, str] = field(default_factory=dict)
 
     def index(self) -> dict[SpotKey, int]:
         return {k: i for i, k in enumerate(self.keys)}
@@ -62,7 +66,8 @@ def robot_reach(station: StationSpec, name: str, model: RobotModel) -> RobotReac
     """The candidates of every spot robot `name` may weld, found as the single-robot planner finds them."""
     allowed = station.allowed(name)
     # Spots beyond the arm's reach at every orientation (plan.reach, a few ms) need no candidates.
-    far = {(r.seam, r.name) for r in reach_report(robot_view(station, name, allowed), model) if not r.reachable}
+    far = {(r.seam, r.name): r for r in reach_report(robot_view(station, name, allowed), model) if not r.reachable}
+    why = {k: f"{r.out_by_m:.3f} m out of reach at the best orientation" for k, r in far.items()}
     cell = robot_view(station, name, [k for k in allowed if k not in far])
     world = CollisionWorld(model, build_scene(cell, model), cell.process.clearance)
     home = np.asarray(cell.home, dtype=float)
@@ -76,6 +81,8 @@ def robot_reach(station: StationSpec, name: str, model: RobotModel) -> RobotReac
             key = (seam.name, c.name)
             if len(c) == 0:
                 unreachable.append(key)
+                failure = spot_failure(cell, c)
+                why[key] = f"{failure.reason} ({failure.detail})"
                 continue
             keys.append(key)
             candidates[key] = c
@@ -91,7 +98,7 @@ def robot_reach(station: StationSpec, name: str, model: RobotModel) -> RobotReac
                       np.asarray(reps).reshape(len(keys), REPRESENTATIVES, n),
                       np.asarray(lo).reshape(len(keys), n), np.asarray(hi).reshape(len(keys), n), home,
                       np.asarray(model.limits.velocity, dtype=float), np.asarray(model.limits.acceleration, dtype=float),
-                      np.asarray(dwell, dtype=float), float(line_s), candidates, tuple(weld_q), tuple(app_q))
+                      np.asarray(dwell, dtype=float), float(line_s), candidates, tuple(weld_q), tuple(app_q), why)
 
 
 def _representatives(q: FloatArray, home: FloatArray) -> FloatArray:
