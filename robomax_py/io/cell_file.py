@@ -174,19 +174,9 @@ class SpotListFile(_Strict):
     grid: Annotated[int, Field(ge=1, le=64)] = 1
 
 
-def _approach_line(v: float) -> float:
-    # A line of no length is no line: every junction's retract and approach would be a move that
-    # does not move, which the timing cannot parameterise (the plan ended "infeasible").
-    if v <= 0:
-        raise ValueError("must be greater than 0: every spot is reached and left on a straight line this long along "
-                         "the electrode axis; for a gun that closes where it stops, a short line such as 0.001 m")
-    return v
-
-
 class ProcessFile(_Strict):
     weld_time: NonNegative = 0.5
-    approach: Annotated[float, Field(allow_inf_nan=False, json_schema_extra={"exclusiveMinimum": 0}),
-                        AfterValidator(_approach_line)] = 0.03
+    approach: NonNegative = 0.03
     clearance: NonNegative = 0.0
     # Extensions (docs/cell-extensions.md).
     gun: Annotated[int, Field(ge=1, le=99)] = 1
