@@ -164,8 +164,15 @@ def spot_table_bytes(robot: RobotModel, orientations: int, n_line: int, cell: Ce
 
 
 def check_ik_work(cell: CellSpec, robot: RobotModel) -> None:
-    """Refuse, before planning, a cell one of whose spots' IK tables alone exceeds the budget, or
-    that pins configuration data on an arm whose targets carry none (`solve.brand_text_of`)."""
+    """Refuse, before planning, a cell one of whose spots' IK tables alone exceeds the budget, that
+    pins configuration data on an arm whose targets carry none (`solve.brand_text_of`), or that
+    gives no approach line (`verify` takes one of 0: it then checks none)."""
+    if cell.process.approach <= 0:
+        # A line of no length is a move that does not move: every junction's timing failed, and
+        # the plan ended "infeasible", blaming the spots.
+        raise CellFileError(cell.source, "process.approach", "0: plan reaches and leaves every spot on a straight "
+                            "line this long along the electrode axis; for a gun that closes where it stops, give a "
+                            "short one such as 0.001 (m)")
     for i, seam in enumerate(cell.seams):
         spot_table_bytes(robot, len(orientation_grid(seam).angles), approach_samples(cell), cell, seam.name)
         pinned = [j for j, spot in enumerate(seam.spots) if spot.config is not None]

@@ -139,6 +139,10 @@ BROKEN_CELLS: list[tuple[str, Callable[[dict[str, Any]], None], str, str]] = [
     ("unknown tool", _set("tool", "laser"), "tool", "unknown tool 'laser'"),
     ("home outside limits", _set("robot.home", [0, -90, 90, 0, 170, 0]), "robot.home[4]", "outside its limits"),
     ("home wrong length", _set("robot.home", [0, -90, 90]), "robot.home", "expected 6 joint values"),
+    # A line of no length: the plan ended "infeasible: timing failed", blaming the spots. (verify
+    # takes 0: it then checks no approach line.)
+    ("no approach line", _set("process.approach", 0), "process.approach",
+     "0: plan reaches and leaves every spot on a straight line this long"),
     ("negative weld time", _set("process.weld_time", -0.5), "process.weld_time", "greater than or equal to 0"),
     ("grid zero", _set("seams.0.grid", 0), "seams[0].grid", "greater than or equal to 1"),
     ("windows out of order",
