@@ -25,7 +25,9 @@ FANUC TP program) of statements (`Statement`) and says, per statement, what it d
 - inside a block (IF, WHILE, FOR, LOOP, TEST, SWITCH ...) the reader cannot tell whether, or how
   often, a statement runs: every jump, end and call there is reported (a label there is passed
   over), and the other statements are passed on marked `conditional` (the readers report the
-  motions among them).
+  motions among them). A loop's first statement (LOOP, WHILE, FOR, REPEAT ...) is reported
+  itself: how often its block runs decides the cycle, and an endless one (KRL's `LOOP ...
+  ENDLOOP` without EXIT, a WHILE on an input that never comes) stops the program there for good.
 
 What is reported becomes an `unsupported` violation in verify: never a skipped statement.
 """
@@ -83,7 +85,8 @@ class Flow:
 
     kind : "plain" (runs, then the next statement), "end" (see `scope`), "goto" / "label"
         (`name` the label), "call" (`name` the routine, `arguments` whether it passes any),
-        "open" / "close" (a block's first / last statement: IF ... THEN, ENDIF ...),
+        "open" / "close" (a block's first / last statement: IF ... THEN, ENDIF ...; `loop` an
+        open whose block repeats: LOOP, WHILE, FOR, REPEAT),
         "unsupported" (`why`).
     scope : of an end: "routine" (RETURN: back to the caller, the program's end in the main
         routine) or "program" (EXIT, ABORT, halt(), and the pauses).
@@ -96,6 +99,7 @@ class Flow:
     scope: Literal["routine", "program"] = "routine"
     pause: bool = False
     why: str = ""
+    loop: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -186,6 +190,10 @@ class _Walker:
                                 conditional=True)
                 i += 1
                 continue
+            if f.kind == "open" and f.loop:
+                # Reported, and passed on as a block's start too: the readers keep their blocks' depth.
+                self.report(s, line, "a loop: verify does not evaluate how often its block runs, nor whether it "
+                                     "ends (the program goes on only when it does)", conditional=inside)
             if f.kind in ("plain", "open", "close"):
                 self.out.steps.append(Step(s, line, inside and f.kind == "plain"))
                 i += 1

@@ -201,3 +201,36 @@ def test_an_unknown_extension_is_bad_input(written: dict[str, Any], tmp_path: Pa
     result = runner.invoke(app, ["verify", str(written["cell_path"]), str(other)])
     assert result.exit_code == EXIT_BAD_INPUT
     assert ".src" in result.output and ".script" in result.output
+
+
+# A block before the first motion, in each dialect's words: a loop (an endless one here, or one on an
+# input: how often it runs decides whether the program ever goes on) and a condition, both empty.
+_BLOCKS: dict[str, tuple[str, str, str]] = {
+    # (what the first motion's line starts with, the loop, the condition)
+    "krl": (r"^(\s*)(PTP )", "{0}LOOP\n{0}ENDLOOP\n", "{0}IF $IN[1] THEN\n{0}ENDIF\n"),
+    "rapid": (r"^(\s*)(MoveAbsJ )", "{0}WHILE TRUE DO\n{0}ENDWHILE\n", "{0}IF DInput(di1) = 1 THEN\n{0}ENDIF\n"),
+    "fanuc": (r"^(\s*)(\d+:J P\[1\])", "{0}  0:  FOR R[1]=1 TO 3 ;\n{0}  0:  ENDFOR ;\n",
+              "{0}  0:  IF (DI[1]=ON) THEN ;\n{0}  0:  ENDIF ;\n"),
+    "urscript": (r"^(\s*)(movej\()", "{0}while get_standard_digital_in(0):\n{0}  sync()\n{0}end\n",
+                 "{0}if get_standard_digital_in(0):\n{0}  sync()\n{0}end\n"),
+}
+
+
+@pytest.mark.parametrize("fmt", sorted(_BLOCKS))
+def test_a_loop_is_reported_and_a_condition_passed(written: dict[str, Any], fmt: str) -> None:
+    # Before, an empty `LOOP ... ENDLOOP` verified clean: the controller never gets past it.
+    first, loop, condition = _BLOCKS[fmt]
+
+    def inserted(block: str) -> Callable[[str], str]:
+        return lambda text: _first(first, text, lambda m: block.format(m[1]) + m[1] + m[2])
+
+    looped = _verify(written, fmt, inserted(loop), "loop")
+    unsupported = [v for v in looped.violations if v.kind == "unsupported"]
+    opening = loop.format("").splitlines()[0].split(":  ")[-1].rstrip(" ;")    # FANUC's line number off
+    assert len(unsupported) == 1 and opening in unsupported[0].detail, looped.violations
+    assert unsupported[0].line is not None
+    conditioned = _verify(written, fmt, inserted(condition), "condition")
+    if fmt == "fanuc":          # its reader reads no statement of an IF ... THEN block: it reports the opening
+        assert [v.kind for v in conditioned.violations] == ["unsupported"], conditioned.violations
+    else:
+        assert conditioned.clean, conditioned.violations

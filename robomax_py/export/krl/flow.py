@@ -81,7 +81,7 @@ def _classifier(defined: set[str]) -> Callable[[Statement], Flow]:
         if label:
             return Flow("label", label.group(1))
         if _BLOCK_START.match(text):
-            return Flow("open")
+            return Flow("open", loop=bool(re.match(r"(LOOP|WHILE|FOR|REPEAT)\b", text, re.IGNORECASE)))
         if _BLOCK_END.match(text):
             return Flow("close")
         if _INTERRUPT_DECL.match(text) and not _TEMPLATE.match(text):

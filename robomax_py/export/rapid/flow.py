@@ -65,7 +65,7 @@ def _classifier(functions: set[str]) -> Callable[[Statement], Flow]:
         if label:
             return Flow("label", label.group(1))
         if _BLOCK_OPEN.match(text):
-            return Flow("open")
+            return Flow("open", loop=first in ("while", "for"))
         if _BLOCK_CLOSE.match(text):
             return Flow("close")
         if first == "if":

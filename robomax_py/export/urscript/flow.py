@@ -89,7 +89,7 @@ def _classifier(functions: set[str]) -> Callable[[Statement], Flow]:
         if text in ("break", "continue"):
             return Flow("unsupported", why=f"{text} leaves a loop")
         if _OPEN.match(text):
-            return Flow("open")
+            return Flow("open", loop=not text.startswith("if"))
         if text == "end":
             return Flow("close")
         if _MIDDLE.match(text):
