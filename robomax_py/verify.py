@@ -118,6 +118,27 @@ def rebuild_read(cell: CellSpec, robot: RobotModel, read: tuple[Any, Path, Any, 
     return controller_rebuild(dialect, cell, robot, main, parsed, station)
 
 
+# No value of a robot program is larger than this (mm, deg, mm/s, s: a position 1,000 km away): a
+# number beyond it, or one that is no number (KRL reads `nan`), is a broken file, not a motion to
+# rebuild (a target of 1E300 mm overflowed the rebuild into an internal fault).
+PLAUSIBLE_MAGNITUDE = 1e9
+
+
+def _numbers_checked(parsed: Any, main: Path) -> None:
+    """ProgramError naming the line of the first instruction, or the frame, one of whose numbers is
+    not finite or beyond `PLAUSIBLE_MAGNITUDE`."""
+    program = parsed.program
+    items = [*((ins, f"line {line}") for ins, line in zip(program.instructions, parsed.lines, strict=True)),
+             *((frame, f"frame {frame.name}") for frame in program.frames)]
+    for item, where in items:
+        for f in dataclasses.fields(item):
+            value = getattr(item, f.name)
+            for v in (value if isinstance(value, tuple) else (value,)):
+                if isinstance(v, float) and not (math.isfinite(v) and abs(v) <= PLAUSIBLE_MAGNITUDE):
+                    why = "is not a number" if math.isnan(v) else f"is beyond any robot's ({PLAUSIBLE_MAGNITUDE:g})"
+                    raise ProgramError(main, where, f"{type(item).__name__} {f.name}: {v!r} {why}")
+
+
 def read_program(robot: RobotModel, path: Path) -> tuple[Any, Path, Any]:
     """A program's files read as verify reads them: (its `Dialect`, its main file, the `Parsed`
     program), with the files beside it the dialect reads too (a KRL .dat, the companions, the
@@ -147,7 +168,9 @@ def read_program_files(robot: RobotModel, path: Path) -> tuple[Any, Path, Any, t
     if dialect.any_extension:
         texts[dialect.extensions[0]] = read_text(path, LIMITS.program, ProgramError, "program file",
                                                  fallback=dialect.fallback_encoding)
-        return dialect, path, dialect.parse(texts, str(path), robot), (path,)
+        parsed = dialect.parse(texts, str(path), robot)
+        _numbers_checked(parsed, path)
+        return dialect, path, parsed, (path,)
     for ext in dialect.extensions:
         sibling = path.with_suffix(ext) if suffix != ext else path
         if sibling == path or sibling.exists():
@@ -172,7 +195,9 @@ def read_program_files(robot: RobotModel, path: Path) -> tuple[Any, Path, Any, t
         if routine is not None:
             texts[name] = read_text(routine, LIMITS.program, ProgramError, "program file",
                                     fallback=dialect.fallback_encoding, max_lines=LIMITS.program_lines)
-    return dialect, main, dialect.parse(texts, str(main), robot), tuple(read)
+    parsed = dialect.parse(texts, str(main), robot)
+    _numbers_checked(parsed, main)
+    return dialect, main, parsed, tuple(read)
 
 
 def _not_a_setup_file(dialect: Any, path: Path) -> None:

@@ -234,3 +234,25 @@ def test_a_loop_is_reported_and_a_condition_passed(written: dict[str, Any], fmt:
         assert [v.kind for v in conditioned.violations] == ["unsupported"], conditioned.violations
     else:
         assert conditioned.clean, conditioned.violations
+
+
+# The first Cartesian target's x, as each dialect writes it, and where (KRL: the .dat).
+_FIRST_X: dict[str, tuple[str, str | None]] = {
+    "krl": (r"(\{X )[-0-9.]+", ".dat"),
+    "rapid": (r"(robtarget \w+ := \[\[)[-0-9.]+", None),
+    "urscript": (r"(movel\(p\[)[-0-9.]+", None),
+    "srcl": (r"(MOVE LIN POS\()[-0-9.]+", None),
+    "as": (r"(LMOVE TRANS\()[-0-9.]+", None),
+}
+
+
+@pytest.mark.parametrize("value", ["nan", "1E300"])
+@pytest.mark.parametrize("fmt", sorted(_FIRST_X))
+def test_a_target_that_is_no_number_is_bad_input_with_its_line(written: dict[str, Any], fmt: str, value: str) -> None:
+    # Before, 1E300 mm passed the readers and overflowed the rebuild (an internal fault), and a KRL
+    # `nan` became a line "that cannot be followed".
+    pattern, ext = _FIRST_X[fmt]
+    edited = _edited(written, fmt, lambda text: _first(pattern, text, lambda m: m[1] + value), f"x_{value}", ext=ext)
+    # Some readers refuse the number themselves ("expected numbers, got nan"), the rest when it is read.
+    with pytest.raises(ProgramError, match=r"line \d+(, column \d+)?: .*(nan|1e\+30\d|1E300)"):
+        verify_program(written["cell"], written["robot"], edited)
