@@ -66,6 +66,9 @@ DESCRIPTIONS: dict[str, str] = {
     "RobotRefFile.home": "Start and end posture: one value per joint, deg (m for a prismatic joint).",
     "RobotRefFile.start": "Where programs start, at rest, when not at home (a continuation): one value per joint, deg "
                           "(m for a prismatic joint); they still end at home.",
+    "RobotRefFile.joint_limits": "The controller's software limits, within the URDF's: one [min, max] per joint, deg (m "
+                                  "for a prismatic joint), null where the URDF's range holds; plan and verify keep to "
+                                  "them.",
     "RobotRefFile.controller": "Numbers the integrator's controller already holds (tool, user frame, inputs).",
     "PoseFile.xyz": "Position, m.",
     "PoseFile.rpy": "Roll, pitch, yaw in deg about the fixed X, Y, Z axes (R = Rz(yaw)·Ry(pitch)·Rx(roll)).",

@@ -434,6 +434,9 @@ class CellSpec:
     # A continuation (`robomax replan`): the configuration (n,) rad its program starts in, at rest,
     # instead of `home`; it still ends at home. None: a whole program, from home to home.
     start: FloatArray | None = None
+    # `robot.joint_limits`: the controller's software limits, (n, 2) [lower, upper] rad (m for a
+    # prismatic joint), within the URDF's. None: the URDF's.
+    joint_limits: FloatArray | None = None
 
     @property
     def q_start(self) -> FloatArray:

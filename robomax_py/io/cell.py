@@ -52,7 +52,13 @@ from robomax_py.io.cell_moving import moving_object
 from robomax_py.io.cell_objects import _object, _pose
 from robomax_py.io.cell_problems import _located, _Problems
 from robomax_py.io.cell_rewrite import dump_cell_file, read_cell_file, read_cell_frames
-from robomax_py.io.cell_robot import _controller, _home, _start
+from robomax_py.io.cell_robot import (
+    _controller,
+    _home,
+    _joint_limits,
+    _start,
+    within_joint_limits,
+)
 from robomax_py.io.cell_spot_lists import _with_spot_lists, spot_list_seams
 from robomax_py.io.frames import resolve_frames
 from robomax_py.io.includes import Expansion, expand_includes
@@ -202,8 +208,11 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
     parts = problems.attempt(_parts, parsed, path, robot_spec, triangles)
     home = problems.attempt(_home, parsed, robot_spec, path)
     start = problems.attempt(_start, parsed, robot_spec, path)
+    joint_limits = problems.attempt(_joint_limits, parsed, robot_spec, path)
     problems.raise_found()
     assert parts is not None and home is not None
+    within_joint_limits(home, joint_limits, "robot.home", robot_spec, path)
+    within_joint_limits(start, joint_limits, "robot.start", robot_spec, path)
     check_tool_load(robot_spec, tool_spec, parts, path)
     if sum(triangles) > CELL_LIMITS.cell_triangles:
         raise CellFileError(path, "objects", f"its meshes and its tool's have {sum(triangles):,} triangles together, "
@@ -240,6 +249,7 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
         parts=parts,
         tcp_limits=_tcp_limits(parsed.pick_place.unloaded) if parsed.pick_place is not None else None,
         start=None if start is None else frozen_array(start),
+        joint_limits=None if joint_limits is None else frozen_array(joint_limits),
     )
     if parsed.continuation is not None:
         cell = file_continuation(cell, parsed.continuation, path)
@@ -249,9 +259,10 @@ def _cell_from_data(data: dict[str, Any], path: Path, digest: str, expansion: Ex
 
 def load_cell_robot(cell: CellSpec) -> Any:
     """The cell's `robomax_py.robot.RobotModel` with its tool mounted (imported lazily: Pinocchio is heavy)."""
-    from robomax_py.robot import load_robot, mount_tool
+    from robomax_py.robot import load_robot, mount_tool, with_joint_limits
 
-    return mount_tool(load_robot(cell.robot), cell.tool.T_flange_tcp)
+    robot = mount_tool(load_robot(cell.robot), cell.tool.T_flange_tcp)
+    return robot if cell.joint_limits is None else with_joint_limits(robot, cell.joint_limits)
 
 
 def _check_unique_names(parsed: CellFile, path: Path) -> None:

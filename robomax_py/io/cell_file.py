@@ -102,6 +102,10 @@ class RobotRefFile(_Strict):
     # Where the program starts, at rest, when not at home (a continuation, `robomax replan`); it
     # still ends at home. Checked as home is.
     start: list[Finite] | None = None
+    # The controller's software limits, narrower than the URDF's (a dress pack's hoses allow the
+    # wrist less than the gear does): one [min, max] per joint, deg (m for a prismatic joint), null
+    # for a joint the URDF's range holds.
+    joint_limits: list[Annotated[list[Finite], Field(min_length=2, max_length=2)] | None] | None = None
     controller: RobotControllerFile = RobotControllerFile()
 
 

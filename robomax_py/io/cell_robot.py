@@ -94,6 +94,55 @@ def _start(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray | None:
     return None if given is None else _joint_values(given, "robot.start", robot, path)
 
 
+def _joint_limits(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray | None:
+    """`robot.joint_limits` in SI, (n, 2) [lower, upper] per joint (the URDF's where null), each
+    within the URDF's; None when not given."""
+    from robomax_py.robot import active_joints, kinematic_model, prismatic_mask
+
+    given = parsed.robot.joint_limits
+    if given is None:
+        return None
+    model = kinematic_model(robot)
+    if len(given) != model.nq:
+        raise CellFileError(path, "robot.joint_limits", f"expected {model.nq} ranges for {robot.name}, one per joint "
+                            f"(null for a joint the URDF's range holds), got {len(given)}")
+    prismatic = prismatic_mask(model)
+    lower, upper = np.asarray(model.lowerPositionLimit, dtype=float), np.asarray(model.upperPositionLimit, dtype=float)
+    out = np.stack([lower, upper], axis=1)
+    for i, pair in enumerate(given):
+        if pair is None:
+            continue
+        unit, scale = ("m", 1.0) if prismatic[i] else ("deg", 180 / math.pi)
+        lo, hi = pair
+        if lo >= hi:
+            raise CellFileError(path, f"robot.joint_limits[{i}]", f"[{lo:g}, {hi:g}] {unit}: expected [min, max] with "
+                                "min below max")
+        if lo / scale < lower[i] - 1e-9 or hi / scale > upper[i] + 1e-9:
+            raise CellFileError(path, f"robot.joint_limits[{i}]",
+                                f"[{lo:g}, {hi:g}] {unit} reaches beyond {model.names[active_joints(model)[i]]}'s limits "
+                                f"in the URDF, [{lower[i] * scale:.3f}, {upper[i] * scale:.3f}] {unit}: software limits "
+                                "narrow a joint's range, never widen it")
+        out[i] = (lo / scale, hi / scale)
+    return out
+
+
+def within_joint_limits(q: np.ndarray | None, limits: np.ndarray | None, key: str, robot: RobotSpec,
+                        path: Path) -> None:
+    """A configuration the cell file gives (`key`: robot.home, robot.start) within `robot.joint_limits`."""
+    from robomax_py.robot import active_joints, kinematic_model, prismatic_mask
+
+    if q is None or limits is None:
+        return
+    outside = (q < limits[:, 0] - 1e-9) | (q > limits[:, 1] + 1e-9)
+    if outside.any():
+        model = kinematic_model(robot)
+        i = int(np.flatnonzero(outside)[0])
+        unit, scale = ("m", 1.0) if prismatic_mask(model)[i] else ("deg", 180 / math.pi)
+        raise CellFileError(path, f"{key}[{i}]", f"{model.names[active_joints(model)[i]]} = {q[i] * scale:.3f} {unit} "
+                            f"is outside robot.joint_limits[{i}], [{limits[i, 0] * scale:.3f}, "
+                            f"{limits[i, 1] * scale:.3f}] {unit}")
+
+
 def _joint_values(values: list[float], key: str, robot: RobotSpec, path: Path) -> np.ndarray:
     """A configuration as a cell file gives it (deg, m for a prismatic joint) in SI, one value per
     joint of the URDF, each within its limits; CellFileError naming `key` otherwise."""

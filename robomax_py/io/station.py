@@ -70,6 +70,7 @@ class StationRobotFile(_Strict):
     base: PoseFile = PoseFile()
     frame: str | None = None
     home: list[Any]
+    joint_limits: list[Any] | None = None     # checked as a cell's robot.joint_limits
     controller: StationControllerFile = StationControllerFile()
 
 
@@ -221,6 +222,8 @@ def _robot(*, shared_data: dict[str, Any], robot: StationRobotFile, index: int, 
                                   "controller": copy.deepcopy(controller)}
     if robot.frame is not None:
         robot_data["frame"] = robot.frame
+    if robot.joint_limits is not None:
+        robot_data["joint_limits"] = copy.deepcopy(robot.joint_limits)
     data = {**copy.deepcopy(shared_data), "name": f"{station}_{robot.name}", "robot": robot_data, "tool": robot.tool}
     try:
         cell = _located(expansion, _cell_from_data, data, path, digest, expansion)

@@ -20,10 +20,11 @@ from robomax_py.robot.model import (
     load_robot,
     mount_tool,
     reach,
+    with_joint_limits,
 )
 
 __all__ = [
     "DEFAULT_TIME_TO_FULL_ACCEL_S", "DEFAULT_TIME_TO_FULL_SPEED_S", "JointLimits", "RobotModel",
     "active_joints", "checked_ik_params", "fk_flange", "fk_tcp", "kinematic_model", "load_robot", "mimic_relation", "mount_tool",
-    "passive_joints", "prismatic_mask", "reach", "urdf_model",
+    "passive_joints", "prismatic_mask", "reach", "urdf_model", "with_joint_limits",
 ]

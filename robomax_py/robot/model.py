@@ -193,6 +193,17 @@ def _disabled_links(spec: RobotSpec, model: pin.Model) -> tuple[frozenset[frozen
     return frozenset(frozenset(p) for p in (*spec.disabled_links, *srdf)), warnings
 
 
+def with_joint_limits(robot: RobotModel, limits: FloatArray) -> RobotModel:
+    """The same robot within narrower position limits, (n, 2) [lower, upper] (a cell's software
+    limits): IK, planning and verify keep to them; speeds and the loaded limits' speeds are kept."""
+    bounds = np.asarray(limits, dtype=float)
+    lower, upper = frozen_array(bounds[:, 0]), frozen_array(bounds[:, 1])
+    loaded = robot.loaded_limits
+    return dataclasses.replace(
+        robot, limits=dataclasses.replace(robot.limits, lower=lower, upper=upper),
+        loaded_limits=None if loaded is None else dataclasses.replace(loaded, lower=lower, upper=upper))
+
+
 def mount_tool(robot: RobotModel, T_flange_tcp: FloatArray) -> RobotModel:
     """The same robot with its TCP moved to a tool's TCP (flange frame, m)."""
     return dataclasses.replace(robot, T_flange_tcp=frozen_array(T_flange_tcp))
