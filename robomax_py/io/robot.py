@@ -287,6 +287,11 @@ def load_robot_spec(path: Path) -> RobotSpec:
     )
 
 
+# No tool's TCP stands farther from the flange than this, m (the longest spot guns and grippers
+# reach about 1.5 m): a farther one is a file in millimetres, where tcp.xyz is metres.
+MAX_TCP_OFFSET_M = 5.0
+
+
 def load_tool_spec(path: Path) -> ToolSpec:
     """Read and check a tool.yaml; its meshes must exist (they are read when the scene is built).
 
@@ -311,6 +316,11 @@ def load_tool_spec(path: Path) -> ToolSpec:
                                  own.scale if own.scale is not None else parsed.scale,
                                  own.tolerance if own.tolerance is not None else parsed.tolerance,
                                  path, key, RobotModelError, keys)
+    offset = math.dist(parsed.tcp.xyz, (0.0, 0.0, 0.0))
+    if offset > MAX_TCP_OFFSET_M:
+        raise RobotModelError(path, "tcp.xyz", f"{parsed.tcp.xyz} puts the TCP {offset:g} m from the flange, farther "
+                              f"than any tool reaches ({MAX_TCP_OFFSET_M:g} m): tcp.xyz is in metres (in mm? "
+                              f"{[round(v / 1000, 6) for v in parsed.tcp.xyz]})")
     rpy = [math.radians(a) for a in parsed.tcp.rpy]
     return ToolSpec(
         name=parsed.name,

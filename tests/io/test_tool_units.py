@@ -255,3 +255,17 @@ def test_a_tool_mesh_that_does_not_read_is_named_by_its_path(tmp_path: Path, wri
     said = " ".join(done.output.split())
     assert done.exit_code == EXIT_BAD_INPUT and "Traceback" not in done.output
     assert f"{tool}: body: cannot read mesh {tool.parent / 'body.stl'}" in said and "MeshShape(" not in said
+
+
+def test_a_tcp_in_millimetres_is_refused_with_its_metres(tmp_path: Path) -> None:
+    # tcp.xyz is metres even where the meshes are millimetres: a TCP 336 m from the flange was taken
+    # as given, and every spot came out "out of reach by 332 m".
+    text = {"name": "gun_mm", "body": "body.stl", "tips": "tips.stl", "units": "mm",
+            "tcp": {"xyz": [200, 0, 270], "rpy": [-90, 0, -90]}}
+    path = _tool(tmp_path / "gun_mm", text, {"body.stl": GUN / "body.stl", "tips.stl": GUN / "tips.stl"})
+    with pytest.raises(RobotModelError, match=r"tool\.yaml: tcp\.xyz: \[200\.0, 0\.0, 270\.0\] puts the TCP 336\.006 m "
+                                              r"from the flange.*in mm\? \[0\.2, 0\.0, 0\.27\]"):
+        load_tool_spec(path)
+    text["tcp"] = {"xyz": [0, 0, 4.9], "rpy": [0, 0, 0]}                     # long, but a tool's
+    assert load_tool_spec(_tool(tmp_path / "long", text, {"body.stl": GUN / "body.stl",
+                                                          "tips.stl": GUN / "tips.stl"})).T_flange_tcp[2, 3] == 4.9
