@@ -100,12 +100,17 @@ def lint_cell(parsed: CellFile, cell: CellSpec, path: Path) -> tuple[Notice, ...
 
 def library_hint(ref: str, kind: str) -> str:
     """' (did you mean 'kr16'?)' for a robot (`kind` 'robot') or tool ('tool') name the library lacks
-    but spells closely (difflib's ratio >= 0.6, its default: 'kr16_2' -> 'kr16'); '' for a path, a name
-    the library has, or one like none of its names."""
+    but spells closely (difflib's ratio >= 0.6, its default: 'kr16_2' -> 'kr16'), what '~' is not for a
+    path that starts with it; '' for another path, a name the library has, or one like none of its
+    names."""
     import difflib
 
     from robomax_py.io.robot import robot_library
 
+    if ref.startswith("~"):
+        # A shell's shorthand: a cell file's paths are taken as written (relative to the file), so a
+        # cell folder means the same on every machine.
+        return " ('~' is not the home folder in a cell file: give the path relative to the cell file, or in full)"
     if "/" in ref or "\\" in ref or ref.endswith((".yaml", ".yml")):
         return ""
     sub, filename = (("tools",), "tool.yaml") if kind == "tool" else ((), "robot.yaml")

@@ -137,6 +137,8 @@ BROKEN_CELLS: list[tuple[str, Callable[[dict[str, Any]], None], str, str]] = [
     ("missing mesh", _set("objects.2.mesh", "parts/nope.stl"), "objects[2].mesh", "not found"),
     ("unknown robot", _set("robot.model", "kr999"), "robot.model", "unknown robot 'kr999'"),
     ("unknown tool", _set("tool", "laser"), "tool", "unknown tool 'laser'"),
+    ("home-folder path", _set("robot.model", "~/robots/kr16/robot.yaml"), "robot.model",
+     "('~' is not the home folder in a cell file: give the path relative to the cell file, or in full): not found"),
     ("home outside limits", _set("robot.home", [0, -90, 90, 0, 170, 0]), "robot.home[4]", "outside its limits"),
     ("home wrong length", _set("robot.home", [0, -90, 90]), "robot.home", "expected 6 joint values"),
     # A line of no length: the plan ended "infeasible: timing failed", blaming the spots. (verify
