@@ -74,6 +74,18 @@ def _process_line(cell: CellSpec) -> str:
     return f"gripper {times}; {lines}"
 
 
+def _software_limits(cell: CellSpec, robot: Any) -> str:
+    """The joints `robot.joint_limits` narrows, as the cell file states them: 'joint_a6 [-185, 185] deg'."""
+    assert cell.joint_limits is not None
+    urdf = robot.model
+    out = []
+    for i, (name, (lo, hi), linear) in enumerate(zip(robot.joint_names, cell.joint_limits, robot.prismatic)):
+        if lo <= urdf.lowerPositionLimit[i] + 1e-12 and hi >= urdf.upperPositionLimit[i] - 1e-12:
+            continue                            # the URDF's range
+        out.append(f"{name} [{lo:.3f}, {hi:.3f}] m" if linear else f"{name} [{np.degrees(lo):.1f}, {np.degrees(hi):.1f}] deg")
+    return ", ".join(out) or "as the URDF's"
+
+
 def cell_summary(cell: CellSpec, robot: Any) -> Group:
     """Robot, tool, objects, seams and spots of a cell, as rich tables."""
     head = Table.grid(padding=(0, 2))
@@ -81,6 +93,8 @@ def cell_summary(cell: CellSpec, robot: Any) -> Group:
     # As the cell file states it: deg, m for a prismatic joint (a track), marked.
     home = ", ".join(f"{v:.3f} m" if prismatic else f"{np.degrees(v):.1f}" for v, prismatic in zip(cell.home, robot.prismatic))
     head.add_row("robot", f"{robot.name}: {robot.dof} axes, IK {robot.ik_solver}, home [{home}] deg")
+    if cell.joint_limits is not None:
+        head.add_row("limits", f"software limits {_software_limits(cell, robot)}")
     tcp = cell.tool.T_flange_tcp[:3, 3]
     load = cell.tool.load
     weight = "" if load is None else f", {load.mass:g} kg at [{', '.join(f'{v:.3f}' for v in load.cog)}] m"

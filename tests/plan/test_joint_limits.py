@@ -79,3 +79,13 @@ def test_a_station_robot_keeps_its_own_software_limits(tmp_path: Path) -> None:
     first, second = (load_cell_robot(r.cell) for r in station.robots)
     assert first.limits.lower[1] < np.radians(-120.0) and first.limits.upper[1] > np.radians(-30.0)  # the URDF's
     assert (second.limits.lower[1], second.limits.upper[1]) == pytest.approx(np.radians([-120.0, -30.0]), abs=1e-12)
+
+
+def test_check_states_the_software_limits(cells: dict[str, Any]) -> None:
+    from typer.testing import CliRunner
+
+    from robomax_py.app.cli import EXIT_OK, app
+
+    result = CliRunner().invoke(app, ["check", str(cells["folder"] / "kept.yaml")])
+    assert result.exit_code == EXIT_OK, result.output
+    assert "software limits joint_a6 [-90.0, 90.0] deg" in " ".join(result.stdout.split())
