@@ -10,7 +10,9 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from typer.testing import CliRunner
 
+from robomax_py.app.cli import EXIT_OK, app
 from robomax_py.export.trajectory_json import render
 from robomax_py.io.cell import load_cell, load_cell_robot
 from robomax_py.io.station import load_station
@@ -82,10 +84,6 @@ def test_a_station_robot_keeps_its_own_software_limits(tmp_path: Path) -> None:
 
 
 def test_check_states_the_software_limits(cells: dict[str, Any]) -> None:
-    from typer.testing import CliRunner
-
-    from robomax_py.app.cli import EXIT_OK, app
-
     result = CliRunner().invoke(app, ["check", str(cells["folder"] / "kept.yaml")])
     assert result.exit_code == EXIT_OK, result.output
     assert "software limits joint_a6 [-90.0, 90.0] deg" in " ".join(result.stdout.split())
