@@ -31,8 +31,9 @@ from robomax_py.io.cell_file_values import (
 from robomax_py.io.cell_problems import _located
 from robomax_py.io.includes import expand_includes
 from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
+from robomax_py.program import identifier
 from robomax_py.safe_files import LIMITS, read_text
-from robomax_py.spec import Brand
+from robomax_py.spec import CLEAR_SUFFIX, Brand
 from robomax_py.spec_station import IoRange, StationRobot, StationSpec, StationSpot
 
 # Robot names become parts of program names and signal names (`<robot>_<zone>_clear`): identifiers.
@@ -123,6 +124,7 @@ def load_station(path: str | Path) -> StationSpec:
     robots = tuple(_robot(shared_data=shared_data, robot=r, index=i, station=name, path=path, digest=digest,
                           expansion=expansion, count=len(names))
                    for i, r in enumerate(keys.robots))
+    _no_interlock_names(shared_data, names, path)
     for i, list_robots in listed.items():
         # The spots list i gives, as the cell reader forms them: that list read alone, in the first
         # robot's cell (a list's seams do not depend on the others'; the whole cell was read above).
@@ -134,6 +136,23 @@ def load_station(path: str | Path) -> StationSpec:
                   for seam in robots[0].cell.seams for spot in seam.spots)
     notices = tuple(dict.fromkeys(n for r in robots for n in r.cell.notices))
     return StationSpec(name=name, source=path.resolve(), digest=digest, robots=robots, spots=spots, notices=notices)
+
+
+def _no_interlock_names(data: dict[str, Any], robots: tuple[str, ...], path: Path) -> None:
+    """Refuse a cell signal (a clamp's, a dynamic object's `<name>_clear`) that a program would
+    write as an interlock's, `<robot>_z<k>_clear` (`station.interlocks`): the robot waiting for the
+    one would wait on the other's input, or both."""
+    pattern = re.compile(rf"({'|'.join(map(re.escape, robots))})_z[0-9]+_clear", re.IGNORECASE)
+    given: list[tuple[str, str]] = []
+    for group, key, suffix in (("objects", "signal", ""), ("dynamic", "name", CLEAR_SUFFIX)):
+        items = data.get(group)
+        for i, item in enumerate(items if isinstance(items, list) else []):
+            if isinstance(item, dict) and isinstance(item.get(key), str):
+                given.append((f"{group}[{i}].{key}", item[key] + suffix))
+    for key, signal in given:
+        if pattern.fullmatch(identifier(signal)):
+            raise CellFileError(path, key, f"the signal '{signal}' is written as a station interlock's "
+                                "(<robot>_z<k>_clear, set by one robot for another): give it another name")
 
 
 def _robot_names(keys: StationKeysFile, path: Path) -> tuple[str, ...]:

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import copy
+import re
 from pathlib import Path
 
 import pytest
@@ -45,3 +46,21 @@ def test_range_too_small_names_its_key(tmp_path: Path) -> None:
         allocate(station, [_lock("r1", "r2", 0), _lock("r1", "r2", 1)])
     assert err.value.key == "robots[0].controller.interlock_io.outputs"
     assert "needs 2" in str(err.value)
+
+
+@pytest.mark.parametrize(("edit", "key", "signal"), [
+    (lambda d: d["objects"][1].update(signal="r1-z2-clear"), "objects[1].signal", "r1-z2-clear"),
+    (lambda d: d.setdefault("dynamic", []).append({"name": "R2_z1", "box": [0.1, 0.1, 0.1], "present": [[0, 1]],
+                                                   "pose": {"xyz": [3, 3, 3]}}), "dynamic[0].name", "R2_z1_clear"),
+], ids=["clamp", "dynamic object"])
+def test_a_cell_signal_written_as_an_interlock_s_is_refused(tmp_path: Path, edit, key: str, signal: str) -> None:  # type: ignore[no-untyped-def]
+    # The robot waiting for the interlock would wait on the cell signal's input, or on both.
+    data = yaml.safe_load(STATION.read_text())
+    for obj in data["objects"]:
+        if "mesh" in obj:
+            obj["mesh"] = str((STATION.parent / obj["mesh"]).resolve())
+    edit(data)
+    path = tmp_path / "station.yaml"
+    path.write_text(yaml.safe_dump(data))
+    with pytest.raises(CellFileError, match=re.escape(f"{key}: the signal '{signal}' is written as a station interlock's")):
+        load_station(path)
