@@ -43,8 +43,9 @@ def plan_cpu(cell: Path, cache: Path, out: Path) -> tuple[float, float]:
     with its caches in `cache`; raises when the command fails."""
     env = {**os.environ,
            "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]),
-           "ROBOMAX_CACHE": str(cache / "robomax"), "NUMBA_CACHE_DIR": str(cache / "numba"),
-           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+           "ROBOMAX_CACHE": str(cache / "robomax"), "NUMBA_CACHE_DIR": str(cache / "numba")}
+    for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        env.pop(name, None)                 # the command sets its own, as for a user
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     started = time.perf_counter()
