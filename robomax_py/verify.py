@@ -128,7 +128,8 @@ def _numbers_checked(parsed: Any, main: Path) -> None:
     """ProgramError naming the line of the first instruction, or the frame, one of whose numbers is
     not finite or beyond `PLAUSIBLE_MAGNITUDE`."""
     program = parsed.program
-    items = [*((ins, f"line {line}") for ins, line in zip(program.instructions, parsed.lines, strict=True)),
+    lines = [*parsed.lines, *[None] * (len(program.instructions) - len(parsed.lines))]    # a reader's slip: no fault
+    items = [*((ins, "the program" if line is None else f"line {line}") for ins, line in zip(program.instructions, lines)),
              *((frame, f"frame {frame.name}") for frame in program.frames)]
     for item, where in items:
         for f in dataclasses.fields(item):
