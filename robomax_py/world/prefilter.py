@@ -140,11 +140,10 @@ class Prefilter:
         group_joint = np.array(joints, dtype=np.int64)
 
         # Obstacle chunks: an unbounded obstacle has none, and is never cleared.
-        chunks = [piece.chunks if piece is not None else [] for piece in bounds_of]
+        counts = np.array([piece.chunk_count if piece is not None else 0 for piece in bounds_of], dtype=np.int64)
         skips = [piece.skip if piece is not None else [] for piece in bounds_of]
-        flat = [c for piece in chunks for c in piece]
-        ch_end = np.cumsum([len(c) for c in chunks]).astype(np.int64)
-        ch_start = ch_end - np.array([len(c) for c in chunks], dtype=np.int64)
+        ch_end = np.cumsum(counts).astype(np.int64)
+        ch_start = ch_end - counts
         ch_skip = np.array([int(start) + k for start, skip in zip(ch_start, skips) for k in skip], dtype=np.int64)
         for g in range(n_geom):
             if is_obs[g] and points_of[g] is None:
@@ -173,7 +172,7 @@ class Prefilter:
             [parent, kind, qi, piece_joint, robot_side, other, is_obs[other].astype(np.int64), group_joint,
              block_kind, block_a, block_b, block_end, block_pairs, ch_start, ch_end, ch_skip,
              np.stack([walk.block, walk.group, walk.skip], axis=1).ravel(), cell_ints.ravel()],
-            len(flat), len(walk.block),
+            int(counts.sum()), len(walk.block),
         )
         return Prefilter(floats=floats, vectors=vectors, matrices=matrices, ints=ints,
                          every_block=np.ones(len(keys), dtype=bool), cells=cells)
@@ -268,7 +267,9 @@ class _PieceBounds:
     placed: FloatArray           # its support points
     sphere: tuple[FloatArray, float]
     box: tuple[FloatArray, FloatArray, FloatArray]
-    chunks: list[FloatArray]     # an obstacle's chunk tree (`_mesh_chunks`); none for a robot piece
+    # An obstacle's chunk tree (`_mesh_chunks`), by its nodes' volumes: the nodes' point sets are
+    # not kept (a 790,000-triangle part's were 71 MB a placement, and this table outlives worlds).
+    chunk_count: int
     skip: list[int]
     chunk_spheres: list[tuple[FloatArray, float]]
     chunk_boxes: list[tuple[FloatArray, FloatArray, FloatArray]]
@@ -296,7 +297,7 @@ def _piece_bounds(geom: Any, placement: FloatArray, obstacle: bool) -> _PieceBou
     # Each sphere is centred on its points' box: the box is computed once for both.
     box = _enclosing_box(placed)
     boxes = [_enclosing_box(c) for c in nodes]
-    entry = _PieceBounds(geom, placed, _enclosing_sphere(placed, box), box, nodes, skip,
+    entry = _PieceBounds(geom, placed, _enclosing_sphere(placed, box), box, len(nodes), skip,
                          [_enclosing_sphere(c, b) for c, b in zip(nodes, boxes)], boxes)
     _BOUNDS[key] = entry
     while len(_BOUNDS) > _BOUNDS_SIZE:

@@ -156,6 +156,25 @@ def test_a_pieces_volumes_are_reused_only_for_the_same_geometry_at_the_same_plac
     assert not np.array_equal(shifted.floats, fresh.floats)
 
 
+def test_the_kept_volumes_hold_no_chunk_points(reference: tuple[CellSpec, RobotModel, CollisionWorld]) -> None:
+    """The per-process table keeps each obstacle's chunk tree by its volumes and their count, not
+    the chunks' point sets (71 MB a placement for a 790,000-triangle part): the panel mesh's tree
+    has as many spheres, boxes and subtree ends as its count."""
+    from robomax_py.world import prefilter
+    from robomax_py.world.acm import OBSTACLE_KINDS
+
+    _, _, world = reference
+    s = world._s
+    prefilter._BOUNDS.clear()
+    Prefilter.of(s.model, s.geom_model, [p.kind in OBSTACLE_KINDS for p in s.pieces], s.pair_a, s.pair_b,
+                 s.pair_margin)
+    trees = [e for e in prefilter._BOUNDS.values() if e.chunk_count > 1]
+    assert trees, "the reference panel is a mesh of more than one chunk"
+    for e in prefilter._BOUNDS.values():
+        assert isinstance(e.chunk_count, int)
+        assert e.chunk_count == len(e.chunk_spheres) == len(e.chunk_boxes) == len(e.skip)
+
+
 def test_timed_segments_are_the_same_with_and_without_the_filter(
     reference: tuple[CellSpec, RobotModel, CollisionWorld], rng: np.random.Generator
 ) -> None:
