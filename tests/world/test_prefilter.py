@@ -337,7 +337,7 @@ def test_piece_bounds_find_each_point_sets_box_once(monkeypatch: Any) -> None:
     monkeypatch.setattr(prefilter, "_enclosing_box", counted)
     geom = coal.Box(0.3, 0.2, 0.1)
     got = prefilter._piece_bounds(geom, np.eye(4), True)       # an obstacle: with its chunk
-    assert got is not None and len(got.chunks) == 1 and len(boxes) == 2
+    assert got is not None and got.chunk_count == 1 and len(boxes) == 2
     monkeypatch.setattr(prefilter, "_enclosing_box", real_box)
     c, r = prefilter._enclosing_sphere(got.placed)
     assert np.array_equal(got.sphere[0], c) and got.sphere[1] == r
