@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 import re
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -97,7 +97,7 @@ def _start(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray | None:
 def _joint_limits(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray | None:
     """`robot.joint_limits` in SI, (n, 2) [lower, upper] per joint (the URDF's where null), each
     within the URDF's; None when not given."""
-    from robomax_py.robot import active_joints, kinematic_model, prismatic_mask
+    from robomax_py.robot import kinematic_model
 
     given = parsed.robot.joint_limits
     if given is None:
@@ -106,22 +106,21 @@ def _joint_limits(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray 
     if len(given) != model.nq:
         raise CellFileError(path, "robot.joint_limits", f"expected {model.nq} ranges for {robot.name}, one per joint "
                             f"(null for a joint the URDF's range holds), got {len(given)}")
-    prismatic = prismatic_mask(model)
     lower, upper = np.asarray(model.lowerPositionLimit, dtype=float), np.asarray(model.upperPositionLimit, dtype=float)
     out = np.stack([lower, upper], axis=1)
     for i, pair in enumerate(given):
         if pair is None:
             continue
-        unit, scale = ("m", 1.0) if prismatic[i] else ("deg", 180 / math.pi)
+        name, unit, scale = _joint_unit(model, i)
         lo, hi = pair
         if lo >= hi:
             raise CellFileError(path, f"robot.joint_limits[{i}]", f"[{lo:g}, {hi:g}] {unit}: expected [min, max] with "
                                 "min below max")
-        if lo / scale < lower[i] - 1e-9 or hi / scale > upper[i] + 1e-9:
+        if lo / scale < lower[i] - _LIMIT_TOL or hi / scale > upper[i] + _LIMIT_TOL:
             raise CellFileError(path, f"robot.joint_limits[{i}]",
-                                f"[{lo:g}, {hi:g}] {unit} reaches beyond {model.names[active_joints(model)[i]]}'s limits "
-                                f"in the URDF, [{lower[i] * scale:.3f}, {upper[i] * scale:.3f}] {unit}: software limits "
-                                "narrow a joint's range, never widen it")
+                                f"[{lo:g}, {hi:g}] {unit} reaches beyond {name}'s limits in the URDF, "
+                                f"[{lower[i] * scale:.3f}, {upper[i] * scale:.3f}] {unit}: software limits narrow a "
+                                "joint's range, never widen it")
         out[i] = (lo / scale, hi / scale)
     return out
 
@@ -129,40 +128,51 @@ def _joint_limits(parsed: CellFile, robot: RobotSpec, path: Path) -> np.ndarray 
 def within_joint_limits(q: np.ndarray | None, limits: np.ndarray | None, key: str, robot: RobotSpec,
                         path: Path) -> None:
     """A configuration the cell file gives (`key`: robot.home, robot.start) within `robot.joint_limits`."""
-    from robomax_py.robot import active_joints, kinematic_model, prismatic_mask
+    from robomax_py.robot import kinematic_model
 
     if q is None or limits is None:
         return
-    outside = (q < limits[:, 0] - 1e-9) | (q > limits[:, 1] + 1e-9)
-    if outside.any():
-        model = kinematic_model(robot)
-        i = int(np.flatnonzero(outside)[0])
-        unit, scale = ("m", 1.0) if prismatic_mask(model)[i] else ("deg", 180 / math.pi)
-        raise CellFileError(path, f"{key}[{i}]", f"{model.names[active_joints(model)[i]]} = {q[i] * scale:.3f} {unit} "
-                            f"is outside robot.joint_limits[{i}], [{limits[i, 0] * scale:.3f}, "
-                            f"{limits[i, 1] * scale:.3f}] {unit}")
+    i = _first_outside(q, limits[:, 0], limits[:, 1])
+    if i is not None:
+        name, unit, scale = _joint_unit(kinematic_model(robot), i)
+        raise CellFileError(path, f"{key}[{i}]", f"{name} = {q[i] * scale:.3f} {unit} is outside "
+                            f"robot.joint_limits[{i}], [{limits[i, 0] * scale:.3f}, {limits[i, 1] * scale:.3f}] {unit}")
 
 
 def _joint_values(values: list[float], key: str, robot: RobotSpec, path: Path) -> np.ndarray:
     """A configuration as a cell file gives it (deg, m for a prismatic joint) in SI, one value per
     joint of the URDF, each within its limits; CellFileError naming `key` otherwise."""
-    from robomax_py.robot import active_joints, kinematic_model, prismatic_mask
+    from robomax_py.robot import kinematic_model, prismatic_mask
 
     model = kinematic_model(robot)
     given = np.asarray(values, dtype=float)
     if len(given) != model.nq:
         raise CellFileError(path, key, f"expected {model.nq} joint values for {robot.name}, got {len(given)}")
-    prismatic = prismatic_mask(model)
-    q = np.where(prismatic, given, np.radians(given))
+    q = np.where(prismatic_mask(model), given, np.radians(given))
     lower, upper = np.asarray(model.lowerPositionLimit), np.asarray(model.upperPositionLimit)
-    tol = 1e-9
-    outside = (q < lower - tol) | (q > upper + tol)
-    if outside.any():
-        i = int(np.flatnonzero(outside)[0])
-        unit, scale = ("m", 1.0) if prismatic[i] else ("deg", 180 / math.pi)
-        raise CellFileError(
-            path, f"{key}[{i}]",
-            f"{model.names[active_joints(model)[i]]} = {given[i]:.3f} {unit} is outside its limits "
-            f"[{lower[i] * scale:.3f}, {upper[i] * scale:.3f}] {unit}",
-        )
+    i = _first_outside(q, lower, upper)
+    if i is not None:
+        name, unit, scale = _joint_unit(model, i)
+        raise CellFileError(path, f"{key}[{i}]", f"{name} = {given[i]:.3f} {unit} is outside its limits "
+                            f"[{lower[i] * scale:.3f}, {upper[i] * scale:.3f}] {unit}")
     return q
+
+
+# How far a configuration or a range may stand outside a joint's limits and still count as within
+# them (rounding of the degrees a file states), rad or m.
+_LIMIT_TOL = 1e-9
+
+
+def _first_outside(q: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> int | None:
+    """The first joint whose value in q lies outside [lower, upper] (within `_LIMIT_TOL`), None for none."""
+    outside = np.flatnonzero((q < lower - _LIMIT_TOL) | (q > upper + _LIMIT_TOL))
+    return int(outside[0]) if outside.size else None
+
+
+def _joint_unit(model: Any, i: int) -> tuple[str, str, float]:
+    """Joint i's name and the unit a cell file states it in, with the factor from SI to that unit:
+    m for a prismatic joint, deg for a revolute one."""
+    from robomax_py.robot import active_joints, prismatic_mask
+
+    name = str(model.names[active_joints(model)[i]])
+    return (name, "m", 1.0) if prismatic_mask(model)[i] else (name, "deg", 180 / math.pi)
