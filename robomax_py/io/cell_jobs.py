@@ -94,28 +94,36 @@ def same_identifier(names: list[str], key: str, path: Path) -> None:
     """Refuse two names of the list at `key` that a program states alike (`program.identifier`:
     other characters than letters, digits and `_` become `_`): its statements, and `verify`
     reading them, could not tell the two apart."""
-    seen: dict[str, int] = {}
-    for i, name in enumerate(names):
-        ident = identifier(name)
-        k = seen.setdefault(ident, i)
-        if k != i:
-            raise CellFileError(path, f"{key}[{i}].name", f"'{name}' and '{names[k]}' ({key.split('.')[-1]}[{k}]) are "
-                                f"both written {ident} in programs, which name things with letters, digits and '_' "
-                                "only: give names that differ there")
+    found = _written_alike(names)
+    if found is not None:
+        i, k, ident = found
+        raise CellFileError(path, f"{key}[{i}].name", f"'{names[i]}' and '{names[k]}' ({key.split('.')[-1]}[{k}]) are "
+                            f"both written {ident} in programs, which name things with letters, digits and '_' "
+                            "only: give names that differ there")
 
 
 def signals_apart(signals: list[tuple[str, str]], path: Path) -> None:
     """Refuse two different signals, given as (key, name) pairs, that a program states alike: the
     same name twice is one input (two clamps may share one), but `clamp-1` and `clamp 1` would both
     be waited for as `clamp_1`, one input standing for two, without a word."""
-    seen: dict[str, tuple[str, str]] = {}
-    for key, name in signals:
+    found = _written_alike([name for _, name in signals])
+    if found is not None:
+        i, k, ident = found
+        raise CellFileError(path, signals[i][0], f"the signal '{signals[i][1]}' and the signal '{signals[k][1]}' "
+                            f"({signals[k][0]}) are both written {ident} in programs, which name signals with letters, "
+                            "digits and '_' only: give names that differ there")
+
+
+def _written_alike(names: list[str]) -> tuple[int, int, str] | None:
+    """(i, k, identifier): the first name i that a program writes as an earlier, different name k
+    (the same name twice is one thing); None when every two are told apart."""
+    seen: dict[str, int] = {}
+    for i, name in enumerate(names):
         ident = identifier(name)
-        first_key, first = seen.setdefault(ident, (key, name))
-        if first != name:
-            raise CellFileError(path, key, f"the signal '{name}' and the signal '{first}' ({first_key}) are both "
-                                f"written {ident} in programs, which name signals with letters, digits and '_' "
-                                "only: give names that differ there")
+        k = seen.setdefault(ident, i)
+        if names[k] != name:
+            return i, k, ident
+    return None
 
 
 def _index_by_name(names: list[str], what: str, key: str, path: Path) -> dict[str, int]:
