@@ -33,7 +33,7 @@ from robomax_py.io.includes import expand_includes
 from robomax_py.io.yaml_files import read_yaml_mapping, validation_error
 from robomax_py.program import identifier
 from robomax_py.safe_files import LIMITS, read_text
-from robomax_py.spec import CLEAR_SUFFIX, Brand
+from robomax_py.spec import Brand, dynamic_signal
 from robomax_py.spec_station import IoRange, StationRobot, StationSpec, StationSpot
 
 # Robot names become parts of program names and signal names (`<robot>_<zone>_clear`): identifiers.
@@ -144,11 +144,12 @@ def _no_interlock_names(data: dict[str, Any], robots: tuple[str, ...], path: Pat
     one would wait on the other's input, or both."""
     pattern = re.compile(rf"({'|'.join(map(re.escape, robots))})_z[0-9]+_clear", re.IGNORECASE)
     given: list[tuple[str, str]] = []
-    for group, key, suffix in (("objects", "signal", ""), ("dynamic", "name", CLEAR_SUFFIX)):
+    for group, key in (("objects", "signal"), ("dynamic", "name")):
         items = data.get(group)
         for i, item in enumerate(items if isinstance(items, list) else []):
             if isinstance(item, dict) and isinstance(item.get(key), str):
-                given.append((f"{group}[{i}].{key}", item[key] + suffix))
+                signal = item[key] if group == "objects" else dynamic_signal(item[key], False)
+                given.append((f"{group}[{i}].{key}", signal))
     for key, signal in given:
         if pattern.fullmatch(identifier(signal)):
             raise CellFileError(path, key, f"the signal '{signal}' is written as a station interlock's "
