@@ -243,8 +243,8 @@ def _one_thread_per_library() -> None:
     """One thread for each linear algebra library, where the user set no number, before numpy loads
     (a command imports it lazily): the planner's matrices are 3x3 to 8x8, far below what a pool
     splits, and its threads spin between calls: a warm plan of the reference cell took 2.65 s of
-    CPU with them and 2.39 s without (medians of 3 alternating runs), at about the same wall time. The processes a batch starts inherit
-    it (a plan per CPU, no pools on top)."""
+    CPU with them and 2.39 s without (medians of 3 alternating runs), at about the same wall time.
+    The processes a batch starts inherit it (a plan per CPU, no pools on top)."""
     if "numpy" in sys.modules:
         return                                  # too late: the pools exist
     for name in _POOL_SIZES:
